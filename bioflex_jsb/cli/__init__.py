@@ -1,0 +1,58 @@
+"""The ``bioflex-jsb`` command: a thin layer over the numerical core and the adapters.
+
+Every sub-command lives in its own module of this package and exposes
+``register(subparsers)``; the module's ``run(args) -> int`` does the work. Errors a user can
+fix are raised as :class:`~bioflex_jsb.cli.common.UsageError` and end as one line on stderr
+with exit status 2; a simulation that diverges exits with status 3.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+from bioflex_jsb.cli.common import EXIT_USAGE, OneLineParser, UsageError
+
+# Sub-command modules, in the order ``--help`` lists them.
+COMMAND_MODULES = (
+    "trim",
+    "linearize",
+)
+
+
+def build_parser() -> OneLineParser:
+    parser = OneLineParser(
+        prog="bioflex-jsb",
+        description=(
+            "Bio-inspired elastic-wing UAV: JSBSim airframe, modal wing, coupled LTI model. "
+            "All inputs and outputs are SI: speeds in m/s, angles in rad in JSON "
+            "(degrees only where a column says deg), frequencies in rad/s unless marked Hz."
+        ),
+    )
+    from bioflex_jsb import __version__
+
+    parser.add_argument("--version", action="version", version=f"bioflex-jsb {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"bioflex_jsb.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return EXIT_USAGE
+    try:
+        return int(args.run(args) or 0)
+    except UsageError as exc:
+        print(f"bioflex-jsb {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print(f"bioflex-jsb {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

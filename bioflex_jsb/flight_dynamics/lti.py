@@ -1,0 +1,256 @@
+"""The coupled LTI model of Eq. (4), its rigid part and the QSD reduction of Eq. (9)–(10).
+
+State order (named in every :class:`StateSpace`):
+    x = [u, α, q, θ, η_1 … η_n, η̇_1 … η̇_n]
+    u [m/s], α [rad], q [rad/s], θ [rad], η_i [rad] (modes normalised on twist), η̇_i [rad/s].
+Input: w_g [m/s], vertical gust velocity, positive **upward** (raises α by w_g/u_0).
+
+Equations used, with the corrections listed in docs/decisions.md ("Paper typos"):
+
+* structural damping 2 ζ_i ω_i (Eq. 2 and A_EĖ print ζ_i ω_i);
+* H_iu = (C_u^Qi + 2 C_0^Qi) Q S c̄ / (m_i u_0) (Table B2 prints m for m_i), C_u^Q = 0;
+* G_R uses M_ẇ (Appendix B prints M_iω).
+
+Derivatives that the paper uses but does not define: C_Dη_i = 2 k C_L0 C_Lη_i and
+C_Dη̇_i = 2 k C_L0 C_Lη̇_i (induced drag of the extra lift, parabolic polar).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bioflex_jsb.flight_dynamics.modal_coefficients import ModalCoefficients
+from bioflex_jsb.flight_dynamics.rigid import (
+    RIGID_STATE_UNITS,
+    RIGID_STATES,
+    FlightCondition,
+    RigidDerivatives,
+    rigid_derivatives,
+    rigid_matrices,
+)
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS, RigidAerodynamics
+
+MODELS = ("rigid", "coupled", "qsd")
+
+
+@dataclass(frozen=True)
+class StateSpace:
+    """ẋ = A x + B u, y = C x + D u with named signals and units.
+
+    ``model`` is ``rigid``, ``coupled`` or ``qsd``; ``speed_m_s`` the trim airspeed.
+    """
+
+    model: str
+    speed_m_s: float
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    d: np.ndarray
+    states: tuple[str, ...]
+    state_units: tuple[str, ...]
+    inputs: tuple[str, ...]
+    input_units: tuple[str, ...]
+    outputs: tuple[str, ...]
+    output_units: tuple[str, ...]
+    notes: dict[str, object] = field(default_factory=dict)
+
+    @property
+    def n_states(self) -> int:
+        return int(self.a.shape[0])
+
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues of A [rad/s]."""
+        return np.linalg.eigvals(self.a)
+
+
+@dataclass(frozen=True)
+class ElasticWingModel:
+    """What the LTI builder needs to know about an elastic wing (speed independent).
+
+    frequencies_rad_s, damping_ratios, generalised_masses_kg_m2: the m_i of Table B2 as used
+    in H_i (see :mod:`bioflex_jsb.flight_dynamics.wing_model` for the convention);
+    coefficients: Table B1; wing_lift_slope_per_rad: C_Lα of the wing alone (lifting line),
+    used for the trim lift distribution in C_0^Q; cm_ac: section moment coefficient about the
+    aerodynamic centre [-].
+    """
+
+    name: str
+    frequencies_rad_s: np.ndarray
+    damping_ratios: np.ndarray
+    generalised_masses_kg_m2: np.ndarray
+    coefficients: ModalCoefficients
+    wing_lift_slope_per_rad: float
+    cm_ac: float
+
+    @property
+    def n_modes(self) -> int:
+        return int(len(self.frequencies_rad_s))
+
+
+@dataclass(frozen=True)
+class ElasticDerivatives:
+    """Dimensional elastic derivatives at one flight condition (Table B2).
+
+    x_eta, z_eta [m/s² per rad]; x_etadot, z_etadot [m/s² per rad/s]; m_eta [1/s²];
+    m_etadot [1/s]; h_u [1/(s·m)]·…: H-terms are generalised accelerations [rad/s² per unit
+    of the state they multiply]. h_eta and h_etadot are (n, n), rows = mode acted on.
+    """
+
+    x_eta: np.ndarray
+    x_etadot: np.ndarray
+    z_eta: np.ndarray
+    z_etadot: np.ndarray
+    m_eta: np.ndarray
+    m_etadot: np.ndarray
+    h_u: np.ndarray
+    h_alpha: np.ndarray
+    h_q: np.ndarray
+    h_eta: np.ndarray
+    h_etadot: np.ndarray
+
+
+def elastic_derivatives(
+    wing: ElasticWingModel,
+    condition: FlightCondition,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    mass_kg: float = MASS_PROPERTIES.mass_kg,
+    iyy_kg_m2: float = MASS_PROPERTIES.iyy_kg_m2,
+) -> ElasticDerivatives:
+    """Table B2 derivatives of the structural modes at ``condition``."""
+    c = wing.coefficients
+    u0 = condition.speed_m_s
+    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+    cb = P.MEAN_AERODYNAMIC_CHORD_M
+    mi = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
+    c_d_eta = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_eta
+    c_d_etadot = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_etadot
+    alpha_wing = condition.cl_trim / wing.wing_lift_slope_per_rad
+    c_0_q = alpha_wing * c.c_alpha_q + wing.cm_ac * c.c_mac_q
+    return ElasticDerivatives(
+        x_eta=-c_d_eta * qs / mass_kg,
+        x_etadot=-c_d_etadot * qs * cb / (2.0 * mass_kg * u0),
+        z_eta=-c.c_l_eta * qs / mass_kg,
+        z_etadot=-c.c_l_etadot * qs * cb / (2.0 * mass_kg * u0),
+        m_eta=c.c_m_eta * qs * cb / iyy_kg_m2,
+        m_etadot=c.c_m_etadot * qs * cb**2 / (2.0 * iyy_kg_m2 * u0),
+        h_u=2.0 * c_0_q * qs * cb / (mi * u0),
+        h_alpha=c.c_alpha_q * qs * cb / mi,
+        h_q=c.c_q_q * qs * cb**2 / (2.0 * mi * u0),
+        h_eta=c.c_eta_q * qs * cb / mi[:, None],
+        h_etadot=c.c_etadot_q * qs * cb**2 / (2.0 * mi[:, None] * u0),
+    )
+
+
+@dataclass(frozen=True)
+class CoupledBlocks:
+    """The sub-matrices of Eq. (4) at one flight condition (Appendix B)."""
+
+    a_rr: np.ndarray
+    a_re: np.ndarray
+    a_redot: np.ndarray
+    a_er: np.ndarray
+    a_ee: np.ndarray
+    a_eedot: np.ndarray
+    g_r: np.ndarray
+    g_e: np.ndarray
+    rigid: RigidDerivatives
+    elastic: ElasticDerivatives
+
+
+def coupled_blocks(
+    wing: ElasticWingModel,
+    condition: FlightCondition,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+) -> CoupledBlocks:
+    """Assemble the blocks of Eq. (4)."""
+    rd = rigid_derivatives(condition, aero)
+    ed = elastic_derivatives(wing, condition, aero)
+    a_rr, g_r = rigid_matrices(rd)
+    u0 = condition.speed_m_s
+    n = wing.n_modes
+
+    def rigid_rows(x, z, m):
+        return np.vstack([x, z / u0, m + rd.m_wdot * z, np.zeros(n)])
+
+    omega = np.asarray(wing.frequencies_rad_s, dtype=float)
+    zeta = np.asarray(wing.damping_ratios, dtype=float)
+    a_er = np.column_stack([ed.h_u, ed.h_alpha, ed.h_q, np.zeros(n)])
+    return CoupledBlocks(
+        a_rr=a_rr,
+        a_re=rigid_rows(ed.x_eta, ed.z_eta, ed.m_eta),
+        a_redot=rigid_rows(ed.x_etadot, ed.z_etadot, ed.m_etadot),
+        a_er=a_er,
+        a_ee=-np.diag(omega**2) + ed.h_eta,
+        a_eedot=-np.diag(2.0 * zeta * omega) + ed.h_etadot,
+        g_r=g_r,
+        g_e=(ed.h_alpha / u0).reshape(n, 1),
+        rigid=rd,
+        elastic=ed,
+    )
+
+
+def elastic_state_names(n: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    names = tuple(f"eta{i + 1}" for i in range(n)) + tuple(f"eta{i + 1}_dot" for i in range(n))
+    units = ("rad",) * n + ("rad/s",) * n
+    return names, units
+
+
+def build_state_space(
+    model: str,
+    condition: FlightCondition,
+    wing: ElasticWingModel | None = None,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+) -> StateSpace:
+    """The ``rigid`` (A_RR), ``coupled`` (Eq. 4) or ``qsd`` (Eq. 9–10) model at ``condition``.
+
+    The QSD model also outputs the quasi-static modal deflections
+    η = −A_EE⁻¹ (A_ER x_R + G_E w_g).
+    """
+    if model not in MODELS:
+        raise ValueError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+    common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
+    if model == "rigid":
+        a, g = rigid_matrices(rigid_derivatives(condition, aero))
+        return StateSpace(
+            model=model, a=a, b=g, c=np.eye(4), d=np.zeros((4, 1)),
+            states=RIGID_STATES, state_units=RIGID_STATE_UNITS,
+            outputs=RIGID_STATES, output_units=RIGID_STATE_UNITS, **common,
+        )
+    if wing is None:
+        raise ValueError(f"the {model} model needs an elastic wing")
+    blk = coupled_blocks(wing, condition, aero)
+    n = wing.n_modes
+    e_names, e_units = elastic_state_names(n)
+    notes = {"wing": wing.name, "overrides": dict(wing.coefficients.overrides)}
+    if model == "coupled":
+        a = np.block(
+            [
+                [blk.a_rr, blk.a_re, blk.a_redot],
+                [np.zeros((n, 4)), np.zeros((n, n)), np.eye(n)],
+                [blk.a_er, blk.a_ee, blk.a_eedot],
+            ]
+        )
+        b = np.vstack([blk.g_r, np.zeros((n, 1)), blk.g_e])
+        states = RIGID_STATES + e_names
+        units = RIGID_STATE_UNITS + e_units
+        return StateSpace(
+            model=model, a=a, b=b, c=np.eye(4 + 2 * n), d=np.zeros((4 + 2 * n, 1)),
+            states=states, state_units=units, outputs=states, output_units=units,
+            notes=notes, **common,
+        )
+    # QSD, Eq. (10)
+    a_ee_inv_a_er = np.linalg.solve(blk.a_ee, blk.a_er)
+    a_ee_inv_g_e = np.linalg.solve(blk.a_ee, blk.g_e)
+    a = blk.a_rr - blk.a_re @ a_ee_inv_a_er
+    b = blk.g_r - blk.a_re @ a_ee_inv_g_e
+    c = np.vstack([np.eye(4), -a_ee_inv_a_er])
+    d = np.vstack([np.zeros((4, 1)), -a_ee_inv_g_e])
+    return StateSpace(
+        model=model, a=a, b=b, c=c, d=d,
+        states=RIGID_STATES, state_units=RIGID_STATE_UNITS,
+        outputs=RIGID_STATES + e_names[:n], output_units=RIGID_STATE_UNITS + e_units[:n],
+        notes=notes, **common,
+    )
