@@ -10,23 +10,19 @@ eigenvalue continuity, never by sort order, so crossings and coalescences do not
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from bioflex_jsb.flight_dynamics.lti import (
-    ElasticWingModel,
-    StateSpace,
-    build_state_space,
-    coupled_blocks,
-)
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
 from bioflex_jsb.parameters import prototype as P
 
 RIGID_LABELS = ("short_period", "phugoid")
-IMAG_TOL_RAD_S = 1e-6  # below this |Im λ| a root is reported as real [rad/s]
+IMAG_TOL_RAD_S = 1e-6
+EXCLUDED_FROM_FLUTTER = ("phugoid",)  # below this |Im λ| a root is reported as real [rad/s]
 
 
 @dataclass(frozen=True)
@@ -133,13 +129,16 @@ class Sweep:
     """Tracked eigenvalues of one model over a speed grid.
 
     ``eigenvalues[k, j]`` is the j-th root at ``speeds_m_s[k]``; ``labels[j]`` its identity
-    (constant along the sweep by construction).
+    (constant along the sweep by construction); ``eigenvectors[k][:, j]`` its eigenvector.
     """
 
     model: str
     speeds_m_s: np.ndarray
     eigenvalues: np.ndarray
     labels: tuple[str, ...]
+    eigenvectors: tuple[np.ndarray, ...]
+    wing: ElasticWingModel | None
+    density_kg_m3: float
 
     def at(self, k: int) -> ModeSet:
         return _collapse(float(self.speeds_m_s[k]), self.model, self.labels, self.eigenvalues[k])
@@ -147,13 +146,31 @@ class Sweep:
     def mode_sets(self) -> list[ModeSet]:
         return [self.at(k) for k in range(len(self.speeds_m_s))]
 
+    def continued(self, k: int, speed_m_s: float) -> np.ndarray:
+        """Roots at ``speed_m_s``, ordered like the labels, continued from grid point ``k``."""
+        lam, vec = _eig(self.model, speed_m_s, self.wing, self.density_kg_m3)
+        perm = _match(self.eigenvalues[k], self.eigenvectors[k], lam, vec)
+        return lam[perm]
+
+
+def _eig(model: str, speed_m_s: float, wing, density_kg_m3: float):
+    ss = build_state_space(model, level_flight_condition(float(speed_m_s), density_kg_m3), wing)
+    return np.linalg.eig(ss.a)
+
+
+def _match(lam_prev, vec_prev, lam, vec) -> np.ndarray:
+    """Permutation of (lam, vec) that best continues (lam_prev, vec_prev)."""
+    mac = _mac(vec_prev, vec)
+    dist = np.abs(lam_prev[:, None] - lam[None, :]) / (1.0 + np.abs(lam_prev)[:, None])
+    rows, cols = linear_sum_assignment((1.0 - mac) + dist)
+    return cols[np.argsort(rows)]
+
 
 def track(
     model: str,
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
     density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
-    build: Callable[[str, FlightCondition, ElasticWingModel | None], StateSpace] | None = None,
 ) -> Sweep:
     """Eigenvalues of ``model`` at increasing ``speeds_m_s`` with labels tracked.
 
@@ -163,16 +180,12 @@ def track(
     speeds = np.asarray(speeds_m_s, dtype=float)
     if speeds.ndim != 1 or len(speeds) == 0 or np.any(np.diff(speeds) <= 0):
         raise ValueError("speeds_m_s must be a non-empty, strictly increasing sequence")
-    build = build or (lambda m, c, w: build_state_space(m, c, w))
-    all_lam = []
-    labels: list[str] | None = None
-    v_prev = lam_prev = None
+    all_lam, all_vec = [], []
+    labels: list[str] = []
     for k, v in enumerate(speeds):
-        cond = level_flight_condition(float(v), density_kg_m3)
-        ss = build(model, cond, wing)
-        lam, vec = np.linalg.eig(ss.a)
+        lam, vec = _eig(model, float(v), wing, density_kg_m3)
         if k == 0:
-            ref = _reference(model, wing, cond)
+            ref = _reference(model, wing, level_flight_condition(float(v), density_kg_m3))
             if model == "qsd":
                 ref = ref[:4]
             ref_lam = np.array([r[1] for r in ref])
@@ -181,16 +194,11 @@ def track(
             perm = cols[np.argsort(rows)]
             labels = [r[0] for r in ref]
         else:
-            mac = _mac(v_prev, vec)
-            scale = 1.0 + np.abs(lam_prev)[:, None]
-            dist = np.abs(lam_prev[:, None] - lam[None, :]) / scale
-            rows, cols = linear_sum_assignment((1.0 - mac) + dist)
-            perm = cols[np.argsort(rows)]
-        lam, vec = lam[perm], vec[:, perm]
-        all_lam.append(lam)
-        v_prev, lam_prev = vec, lam
-    assert labels is not None
-    return Sweep(model, speeds, np.array(all_lam), tuple(labels))
+            perm = _match(all_lam[-1], all_vec[-1], lam, vec)
+        all_lam.append(lam[perm])
+        all_vec.append(vec[:, perm])
+    return Sweep(model, speeds, np.array(all_lam), tuple(labels), tuple(all_vec), wing,
+                 density_kg_m3)
 
 
 def sweep_grid(
@@ -255,7 +263,10 @@ def find_flutter(
 ) -> FlutterResult:
     """Scan the coupled model over ``range_m_s`` and bisect the first crossing to ``tol_m_s``.
 
-    A root counts as unstable when Re λ > ``growth_tol_1_s`` [1/s].
+    A root counts as unstable when Re λ > ``growth_tol_1_s`` [1/s]. The phugoid is left out
+    of the search, as the paper leaves it out of Figs. 15-19 (Section 3.2: the vortex model
+    cannot give the drag the phugoid depends on): in the linear model it goes unstable below
+    about 10 m/s, where the formal trim C_L exceeds 2, for the rigid aircraft as well.
     """
     lo, hi = range_m_s
     if not (0.0 < lo < hi):
@@ -263,7 +274,8 @@ def find_flutter(
     grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
     grid = grid[grid <= hi + 1e-12]
     sweep = track("coupled", grid, wing, density_kg_m3)
-    growth = sweep.eigenvalues.real.max(axis=1)
+    considered = np.array([lab not in EXCLUDED_FROM_FLUTTER for lab in sweep.labels])
+    growth = sweep.eigenvalues[:, considered].real.max(axis=1)
     in_range = grid >= lo - 1e-12
     unstable = np.nonzero((growth > growth_tol_1_s) & in_range)[0]
     if len(unstable) == 0:
@@ -275,8 +287,7 @@ def find_flutter(
         a, b = float(grid[k - 1]), float(grid[k])
 
         def max_re(v: float) -> float:
-            ss = build_state_space("coupled", level_flight_condition(v, density_kg_m3), wing)
-            return float(np.linalg.eigvals(ss.a).real.max())
+            return float(sweep.continued(k - 1, v)[considered].real.max())
 
         while b - a > tol_m_s:
             mid = 0.5 * (a + b)
@@ -285,8 +296,10 @@ def find_flutter(
             else:
                 a = mid
         v_cross = b
-    j = int(np.argmax(sweep.eigenvalues[k].real))
-    root = sweep.eigenvalues[k, j]
+    at_cross = sweep.continued(k - 1, v_cross) if k > 0 else sweep.eigenvalues[k]
+    masked = np.where(considered, at_cross.real, -np.inf)
+    j = int(np.argmax(masked))
+    root = at_cross[j]
     kind = "flutter" if abs(root.imag) > IMAG_TOL_RAD_S else "divergence"
     return FlutterResult(
         wing.name,

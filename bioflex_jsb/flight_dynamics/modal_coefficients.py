@@ -61,7 +61,8 @@ class ModalCoefficients:
         """Named coefficients as plain lists (for JSON output)."""
         out: dict[str, object] = {}
         for name in (
-            "c_l_eta", "c_l_etadot", "c_m_eta", "c_m_etadot", "c_mac_q", "c_alpha_q", "c_q_q", "c_eta_q", "c_etadot_q",
+            "c_l_eta", "c_l_etadot", "c_m_eta", "c_m_etadot", "c_mac_q",
+            "c_alpha_q", "c_q_q", "c_eta_q", "c_etadot_q",
         ):
             out[name] = np.asarray(getattr(self, name)).tolist()
         out["overrides"] = dict(self.overrides)

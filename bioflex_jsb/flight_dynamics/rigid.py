@@ -125,7 +125,12 @@ def rigid_matrices(d: RigidDerivatives) -> tuple[np.ndarray, np.ndarray]:
         [
             [d.x_u, d.x_alpha, 0.0, -g],
             [d.z_u / u0, d.z_alpha / u0, 1.0, 0.0],
-            [d.m_u + d.m_wdot * d.z_u, d.m_alpha + d.m_wdot * d.z_alpha, d.m_q + d.m_wdot * u0, 0.0],
+            [
+                d.m_u + d.m_wdot * d.z_u,
+                d.m_alpha + d.m_wdot * d.z_alpha,
+                d.m_q + d.m_wdot * u0,
+                0.0,
+            ],
             [0.0, 0.0, 1.0, 0.0],
         ]
     )

@@ -1,0 +1,198 @@
+"""The modal wing of the co-simulation: one step of the elastic wing, no I/O.
+
+Each airframe step the co-simulation loop (``bioflex_jsb.adapters.cosim``) hands the wing the
+flow state it reads from JSBSim (:class:`FlowState`), takes the incremental loads
+(:class:`WingLoads`) and writes them into the airframe's external reactions.
+
+Model (the same physics as the LTI model of Eq. 4, with the *current* dynamic pressure and
+airspeed instead of trim values, so the loads are nonlinear in airspeed):
+
+* the modal coordinates are perturbations Δη from the static deformation at trim (the rigid
+  aerodynamics of the airframe already carry the trimmed, deformed wing);
+* generalised force on mode i:
+  Q_i = Q S c̄ [C_α^Qi Δα + C_q^Qi q c̄/(2V) + Σ_j C_ηj^Qi Δη_j + Σ_j C_η̇j^Qi Δη̇_j c̄/(2V)]
+  + (Q − Q_0) S c̄ C_0^Qi, with Δα = α − α_0 (α measured against the air, gusts included);
+* modal equation m_i (Δη̈_i + 2 ζ_i ω_i Δη̇_i + ω_i² Δη_i) = Q_i;
+* incremental loads: ΔL = Q S (C_Lη·Δη + C_Lη̇·Δη̇ c̄/(2V)) (up), ΔD = Q S (C_Dη·Δη +
+  C_Dη̇·Δη̇ c̄/(2V)) (aft, along the air velocity), ΔM = Q S c̄ (C_mη·Δη + C_mη̇·Δη̇ c̄/(2V))
+  (nose up, about the centre of gravity). The modes are symmetric, so there is no rolling
+  moment; roll rate p does not enter.
+
+Integration (``coupled``): exact discretisation with the inputs held over the step
+(zero-order hold): [Δη, Δη̇]_{k+1} = Φ x_k + Γ f_k with Φ, Γ from the matrix exponential of
+the augmented system. It is exact for the linear modal equations at any step, so it is
+stable and accurate up to the third mode (107 Hz) at JSBSim's rates. Φ and Γ depend on Q and
+V; they are recomputed when either moves by more than ``refresh_rel`` (default 0.1 %).
+
+Coupling lag: the loads applied during airframe step k come from the modal state at the
+start of the step, which was advanced with the flow of step k−1: a one-step lag in the
+α → η → load path, removed by halving the step (see tests/test_cosim_convergence.py).
+``qsd`` has no lag: Δη is the quasi-static solution of the current flow.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import expm
+
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+
+WING_MODELS = ("rigid", "coupled", "qsd")
+
+
+@dataclass(frozen=True)
+class FlowState:
+    """Flow at the wing, read from the airframe each step.
+
+    alpha_rad: angle of attack against the air (gust included) [rad]; q_rad_s: pitch rate
+    [rad/s]; airspeed_m_s: true airspeed [m/s]; dynamic_pressure_pa [Pa].
+    """
+
+    alpha_rad: float
+    q_rad_s: float
+    airspeed_m_s: float
+    dynamic_pressure_pa: float
+
+
+@dataclass(frozen=True)
+class WingLoads:
+    """Incremental loads of the elastic wing on the airframe.
+
+    lift_n: up, perpendicular to the air velocity [N]; drag_n: along the air velocity,
+    positive aft [N]; pitch_moment_n_m: about the centre of gravity, nose up [N·m].
+    """
+
+    lift_n: float
+    drag_n: float
+    pitch_moment_n_m: float
+
+
+@dataclass(frozen=True)
+class TrimReference:
+    """The trim the perturbations are taken from: α_0 [rad], Q_0 [Pa], C_L0 [-]."""
+
+    alpha_rad: float
+    dynamic_pressure_pa: float
+    cl_trim: float
+
+
+class ModalWing:
+    """Elastic wing state and its step. ``model`` is ``rigid``, ``coupled`` or ``qsd``."""
+
+    def __init__(
+        self,
+        wing: ElasticWingModel,
+        trim: TrimReference,
+        model: str = "coupled",
+        dt_s: float = 1.0 / 120.0,
+        aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+        refresh_rel: float = 1e-3,
+    ) -> None:
+        if model not in WING_MODELS:
+            raise ValueError(f"unknown wing model {model!r}; accepted: {', '.join(WING_MODELS)}")
+        if not (np.isfinite(dt_s) and dt_s > 0.0):
+            raise ValueError(f"time step must be finite and > 0 s, got {dt_s!r}")
+        self.wing = wing
+        self.trim = trim
+        self.model = model
+        self.dt_s = float(dt_s)
+        self.refresh_rel = float(refresh_rel)
+        n = wing.n_modes
+        self.n_modes = n
+        c = wing.coefficients
+        self._m = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
+        self._omega = np.asarray(wing.frequencies_rad_s, dtype=float)
+        self._zeta = np.asarray(wing.damping_ratios, dtype=float)
+        self._c_alpha = np.asarray(c.c_alpha_q, dtype=float)
+        self._c_q = np.asarray(c.c_q_q, dtype=float)
+        self._c_eta = np.asarray(c.c_eta_q, dtype=float)
+        self._c_etadot = np.asarray(c.c_etadot_q, dtype=float)
+        alpha_wing = trim.cl_trim / wing.wing_lift_slope_per_rad
+        self._c_0 = alpha_wing * self._c_alpha + wing.cm_ac * np.asarray(c.c_mac_q, dtype=float)
+        k2 = 2.0 * aero.k_induced * trim.cl_trim
+        self._load_eta = np.vstack([c.c_l_eta, k2 * c.c_l_eta, c.c_m_eta * P.MEAN_AERODYNAMIC_CHORD_M])
+        self._load_etadot = np.vstack(
+            [c.c_l_etadot, k2 * c.c_l_etadot, c.c_m_etadot * P.MEAN_AERODYNAMIC_CHORD_M]
+        )
+        self.eta = np.zeros(n)
+        self.eta_dot = np.zeros(n)
+        self._key: tuple[float, float] | None = None
+        self._phi = self._gamma = None
+
+    # -- modal dynamics -------------------------------------------------------------------
+    def _matrices(self, q_pa: float, v_m_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Continuous A_e (2n×2n) and B_e (2n×3) for inputs f = [Δα, q, ΔQ]."""
+        n = self.n_modes
+        s, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
+        qsc = q_pa * s * cb / self._m
+        k = np.diag(self._omega**2) - qsc[:, None] * self._c_eta
+        dmp = np.diag(2.0 * self._zeta * self._omega) - (
+            qsc[:, None] * self._c_etadot * cb / (2.0 * v_m_s)
+        )
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-k, -dmp]])
+        b = np.zeros((2 * n, 3))
+        b[n:, 0] = qsc * self._c_alpha
+        b[n:, 1] = qsc * self._c_q * cb / (2.0 * v_m_s)
+        b[n:, 2] = s * cb * self._c_0 / self._m
+        return a, b
+
+    def _discrete(self, q_pa: float, v_m_s: float) -> tuple[np.ndarray, np.ndarray]:
+        key = self._key
+        if (
+            key is None
+            or abs(q_pa - key[0]) > self.refresh_rel * abs(key[0])
+            or abs(v_m_s - key[1]) > self.refresh_rel * abs(key[1])
+        ):
+            a, b = self._matrices(q_pa, v_m_s)
+            n2, m = b.shape
+            aug = np.zeros((n2 + m, n2 + m))
+            aug[:n2, :n2] = a
+            aug[:n2, n2:] = b
+            e = expm(aug * self.dt_s)
+            self._phi, self._gamma = e[:n2, :n2], e[:n2, n2:]
+            self._key = (q_pa, v_m_s)
+        return self._phi, self._gamma
+
+    def _inputs(self, flow: FlowState) -> np.ndarray:
+        return np.array(
+            [
+                flow.alpha_rad - self.trim.alpha_rad,
+                flow.q_rad_s,
+                flow.dynamic_pressure_pa - self.trim.dynamic_pressure_pa,
+            ]
+        )
+
+    def quasi_static_eta(self, flow: FlowState) -> np.ndarray:
+        """Δη that balances the current flow with η̇ = η̈ = 0 (Eq. 9-10) [rad]."""
+        a, b = self._matrices(flow.dynamic_pressure_pa, flow.airspeed_m_s)
+        n = self.n_modes
+        return np.linalg.solve(a[n:, :n], -b[n:] @ self._inputs(flow))
+
+    def step(self, flow: FlowState) -> None:
+        """Advance the modal state over one step with ``flow`` held (zero-order hold)."""
+        if self.model == "coupled":
+            phi, gamma = self._discrete(flow.dynamic_pressure_pa, flow.airspeed_m_s)
+            x = phi @ np.concatenate([self.eta, self.eta_dot]) + gamma @ self._inputs(flow)
+            self.eta, self.eta_dot = x[: self.n_modes], x[self.n_modes :]
+        elif self.model == "qsd":
+            self.eta = self.quasi_static_eta(flow)
+            self.eta_dot = np.zeros(self.n_modes)
+
+    def loads(self, flow: FlowState) -> WingLoads:
+        """Incremental loads of the current modal state in ``flow``."""
+        if self.model == "rigid":
+            return WingLoads(0.0, 0.0, 0.0)
+        if self.model == "qsd":
+            self.eta = self.quasi_static_eta(flow)
+        qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+        rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
+        lift, drag, moment = qs * (self._load_eta @ self.eta + self._load_etadot @ self.eta_dot * rate)
+        return WingLoads(float(lift), float(drag), float(moment))
+
+    def tip_twist_rad(self, tip_twist_per_mode: np.ndarray) -> float:
+        """Elastic tip twist Σ θ_i(b/2) Δη_i [rad], positive leading edge up."""
+        return float(np.asarray(tip_twist_per_mode) @ self.eta)
