@@ -114,9 +114,10 @@ class ModalWing:
         alpha_wing = trim.cl_trim / wing.wing_lift_slope_per_rad
         self._c_0 = alpha_wing * self._c_alpha + wing.cm_ac * np.asarray(c.c_mac_q, dtype=float)
         k2 = 2.0 * aero.k_induced * trim.cl_trim
-        self._load_eta = np.vstack([c.c_l_eta, k2 * c.c_l_eta, c.c_m_eta * P.MEAN_AERODYNAMIC_CHORD_M])
+        cb = P.MEAN_AERODYNAMIC_CHORD_M
+        self._load_eta = np.vstack([c.c_l_eta, k2 * c.c_l_eta, c.c_m_eta * cb])
         self._load_etadot = np.vstack(
-            [c.c_l_etadot, k2 * c.c_l_etadot, c.c_m_etadot * P.MEAN_AERODYNAMIC_CHORD_M]
+            [c.c_l_etadot, k2 * c.c_l_etadot, c.c_m_etadot * cb]
         )
         self.eta = np.zeros(n)
         self.eta_dot = np.zeros(n)
@@ -190,7 +191,8 @@ class ModalWing:
             self.eta = self.quasi_static_eta(flow)
         qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
         rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
-        lift, drag, moment = qs * (self._load_eta @ self.eta + self._load_etadot @ self.eta_dot * rate)
+        coeffs = self._load_eta @ self.eta + self._load_etadot @ self.eta_dot * rate
+        lift, drag, moment = qs * coeffs
         return WingLoads(float(lift), float(drag), float(moment))
 
     def tip_twist_rad(self, tip_twist_per_mode: np.ndarray) -> float:
