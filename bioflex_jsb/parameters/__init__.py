@@ -1,1 +1,1 @@
-"""Parameter sets: ``prototype`` holds the paper's numbers; the others are estimates/calibrations."""
+"""Parameter sets: ``prototype`` holds the paper's numbers; the others are estimates."""
