@@ -17,6 +17,8 @@ from bioflex_jsb.cli.common import EXIT_USAGE, OneLineParser, UsageError
 COMMAND_MODULES = (
     "trim",
     "linearize",
+    "modes",
+    "flutter",
 )
 
 

@@ -47,3 +47,45 @@ def print_json(payload: Any) -> None:
     """Write ``payload`` as JSON to stdout (NaN is refused: it is not valid JSON)."""
     json.dump(payload, sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")
+
+
+def models_list(text: str) -> tuple[str, ...]:
+    """argparse type: comma-separated subset of rigid,coupled,qsd."""
+    from bioflex_jsb.flight_dynamics.lti import MODELS
+
+    names = tuple(t.strip() for t in text.split(",") if t.strip())
+    bad = [n for n in names if n not in MODELS]
+    if not names or bad:
+        raise argparse.ArgumentTypeError(
+            f"unknown model {bad[0] if bad else text!r}; accepted: {','.join(MODELS)}"
+        )
+    return tuple(dict.fromkeys(names))
+
+
+def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original") -> None:
+    """--wing and --mass-basis, shared by every command that builds the elastic wing."""
+    from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS, MASS_BASES, VARIANTS
+
+    parser.add_argument(
+        "--wing", default=default, metavar="NAME|FILE.toml",
+        help=f"wing variant: {', '.join(VARIANTS)}, or a variant file (docs/wing_variants.md); "
+        f"default {default}",
+    )
+    parser.add_argument(
+        "--mass-basis", choices=MASS_BASES, default=DEFAULT_MASS_BASIS,
+        help="generalised masses as the paper uses them (half-wing m_i against whole-span "
+        "forces) or the consistent whole-wing basis (docs/decisions.md); default "
+        f"{DEFAULT_MASS_BASIS}",
+    )
+
+
+def wing_from_args(args: argparse.Namespace):
+    """Build the wing named by --wing; any problem becomes a one-line UsageError."""
+    from bioflex_jsb.flight_dynamics.wing_model import VariantError, build_wing, resolve_variant
+
+    try:
+        return build_wing(resolve_variant(args.wing), mass_basis=args.mass_basis)
+    except VariantError as exc:
+        raise UsageError(str(exc)) from None
+    except ValueError as exc:  # modal-file and modal-data errors name their field
+        raise UsageError(f"wing {args.wing!r}: {exc}") from None

@@ -72,3 +72,12 @@ DEFAULT_PLANFORM = Planform(
     outer_sweep_rad=math.radians(20.0),
     x_cg_m=0.30 * P.MEAN_AERODYNAMIC_CHORD_M,
 )
+
+# ESTIMATE (docs/decisions.md, "Structural damping"): the paper neglects structural damping
+# (Section 3.1, "much lower than the aerodynamic damping"), but the quasi-steady strip
+# aerodynamics of Eq. (3) give a pure twist mode no aerodynamic damping at all (there is no
+# pitch-rate term for the section). Undamped, the first mode is then pushed unstable at any
+# airspeed by arbitrarily weak coupling with the rigid-body plunge. We give every mode the
+# 2 % of critical damping typical of cured carbon-fibre laminates (1–3 %); it moves the
+# short-period roots of Tables 3 and 6 by less than 0.01 rad/s.
+MODAL_DAMPING_RATIO = 0.02
