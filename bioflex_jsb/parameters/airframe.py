@@ -81,23 +81,34 @@ class RigidAerodynamics:
 # The same constant non-dimensional derivatives give −7.4 ± 12.0i at 20 m/s (Table 3) because
 # the short-period roots scale with airspeed. The split C_mα̇ = 0.34 C_mq is the tail-lag
 # estimate dε/dα = 2 C_Lα/(π AR) = 0.34. C_mα = −1.05 means a static margin of 0.20 c̄.
+# Checked in JSBSim: the full linearization of the generated airframe (drag, thrust, trim α,
+# RPM quasi-static) reproduces both Table 3 rigid rows within 1 %
+# (tests/test_trim_linearize.py), so these three values needed no re-calibration.
 # C_Lα = 5.3 /rad: lifting-line slope of the AR 9.3 wing (≈ 5.0) plus the small tail (≈ 0.3).
 RIGID_AERODYNAMICS = RigidAerodynamics(
-    cl0=0.25,  # ESTIMATE: cambered membrane aerofoil, zero-lift angle ≈ −2.7°
+    # ESTIMATE: cambered thin membrane aerofoil, zero-lift angle −C_L0/C_Lα ≈ −4.3° (thin-
+    # aerofoil theory puts α_0L ≈ −2h/c for a circular-arc camber line: ≈ 3.8 % camber, at the
+    # low end of bird-wing sections). Raised from 0.25 so that 10 m/s (C_L = 1.29 in level
+    # flight) trims inside the linear lift range that ends at alpha_stall_rad = 11°.
+    cl0=0.40,
     cl_alpha_per_rad=5.3,
-    cl_max=1.2,  # ESTIMATE: thin cambered membrane at Re ≈ 2e5
+    # ESTIMATE: thin cambered membrane at Re ≈ 1.2e5–3e5; gliding birds' wings reach
+    # C_L,max ≈ 1.4–1.6. Must exceed the linear curve's C_L(α_stall) = 1.42: the lift curve
+    # rounds over from there to this peak (see POST_STALL).
+    cl_max=1.50,
     alpha_stall_rad=math.radians(11.0),
     cl_delta_e_per_rad=0.35,  # ESTIMATE: tail lift per elevator, S_t/S·C_Lα,t·τ
     cd0=0.030,  # ESTIMATE: small UAV with fuselage and tails at Re ≈ 2e5
     k_induced=1.0 / (math.pi * P.ASPECT_RATIO * 0.85),  # Oswald e = 0.85
-    cm0=0.05,  # ESTIMATE: trims at ≈ 2.5° α with small elevator at cruise
+    cm0=0.05,  # ESTIMATE: JSBSim trims at ≈ 1.8° α with ≈ +1° elevator at 15 m/s cruise
     cm_alpha_per_rad=-1.05,  # CALIBRATED to Table 3 rigid rows
     cm_q_per_rad=-7.3,  # CALIBRATED to Table 3 rigid rows
     cm_alphadot_per_rad=-2.5,  # CALIBRATED to Table 3 rigid rows (0.34 × C_mq)
     cm_delta_e_per_rad=-0.9,  # ESTIMATE: tail volume 0.4 × C_Lα,t 3.5 × τ 0.65
     cy_beta_per_rad=-0.30,  # ESTIMATE: fuselage + fin
     cl_beta_per_rad=-0.06,  # ESTIMATE: small dihedral effect
-    cl_p_per_rad=-0.45,  # ESTIMATE: strip theory, −C_Lα/8 · (1+3λ)/(1+λ) for λ = 1 ≈ −0.66, less tip loss
+    # ESTIMATE: strip theory, −C_Lα/8 · (1+3λ)/(1+λ) for λ = 1 ≈ −0.66, less tip loss
+    cl_p_per_rad=-0.45,
     cl_r_per_rad=0.08,  # ESTIMATE: C_L/4 at cruise
     cl_delta_a_per_rad=0.20,  # ESTIMATE: outboard ailerons, 25 % chord, 40 % span
     cn_beta_per_rad=0.06,  # ESTIMATE: small fin on a short arm
@@ -105,4 +116,186 @@ RIGID_AERODYNAMICS = RigidAerodynamics(
     cn_r_per_rad=-0.08,  # ESTIMATE: fin damping
     cn_delta_r_per_rad=-0.05,  # ESTIMATE
     cy_delta_r_per_rad=0.10,  # ESTIMATE
+)
+
+
+# --------------------------------------------------------------------------------------
+# Beyond the linear range: the shape of the stall (used by the JSBSim lift and drag tables)
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PostStall:
+    """Shape of the lift and drag curves outside the linear range of :class:`RigidAerodynamics`.
+
+    Positive side: from ``alpha_stall_rad`` the lift curve rounds over (a parabola that leaves
+    the linear curve with its slope C_Lα and peaks at ``cl_max``), then decays towards the
+    flat-plate value C_N90·sin α·cos α with the angle constant ``decay_rad``. The negative side
+    is the mirror image about ``alpha_negative_stall_rad`` (peak C_L(α_neg) − (C_L,max − C_L(α_s))).
+    Separated-flow drag C_N90·(sin²α − sin²α_edge) is added beyond either edge.
+
+    Attributes:
+        alpha_negative_stall_rad: end of the linear range at negative α [rad].
+        normal_force_90deg: C_N at α = 90° of the whole wing [-] (flat plate of AR ≈ 9).
+        decay_rad: angle over which post-peak lift relaxes to the flat-plate value [rad].
+        alpha_table_min_rad, alpha_table_max_rad: extent of the JSBSim α tables [rad].
+        alpha_table_step_rad: spacing of the JSBSim α tables (plus the break points) [rad].
+    """
+
+    alpha_negative_stall_rad: float
+    normal_force_90deg: float
+    decay_rad: float
+    alpha_table_min_rad: float
+    alpha_table_max_rad: float
+    alpha_table_step_rad: float
+
+
+POST_STALL = PostStall(
+    alpha_negative_stall_rad=math.radians(-10.0),  # ESTIMATE: the issue's linear range −10°..11°
+    normal_force_90deg=1.25,  # ESTIMATE: flat plate of aspect ratio ≈ 9 broadside (Hoerner)
+    decay_rad=math.radians(4.0),  # ESTIMATE: abrupt thin-aerofoil leading-edge stall
+    alpha_table_min_rad=math.radians(-30.0),  # the issue asks for at least −20°..+30°
+    alpha_table_max_rad=math.radians(30.0),
+    alpha_table_step_rad=math.radians(1.0),  # resolution of the stall region
+)
+
+
+# --------------------------------------------------------------------------------------
+# Geometry needed by the JSBSim airframe: CG, propeller, contact points
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AirframeGeometry:
+    """Positions in the JSBSim *structural frame*, SI [m].
+
+    Structural frame: origin at the fuselage nose, x positive **aft**, y positive to
+    starboard, z positive **up** (JSBSim's convention; docs/conventions.md). The wing frame of
+    :mod:`bioflex_jsb.parameters.wing` has its origin at the root leading edge, which sits at
+    ``wing_root_leading_edge_x_m`` here.
+
+    Attributes:
+        wing_root_leading_edge_x_m: x of the root leading edge [m].
+        cg_x_m, cg_z_m: centre of gravity [m]; also the aerodynamic reference point, so the
+            pitching-moment coefficients are about the CG as in RIGID_AERODYNAMICS.
+        propeller_x_m, propeller_z_m: propeller hub [m] (tractor; thrust line through the CG).
+        contact_points_m: (name, x, y, z) of the structure contact points [m].
+    """
+
+    wing_root_leading_edge_x_m: float
+    cg_x_m: float
+    cg_z_m: float
+    propeller_x_m: float
+    propeller_z_m: float
+    contact_points_m: tuple[tuple[str, float, float, float], ...]
+
+
+_WING_ROOT_LE_X_M = 0.30  # ESTIMATE: Fig. 1, wing root a little over 1/3 of the 0.85 m fuselage
+_CG_X_M = _WING_ROOT_LE_X_M + 0.30 * P.MEAN_AERODYNAMIC_CHORD_M  # wing.DEFAULT_PLANFORM.x_cg_m
+
+AIRFRAME_GEOMETRY = AirframeGeometry(
+    wing_root_leading_edge_x_m=_WING_ROOT_LE_X_M,
+    cg_x_m=_CG_X_M,
+    cg_z_m=0.0,  # ESTIMATE: on the fuselage axis (defines z = 0)
+    propeller_x_m=-0.03,  # ESTIMATE: tractor propeller 3 cm ahead of the nose
+    propeller_z_m=0.0,  # ESTIMATE: thrust line through the CG (no thrust pitching moment)
+    contact_points_m=(
+        # ESTIMATE: belly skid under the nose, tail skid, and the two wing tips (z = 0);
+        # they only matter on the ground, the analyses here fly in the air.
+        ("nose-skid", 0.05, 0.0, -0.05),  # 5 cm behind the nose, 5 cm below the axis
+        ("tail-skid", P.FUSELAGE_LENGTH_M - 0.05, 0.0, -0.03),  # Table 1 length, 3 cm below
+        ("left-wing-tip", _CG_X_M, -P.SPAN_M / 2.0, 0.0),  # Table 1 span
+        ("right-wing-tip", _CG_X_M, P.SPAN_M / 2.0, 0.0),
+    ),
+)
+
+
+# --------------------------------------------------------------------------------------
+# Electric propulsion (not in the paper: an ESTIMATE sized for 10-25 m/s level flight)
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Propulsion:
+    """Electric motor and fixed-pitch propeller.
+
+    The propeller's thrust and power coefficient tables are computed from this blade
+    geometry by blade-element momentum theory in :mod:`bioflex_jsb.adapters.airframe_xml`.
+
+    Attributes:
+        motor_max_shaft_power_w: shaft power at full throttle [W] (JSBSim ``electric`` engine:
+            power = throttle × this, independent of RPM).
+        prop_diameter_m, prop_pitch_m: propeller diameter and geometric pitch [m].
+        prop_blades: number of blades [-].
+        prop_chord_stations: (r/R, c/R) pairs of the blade chord distribution [-].
+        prop_hub_radius_fraction: r/R where the blade starts [-].
+        prop_section_lift_slope_per_rad: blade-section lift slope [1/rad].
+        prop_section_zero_lift_rad: section zero-lift angle relative to the pitch line [rad].
+        prop_section_cl_max: section lift limit (stall) [-].
+        prop_section_cd0, prop_section_cd_k: section drag c_d = cd0 + k c_l² [-].
+        rotor_inertia_kg_m2: propeller plus motor rotor polar moment of inertia [kg·m²].
+        advance_ratio_max: end of the J = V/(nD) tables [-] (past zero thrust).
+    """
+
+    motor_max_shaft_power_w: float
+    prop_diameter_m: float
+    prop_pitch_m: float
+    prop_blades: int
+    prop_chord_stations: tuple[tuple[float, float], ...]
+    prop_hub_radius_fraction: float
+    prop_section_lift_slope_per_rad: float
+    prop_section_zero_lift_rad: float
+    prop_section_cl_max: float
+    prop_section_cd0: float
+    prop_section_cd_k: float
+    rotor_inertia_kg_m2: float
+    advance_ratio_max: float
+
+
+_INCH_M = 0.0254  # definition of the inch, for propeller sizes quoted in inches
+PROPULSION = Propulsion(
+    # ESTIMATE: level flight needs D·V ≈ 1.8 N × 15 m/s = 28 W at cruise and 3.8 N × 25 m/s =
+    # 95 W at 25 m/s (RIGID_AERODYNAMICS drag polar); with a propeller efficiency ≈ 0.6–0.7 a
+    # 300 W motor (120 W/kg, usual for 2–3 kg hand-launched UAVs) flies 25 m/s at under half
+    # throttle and tops out at ≈ 32 m/s (JSBSim trim). Cruise electrical power ≈ 28 W /
+    # (0.6 propeller × 0.8 motor) ≈ 60 W for 20 min (Table 1 endurance) ≈ 20 Wh, a 4-cell
+    # 2.2 Ah pack: consistent with Table 1's 2.5 kg.
+    motor_max_shaft_power_w=300.0,
+    prop_diameter_m=12.0 * _INCH_M,  # ESTIMATE: 12×8 in, a common size on 300 W motors
+    prop_pitch_m=8.0 * _INCH_M,  # ESTIMATE: p/D = 0.67 keeps thrust to well above 25 m/s
+    prop_blades=2,  # ESTIMATE
+    # ESTIMATE: chord distribution of a typical thin-electric (APC-E-like) blade
+    prop_chord_stations=((0.15, 0.10), (0.40, 0.18), (0.75, 0.15), (1.00, 0.07)),
+    prop_hub_radius_fraction=0.15,  # ESTIMATE: spinner radius
+    prop_section_lift_slope_per_rad=0.9 * 2.0 * math.pi,  # ESTIMATE: thin section, low Re
+    prop_section_zero_lift_rad=math.radians(-2.0),  # ESTIMATE: cambered flat-bottom section
+    prop_section_cl_max=1.1,  # ESTIMATE: low-Re section stall
+    prop_section_cd0=0.020,  # ESTIMATE: Re ≈ 1e5 section drag
+    prop_section_cd_k=0.02,  # ESTIMATE
+    # NUMERICAL (an effective value, not the physical one): the physical estimate is
+    # ≈ 1.5e-4 kg·m² (25 g blade pair ≈ m D²/12 × 0.6 tapered = 1.2e-4, motor bell 0.3e-4),
+    # but JSBSim's trim brings the RPM to steady state by explicit Euler steps of a fixed
+    # 0.5 s (FGPropulsion::GetSteadyState), which is stable only if
+    # I > ½ · 0.5 s · |∂(Q_motor − Q_prop)/∂ω|. With these tables that needs ≈ 1.0e-3 kg·m²
+    # from 3 to 80 m/s at any throttle; 1.2e-3 adds 20 % margin. Trim and the (quasi-static
+    # in RPM) linearization do not depend on it; time simulations see a slower RPM response.
+    rotor_inertia_kg_m2=1.2e-3,
+    advance_ratio_max=1.3,  # beyond the ≈ 0.9 zero-thrust J of a 12×8
+)
+
+
+# --------------------------------------------------------------------------------------
+# Control-surface travel
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ControlLimits:
+    """Maximum deflection of each surface, symmetric about zero [rad].
+
+    Signs (JSBSim's): +elevator = trailing edge down (nose down); +aileron = left aileron
+    trailing edge down, right up (roll right); +rudder = trailing edge left (nose left).
+    """
+
+    elevator_max_rad: float
+    aileron_max_rad: float
+    rudder_max_rad: float
+
+
+CONTROL_LIMITS = ControlLimits(
+    elevator_max_rad=math.radians(20.0),  # ESTIMATE: usual small-UAV servo throw
+    aileron_max_rad=math.radians(20.0),  # ESTIMATE
+    rudder_max_rad=math.radians(25.0),  # ESTIMATE
 )

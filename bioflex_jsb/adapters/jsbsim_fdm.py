@@ -1,0 +1,757 @@
+"""JSBSim adapter for the rigid airframe: load, initial conditions, trim, linearization.
+
+This is the only module of bioflex-jsb that imports :mod:`jsbsim`. Everything that crosses
+its boundary is SI (m, s, kg, N, rad); JSBSim's slug-ft-s/degree values are converted here,
+once, with the constants of :mod:`bioflex_jsb.units`.
+
+JSBSim root
+-----------
+The JSBSim root is the directory holding ``aircraft/`` and ``systems/``. It is, in order:
+
+1. the ``root`` argument, when given;
+2. the directory named by the environment variable ``BIOFLEX_JSBSIM_ROOT``, when set;
+3. a repository checkout: ``aircraft/`` and ``systems/`` beside the ``bioflex_jsb`` package;
+4. an installed wheel: ``bioflex_jsb/jsbsim_root/`` inside the package.
+
+A root named explicitly (1, 2) that lacks the aircraft is an error, never skipped; between
+3 and 4 the first that holds the aircraft file is used; if neither does, the error says where
+it looked. JSBSim's console output (very verbose) is captured, not printed: see
+:attr:`Airframe.load_messages` and :attr:`Airframe.warnings`.
+
+Trim
+----
+:meth:`Airframe.trim` uses JSBSim's own trim routine, ``FGFDMExec::DoTrim`` in *full* mode
+(α, throttle and elevator for u̇, ẇ, q̇; bank, aileron, rudder and sideslip for the lateral
+accelerations, which the propeller torque needs): wings-level, constant-altitude flight at
+the requested true airspeed. When it fails, :class:`TrimError` carries one line naming the
+control that ran out (throttle at 1, elevator at a stop, α at the stall limit) or the
+condition that stayed out of tolerance.
+
+One JSBSim detail is handled here: the trim finds the propeller's steady RPM by explicit
+Euler steps of 0.5 s, which cannot start from the propeller at rest (an ``electric`` engine
+at 0 RPM applies its power over 1 rad/s). Before trimming, one normal time step with a
+throttle chosen for the purpose brings the propeller to its windmilling RPM at the trim
+speed; the trim then restarts the airframe from the initial condition (only the RPM carries
+over). The same Euler steps are why ``PROPULSION.rotor_inertia_kg_m2`` is an effective value,
+about 8 times the physical one (see its comment): trim and linearization do not depend on it,
+but time simulations see a slower RPM response and a larger propeller gyroscopic coupling
+between pitch and yaw rates (zero in symmetric, wings-level manoeuvres).
+
+Linearization
+-------------
+:meth:`Airframe.linearize` trims, then runs ``jsbsim.FGLinearization``, whose state vector is
+[Vt, α, θ, q, RPM(s), β, φ, p, ψ, r, latitude, longitude, altitude]. It is turned into the
+paper's rigid longitudinal model x_R = [u, α, q, θ] (u the airspeed perturbation [m/s]; α,
+θ [rad]; q [rad/s]) by
+
+* residualising the propeller RPM states r as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
+  (the RPM settles in a fraction of the short-period time scale at the physical rotor
+  inertia; JSBSim's state space already re-solves the RPM to steady state at every
+  perturbation, so A_xr is zero to rounding and the thrust change with airspeed is in the u
+  column);
+* dropping the lateral states (β, φ, p, ψ, r), decoupled from the longitudinal ones at a
+  wings-level trim, and the position states (latitude, longitude, altitude: the paper's x_R
+  has no altitude; the density gradient over the short period's height change is negligible);
+* converting Vt from ft/s to m/s (rows and columns).
+
+The eigenvalues are labelled by frequency: the two of larger modulus are the short period,
+the two of smaller modulus the phugoid.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import jsbsim
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.adapters import airframe_xml
+from bioflex_jsb.parameters.airframe import PROPULSION
+
+ROOT_ENV_VAR = "BIOFLEX_JSBSIM_ROOT"
+DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
+
+# Altitude range accepted for initial conditions [m]: sea level (the paper's Q uses
+# ρ = 1.225 kg/m³) up to the tropopause; below −500 m ISA is undefined in practice.
+ALTITUDE_RANGE_M = (-500.0, 11000.0)
+# Airspeed range accepted before asking JSBSim [m/s]: above 0, below 1/3 of the speed of
+# sound (the aerodynamic model is incompressible; Table 1's UAV flies at 10–25 m/s).
+SPEED_MAX_M_S = 110.0
+
+# JSBSim's trim modes (FGFDMExec::DoTrim): 0 longitudinal, 1 full.
+TRIM_MODE_FULL = 1
+# A normalised control this close to its stop counts as saturated in the trim diagnosis
+# (JSBSim's trim report prints controls to 2 significant digits).
+SATURATION_MARGIN = 0.01
+
+
+class FdmError(Exception):
+    """Base of the adapter's errors; the message is always a single line."""
+
+
+class AircraftLoadError(FdmError):
+    """The JSBSim root or aircraft file is missing, malformed or rejected by JSBSim."""
+
+
+class TrimError(FdmError):
+    """JSBSim's trim failed; the message names the saturated control or failed condition."""
+
+
+class LinearizationError(FdmError):
+    """JSBSim's linear model could not be reduced to the rigid longitudinal states."""
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+# ======================================================================================
+# Locating the JSBSim root
+# ======================================================================================
+
+
+def _package_dir() -> Path:
+    return Path(__file__).resolve().parents[1]
+
+
+def candidate_roots() -> list[Path]:
+    """Default JSBSim roots, in the order they are tried: checkout, then installed wheel."""
+    return [_package_dir().parent, _package_dir() / "jsbsim_root"]
+
+
+def aircraft_file(root: Path, aircraft: str = DEFAULT_AIRCRAFT) -> Path:
+    """Path JSBSim loads for ``aircraft`` under ``root``: aircraft/<name>/<name>.xml."""
+    return Path(root) / "aircraft" / aircraft / f"{aircraft}.xml"
+
+
+def locate_root(root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT) -> Path:
+    """The JSBSim root to use (see the module docstring); raises :class:`AircraftLoadError`."""
+    if root is None and os.environ.get(ROOT_ENV_VAR):
+        root = os.environ[ROOT_ENV_VAR]
+        origin = f"${ROOT_ENV_VAR}"
+    else:
+        origin = "the given JSBSim root"
+    if root is not None:
+        path = Path(root).expanduser().resolve()
+        if not path.is_dir():
+            raise AircraftLoadError(f"{origin} {str(path)!r} is not a directory")
+        if not aircraft_file(path, aircraft).is_file():
+            raise AircraftLoadError(
+                f"no aircraft file {str(aircraft_file(path, aircraft))!r} under {origin}"
+            )
+        return path
+    for path in candidate_roots():
+        if aircraft_file(path, aircraft).is_file() and (path / "systems").is_dir():
+            return path
+    tried = ", ".join(repr(str(p)) for p in candidate_roots())
+    hint = f"set {ROOT_ENV_VAR} or pass a JSBSim root"
+    if aircraft == DEFAULT_AIRCRAFT:
+        hint += " (python -m bioflex_jsb.adapters.airframe_xml writes the bioflex files)"
+    raise AircraftLoadError(
+        f"cannot find the JSBSim files of {aircraft!r} (aircraft/ and systems/) in {tried}; " + hint
+    )
+
+
+# ======================================================================================
+# JSBSim console output
+# ======================================================================================
+
+
+@dataclass(frozen=True)
+class LogRecord:
+    """One message of JSBSim's logger: ``level`` is a :class:`jsbsim.LogLevel` value."""
+
+    level: int
+    text: str
+
+
+class _CapturingLogger(jsbsim.FGLogger):
+    """Keeps JSBSim's messages instead of printing them."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.records: list[LogRecord] = []
+        self._level = int(jsbsim.LogLevel.INFO)
+        self._parts: list[str] = []
+
+    def set_level(self, level) -> None:
+        self._level = int(level)
+        self._parts = []
+
+    def file_location(self, filename: str, line: int) -> None:
+        self._parts.append(f"{filename}:{line}: ")
+
+    def message(self, message: str) -> None:
+        self._parts.append(message)
+
+    def format(self, log_format) -> None:  # colours and emphasis are dropped
+        return None
+
+    def flush(self) -> None:
+        text = "".join(self._parts)
+        self._parts = []
+        if text.strip():
+            self.records.append(LogRecord(self._level, text))
+
+
+@contextlib.contextmanager
+def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
+    previous = jsbsim.get_logger()
+    jsbsim.set_logger(logger)
+    try:
+        yield logger
+    finally:
+        jsbsim.set_logger(previous)
+
+
+# ======================================================================================
+# Results
+# ======================================================================================
+
+
+@dataclass(frozen=True)
+class TrimResult:
+    """A converged JSBSim trim: wings-level, constant-altitude flight.
+
+    Attributes:
+        speed_m_s: true airspeed [m/s]; altitude_m: altitude above sea level [m].
+        alpha_rad, theta_rad: angle of attack and pitch attitude [rad] (θ = α in level flight).
+        elevator_norm: elevator position, −1..1 of its travel (+ = trailing edge down).
+        elevator_rad: elevator deflection [rad] (+ = trailing edge down, nose-down moment).
+        throttle: throttle position 0..1 (fraction of the motor's maximum shaft power).
+        aileron_norm: aileron position −1..1 holding the propeller torque (+ = roll right).
+        propeller_rpm: propeller speed [rev/min]; thrust_n: propeller thrust [N].
+        converged: True: JSBSim reported every trim condition within tolerance.
+        residuals: the accelerations left: ``udot_m_s2``, ``wdot_m_s2`` [m/s²],
+            ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²].
+    """
+
+    speed_m_s: float
+    altitude_m: float
+    alpha_rad: float
+    theta_rad: float
+    elevator_norm: float
+    elevator_rad: float
+    throttle: float
+    aileron_norm: float
+    propeller_rpm: float
+    thrust_n: float
+    converged: bool
+    residuals: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class ModeEigenvalue:
+    """One eigenvalue of a conjugate pair (the one with im ≥ 0), with its mode.
+
+    re, im [rad/s]; damping ζ = −re/|λ| [-]; frequency_rad_s ω_n = |λ| [rad/s].
+    """
+
+    mode: str
+    re: float
+    im: float
+    damping: float
+    frequency_rad_s: float
+
+
+RIGID_STATES = ("u", "alpha", "q", "theta")
+RIGID_STATE_UNITS = ("m/s", "rad", "rad/s", "rad")
+
+
+@dataclass(frozen=True)
+class RigidLinearization:
+    """JSBSim's linear model at a trim, reduced to x_R = [u, α, q, θ] (SI).
+
+    Attributes:
+        speed_m_s: trim airspeed [m/s].
+        trim: the trim it was taken at.
+        a: 4×4 system matrix, states :data:`RIGID_STATES` in :data:`RIGID_STATE_UNITS`
+            (row i: d x_i/dt; e.g. a[0, 1] = ∂u̇/∂α [m/s² per rad]).
+        eigenvalues: one :class:`ModeEigenvalue` per conjugate pair (or real root),
+            short period first.
+        jsbsim_states: JSBSim's full state list the model was reduced from.
+        residualised_states: the states eliminated as quasi-static (propeller RPM).
+    """
+
+    speed_m_s: float
+    trim: TrimResult
+    a: np.ndarray
+    eigenvalues: tuple[ModeEigenvalue, ...]
+    jsbsim_states: tuple[str, ...]
+    residualised_states: tuple[str, ...]
+    states: tuple[str, ...] = RIGID_STATES
+    state_units: tuple[str, ...] = RIGID_STATE_UNITS
+
+    def mode(self, name: str) -> ModeEigenvalue:
+        """The eigenvalue (im ≥ 0) of mode ``name`` ('short_period' or 'phugoid')."""
+        for ev in self.eigenvalues:
+            if ev.mode == name:
+                return ev
+        raise KeyError(f"no {name!r} eigenvalue")
+
+
+def label_modes(eigenvalues: np.ndarray) -> tuple[ModeEigenvalue, ...]:
+    """Label the 4 longitudinal eigenvalues by frequency and keep one per conjugate pair.
+
+    The two of larger modulus are the short period, the two of smaller the phugoid. Complex
+    pairs are reported once (im > 0); real roots each appear (im = 0).
+    """
+    lam = np.asarray(eigenvalues, dtype=complex)
+    if lam.shape != (4,):
+        raise ValueError(f"expected 4 longitudinal eigenvalues, got {lam.shape}")
+    order = np.argsort(-np.abs(lam), kind="stable")
+    out = []
+    for rank, i in enumerate(order):
+        value = lam[i]
+        if value.imag < 0.0:
+            continue
+        modulus = abs(value)
+        out.append(
+            ModeEigenvalue(
+                mode="short_period" if rank < 2 else "phugoid",
+                re=float(value.real),
+                im=float(abs(value.imag)),
+                damping=float(-value.real / modulus) if modulus > 0 else 1.0,
+                frequency_rad_s=float(modulus),
+            )
+        )
+    return tuple(out)
+
+
+# ======================================================================================
+# The airframe
+# ======================================================================================
+
+
+def _check_speed(speed_m_s: float) -> float:
+    v = float(speed_m_s)
+    if not math.isfinite(v) or v <= 0.0:
+        raise ValueError(f"airspeed must be a finite number > 0 m/s, got {speed_m_s!r}")
+    if v > SPEED_MAX_M_S:
+        raise ValueError(
+            f"airspeed {v:g} m/s is above {SPEED_MAX_M_S:g} m/s, where the incompressible "
+            "aerodynamic model ends"
+        )
+    return v
+
+
+def _check_altitude(altitude_m: float) -> float:
+    h = float(altitude_m)
+    lo, hi = ALTITUDE_RANGE_M
+    if not math.isfinite(h) or not lo <= h <= hi:
+        raise ValueError(f"altitude must be between {lo:g} and {hi:g} m, got {altitude_m!r}")
+    return h
+
+
+def _alpha_limits_rad(path: Path) -> tuple[float, float]:
+    """The <alphalimits> of the aircraft file [rad] (the range JSBSim's trim searches)."""
+    try:
+        tree = ET.parse(path)
+    except ET.ParseError as exc:
+        raise AircraftLoadError(f"aircraft file {str(path)!r} is not valid XML: {exc}") from None
+    lim = tree.getroot().find("aerodynamics/alphalimits")
+    if lim is None:
+        # JSBSim's trim then searches −5°..20° (FGTrimAxis); report that range.
+        return math.radians(-5.0), math.radians(20.0)
+    scale = 1.0 if lim.get("unit", "RAD").upper() == "RAD" else math.pi / 180.0
+    try:
+        return float(lim.findtext("min")) * scale, float(lim.findtext("max")) * scale
+    except (TypeError, ValueError):
+        raise AircraftLoadError(f"malformed <alphalimits> in {str(path)!r}") from None
+
+
+@lru_cache(maxsize=1)
+def _zero_thrust_advance_ratio() -> float:
+    """J at which the propeller's C_T(J) crosses zero [-] (windmilling)."""
+    j, ct, _ = airframe_xml.propeller_tables(PROPULSION)
+    k = int(np.argmax(ct <= 0.0))
+    return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
+
+
+class Airframe:
+    """One loaded JSBSim instance of the rigid airframe.
+
+    Args:
+        root: JSBSim root (see :func:`locate_root`); None for the default search.
+        aircraft: aircraft name (directory and file name under ``aircraft/``).
+    """
+
+    def __init__(self, root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT):
+        self.root = locate_root(root, aircraft)
+        self.aircraft = aircraft
+        self.aircraft_path = aircraft_file(self.root, aircraft)
+        self.alpha_limits_rad = _alpha_limits_rad(self.aircraft_path)
+        self._log = _CapturingLogger()
+        with _captured(self._log):
+            self._fdm = jsbsim.FGFDMExec(str(self.root), None)
+            try:
+                loaded = self._fdm.load_model(aircraft)
+            except jsbsim.BaseError as exc:
+                raise AircraftLoadError(
+                    f"JSBSim rejected {str(self.aircraft_path)!r}: {_one_line(exc)}"
+                ) from None
+        if not loaded:
+            raise AircraftLoadError(
+                f"JSBSim could not load {str(self.aircraft_path)!r}: "
+                f"{self._first_message(jsbsim.LogLevel.ERROR) or 'no reason given'}"
+            )
+        self._dt_nominal_s = float(self._fdm.get_delta_t())
+        self.load_messages: tuple[LogRecord, ...] = tuple(self._log.records)
+        self._log.records.clear()
+
+    # ---- JSBSim messages ----------------------------------------------------------
+    @property
+    def warnings(self) -> list[str]:
+        """Warnings and errors JSBSim printed while loading the aircraft (one per message)."""
+        return [
+            _one_line(r.text)
+            for r in self.load_messages
+            if jsbsim.LogLevel.WARN <= r.level <= jsbsim.LogLevel.FATAL
+        ]
+
+    def _first_message(self, min_level: int) -> str:
+        for r in self._log.records:
+            if min_level <= r.level <= jsbsim.LogLevel.FATAL:
+                return _one_line(r.text)
+        return ""
+
+    # ---- properties ---------------------------------------------------------------
+    def __getitem__(self, name: str) -> float:
+        """Raw JSBSim property value (JSBSim units, as the property name says)."""
+        return float(self._fdm[name])
+
+    def __setitem__(self, name: str, value: float) -> None:
+        """Set an existing JSBSim property (a misspelt name raises KeyError instead of
+        silently creating a new, unused property)."""
+        if not self._fdm.get_property_manager().hasNode(name):
+            raise KeyError(f"JSBSim has no property {name!r}")
+        self._fdm[name] = float(value)
+
+    def _restore_time_step(self) -> None:
+        """FGLinearization leaves the time step at 0 (it suspends integration while
+        perturbing); put back the step the model was loaded with."""
+        if self._fdm.integration_suspended():
+            self._fdm.resume_integration()
+        if self._fdm.get_delta_t() != self._dt_nominal_s:
+            self._fdm.set_dt(self._dt_nominal_s)
+
+    # ---- initial conditions ---------------------------------------------------------
+    def set_initial_conditions(self, speed_m_s: float, altitude_m: float = 0.0) -> None:
+        """Level, wings-level flight at true airspeed ``speed_m_s`` [m/s] and altitude
+        ``altitude_m`` [m] above sea level in JSBSim's standard atmosphere (ISA; 0 m = sea
+        level, ρ = 1.225 kg/m³), at 45° latitude where JSBSim's gravity is the standard
+        9.806 m/s². The ground is put ``TERRAIN_CLEARANCE_M`` below."""
+        v = _check_speed(speed_m_s)
+        h = _check_altitude(altitude_m)
+        fdm = self._fdm
+        self._restore_time_step()
+        fdm["ic/lat-geod-rad"] = airframe_xml.INIT_LATITUDE_RAD  # standard gravity there
+        fdm["ic/long-gc-rad"] = 0.0
+        fdm["ic/terrain-elevation-ft"] = (h - airframe_xml.TERRAIN_CLEARANCE_M) * U.FT_PER_M
+        fdm["ic/h-sl-ft"] = h * U.FT_PER_M
+        for name in ("ic/phi-rad", "ic/psi-true-rad", "ic/beta-rad", "ic/gamma-rad"):
+            fdm[name] = 0.0
+        for name in ("ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", "ic/alpha-rad"):
+            fdm[name] = 0.0
+        fdm["ic/vt-fps"] = v * U.FT_PER_M
+        for name in (
+            "fcs/elevator-cmd-norm",
+            "fcs/aileron-cmd-norm",
+            "fcs/rudder-cmd-norm",
+            "fcs/pitch-trim-cmd-norm",
+            "fcs/roll-trim-cmd-norm",
+            "fcs/yaw-trim-cmd-norm",
+        ):
+            fdm[name] = 0.0
+        with _captured(self._log):
+            fdm.run_ic()
+
+    def _spin_up_propeller(self, speed_m_s: float) -> None:
+        """Bring the propeller from rest to its windmilling RPM at ``speed_m_s`` in one step.
+
+        At 0 RPM JSBSim's propeller turns the engine power P [ft·lbf/s] into a torque of
+        P/(1 rad/s), so one step of dt [s] gives ω = throttle·P_max·dt/I. The throttle for
+        ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set for that single step.
+        """
+        fdm = self._fdm
+        omega_rad_s = (
+            2.0 * math.pi * speed_m_s / (_zero_thrust_advance_ratio() * PROPULSION.prop_diameter_m)
+        )
+        inertia_slug_ft2 = PROPULSION.rotor_inertia_kg_m2 * U.SLUG_FT2_PER_KG_M2
+        power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w * U.LBF_FT_PER_N_M
+        throttle = omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t())
+        fdm["fcs/throttle-cmd-norm"] = min(1.0, throttle)
+        with _captured(self._log):
+            fdm.run()
+
+    # ---- trim -----------------------------------------------------------------------
+    def trim(self, speed_m_s: float, altitude_m: float = 0.0) -> TrimResult:
+        """Trim for level flight at ``speed_m_s`` [m/s], ``altitude_m`` [m] (JSBSim full trim).
+
+        Raises:
+            ValueError: speed or altitude outside the accepted range.
+            TrimError: JSBSim's trim failed; one-line diagnosis.
+        """
+        v = _check_speed(speed_m_s)
+        h = _check_altitude(altitude_m)
+        self.set_initial_conditions(v, h)
+        self._spin_up_propeller(v)
+        self._log.records.clear()
+        with _captured(self._log):
+            try:
+                self._fdm.do_trim(TRIM_MODE_FULL)
+                failed = False
+            except jsbsim.TrimFailureError:
+                failed = True
+        if failed:
+            raise TrimError(self._diagnose_trim_failure(v))
+        return self._trim_result(v, h)
+
+    def _trim_result(self, v: float, h: float) -> TrimResult:
+        fdm = self._fdm
+        return TrimResult(
+            speed_m_s=v,
+            altitude_m=h,
+            alpha_rad=float(fdm["aero/alpha-rad"]),
+            theta_rad=float(fdm["attitude/theta-rad"]),
+            elevator_norm=float(fdm["fcs/elevator-pos-norm"]),
+            elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
+            throttle=float(fdm["fcs/throttle-pos-norm"]),
+            aileron_norm=float(fdm["fcs/left-aileron-pos-norm"]),
+            propeller_rpm=float(fdm["propulsion/engine/propeller-rpm"]),
+            thrust_n=float(fdm["propulsion/engine/thrust-lbs"]) * U.N_PER_LBF,
+            converged=True,
+            residuals={
+                "udot_m_s2": float(fdm["accelerations/udot-ft_sec2"]) * U.M_PER_FT,
+                "wdot_m_s2": float(fdm["accelerations/wdot-ft_sec2"]) * U.M_PER_FT,
+                "qdot_rad_s2": float(fdm["accelerations/qdot-rad_sec2"]),
+                "pdot_rad_s2": float(fdm["accelerations/pdot-rad_sec2"]),
+                "rdot_rad_s2": float(fdm["accelerations/rdot-rad_sec2"]),
+            },
+        )
+
+    # JSBSim's trim report: one line per axis, e.g.
+    # "  Throttle            : 1      udot : -3.68e+01 Tolerance: 1e-03  Failed"
+    _REPORT_LINE = re.compile(
+        r"^\s*(?P<control>[A-Za-z][A-Za-z ]*?)\s*:\s*(?P<value>\S+)\s+(?P<state>\w+)\s*:\s*"
+        r"(?P<residual>\S+)\s+Tolerance:\s*\S+\s+(?P<verdict>Passed|Failed)\s*$",
+        re.MULTILINE,
+    )
+    _UNTRIMMABLE = re.compile(r"Sorry, (?P<state>\w+) doesn't appear to be trimmable")
+
+    def _diagnose_trim_failure(self, v: float) -> str:
+        """One line: which control saturated or which condition failed (from JSBSim's
+        trim messages: the 'not trimmable' verdict and the final axis report)."""
+        text = "\n".join(r.text for r in self._log.records)
+        axes: dict[str, tuple[str, float, float, bool]] = {}
+        for m in self._REPORT_LINE.finditer(text):
+            try:
+                value, residual = float(m["value"]), float(m["residual"])
+            except ValueError:
+                continue
+            axes[m["state"]] = (m["control"], value, residual, m["verdict"] == "Passed")
+        untrimmable = [m["state"] for m in self._UNTRIMMABLE.finditer(text)]
+        where = f"at {v:g} m/s"
+        lo_deg, hi_deg = (math.degrees(a) for a in self.alpha_limits_rad)
+
+        def sign(state: str) -> float:
+            return axes[state][2] if state in axes else 0.0
+
+        def saturated(state: str, limit: float) -> bool:
+            return state in axes and abs(axes[state][1] - limit) <= SATURATION_MARGIN
+
+        if "udot" in untrimmable or saturated("udot", 1.0):
+            if sign("udot") < 0.0 or saturated("udot", 1.0):
+                return (
+                    f"cannot trim {where}: level flight needs more thrust than the motor gives "
+                    "(throttle saturated at 1)"
+                )
+            return f"cannot trim {where}: the aircraft accelerates even at zero throttle"
+        if "wdot" in untrimmable:
+            if sign("wdot") >= 0.0:
+                return (
+                    f"cannot trim {where}: level flight needs an angle of attack beyond the "
+                    f"stall limit {hi_deg:.1f} deg (speed below the stall speed)"
+                )
+            return (
+                f"cannot trim {where}: level flight needs an angle of attack below the "
+                f"negative-stall limit {lo_deg:.1f} deg"
+            )
+        if "qdot" in untrimmable or saturated("qdot", 1.0) or saturated("qdot", -1.0):
+            stop = "nose-down" if sign("qdot") > 0.0 else "nose-up"
+            return (
+                f"cannot trim {where}: the elevator is at its {stop} stop and cannot balance "
+                "the pitching moment"
+            )
+        if untrimmable:
+            return f"cannot trim {where}: JSBSim finds {', '.join(untrimmable)} untrimmable"
+        failed = [f"{s} (by {c.strip().lower()})" for s, (c, _, _, ok) in axes.items() if not ok]
+        if failed:
+            return (
+                f"cannot trim {where}: JSBSim's trim did not converge; out of tolerance: "
+                + ", ".join(failed)
+            )
+        reason = self._first_message(jsbsim.LogLevel.WARN)
+        return f"cannot trim {where}: JSBSim's trim failed" + (f" ({reason})" if reason else "")
+
+    # ---- linearization ----------------------------------------------------------------
+    def linearize(self, speed_m_s: float, altitude_m: float = 0.0) -> RigidLinearization:
+        """Trim at ``speed_m_s`` [m/s], then JSBSim's linear model reduced to x_R (SI).
+
+        Raises:
+            ValueError, TrimError: as :meth:`trim`.
+            LinearizationError: JSBSim's state list lacks a rigid state, or the RPM block
+                cannot be residualised.
+        """
+        trim = self.trim(speed_m_s, altitude_m)
+        with _captured(self._log):
+            lin = jsbsim.FGLinearization(self._fdm)
+            a_full = np.array(lin.system_matrix, dtype=float)
+            names = tuple(lin.x_names)
+            units = tuple(lin.x_units)
+        self._restore_time_step()
+        a, residualised = reduce_to_rigid(a_full, names, units)
+        eig = label_modes(np.linalg.eigvals(a))
+        return RigidLinearization(
+            speed_m_s=trim.speed_m_s,
+            trim=trim,
+            a=a,
+            eigenvalues=eig,
+            jsbsim_states=names,
+            residualised_states=residualised,
+        )
+
+    # ---- modal-wing hooks -----------------------------------------------------------------
+    def set_external_reactions(
+        self,
+        lift_n: float = 0.0,
+        drag_n: float = 0.0,
+        pitch_moment_n_m: float = 0.0,
+        roll_moment_n_m: float = 0.0,
+    ) -> None:
+        """Set the external-reaction hooks (see :mod:`bioflex_jsb.adapters.airframe_xml`).
+
+        lift_n: force along body −z (up) [N]; drag_n: along body −x (aft) [N];
+        pitch_moment_n_m: about body +y, nose up [N·m]; roll_moment_n_m: about body +x,
+        right wing down [N·m]. They act from the next time step on.
+        """
+        prop = airframe_xml.external_property
+        self[prop("modal-lift")] = float(lift_n) * U.LBF_PER_N
+        self[prop("modal-drag")] = float(drag_n) * U.LBF_PER_N
+        self[prop("modal-pitch")] = float(pitch_moment_n_m) * U.LBF_FT_PER_N_M
+        self[prop("modal-roll")] = float(roll_moment_n_m) * U.LBF_FT_PER_N_M
+
+    def run(self, steps: int = 1) -> None:
+        """Advance JSBSim by ``steps`` time steps of its integration step."""
+        with _captured(self._log):
+            for _ in range(int(steps)):
+                self._fdm.run()
+
+    @property
+    def dt_s(self) -> float:
+        """JSBSim's integration time step [s]."""
+        return float(self._fdm.get_delta_t())
+
+    def set_dt(self, dt_s: float) -> None:
+        """Set JSBSim's integration time step [s] (kept across trims and linearizations)."""
+        dt = float(dt_s)
+        if not math.isfinite(dt) or not 0.0 < dt <= 0.1:
+            raise ValueError(f"time step must be in (0, 0.1] s, got {dt_s!r}")
+        self._dt_nominal_s = dt
+        self._restore_time_step()
+
+    def property_node(self, name: str):
+        """JSBSim's node of an existing property, for fast repeated reads in a loop
+        (``node.get_double_value()``, JSBSim units as the name says)."""
+        node = self._fdm.get_property_manager().get_node(name, False)
+        if node is None:
+            raise KeyError(f"JSBSim has no property {name!r}")
+        return node
+
+
+# JSBSim state names (FGStateSpace) of the rigid longitudinal model, in x_R order, and
+# the factor from JSBSim's unit to SI.
+_RIGID_JSBSIM = (("Vt", "ft/s", U.M_PER_FT), ("Alpha", "rad", 1.0), ("Q", "rad/s", 1.0),
+                 ("Theta", "rad", 1.0))  # fmt: skip
+_FAST_PREFIXES = ("Rpm", "PropPitch")  # engine states residualised as quasi-static
+_DROPPED = {"Beta", "Phi", "P", "Psi", "R", "Latitude", "Longitude", "Alt"}
+
+
+def reduce_to_rigid(
+    a_full: np.ndarray, names: tuple[str, ...], units: tuple[str, ...]
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """JSBSim's system matrix → 4×4 A in x_R = [u, α, q, θ], SI (see module docstring).
+
+    Returns the matrix and the names of the residualised (quasi-static) states.
+    """
+    index = {n: i for i, n in enumerate(names)}
+    keep = []
+    scale = []
+    for name, unit, to_si in _RIGID_JSBSIM:
+        if name not in index:
+            raise LinearizationError(f"JSBSim's linear model has no {name!r} state: {names}")
+        if units[index[name]] != unit:
+            raise LinearizationError(
+                f"JSBSim's {name!r} state is in {units[index[name]]!r}, expected {unit!r}"
+            )
+        keep.append(index[name])
+        scale.append(to_si)
+    fast = [i for i, n in enumerate(names) if n.startswith(_FAST_PREFIXES)]
+    unknown = [n for n in names if n not in _DROPPED and not n.startswith(_FAST_PREFIXES)]
+    unknown = [n for n in unknown if n not in {r[0] for r in _RIGID_JSBSIM}]
+    if unknown:
+        raise LinearizationError(f"JSBSim's linear model has unexpected states {unknown}")
+    a_xx = a_full[np.ix_(keep, keep)]
+    if fast:
+        a_xr = a_full[np.ix_(keep, fast)]
+        a_rx = a_full[np.ix_(fast, keep)]
+        a_rr = a_full[np.ix_(fast, fast)]
+        if not np.all(np.isfinite(a_rr)) or np.linalg.cond(a_rr) > 1e12:
+            raise LinearizationError("the propeller RPM block of JSBSim's model is singular")
+        a_xx = a_xx - a_xr @ np.linalg.solve(a_rr, a_rx)
+    s = np.diag(scale)
+    a_si = s @ a_xx @ np.linalg.inv(s)
+    if not np.all(np.isfinite(a_si)):
+        raise LinearizationError("JSBSim's linear model has non-finite entries")
+    return a_si, tuple(names[i] for i in fast)
+
+
+# ======================================================================================
+# Convenience functions: a fresh airframe per call
+# ======================================================================================
+
+
+def load_airframe(
+    root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT
+) -> Airframe:
+    """Load the airframe (JSBSim console output captured; see :attr:`Airframe.warnings`)."""
+    return Airframe(root, aircraft)
+
+
+def trim(
+    speed_m_s: float,
+    altitude_m: float = 0.0,
+    root: str | os.PathLike | None = None,
+    aircraft: str = DEFAULT_AIRCRAFT,
+) -> TrimResult:
+    """Level-flight trim at ``speed_m_s`` [m/s] and ``altitude_m`` [m] (ISA sea level default)."""
+    return Airframe(root, aircraft).trim(speed_m_s, altitude_m)
+
+
+def linearize(
+    speed_m_s: float,
+    altitude_m: float = 0.0,
+    root: str | os.PathLike | None = None,
+    aircraft: str = DEFAULT_AIRCRAFT,
+) -> RigidLinearization:
+    """Rigid longitudinal linear model x_R = [u, α, q, θ] at the trim for ``speed_m_s``."""
+    return Airframe(root, aircraft).linearize(speed_m_s, altitude_m)

@@ -1,0 +1,123 @@
+"""``bioflex-jsb trim``: level-flight trim of the rigid JSBSim airframe."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from bioflex_jsb.cli.common import UsageError, positive_float, print_json
+
+HELP = """Trim the rigid JSBSim airframe for wings-level, constant-altitude flight with
+JSBSim's own trim routine. Units: --speed is the true airspeed in m/s, --altitude the
+height above sea level in m (standard atmosphere; default 0 m, rho = 1.225 kg/m^3). The
+table gives angles in degrees (alpha, theta, elevator; + elevator = trailing edge down),
+the elevator also as a fraction -1..1 of its travel and the throttle as 0..1 of the motor's
+maximum shaft power. With --json, angles are in rad (keys ending in _rad), residual
+accelerations in m/s^2 and rad/s^2. A speed the aircraft cannot fly (below the stall speed,
+beyond the motor's thrust) ends with a one-line reason and exit status 2."""
+
+
+def finite_float(label: str, unit: str):
+    """argparse type: any finite number, e.g. an altitude (may be negative)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{label} must be a number in {unit}, got {text!r}"
+            ) from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(
+                f"{label} must be a finite number in {unit}, got {text!r}"
+            )
+        return value
+
+    parse.__name__ = label
+    return parse
+
+
+def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
+    """--speed, --altitude and the JSBSim model options shared by trim and linearize."""
+    p.add_argument(
+        "--speed", type=positive_float("speed", "m/s"), required=True, metavar="V",
+        help="true airspeed [m/s]",
+    )  # fmt: skip
+    p.add_argument(
+        "--altitude", type=finite_float("altitude", "m"), default=0.0, metavar="M",
+        help="altitude above sea level [m], standard atmosphere (default 0: ISA sea level)",
+    )  # fmt: skip
+    p.add_argument(
+        "--jsbsim-root", metavar="DIR", default=None,
+        help="JSBSim root holding aircraft/ and systems/ (default: the package's own files, "
+        "or $BIOFLEX_JSBSIM_ROOT)",
+    )  # fmt: skip
+    p.add_argument(
+        "--aircraft", metavar="NAME", default=None,
+        help="aircraft name under aircraft/ (default: bioflex)",
+    )  # fmt: skip
+
+
+def load_airframe(args: argparse.Namespace):
+    """The JSBSim airframe the options name; adapter errors become UsageError."""
+    from bioflex_jsb.adapters import jsbsim_fdm
+
+    aircraft = args.aircraft or jsbsim_fdm.DEFAULT_AIRCRAFT
+    try:
+        return jsbsim_fdm.load_airframe(args.jsbsim_root, aircraft)
+    except jsbsim_fdm.FdmError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def register(sub) -> None:
+    p = sub.add_parser("trim", help="level-flight trim of the JSBSim airframe", description=HELP)
+    add_flight_condition_arguments(p)
+    p.add_argument("--json", action="store_true", help="print JSON (SI, rad) instead of a table")
+    p.set_defaults(run=run)
+
+
+def trim_payload(result) -> dict:
+    """JSON form of a :class:`~bioflex_jsb.adapters.jsbsim_fdm.TrimResult` (SI, rad)."""
+    return {
+        "speed_m_s": result.speed_m_s,
+        "altitude_m": result.altitude_m,
+        "alpha_rad": result.alpha_rad,
+        "theta_rad": result.theta_rad,
+        "elevator_rad": result.elevator_rad,
+        "elevator_norm": result.elevator_norm,
+        "throttle": result.throttle,
+        "aileron_norm": result.aileron_norm,
+        "propeller_rpm": result.propeller_rpm,
+        "thrust_n": result.thrust_n,
+        "converged": result.converged,
+        "residuals": dict(result.residuals),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.adapters import jsbsim_fdm
+
+    airframe = load_airframe(args)
+    try:
+        result = airframe.trim(args.speed, args.altitude)
+    except (jsbsim_fdm.FdmError, ValueError) as exc:
+        raise UsageError(str(exc)) from None
+    if args.json:
+        print_json(trim_payload(result))
+        return 0
+    deg = math.degrees
+    rows = [
+        ("speed", f"{result.speed_m_s:.2f}", "m/s"),
+        ("altitude", f"{result.altitude_m:.1f}", "m"),
+        ("alpha", f"{deg(result.alpha_rad):.2f}", "deg"),
+        ("theta", f"{deg(result.theta_rad):.2f}", "deg"),
+        ("elevator", f"{deg(result.elevator_rad):.2f}", "deg (+ trailing edge down)"),
+        ("elevator", f"{result.elevator_norm:.3f}", "of travel, -1..1"),
+        ("throttle", f"{result.throttle:.3f}", "0..1"),
+        ("propeller", f"{result.propeller_rpm:.0f}", "rev/min"),
+        ("thrust", f"{result.thrust_n:.3f}", "N"),
+    ]
+    print(f"Trim (JSBSim, wings level, level flight), converged: {result.converged}")
+    for name, value, unit in rows:
+        print(f"  {name:<10} {value:>10}  {unit}")
+    return 0
