@@ -208,3 +208,37 @@ def test_trim_holds_in_a_time_simulation(airframe):
     assert airframe["aero/alpha-rad"] == pytest.approx(t.alpha_rad, abs=1e-4)
     assert airframe["position/h-sl-ft"] * U.M_PER_FT == pytest.approx(h0_m, abs=0.01)
     assert abs(airframe["attitude/phi-rad"]) < 1e-3  # the aileron trim holds the prop torque
+
+
+def _report(*lines: str) -> list[jsbsim_fdm.LogRecord]:
+    """Trim messages in the layout JSBSim's FGTrim prints (level 4 = ERROR, 6 = STDOUT)."""
+    return [jsbsim_fdm.LogRecord(6, line + "\n") for line in lines]
+
+
+@pytest.mark.parametrize(
+    ("records", "expected"),
+    [
+        (  # pitch trim at +1 and still nose-up: elevator at its nose-down stop
+            [jsbsim_fdm.LogRecord(4, "  Sorry, qdot doesn't appear to be trimmable\n")]
+            + _report(
+                "  Angle of Attack     : 2.1    wdot : 1.00e-04  Tolerance: 1e-03  Passed",
+                "  Throttle            : 0.2    udot : 2.00e-05  Tolerance: 1e-03  Passed",
+                "  Pitch Trim          : 1      qdot : 3.50e+00  Tolerance: 1e-04  Failed",
+            ),
+            "elevator is at its nose-down stop",
+        ),
+        (  # no verdict, iterations exhausted: name the axes out of tolerance
+            _report(
+                "  Angle of Attack     : 2.1    wdot : 5.00e-02  Tolerance: 1e-03  Failed",
+                "  Throttle            : 0.2    udot : 2.00e-05  Tolerance: 1e-03  Passed",
+                "  Ailerons            : 0.1    pdot : 3.00e-02  Tolerance: 1e-04  Failed",
+            ),
+            "out of tolerance: wdot (by angle of attack), pdot (by ailerons)",
+        ),
+    ],
+)
+def test_trim_failure_diagnosis_from_jsbsim_report(airframe, records, expected):
+    airframe._log.records[:] = records
+    message = airframe._diagnose_trim_failure(15.0)
+    assert expected in message and "\n" not in message
+    airframe._log.records.clear()

@@ -433,8 +433,8 @@ def render_aircraft(
     ext = _el(root, "external_reactions")
     _comment(
         ext,
-        "hooks for the modal wing, zero by default; set "
-        "external_reactions/<name>/magnitude (see airframe_xml.py docstring)",
+        "hooks for the modal wing, zero by default; set external_reactions/<name>/magnitude "
+        "(forces, lbs) or .../magnitude-lbsft (moments); see airframe_xml.py docstring",
     )
     for name, (direction, text) in EXTERNAL_FORCES.items():
         _comment(ext, text)
