@@ -164,11 +164,23 @@ def coupled_blocks(
     wing: ElasticWingModel,
     condition: FlightCondition,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    a_rr: np.ndarray | None = None,
 ) -> CoupledBlocks:
-    """Assemble the blocks of Eq. (4)."""
+    """Assemble the blocks of Eq. (4).
+
+    ``a_rr`` replaces the analytic A_RR (e.g. by JSBSim's linearization of the airframe at
+    the same trim); G_R is then its α column over u_0, which is what Appendix B's G_R is.
+    """
     rd = rigid_derivatives(condition, aero)
     ed = elastic_derivatives(wing, condition, aero)
-    a_rr, g_r = rigid_matrices(rd)
+    a_rr_analytic, g_r = rigid_matrices(rd)
+    if a_rr is None:
+        a_rr = a_rr_analytic
+    else:
+        a_rr = np.asarray(a_rr, dtype=float)
+        if a_rr.shape != (4, 4):
+            raise ValueError(f"a_rr must be 4x4, got {a_rr.shape}")
+        g_r = (a_rr[:, 1] / condition.speed_m_s).reshape(4, 1)
     u0 = condition.speed_m_s
     n = wing.n_modes
 
@@ -203,17 +215,22 @@ def build_state_space(
     condition: FlightCondition,
     wing: ElasticWingModel | None = None,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    a_rr: np.ndarray | None = None,
 ) -> StateSpace:
     """The ``rigid`` (A_RR), ``coupled`` (Eq. 4) or ``qsd`` (Eq. 9–10) model at ``condition``.
 
     The QSD model also outputs the quasi-static modal deflections
-    η = −A_EE⁻¹ (A_ER x_R + G_E w_g).
+    η = −A_EE⁻¹ (A_ER x_R + G_E w_g). ``a_rr`` replaces the analytic rigid block (see
+    :func:`coupled_blocks`).
     """
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
     if model == "rigid":
         a, g = rigid_matrices(rigid_derivatives(condition, aero))
+        if a_rr is not None:
+            a = np.asarray(a_rr, dtype=float)
+            g = (a[:, 1] / condition.speed_m_s).reshape(4, 1)
         return StateSpace(
             model=model, a=a, b=g, c=np.eye(4), d=np.zeros((4, 1)),
             states=RIGID_STATES, state_units=RIGID_STATE_UNITS,
@@ -221,7 +238,7 @@ def build_state_space(
         )
     if wing is None:
         raise ValueError(f"the {model} model needs an elastic wing")
-    blk = coupled_blocks(wing, condition, aero)
+    blk = coupled_blocks(wing, condition, aero, a_rr)
     n = wing.n_modes
     e_names, e_units = elastic_state_names(n)
     notes = {"wing": wing.name, "overrides": dict(wing.coefficients.overrides)}

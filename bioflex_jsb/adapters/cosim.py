@@ -1,0 +1,208 @@
+"""The co-simulation loop: JSBSim's rigid airframe with the Python modal wing, through a gust.
+
+Per JSBSim step k (time t_k, airframe state x_k):
+
+1. the gust w_g(t_k) is written to JSBSim's wind (``atmosphere/wind-down-fps`` = −w_g);
+2. the flow at the wing (α, V, Q against the air, q) is computed from x_k and that wind, the
+   same way JSBSim's FGAuxiliary computes it for this step;
+3. the wing's loads from its state η_k in that flow go into ``external_reactions``
+   (lift/drag turned from wind to body axes with α_k);
+4. JSBSim runs one step (x_k → x_{k+1}); the sample at t_k is logged (n_z is JSBSim's for
+   this step's forces);
+5. the wing advances η_k → η_{k+1} with the flow of step k held (exact discretisation).
+
+So the loads of step k use the modal state reached with the flow of step k−1: a one-step lag
+in the α → η → load path of the ``coupled`` model (the ``qsd`` model solves η from the flow
+of step k itself). ``tests/test_cosim.py`` halves the step to show it does not matter.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.simulation.gusts import GustField, GustSpec
+from bioflex_jsb.simulation.modal_wing import FlowState, ModalWing, TrimReference
+from bioflex_jsb.simulation.results import TimeHistory
+
+# A modal coordinate beyond this is outside the linear (small-twist) range of the model:
+# 0.26 rad = 15° of elastic twist where the mode's twist is largest.
+ETA_LIMIT_RAD = 0.26
+
+
+class Divergence(Exception):
+    """The run left the model's valid range; the message names cause, time and mode."""
+
+
+@dataclass(frozen=True)
+class RunSetup:
+    """What a gust run needs. dt_s None keeps JSBSim's step (1/120 s by default)."""
+
+    speed_m_s: float
+    gust: GustSpec
+    duration_s: float = 6.0
+    gust_start_s: float = 0.5
+    altitude_m: float = 0.0
+    dt_s: float | None = None
+
+
+_READ = {
+    "u": "velocities/u-fps",
+    "v": "velocities/v-fps",
+    "w": "velocities/w-fps",
+    "q": "velocities/q-rad_sec",
+    "theta": "attitude/theta-rad",
+    "phi": "attitude/phi-rad",
+    "rho": "atmosphere/rho-slugs_ft3",
+    "nz": "accelerations/Nz",
+    "h": "position/h-sl-ft",
+}
+
+
+def base_channels(n_modes: int) -> dict[str, str]:
+    """Channel names of a gust run and their units."""
+    units = {
+        "u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-", "w_g": "m/s",
+        "airspeed_m_s": "m/s", "altitude_m": "m",
+        "lift_n": "N", "drag_n": "N", "pitch_moment_n_m": "N*m",
+    }
+    for i in range(n_modes):
+        units[f"eta{i + 1}"] = "rad"
+        units[f"eta{i + 1}_dot"] = "rad/s"
+    return units
+
+
+def run_gust(
+    airframe: Airframe,
+    wing: ElasticWingModel,
+    model: str,
+    setup: RunSetup,
+    on_sample: Callable[[int, float, dict[str, float]], None] | None = None,
+) -> TimeHistory:
+    """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd).
+
+    ``on_sample(k, t_s, values)`` is called after every step (logging, progress). A run that
+    leaves the valid range stops: the returned history holds every step up to then and its
+    ``stopped`` field says why.
+    """
+    trim = airframe.trim(setup.speed_m_s, setup.altitude_m)
+    if setup.dt_s is not None:
+        airframe.set_dt(setup.dt_s)
+    dt = airframe.dt_s
+    cond = level_flight_condition(setup.speed_m_s)
+    nodes = {k: airframe.property_node(v) for k, v in _READ.items()}
+    wind_node = airframe.property_node("atmosphere/wind-down-fps")
+    # The reference dynamic pressure is JSBSim's own at trim (same density as the run).
+    rho0 = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
+    ref = TrimReference(trim.alpha_rad, 0.5 * rho0 * setup.speed_m_s**2, cond.cl_trim)
+    mw = ModalWing(wing, ref, model=model, dt_s=dt)
+    gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
+    n_steps = int(round(setup.duration_s / dt))
+    units = base_channels(wing.n_modes)
+    data = {name: np.full(n_steps, np.nan) for name in units}
+    time_s = np.arange(n_steps) * dt
+    theta0 = trim.theta_rad
+    alpha_min, alpha_max = airframe.alpha_limits_rad
+    stopped = None
+    k = 0
+    for k in range(n_steps):
+        t = k * dt
+        w_g = gust.vertical_m_s(t)
+        wind_down_fps = -w_g * U.FT_PER_M
+        wind_node.set_double_value(wind_down_fps)
+        u = nodes["u"].get_double_value()
+        v = nodes["v"].get_double_value()
+        w = nodes["w"].get_double_value()
+        theta = nodes["theta"].get_double_value()
+        phi = nodes["phi"].get_double_value()
+        # air-relative body velocity: subtract the NED wind seen in body axes
+        ua = u + wind_down_fps * math.sin(theta)
+        va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
+        wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
+        alpha = math.atan2(wa, ua)
+        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+        rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
+        q_rate = nodes["q"].get_double_value()
+        flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
+        loads = mw.loads(flow)
+        ca, sa = math.cos(alpha), math.sin(alpha)
+        airframe.set_external_reactions(
+            lift_n=loads.lift_n * ca + loads.drag_n * sa,
+            drag_n=loads.drag_n * ca - loads.lift_n * sa,
+            pitch_moment_n_m=loads.pitch_moment_n_m,
+        )
+        airframe.run(1)
+        row = {
+            "u": vt - setup.speed_m_s,
+            "alpha": alpha - trim.alpha_rad,
+            "q": q_rate,
+            "theta": theta - theta0,
+            "n_z": nodes["nz"].get_double_value(),
+            "w_g": w_g,
+            "airspeed_m_s": vt,
+            "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
+            "lift_n": loads.lift_n,
+            "drag_n": loads.drag_n,
+            "pitch_moment_n_m": loads.pitch_moment_n_m,
+        }
+        for i in range(wing.n_modes):
+            row[f"eta{i + 1}"] = float(mw.eta[i])
+            row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
+        for name, value in row.items():
+            data[name][k] = value
+        if on_sample is not None:
+            on_sample(k, t, row)
+        stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes)
+        if stopped:
+            break
+        mw.step(flow)
+    n = k + 1
+    run = TimeHistory(
+        model=model,
+        time_s=time_s[:n],
+        channels={name: arr[:n] for name, arr in data.items()},
+        units=units,
+        meta={
+            "source": "jsbsim-cosim",
+            "speed_m_s": setup.speed_m_s,
+            "dt_s": dt,
+            "gust": setup.gust.text(),
+            "gust_start_s": setup.gust_start_s,
+            "trim_alpha_rad": trim.alpha_rad,
+            "trim_theta_rad": trim.theta_rad,
+            "trim_elevator_rad": trim.elevator_rad,
+            "trim_throttle": trim.throttle,
+        },
+        stopped=stopped,
+    )
+    return run
+
+
+def _check_range(row, t, alpha, alpha_min, alpha_max, n_modes) -> str | None:
+    """Why the run must stop at this sample, or None."""
+    bad = [name for name, value in row.items() if not math.isfinite(value)]
+    if bad:
+        return f"the state became non-finite ({bad[0]}) at t = {t:.3f} s"
+    if not alpha_min <= alpha <= alpha_max:
+        return (
+            f"angle of attack {math.degrees(alpha):.1f} deg left the model's range "
+            f"({math.degrees(alpha_min):.0f}..{math.degrees(alpha_max):.0f} deg, stall) "
+            f"at t = {t:.3f} s"
+        )
+    etas = [abs(row[f"eta{i + 1}"]) for i in range(n_modes)]
+    if etas and max(etas) > ETA_LIMIT_RAD:
+        i = int(np.argmax(etas))
+        return (
+            f"mode aeroelastic_{i + 1} diverged: |eta{i + 1}| = {etas[i]:.2f} rad > "
+            f"{ETA_LIMIT_RAD} rad (beyond the linear range) at t = {t:.3f} s"
+        )
+    if row["altitude_m"] < 0.0:
+        return f"the aircraft reached the ground at t = {t:.3f} s"
+    return None

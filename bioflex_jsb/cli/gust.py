@@ -1,0 +1,174 @@
+"""``bioflex-jsb gust``: nonlinear 6-DoF gust runs of the JSBSim airframe with the modal wing."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from bioflex_jsb.cli.common import (
+    EXIT_DIVERGED,
+    UsageError,
+    add_wing_arguments,
+    models_list,
+    positive_float,
+    print_json,
+    wing_from_args,
+)
+
+HELP = """Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic wing
+as each of --models (rigid: wing loads off; coupled: dynamic modal states; qsd: quasi-static
+deformation) and summarise each run: peak perturbations of airspeed u [m/s], angle of attack
+alpha [deg], pitch rate q [deg/s], pitch angle theta [deg] and load factor n_z [-]; the
+overshoot of alpha past trim after its first peak [% of that peak]; and the settling time
+[s] until |alpha - trim| stays within 5 % of its peak. Gusts are vertical, positive up:
+sharp:AMPLITUDE_m_s, 1cos:AMPLITUDE_m_s:LENGTH_m, dryden:SIGMA_m_s:SCALE_m[:SEED],
+vonkarman:SIGMA_m_s:SCALE_m[:SEED]. With no arguments: the optimised wing at 15 m/s through
+a 3 m/s sharp-edged gust (the paper's Fig. 21 case), all three models."""
+
+
+def gust_type(text: str):
+    from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
+
+    try:
+        return parse_gust(text)
+    except GustSpecError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_run_arguments(p: argparse.ArgumentParser, default_gust: str) -> None:
+    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
+                   help="trim airspeed [m/s] (default 15, the paper's cruise)")
+    p.add_argument("--gust", type=gust_type, default=gust_type(default_gust),
+                   help=f"gust specification (default {default_gust}); see above")
+    p.add_argument("--duration", type=positive_float("duration", "s"), default=5.0,
+                   help="simulated time [s] (default 5)")
+    p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
+                   help="time the gust starts [s] (default 0.5)")
+    p.add_argument("--dt", type=positive_float("time step", "s"), default=None,
+                   help="JSBSim time step [s] (default: the aircraft's 1/120 s)")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("gust", help="nonlinear gust runs (rigid, coupled, QSD)", description=HELP)
+    add_wing_arguments(p, default="optimised")
+    add_run_arguments(p, "sharp:3")
+    p.add_argument("--models", type=models_list, default=("rigid", "coupled", "qsd"),
+                   help="comma-separated subset of rigid,coupled,qsd (default: all three)")
+    p.add_argument("--out", metavar="RUN.mcap", help="write every step of every run to RUN.mcap")
+    p.add_argument("--plot", metavar="FILE.png", default=None,
+                   help="time histories to FILE.png (default gust.png when run without --json)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(run=run)
+
+
+def progress_bar(total: int, label: str):
+    """A tqdm bar on a terminal, nothing otherwise (so pipes and CI stay clean)."""
+    if not sys.stderr.isatty():
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=label, unit="step", leave=False, file=sys.stderr)
+
+
+def fly(args, build, models, log=None):
+    """Run each model; return (runs, stop message or None)."""
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
+
+    setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
+    if args.gust_start >= args.duration:
+        raise UsageError(
+            f"--gust-start {args.gust_start:g} s must be before the end of the run "
+            f"(--duration {args.duration:g} s)"
+        )
+    runs = []
+    try:
+        airframe = Airframe()
+        for model in models:
+            steps = int(round(args.duration / (args.dt or airframe.dt_s)))
+            bar = progress_bar(steps, f"{build.variant.name} {model}")
+            on_sample = None
+            if bar is not None or log is not None:
+                def on_sample(k, t, row, bar=bar, model=model, steps=steps):
+                    if bar is not None and k % 50 == 0:
+                        bar.update(min(50, steps - bar.n))
+                    if log is not None:
+                        log.sample(model, t, row)
+            run = run_gust(airframe, build.model, model, setup, on_sample)
+            if bar is not None:
+                bar.close()
+            run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
+                            overrides=dict(build.model.coefficients.overrides))
+            runs.append(run)
+            if run.stopped:
+                return runs, f"{model} run stopped: {run.stopped}"
+    except FdmError as exc:
+        raise UsageError(str(exc)) from None
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return runs, None
+
+
+def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.simulation.results import gust_metrics
+
+    build = wing_from_args(args)
+    log = None
+    if args.out:
+        from bioflex_jsb.adapters.mcap_log import RunLog
+
+        log = RunLog.open(args.out, command="gust", args=args, build=build)
+    try:
+        runs, stop = fly(args, build, args.models, log)
+    finally:
+        if log is not None:
+            log.close()
+    summary = {r.model: gust_metrics(r, args.gust_start).as_dict() for r in runs}
+    plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
+    if plot:
+        from bioflex_jsb.adapters import plotting
+
+        try:
+            plotting.time_histories(
+                runs, plot,
+                f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}",
+            )
+        except OSError as exc:
+            raise UsageError(f"cannot write plot {plot!r}: {exc.strerror}") from None
+    if args.json:
+        print_json({
+            "wing": build.variant.name,
+            "speed_m_s": args.speed,
+            "gust": args.gust.text(),
+            "mass_basis": build.mass_basis,
+            "overrides": dict(build.model.coefficients.overrides),
+            "summary": summary,
+            "stopped": stop,
+            "plot": plot,
+            "out": args.out,
+        })
+    else:
+        print_summary(build, args, summary)
+        if plot:
+            print(f"time histories written to {plot}")
+        if args.out:
+            print(f"log written to {args.out}")
+    if stop:
+        print(f"bioflex-jsb gust: diverged: {stop}", file=sys.stderr)
+        return EXIT_DIVERGED
+    return 0
+
+
+def print_summary(build, args, summary) -> None:
+    deg = 180.0 / math.pi
+    print(f"wing {build.variant.name}, {args.speed:g} m/s, gust {args.gust.text()} "
+          f"(mass basis {build.mass_basis})")
+    head = (f"{'model':<8} {'Δu [m/s]':>9} {'Δα [deg]':>9} {'Δq [deg/s]':>11} {'Δθ [deg]':>9} "
+            f"{'Δn_z [-]':>9} {'overshoot':>10} {'settling [s]':>13}")
+    print(head)
+    for model, m in summary.items():
+        settle = "-" if m["settling_time_s"] is None else f"{m['settling_time_s']:.2f}"
+        print(f"{model:<8} {m['peak_du_m_s']:9.3f} {m['peak_dalpha_rad'] * deg:9.3f} "
+              f"{m['peak_dq_rad_s'] * deg:11.3f} {m['peak_dtheta_rad'] * deg:9.3f} "
+              f"{m['peak_dn_z']:9.3f} {100 * m['overshoot']:9.1f}% {settle:>13}")
