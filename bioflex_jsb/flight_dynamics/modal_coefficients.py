@@ -212,3 +212,28 @@ def modal_coefficients(
         c_eta_q=c_eta_q,
         c_etadot_q=c_etadot_q,
     )
+
+
+def offset_shift_for_c_eta11(modes, strips: SpanwiseGeometry, target: float,
+                             reference_area_m2: float = P.REFERENCE_AREA_M2,
+                             cbar_m: float = P.MEAN_AERODYNAMIC_CHORD_M) -> float:
+    """Uniform shift Δe [m] of the aerodynamic-centre offset e(y) that makes C_η1^Q1 = target.
+
+    C_η1^Q1 = (1/(S c̄)) ∫ θ_1 (e θ_1 − φ_1) C_lα c dy is linear in e, so
+    Δe = (target − C_η1^Q1) S c̄ / ∫ θ_1² C_lα c dy. This is how a published C_η1^Q1 is
+    pinned without breaking the other coefficients: every work term e θ_i − φ_i moves with
+    the same e, as the paper's "adjusted to" (Sections 4.1, 4.2) does by moving the axes.
+    """
+    y = strips.stations_m
+    theta1 = np.interp(y, modes.stations_m, modes.twist_rad[0])
+    weight = float((theta1**2 * strips.cl_alpha_c_m) @ (2.0 * strips.weights_m))
+    if weight <= 0.0:
+        raise ValueError("mode 1 has no twist: C_eta1^Q1 cannot be pinned through e")
+    current = modal_coefficients(modes, strips, reference_area_m2=reference_area_m2,
+                                 cbar_m=cbar_m).c_eta_q[0, 0]
+    return (target - current) * reference_area_m2 * cbar_m / weight
+
+
+def shifted(strips: SpanwiseGeometry, delta_e_m: float) -> SpanwiseGeometry:
+    """``strips`` with the aerodynamic-centre offset e(y) moved by ``delta_e_m`` [m]."""
+    return replace(strips, e_m=strips.e_m + delta_e_m)
