@@ -1,0 +1,135 @@
+"""Structural properties of the membrane half wing: estimates and calibrations.
+
+The paper gives the materials (Table A1), the axis positions (Table 8) and the frequencies and
+generalised masses of the first three modes (Table 2), but not the thicknesses, the ribs or
+any stiffness. This module holds what the beam model of :mod:`bioflex_jsb.structures.beam`
+needs, each value with its source:
+
+* ``Table …``: printed in the paper (through :mod:`bioflex_jsb.parameters.prototype`);
+* ``ESTIMATE``: not in the paper, chosen from how such a wing is built (reason given);
+* ``CALIBRATED to …``: chosen so that the beam reproduces the named Table 2 frequencies;
+  :func:`bioflex_jsb.structures.wing_model.calibrate_stiffness` recomputes them and
+  ``tests/test_structures.py`` checks that the numbers here are what it finds.
+
+Mode identification (``docs/structures.md``, "Which mode is which"): with ribs, mode 1 is the
+first torsion mode, mode 2 the second torsion mode and mode 3 the first bending mode; without
+ribs, modes 1–3 are the first three torsion modes and first bending lies above them. The
+torsional stiffness tapers strongly towards the tip (the bird-like wing is stiff at the "arm"
+and only membrane at the "hand"); the calibrated tip value is close to the open-section
+stiffness of the bare membrane, which is the physical floor.
+
+Units SI; frame and signs as in ``docs/conventions.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
+from bioflex_jsb.structures.sections import ChordwiseLayup, Layer, Material, Ribs
+
+# --------------------------------------------------------------------------------------
+# Materials (Table A1). Poisson's ratio is not in the paper.
+# --------------------------------------------------------------------------------------
+# ESTIMATE: ν = 0.3 for the cross-plied carbon membrane, which Appendix A says behaves
+# isotropically; it only enters the open-section torsion floor G·th³·c/3 (a reference value,
+# not used by the beam), through G = E / (2(1 + ν)).
+CARBON_POISSON_RATIO = 0.3
+# ESTIMATE: ν = 0.3 for the Kevlar fabric, the same isotropic assumption.
+KEVLAR_POISSON_RATIO = 0.3
+
+CARBON = Material(
+    "carbon-fibre composite",
+    density_kg_m3=P.CARBON_DENSITY_KG_M3,  # Table A1
+    youngs_modulus_pa=P.CARBON_YOUNGS_MODULUS_PA,  # Table A1
+    poisson_ratio=CARBON_POISSON_RATIO,
+)
+KEVLAR = Material(
+    "Kevlar",
+    density_kg_m3=P.KEVLAR_DENSITY_KG_M3,  # Table A1
+    youngs_modulus_pa=P.KEVLAR_YOUNGS_MODULUS_PA,  # Table A1
+    poisson_ratio=KEVLAR_POISSON_RATIO,
+)
+
+# --------------------------------------------------------------------------------------
+# Membrane and ribs
+# --------------------------------------------------------------------------------------
+# ESTIMATE: the original wing (Fig. 2(a), "average membrane thickness") is two cross-plied
+# carbon layers (Appendix A: adjacent layers perpendicular) of 0.1 mm, a common thin prepreg
+# ply; 0.2 mm also brackets the Kevlar sheet of Appendix A (0.15–0.2 mm).
+MEMBRANE_THICKNESS_M = 0.2e-3
+ORIGINAL_LAYUP = ChordwiseLayup((Layer(CARBON, MEMBRANE_THICKNESS_M, 0.0, 1.0),))
+
+# ESTIMATE: carbon ribs of 2 mm × 2 mm section spanning the chord, ten per half wing
+# (pitch 0.085 m = semispan / 10); the count and section are read as plausible for Fig. 2(b),
+# which the copy of the paper does not show in detail. They add 23 % to the membrane mass.
+RIB_CROSS_SECTION_M2 = 2e-3 * 2e-3
+RIB_PITCH_M = DEFAULT_PLANFORM.semispan_m / 10.0
+RIBS = Ribs(CARBON, cross_section_m2=RIB_CROSS_SECTION_M2, pitch_m=RIB_PITCH_M)
+
+
+@dataclass(frozen=True)
+class WingStructure:
+    """Everything the beam needs to build one half wing.
+
+    semispan_m, chord_m [m]; layup and ribs (``None``: no ribs); torsional stiffness GJ at the
+    root [N·m²] and tip/root ratio [-] (linear taper); uniform bending stiffness EI [N·m²];
+    ``calibrated_to`` names the Table 2 values the stiffnesses reproduce.
+    """
+
+    name: str
+    semispan_m: float
+    chord_m: float
+    layup: ChordwiseLayup
+    ribs: Ribs | None
+    torsional_stiffness_root_n_m2: float
+    torsional_stiffness_tip_ratio: float
+    bending_stiffness_n_m2: float
+    calibrated_to: str
+
+
+# CALIBRATED to Table 2 "with ribs", mode 3 = first bending, 107.2 Hz (x_I = x_E: bending is
+# uncoupled, so EI alone sets it). Chordwise ribs add no spanwise bending stiffness, so the
+# same EI serves the wing without ribs (whose first bending then lies above its 3rd mode).
+# Note: EI/m' ≈ 1.9e4 m²/s² means a mass radius of gyration of ≈ 18 mm for carbon
+# (E/ρ = 5.6e7 m²/s²), several times what a thin 0.183 m aerofoil allows: the Table 2
+# frequencies are not those of a 0.85 m constant-chord membrane cantilever in bending
+# (docs/structures.md, "Plausibility").
+BENDING_STIFFNESS_N_M2 = 1386.0
+
+# CALIBRATED to Table 2 "with ribs": 30.9 Hz (mode 1, first torsion) sets the root value,
+# 71.9/30.9 (mode 2, second torsion) sets the taper. Tip value 0.024 N·m² ≈ 1.4 × the bare
+# membrane's open-section GJ (0.0169 N·m², ORIGINAL_LAYUP).
+RIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2 = 3.764
+RIBBED_TORSIONAL_STIFFNESS_TIP_RATIO = 0.006390
+
+# CALIBRATED to Table 2 "without ribs": 20.8 Hz (mode 1) and 49.6/20.8 (mode 2). Mode 3,
+# 79.6 Hz, is NOT used: the beam predicts it (third torsion mode). Tip value 0.032 N·m² ≈
+# 1.9 × the bare membrane's open-section GJ.
+UNRIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2 = 1.347
+UNRIBBED_TORSIONAL_STIFFNESS_TIP_RATIO = 0.02402
+
+RIBBED_WING = WingStructure(
+    name="original wing with ribs (Fig. 2(a) membrane + ribs, x_I = x_E = 0.5)",
+    semispan_m=DEFAULT_PLANFORM.semispan_m,  # Table 1 (b/2)
+    chord_m=DEFAULT_PLANFORM.chord_m,  # Table 1 c̄, constant chord (parameters.wing)
+    layup=ORIGINAL_LAYUP,
+    ribs=RIBS,
+    torsional_stiffness_root_n_m2=RIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2,
+    torsional_stiffness_tip_ratio=RIBBED_TORSIONAL_STIFFNESS_TIP_RATIO,
+    bending_stiffness_n_m2=BENDING_STIFFNESS_N_M2,
+    calibrated_to="Table 2 with ribs: 30.9, 71.9, 107.2 Hz",
+)
+
+UNRIBBED_WING = WingStructure(
+    name="original wing without ribs (Fig. 2(a) membrane, x_I = x_E = 0.5)",
+    semispan_m=DEFAULT_PLANFORM.semispan_m,  # Table 1 (b/2)
+    chord_m=DEFAULT_PLANFORM.chord_m,  # Table 1 c̄
+    layup=ORIGINAL_LAYUP,
+    ribs=None,
+    torsional_stiffness_root_n_m2=UNRIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2,
+    torsional_stiffness_tip_ratio=UNRIBBED_TORSIONAL_STIFFNESS_TIP_RATIO,
+    bending_stiffness_n_m2=BENDING_STIFFNESS_N_M2,
+    calibrated_to="Table 2 without ribs: 20.8, 49.6 Hz (79.6 Hz predicted)",
+)

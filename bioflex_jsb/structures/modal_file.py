@@ -1,0 +1,366 @@
+"""Modal-data files: bring your own finite-element modes (TOML, read with :mod:`tomllib`).
+
+This is the only module of :mod:`bioflex_jsb.structures` that touches files. The format is
+documented in ``docs/structures.md`` ("Modal-data files"); an example is shipped as
+``bioflex_jsb/data/modes/example_ribbed.toml``. In short::
+
+    format = "bioflex-jsb-modes"        # required, identifies the file
+    format_version = 1                  # required
+    source = "my FE model, run 12"      # optional text
+    notes = "..."                       # optional text
+
+    [units]                             # required, every key required
+    length = "mm"                       # "m" | "mm": stations and bending
+    angle = "deg"                       # "rad" | "deg": twist
+    frequency = "Hz"                    # "Hz" | "rad/s"
+    generalised_mass = "kg*m^2"         # "kg*m^2" only
+
+    [stations]
+    y = [0.0, 85.0, ..., 850.0]         # starboard half, root (0) to tip, increasing
+
+    [axes]                              # optional; scalar or one value per station
+    x_elastic_frac = 0.5                # chord fraction aft of the leading edge (Eq. 12)
+    x_inertial_frac = 0.5               # (Eq. 11); both default to 0.5 (Table 8, original)
+
+    [[mode]]                            # one table per mode, lowest frequency first
+    frequency = 30.9
+    damping_ratio = 0.0                 # optional, default 0 (Section 3.1)
+    generalised_mass = 4.87e-5          # half wing, for the shapes as given [kg·m²]
+    bending = [...]                     # elastic-axis displacement per unit η, + DOWN
+    twist = [...]                       # section twist per unit η, + LEADING EDGE UP
+
+Shapes may be in any scaling: the reader rescales every mode to the project normalisation
+(max |twist| = 1 rad/rad, tip twist positive; see :mod:`.modal_data`) and scales the
+generalised mass with it (``normalise=False`` keeps the file's scaling).
+
+Every problem raises :class:`ModalFileError` with a one-line message that names the file, the
+key (e.g. ``mode[2].twist``) and, where it can be found, the line number.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
+
+FORMAT_NAME = "bioflex-jsb-modes"
+FORMAT_VERSION = 1
+
+# Unit name -> factor to SI (m, rad, rad/s, kg·m²).
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
+FREQUENCY_UNITS = {"Hz": 2.0 * math.pi, "rad/s": 1.0}
+GENERALISED_MASS_UNITS = {"kg*m^2": 1.0}
+_UNIT_TABLES = {
+    "length": LENGTH_UNITS,
+    "angle": ANGLE_UNITS,
+    "frequency": FREQUENCY_UNITS,
+    "generalised_mass": GENERALISED_MASS_UNITS,
+}
+
+# Default axis position when [axes] is absent: Table 8, original wing (x_I = x_E = 0.5).
+DEFAULT_AXIS_FRAC = 0.5
+
+_TOP_KEYS = {"format", "format_version", "source", "notes", "units", "stations", "axes", "mode"}
+_MODE_KEYS = {"frequency", "damping_ratio", "generalised_mass", "bending", "twist"}
+
+
+class ModalFileError(ValueError):
+    """A modal-data file that cannot be used; one-line message naming key and line."""
+
+
+class _Locator:
+    """Finds the line of a key in the TOML text (for messages about parsed values)."""
+
+    _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+
+    def __init__(self, text: str) -> None:
+        self.lines = text.splitlines()
+
+    def line_of(self, table: str | None, key: str | None = None, index: int = 0) -> int | None:
+        """1-based line of ``key`` in ``table`` (``index``-th ``[[table]]``); None if absent."""
+        current: str | None = None
+        count = -1
+        key_re = re.compile(rf"^\s*{re.escape(key)}\s*=") if key else None
+        for number, line in enumerate(self.lines, start=1):
+            match = self._HEADER.match(line)
+            if match:
+                current = match.group(2)
+                if current == table:
+                    count += 1
+                    if key is None and (match.group(1) == "[" or count == index):
+                        return number
+                continue
+            in_table = (table is None and current is None) or (
+                current == table and (count == index)
+            )
+            if key_re is not None and in_table and key_re.match(line):
+                return number
+        return None
+
+
+class _Reader:
+    def __init__(self, text: str, name: str) -> None:
+        self.name = name
+        self.loc = _Locator(text)
+
+    def fail(self, what: str, message: str, table=None, key=None, index: int = 0):
+        line = self.loc.line_of(table, key, index) if (table or key) else None
+        if line is None and table is None and key:  # an unknown top-level [table]
+            line = self.loc.line_of(key)
+        where = f" (line {line})" if line is not None else ""
+        text = f"{self.name}: {what}: {message}{where}".replace("\n", " ")
+        raise ModalFileError(text)
+
+    # --------------------------------------------------------------------------------------
+    def number(self, value, what, table, key, index=0) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(what, f"expected a number, got {type(value).__name__}", table, key, index)
+        x = float(value)
+        if not math.isfinite(x):
+            self.fail(what, f"non-finite value {x}", table, key, index)
+        return x
+
+    def array(self, value, what, table, key, index=0, length=None) -> np.ndarray:
+        if not isinstance(value, list):
+            self.fail(what, f"expected an array of numbers, got {type(value).__name__}",
+                      table, key, index)
+        out = np.empty(len(value))
+        for j, item in enumerate(value):
+            if isinstance(item, bool) or not isinstance(item, (int, float)):
+                self.fail(what, f"element {j} is not a number ({item!r})", table, key, index)
+            if not math.isfinite(float(item)):
+                self.fail(what, f"element {j} is non-finite ({float(item)})", table, key, index)
+            out[j] = float(item)
+        if length is not None and out.size != length:
+            self.fail(what, f"expected {length} values (one per station), got {out.size}",
+                      table, key, index)
+        return out
+
+    def axis(self, value, what, key, k) -> np.ndarray:
+        if isinstance(value, list):
+            arr = self.array(value, what, "axes", key, length=k)
+        else:
+            arr = np.full(k, self.number(value, what, "axes", key))
+        if np.any((arr < 0.0) | (arr > 1.0)):
+            self.fail(what, "chord fractions must lie in [0, 1]", "axes", key)
+        return arr
+
+    # --------------------------------------------------------------------------------------
+    def parse(self, data: dict, normalise: bool) -> ModalData:
+        unknown = sorted(set(data) - _TOP_KEYS)
+        if unknown:
+            self.fail(unknown[0], f"unknown key (accepted: {', '.join(sorted(_TOP_KEYS))})",
+                      None, unknown[0])
+        if data.get("format") != FORMAT_NAME:
+            self.fail("format", f"missing or not {FORMAT_NAME!r}", None, "format")
+        if data.get("format_version") != FORMAT_VERSION:
+            self.fail("format_version", f"missing or not {FORMAT_VERSION}", None,
+                      "format_version")
+        for key in ("source", "notes"):
+            if key in data and not isinstance(data[key], str):
+                self.fail(key, "expected a string", None, key)
+
+        units = data.get("units")
+        if not isinstance(units, dict):
+            self.fail("units", "missing [units] table (length, angle, frequency, "
+                      "generalised_mass)")
+        for key in sorted(set(units) - set(_UNIT_TABLES)):
+            self.fail(f"units.{key}", "unknown key", "units", key)
+        factor = {}
+        for key, table in _UNIT_TABLES.items():
+            if key not in units:
+                self.fail(f"units.{key}", "missing", "units")
+            if units[key] not in table:
+                self.fail(f"units.{key}",
+                          f"unknown unit {units[key]!r} (accepted: {', '.join(table)})",
+                          "units", key)
+            factor[key] = table[units[key]]
+
+        stations = data.get("stations")
+        if not isinstance(stations, dict) or "y" not in stations:
+            self.fail("stations.y", "missing [stations] table with y = [...]")
+        for key in sorted(set(stations) - {"y"}):
+            self.fail(f"stations.{key}", "unknown key", "stations", key)
+        y = self.array(stations["y"], "stations.y", "stations", "y") * factor["length"]
+        if y.size < 2:
+            self.fail("stations.y", "need at least two stations", "stations", "y")
+        if np.any(np.diff(y) <= 0.0):
+            j = int(np.argmax(np.diff(y) <= 0.0)) + 1
+            self.fail("stations.y", f"not strictly increasing at element {j}", "stations", "y")
+        if y[0] < 0.0:
+            self.fail("stations.y", "stations are on the starboard half (y ≥ 0)",
+                      "stations", "y")
+        k = y.size
+
+        axes = data.get("axes", {})
+        if not isinstance(axes, dict):
+            self.fail("axes", "expected a table")
+        for key in sorted(set(axes) - {"x_elastic_frac", "x_inertial_frac"}):
+            self.fail(f"axes.{key}", "unknown key", "axes", key)
+        x_e = self.axis(axes.get("x_elastic_frac", DEFAULT_AXIS_FRAC), "axes.x_elastic_frac",
+                        "x_elastic_frac", k)
+        x_i = self.axis(axes.get("x_inertial_frac", DEFAULT_AXIS_FRAC),
+                        "axes.x_inertial_frac", "x_inertial_frac", k)
+
+        modes = data.get("mode")
+        if not isinstance(modes, list) or not modes:
+            self.fail("mode", "no [[mode]] table: at least one mode is needed")
+        freq, damp, mass, bend, twist = [], [], [], [], []
+        for i, mode in enumerate(modes):
+            tag = f"mode[{i + 1}]"
+            if not isinstance(mode, dict):
+                self.fail(tag, "expected a [[mode]] table")
+            for key in sorted(set(mode) - _MODE_KEYS):
+                accepted = ", ".join(sorted(_MODE_KEYS))
+                self.fail(f"{tag}.{key}", f"unknown key (accepted: {accepted})",
+                          "mode", key, i)
+            for key in ("frequency", "generalised_mass", "bending", "twist"):
+                if key not in mode:
+                    self.fail(f"{tag}.{key}", "missing", "mode", None, i)
+            f = self.number(mode["frequency"], f"{tag}.frequency", "mode", "frequency", i)
+            if f <= 0.0:
+                self.fail(f"{tag}.frequency", "must be positive", "mode", "frequency", i)
+            z = self.number(mode.get("damping_ratio", 0.0), f"{tag}.damping_ratio", "mode",
+                            "damping_ratio", i)
+            if z < 0.0:
+                self.fail(f"{tag}.damping_ratio", "must be ≥ 0", "mode", "damping_ratio", i)
+            m = self.number(mode["generalised_mass"], f"{tag}.generalised_mass", "mode",
+                            "generalised_mass", i)
+            if m <= 0.0:
+                self.fail(f"{tag}.generalised_mass", "must be positive", "mode",
+                          "generalised_mass", i)
+            b = self.array(mode["bending"], f"{tag}.bending", "mode", "bending", i, k)
+            t = self.array(mode["twist"], f"{tag}.twist", "mode", "twist", i, k)
+            if not np.any(b) and not np.any(t):
+                self.fail(f"{tag}.twist", "bending and twist are both all zero", "mode",
+                          "twist", i)
+            freq.append(f * factor["frequency"])
+            damp.append(z)
+            mass.append(m * factor["generalised_mass"])
+            bend.append(b * factor["length"])
+            twist.append(t * factor["angle"])
+        if np.any(np.diff(freq) < 0.0):
+            j = int(np.argmax(np.diff(freq) < 0.0)) + 1
+            self.fail(f"mode[{j + 1}].frequency",
+                      "modes must be listed by increasing frequency", "mode", "frequency", j)
+        try:
+            modal = ModalData(
+                frequencies_rad_s=np.array(freq),
+                damping_ratios=np.array(damp),
+                generalised_masses_kg_m2=np.array(mass),
+                stations_m=y,
+                bending_m=np.array(bend),
+                twist_rad=np.array(twist),
+                x_elastic_frac=x_e,
+                x_inertial_frac=x_i,
+                source=str(data.get("source", self.name)),
+                notes=str(data.get("notes", "")),
+            )
+            return modal.normalised() if normalise else modal
+        except ModalDataError as exc:  # should be caught above; keep the one-line promise
+            self.fail("data", str(exc))
+
+
+def parse_modal_text(text: str, *, name: str = "<modal text>", normalise: bool = True) -> ModalData:
+    """Parse modal-file ``text``; ``name`` is used in error messages."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModalFileError(f"{name}: TOML syntax error: {exc}".replace("\n", " ")) from None
+    return _Reader(text, name).parse(data, normalise)
+
+
+def read_modal_file(path: str | Path, *, normalise: bool = True) -> ModalData:
+    """Read a modal-data file into SI :class:`ModalData` (normalised unless told not to)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModalFileError(f"{p}: cannot read: {exc}".replace("\n", " ")) from None
+    return parse_modal_text(text, name=str(p), normalise=normalise)
+
+
+# ------------------------------------------------------------------------------------------
+# Writer
+# ------------------------------------------------------------------------------------------
+def _fmt(x: float) -> str:
+    # repr gives the shortest string that round-trips exactly; TOML accepts it as a float.
+    s = repr(float(x))
+    return s if any(c in s for c in ".en") else s + ".0"
+
+
+def _fmt_array(values, per_line: int = 6) -> str:
+    items = [_fmt(v) for v in values]
+    if len(items) <= per_line:
+        return "[" + ", ".join(items) + "]"
+    rows = [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+    return "[\n    " + ",\n    ".join(rows) + ",\n]"
+
+
+def _fmt_axis(values) -> str:
+    """A scalar when the axis position is the same at every station, else an array."""
+    values = np.asarray(values, dtype=float)
+    return _fmt(values[0]) if np.all(values == values[0]) else _fmt_array(values)
+
+
+def _toml_string(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def format_modal_text(
+    modes: ModalData,
+    *,
+    length: str = "m",
+    angle: str = "rad",
+    frequency: str = "Hz",
+    header: str = "",
+) -> str:
+    """The TOML text of ``modes`` in the given units (see the module docstring)."""
+    for key, unit in (("length", length), ("angle", angle), ("frequency", frequency)):
+        if unit not in _UNIT_TABLES[key]:
+            raise ModalFileError(f"writer: units.{key}: unknown unit {unit!r}")
+    lf, af, ff = LENGTH_UNITS[length], ANGLE_UNITS[angle], FREQUENCY_UNITS[frequency]
+    out = []
+    if header:
+        out += ["# " + line for line in header.splitlines()]
+    out += [
+        f"format = {_toml_string(FORMAT_NAME)}",
+        f"format_version = {FORMAT_VERSION}",
+        f"source = {_toml_string(modes.source)}",
+        f"notes = {_toml_string(modes.notes)}",
+        "",
+        "[units]",
+        f"length = {_toml_string(length)}",
+        f"angle = {_toml_string(angle)}",
+        f"frequency = {_toml_string(frequency)}",
+        'generalised_mass = "kg*m^2"',
+        "",
+        "[stations]",
+        f"y = {_fmt_array(modes.stations_m / lf)}",
+        "",
+        "[axes]",
+        f"x_elastic_frac = {_fmt_axis(modes.x_elastic_frac)}",
+        f"x_inertial_frac = {_fmt_axis(modes.x_inertial_frac)}",
+    ]
+    for i in range(modes.n_modes):
+        out += [
+            "",
+            "[[mode]]",
+            f"frequency = {_fmt(modes.frequencies_rad_s[i] / ff)}",
+            f"damping_ratio = {_fmt(modes.damping_ratios[i])}",
+            f"generalised_mass = {_fmt(modes.generalised_masses_kg_m2[i])}",
+            f"bending = {_fmt_array(modes.bending_m[i] / lf)}",
+            f"twist = {_fmt_array(modes.twist_rad[i] / af)}",
+        ]
+    return "\n".join(out) + "\n"
+
+
+def write_modal_file(path: str | Path, modes: ModalData, **units_and_header) -> None:
+    """Write ``modes`` to ``path`` (keywords as :func:`format_modal_text`)."""
+    Path(path).write_text(format_modal_text(modes, **units_and_header), encoding="utf-8")

@@ -1,0 +1,244 @@
+"""The prototype's half wing as a beam: modes, calibration and the Table 2 comparison.
+
+Pure numerics (no I/O). :func:`wing_modes` is what the rest of bioflex-jsb calls to get the
+default modal data; :func:`calibrate_stiffness` is how the stiffnesses of
+:mod:`bioflex_jsb.parameters.wing_structure` were obtained; :func:`table2_comparison` puts
+the beam's frequencies and generalised masses beside Table 2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq
+
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING, WingStructure
+from bioflex_jsb.structures.beam import (
+    DEFAULT_N_ELEMENTS,
+    BeamSections,
+    beam_modes,
+    solve_beam,
+    wing_from_membrane,
+)
+from bioflex_jsb.structures.modal_data import ModalData
+
+# A mode is "twist-dominated" when more than half of its strain energy is torsional.
+TWIST_DOMINATED_ENERGY_FRACTION = 0.5  # definition (docs/structures.md)
+
+
+def wing_sections(
+    structure: WingStructure = RIBBED_WING,
+    *,
+    x_inertial_frac: float | None = None,
+    x_elastic_frac: float | None = None,
+    n_stations: int = 41,
+) -> BeamSections:
+    """Beam sections of ``structure``; axis overrides as in :func:`wing_from_membrane`."""
+    return wing_from_membrane(
+        semispan_m=structure.semispan_m,
+        chord_m=structure.chord_m,
+        layup=structure.layup,
+        ribs=structure.ribs,
+        torsional_stiffness_root_n_m2=structure.torsional_stiffness_root_n_m2,
+        torsional_stiffness_tip_ratio=structure.torsional_stiffness_tip_ratio,
+        bending_stiffness_n_m2=structure.bending_stiffness_n_m2,
+        x_inertial_frac=x_inertial_frac,
+        x_elastic_frac=x_elastic_frac,
+        n_stations=n_stations,
+        description=structure.name,
+    )
+
+
+def wing_modes(
+    structure: WingStructure = RIBBED_WING,
+    n_modes: int = 3,
+    *,
+    x_inertial_frac: float | None = None,
+    x_elastic_frac: float | None = None,
+    n_elements: int = DEFAULT_N_ELEMENTS,
+    damping_ratio: float = P.STRUCTURAL_DAMPING_RATIO,
+) -> ModalData:
+    """Normalised modes of the half wing (default: the ribbed original wing, 3 modes)."""
+    sections = wing_sections(
+        structure, x_inertial_frac=x_inertial_frac, x_elastic_frac=x_elastic_frac
+    )
+    return beam_modes(
+        sections,
+        n_modes,
+        n_elements=n_elements,
+        damping_ratio=damping_ratio,
+        notes=f"calibrated to {structure.calibrated_to}",
+    )
+
+
+# ------------------------------------------------------------------------------------------
+# Calibration
+# ------------------------------------------------------------------------------------------
+def _split_modes(structure: WingStructure, n_modes: int, n_elements: int):
+    """Frequencies [Hz] of the torsion-dominated and bending-dominated modes (sorted)."""
+    sol = solve_beam(wing_sections(structure), n_modes, n_elements)
+    f = sol.frequencies_rad_s / (2.0 * np.pi)
+    tors = sol.torsion_energy_fraction > TWIST_DOMINATED_ENERGY_FRACTION
+    return f[tors], f[~tors]
+
+
+@dataclass(frozen=True)
+class StiffnessCalibration:
+    """Result of :func:`calibrate_stiffness` (values to copy into ``wing_structure``)."""
+
+    torsional_stiffness_root_n_m2: float
+    torsional_stiffness_tip_ratio: float
+    bending_stiffness_n_m2: float
+
+
+def calibrate_stiffness(
+    structure: WingStructure,
+    torsion_targets_hz: tuple[float, float],
+    bending_target_hz: float | None = None,
+    *,
+    n_elements: int = DEFAULT_N_ELEMENTS,
+) -> StiffnessCalibration:
+    """Stiffnesses that put the first two torsion modes (and the first bending mode) on target.
+
+    Requires x_I = x_E (the layup's own axes), so that bending and torsion are uncoupled:
+
+    * the taper ratio GJ_tip/GJ_root alone sets f_T2/f_T1 (root value scales both): solved
+      with Brent's method on [1e-4, 1];
+    * then f ∝ √GJ_root gives the root value in one step;
+    * f_B1 ∝ √EI gives EI in one step (kept from ``structure`` when no bending target).
+    """
+    f1, f2 = torsion_targets_hz
+
+    def with_gj(root: float, ratio: float) -> WingStructure:
+        return replace(structure, torsional_stiffness_root_n_m2=root,
+                       torsional_stiffness_tip_ratio=ratio)
+
+    # Pure bending must stay out of the way of the first two torsion modes while solving.
+    stiff = replace(structure, bending_stiffness_n_m2=1e9)  # ESTIMATE: puts bending > 1e4 Hz
+
+    def ratio_error(ratio: float) -> float:
+        ft, _ = _split_modes(replace(stiff, torsional_stiffness_tip_ratio=ratio), 2, n_elements)
+        return ft[1] / ft[0] - f2 / f1
+
+    ratio = brentq(ratio_error, 1e-4, 1.0, xtol=1e-10, rtol=1e-10)
+    ft, _ = _split_modes(replace(stiff, torsional_stiffness_tip_ratio=ratio), 2, n_elements)
+    root = stiff.torsional_stiffness_root_n_m2 * (f1 / ft[0]) ** 2
+    ei = structure.bending_stiffness_n_m2
+    if bending_target_hz is not None:
+        probe = with_gj(root, ratio)
+        for _ in range(2):  # exact in one step for uniform EI; the second pass checks it
+            _, fb = _split_modes(replace(probe, bending_stiffness_n_m2=ei), 6, n_elements)
+            ei *= (bending_target_hz / fb[0]) ** 2
+    return StiffnessCalibration(root, ratio, ei)
+
+
+def calibrate_default_wings(n_elements: int = DEFAULT_N_ELEMENTS):
+    """Recompute the calibrated numbers of ``wing_structure`` (ribbed, then unribbed)."""
+    f_r = P.MODE_FREQUENCIES_RIBS_HZ
+    f_n = P.MODE_FREQUENCIES_NO_RIBS_HZ
+    ribbed = calibrate_stiffness(RIBBED_WING, (f_r[0], f_r[1]), f_r[2], n_elements=n_elements)
+    unribbed_structure = replace(UNRIBBED_WING,
+                                 bending_stiffness_n_m2=ribbed.bending_stiffness_n_m2)
+    unribbed = calibrate_stiffness(unribbed_structure, (f_n[0], f_n[1]), None,
+                                   n_elements=n_elements)
+    return ribbed, unribbed
+
+
+# ------------------------------------------------------------------------------------------
+# Table 2 comparison
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Table2Row:
+    """One mode: model vs Table 2 (frequencies [Hz], generalised masses [kg·m²])."""
+
+    mode: int
+    kind: str
+    model_frequency_hz: float
+    paper_frequency_hz: float
+    model_generalised_mass_kg_m2: float
+    paper_generalised_mass_kg_m2: float
+    torsion_energy_fraction: float
+    twist_free: bool
+
+    @property
+    def frequency_error(self) -> float:
+        """Relative frequency error (model − paper)/paper [-]."""
+        return self.model_frequency_hz / self.paper_frequency_hz - 1.0
+
+
+def table2_comparison(ribs: bool = True, n_elements: int = DEFAULT_N_ELEMENTS) -> list[Table2Row]:
+    """Rows for the three modes of Table 2 (``ribs`` selects the column)."""
+    structure = RIBBED_WING if ribs else UNRIBBED_WING
+    paper_f = P.MODE_FREQUENCIES_RIBS_HZ if ribs else P.MODE_FREQUENCIES_NO_RIBS_HZ
+    paper_m = P.GENERALISED_MASSES_RIBS_KG_M2 if ribs else P.GENERALISED_MASSES_NO_RIBS_KG_M2
+    sol = solve_beam(wing_sections(structure), 3, n_elements)
+    modes = wing_modes(structure, 3, n_elements=n_elements)
+    free = modes.twist_free()
+    rows = []
+    n_t = n_b = 0
+    for i in range(3):
+        frac = float(sol.torsion_energy_fraction[i])
+        if frac > TWIST_DOMINATED_ENERGY_FRACTION:
+            n_t += 1
+            kind = f"torsion {n_t}"
+        else:
+            n_b += 1
+            kind = f"bending {n_b}"
+        rows.append(Table2Row(i + 1, kind, float(modes.frequencies_hz[i]), paper_f[i],
+                              float(modes.generalised_masses_kg_m2[i]), paper_m[i], frac,
+                              bool(free[i])))
+    return rows
+
+
+def table2_report(n_elements: int = DEFAULT_N_ELEMENTS) -> str:
+    """Plain-text table of :func:`table2_comparison` for both columns (for docs and reports)."""
+    lines = ["column     mode kind        f model  f Table2  error    m_i model  m_i Table2"]
+    for ribs in (True, False):
+        for r in table2_comparison(ribs, n_elements):
+            note = " (no twist: scaled on tip deflection)" if r.twist_free else ""
+            lines.append(
+                f"{'ribs' if ribs else 'no ribs':10s} {r.mode:4d} {r.kind:11s} "
+                f"{r.model_frequency_hz:8.2f} {r.paper_frequency_hz:8.1f} "
+                f"{100 * r.frequency_error:+6.2f}%  {r.model_generalised_mass_kg_m2:9.3e} "
+                f"{r.paper_generalised_mass_kg_m2:9.3e}{note}"
+            )
+    return "\n".join(lines)
+
+
+def tip_bending_twist_ratio_m(modes: ModalData, mode: int = 0) -> float:
+    """φ(tip)/θ(tip) of one mode [m/rad]: positive = elastic axis down when the LE twists up."""
+    return float(modes.bending_m[mode, -1] / modes.twist_rad[mode, -1])
+
+
+EXAMPLE_FILE_HEADER = """Example modal-data file (docs/structures.md, "Modal-data files")
+The three modes of the default ribbed half wing (beam model, bioflex_jsb.structures.wing_model),
+at 11 stations, lengths in mm to show the unit conversion. Starboard half wing, root clamped.
+bending: elastic-axis displacement per unit modal coordinate, positive DOWN.
+twist: section twist per unit modal coordinate, positive LEADING EDGE UP.
+generalised_mass: half wing, for the shapes as written [kg*m^2].
+Mode 3 is pure bending (x_I = x_E): its twist is zero, it is scaled on tip deflection/semispan.
+Regenerate: python -c "from bioflex_jsb.structures.wing_model import write_example_file as w; w()"
+"""
+
+
+def example_modes(n_stations: int = 11) -> ModalData:
+    """The modes shipped in ``bioflex_jsb/data/modes/example_ribbed.toml`` (ribbed wing)."""
+    sections = wing_sections(RIBBED_WING)
+    return beam_modes(
+        sections,
+        3,
+        stations_m=np.linspace(0.0, RIBBED_WING.semispan_m, n_stations),
+        notes=f"calibrated to {RIBBED_WING.calibrated_to}",
+    )
+
+
+def write_example_file(path=None) -> None:
+    """Regenerate the shipped example file (the one function here that writes a file)."""
+    from pathlib import Path
+
+    from bioflex_jsb.structures.modal_file import write_modal_file
+
+    target = Path(path) if path else Path(__file__).parents[1] / "data/modes/example_ribbed.toml"
+    write_modal_file(target, example_modes(), length="mm", header=EXAMPLE_FILE_HEADER)
