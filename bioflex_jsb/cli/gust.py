@@ -124,7 +124,10 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if log is not None:
             log.close()
-    summary = {r.model: gust_metrics(r, args.gust_start).as_dict() for r in runs}
+    summary = {}
+    for r in runs:
+        summary[r.model] = gust_metrics(r, args.gust_start).as_dict()
+        summary[r.model]["time_beyond_stall_s"] = r.meta["time_beyond_stall_s"]
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     if plot:
         from bioflex_jsb.adapters import plotting
@@ -172,3 +175,8 @@ def print_summary(build, args, summary) -> None:
         print(f"{model:<8} {m['peak_du_m_s']:9.3f} {m['peak_dalpha_rad'] * deg:9.3f} "
               f"{m['peak_dq_rad_s'] * deg:11.3f} {m['peak_dtheta_rad'] * deg:9.3f} "
               f"{m['peak_dn_z']:9.3f} {100 * m['overshoot']:9.1f}% {settle:>13}")
+    for model, m in summary.items():
+        if m["time_beyond_stall_s"] > 0.0:
+            print(f"note: {model}: angle of attack beyond the lift peak for "
+                  f"{m['time_beyond_stall_s']:.2f} s (post-stall aerodynamics of the airframe; "
+                  "the modal derivatives are linear and only indicative there)")
