@@ -72,7 +72,7 @@ def progress_bar(total: int, label: str):
 
 
 def fly(args, build, models, log=None):
-    """Run each model; return (runs, stop message or None)."""
+    """Run each model (all of them, also after one stops); return (runs, stop messages)."""
     from bioflex_jsb.adapters.cosim import RunSetup, run_gust
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
 
@@ -82,7 +82,7 @@ def fly(args, build, models, log=None):
             f"--gust-start {args.gust_start:g} s must be before the end of the run "
             f"(--duration {args.duration:g} s)"
         )
-    runs = []
+    runs, stops = [], []
     try:
         airframe = Airframe()
         for model in models:
@@ -102,12 +102,12 @@ def fly(args, build, models, log=None):
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)
             if run.stopped:
-                return runs, f"{model} run stopped: {run.stopped}"
+                stops.append(f"{model} run stopped: {run.stopped}")
     except FdmError as exc:
         raise UsageError(str(exc)) from None
     except ValueError as exc:
         raise UsageError(str(exc)) from None
-    return runs, None
+    return runs, stops
 
 
 def run(args: argparse.Namespace) -> int:
@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
 
         log = RunLog.open(args.out, command="gust", args=args, build=build)
     try:
-        runs, stop = fly(args, build, args.models, log)
+        runs, stops = fly(args, build, args.models, log)
     finally:
         if log is not None:
             log.close()
@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
             "mass_basis": build.mass_basis,
             "overrides": dict(build.model.coefficients.overrides),
             "summary": summary,
-            "stopped": stop,
+            "stopped": stops,
             "plot": plot,
             "out": args.out,
         })
@@ -157,8 +157,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"time histories written to {plot}")
         if args.out:
             print(f"log written to {args.out}")
-    if stop:
+    for stop in stops:
         print(f"bioflex-jsb gust: diverged: {stop}", file=sys.stderr)
+    if stops:
         return EXIT_DIVERGED
     return 0
 
