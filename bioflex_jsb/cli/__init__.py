@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "modes",
     "flutter",
     "gust",
+    "compare",
 )
 
 
