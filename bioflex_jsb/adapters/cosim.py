@@ -26,7 +26,7 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.adapters.airframe_xml import alpha_peak_rad
-from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+from bioflex_jsb.adapters.jsbsim_fdm import Airframe, TrimResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters.airframe import POST_STALL
@@ -71,6 +71,7 @@ _READ = {
     "rho": "atmosphere/rho-slugs_ft3",
     "nz": "accelerations/Nz",
     "h": "position/h-sl-ft",
+    "agl": "position/h-agl-ft",
 }
 
 
@@ -93,14 +94,16 @@ def run_gust(
     model: str,
     setup: RunSetup,
     on_sample: Callable[[int, float, dict[str, float]], None] | None = None,
+    trim: TrimResult | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd).
 
     ``on_sample(k, t_s, values)`` is called after every step (logging, progress). A run that
     leaves the valid range stops: the returned history holds every step up to then and its
-    ``stopped`` field says why.
+    ``stopped`` field says why. ``trim``: the airframe was just trimmed to this (skip it).
     """
-    trim = airframe.trim(setup.speed_m_s, setup.altitude_m)
+    if trim is None:
+        trim = airframe.trim(setup.speed_m_s, setup.altitude_m)
     if setup.dt_s is not None:
         airframe.set_dt(setup.dt_s)
     dt = airframe.dt_s
@@ -170,7 +173,8 @@ def run_gust(
         if on_sample is not None:
             on_sample(k, t, row)
         stall_steps += alpha > alpha_peak
-        stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes)
+        stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
+                               nodes["agl"].get_double_value())
         if stopped:
             break
         mw.step(flow)
@@ -198,7 +202,7 @@ def run_gust(
     return run
 
 
-def _check_range(row, t, alpha, alpha_min, alpha_max, n_modes) -> str | None:
+def _check_range(row, t, alpha, alpha_min, alpha_max, n_modes, agl_ft) -> str | None:
     """Why the run must stop at this sample, or None."""
     bad = [name for name, value in row.items() if not math.isfinite(value)]
     if bad:
@@ -216,6 +220,6 @@ def _check_range(row, t, alpha, alpha_min, alpha_max, n_modes) -> str | None:
             f"mode aeroelastic_{i + 1} diverged: |eta{i + 1}| = {etas[i]:.2f} rad > "
             f"{ETA_LIMIT_RAD} rad (beyond the linear range) at t = {t:.3f} s"
         )
-    if row["altitude_m"] < 0.0:
+    if agl_ft <= 0.0:
         return f"the aircraft reached the ground at t = {t:.3f} s"
     return None

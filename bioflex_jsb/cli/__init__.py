@@ -21,6 +21,7 @@ COMMAND_MODULES = (
     "flutter",
     "gust",
     "compare",
+    "bench",
 )
 
 

@@ -1,0 +1,92 @@
+"""``bioflex-jsb bench``: cost of the co-simulation against bare JSBSim, measured in one run."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from bioflex_jsb.cli.common import UsageError, positive_float, print_json
+
+HELP = """Time bare JSBSim (the same airframe and time step, no Python in the loop beyond the
+step call) and the co-simulation (JSBSim + modal wing, coupled model, reading the flow and
+writing the loads every step) in the same process, interleaved --repeat times, and print
+microseconds per step of each and their ratio (median over repeats). Also the cost of MCAP
+logging every step (log_ratio = logged / unlogged co-simulation). Machines are shared and
+noisy: compare the ratios, not the absolute times."""
+
+
+def register(sub) -> None:
+    p = sub.add_parser("bench", help="µs per step: bare JSBSim vs co-simulation",
+                       description=HELP)
+    p.add_argument("--steps", type=int, default=1200, help="steps per timing (default 1200)")
+    p.add_argument("--repeat", type=int, default=5, help="interleaved repeats (default 5)")
+    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
+                   help="trim airspeed [m/s]")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import statistics
+    import tempfile
+    from pathlib import Path
+
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.adapters.mcap_log import RunLog
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    if args.steps < 10 or args.repeat < 1:
+        raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
+    airframe = Airframe()
+    build = build_wing(VARIANTS["original"])
+    dt = airframe.dt_s
+    setup = RunSetup(args.speed, parse_gust("sharp:0.3"), duration_s=args.steps * dt,
+                     gust_start_s=0.5 * args.steps * dt)
+
+    def bare() -> float:
+        airframe.trim(args.speed)
+        t0 = time.perf_counter()
+        airframe.run(args.steps)
+        return (time.perf_counter() - t0) / args.steps
+
+    def cosim(log=None) -> float:
+        on_sample = (lambda k, t, row: log.sample("coupled", t, row)) if log else None
+        trim = airframe.trim(args.speed)  # outside the timing, as for bare()
+        t0 = time.perf_counter()
+        run = run_gust(airframe, build.model, "coupled", setup, on_sample, trim=trim)
+        elapsed = time.perf_counter() - t0
+        if run.stopped:
+            raise UsageError(f"benchmark run stopped: {run.stopped}")
+        return elapsed / len(run.time_s)
+
+    bare_t, cosim_t, logged_t = [], [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(args.repeat):
+            bare_t.append(bare())
+            cosim_t.append(cosim())
+            log = RunLog.open(Path(tmp) / f"bench{i}.mcap", "bench", args, build)
+            try:
+                logged_t.append(cosim(log))
+            finally:
+                log.close()
+    b, c, lg = (statistics.median(x) * 1e6 for x in (bare_t, cosim_t, logged_t))
+    payload = {
+        "bare_us_per_step": b,
+        "cosim_us_per_step": c,
+        "ratio": c / b,
+        "logged_us_per_step": lg,
+        "log_ratio": lg / c,
+        "dt_s": dt,
+        "steps": args.steps,
+        "repeat": args.repeat,
+    }
+    if args.json:
+        print_json(payload)
+    else:
+        print(f"time step {dt:.5f} s, {args.steps} steps × {args.repeat} repeats (median)")
+        print(f"bare JSBSim        {b:8.1f} µs/step")
+        print(f"co-simulation      {c:8.1f} µs/step   ratio {c / b:5.2f}")
+        print(f"co-sim + MCAP log  {lg:8.1f} µs/step   log_ratio {lg / c:5.2f}")
+    return 0
