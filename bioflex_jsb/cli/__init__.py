@@ -19,6 +19,7 @@ COMMAND_MODULES = (
     "linearize",
     "modes",
     "flutter",
+    "export",
     "gust",
     "compare",
     "bench",
