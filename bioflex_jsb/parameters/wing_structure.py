@@ -11,9 +11,9 @@ needs, each value with its source:
   :func:`bioflex_jsb.structures.wing_model.calibrate_stiffness` recomputes them and
   ``tests/test_structures.py`` checks that the numbers here are what it finds.
 
-Mode identification (``docs/structures.md``, "Which mode is which"): with ribs, mode 1 is the
-first torsion mode, mode 2 the second torsion mode and mode 3 the first bending mode; without
-ribs, modes 1–3 are the first three torsion modes and first bending lies above them. The
+Mode identification (``docs/structures.md``, "Which mode is which"): with and without ribs,
+modes 1–3 are the first three torsion modes (Section 3.1: twist-dominated) and the first
+bending mode lies above them. The
 torsional stiffness tapers strongly towards the tip (the bird-like wing is stiff at the "arm"
 and only membrane at the "hand"); the calibrated tip value is close to the open-section
 stiffness of the bare membrane, which is the physical floor.
@@ -89,17 +89,27 @@ class WingStructure:
     calibrated_to: str
 
 
-# CALIBRATED to Table 2 "with ribs", mode 3 = first bending, 107.2 Hz (x_I = x_E: bending is
-# uncoupled, so EI alone sets it). Chordwise ribs add no spanwise bending stiffness, so the
-# same EI serves the wing without ribs (whose first bending then lies above its 3rd mode).
-# Note: EI/m' ≈ 1.9e4 m²/s² means a mass radius of gyration of ≈ 18 mm for carbon
-# (E/ρ = 5.6e7 m²/s²), several times what a thin 0.183 m aerofoil allows: the Table 2
-# frequencies are not those of a 0.85 m constant-chord membrane cantilever in bending
-# (docs/structures.md, "Plausibility").
-BENDING_STIFFNESS_N_M2 = 1386.0
+# ESTIMATE: the paper gives no bending frequency; Section 3.1 (Figs. 7-12) says the first three
+# modes with ribs are all twist-dominated, and Table 2's small third generalised mass
+# (8.37e-6 kg*m^2, twist-normalised) confirms it. The first bending mode is therefore placed
+# above the third Table 2 mode, at this factor times it (>= 1.3 asked; 1.5 keeps a clear
+# margin without a number from the paper).
+FIRST_BENDING_OVER_MODE_3 = 1.5
+
+# CALIBRATED (effective value) to put the ribbed wing's first bending mode at
+# FIRST_BENDING_OVER_MODE_3 x 107.2 Hz = 160.8 Hz (x_I = x_E: bending is uncoupled, EI alone
+# sets it). It is an EFFECTIVE stiffness standing for the spar/ribbed structure, not derived
+# from the membrane. Chordwise ribs add no spanwise bending stiffness, so the same EI serves
+# the wing without ribs (first bending then lies even higher, lighter wing).
+# Note: EI/m' ~ 4.3e4 m^2/s^2 means a mass radius of gyration of ~28 mm for carbon
+# (E/rho = 5.6e7 m^2/s^2), far more than a thin 0.183 m aerofoil allows: only a spar or a
+# cambered/tapered real wing can be this stiff (docs/structures.md, "Plausibility").
+BENDING_STIFFNESS_N_M2 = 3118.0
 
 # CALIBRATED to Table 2 "with ribs": 30.9 Hz (mode 1, first torsion) sets the root value,
-# 71.9/30.9 (mode 2, second torsion) sets the taper. Tip value 0.024 N·m² ≈ 1.4 × the bare
+# 71.9/30.9 (mode 2, second torsion) sets the taper. Mode 3 (third torsion) is then predicted
+# at 114.1 Hz, +6.4 % against 107.2 Hz: KNOWN GAP, no monotone one-parameter GJ or inertia
+# taper closes it (docs/structures.md, "Third ribbed mode"). Tip value 0.024 N·m² ≈ 1.4 × the bare
 # membrane's open-section GJ (0.0169 N·m², ORIGINAL_LAYUP).
 RIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2 = 3.764
 RIBBED_TORSIONAL_STIFFNESS_TIP_RATIO = 0.006390
@@ -119,7 +129,7 @@ RIBBED_WING = WingStructure(
     torsional_stiffness_root_n_m2=RIBBED_TORSIONAL_STIFFNESS_ROOT_N_M2,
     torsional_stiffness_tip_ratio=RIBBED_TORSIONAL_STIFFNESS_TIP_RATIO,
     bending_stiffness_n_m2=BENDING_STIFFNESS_N_M2,
-    calibrated_to="Table 2 with ribs: 30.9, 71.9, 107.2 Hz",
+    calibrated_to="Table 2 with ribs: 30.9, 71.9 Hz (107.2 Hz: torsion 3 predicted at +6.4 %)",
 )
 
 UNRIBBED_WING = WingStructure(

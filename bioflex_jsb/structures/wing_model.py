@@ -14,7 +14,12 @@ import numpy as np
 from scipy.optimize import brentq
 
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING, WingStructure
+from bioflex_jsb.parameters.wing_structure import (
+    FIRST_BENDING_OVER_MODE_3,
+    RIBBED_WING,
+    UNRIBBED_WING,
+    WingStructure,
+)
 from bioflex_jsb.structures.beam import (
     DEFAULT_N_ELEMENTS,
     BeamSections,
@@ -138,7 +143,9 @@ def calibrate_default_wings(n_elements: int = DEFAULT_N_ELEMENTS):
     """Recompute the calibrated numbers of ``wing_structure`` (ribbed, then unribbed)."""
     f_r = P.MODE_FREQUENCIES_RIBS_HZ
     f_n = P.MODE_FREQUENCIES_NO_RIBS_HZ
-    ribbed = calibrate_stiffness(RIBBED_WING, (f_r[0], f_r[1]), f_r[2], n_elements=n_elements)
+    first_bending_hz = FIRST_BENDING_OVER_MODE_3 * f_r[2]  # ESTIMATE factor (wing_structure)
+    ribbed = calibrate_stiffness(RIBBED_WING, (f_r[0], f_r[1]), first_bending_hz,
+                                 n_elements=n_elements)
     unribbed_structure = replace(UNRIBBED_WING,
                                  bending_stiffness_n_m2=ribbed.bending_stiffness_n_m2)
     unribbed = calibrate_stiffness(unribbed_structure, (f_n[0], f_n[1]), None,
@@ -218,7 +225,7 @@ at 11 stations, lengths in mm to show the unit conversion. Starboard half wing, 
 bending: elastic-axis displacement per unit modal coordinate, positive DOWN.
 twist: section twist per unit modal coordinate, positive LEADING EDGE UP.
 generalised_mass: half wing, for the shapes as written [kg*m^2].
-Mode 3 is pure bending (x_I = x_E): its twist is zero, it is scaled on tip deflection/semispan.
+Modes 1-3 are pure torsion (x_I = x_E): their bending is zero.
 Regenerate: python -c "from bioflex_jsb.structures.wing_model import write_example_file as w; w()"
 """
 
