@@ -15,6 +15,7 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 HELP = """Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic wing
 as each of --models (rigid: wing loads off; coupled: dynamic modal states; qsd: quasi-static
@@ -45,8 +46,8 @@ def add_run_arguments(p: argparse.ArgumentParser, default_gust: str) -> None:
                    help="simulated time [s] (default 5)")
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
                    help="time the gust starts [s] (default 0.5)")
-    p.add_argument("--dt", type=positive_float("time step", "s"), default=None,
-                   help="JSBSim time step [s] (default: the aircraft's 1/120 s)")
+    p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
+                   help=f"co-simulation (JSBSim) time step [s] (default {DEFAULT_DT_S:.6f})")
 
 
 def register(sub) -> None:
@@ -77,6 +78,8 @@ def fly(args, build, models, log=None):
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
 
     setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
+    if args.dt > 0.02:
+        raise UsageError(f"--dt {args.dt:g} s is too coarse; accepted: up to 0.02 s")
     if args.gust_start >= args.duration:
         raise UsageError(
             f"--gust-start {args.gust_start:g} s must be before the end of the run "
@@ -86,7 +89,7 @@ def fly(args, build, models, log=None):
     try:
         airframe = Airframe()
         for model in models:
-            steps = int(round(args.duration / (args.dt or airframe.dt_s)))
+            steps = int(round(args.duration / args.dt))
             bar = progress_bar(steps, f"{build.variant.name} {model}")
             on_sample = None
             if bar is not None or log is not None:
