@@ -92,7 +92,9 @@ def test_divergence_speed_matches_closed_form():
                               "C_alpha^Q1", "C_q^Q1", "C_etadot1^Q1")}
     w = replace(w, coefficients=w.coefficients.with_overrides({**zero, "C_eta1^Q1": c_eta}))
     w = replace(w, cm_ac=0.0)
-    q_div = (2 * np.pi * f_hz) ** 2 * m1 / (c_eta * P.REFERENCE_AREA_M2 * P.MEAN_AERODYNAMIC_CHORD_M)
+    q_div = (2 * np.pi * f_hz) ** 2 * m1 / (
+        c_eta * P.REFERENCE_AREA_M2 * P.MEAN_AERODYNAMIC_CHORD_M
+    )
     v_div = np.sqrt(2 * q_div / P.SEA_LEVEL_DENSITY_KG_M3)
     res = eigen.find_flutter(w, (5.0, 40.0))
     assert res.kind == "divergence"
