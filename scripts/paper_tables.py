@@ -23,7 +23,8 @@ TOLERANCE = {"rigid": 0.05, "coupled": 0.10, "qsd": 0.10}
 
 def table2() -> None:
     print("Table 2: structural modes (beam model vs paper; masses normalised on twist)")
-    print(f"{'':10}{'mode':>5} {'f paper [Hz]':>13} {'f model':>9} {'m_i paper':>11} {'m_i model':>11}")
+    print(f"{'':10}{'mode':>5} {'f paper [Hz]':>13} {'f model':>9} {'m_i paper':>11} "
+          f"{'m_i model':>11}")
     for label, structure, f_p, m_p in (
         ("ribs", RIBBED_WING, P.MODE_FREQUENCIES_RIBS_HZ, P.GENERALISED_MASSES_RIBS_KG_M2),
         ("no ribs", UNRIBBED_WING, P.MODE_FREQUENCIES_NO_RIBS_HZ,
