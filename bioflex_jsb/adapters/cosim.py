@@ -85,6 +85,13 @@ _READ = {
     "nz": "accelerations/Nz",
     "h": "position/h-sl-ft",
     "agl": "position/h-agl-ft",
+    "lat": "position/lat-geod-rad",
+    "lon": "position/long-gc-rad",
+    "psi": "attitude/psi-rad",
+    "p": "velocities/p-rad_sec",
+    "r": "velocities/r-rad_sec",
+    "elevator": "fcs/elevator-pos-rad",
+    "throttle": "fcs/throttle-pos-norm",
 }
 
 
@@ -94,6 +101,10 @@ def base_channels(n_modes: int) -> dict[str, str]:
         "u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-", "w_g": "m/s",
         "airspeed_m_s": "m/s", "altitude_m": "m",
         "lift_n": "N", "drag_n": "N", "pitch_moment_n_m": "N*m",
+        # absolute pose and the rest of the state, for logs and ground stations
+        "latitude_rad": "rad", "longitude_rad": "rad", "phi_rad": "rad",
+        "theta_rad": "rad", "psi_rad": "rad", "p_rad_s": "rad/s", "r_rad_s": "rad/s",
+        "elevator_rad": "rad", "throttle": "-",
     }
     for i in range(n_modes):
         units[f"eta{i + 1}"] = "rad"
@@ -140,62 +151,77 @@ def run_gust(
     alpha_peak = alpha_peak_rad()
     stall_steps = 0
     stopped = None
+    interrupted = False
     k = 0
-    for k in range(n_steps):
-        t = k * dt
-        w_g = gust.vertical_m_s(t)
-        wind_down_fps = -w_g * U.FT_PER_M
-        wind_node.set_double_value(wind_down_fps)
-        u = nodes["u"].get_double_value()
-        v = nodes["v"].get_double_value()
-        w = nodes["w"].get_double_value()
-        theta = nodes["theta"].get_double_value()
-        phi = nodes["phi"].get_double_value()
-        # air-relative body velocity: subtract the NED wind seen in body axes
-        ua = u + wind_down_fps * math.sin(theta)
-        va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
-        wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
-        alpha = math.atan2(wa, ua)
-        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
-        rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
-        q_rate = nodes["q"].get_double_value()
-        flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
-        loads = mw.loads(flow)
-        ca, sa = math.cos(alpha), math.sin(alpha)
-        airframe.set_external_reactions(
-            lift_n=loads.lift_n * ca + loads.drag_n * sa,
-            drag_n=loads.drag_n * ca - loads.lift_n * sa,
-            pitch_moment_n_m=loads.pitch_moment_n_m,
-        )
-        airframe.run(1)
-        row = {
-            "u": vt - setup.speed_m_s,
-            "alpha": alpha - trim.alpha_rad,
-            "q": q_rate,
-            "theta": theta - theta0,
-            "n_z": nodes["nz"].get_double_value(),
-            "w_g": w_g,
-            "airspeed_m_s": vt,
-            "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
-            "lift_n": loads.lift_n,
-            "drag_n": loads.drag_n,
-            "pitch_moment_n_m": loads.pitch_moment_n_m,
-        }
-        for i in range(wing.n_modes):
-            row[f"eta{i + 1}"] = float(mw.eta[i])
-            row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
-        for name, value in row.items():
-            data[name][k] = value
-        if on_sample is not None:
-            on_sample(k, t, row)
-        stall_steps += alpha > alpha_peak
-        stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
-                               nodes["agl"].get_double_value())
-        if stopped:
-            break
-        mw.step(flow)
+    try:
+        for k in range(n_steps):
+            t = k * dt
+            w_g = gust.vertical_m_s(t)
+            wind_down_fps = -w_g * U.FT_PER_M
+            wind_node.set_double_value(wind_down_fps)
+            u = nodes["u"].get_double_value()
+            v = nodes["v"].get_double_value()
+            w = nodes["w"].get_double_value()
+            theta = nodes["theta"].get_double_value()
+            phi = nodes["phi"].get_double_value()
+            # air-relative body velocity: subtract the NED wind seen in body axes
+            ua = u + wind_down_fps * math.sin(theta)
+            va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
+            wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
+            alpha = math.atan2(wa, ua)
+            vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+            rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
+            q_rate = nodes["q"].get_double_value()
+            flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
+            loads = mw.loads(flow)
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            airframe.set_external_reactions(
+                lift_n=loads.lift_n * ca + loads.drag_n * sa,
+                drag_n=loads.drag_n * ca - loads.lift_n * sa,
+                pitch_moment_n_m=loads.pitch_moment_n_m,
+            )
+            airframe.run(1)
+            row = {
+                "u": vt - setup.speed_m_s,
+                "alpha": alpha - trim.alpha_rad,
+                "q": q_rate,
+                "theta": theta - theta0,
+                "n_z": nodes["nz"].get_double_value(),
+                "w_g": w_g,
+                "airspeed_m_s": vt,
+                "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
+                "latitude_rad": nodes["lat"].get_double_value(),
+                "longitude_rad": nodes["lon"].get_double_value(),
+                "phi_rad": phi,
+                "theta_rad": theta,
+                "psi_rad": nodes["psi"].get_double_value(),
+                "p_rad_s": nodes["p"].get_double_value(),
+                "r_rad_s": nodes["r"].get_double_value(),
+                "elevator_rad": nodes["elevator"].get_double_value(),
+                "throttle": nodes["throttle"].get_double_value(),
+                "lift_n": loads.lift_n,
+                "drag_n": loads.drag_n,
+                "pitch_moment_n_m": loads.pitch_moment_n_m,
+            }
+            for i in range(wing.n_modes):
+                row[f"eta{i + 1}"] = float(mw.eta[i])
+                row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
+            for name, value in row.items():
+                data[name][k] = value
+            if on_sample is not None:
+                on_sample(k, t, row)
+            stall_steps += alpha > alpha_peak
+            stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
+                                   nodes["agl"].get_double_value())
+            if stopped:
+                break
+            mw.step(flow)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
+        interrupted = True
+        stopped = f"interrupted at t = {k * dt:.3f} s"
+        k -= 1  # sample k was not completed
     airframe.set_external_reactions()  # leave no modal loads behind for the next user
-    n = k + 1
+    n = max(k + 1, 0)
     run = TimeHistory(
         model=model,
         time_s=time_s[:n],
@@ -213,6 +239,7 @@ def run_gust(
             "trim_throttle": trim.throttle,
             "alpha_peak_rad": alpha_peak,
             "time_beyond_stall_s": stall_steps * dt,
+            "interrupted": interrupted,
         },
         stopped=stopped,
     )

@@ -9,6 +9,7 @@ with exit status 2; a simulation that diverges exits with status 3.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
 
 from bioflex_jsb.cli.common import EXIT_USAGE, OneLineParser, UsageError
@@ -53,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return EXIT_USAGE
+    previous = signal.getsignal(signal.SIGTERM)
+    signal.signal(signal.SIGTERM, _terminate)  # SIGTERM stops a run like Ctrl-C: logs close
     try:
         return int(args.run(args) or 0)
     except UsageError as exc:
@@ -61,6 +64,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"bioflex-jsb {args.command}: interrupted", file=sys.stderr)
         return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":  # pragma: no cover

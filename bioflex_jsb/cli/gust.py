@@ -63,6 +63,14 @@ def register(sub) -> None:
     p.set_defaults(run=run)
 
 
+class Interrupted(Exception):
+    """The user stopped the runs (Ctrl-C, SIGTERM); ``runs`` holds what was flown."""
+
+    def __init__(self, runs):
+        super().__init__("interrupted")
+        self.runs = runs
+
+
 def progress_bar(total: int, label: str):
     """A tqdm bar on a terminal, nothing otherwise (so pipes and CI stay clean)."""
     if not sys.stderr.isatty():
@@ -104,6 +112,8 @@ def fly(args, build, models, log=None):
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)
+            if run.meta.get("interrupted"):
+                raise Interrupted(runs)
             if run.stopped:
                 stops.append(f"{model} run stopped: {run.stopped}")
     except FdmError as exc:
@@ -124,6 +134,12 @@ def run(args: argparse.Namespace) -> int:
         log = RunLog.open(args.out, command="gust", args=args, build=build)
     try:
         runs, stops = fly(args, build, args.models, log)
+    except Interrupted as stop:
+        last = stop.runs[-1]
+        kept = f"; the log {args.out} holds every step flown" if args.out else ""
+        print(f"bioflex-jsb gust: interrupted during the {last.model} run at "
+              f"t = {last.time_s[-1] if len(last.time_s) else 0.0:.3f} s{kept}", file=sys.stderr)
+        return 130
     finally:
         if log is not None:
             log.close()
