@@ -38,6 +38,7 @@ from bioflex_jsb.structures.sections import (
     elastic_axis_frac,
     inertial_axis_frac,
     mass_per_length_kg_m,
+    open_section_torsional_stiffness_n_m2,
     torsional_inertia_kg_m,
 )
 
@@ -370,6 +371,13 @@ def beam_modes(
 # ------------------------------------------------------------------------------------------
 # Sections from physical wing data
 # ------------------------------------------------------------------------------------------
+# Width of the step in m' and I_α' at the arm/hand boundary: the hand's sections start this far
+# outboard of the kink station (BeamSections needs strictly increasing stations). DEFINITION:
+# 1e-6 of the semispan (0.85 µm) is far inside any element (a 40-element mesh has its first
+# Gauss point 1.5 mm from a node), so the step is sharp for the quadrature.
+HAND_STEP_WIDTH_FRAC = 1e-6
+
+
 def wing_from_membrane(
     *,
     semispan_m: float,
@@ -377,12 +385,15 @@ def wing_from_membrane(
     layup: ChordwiseLayup,
     ribs: Ribs | None,
     torsional_stiffness_root_n_m2: float,
-    torsional_stiffness_tip_ratio: float,
+    torsional_stiffness_tip_ratio: float | None,
     bending_stiffness_n_m2: float,
     x_inertial_frac: float | None = None,
     x_elastic_frac: float | None = None,
     n_stations: int = 41,
     description: str = "membrane wing",
+    hand_start_m: float | None = None,
+    torsional_stiffness_kink_ratio: float | None = None,
+    hand_inertia_ratio: float = 1.0,
 ) -> BeamSections:
     """Beam sections of a constant-chord membrane wing.
 
@@ -391,19 +402,41 @@ def wing_from_membrane(
 
     Stiffness: the membrane's spanwise bending and torsional stiffness depend on the camber,
     the leading-edge region and the ribs' restraint of aerofoil distortion, which the paper
-    does not give; they are effective values: a uniform EI [N·m²] and a GJ [N·m²] that tapers
-    linearly from ``torsional_stiffness_root_n_m2`` at the root to
-    ``torsional_stiffness_tip_ratio`` × that at the tip (see
-    :mod:`bioflex_jsb.parameters.wing_structure` for the calibration).
+    does not give; they are effective values: a uniform EI [N·m²] and a GJ [N·m²] that is
+    ``torsional_stiffness_root_n_m2`` at the root and ``torsional_stiffness_tip_ratio`` × that
+    at the tip (``None``: the tip keeps exactly the bare membrane's open-section stiffness
+    G c th³/3, :func:`open_section_torsional_stiffness_n_m2`, the physical floor). See
+    :mod:`bioflex_jsb.parameters.wing_structure` for the calibration.
+
+    * ``hand_start_m is None``: GJ tapers linearly from root to tip, uniform mass.
+    * Arm/hand wing (``hand_start_m`` = the planform kink, 0 < y_k < b/2): GJ is piecewise
+      linear, root → ``torsional_stiffness_kink_ratio`` × root at y_k → tip value; the hand
+      (y > y_k) carries ``hand_inertia_ratio`` (h) × the arm's mass per span AND torsional
+      inertia. The hand's mass is reduced uniformly over its chord, so its mass centre, x_I,
+      is unchanged (Section 4.1: the feathered hand is light). This also reduces the wing mass.
 
     Axis overrides (the sensitivity study of Section 4): ``x_inertial_frac`` /
-    ``x_elastic_frac`` replace the Eq. (11)/(12) values. Moving an axis models a
-    redistribution (ballast, a different layup) that keeps the section mass and its
-    centroidal inertia; the inertia about the (possibly moved) elastic axis follows from the
-    parallel-axis theorem: I_α' = I_cg' + m' ((x_I − x_E) c)².
+    ``x_elastic_frac`` replace the Eq. (11)/(12) values over the whole span (arm and hand).
+    Moving an axis models a redistribution (ballast, a different layup) that keeps the section
+    mass and its centroidal inertia; the inertia about the (possibly moved) elastic axis follows
+    from the parallel-axis theorem: I_α' = I_cg' + m' ((x_I − x_E) c)² (arm and hand alike, so
+    the hand's I_α' and S_α' are h × the arm's for any override).
     """
     if n_stations < 2:
         raise BeamInputError(f"n_stations: need ≥ 2, got {n_stations}")
+    if not hand_inertia_ratio > 0.0:
+        raise BeamInputError(f"hand_inertia_ratio: must be positive, got {hand_inertia_ratio}")
+    if hand_start_m is None:
+        if torsional_stiffness_kink_ratio is not None or hand_inertia_ratio != 1.0:
+            raise BeamInputError(
+                "hand_start_m: needed with torsional_stiffness_kink_ratio or hand_inertia_ratio"
+            )
+    else:
+        if not 0.0 < hand_start_m < semispan_m:
+            raise BeamInputError(f"hand_start_m: must lie inside (0, {semispan_m}) m")
+        if torsional_stiffness_kink_ratio is None or not torsional_stiffness_kink_ratio > 0.0:
+            raise BeamInputError("torsional_stiffness_kink_ratio: a positive value is needed "
+                                 "with hand_start_m")
     xi_layup = inertial_axis_frac(layup, ribs)
     xe_layup = elastic_axis_frac(layup)
     x_i = xi_layup if x_inertial_frac is None else float(x_inertial_frac)
@@ -411,18 +444,36 @@ def wing_from_membrane(
     mass = mass_per_length_kg_m(layup, chord_m, ribs)
     i_cg = torsional_inertia_kg_m(layup, chord_m, xi_layup, ribs)
     i_ea = i_cg + mass * ((x_i - x_e) * chord_m) ** 2
+    gj_root = float(torsional_stiffness_root_n_m2)
+    if torsional_stiffness_tip_ratio is None:
+        gj_tip = open_section_torsional_stiffness_n_m2(layup, chord_m)
+    else:
+        gj_tip = gj_root * float(torsional_stiffness_tip_ratio)
     y = np.linspace(0.0, semispan_m, n_stations)
-    gj = torsional_stiffness_root_n_m2 * (
-        1.0 - (1.0 - torsional_stiffness_tip_ratio) * y / semispan_m
-    )
+    if hand_start_m is None:
+        gj = gj_root + (gj_tip - gj_root) * y / semispan_m
+        scale = np.ones_like(y)
+        shape = "linear GJ taper"
+    else:
+        yk = float(hand_start_m)
+        step = HAND_STEP_WIDTH_FRAC * semispan_m
+        keep = np.abs(y - yk) > 10.0 * step  # a grid station at the kink is replaced by it
+        y = np.concatenate([y[keep], [yk, yk + step]])
+        y.sort()
+        gj_kink = gj_root * float(torsional_stiffness_kink_ratio)
+        gj = np.interp(y, [0.0, yk, semispan_m], [gj_root, gj_kink, gj_tip])
+        scale = np.where(y > yk, float(hand_inertia_ratio), 1.0)
+        shape = (f"arm/hand: GJ kink at y = {yk:.4f} m ({torsional_stiffness_kink_ratio:.4g} x "
+                 f"root), hand inertia x {hand_inertia_ratio:.4g}")
+    n = y.size
     return BeamSections(
         stations_m=y,
-        bending_stiffness_n_m2=np.full(n_stations, bending_stiffness_n_m2),
+        bending_stiffness_n_m2=np.full(n, bending_stiffness_n_m2),
         torsional_stiffness_n_m2=gj,
-        mass_per_length_kg_m=np.full(n_stations, mass),
-        torsional_inertia_kg_m=np.full(n_stations, i_ea),
-        chord_m=np.full(n_stations, chord_m),
-        x_elastic_frac=np.full(n_stations, x_e),
-        x_inertial_frac=np.full(n_stations, x_i),
-        description=f"{description}; x_I = {x_i:.3f} c, x_E = {x_e:.3f} c",
+        mass_per_length_kg_m=mass * scale,
+        torsional_inertia_kg_m=i_ea * scale,
+        chord_m=np.full(n, chord_m),
+        x_elastic_frac=np.full(n, x_e),
+        x_inertial_frac=np.full(n, x_i),
+        description=f"{description}; x_I = {x_i:.3f} c, x_E = {x_e:.3f} c; {shape}",
     )

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, least_squares
 
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing_structure import (
@@ -28,6 +28,7 @@ from bioflex_jsb.structures.beam import (
     wing_from_membrane,
 )
 from bioflex_jsb.structures.modal_data import ModalData
+from bioflex_jsb.structures.sections import open_section_torsional_stiffness_n_m2
 
 # A mode is "twist-dominated" when more than half of its strain energy is torsional.
 TWIST_DOMINATED_ENERGY_FRACTION = 0.5  # definition (docs/structures.md)
@@ -53,6 +54,9 @@ def wing_sections(
         x_elastic_frac=x_elastic_frac,
         n_stations=n_stations,
         description=structure.name,
+        hand_start_m=structure.hand_start_m,
+        torsional_stiffness_kink_ratio=structure.torsional_stiffness_kink_ratio,
+        hand_inertia_ratio=structure.hand_inertia_ratio,
     )
 
 
@@ -91,37 +95,112 @@ def _split_modes(structure: WingStructure, n_modes: int, n_elements: int):
 
 @dataclass(frozen=True)
 class StiffnessCalibration:
-    """Result of :func:`calibrate_stiffness` (values to copy into ``wing_structure``)."""
+    """Result of :func:`calibrate_stiffness` (values to copy into ``wing_structure``).
+
+    ``torsional_stiffness_tip_ratio`` is the effective tip/root GJ ratio (for the arm/hand
+    wing: the membrane floor / root). ``torsional_stiffness_kink_ratio`` and
+    ``hand_inertia_ratio`` are ``None`` / 1 for the linear taper.
+    """
 
     torsional_stiffness_root_n_m2: float
     torsional_stiffness_tip_ratio: float
     bending_stiffness_n_m2: float
+    torsional_stiffness_kink_ratio: float | None = None
+    hand_inertia_ratio: float = 1.0
+
+
+# Pure bending must stay out of the way of the torsion modes while solving for GJ.
+_STIFF_BENDING_N_M2 = 1e9  # ESTIMATE: puts first bending above 1e4 Hz (x_I = x_E: uncoupled)
+
+
+def calibrate_bending_stiffness(
+    structure: WingStructure, target_hz: float, *, n_elements: int = DEFAULT_N_ELEMENTS
+) -> float:
+    """EI [N·m²] that puts the first bending-dominated mode of ``structure`` at ``target_hz``.
+
+    f_B1 ∝ √EI (uniform EI, x_I = x_E): exact in one step, a second pass checks it.
+    """
+    ei = structure.bending_stiffness_n_m2
+    for _ in range(2):
+        _, fb = _split_modes(replace(structure, bending_stiffness_n_m2=ei), 6, n_elements)
+        ei *= (target_hz / fb[0]) ** 2
+    return float(ei)
+
+
+def _calibrate_arm_hand(structure: WingStructure, targets: tuple[float, float, float],
+                        n_elements: int) -> WingStructure:
+    """GJ root, kink ratio and hand inertia ratio that put torsion 1–3 on ``targets``.
+
+    Tip GJ = the membrane's open-section floor (``torsional_stiffness_tip_ratio=None``).
+    Three equations, three unknowns: :func:`scipy.optimize.least_squares` on the relative
+    errors, unknowns in log form (all positive). The start (uniform GJ, no kink, h = 1) is
+    deliberately far from the answer; the residual at the solution is checked.
+    """
+    stiff = replace(structure, bending_stiffness_n_m2=_STIFF_BENDING_N_M2,
+                    torsional_stiffness_tip_ratio=None)
+    target = np.asarray(targets, dtype=float)
+
+    def build(p: np.ndarray) -> WingStructure:
+        return replace(stiff, torsional_stiffness_root_n_m2=float(np.exp(p[0])),
+                       torsional_stiffness_kink_ratio=float(np.exp(p[1])),
+                       hand_inertia_ratio=float(np.exp(p[2])))
+
+    def residual(p: np.ndarray) -> np.ndarray:
+        ft, _ = _split_modes(build(p), 3, n_elements)
+        return ft[:3] / target - 1.0
+
+    # Start: root GJ of the linear-taper fit order of magnitude, kink at 0.3, h = 1.
+    p0 = np.log([3.0, 0.3, 1.0])
+    sol = least_squares(residual, p0, x_scale=1.0, xtol=1e-13, ftol=1e-13, gtol=1e-13,
+                        bounds=(np.log([1e-2, 1e-3, 0.05]), np.log([1e3, 1.0, 2.0])))
+    # 1e-8 relative: a converged square system solves to round-off; a miss is far larger.
+    if np.max(np.abs(sol.fun)) > 1e-8:
+        raise RuntimeError(f"arm/hand calibration did not converge: errors {sol.fun}")
+    return replace(build(sol.x), bending_stiffness_n_m2=structure.bending_stiffness_n_m2)
 
 
 def calibrate_stiffness(
     structure: WingStructure,
-    torsion_targets_hz: tuple[float, float],
+    torsion_targets_hz: tuple[float, ...],
     bending_target_hz: float | None = None,
     *,
     n_elements: int = DEFAULT_N_ELEMENTS,
 ) -> StiffnessCalibration:
-    """Stiffnesses that put the first two torsion modes (and the first bending mode) on target.
+    """Stiffnesses (and hand inertia) that put the torsion modes (and first bending) on target.
 
-    Requires x_I = x_E (the layup's own axes), so that bending and torsion are uncoupled:
+    Requires x_I = x_E (the layup's own axes), so that bending and torsion are uncoupled.
+
+    Two targets (linear GJ taper, ``structure.hand_start_m`` ignored):
 
     * the taper ratio GJ_tip/GJ_root alone sets f_T2/f_T1 (root value scales both): solved
       with Brent's method on [1e-4, 1];
-    * then f ∝ √GJ_root gives the root value in one step;
-    * f_B1 ∝ √EI gives EI in one step (kept from ``structure`` when no bending target).
+    * then f ∝ √GJ_root gives the root value in one step.
+
+    Three targets (arm/hand wing, ``structure.hand_start_m`` set): GJ root, GJ kink ratio and
+    hand inertia ratio h with the tip GJ at the membrane floor (:func:`_calibrate_arm_hand`).
+
+    ``bending_target_hz``: f_B1 ∝ √EI gives EI in one step on the calibrated structure (kept
+    from ``structure`` when ``None``).
     """
-    f1, f2 = torsion_targets_hz
-
-    def with_gj(root: float, ratio: float) -> WingStructure:
-        return replace(structure, torsional_stiffness_root_n_m2=root,
-                       torsional_stiffness_tip_ratio=ratio)
-
-    # Pure bending must stay out of the way of the first two torsion modes while solving.
-    stiff = replace(structure, bending_stiffness_n_m2=1e9)  # ESTIMATE: puts bending > 1e4 Hz
+    targets = tuple(float(f) for f in torsion_targets_hz)
+    if len(targets) == 3:
+        if structure.hand_start_m is None:
+            raise ValueError("calibrate_stiffness: three targets need structure.hand_start_m")
+        fit = _calibrate_arm_hand(structure, targets, n_elements)
+        ei = structure.bending_stiffness_n_m2
+        if bending_target_hz is not None:
+            ei = calibrate_bending_stiffness(fit, bending_target_hz, n_elements=n_elements)
+        floor = open_section_torsional_stiffness_n_m2(structure.layup, structure.chord_m)
+        return StiffnessCalibration(
+            fit.torsional_stiffness_root_n_m2, floor / fit.torsional_stiffness_root_n_m2, ei,
+            fit.torsional_stiffness_kink_ratio, fit.hand_inertia_ratio)
+    if len(targets) != 2:
+        raise ValueError("calibrate_stiffness: give two (linear taper) or three (arm/hand) "
+                         "torsion targets")
+    f1, f2 = targets
+    linear = replace(structure, hand_start_m=None, torsional_stiffness_kink_ratio=None,
+                     hand_inertia_ratio=1.0)
+    stiff = replace(linear, bending_stiffness_n_m2=_STIFF_BENDING_N_M2)
 
     def ratio_error(ratio: float) -> float:
         ft, _ = _split_modes(replace(stiff, torsional_stiffness_tip_ratio=ratio), 2, n_elements)
@@ -132,22 +211,29 @@ def calibrate_stiffness(
     root = stiff.torsional_stiffness_root_n_m2 * (f1 / ft[0]) ** 2
     ei = structure.bending_stiffness_n_m2
     if bending_target_hz is not None:
-        probe = with_gj(root, ratio)
-        for _ in range(2):  # exact in one step for uniform EI; the second pass checks it
-            _, fb = _split_modes(replace(probe, bending_stiffness_n_m2=ei), 6, n_elements)
-            ei *= (bending_target_hz / fb[0]) ** 2
+        probe = replace(linear, torsional_stiffness_root_n_m2=root,
+                        torsional_stiffness_tip_ratio=ratio)
+        ei = calibrate_bending_stiffness(probe, bending_target_hz, n_elements=n_elements)
     return StiffnessCalibration(root, ratio, ei)
 
 
 def calibrate_default_wings(n_elements: int = DEFAULT_N_ELEMENTS):
-    """Recompute the calibrated numbers of ``wing_structure`` (ribbed, then unribbed)."""
+    """Recompute the calibrated numbers of ``wing_structure`` (ribbed, then unribbed).
+
+    * EI: first bending of the ribbed wing with UNIFORM mass (h = 1, the membrane + rib
+      estimate) at FIRST_BENDING_OVER_MODE_3 × 107.2 Hz (x_I = x_E: GJ does not enter). The
+      lighter hand of the calibrated wing then puts its first bending higher.
+    * ribbed: arm/hand GJ and hand inertia ratio on all three Table 2 "with ribs" modes;
+    * unribbed: linear GJ taper on modes 1–2 of Table 2 "without ribs" (mode 3 predicted).
+    """
     f_r = P.MODE_FREQUENCIES_RIBS_HZ
     f_n = P.MODE_FREQUENCIES_NO_RIBS_HZ
     first_bending_hz = FIRST_BENDING_OVER_MODE_3 * f_r[2]  # ESTIMATE factor (wing_structure)
-    ribbed = calibrate_stiffness(RIBBED_WING, (f_r[0], f_r[1]), first_bending_hz,
+    uniform_mass = replace(RIBBED_WING, hand_inertia_ratio=1.0)
+    ei = calibrate_bending_stiffness(uniform_mass, first_bending_hz, n_elements=n_elements)
+    ribbed = calibrate_stiffness(replace(RIBBED_WING, bending_stiffness_n_m2=ei), f_r, None,
                                  n_elements=n_elements)
-    unribbed_structure = replace(UNRIBBED_WING,
-                                 bending_stiffness_n_m2=ribbed.bending_stiffness_n_m2)
+    unribbed_structure = replace(UNRIBBED_WING, bending_stiffness_n_m2=ei)
     unribbed = calibrate_stiffness(unribbed_structure, (f_n[0], f_n[1]), None,
                                    n_elements=n_elements)
     return ribbed, unribbed
