@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from bioflex_jsb.flight_dynamics import eigen
-from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS, VARIANTS, build_wing
 from bioflex_jsb.parameters import prototype as P
 
 # Where the paper prints a table for a variant: (table name, data) — Tables 4, 5, 7 are
@@ -43,7 +43,7 @@ class EigenRow:
         return (self.model_im - self.paper_im) / abs(self.paper_im)
 
 
-def short_period_rows(wing_name: str, mass_basis: str = "paper") -> list[EigenRow]:
+def short_period_rows(wing_name: str, mass_basis: str = DEFAULT_MASS_BASIS) -> list[EigenRow]:
     """Every published short-period row of ``wing_name`` beside the model's."""
     table, data = PUBLISHED_TABLES[wing_name]
     build = build_wing(VARIANTS[wing_name], mass_basis=mass_basis)
@@ -80,7 +80,7 @@ class TrendRow:
         return self.d_frequency_rad_s > 0.0 and self.d_damping < 0.0
 
 
-def trend_rows(speeds_m_s=(15.0, 20.0), mass_basis: str = "paper") -> list[TrendRow]:
+def trend_rows(speeds_m_s=(15.0, 20.0), mass_basis: str = DEFAULT_MASS_BASIS) -> list[TrendRow]:
     """Short-period change against rigid for every named variant."""
     rows = []
     rigid = {s.speed_m_s: s.get("short_period") for s in eigen.modes_at("rigid", speeds_m_s)}
@@ -94,7 +94,7 @@ def trend_rows(speeds_m_s=(15.0, 20.0), mass_basis: str = "paper") -> list[Trend
     return rows
 
 
-def flutter_rows(range_m_s=(5.0, 30.0), mass_basis: str = "paper") -> list[eigen.FlutterResult]:
+def flutter_rows(range_m_s=(5.0, 30.0), mass_basis: str = DEFAULT_MASS_BASIS) -> list[eigen.FlutterResult]:
     """Flutter search of every named variant."""
     return [
         eigen.find_flutter(build_wing(v, mass_basis=mass_basis).model, range_m_s)

@@ -88,7 +88,7 @@ def flutter(mass_basis: str) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--mass-basis", choices=("paper", "consistent"), default="paper")
+    parser.add_argument("--mass-basis", choices=("paper", "consistent"), default="consistent")
     args = parser.parse_args()
     table2()
     eigen_tables(args.mass_basis)

@@ -23,22 +23,19 @@ def test_table3_original_wing(row):
     assert abs(row.im_error) <= TOL[row.model]
 
 
-@pytest.mark.parametrize(
-    "row", [r for r in TABLE6 if r.speed_m_s == 15.0 or r.model == "rigid"],
-    ids=lambda r: f"{r.speed_m_s:g}-{r.model}",
-)
+@pytest.mark.parametrize("row", TABLE6, ids=lambda r: f"{r.speed_m_s:g}-{r.model}")
 def test_table6_inertial_forward(row):
     assert abs(row.re_error) <= TOL[row.model]
     assert abs(row.im_error) <= TOL[row.model]
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "known miss, shown by scripts/paper_tables.py: at 20 m/s the paper's frequency drop for "
-    "C_eta1^Q1 = -0.1 (12.0 -> 8.1 rad/s) is larger than the model's; not tuned away"))
-@pytest.mark.parametrize("model", ["coupled", "qsd"])
-def test_table6_inertial_forward_20_m_s_imaginary_part(model):
-    row = next(r for r in TABLE6 if r.speed_m_s == 20.0 and r.model == model)
-    assert abs(row.re_error) <= TOL[model] and abs(row.im_error) <= TOL[model]
+def test_paper_mass_basis_overshoots_table3():
+    # The literal Table B2 reading (half-wing m_i against whole-span forces) doubles the H
+    # terms; with the calibrated modes it overshoots Table 3's frequency drop by > 10 %,
+    # which is why the consistent basis is the default (docs/decisions.md).
+    rows = validation.short_period_rows("original", mass_basis="paper")
+    worst = max(abs(r.im_error) for r in rows if r.model != "rigid")
+    assert worst > TOL["coupled"]
 
 
 def test_named_variants_carry_their_published_c_eta1_q1_and_report_the_pin():

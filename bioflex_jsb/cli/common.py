@@ -73,9 +73,9 @@ def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original
     )
     parser.add_argument(
         "--mass-basis", choices=MASS_BASES, default=DEFAULT_MASS_BASIS,
-        help="generalised masses as the paper uses them (half-wing m_i against whole-span "
-        "forces) or the consistent whole-wing basis (docs/decisions.md); default "
-        f"{DEFAULT_MASS_BASIS}",
+        help="generalised masses of the whole wing against whole-span forces (consistent) or "
+        "the half-wing m_i as Table B2 reads literally (paper: every H term doubled); "
+        f"docs/decisions.md; default {DEFAULT_MASS_BASIS}",
     )
 
 

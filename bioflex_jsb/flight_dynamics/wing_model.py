@@ -9,13 +9,11 @@ coefficient overrides. The chain is
     Table B1 quadrature (modal_coefficients) → C-coefficients (+ overrides, reported)
     → :class:`~bioflex_jsb.flight_dynamics.lti.ElasticWingModel`.
 
-Generalised-mass basis (docs/decisions.md, "Generalised mass basis"): Table 2 comes from a
-clamped *half*-wing FE model (three distinct modes, no symmetric/antisymmetric pairs), while
-Table B1 integrates over the *whole* span and Table B2 divides by that m_i. ``"paper"``
-keeps this (H terms as printed); ``"consistent"`` divides by the whole-wing generalised mass
-2 m_i, which halves every H term. The paper's results (Tables 3 and 6, body-freedom flutter
-above 20 m/s) need ``"paper"``; it is the default so that the published cases are reproduced,
-and every output names the basis it used.
+Generalised-mass basis (docs/decisions.md, "Generalised mass basis"): the beam model, like
+Table 2, gives the generalised masses of a clamped *half* wing, while Table B1 integrates the
+aerodynamic work over the *whole* span. ``"consistent"`` (default) divides the whole-span
+forces by the whole-wing generalised mass 2 m_i; ``"paper"`` divides them by the half-wing
+m_i as Table B2 reads literally, which doubles every H term. Every output names the basis.
 """
 
 from __future__ import annotations
@@ -40,7 +38,7 @@ from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, MODAL_DAMPING_RATIO, Planform
 
 MASS_BASES = ("paper", "consistent")
-DEFAULT_MASS_BASIS = "paper"
+DEFAULT_MASS_BASIS = "consistent"
 DEFAULT_N_MODES = 3
 # ESTIMATE: section moment coefficient about the aerodynamic centre of a thin cambered plate
 # with ≈ 2 % camber (thin-aerofoil theory, −π/2·(2 h/c)·… ≈ −0.05). Enters only C_0^Q (H_iu).
