@@ -52,7 +52,8 @@ def test_loads_without_warnings_in_python(airframe):
     assert len(airframe.load_messages) > 10
     assert airframe.warnings == []
     # the engine and propeller were found in aircraft/bioflex/Engines/
-    assert airframe["propulsion/engine/thrust-lbs"] == pytest.approx(0.0, abs=1e-9)
+    assert airframe.engine_count == PROPULSION.rotor_count == 2
+    assert airframe.total_thrust_n == pytest.approx(0.0, abs=1e-9)
     assert "Could not" not in " ".join(r.text for r in airframe.load_messages)
 
 
@@ -233,10 +234,48 @@ def test_flight_controls_scale_to_the_deflection_limits(airframe):
 
 
 def test_motor_power_is_the_parameter():
+    # each motor of the contra-rotating pair has half the total shaft power
     root = ET.parse(REPO / "aircraft/bioflex/Engines/bioflex_motor.xml").getroot()
     assert root.tag == "electric_engine"
-    assert float(root.findtext("power")) == PROPULSION.motor_max_shaft_power_w
+    power = float(root.findtext("power")) * PROPULSION.rotor_count
+    assert power == pytest.approx(PROPULSION.motor_max_shaft_power_w, rel=1e-9)
     assert root.find("power").get("unit") == "WATTS"
+
+
+def test_propulsion_is_a_contra_rotating_pair():
+    """Two identical engines and propellers at one point, opposite senses; each propeller
+    has half the tables and half the inertia of the single equivalent propeller."""
+    engines = _xml().findall("propulsion/engine")
+    assert len(engines) == 2
+    assert {e.get("file") for e in engines} == {X.ENGINE_FILE}
+    thrusters = [e.find("thruster") for e in engines]
+    assert [float(t.findtext("sense")) for t in thrusters] == [1.0, -1.0]
+    locations = {tuple(t.findtext(f"location/{a}") for a in "xyz") for t in thrusters}
+    assert len(locations) == 1
+    prop = ET.parse(REPO / "aircraft/bioflex/Engines/bioflex_propeller.xml").getroot()
+    ixx = float(prop.findtext("ixx")) / U.SLUG_FT2_PER_KG_M2
+    assert ixx == pytest.approx(PROPULSION.rotor_inertia_kg_m2 / 2, rel=1e-8)
+    _, ct, cp = X.propeller_tables()
+    for name, full in (("C_THRUST", ct), ("C_POWER", cp)):
+        text = prop.find(f"table[@name='{name}']/tableData").text
+        half = np.array([float(line.split()[1]) for line in text.strip().splitlines()])
+        np.testing.assert_allclose(half, full / 2, rtol=1e-8)
+    with pytest.raises(ValueError):
+        type(PROPULSION)(**{**PROPULSION.__dict__, "rotor_count": 1})
+
+
+def test_one_throttle_lever_drives_both_motors(airframe):
+    airframe.set_initial_conditions(15.0)
+    airframe["fcs/throttle-cmd-norm"] = 0.3
+    airframe.run(5)
+    assert airframe["fcs/throttle-pos-norm[0]"] == pytest.approx(0.3)
+    assert airframe["fcs/throttle-pos-norm[1]"] == pytest.approx(0.3)
+    rpm0 = airframe["propulsion/engine[0]/propeller-rpm"]
+    assert rpm0 > 0.0 and airframe["propulsion/engine[1]/propeller-rpm"] == rpm0
+    # opposite spin: the propellers' reaction torques and angular momenta cancel
+    assert airframe["moments/l-prop-lbsft"] == pytest.approx(0.0, abs=1e-12)
+    assert airframe["moments/n-prop-lbsft"] == pytest.approx(0.0, abs=1e-12)
+    airframe["fcs/throttle-cmd-norm"] = 0.0
 
 
 def test_time_step_and_property_nodes(airframe):

@@ -41,6 +41,8 @@ def test_every_speed_of_the_envelope_trims(trims):
         assert abs(t.elevator_norm) < 0.8  # margin on the elevator travel
         # inside the linear lift range, with margin to the stall
         assert math.radians(-10.0) < t.alpha_rad < RIGID_AERODYNAMICS.alpha_stall_rad - 0.01
+        # contra-rotating pair: no net propeller torque, so no aileron (nor rudder) to hold it
+        assert abs(t.aileron_norm) < 1e-4
 
 
 def test_trim_trends(trims):
@@ -111,7 +113,7 @@ def test_linear_model_structure(airframe):
     lin = airframe.linearize(15.0)
     assert lin.states == ("u", "alpha", "q", "theta")
     assert lin.a.shape == (4, 4)
-    assert lin.residualised_states == ("Rpm0",)
+    assert lin.residualised_states == ("Rpm0", "Rpm1")  # one per rotor of the pair
     assert {"Beta", "P", "R", "Phi"} <= set(lin.jsbsim_states)
     # kinematics: theta_dot = q; alpha_dot = q + ...
     np.testing.assert_allclose(lin.a[3], [0.0, 0.0, 1.0, 0.0], atol=1e-9)
@@ -182,6 +184,26 @@ def test_reduce_to_rigid_residualises_a_coupled_fast_state():
         jsbsim_fdm.reduce_to_rigid(a, ("Vt", "Alpha", "Theta", "Qx", "Rpm0", "Beta"), units)
 
 
+def test_reduce_to_rigid_uses_the_symmetric_rpm_of_a_rotor_pair():
+    """Two identical rotors: JSBSim's 2x2 RPM block is singular (only Rpm0's column is
+    filled); the symmetric combination (columns summed, rows averaged) is what is
+    residualised, and it equals the single-rotor result."""
+    names = ("Vt", "Alpha", "Theta", "Q", "Rpm0", "Rpm1", "Beta")
+    units = ("ft/s", "rad", "rad", "rad/s", "rev/min", "rev/min", "rad")
+    a = np.zeros((7, 7))
+    a[0, 0], a[0, 4], a[0, 5] = -0.2, 0.005, 0.005  # each rotor gives half the thrust
+    a[4, 0], a[4, 4] = -30.0, -5.0  # both RPM rows see only Rpm0, as JSBSim's do
+    a[5, 0], a[5, 4] = -30.0, -5.0
+    a[1, 1], a[1, 3] = -6.0, 1.0
+    a[2, 3] = 1.0
+    a[3, 1], a[3, 3] = -80.0, -5.0
+    a[6, 6] = -1.0
+    assert np.linalg.matrix_rank(a[4:6, 4:6]) == 1
+    red, fast = jsbsim_fdm.reduce_to_rigid(a, names, units)
+    assert fast == ("Rpm0", "Rpm1")
+    assert red[0, 0] == pytest.approx(-0.2 - 0.01 * (-30.0) / (-5.0))
+
+
 def test_initial_condition_validation(airframe):
     for bad in (0.0, -1.0, float("nan"), float("inf"), 500.0):
         with pytest.raises(ValueError):
@@ -207,7 +229,46 @@ def test_trim_holds_in_a_time_simulation(airframe):
     assert airframe["velocities/vt-fps"] * U.M_PER_FT == pytest.approx(15.0, abs=0.01)
     assert airframe["aero/alpha-rad"] == pytest.approx(t.alpha_rad, abs=1e-4)
     assert airframe["position/h-sl-ft"] * U.M_PER_FT == pytest.approx(h0_m, abs=0.01)
-    assert abs(airframe["attitude/phi-rad"]) < 1e-3  # the aileron trim holds the prop torque
+    # wings level: no propeller torque to hold (the trim bank, ~1.6e-4 rad, balances the
+    # Coriolis acceleration of JSBSim's rotating Earth)
+    assert abs(airframe["attitude/phi-rad"]) < 1e-3
+
+
+GUST_M_S = 0.3  # upward step of the vertical wind [m/s]
+
+
+def test_symmetric_vertical_gust_stays_symmetric(airframe):
+    """The paper's longitudinal case: a 0.3 m/s upward step gust from a wings-level 15 m/s
+    trim. With the contra-rotating pair the propellers' gyroscopic moments (effective
+    inertia 8x physical) and reaction torques cancel exactly, so the lateral motion stays at
+    the level of numerical symmetry. Measured: |r| ~ 1e-5 rad/s, |p| ~ 6e-6 rad/s,
+    |beta| ~ 3e-6 rad (the trim bank of ~1.6e-4 rad, which balances the Coriolis
+    acceleration of JSBSim's rotating Earth, turns 1.6e-4 of the earth-vertical gust into
+    sideslip); a single propeller gave r ~ 0.5 q ~ 4e-3 rad/s and beta ~ 7e-3 rad. The
+    bounds (1e-3 rad/s, 1e-4 rad) are well above the numerical level and well below the
+    single-propeller coupling."""
+    t = airframe.trim(15.0)
+    assert abs(t.aileron_norm) < 1e-4
+    assert airframe["fcs/throttle-pos-norm[1]"] == t.throttle  # both motors, one lever
+    assert airframe["propulsion/engine[1]/propeller-rpm"] == pytest.approx(t.propeller_rpm)
+    dt = airframe.dt_s
+    k_gust = round(0.5 / dt)
+    r_max = p_max = beta_max = q_max = 0.0
+    try:
+        for k in range(round(2.0 / dt)):
+            if k == k_gust:
+                airframe["atmosphere/wind-down-fps"] = -GUST_M_S * 3.28084  # upward
+            airframe.run(1)
+            r_max = max(r_max, abs(airframe["velocities/r-rad_sec"]))
+            p_max = max(p_max, abs(airframe["velocities/p-rad_sec"]))
+            beta_max = max(beta_max, abs(airframe["aero/beta-rad"]))
+            q_max = max(q_max, abs(airframe["velocities/q-rad_sec"]))
+    finally:
+        airframe["atmosphere/wind-down-fps"] = 0.0
+    assert q_max > 5e-3  # the gust does excite the short period
+    assert r_max < 1e-3
+    assert p_max < 1e-3
+    assert beta_max < 1e-4
 
 
 def _report(*lines: str) -> list[jsbsim_fdm.LogRecord]:

@@ -7,12 +7,32 @@ the named constants of :mod:`bioflex_jsb.units`, and writes the JSBSim files:
 ``aircraft/bioflex/bioflex.xml``                      the aircraft (metrics, mass, contacts,
                                                       propulsion, systems, aerodynamics,
                                                       external reactions)
-``aircraft/bioflex/Engines/bioflex_motor.xml``        ``electric`` engine (shaft power)
+``aircraft/bioflex/Engines/bioflex_motor.xml``        ``electric`` engine (shaft power of one
+                                                      motor of the pair)
 ``aircraft/bioflex/Engines/bioflex_propeller.xml``    fixed-pitch propeller, C_T(J) and C_P(J)
+                                                      of one rotor of the pair
 ``aircraft/bioflex/reset_cruise.xml``                 initial condition: Table 1 cruise, ISA sea
                                                       level, for scripts and the console program
 ``systems/bioflex_flight_controls.xml``               elevator, aileron, rudder, throttle
 ====================================================  =========================================
+
+Propulsion: a contra-rotating pair
+----------------------------------
+The paper's model is longitudinal, so the propulsion must not couple a symmetric manoeuvre
+into the lateral axes. A single propeller does: its angular momentum I_p·ω·x̂ gives the
+gyroscopic moment PQR × (I_p ω x̂), which turns pitch rate into yaw, and ``PROPULSION``'s
+rotor inertia is an effective value 8 times the physical one (JSBSim's trim finds the RPM by
+0.5 s Euler steps, stable only with that inertia; see its comment), so a 0.3 m/s vertical gust
+gave r ≈ 0.5 q. The drive is therefore rendered as ``PROPULSION.rotor_count`` (2) identical
+``electric`` engines, each with 1/2 of the motor power, driving identical propellers at the
+same point of the thrust line with ``<sense>`` +1 and −1. Each propeller has 1/2 of the
+blade-element C_T(J), C_P(J) of :func:`propeller_tables` and 1/2 of the rotor inertia, so at
+a common throttle each rotor turns at the single propeller's RPM with half its thrust and
+power: total thrust, power, trim throttle and RPM response are unchanged, while the angular
+momenta and reaction torques cancel exactly (no aileron at trim, a symmetric gust stays
+symmetric). One throttle lever, ``fcs/throttle-cmd-norm`` (engine 0's command), drives every
+motor's ``fcs/throttle-pos-norm[i]``; JSBSim's trim sets all commands together. Per-rotor
+properties are ``propulsion/engine[i]/...``; the total thrust is their sum.
 
 The committed files are this module's output; ``python -m bioflex_jsb.adapters.airframe_xml``
 rewrites them (``--root DIR`` writes elsewhere) and a test checks they are up to date. Edit the
@@ -344,6 +364,7 @@ def render_aircraft(
     mass: MassProperties = MASS_PROPERTIES,
     geom: AirframeGeometry = AIRFRAME_GEOMETRY,
     stall: PostStall = POST_STALL,
+    prop: Propulsion = PROPULSION,
 ) -> str:
     """Text of ``aircraft/bioflex/bioflex.xml``."""
     root = ET.Element(
@@ -411,17 +432,25 @@ def render_aircraft(
 
     # ---- propulsion ----
     prop_el = _el(root, "propulsion")
-    _comment(prop_el, "electric motor + fixed-pitch propeller: parameters.airframe.PROPULSION")
-    eng = _el(prop_el, "engine", file=ENGINE_FILE)
+    _comment(
+        prop_el,
+        "contra-rotating pair (parameters.airframe.PROPULSION): identical electric motors and "
+        "fixed-pitch propellers at the same point, opposite senses, so that gyroscopic moments "
+        "and reaction torques cancel and the longitudinal model stays symmetric",
+    )
     prop_xyz = (geom.propeller_x_m, 0.0, geom.propeller_z_m)
-    thr = _el(eng, "thruster", file=PROPELLER_FILE)
-    _xyz(thr, "location", prop_xyz)
-    orient = _el(thr, "orient", unit="RAD")
-    for axis in ("roll", "pitch", "yaw"):
-        _el(orient, axis, 0.0)
-    _comment(thr, "sense 1: clockwise seen from behind; no p-factor model")
-    _el(thr, "sense", 1.0)
-    _el(thr, "p_factor", 0.0)
+    for i in range(prop.rotor_count):
+        sense = 1.0 if i % 2 == 0 else -1.0
+        eng = _el(prop_el, "engine", file=ENGINE_FILE)
+        thr = _el(eng, "thruster", file=PROPELLER_FILE)
+        _xyz(thr, "location", prop_xyz)
+        orient = _el(thr, "orient", unit="RAD")
+        for axis in ("roll", "pitch", "yaw"):
+            _el(orient, axis, 0.0)
+        turn = "clockwise" if sense > 0 else "counter-clockwise"
+        _comment(thr, f"sense {sense:+.0f}: {turn} seen from behind; no p-factor model")
+        _el(thr, "sense", sense)
+        _el(thr, "p_factor", 0.0)
 
     # ---- systems ----
     _el(root, "system", file=SYSTEM_FILE)
@@ -570,22 +599,36 @@ def _render_aerodynamics(root: ET.Element, aero: RigidAerodynamics, stall: PostS
 def render_engine(prop: Propulsion = PROPULSION) -> str:
     """Text of ``aircraft/bioflex/Engines/bioflex_motor.xml``."""
     root = ET.Element("electric_engine", name=ENGINE_FILE)
-    _comment(root, "PROPULSION.motor_max_shaft_power_w (ESTIMATE, airframe.py)")
-    _el(root, "power", prop.motor_max_shaft_power_w, unit="WATTS")
+    _comment(
+        root,
+        "one motor of the contra-rotating pair: "
+        "PROPULSION.motor_max_shaft_power_w / rotor_count (ESTIMATE, airframe.py)",
+    )
+    _el(root, "power", prop.motor_max_shaft_power_w / prop.rotor_count, unit="WATTS")
     return _serialise(root)
 
 
 def render_propeller(prop: Propulsion = PROPULSION) -> str:
     """Text of ``aircraft/bioflex/Engines/bioflex_propeller.xml``."""
     root = ET.Element("propeller", name=PROPELLER_FILE)
-    _comment(root, "PROPULSION (ESTIMATE, airframe.py): rotor inertia, diameter, blades")
-    _el(root, "ixx", prop.rotor_inertia_kg_m2 * U.SLUG_FT2_PER_KG_M2, unit="SLUG*FT2")
+    _comment(
+        root,
+        "one rotor of the contra-rotating pair, PROPULSION (ESTIMATE, airframe.py): "
+        "rotor_inertia_kg_m2 / rotor_count (effective value, 8x physical: trim RPM iteration), "
+        "diameter, blades",
+    )
+    ixx = prop.rotor_inertia_kg_m2 / prop.rotor_count
+    _el(root, "ixx", ixx * U.SLUG_FT2_PER_KG_M2, unit="SLUG*FT2")
     _el(root, "diameter", prop.prop_diameter_m * U.FT_PER_M, unit="FT")
     _el(root, "numblades", str(prop.prop_blades))
     _el(root, "constspeed", "0")
     j, ct, cp = propeller_tables(prop)
-    _comment(root, "C_T(J), C_P(J): blade-element momentum theory on the PROPULSION blade")
-    for name, values in (("C_THRUST", ct), ("C_POWER", cp)):
+    _comment(
+        root,
+        "C_T(J), C_P(J): blade-element momentum theory on the PROPULSION blade, divided by "
+        "rotor_count (each rotor gives its share of the thrust and absorbs its share of the power)",
+    )
+    for name, values in (("C_THRUST", ct / prop.rotor_count), ("C_POWER", cp / prop.rotor_count)):
         t = _el(root, "table", name=name, type="internal")
         lines = "".join(
             f"\n      {_num(x):>14} {_num(y):>14}" for x, y in zip(j, values, strict=True)
@@ -594,12 +637,16 @@ def render_propeller(prop: Propulsion = PROPULSION) -> str:
     return _serialise(root)
 
 
-def render_flight_controls(limits: ControlLimits = CONTROL_LIMITS) -> str:
+def render_flight_controls(
+    limits: ControlLimits = CONTROL_LIMITS, prop: Propulsion = PROPULSION
+) -> str:
     """Text of ``systems/bioflex_flight_controls.xml``.
 
     Each surface: command + trim (JSBSim's trim drives the *-trim-cmd-norm properties),
     clipped to −1..1 → ``fcs/<surface>-pos-norm``, times the maximum deflection →
     ``fcs/<surface>-pos-rad``. No actuator lag (the rigid analyses use surface positions).
+    One throttle lever: ``fcs/throttle-cmd-norm`` drives every motor of the contra-rotating
+    pair (``fcs/throttle-pos-norm[i]``).
     """
     root = ET.Element("system", name="bioflex-flight-controls")
     _comment(root, "deflection limits: parameters.airframe.CONTROL_LIMITS (ESTIMATE)")
@@ -634,13 +681,15 @@ def render_flight_controls(limits: ControlLimits = CONTROL_LIMITS) -> str:
             _el(inv, "gain", max_rad)
             _el(inv, "output", "fcs/right-aileron-pos-rad")
     ch = _el(root, "channel", name="Throttle")
+    _comment(ch, "one lever for the contra-rotating pair: every motor gets the same throttle")
     g = _el(ch, "pure_gain", name="fcs/throttle-pos-gain")
     _el(g, "input", "fcs/throttle-cmd-norm")
     _el(g, "gain", 1.0)  # direct: no throttle lag in the rigid analyses
     clip = _el(g, "clipto")
     _el(clip, "min", 0.0)  # throttle range 0..1
     _el(clip, "max", 1.0)
-    _el(g, "output", "fcs/throttle-pos-norm")
+    for i in range(prop.rotor_count):
+        _el(g, "output", f"fcs/throttle-pos-norm[{i}]")
     return _serialise(root)
 
 
@@ -656,7 +705,7 @@ def render_initial_condition() -> str:
         _el(root, tag, 0.0, unit="RAD")  # level attitude, wings level, heading north
     _el(root, "latitude", INIT_LATITUDE_RAD, unit="RAD")
     _el(root, "longitude", 0.0, unit="RAD")  # arbitrary meridian
-    _el(root, "running", "0")  # engine 0 running (the electric motor has no start sequence)
+    _el(root, "running", "-1")  # all engines running (electric motors: no start sequence)
     return _serialise(root)
 
 

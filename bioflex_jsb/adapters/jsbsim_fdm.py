@@ -22,20 +22,22 @@ Trim
 ----
 :meth:`Airframe.trim` uses JSBSim's own trim routine, ``FGFDMExec::DoTrim`` in *full* mode
 (α, throttle and elevator for u̇, ẇ, q̇; bank, aileron, rudder and sideslip for the lateral
-accelerations, which the propeller torque needs): wings-level, constant-altitude flight at
-the requested true airspeed. When it fails, :class:`TrimError` carries one line naming the
+accelerations): wings-level, constant-altitude flight at the requested true airspeed. The
+propulsion is a contra-rotating pair (see :mod:`bioflex_jsb.adapters.airframe_xml`): JSBSim's
+trim drives both motors' throttles together, the reaction torques cancel, and the lateral
+controls come out at zero. When it fails, :class:`TrimError` carries one line naming the
 control that ran out (throttle at 1, elevator at a stop, α at the stall limit) or the
 condition that stayed out of tolerance.
 
 One JSBSim detail is handled here: the trim finds the propeller's steady RPM by explicit
 Euler steps of 0.5 s, which cannot start from the propeller at rest (an ``electric`` engine
 at 0 RPM applies its power over 1 rad/s). Before trimming, one normal time step with a
-throttle chosen for the purpose brings the propeller to its windmilling RPM at the trim
+throttle chosen for the purpose brings both propellers to their windmilling RPM at the trim
 speed; the trim then restarts the airframe from the initial condition (only the RPM carries
 over). The same Euler steps are why ``PROPULSION.rotor_inertia_kg_m2`` is an effective value,
 about 8 times the physical one (see its comment): trim and linearization do not depend on it,
-but time simulations see a slower RPM response and a larger propeller gyroscopic coupling
-between pitch and yaw rates (zero in symmetric, wings-level manoeuvres).
+time simulations see a slower RPM response, and the two rotors' gyroscopic moments, equal
+and opposite, cancel exactly (a symmetric gust stays symmetric).
 
 Linearization
 -------------
@@ -44,11 +46,17 @@ Linearization
 paper's rigid longitudinal model x_R = [u, α, q, θ] (u the airspeed perturbation [m/s]; α,
 θ [rad]; q [rad/s]) by
 
-* residualising the propeller RPM states r as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
+* residualising the propeller RPM states r (``Rpm0``, ``Rpm1``: one per rotor of the pair)
+  as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
   (the RPM settles in a fraction of the short-period time scale at the physical rotor
   inertia; JSBSim's state space already re-solves the RPM to steady state at every
   perturbation, so A_xr is zero to rounding and the thrust change with airspeed is in the u
-  column);
+  column). The rotors of the contra-rotating pair are identical and identically driven, so a
+  longitudinal perturbation moves their RPMs together: the RPM states are first reduced to
+  their symmetric combination (δRpm0 = δRpm1: columns summed, rows averaged); the
+  antisymmetric one (one rotor faster than the other) is lateral, like β, φ, p, ψ, r, and is
+  dropped with them. JSBSim's own 2×2 RPM block is singular (perturbing Rpm1 changes
+  nothing), the symmetric 1×1 block is not;
 * dropping the lateral states (β, φ, p, ψ, r), decoupled from the longitudinal ones at a
   wings-level trim, and the position states (latitude, longitude, altitude: the paper's x_R
   has no altitude; the density gradient over the short period's height change is negligible);
@@ -227,9 +235,12 @@ class TrimResult:
         alpha_rad, theta_rad: angle of attack and pitch attitude [rad] (θ = α in level flight).
         elevator_norm: elevator position, −1..1 of its travel (+ = trailing edge down).
         elevator_rad: elevator deflection [rad] (+ = trailing edge down, nose-down moment).
-        throttle: throttle position 0..1 (fraction of the motor's maximum shaft power).
-        aileron_norm: aileron position −1..1 holding the propeller torque (+ = roll right).
-        propeller_rpm: propeller speed [rev/min]; thrust_n: propeller thrust [N].
+        throttle: throttle position 0..1 of every motor of the contra-rotating pair
+            (fraction of the maximum shaft power).
+        aileron_norm: aileron position −1..1 (+ = roll right); ≈ 0, the pair's reaction
+            torques cancel.
+        propeller_rpm: speed of one propeller [rev/min] (both turn at the same speed);
+            thrust_n: total thrust of the pair [N].
         converged: True: JSBSim reported every trim condition within tolerance.
         residuals: the accelerations left: ``udot_m_s2``, ``wdot_m_s2`` [m/s²],
             ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²].
@@ -405,6 +416,7 @@ class Airframe:
                 f"{self._first_message(jsbsim.LogLevel.ERROR) or 'no reason given'}"
             )
         self._dt_nominal_s = float(self._fdm.get_delta_t())
+        self.engine_count = int(self._fdm.get_propulsion().get_num_engines())
         self.load_messages: tuple[LogRecord, ...] = tuple(self._log.records)
         self._log.records.clear()
 
@@ -425,6 +437,14 @@ class Airframe:
         return ""
 
     # ---- properties ---------------------------------------------------------------
+    @property
+    def total_thrust_n(self) -> float:
+        """Thrust of all engines (the contra-rotating pair) [N]."""
+        lbs = sum(
+            float(self._fdm[f"propulsion/engine[{i}]/thrust-lbs"]) for i in range(self.engine_count)
+        )
+        return lbs * U.N_PER_LBF
+
     def __getitem__(self, name: str) -> float:
         """Raw JSBSim property value (JSBSim units, as the property name says)."""
         return float(self._fdm[name])
@@ -476,20 +496,23 @@ class Airframe:
             fdm.run_ic()
 
     def _spin_up_propeller(self, speed_m_s: float) -> None:
-        """Bring the propeller from rest to its windmilling RPM at ``speed_m_s`` in one step.
+        """Bring both propellers from rest to their windmilling RPM at ``speed_m_s`` in one step.
 
         At 0 RPM JSBSim's propeller turns the engine power P [ft·lbf/s] into a torque of
-        P/(1 rad/s), so one step of dt [s] gives ω = throttle·P_max·dt/I. The throttle for
-        ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set for that single step.
+        P/(1 rad/s), so one step of dt [s] gives ω = throttle·P·dt/I per rotor (each rotor
+        has 1/rotor_count of the power and of the inertia). The throttle for
+        ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set on every engine for that step.
         """
         fdm = self._fdm
+        n = PROPULSION.rotor_count
         omega_rad_s = (
             2.0 * math.pi * speed_m_s / (_zero_thrust_advance_ratio() * PROPULSION.prop_diameter_m)
         )
-        inertia_slug_ft2 = PROPULSION.rotor_inertia_kg_m2 * U.SLUG_FT2_PER_KG_M2
-        power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w * U.LBF_FT_PER_N_M
-        throttle = omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t())
-        fdm["fcs/throttle-cmd-norm"] = min(1.0, throttle)
+        inertia_slug_ft2 = PROPULSION.rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
+        power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
+        throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
+        for i in range(self.engine_count):
+            fdm[f"fcs/throttle-cmd-norm[{i}]"] = throttle
         with _captured(self._log):
             fdm.run()
 
@@ -527,8 +550,8 @@ class Airframe:
             elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
             throttle=float(fdm["fcs/throttle-pos-norm"]),
             aileron_norm=float(fdm["fcs/left-aileron-pos-norm"]),
-            propeller_rpm=float(fdm["propulsion/engine/propeller-rpm"]),
-            thrust_n=float(fdm["propulsion/engine/thrust-lbs"]) * U.N_PER_LBF,
+            propeller_rpm=float(fdm["propulsion/engine[0]/propeller-rpm"]),
+            thrust_n=self.total_thrust_n,
             converged=True,
             residuals={
                 "udot_m_s2": float(fdm["accelerations/udot-ft_sec2"]) * U.M_PER_FT,
@@ -712,9 +735,16 @@ def reduce_to_rigid(
         raise LinearizationError(f"JSBSim's linear model has unexpected states {unknown}")
     a_xx = a_full[np.ix_(keep, keep)]
     if fast:
-        a_xr = a_full[np.ix_(keep, fast)]
-        a_rx = a_full[np.ix_(fast, keep)]
-        a_rr = a_full[np.ix_(fast, fast)]
+        # symmetric combination of identical rotors: one state per prefix (Rpm, PropPitch)
+        groups = sorted({p for n in (names[i] for i in fast) for p in _FAST_PREFIXES
+                         if n.startswith(p)})  # fmt: skip
+        e = np.zeros((len(fast), len(groups)))
+        for row, i in enumerate(fast):
+            e[row, next(g for g, p in enumerate(groups) if names[i].startswith(p))] = 1.0
+        mean = np.linalg.solve(e.T @ e, e.T)  # average over the rotors of each group
+        a_xr = a_full[np.ix_(keep, fast)] @ e
+        a_rx = mean @ a_full[np.ix_(fast, keep)]
+        a_rr = mean @ a_full[np.ix_(fast, fast)] @ e
         if not np.all(np.isfinite(a_rr)) or np.linalg.cond(a_rr) > 1e12:
             raise LinearizationError("the propeller RPM block of JSBSim's model is singular")
         a_xx = a_xx - a_xr @ np.linalg.solve(a_rr, a_rx)

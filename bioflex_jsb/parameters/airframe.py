@@ -211,14 +211,27 @@ AIRFRAME_GEOMETRY = AirframeGeometry(
 # --------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Propulsion:
-    """Electric motor and fixed-pitch propeller.
+    """Electric drive: a contra-rotating pair of fixed-pitch propellers on one motor power.
 
     The propeller's thrust and power coefficient tables are computed from this blade
     geometry by blade-element momentum theory in :mod:`bioflex_jsb.adapters.airframe_xml`.
 
+    Contra-rotating pair (DECISION, ``rotor_count`` = 2): the paper's model is longitudinal,
+    and a symmetric (vertical) gust must leave the airframe symmetric. A single propeller's
+    angular momentum I_p·ω·x̂ gives a gyroscopic moment PQR × (I_p ω x̂) that turns pitch rate
+    into yaw (r ≈ 0.5 q with the effective ``rotor_inertia_kg_m2`` below) and its reaction
+    torque needs aileron at trim. The JSBSim rendering therefore splits the drive described
+    here (one blade geometry, ``motor_max_shaft_power_w``, ``rotor_inertia_kg_m2``: the
+    totals) into ``rotor_count`` identical electric engines, each with 1/rotor_count of the
+    power, driving identical propellers at the same point of the thrust line with opposite
+    senses; each propeller has 1/rotor_count of the C_T(J), C_P(J) tables and of the rotor
+    inertia. At a common throttle every rotor then turns at the single propeller's RPM, the
+    total thrust, power and RPM response are the single propeller's, and the angular momenta
+    and reaction torques cancel exactly.
+
     Attributes:
-        motor_max_shaft_power_w: shaft power at full throttle [W] (JSBSim ``electric`` engine:
-            power = throttle × this, independent of RPM).
+        motor_max_shaft_power_w: total shaft power at full throttle [W], all motors (JSBSim
+            ``electric`` engine: power = throttle × this, independent of RPM).
         prop_diameter_m, prop_pitch_m: propeller diameter and geometric pitch [m].
         prop_blades: number of blades [-].
         prop_chord_stations: (r/R, c/R) pairs of the blade chord distribution [-].
@@ -227,8 +240,11 @@ class Propulsion:
         prop_section_zero_lift_rad: section zero-lift angle relative to the pitch line [rad].
         prop_section_cl_max: section lift limit (stall) [-].
         prop_section_cd0, prop_section_cd_k: section drag c_d = cd0 + k c_l² [-].
-        rotor_inertia_kg_m2: propeller plus motor rotor polar moment of inertia [kg·m²].
+        rotor_inertia_kg_m2: propellers plus motor rotors polar moment of inertia, total of
+            the pair [kg·m²].
         advance_ratio_max: end of the J = V/(nD) tables [-] (past zero thrust).
+        rotor_count: number of contra-rotating rotors the drive is split into [-] (2: a
+            pair with opposite senses; must be even so that the senses cancel).
     """
 
     motor_max_shaft_power_w: float
@@ -244,6 +260,13 @@ class Propulsion:
     prop_section_cd_k: float
     rotor_inertia_kg_m2: float
     advance_ratio_max: float
+    rotor_count: int = 2
+
+    def __post_init__(self) -> None:
+        if self.rotor_count < 2 or self.rotor_count % 2:
+            raise ValueError(
+                f"rotor_count must be even and >= 2 (contra-rotating pairs), got {self.rotor_count}"
+            )
 
 
 _INCH_M = 0.0254  # definition of the inch, for propeller sizes quoted in inches
@@ -266,15 +289,20 @@ PROPULSION = Propulsion(
     prop_section_cl_max=1.1,  # ESTIMATE: low-Re section stall
     prop_section_cd0=0.020,  # ESTIMATE: Re ≈ 1e5 section drag
     prop_section_cd_k=0.02,  # ESTIMATE
-    # NUMERICAL (an effective value, not the physical one): the physical estimate is
-    # ≈ 1.5e-4 kg·m² (25 g blade pair ≈ m D²/12 × 0.6 tapered = 1.2e-4, motor bell 0.3e-4),
-    # but JSBSim's trim brings the RPM to steady state by explicit Euler steps of a fixed
-    # 0.5 s (FGPropulsion::GetSteadyState), which is stable only if
-    # I > ½ · 0.5 s · |∂(Q_motor − Q_prop)/∂ω|. With these tables that needs ≈ 1.0e-3 kg·m²
-    # from 3 to 80 m/s at any throttle; 1.2e-3 adds 20 % margin. Trim and the (quasi-static
-    # in RPM) linearization do not depend on it; time simulations see a slower RPM response.
+    # NUMERICAL (an effective value, not the physical one; total of the pair, each rotor
+    # has half): the physical estimate is ≈ 1.5e-4 kg·m² (25 g of blades ≈ m D²/12 × 0.6
+    # tapered = 1.2e-4, motor bells 0.3e-4), but JSBSim's trim brings each rotor's RPM to
+    # steady state by explicit Euler steps of a fixed 0.5 s (FGPropulsion::GetSteadyState),
+    # which is stable only if I > ½ · 0.5 s · |∂(Q_motor − Q_prop)/∂ω| per rotor. Each rotor
+    # has half the torques and half the inertia, so the condition is the single propeller's:
+    # ≈ 1.0e-3 kg·m² in total from 3 to 80 m/s at any throttle; 1.2e-3 adds 20 % margin
+    # (8 × physical). Trim and the (quasi-static in RPM) linearization do not depend on it;
+    # time simulations see a slower RPM response. Its gyroscopic moment, 8 × too large, would
+    # couple pitch into yaw with a single propeller; the contra-rotating pair cancels it
+    # exactly (see the class docstring).
     rotor_inertia_kg_m2=1.2e-3,
     advance_ratio_max=1.3,  # beyond the ≈ 0.9 zero-thrust J of a 12×8
+    rotor_count=2,  # DECISION: contra-rotating pair, symmetric gust response (class docstring)
 )
 
 
