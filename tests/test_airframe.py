@@ -32,6 +32,9 @@ def test_committed_files_are_the_generated_rendering():
         "aircraft/bioflex/Engines/bioflex_motor.xml",
         "aircraft/bioflex/Engines/bioflex_propeller.xml",
         "aircraft/bioflex/reset_cruise.xml",
+        "aircraft/bioflex_trim/bioflex_trim.xml",
+        "aircraft/bioflex_trim/Engines/bioflex_motor.xml",
+        "aircraft/bioflex_trim/Engines/bioflex_trim_propeller.xml",
         "systems/bioflex_flight_controls.xml",
     }
     for rel, text in rendered.items():
@@ -41,20 +44,64 @@ def test_committed_files_are_the_generated_rendering():
 
 def test_write_all_writes_a_loadable_root(tmp_path):
     written = X.write_all(tmp_path)
-    assert len(written) == 5 and all(p.is_file() for p in written)
+    assert len(written) == len(X.render_all()) and all(p.is_file() for p in written)
     af = jsbsim_fdm.load_airframe(tmp_path)
     assert af.root == tmp_path.resolve()
+    assert af.trim_aircraft == X.TRIM_AIRCRAFT_NAME
     assert af.warnings == []
 
 
 def test_loads_without_warnings_in_python(airframe):
-    # JSBSim printed its usual startup report (captured), and nothing at WARN level or above.
+    # JSBSim printed its usual startup report (captured), and nothing at WARN level or above,
+    # for the flying aircraft and for its trim companion (loaded beside it)
+    assert airframe.trim_aircraft == X.TRIM_AIRCRAFT_NAME
     assert len(airframe.load_messages) > 10
+    assert len(airframe.trim_load_messages) > 10
     assert airframe.warnings == []
     # the engine and propeller were found in aircraft/bioflex/Engines/
     assert airframe.engine_count == PROPULSION.rotor_count == 2
     assert airframe.total_thrust_n == pytest.approx(0.0, abs=1e-9)
     assert "Could not" not in " ".join(r.text for r in airframe.load_messages)
+
+
+@pytest.mark.parametrize("aircraft", [X.AIRCRAFT_NAME, X.TRIM_AIRCRAFT_NAME])
+def test_each_aircraft_file_loads_alone_without_warnings(aircraft):
+    af = jsbsim_fdm.load_airframe(REPO, aircraft)
+    assert len(af.load_messages) > 10
+    assert af.warnings == []
+    assert af.engine_count == PROPULSION.rotor_count
+    text = " ".join(r.text for r in af.load_messages)
+    assert "Could not" not in text and aircraft in text
+
+
+def test_trim_companion_differs_only_in_the_rotor_inertia():
+    flying = (REPO / "aircraft/bioflex/bioflex.xml").read_text(encoding="utf-8")
+    companion = (REPO / "aircraft/bioflex_trim/bioflex_trim.xml").read_text(encoding="utf-8")
+    changed = [
+        (a, b)
+        for a, b in zip(flying.splitlines(), companion.splitlines(), strict=True)
+        if a != b
+    ]
+    assert changed and all(
+        X.AIRCRAFT_NAME in a and X.TRIM_AIRCRAFT_NAME in b or "description" in a
+        for a, b in changed
+    )
+    assert (REPO / "aircraft/bioflex_trim/Engines/bioflex_motor.xml").read_text() == (
+        REPO / "aircraft/bioflex/Engines/bioflex_motor.xml"
+    ).read_text()
+    engines = REPO / "aircraft/bioflex/Engines"
+    phys = ET.parse(engines / "bioflex_propeller.xml").getroot()
+    eff = ET.parse(REPO / "aircraft/bioflex_trim/Engines/bioflex_trim_propeller.xml").getroot()
+    ixx_phys = float(phys.findtext("ixx")) / U.SLUG_FT2_PER_KG_M2 * PROPULSION.rotor_count
+    ixx_eff = float(eff.findtext("ixx")) / U.SLUG_FT2_PER_KG_M2 * PROPULSION.rotor_count
+    assert ixx_phys == pytest.approx(PROPULSION.rotor_inertia_kg_m2, rel=1e-8)
+    assert ixx_eff == pytest.approx(PROPULSION.trim_rotor_inertia_kg_m2, rel=1e-8)
+    assert ixx_eff > 5.0 * ixx_phys  # effective (trim iteration) vs physical
+    for tag in ("diameter", "numblades", "constspeed"):
+        assert phys.findtext(tag) == eff.findtext(tag)
+    for name in ("C_THRUST", "C_POWER"):
+        q = f"table[@name='{name}']/tableData"
+        assert phys.find(q).text == eff.find(q).text
 
 
 def test_console_program_runs_a_script_without_warnings(tmp_path):
@@ -254,7 +301,7 @@ def test_propulsion_is_a_contra_rotating_pair():
     assert len(locations) == 1
     prop = ET.parse(REPO / "aircraft/bioflex/Engines/bioflex_propeller.xml").getroot()
     ixx = float(prop.findtext("ixx")) / U.SLUG_FT2_PER_KG_M2
-    assert ixx == pytest.approx(PROPULSION.rotor_inertia_kg_m2 / 2, rel=1e-8)
+    assert ixx == pytest.approx(PROPULSION.rotor_inertia_kg_m2 / 2, rel=1e-8)  # physical
     _, ct, cp = X.propeller_tables()
     for name, full in (("C_THRUST", ct), ("C_POWER", cp)):
         text = prop.find(f"table[@name='{name}']/tableData").text
@@ -291,3 +338,23 @@ def test_time_step_and_property_nodes(airframe):
     with pytest.raises(ValueError):
         airframe.set_dt(0.0)
     airframe.set_dt(1.0 / 120.0)
+
+
+def test_per_step_loop_helpers_match_the_public_ones(airframe):
+    """step() inside capturing() is run(1); the writer is set_external_reactions."""
+    airframe.set_initial_conditions(15.0)
+    write = airframe.external_reaction_writer()
+    with airframe.capturing():
+        write(2.0, 0.5, 0.3)
+        airframe.step()
+    assert airframe["forces/fbz-external-lbs"] == pytest.approx(-2.0 * U.LBF_PER_N, rel=1e-12)
+    assert airframe["forces/fbx-external-lbs"] == pytest.approx(-0.5 * U.LBF_PER_N, rel=1e-12)
+    assert airframe["moments/m-external-lbsft"] == pytest.approx(
+        0.3 * U.LBF_FT_PER_N_M, rel=1e-12
+    )
+    t0 = airframe["simulation/sim-time-sec"]
+    with airframe.capturing():
+        for _ in range(3):
+            airframe.step()
+    assert airframe["simulation/sim-time-sec"] == pytest.approx(t0 + 3 * airframe.dt_s)
+    airframe.set_external_reactions()

@@ -221,6 +221,47 @@ def test_initial_condition_validation(airframe):
     assert airframe["position/h-agl-ft"] * U.M_PER_FT > 100.0  # the ground is far below
 
 
+def test_flying_instance_is_set_to_the_companion_trim(airframe):
+    """The flying aircraft (physical rotor inertia) is put at the trim JSBSim found for the
+    companion (effective inertia): same state, controls and propeller RPM, accelerations
+    within JSBSim's trim tolerances."""
+    assert airframe.trim_aircraft == "bioflex_trim"
+    for v in (10.0, 15.0, 25.0):
+        t = airframe.trim(v)
+        companion = airframe._trim_fdm
+        for name in ("propulsion/engine[0]/propeller-rpm", "propulsion/engine[1]/propeller-rpm"):
+            assert airframe[name] == pytest.approx(companion[name], rel=1e-9)
+        for name in ("aero/alpha-rad", "attitude/theta-rad", "fcs/elevator-pos-norm",
+                     "fcs/throttle-pos-norm[1]"):
+            assert airframe[name] == pytest.approx(companion[name], abs=1e-12), name
+        assert airframe["velocities/vt-fps"] * U.M_PER_FT == pytest.approx(v, rel=1e-9)
+        acc = max(abs(t.residuals["udot_m_s2"]), abs(t.residuals["wdot_m_s2"]))
+        assert acc * U.FT_PER_M <= jsbsim_fdm.TRIM_TOLERANCE_FT_S2
+        for key in ("qdot_rad_s2", "pdot_rad_s2", "rdot_rad_s2"):
+            assert abs(t.residuals[key]) <= jsbsim_fdm.TRIM_TOLERANCE_RAD_S2
+        assert 0.0 < airframe.last_rpm_settle_s < jsbsim_fdm.RPM_SETTLE_MAX_S
+
+
+def test_propeller_rpm_follows_the_airspeed_quickly(airframe):
+    """Physical rotor inertia: after a 1 m/s headwind step the RPM reaches its new value
+    within about a second (time constant ≈ 0.3 s), not the several seconds of 8x."""
+    airframe.trim(15.0)
+    rpm0 = airframe["propulsion/engine[0]/propeller-rpm"]
+    try:
+        airframe["atmosphere/wind-north-fps"] = -1.0 / U.M_PER_FT  # headwind (heading north)
+        rpm = []
+        for _ in range(round(1.5 / airframe.dt_s)):
+            airframe.run(1)
+            rpm.append(airframe["propulsion/engine[0]/propeller-rpm"])
+    finally:
+        airframe["atmosphere/wind-north-fps"] = 0.0
+    rpm = np.array(rpm) - rpm0
+    final = rpm[-1]
+    assert abs(final) > 1.0  # the RPM does change with the airspeed
+    k63 = int(np.argmax(np.abs(rpm) >= 0.63 * abs(final)))
+    assert k63 * airframe.dt_s < 0.6
+
+
 def test_trim_holds_in_a_time_simulation(airframe):
     """Five seconds of JSBSim flight from the 15 m/s trim stay at the trim point."""
     t = airframe.trim(15.0)
@@ -239,8 +280,8 @@ GUST_M_S = 0.3  # upward step of the vertical wind [m/s]
 
 def test_symmetric_vertical_gust_stays_symmetric(airframe):
     """The paper's longitudinal case: a 0.3 m/s upward step gust from a wings-level 15 m/s
-    trim. With the contra-rotating pair the propellers' gyroscopic moments (effective
-    inertia 8x physical) and reaction torques cancel exactly, so the lateral motion stays at
+    trim. With the contra-rotating pair the propellers' gyroscopic moments and reaction
+    torques cancel exactly, so the lateral motion stays at
     the level of numerical symmetry. Measured: |r| ~ 1e-5 rad/s, |p| ~ 6e-6 rad/s,
     |beta| ~ 3e-6 rad (the trim bank of ~1.6e-4 rad, which balances the Coriolis
     acceleration of JSBSim's rotating Earth, turns 1.6e-4 of the earth-vertical gust into

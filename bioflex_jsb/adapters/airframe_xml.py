@@ -13,6 +13,9 @@ the named constants of :mod:`bioflex_jsb.units`, and writes the JSBSim files:
                                                       of one rotor of the pair
 ``aircraft/bioflex/reset_cruise.xml``                 initial condition: Table 1 cruise, ISA sea
                                                       level, for scripts and the console program
+``aircraft/bioflex_trim/bioflex_trim.xml``            trim companion: the same aircraft with the
+                                                      effective rotor inertia (see below)
+``aircraft/bioflex_trim/Engines/...``                 its motor and ``bioflex_trim_propeller``
 ``systems/bioflex_flight_controls.xml``               elevator, aileron, rudder, throttle
 ====================================================  =========================================
 
@@ -20,10 +23,9 @@ Propulsion: a contra-rotating pair
 ----------------------------------
 The paper's model is longitudinal, so the propulsion must not couple a symmetric manoeuvre
 into the lateral axes. A single propeller does: its angular momentum I_p·ω·x̂ gives the
-gyroscopic moment PQR × (I_p ω x̂), which turns pitch rate into yaw, and ``PROPULSION``'s
-rotor inertia is an effective value 8 times the physical one (JSBSim's trim finds the RPM by
-0.5 s Euler steps, stable only with that inertia; see its comment), so a 0.3 m/s vertical gust
-gave r ≈ 0.5 q. The drive is therefore rendered as ``PROPULSION.rotor_count`` (2) identical
+gyroscopic moment PQR × (I_p ω x̂), which turns pitch rate into yaw (with 8 times the
+physical rotor inertia a 0.3 m/s vertical gust gave r ≈ 0.5 q). The drive is therefore
+rendered as ``PROPULSION.rotor_count`` (2) identical
 ``electric`` engines, each with 1/2 of the motor power, driving identical propellers at the
 same point of the thrust line with ``<sense>`` +1 and −1. Each propeller has 1/2 of the
 blade-element C_T(J), C_P(J) of :func:`propeller_tables` and 1/2 of the rotor inertia, so at
@@ -33,6 +35,17 @@ momenta and reaction torques cancel exactly (no aileron at trim, a symmetric gus
 symmetric). One throttle lever, ``fcs/throttle-cmd-norm`` (engine 0's command), drives every
 motor's ``fcs/throttle-pos-norm[i]``; JSBSim's trim sets all commands together. Per-rotor
 properties are ``propulsion/engine[i]/...``; the total thrust is their sum.
+
+Two aircraft from the same parameters
+---------------------------------------
+JSBSim's trim finds the propeller RPM by explicit Euler steps of a fixed 0.5 s
+(``FGPropulsion::GetSteadyState``), stable only with a rotor inertia about 8 times the physical
+one (``PROPULSION.trim_rotor_inertia_kg_m2``, see its comment). The flying aircraft
+``bioflex`` has the physical ``rotor_inertia_kg_m2``, so the RPM (and the thrust) follows the
+airspeed within ≈ 0.3 s in time simulations; the trim companion ``bioflex_trim`` is the same
+rendering with the effective inertia in its propeller file ``bioflex_trim_propeller`` and
+nothing else changed. Its steady states are the flying aircraft's; :mod:`jsbsim_fdm` trims it
+and sets the flying aircraft to that trim.
 
 The committed files are this module's output; ``python -m bioflex_jsb.adapters.airframe_xml``
 rewrites them (``--root DIR`` writes elsewhere) and a test checks they are up to date. Edit the
@@ -114,6 +127,10 @@ from bioflex_jsb.parameters.airframe import (
 AIRCRAFT_NAME = "bioflex"
 ENGINE_FILE = "bioflex_motor"
 PROPELLER_FILE = "bioflex_propeller"
+# Trim companion: the same aircraft with the effective rotor inertia (module docstring).
+TRIM_SUFFIX = "_trim"
+TRIM_AIRCRAFT_NAME = AIRCRAFT_NAME + TRIM_SUFFIX
+TRIM_PROPELLER_FILE = PROPELLER_FILE.replace("bioflex", TRIM_AIRCRAFT_NAME, 1)
 SYSTEM_FILE = "bioflex_flight_controls"
 INIT_FILE = "reset_cruise"
 
@@ -365,11 +382,15 @@ def render_aircraft(
     geom: AirframeGeometry = AIRFRAME_GEOMETRY,
     stall: PostStall = POST_STALL,
     prop: Propulsion = PROPULSION,
+    trim_companion: bool = False,
 ) -> str:
-    """Text of ``aircraft/bioflex/bioflex.xml``."""
+    """Text of ``aircraft/bioflex/bioflex.xml`` (``trim_companion``: of
+    ``aircraft/bioflex_trim/bioflex_trim.xml``, the same with the effective-inertia propeller)."""
+    name = TRIM_AIRCRAFT_NAME if trim_companion else AIRCRAFT_NAME
+    propeller_file = TRIM_PROPELLER_FILE if trim_companion else PROPELLER_FILE
     root = ET.Element(
         "fdm_config",
-        {"name": AIRCRAFT_NAME, "version": "2.0", "release": "PRODUCTION"},
+        {"name": name, "version": "2.0", "release": "PRODUCTION"},
     )
     root.set("xmlns:xsi", "http://www.w3.org/2001/XMLSchema-instance")
     root.set("xsi:noNamespaceSchemaLocation", "http://jsbsim.sourceforge.net/JSBSim.xsd")
@@ -382,7 +403,12 @@ def render_aircraft(
         hdr,
         "description",
         "Rigid airframe of the 2.5 kg bio-inspired elastic-wing UAV (paper Table 1) with "
-        "estimated aerodynamics calibrated to the rigid short period of Table 3.",
+        "estimated aerodynamics calibrated to the rigid short period of Table 3."
+        + (
+            " Trim companion: effective rotor inertia for JSBSim's trim RPM iteration."
+            if trim_companion
+            else ""
+        ),
     )
     _el(
         hdr,
@@ -442,7 +468,7 @@ def render_aircraft(
     for i in range(prop.rotor_count):
         sense = 1.0 if i % 2 == 0 else -1.0
         eng = _el(prop_el, "engine", file=ENGINE_FILE)
-        thr = _el(eng, "thruster", file=PROPELLER_FILE)
+        thr = _el(eng, "thruster", file=propeller_file)
         _xyz(thr, "location", prop_xyz)
         orient = _el(thr, "orient", unit="RAD")
         for axis in ("roll", "pitch", "yaw"):
@@ -608,16 +634,24 @@ def render_engine(prop: Propulsion = PROPULSION) -> str:
     return _serialise(root)
 
 
-def render_propeller(prop: Propulsion = PROPULSION) -> str:
-    """Text of ``aircraft/bioflex/Engines/bioflex_propeller.xml``."""
-    root = ET.Element("propeller", name=PROPELLER_FILE)
+def render_propeller(prop: Propulsion = PROPULSION, trim_companion: bool = False) -> str:
+    """Text of ``aircraft/bioflex/Engines/bioflex_propeller.xml`` (physical rotor inertia) or,
+    with ``trim_companion``, of ``aircraft/bioflex_trim/Engines/bioflex_trim_propeller.xml``
+    (effective inertia for JSBSim's trim; everything else identical)."""
+    root = ET.Element("propeller", name=TRIM_PROPELLER_FILE if trim_companion else PROPELLER_FILE)
+    inertia = (
+        "trim_rotor_inertia_kg_m2 / rotor_count (effective value, 8x physical: JSBSim's trim "
+        "RPM iteration)"
+        if trim_companion
+        else "rotor_inertia_kg_m2 / rotor_count (physical)"
+    )
     _comment(
         root,
-        "one rotor of the contra-rotating pair, PROPULSION (ESTIMATE, airframe.py): "
-        "rotor_inertia_kg_m2 / rotor_count (effective value, 8x physical: trim RPM iteration), "
+        f"one rotor of the contra-rotating pair, PROPULSION (ESTIMATE, airframe.py): {inertia}, "
         "diameter, blades",
     )
-    ixx = prop.rotor_inertia_kg_m2 / prop.rotor_count
+    total = prop.trim_rotor_inertia_kg_m2 if trim_companion else prop.rotor_inertia_kg_m2
+    ixx = total / prop.rotor_count
     _el(root, "ixx", ixx * U.SLUG_FT2_PER_KG_M2, unit="SLUG*FT2")
     _el(root, "diameter", prop.prop_diameter_m * U.FT_PER_M, unit="FT")
     _el(root, "numblades", str(prop.prop_blades))
@@ -712,11 +746,15 @@ def render_initial_condition() -> str:
 def render_all() -> dict[str, str]:
     """All generated files: path relative to the JSBSim root → text."""
     craft = f"aircraft/{AIRCRAFT_NAME}"
+    companion = f"aircraft/{TRIM_AIRCRAFT_NAME}"
     return {
         f"{craft}/{AIRCRAFT_NAME}.xml": render_aircraft(),
         f"{craft}/Engines/{ENGINE_FILE}.xml": render_engine(),
         f"{craft}/Engines/{PROPELLER_FILE}.xml": render_propeller(),
         f"{craft}/{INIT_FILE}.xml": render_initial_condition(),
+        f"{companion}/{TRIM_AIRCRAFT_NAME}.xml": render_aircraft(trim_companion=True),
+        f"{companion}/Engines/{ENGINE_FILE}.xml": render_engine(),
+        f"{companion}/Engines/{TRIM_PROPELLER_FILE}.xml": render_propeller(trim_companion=True),
         f"systems/{SYSTEM_FILE}.xml": render_flight_controls(),
     }
 

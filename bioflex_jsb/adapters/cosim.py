@@ -153,69 +153,72 @@ def run_gust(
     stopped = None
     interrupted = False
     k = 0
+    write_reactions = airframe.external_reaction_writer()  # nodes looked up once
+    step = airframe.step
     try:
-        for k in range(n_steps):
-            t = k * dt
-            w_g = gust.vertical_m_s(t)
-            wind_down_fps = -w_g * U.FT_PER_M
-            wind_node.set_double_value(wind_down_fps)
-            u = nodes["u"].get_double_value()
-            v = nodes["v"].get_double_value()
-            w = nodes["w"].get_double_value()
-            theta = nodes["theta"].get_double_value()
-            phi = nodes["phi"].get_double_value()
-            # air-relative body velocity: subtract the NED wind seen in body axes
-            ua = u + wind_down_fps * math.sin(theta)
-            va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
-            wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
-            alpha = math.atan2(wa, ua)
-            vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
-            rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
-            q_rate = nodes["q"].get_double_value()
-            flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
-            loads = mw.loads(flow)
-            ca, sa = math.cos(alpha), math.sin(alpha)
-            airframe.set_external_reactions(
-                lift_n=loads.lift_n * ca + loads.drag_n * sa,
-                drag_n=loads.drag_n * ca - loads.lift_n * sa,
-                pitch_moment_n_m=loads.pitch_moment_n_m,
-            )
-            airframe.run(1)
-            row = {
-                "u": vt - setup.speed_m_s,
-                "alpha": alpha - trim.alpha_rad,
-                "q": q_rate,
-                "theta": theta - theta0,
-                "n_z": nodes["nz"].get_double_value(),
-                "w_g": w_g,
-                "airspeed_m_s": vt,
-                "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
-                "latitude_rad": nodes["lat"].get_double_value(),
-                "longitude_rad": nodes["lon"].get_double_value(),
-                "phi_rad": phi,
-                "theta_rad": theta,
-                "psi_rad": nodes["psi"].get_double_value(),
-                "p_rad_s": nodes["p"].get_double_value(),
-                "r_rad_s": nodes["r"].get_double_value(),
-                "elevator_rad": nodes["elevator"].get_double_value(),
-                "throttle": nodes["throttle"].get_double_value(),
-                "lift_n": loads.lift_n,
-                "drag_n": loads.drag_n,
-                "pitch_moment_n_m": loads.pitch_moment_n_m,
-            }
-            for i in range(wing.n_modes):
-                row[f"eta{i + 1}"] = float(mw.eta[i])
-                row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
-            for name, value in row.items():
-                data[name][k] = value
-            if on_sample is not None:
-                on_sample(k, t, row)
-            stall_steps += alpha > alpha_peak
-            stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
-                                   nodes["agl"].get_double_value())
-            if stopped:
-                break
-            mw.step(flow)
+        with airframe.capturing():  # JSBSim's output captured once for the loop
+            for k in range(n_steps):
+                t = k * dt
+                w_g = gust.vertical_m_s(t)
+                wind_down_fps = -w_g * U.FT_PER_M
+                wind_node.set_double_value(wind_down_fps)
+                u = nodes["u"].get_double_value()
+                v = nodes["v"].get_double_value()
+                w = nodes["w"].get_double_value()
+                theta = nodes["theta"].get_double_value()
+                phi = nodes["phi"].get_double_value()
+                # air-relative body velocity: subtract the NED wind seen in body axes
+                ua = u + wind_down_fps * math.sin(theta)
+                va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
+                wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
+                alpha = math.atan2(wa, ua)
+                vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+                rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
+                q_rate = nodes["q"].get_double_value()
+                flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
+                loads = mw.loads(flow)
+                ca, sa = math.cos(alpha), math.sin(alpha)
+                write_reactions(
+                    loads.lift_n * ca + loads.drag_n * sa,
+                    loads.drag_n * ca - loads.lift_n * sa,
+                    loads.pitch_moment_n_m,
+                )
+                step()
+                row = {
+                    "u": vt - setup.speed_m_s,
+                    "alpha": alpha - trim.alpha_rad,
+                    "q": q_rate,
+                    "theta": theta - theta0,
+                    "n_z": nodes["nz"].get_double_value(),
+                    "w_g": w_g,
+                    "airspeed_m_s": vt,
+                    "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
+                    "latitude_rad": nodes["lat"].get_double_value(),
+                    "longitude_rad": nodes["lon"].get_double_value(),
+                    "phi_rad": phi,
+                    "theta_rad": theta,
+                    "psi_rad": nodes["psi"].get_double_value(),
+                    "p_rad_s": nodes["p"].get_double_value(),
+                    "r_rad_s": nodes["r"].get_double_value(),
+                    "elevator_rad": nodes["elevator"].get_double_value(),
+                    "throttle": nodes["throttle"].get_double_value(),
+                    "lift_n": loads.lift_n,
+                    "drag_n": loads.drag_n,
+                    "pitch_moment_n_m": loads.pitch_moment_n_m,
+                }
+                for i in range(wing.n_modes):
+                    row[f"eta{i + 1}"] = float(mw.eta[i])
+                    row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
+                for name, value in row.items():
+                    data[name][k] = value
+                if on_sample is not None:
+                    on_sample(k, t, row)
+                stall_steps += alpha > alpha_peak
+                stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
+                                       nodes["agl"].get_double_value())
+                if stopped:
+                    break
+                mw.step(flow)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
         stopped = f"interrupted at t = {k * dt:.3f} s"

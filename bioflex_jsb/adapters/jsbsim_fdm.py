@@ -29,15 +29,40 @@ controls come out at zero. When it fails, :class:`TrimError` carries one line na
 control that ran out (throttle at 1, elevator at a stop, α at the stall limit) or the
 condition that stayed out of tolerance.
 
-One JSBSim detail is handled here: the trim finds the propeller's steady RPM by explicit
-Euler steps of 0.5 s, which cannot start from the propeller at rest (an ``electric`` engine
-at 0 RPM applies its power over 1 rad/s). Before trimming, one normal time step with a
-throttle chosen for the purpose brings both propellers to their windmilling RPM at the trim
-speed; the trim then restarts the airframe from the initial condition (only the RPM carries
-over). The same Euler steps are why ``PROPULSION.rotor_inertia_kg_m2`` is an effective value,
-about 8 times the physical one (see its comment): trim and linearization do not depend on it,
-time simulations see a slower RPM response, and the two rotors' gyroscopic moments, equal
-and opposite, cancel exactly (a symmetric gust stays symmetric).
+Two JSBSim instances: the flying aircraft and its trim companion
+------------------------------------------------------------------
+JSBSim's trim finds the propeller's steady RPM by explicit Euler steps of a fixed 0.5 s
+(``FGPropulsion::GetSteadyState``), stable only with a rotor inertia about 8 times the
+physical one (``PROPULSION.trim_rotor_inertia_kg_m2``). The flying aircraft (``bioflex``)
+has the physical ``rotor_inertia_kg_m2``, so that in time simulations the RPM, and the
+thrust, follow the airspeed within ≈ 0.3 s (quasi-static on the phugoid time scale, as in
+JSBSim's linearization); an 8-times inertia made the RPM lag the airspeed by seconds. The
+generator writes a trim companion (``bioflex_trim``: the same aircraft, only the propeller
+inertia differs), which :class:`Airframe` loads beside the flying instance when its file
+exists. :meth:`Airframe.trim`:
+
+1. trims the companion with ``DoTrim``. The Euler steps cannot start from the propeller at
+   rest (an ``electric`` engine at 0 RPM applies its power over 1 rad/s): one normal time
+   step with a throttle chosen for the purpose first brings both propellers to their
+   windmilling RPM at the trim speed (the trim restarts the airframe from the initial
+   condition; only the RPM carries over);
+2. sets the flying instance to that trim: initial condition (position, Euler angles, body
+   velocities and rates) and every control command copied from the companion; then, with
+   JSBSim's integrators of the airframe state switched off (``eNone``: the airframe holds
+   the trim state while the propeller model keeps integrating its RPM), time steps until
+   both rotors' RPM equal the companion's trim RPM (the same steady state: the inertia
+   does not enter it); finally ``RunIC`` from the trim initial condition with the
+   integrators restored (the RPM carries over, the multistep integrators' history starts
+   afresh);
+3. checks the flying instance is in trim: its accelerations within JSBSim's trim tolerances
+   (``TrimResult.residuals`` are the flying instance's).
+
+The linear model is JSBSim's linearization of the companion at its trim: with the RPM
+residualised as quasi-static (below) the reduced model does not depend on the rotor inertia
+(it only scales the RPM row), so the flying instance's is the same. An aircraft without a
+companion file (``<name>_trim``) is trimmed and linearized itself, as before. In both
+instances the two rotors' gyroscopic moments, equal and opposite, cancel exactly (a
+symmetric gust stays symmetric).
 
 Linearization
 -------------
@@ -48,8 +73,8 @@ paper's rigid longitudinal model x_R = [u, α, q, θ] (u the airspeed perturbati
 
 * residualising the propeller RPM states r (``Rpm0``, ``Rpm1``: one per rotor of the pair)
   as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
-  (the RPM settles in a fraction of the short-period time scale at the physical rotor
-  inertia; JSBSim's state space already re-solves the RPM to steady state at every
+  (the RPM settles in ≈ 0.3 s at the physical rotor inertia; JSBSim's state space already
+  re-solves the RPM to steady state at every
   perturbation, so A_xr is zero to rounding and the thrust change with airspeed is in the u
   column). The rotors of the contra-rotating pair are identical and identically driven, so a
   longitudinal perturbation moves their RPMs together: the RPM states are first reduced to
@@ -73,7 +98,7 @@ import math
 import os
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -100,6 +125,38 @@ TRIM_MODE_FULL = 1
 # A normalised control this close to its stop counts as saturated in the trim diagnosis
 # (JSBSim's trim report prints controls to 2 significant digits).
 SATURATION_MARGIN = 0.01
+# JSBSim's trim tolerances (FGTrimAxis): on udot, wdot [ft/s²] and on qdot, pdot, rdot
+# [rad/s²]; the flying instance, set to the companion's trim, must meet them too.
+TRIM_TOLERANCE_FT_S2 = 1e-3
+TRIM_TOLERANCE_RAD_S2 = 1e-4
+# Settling the flying instance's propeller RPM on the companion's trim RPM (airframe held):
+# relative RPM agreement asked for [-], and the longest settling time allowed [s] (the
+# physical rotor's time constant is ≈ 0.3 s at cruise).
+RPM_SETTLE_REL_TOL = 1e-9
+RPM_SETTLE_MAX_S = 60.0
+# JSBSim's integrator choices (FGPropagate) and the one that holds a state: 0 = eNone.
+_INTEGRATOR_PROPERTIES = (
+    "simulation/integrator/rate/rotational",
+    "simulation/integrator/rate/translational",
+    "simulation/integrator/position/rotational",
+    "simulation/integrator/position/translational",
+)
+_INTEGRATOR_NONE = 0
+# Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
+# throttle commands of every engine are added per aircraft.
+_TRIM_CONTROLS = (
+    "fcs/elevator-cmd-norm",
+    "fcs/aileron-cmd-norm",
+    "fcs/rudder-cmd-norm",
+    "fcs/pitch-trim-cmd-norm",
+    "fcs/roll-trim-cmd-norm",
+    "fcs/yaw-trim-cmd-norm",
+)
+_WIND_PROPERTIES = (
+    "atmosphere/wind-north-fps",
+    "atmosphere/wind-east-fps",
+    "atmosphere/wind-down-fps",
+)
 
 
 class FdmError(Exception):
@@ -243,7 +300,8 @@ class TrimResult:
             thrust_n: total thrust of the pair [N].
         converged: True: JSBSim reported every trim condition within tolerance.
         residuals: the accelerations left: ``udot_m_s2``, ``wdot_m_s2`` [m/s²],
-            ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²].
+            ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²] (of the flying
+            instance, set to the companion's trim; see the module docstring).
     """
 
     speed_m_s: float
@@ -388,12 +446,43 @@ def _zero_thrust_advance_ratio() -> float:
     return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
 
 
+def _load_fdm(root: Path, aircraft: str, path: Path, log: _CapturingLogger) -> jsbsim.FGFDMExec:
+    """A JSBSim instance with ``aircraft`` loaded (messages into ``log``)."""
+    with _captured(log):
+        fdm = jsbsim.FGFDMExec(str(root), None)
+        try:
+            loaded = fdm.load_model(aircraft)
+        except jsbsim.BaseError as exc:
+            raise AircraftLoadError(f"JSBSim rejected {str(path)!r}: {_one_line(exc)}") from None
+    if not loaded:
+        first = next(
+            (
+                _one_line(r.text)
+                for r in log.records
+                if jsbsim.LogLevel.ERROR <= r.level <= jsbsim.LogLevel.FATAL
+            ),
+            "",
+        )
+        raise AircraftLoadError(
+            f"JSBSim could not load {str(path)!r}: {first or 'no reason given'}"
+        )
+    return fdm
+
+
 class Airframe:
-    """One loaded JSBSim instance of the rigid airframe.
+    """One loaded JSBSim instance of the rigid airframe, with its trim companion.
 
     Args:
         root: JSBSim root (see :func:`locate_root`); None for the default search.
-        aircraft: aircraft name (directory and file name under ``aircraft/``).
+        aircraft: aircraft name (directory and file name under ``aircraft/``). When
+            ``aircraft/<name>_trim/<name>_trim.xml`` exists it is loaded too, as the trim
+            companion (module docstring); otherwise the aircraft trims itself.
+
+    Attributes:
+        trim_aircraft: name of the aircraft JSBSim's trim and linearization run on (the
+            companion, or ``aircraft`` itself).
+        load_messages, trim_load_messages: JSBSim's messages while loading the flying
+            aircraft and the companion (empty without one).
     """
 
     def __init__(self, root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT):
@@ -402,31 +491,40 @@ class Airframe:
         self.aircraft_path = aircraft_file(self.root, aircraft)
         self.alpha_limits_rad = _alpha_limits_rad(self.aircraft_path)
         self._log = _CapturingLogger()
-        with _captured(self._log):
-            self._fdm = jsbsim.FGFDMExec(str(self.root), None)
-            try:
-                loaded = self._fdm.load_model(aircraft)
-            except jsbsim.BaseError as exc:
-                raise AircraftLoadError(
-                    f"JSBSim rejected {str(self.aircraft_path)!r}: {_one_line(exc)}"
-                ) from None
-        if not loaded:
-            raise AircraftLoadError(
-                f"JSBSim could not load {str(self.aircraft_path)!r}: "
-                f"{self._first_message(jsbsim.LogLevel.ERROR) or 'no reason given'}"
-            )
+        self._fdm = _load_fdm(self.root, aircraft, self.aircraft_path, self._log)
         self._dt_nominal_s = float(self._fdm.get_delta_t())
         self.engine_count = int(self._fdm.get_propulsion().get_num_engines())
         self.load_messages: tuple[LogRecord, ...] = tuple(self._log.records)
         self._log.records.clear()
+        companion = aircraft + airframe_xml.TRIM_SUFFIX
+        companion_path = aircraft_file(self.root, companion)
+        self.trim_load_messages: tuple[LogRecord, ...] = ()
+        if companion_path.is_file():
+            self.trim_aircraft = companion
+            self._trim_fdm = _load_fdm(self.root, companion, companion_path, self._log)
+            self._trim_fdm.set_dt(self._dt_nominal_s)
+            self.trim_load_messages = tuple(self._log.records)
+            self._log.records.clear()
+            n = int(self._trim_fdm.get_propulsion().get_num_engines())
+            if n != self.engine_count:
+                raise AircraftLoadError(
+                    f"trim companion {str(companion_path)!r} has {n} engines, "
+                    f"{aircraft!r} has {self.engine_count}"
+                )
+        else:
+            self.trim_aircraft = aircraft
+            self._trim_fdm = self._fdm
+        self._nodes: dict[str, object] = {}
+        self.last_rpm_settle_s = 0.0  # time the flying instance's RPM took to settle [s]
 
     # ---- JSBSim messages ----------------------------------------------------------
     @property
     def warnings(self) -> list[str]:
-        """Warnings and errors JSBSim printed while loading the aircraft (one per message)."""
+        """Warnings and errors JSBSim printed while loading the aircraft and its trim
+        companion (one per message)."""
         return [
             _one_line(r.text)
-            for r in self.load_messages
+            for r in self.load_messages + self.trim_load_messages
             if jsbsim.LogLevel.WARN <= r.level <= jsbsim.LogLevel.FATAL
         ]
 
@@ -456,13 +554,18 @@ class Airframe:
             raise KeyError(f"JSBSim has no property {name!r}")
         self._fdm[name] = float(value)
 
+    def _instances(self) -> tuple[jsbsim.FGFDMExec, ...]:
+        return (self._fdm,) if self._trim_fdm is self._fdm else (self._fdm, self._trim_fdm)
+
     def _restore_time_step(self) -> None:
         """FGLinearization leaves the time step at 0 (it suspends integration while
-        perturbing); put back the step the model was loaded with."""
-        if self._fdm.integration_suspended():
-            self._fdm.resume_integration()
-        if self._fdm.get_delta_t() != self._dt_nominal_s:
-            self._fdm.set_dt(self._dt_nominal_s)
+        perturbing); put back the step the model was loaded with (or set with set_dt), in
+        the flying instance and in the companion."""
+        for fdm in self._instances():
+            if fdm.integration_suspended():
+                fdm.resume_integration()
+            if fdm.get_delta_t() != self._dt_nominal_s:
+                fdm.set_dt(self._dt_nominal_s)
 
     # ---- initial conditions ---------------------------------------------------------
     def set_initial_conditions(self, speed_m_s: float, altitude_m: float = 0.0) -> None:
@@ -470,10 +573,10 @@ class Airframe:
         ``altitude_m`` [m] above sea level in JSBSim's standard atmosphere (ISA; 0 m = sea
         level, ρ = 1.225 kg/m³), at 45° latitude where JSBSim's gravity is the standard
         9.806 m/s². The ground is put ``TERRAIN_CLEARANCE_M`` below."""
-        v = _check_speed(speed_m_s)
-        h = _check_altitude(altitude_m)
-        fdm = self._fdm
         self._restore_time_step()
+        self._set_level_ic(self._fdm, _check_speed(speed_m_s), _check_altitude(altitude_m))
+
+    def _set_level_ic(self, fdm: jsbsim.FGFDMExec, v: float, h: float) -> None:
         fdm["ic/lat-geod-rad"] = airframe_xml.INIT_LATITUDE_RAD  # standard gravity there
         fdm["ic/long-gc-rad"] = 0.0
         fdm["ic/terrain-elevation-ft"] = (h - airframe_xml.TERRAIN_CLEARANCE_M) * U.FT_PER_M
@@ -483,32 +586,26 @@ class Airframe:
         for name in ("ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", "ic/alpha-rad"):
             fdm[name] = 0.0
         fdm["ic/vt-fps"] = v * U.FT_PER_M
-        for name in (
-            "fcs/elevator-cmd-norm",
-            "fcs/aileron-cmd-norm",
-            "fcs/rudder-cmd-norm",
-            "fcs/pitch-trim-cmd-norm",
-            "fcs/roll-trim-cmd-norm",
-            "fcs/yaw-trim-cmd-norm",
-        ):
+        for name in _TRIM_CONTROLS:
             fdm[name] = 0.0
         with _captured(self._log):
             fdm.run_ic()
 
-    def _spin_up_propeller(self, speed_m_s: float) -> None:
-        """Bring both propellers from rest to their windmilling RPM at ``speed_m_s`` in one step.
+    def _spin_up_propeller(self, fdm: jsbsim.FGFDMExec, speed_m_s: float) -> None:
+        """Bring both propellers of ``fdm`` (the trim instance) from rest to their windmilling
+        RPM at ``speed_m_s`` in one step.
 
         At 0 RPM JSBSim's propeller turns the engine power P [ft·lbf/s] into a torque of
         P/(1 rad/s), so one step of dt [s] gives ω = throttle·P·dt/I per rotor (each rotor
-        has 1/rotor_count of the power and of the inertia). The throttle for
-        ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set on every engine for that step.
+        has 1/rotor_count of the power and of the inertia, the companion's effective one).
+        The throttle for ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set on every
+        engine for that step.
         """
-        fdm = self._fdm
         n = PROPULSION.rotor_count
         omega_rad_s = (
             2.0 * math.pi * speed_m_s / (_zero_thrust_advance_ratio() * PROPULSION.prop_diameter_m)
         )
-        inertia_slug_ft2 = PROPULSION.rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
+        inertia_slug_ft2 = PROPULSION.trim_rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
         power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
         throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
         for i in range(self.engine_count):
@@ -518,26 +615,106 @@ class Airframe:
 
     # ---- trim -----------------------------------------------------------------------
     def trim(self, speed_m_s: float, altitude_m: float = 0.0) -> TrimResult:
-        """Trim for level flight at ``speed_m_s`` [m/s], ``altitude_m`` [m] (JSBSim full trim).
+        """Trim for level flight in still air at ``speed_m_s`` [m/s], ``altitude_m`` [m]
+        (JSBSim full trim of the companion, the flying instance set to it: module docstring).
 
         Raises:
             ValueError: speed or altitude outside the accepted range.
-            TrimError: JSBSim's trim failed; one-line diagnosis.
+            TrimError: JSBSim's trim failed, or the flying instance is not in trim at the
+                companion's trim point; one-line diagnosis.
         """
         v = _check_speed(speed_m_s)
         h = _check_altitude(altitude_m)
-        self.set_initial_conditions(v, h)
-        self._spin_up_propeller(v)
+        self._restore_time_step()
+        for fdm in self._instances():
+            for name in _WIND_PROPERTIES:
+                fdm[name] = 0.0
+        tfdm = self._trim_fdm
+        self._set_level_ic(tfdm, v, h)
+        self._spin_up_propeller(tfdm, v)
         self._log.records.clear()
         with _captured(self._log):
             try:
-                self._fdm.do_trim(TRIM_MODE_FULL)
+                tfdm.do_trim(TRIM_MODE_FULL)
                 failed = False
             except jsbsim.TrimFailureError:
                 failed = True
         if failed:
+            if tfdm is not self._fdm:  # leave the flying instance at a defined state
+                self._set_level_ic(self._fdm, v, h)
             raise TrimError(self._diagnose_trim_failure(v))
-        return self._trim_result(v, h)
+        if tfdm is not self._fdm:
+            self._fly_at_companion_trim(v)
+        result = self._trim_result(v, h)
+        self._check_in_trim(result)
+        return result
+
+    def _fly_at_companion_trim(self, v: float) -> None:
+        """Set the flying instance to the companion's trim: state, controls, propeller RPM."""
+        src, fdm = self._trim_fdm, self._fdm
+        # position and attitude first, then the body velocities in that attitude
+        fdm["ic/lat-geod-rad"] = src["position/lat-geod-rad"]
+        fdm["ic/long-gc-rad"] = src["position/long-gc-rad"]
+        fdm["ic/terrain-elevation-ft"] = src["position/terrain-elevation-asl-ft"]
+        fdm["ic/h-sl-ft"] = src["position/h-sl-ft"]
+        fdm["ic/phi-rad"] = src["attitude/phi-rad"]
+        fdm["ic/theta-rad"] = src["attitude/theta-rad"]
+        fdm["ic/psi-true-rad"] = src["attitude/psi-rad"]
+        fdm["ic/u-fps"] = src["velocities/u-fps"]
+        fdm["ic/v-fps"] = src["velocities/v-fps"]
+        fdm["ic/w-fps"] = src["velocities/w-fps"]
+        fdm["ic/p-rad_sec"] = src["velocities/p-rad_sec"]
+        fdm["ic/q-rad_sec"] = src["velocities/q-rad_sec"]
+        fdm["ic/r-rad_sec"] = src["velocities/r-rad_sec"]
+        controls = _TRIM_CONTROLS + tuple(
+            f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engine_count)
+        )
+        for name in controls:
+            fdm[name] = src[name]
+        rpm_names = [f"propulsion/engine[{i}]/propeller-rpm" for i in range(self.engine_count)]
+        targets = [float(src[name]) for name in rpm_names]
+        integrators = {name: fdm[name] for name in _INTEGRATOR_PROPERTIES}
+        dt = fdm.get_delta_t()
+        steps = 0
+        with _captured(self._log):
+            fdm.run_ic()
+            try:  # hold the airframe at the trim state; the propellers integrate their RPM
+                for name in _INTEGRATOR_PROPERTIES:
+                    fdm[name] = _INTEGRATOR_NONE
+                limit = max(1, round(RPM_SETTLE_MAX_S / dt))
+                while steps < limit:
+                    fdm.run()
+                    steps += 1
+                    if all(
+                        abs(fdm[name] - target) <= RPM_SETTLE_REL_TOL * abs(target)
+                        for name, target in zip(rpm_names, targets, strict=True)
+                    ):
+                        break
+            finally:
+                for name, value in integrators.items():
+                    fdm[name] = value
+            fdm.run_ic()  # back to the trim state; the RPM carries over
+        self.last_rpm_settle_s = steps * dt
+        rpm = [float(fdm[name]) for name in rpm_names]
+        worst = max(abs(r - t) / abs(t) for r, t in zip(rpm, targets, strict=True))
+        if worst > RPM_SETTLE_REL_TOL:
+            raise TrimError(
+                f"cannot trim at {v:g} m/s: the flying aircraft's propeller RPM did not settle "
+                f"on the trim RPM {targets[0]:.1f} rev/min in {RPM_SETTLE_MAX_S:g} s "
+                f"(relative difference {worst:.1e})"
+            )
+
+    def _check_in_trim(self, result: TrimResult) -> None:
+        """The flying instance's accelerations are within JSBSim's trim tolerances."""
+        r = result.residuals
+        ft_s2 = max(abs(r["udot_m_s2"]), abs(r["wdot_m_s2"])) * U.FT_PER_M
+        rad_s2 = max(abs(r["qdot_rad_s2"]), abs(r["pdot_rad_s2"]), abs(r["rdot_rad_s2"]))
+        if ft_s2 > TRIM_TOLERANCE_FT_S2 or rad_s2 > TRIM_TOLERANCE_RAD_S2:
+            worst = ", ".join(f"{k} {x:.1e}" for k, x in r.items())
+            raise TrimError(
+                f"cannot trim at {result.speed_m_s:g} m/s: the flying aircraft set to the trim "
+                f"companion's trim is out of tolerance ({worst})"
+            )
 
     def _trim_result(self, v: float, h: float) -> TrimResult:
         fdm = self._fdm
@@ -636,8 +813,8 @@ class Airframe:
                 cannot be residualised.
         """
         trim = self.trim(speed_m_s, altitude_m)
-        with _captured(self._log):
-            lin = jsbsim.FGLinearization(self._fdm)
+        with _captured(self._log):  # the companion, at its trim (module docstring)
+            lin = jsbsim.FGLinearization(self._trim_fdm)
             a_full = np.array(lin.system_matrix, dtype=float)
             names = tuple(lin.x_names)
             units = tuple(lin.x_units)
@@ -673,11 +850,40 @@ class Airframe:
         self[prop("modal-pitch")] = float(pitch_moment_n_m) * U.LBF_FT_PER_N_M
         self[prop("modal-roll")] = float(roll_moment_n_m) * U.LBF_FT_PER_N_M
 
+    def external_reaction_writer(self) -> Callable[[float, float, float], None]:
+        """A fast writer of the modal external reactions for a per-step loop:
+        ``write(lift_n, drag_n, pitch_moment_n_m)`` [N, N, N·m], the same directions and
+        units as :meth:`set_external_reactions` (the roll moment is left as it is). The
+        property nodes are looked up once, here."""
+        prop = airframe_xml.external_property
+        set_lift = self.property_node(prop("modal-lift")).set_double_value
+        set_drag = self.property_node(prop("modal-drag")).set_double_value
+        set_pitch = self.property_node(prop("modal-pitch")).set_double_value
+        lbf_per_n, lbf_ft_per_n_m = U.LBF_PER_N, U.LBF_FT_PER_N_M
+
+        def write(lift_n: float, drag_n: float, pitch_moment_n_m: float) -> None:
+            set_lift(lift_n * lbf_per_n)
+            set_drag(drag_n * lbf_per_n)
+            set_pitch(pitch_moment_n_m * lbf_ft_per_n_m)
+
+        return write
+
     def run(self, steps: int = 1) -> None:
         """Advance JSBSim by ``steps`` time steps of its integration step."""
         with _captured(self._log):
             for _ in range(int(steps)):
                 self._fdm.run()
+
+    @contextlib.contextmanager
+    def capturing(self) -> Iterator[None]:
+        """Capture JSBSim's console output for a whole loop of :meth:`step` calls."""
+        with _captured(self._log):
+            yield
+
+    def step(self) -> None:
+        """Advance JSBSim by one time step, without entering the output capture: for a
+        per-step loop inside ``with airframe.capturing():``."""
+        self._fdm.run()
 
     @property
     def dt_s(self) -> float:

@@ -219,7 +219,7 @@ class Propulsion:
     Contra-rotating pair (DECISION, ``rotor_count`` = 2): the paper's model is longitudinal,
     and a symmetric (vertical) gust must leave the airframe symmetric. A single propeller's
     angular momentum I_p·ω·x̂ gives a gyroscopic moment PQR × (I_p ω x̂) that turns pitch rate
-    into yaw (r ≈ 0.5 q with the effective ``rotor_inertia_kg_m2`` below) and its reaction
+    into yaw (r ≈ 0.5 q at 8 × the physical ``rotor_inertia_kg_m2``) and its reaction
     torque needs aileron at trim. The JSBSim rendering therefore splits the drive described
     here (one blade geometry, ``motor_max_shaft_power_w``, ``rotor_inertia_kg_m2``: the
     totals) into ``rotor_count`` identical electric engines, each with 1/rotor_count of the
@@ -241,7 +241,9 @@ class Propulsion:
         prop_section_cl_max: section lift limit (stall) [-].
         prop_section_cd0, prop_section_cd_k: section drag c_d = cd0 + k c_l² [-].
         rotor_inertia_kg_m2: propellers plus motor rotors polar moment of inertia, total of
-            the pair [kg·m²].
+            the pair [kg·m²] (physical: the flying aircraft's rotors).
+        trim_rotor_inertia_kg_m2: effective rotor inertia of the trim companion aircraft,
+            total of the pair [kg·m²] (numerical: JSBSim's trim RPM iteration, see below).
         advance_ratio_max: end of the J = V/(nD) tables [-] (past zero thrust).
         rotor_count: number of contra-rotating rotors the drive is split into [-] (2: a
             pair with opposite senses; must be even so that the senses cancel).
@@ -259,6 +261,7 @@ class Propulsion:
     prop_section_cd0: float
     prop_section_cd_k: float
     rotor_inertia_kg_m2: float
+    trim_rotor_inertia_kg_m2: float
     advance_ratio_max: float
     rotor_count: int = 2
 
@@ -289,18 +292,20 @@ PROPULSION = Propulsion(
     prop_section_cl_max=1.1,  # ESTIMATE: low-Re section stall
     prop_section_cd0=0.020,  # ESTIMATE: Re ≈ 1e5 section drag
     prop_section_cd_k=0.02,  # ESTIMATE
-    # NUMERICAL (an effective value, not the physical one; total of the pair, each rotor
-    # has half): the physical estimate is ≈ 1.5e-4 kg·m² (25 g of blades ≈ m D²/12 × 0.6
-    # tapered = 1.2e-4, motor bells 0.3e-4), but JSBSim's trim brings each rotor's RPM to
-    # steady state by explicit Euler steps of a fixed 0.5 s (FGPropulsion::GetSteadyState),
-    # which is stable only if I > ½ · 0.5 s · |∂(Q_motor − Q_prop)/∂ω| per rotor. Each rotor
-    # has half the torques and half the inertia, so the condition is the single propeller's:
-    # ≈ 1.0e-3 kg·m² in total from 3 to 80 m/s at any throttle; 1.2e-3 adds 20 % margin
-    # (8 × physical). Trim and the (quasi-static in RPM) linearization do not depend on it;
-    # time simulations see a slower RPM response. Its gyroscopic moment, 8 × too large, would
-    # couple pitch into yaw with a single propeller; the contra-rotating pair cancels it
-    # exactly (see the class docstring).
-    rotor_inertia_kg_m2=1.2e-3,
+    # ESTIMATE (total of the pair, each rotor has half): 25 g of blades ≈ m D²/12 × 0.6
+    # tapered = 1.2e-4 kg·m², motor bells 0.3e-4. The flying aircraft (bioflex.xml) has this
+    # physical value: RPM time constant ≈ 0.3 s at cruise, so the thrust follows the airspeed
+    # quasi-statically on the phugoid time scale, as in JSBSim's linearization.
+    rotor_inertia_kg_m2=1.5e-4,
+    # NUMERICAL (an effective value, only in the trim companion aircraft bioflex_trim.xml):
+    # JSBSim's trim brings each rotor's RPM to steady state by explicit Euler steps of a fixed
+    # 0.5 s (FGPropulsion::GetSteadyState), stable only if I > ½ · 0.5 s · |∂(Q_motor −
+    # Q_prop)/∂ω| per rotor. Each rotor has half the torques and half the inertia, so the
+    # condition is the single propeller's: ≈ 1.0e-3 kg·m² in total from 3 to 80 m/s at any
+    # throttle; 1.2e-3 adds 20 % margin (8 × physical). The steady state (trim, and the
+    # linearization with the RPM residualised) does not depend on the inertia; the adapter
+    # trims the companion and sets the flying aircraft to that trim (jsbsim_fdm.Airframe).
+    trim_rotor_inertia_kg_m2=1.2e-3,
     advance_ratio_max=1.3,  # beyond the ≈ 0.9 zero-thrust J of a 12×8
     rotor_count=2,  # DECISION: contra-rotating pair, symmetric gust response (class docstring)
 )
