@@ -1,0 +1,67 @@
+"""``bioflex-jsb export-jsbsim``: the modal wing as JSBSim systems and an aircraft that flies it."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from bioflex_jsb.cli.common import UsageError, add_wing_arguments, print_json, wing_from_args
+
+HELP = """Write a JSBSim root under --out DIR: systems/bioflex_modal_<wing>.xml (the modal wing
+integrated by JSBSim: exact discrete step scheduled on dynamic pressure, loads into the
+airframe's external reactions) and aircraft/bioflex_<wing>/ (the bioflex airframe including
+it, with its trim companion). Fly it with `jsbsim --root=DIR --aircraft=bioflex_<wing>`. The
+system holds for one time step, --dt [s] (default 1/480 s); the trim lift coefficient is that
+of level flight at --speed [m/s]. See docs/native.md."""
+
+
+def register(sub) -> None:
+    from bioflex_jsb.adapters.jsbsim_export import EXPORT_MODELS
+    from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+    p = sub.add_parser("export-jsbsim", help="write the modal wing as JSBSim systems",
+                       description=HELP)
+    add_wing_arguments(p)
+    p.add_argument("--model", choices=EXPORT_MODELS, default="coupled")
+    p.add_argument("--out", required=True, metavar="DIR", help="JSBSim root to write into")
+    p.add_argument("--dt", type=float, default=DEFAULT_DT_S,
+                   help=f"JSBSim step the system is exported for [s] (default {DEFAULT_DT_S:.6g})")
+    p.add_argument("--speed", type=float, default=15.0,
+                   help="trim airspeed of the trim lift coefficient [m/s] (default 15)")
+    p.add_argument("--json", action="store_true", help="print what was written as JSON")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.adapters import jsbsim_export as J
+
+    build = wing_from_args(args)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {args.out!r} is not a directory")
+    try:
+        spec = J.ExportSpec(build.model, build.variant.name, args.model, args.dt, args.speed)
+    except J.ExportError as exc:
+        raise UsageError(str(exc)) from None
+    try:
+        written = J.export(spec, out)
+    except OSError as exc:
+        raise UsageError(f"cannot write into {args.out!r}: {exc.strerror or exc}") from None
+    nums = J.modal_numbers(spec.wing, spec.cl_trim)
+    info = {
+        "out": str(out),
+        "aircraft": J.aircraft_name(spec.variant, spec.model),
+        "system": J.system_name(spec.variant, spec.model),
+        "model": spec.model,
+        "dt_s": spec.dt_s,
+        "files": [str(p) for p in written],
+    }
+    if spec.model == "coupled":
+        info["phi_interp_error"] = J.interpolation_error(nums, spec.dt_s)
+        info["phi_spectral_radius_max_to_30_m_s"] = J.spectral_radius_max(nums, spec.dt_s)
+    if args.json:
+        print_json(info)
+    else:
+        print(f"{spec.model} modal wing {spec.variant!r} for a {spec.dt_s:.6g} s step: "
+              f"aircraft {info['aircraft']} under {out} ({len(written)} files)")
+    return 0
