@@ -1,54 +1,162 @@
-"""MCAP logs of runs (the only module that imports ``mcap``).
+"""MCAP logs of runs: writing (every step of a run), reading back, recovering a killed log.
 
-Topics (JSON-schema encoded, one set per wing model of the run; units in every field name
-and in the schema descriptions):
+This is the only module that imports ``mcap``. Topics (JSON messages with JSON schemas;
+``<model>`` is ``rigid``, ``coupled`` or ``qsd``; units in every field name and in the schema
+descriptions; the full table is in ``docs/logging.md``):
 
-* ``/bioflex/<model>/rigid_body``: perturbations from trim and the flight state;
-* ``/bioflex/<model>/modal``: modal coordinates η [rad] and rates η̇ [rad/s];
-* ``/bioflex/<model>/modal_loads``: the elastic wing's loads on the airframe;
-* ``/bioflex/<model>/gust``: the vertical gust w_g [m/s, up].
+* ``/bioflex/<model>/rigid_body`` (``bioflex.RigidBody``): perturbations from trim, the
+  absolute attitude, body rates, airspeed, load factor, altitude (the position is on
+  ``pose`` and ``location``);
+* ``/bioflex/<model>/modal`` (``bioflex.Modal``): modal coordinates η [rad], rates η̇ [rad/s];
+* ``/bioflex/<model>/modal_loads`` (``bioflex.ModalLoads``): the elastic wing's loads applied;
+* ``/bioflex/<model>/gust`` (``bioflex.Gust``): the vertical gust w_g [m/s, up];
+* ``/bioflex/<model>/controls`` (``bioflex.Controls``): elevator [rad], throttle [-];
+* ``/bioflex/<model>/pose`` (``foxglove.FrameTransform``): ``world`` → ``<model>_body``;
+* ``/bioflex/<model>/location`` (``foxglove.LocationFix``): latitude, longitude [deg], altitude;
+* ``/bioflex/<model>/lti_prediction`` (``bioflex.LtiPrediction``): the linear model's response
+  to the same gust, where one ran alongside (:meth:`RunLog.prediction`).
 
-Log time is simulation time [ns from the run's start]. A metadata record ``bioflex.run``
-holds the command, its arguments, the wing variant and the package versions.
+Frames: ``world`` is a local East-North-Up frame [m] whose origin is the aircraft's position
+at the first sample of the file (flat-Earth tangent plane on the WGS-84 ellipsoid);
+``<model>_body`` is the body frame with x forward, y to port (left), z up (FLU, as Foxglove and
+ROS expect). Log and publish times are simulation time [ns from the run's start].
+
+Metadata records: ``bioflex.run`` (command, its arguments as JSON, the argument list that
+repeats the run, wing variant and overrides, speed, gust and seed, models, time step, package
+and JSBSim versions) and ``bioflex.world_frame`` (the ENU origin).
+
+Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_WALL_S` of
+wall time, or 4096 steps) and written to the operating system at once, so a process killed
+hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed file
+from the complete chunks of such a log. A step's numbers are kept as a tuple and formatted
+when its chunk closes, all seven records of a step by one string formatting (fixed-width
+numbers, so record lengths and index offsets are known in advance).
+
+The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
+the 20 % overhead budget allows at seven messages per step); every record other than the
+messages in a chunk is serialised with the ``mcap`` package's record classes, and the files are
+checked by independent readers in the tests (``@mcap/core``, ``pymcap-cli doctor``).
 """
 
 from __future__ import annotations
 
 import json
+import math
+import operator
 import platform
+import signal
+import struct
+import time
+import zlib
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
-from mcap.writer import CompressionType, Writer
+from mcap.data_stream import RecordBuilder
+from mcap.records import (
+    Channel,
+    Chunk,
+    ChunkIndex,
+    DataEnd,
+    Header,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
 
 from bioflex_jsb import __version__
 
-_SCHEMAS = {
+MAGIC = b"\x89MCAP0\r\n"
+CHUNK_SPAN_S = 0.5  # simulated time per chunk [s]: the most a SIGKILL can lose
+CHUNK_WALL_S = 1.0  # wall time per chunk [s] (runs slower than real time, SITL sessions)
+CHUNK_MAX_BYTES = 4 * 1024 * 1024  # uncompressed chunk size limit [bytes]
+COMPRESSION = "zstd"
+RUN_METADATA = "bioflex.run"
+FRAME_METADATA = "bioflex.world_frame"
+WORLD_FRAME = "world"
+GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
+          "lti_prediction")
+
+_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE = 0x03, 0x04, 0x05
+_OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
+NUMBER = "%.9g"  # numbers of the general path: 9 significant digits (relative ≤ 5e-10)
+_MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
+_HEAD_TAIL = struct.Struct("<IQQ")  # sequence, log time, publish time of a message record
+FIXED_NUMBER = "% .8e"  # fixed-width numbers of the fast path (same 9 significant digits)
+_WGS84_A_M = 6378137.0
+_WGS84_E2 = 6.69437999014e-3
+
+
+def topic(model: str, group: str) -> str:
+    """The topic of ``group`` (one of :data:`GROUPS`) for the wing ``model``."""
+    return f"/bioflex/{model}/{group}"
+
+
+def body_frame(model: str) -> str:
+    return f"{model}_body"
+
+
+def _num(description: str) -> dict:
+    return {"type": "number", "description": description}
+
+
+_TIME = {
+    "type": "object",
+    "title": "time",
+    "description": "simulation time since the start of the run",
+    "properties": {"sec": {"type": "integer", "minimum": 0, "description": "whole seconds [s]"},
+                   "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999,
+                            "description": "nanoseconds [ns]"}},
+}
+
+# Fields of rigid_body, in message order: (field, row key, description).
+_RIGID_FIELDS = (
+    ("du_m_s", "u", "airspeed perturbation from trim [m/s]"),
+    ("dalpha_rad", "alpha", "angle-of-attack perturbation from trim, against the air [rad]"),
+    ("dtheta_rad", "theta", "pitch-angle perturbation from trim [rad]"),
+    ("airspeed_m_s", "airspeed_m_s", "true airspeed [m/s]"),
+    ("n_z", "n_z", "load factor, up, 1 in level flight [-]"),
+    ("roll_rad", "phi_rad", "roll angle φ, right wing down positive (NED Euler) [rad]"),
+    ("pitch_rad", "theta_rad", "pitch angle θ, nose up positive (NED Euler) [rad]"),
+    ("yaw_rad", "psi_rad", "heading ψ, clockwise from north (NED Euler) [rad]"),
+    ("p_rad_s", "p_rad_s", "roll rate about body x (forward) [rad/s]"),
+    ("q_rad_s", "q", "pitch rate about body y (starboard), nose up [rad/s]"),
+    ("r_rad_s", "r_rad_s", "yaw rate about body z (down) [rad/s]"),
+    ("altitude_m", "altitude_m", "altitude above sea level [m]"),
+)
+# Fields logged only when the run provides them (row key = field name).
+_RIGID_OPTIONAL = (
+    ("alpha_rad", "angle of attack against the air [rad]"),
+    ("beta_rad", "sideslip angle, wind from starboard positive [rad]"),
+    ("v_north_m_s", "inertial velocity, north [m/s]"),
+    ("v_east_m_s", "inertial velocity, east [m/s]"),
+    ("v_down_m_s", "inertial velocity, down [m/s]"),
+)
+
+SCHEMAS: dict[str, dict] = {
     "rigid_body": {
         "title": "bioflex.RigidBody",
-        "description": "Airframe state; perturbations are from the trim at the run start.",
+        "description": "Airframe state after each step; perturbations (d…) are from the trim "
+        "at the run start. The position is on the pose topic (world frame, local ENU) and "
+        "the location topic (WGS-84); the time is the message's log time.",
         "type": "object",
         "properties": {
-            "t_s": {"type": "number", "description": "simulation time [s]"},
-            "u_m_s": {"type": "number", "description": "airspeed perturbation [m/s]"},
-            "alpha_rad": {"type": "number",
-                          "description": "angle-of-attack perturbation against the air [rad]"},
-            "q_rad_s": {"type": "number", "description": "pitch rate, body y, nose up [rad/s]"},
-            "theta_rad": {"type": "number", "description": "pitch-angle perturbation [rad]"},
-            "n_z": {"type": "number", "description": "load factor, up, 1 in level flight [-]"},
-            "airspeed_m_s": {"type": "number", "description": "true airspeed [m/s]"},
-            "altitude_m": {"type": "number", "description": "altitude above sea level [m]"},
+            **{f: _num(d) for f, _, d in _RIGID_FIELDS},
+            **{f: _num(d) for f, d in _RIGID_OPTIONAL},
         },
     },
     "modal": {
         "title": "bioflex.Modal",
-        "description": "Modal coordinates of the elastic wing (perturbations from trim).",
+        "description": "Modal coordinates of the elastic wing (perturbations from trim); "
+        "modes normalised on twist, positive leading edge up (docs/conventions.md).",
         "type": "object",
         "properties": {
-            "t_s": {"type": "number", "description": "simulation time [s]"},
             "eta_rad": {"type": "array", "items": {"type": "number"},
-                        "description": "η_i, mode i+1, normalised on twist [rad]"},
+                        "description": "η_i, element i is mode i+1 [rad]"},
             "eta_dot_rad_s": {"type": "array", "items": {"type": "number"},
-                              "description": "η̇_i [rad/s]"},
+                              "description": "η̇_i, element i is mode i+1 [rad/s]"},
         },
     },
     "modal_loads": {
@@ -56,23 +164,88 @@ _SCHEMAS = {
         "description": "Incremental loads of the elastic wing applied to the airframe.",
         "type": "object",
         "properties": {
-            "t_s": {"type": "number", "description": "simulation time [s]"},
-            "lift_n": {"type": "number", "description": "lift, up, normal to the air velocity [N]"},
-            "drag_n": {"type": "number", "description": "drag, aft, along the air velocity [N]"},
-            "pitch_moment_n_m": {"type": "number",
-                                 "description": "pitching moment about the CG, nose up [N*m]"},
+            "lift_n": _num("lift, up, normal to the air velocity [N]"),
+            "drag_n": _num("drag, aft, along the air velocity [N]"),
+            "pitch_moment_n_m": _num("pitching moment about the CG, nose up [N*m]"),
         },
     },
     "gust": {
         "title": "bioflex.Gust",
-        "description": "Vertical gust applied to the airframe.",
+        "description": "Wind field applied to the airframe (vertical gust only).",
         "type": "object",
         "properties": {
-            "t_s": {"type": "number", "description": "simulation time [s]"},
-            "w_g_m_s": {"type": "number", "description": "vertical gust velocity, up [m/s]"},
+            "w_g_m_s": _num("vertical gust velocity, up [m/s] (JSBSim wind-down = -w_g)"),
+        },
+    },
+    "controls": {
+        "title": "bioflex.Controls",
+        "description": "Control inputs (held at trim in gust runs).",
+        "type": "object",
+        "properties": {
+            "elevator_rad": _num("elevator deflection, trailing edge down positive [rad]"),
+            "throttle": _num("throttle, 0 to 1 [-]"),
+        },
+    },
+    "pose": {
+        "title": "foxglove.FrameTransform",
+        "description": "Aircraft pose: transform from the parent frame `world` (local ENU, "
+        "origin at the first sample of the file) to the child frame `<model>_body` (x "
+        "forward, y left, z up).",
+        "type": "object",
+        "properties": {
+            "timestamp": _TIME,
+            "parent_frame_id": {"type": "string", "description": "parent frame (world)"},
+            "child_frame_id": {"type": "string", "description": "child frame (<model>_body)"},
+            "translation": {
+                "type": "object", "title": "foxglove.Vector3",
+                "description": "body origin (CG) in the world frame [m]",
+                "properties": {"x": _num("east [m]"), "y": _num("north [m]"),
+                               "z": _num("up [m]")},
+            },
+            "rotation": {
+                "type": "object", "title": "foxglove.Quaternion",
+                "description": "rotation of the body frame in the world frame [-]",
+                "properties": {"x": _num("x [-]"), "y": _num("y [-]"), "z": _num("z [-]"),
+                               "w": _num("w [-]")},
+            },
+        },
+    },
+    "location": {
+        "title": "foxglove.LocationFix",
+        "description": "Aircraft position on the WGS-84 ellipsoid (exact, from the simulation).",
+        "type": "object",
+        "properties": {
+            "timestamp": _TIME,
+            "frame_id": {"type": "string", "description": "frame at the position (body)"},
+            "latitude": _num("geodetic latitude [deg]"),
+            "longitude": _num("longitude [deg]"),
+            "altitude": _num("altitude above sea level [m]"),
+            "position_covariance": {
+                "type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9,
+                "description": "ENU position covariance, row-major [m^2] (zero: exact)"},
+            "position_covariance_type": {
+                "type": "integer", "enum": [0, 1, 2, 3],
+                "description": "0 unknown, 1 approximated, 2 diagonal known, 3 known"},
+        },
+    },
+    "lti_prediction": {
+        "title": "bioflex.LtiPrediction",
+        "description": "Response of the linear model (Eq. 4) to the same gust samples, as "
+        "perturbations from trim.",
+        "type": "object",
+        "properties": {
+            "du_m_s": _num("airspeed perturbation [m/s]"),
+            "dalpha_rad": _num("angle-of-attack perturbation, against the air [rad]"),
+            "q_rad_s": _num("pitch rate [rad/s]"),
+            "dtheta_rad": _num("pitch-angle perturbation [rad]"),
+            "n_z": _num("load factor [-]"),
+            "eta_rad": {"type": "array", "items": {"type": "number"},
+                        "description": "modal coordinates, element i is mode i+1 [rad]"},
         },
     },
 }
+for _s in SCHEMAS.values():
+    _s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
 
 
 def _version(package: str) -> str:
@@ -84,24 +257,337 @@ def _version(package: str) -> str:
         return "unknown"
 
 
-class RunLog:
-    """An open MCAP file that runs write their samples into."""
+@contextmanager
+def _signals_deferred():
+    """Hold SIGINT/SIGTERM while a chunk or the summary is written (no half-written record)."""
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    except (AttributeError, ValueError, OSError):  # not Unix or not the main thread
+        old = None
+    try:
+        yield
+    finally:
+        if old is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
-    def __init__(self, path: Path, writer: Writer, stream) -> None:
-        self.path = path
-        self._writer = writer
+
+def _message_index(channel_id: int, entries: list[tuple[int, int]]) -> bytes:
+    """A Message Index record (opcode 0x07): channel id, then (log time, offset) pairs."""
+    n = len(entries)
+    flat = [x for pair in entries for x in pair]
+    return struct.pack(f"<BQHI{2 * n}Q", 0x07, 6 + 16 * n, channel_id, 16 * n, *flat)
+
+
+def _record_bytes(record) -> bytes:
+    b = RecordBuilder()
+    record.write(b)
+    return b.end()
+
+
+class McapFileWriter:
+    """A chunked, indexed MCAP writer built for many small messages per step.
+
+    Messages go into the chunk in progress with :meth:`append` (cheap: one ``struct`` pack and
+    a bytearray append); the chunk is closed by the caller's policy (:meth:`chunk_due`), and
+    each closed chunk is compressed, written with its message indexes and flushed to the
+    operating system. :meth:`finish` writes the summary (schemas, channels, statistics, chunk
+    and metadata indexes, summary offsets) and the footer with its CRC.
+    """
+
+    def __init__(self, stream, library: str) -> None:
+        import zstandard
+
         self._stream = stream
+        # level 1: twice as fast as the default 3 and as small on these JSON chunks
+        self._compress = zstandard.ZstdCompressor(level=1).compress
+        self._crc = 0
+        self._offset = 0
+        self._schemas: list[Schema] = []
+        self._channels: list[Channel] = []
+        self._chunk_indexes: list[ChunkIndex] = []
+        self._metadata_indexes: list[MetadataIndex] = []
+        self._counts: dict[int, int] = {}
+        self._start_ns: int | None = None
+        self._end_ns = 0
+        self._n_messages = 0
+        self._buf = bytearray()
+        self._index: dict[int, list[tuple[int, int]]] = {}
+        self.chunk_opened_wall_s = time.monotonic()
+        self.chunk_first_ns: int | None = None
+        self.finished = False
+        self._write(MAGIC + _record_bytes(Header(profile="", library=library)))
+
+    def _write(self, data: bytes) -> None:
+        self._stream.write(data)
+        self._crc = zlib.crc32(data, self._crc)
+        self._offset += len(data)
+
+    def add_schema(self, name: str, data: dict) -> int:
+        schema = Schema(id=len(self._schemas) + 1, name=name, encoding="jsonschema",
+                        data=json.dumps(data, ensure_ascii=False).encode())
+        self._schemas.append(schema)
+        self._write(_record_bytes(schema))
+        return schema.id
+
+    def add_channel(self, topic_name: str, schema_id: int, metadata: dict[str, str]) -> int:
+        channel = Channel(id=len(self._channels) + 1, topic=topic_name, message_encoding="json",
+                          schema_id=schema_id, metadata=metadata)
+        self._channels.append(channel)
+        self._index[channel.id] = []
+        self._counts[channel.id] = 0
+        self._write(_record_bytes(channel))
+        return channel.id
+
+    def add_metadata(self, name: str, data: dict[str, str]) -> None:
+        record = _record_bytes(Metadata(name=name, metadata=data))
+        self._metadata_indexes.append(MetadataIndex(offset=self._offset, length=len(record),
+                                                    name=name))
+        self._write(record)
+
+    def append(self, channel_id: int, log_ns: int, sequence: int, data: bytes) -> None:
+        """One message into the chunk in progress (log time = publish time = ``log_ns``)."""
+        buf = self._buf
+        self._index[channel_id].append((log_ns, len(buf)))
+        buf += _MSG_HEADER.pack(_OP_MESSAGE, 22 + len(data), channel_id, sequence, log_ns,
+                                log_ns) + data
+        if self.chunk_first_ns is None:
+            self.chunk_first_ns = log_ns
+
+    def append_step(self, log_ns: int, sequence: int, messages) -> None:
+        """Several messages of one log time: ``messages`` holds (channel id, data) pairs.
+
+        The index entries go in first and the bytes last, in one bytearray extension, so an
+        interrupt in between leaves entries past the end of the chunk, which
+        :meth:`close_chunk` drops (the chunk never indexes a message it does not hold).
+        """
+        buf = self._buf
+        offset = len(buf)
+        index = self._index
+        pack = _MSG_HEADER.pack
+        parts = []
+        for cid, data in messages:
+            index[cid].append((log_ns, offset))
+            size = len(data)
+            parts.append(pack(_OP_MESSAGE, 22 + size, cid, sequence, log_ns, log_ns))
+            parts.append(data)
+            offset += 31 + size
+        buf += b"".join(parts)
+        if self.chunk_first_ns is None:
+            self.chunk_first_ns = log_ns
+
+    def append_block(self, block: bytes, index: dict[int, list[tuple[int, int]]]) -> None:
+        """Messages already serialised: ``index`` maps channel id to (log time, offset in
+        ``block``) of each. Callers hold signals (see RunLog.flush)."""
+        base = len(self._buf)
+        for cid, entries in index.items():
+            if base:
+                entries = [(t, o + base) for t, o in entries]
+            self._index[cid].extend(entries)
+            first = entries[0][0]
+            if self.chunk_first_ns is None or first < self.chunk_first_ns:
+                self.chunk_first_ns = first
+        self._buf += block
+
+    def chunk_bytes(self) -> int:
+        return len(self._buf)
+
+    def close_chunk(self) -> None:
+        """Compress and write the chunk in progress with its message indexes; flush."""
+        with _signals_deferred():
+            self._close_chunk()
+
+    def _close_chunk(self) -> None:
+        data = bytes(self._buf)
+        n = len(data)
+        indexes = {}
+        for cid, entries in self._index.items():
+            while entries and entries[-1][1] >= n:  # a message interrupted before its bytes
+                entries.pop()
+            if entries:
+                indexes[cid] = entries
+        self.chunk_opened_wall_s = time.monotonic()
+        self.chunk_first_ns = None
+        if not indexes:
+            self._buf = bytearray()
+            return
+        # each channel's entries are in log-time order (steps, then predictions, in order)
+        start = min(e[0][0] for e in indexes.values())
+        end = max(e[-1][0] for e in indexes.values())
+        compressed = self._compress(data)
+        chunk = _record_bytes(Chunk(compression=COMPRESSION, data=compressed,
+                                    message_start_time=start, message_end_time=end,
+                                    uncompressed_crc=zlib.crc32(data), uncompressed_size=n))
+        chunk_start = self._offset
+        offsets = {}
+        index_bytes = bytearray()
+        for cid, entries in indexes.items():
+            offsets[cid] = chunk_start + len(chunk) + len(index_bytes)
+            index_bytes += _message_index(cid, entries)
+            self._counts[cid] += len(entries)
+            self._n_messages += len(entries)
+        self._chunk_indexes.append(ChunkIndex(
+            message_start_time=start, message_end_time=end, chunk_start_offset=chunk_start,
+            chunk_length=len(chunk), message_index_offsets=offsets,
+            message_index_length=len(index_bytes), compression=COMPRESSION,
+            compressed_size=len(compressed), uncompressed_size=n))
+        self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
+        self._end_ns = max(self._end_ns, end)
+        self._buf = bytearray()
+        for entries in self._index.values():
+            entries.clear()
+        self._write(chunk + bytes(index_bytes))
+        self._stream.flush()
+
+    def finish(self) -> None:
+        """Close the last chunk, write the summary and the footer, flush."""
+        if self.finished:
+            return
+        with _signals_deferred():
+            self._close_chunk()
+            self._write(_record_bytes(DataEnd(data_section_crc=self._crc)))
+            summary_start = self._offset
+            summary = bytearray()
+            groups = []
+
+            def group(opcode: int, records) -> None:
+                start = len(summary)
+                for r in records:
+                    summary.extend(_record_bytes(r))
+                if len(summary) > start:
+                    groups.append(SummaryOffset(group_opcode=opcode,
+                                                group_start=summary_start + start,
+                                                group_length=len(summary) - start))
+
+            group(_OP_SCHEMA, self._schemas)
+            group(_OP_CHANNEL, self._channels)
+            group(_OP_STATISTICS, [Statistics(
+                message_count=self._n_messages, schema_count=len(self._schemas),
+                channel_count=len(self._channels), attachment_count=0,
+                metadata_count=len(self._metadata_indexes),
+                chunk_count=len(self._chunk_indexes),
+                message_start_time=self._start_ns or 0, message_end_time=self._end_ns,
+                channel_message_counts=dict(self._counts))])
+            group(_OP_CHUNK_INDEX, self._chunk_indexes)
+            group(_OP_METADATA_INDEX, self._metadata_indexes)
+            summary_offset_start = summary_start + len(summary)
+            for g in groups:
+                summary.extend(_record_bytes(g))
+            footer_prefix = struct.pack("<BQQQ", 0x02, 20, summary_start, summary_offset_start)
+            crc = zlib.crc32(footer_prefix, zlib.crc32(summary))
+            self._write(bytes(summary) + footer_prefix + struct.pack("<I", crc) + MAGIC)
+            self._stream.flush()
+            self.finished = True
+
+
+class _ModelChannels:
+    """Channel ids and message templates of one wing model."""
+
+    def __init__(self, log: RunLog, model: str, row: dict[str, float]) -> None:
+        n = sum(1 for k in row if k.startswith("eta") and not k.endswith("_dot"))
+        self.ids = {g: log._channel_id(model, g) for g in GROUPS if g != "lti_prediction"}
+        self.seq = 0
+        optional = [f for f, _ in _RIGID_OPTIONAL if f in row]
+        self.rigid_keys = [k for _, k, _ in _RIGID_FIELDS] + optional
+        self.modal_keys = [f"eta{i + 1}" for i in range(n)] + [f"eta{i + 1}_dot"
+                                                               for i in range(n)]
+        rigid_fields = [f for f, _, _ in _RIGID_FIELDS] + optional
+        eta = ",".join(["%s"] * n)
+        frame = body_frame(model)
+        # JSON templates, "%s" for each number; format() turns them into "%.10g" ones
+        templates_s = {
+            "rigid_body": "{" + ",".join(f'"{f}":%s' for f in rigid_fields) + "}",
+            "modal": f'{{"eta_rad":[{eta}],"eta_dot_rad_s":[{eta}]}}',
+            "modal_loads": '{"lift_n":%s,"drag_n":%s,"pitch_moment_n_m":%s}',
+            "gust": '{"w_g_m_s":%s}',
+            "controls": '{"elevator_rad":%s,"throttle":%s}',
+            "pose": '{"timestamp":{"sec":%s,"nsec":%s},"parent_frame_id":"' + WORLD_FRAME
+            + '","child_frame_id":"' + frame + '","translation":{"x":%s,"y":%s,"z":%s},'
+            '"rotation":{"x":%s,"y":%s,"z":%s,"w":%s}}',
+            "location": '{"timestamp":{"sec":%s,"nsec":%s},"frame_id":"' + frame
+            + '","latitude":%s,"longitude":%s,"altitude":%s,'
+            '"position_covariance":[0,0,0,0,0,0,0,0,0],"position_covariance_type":0}',
+        }
+        order = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
+        self.id_list = [self.ids[g] for g in order]
+        self.templates_s = [templates_s[g] for g in order]
+        self.counts = [t.count("%s") for t in self.templates_s]
+        # fixed-width JSON: numbers "% .8e" (15 characters), integers "%10d"
+        fixed = [t.replace('"sec":%s,"nsec":%s', '"sec":%10d,"nsec":%10d')
+                 .replace("%s", FIXED_NUMBER) for t in self.templates_s]
+        self.step_template = ""  # str (latin-1 bytes): str formatting of floats is faster
+        self.offsets = []
+        offset = 0
+        for cid, t, n in zip(self.id_list, fixed, self.counts, strict=True):
+            size = len(t % ((0,) * n))  # every number and integer has its fixed width
+            head = struct.pack("<BQH", _OP_MESSAGE, 22 + size, cid).decode("latin-1")
+            self.step_template += head.replace("%", "%%") + "%s" + t
+            self.offsets.append(offset)
+            offset += 31 + size
+        self.step_size = offset
+        self.n_rigid = len(self.rigid_keys)
+        self.n_modal = len(self.modal_keys)
+        self.i_altitude = self.rigid_keys.index("altitude_m")
+        self.getter = operator.itemgetter(  # the row values one step keeps
+            *self.rigid_keys, *self.modal_keys, "lift_n", "drag_n", "pitch_moment_n_m", "w_g",
+            "elevator_rad", "throttle", "latitude_rad", "longitude_rad", "phi_rad", "theta_rad",
+            "psi_rad")
+
+
+    def general_step(self, values: tuple) -> tuple[bytes, list[int]]:
+        """The seven records of a step in variable width; non-finite numbers become null."""
+        parts, offsets, offset, k = [], [], 0, 0
+        for cid, tpl, n in zip(self.id_list, self.templates_s, self.counts, strict=True):
+            head = values[k].encode("latin-1")
+            nums = values[k + 1:k + 1 + n]
+            k += 1 + n
+            data = (tpl % tuple(x if isinstance(x, int) else _json_number(x)
+                                for x in nums)).encode()
+            parts.append(struct.pack("<BQH", _OP_MESSAGE, 22 + len(data), cid) + head + data)
+            offsets.append(offset)
+            offset += 31 + len(data)
+        return b"".join(parts), offsets
+
+
+def enu_quaternion(roll_rad: float, pitch_rad: float, yaw_rad: float) -> tuple[float, ...]:
+    """(x, y, z, w) of the FLU body frame in the ENU world frame from NED Euler angles.
+
+    NED/FRD Euler angles (φ right wing down, θ nose up, ψ clockwise from north) become the
+    ENU/FLU angles roll φ, pitch −θ, yaw π/2 − ψ; the quaternion is their Z-Y-X product.
+    """
+    hr = 0.5 * roll_rad
+    hp = -0.5 * pitch_rad
+    hy = 0.5 * (0.5 * math.pi - yaw_rad)
+    cr, sr = math.cos(hr), math.sin(hr)
+    cp, sp = math.cos(hp), math.sin(hp)
+    cy, sy = math.cos(hy), math.sin(hy)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+def _json_number(v) -> str:
+    """A number as JSON text (as NUMBER formats it), null if not finite."""
+    v = float(v)
+    return NUMBER % v if math.isfinite(v) else "null"
+
+
+class RunLog:
+    """An open MCAP file that runs write their samples into (see the module docstring)."""
+
+    def __init__(self, path: Path, stream, writer: McapFileWriter) -> None:
+        self.path = path
+        self._stream = stream
+        self._writer = writer
         self._schema_ids: dict[str, int] = {}
-        self._channels: dict[tuple[str, str], int] = {}
-        self._seq: dict[int, int] = {}
-        for name, schema in _SCHEMAS.items():
-            self._schema_ids[name] = writer.register_schema(
-                name=schema["title"], encoding="jsonschema", data=json.dumps(schema).encode()
-            )
+        self._models: dict[str, _ModelChannels] = {}
+        self._origin: tuple[float, float, float, float, float] | None = None
+        self._pending: list[tuple[_ModelChannels, int, int, tuple]] = []
+        self._pending_first_ns: int | None = None
+        self._pending_wall_s = 0.0
         self.closed = False
 
     @classmethod
     def open(cls, path: str | Path, command: str, args, build) -> RunLog:
+        """Create ``path`` and write the run metadata of ``command`` run with ``args``."""
         p = Path(path)
         try:
             stream = open(p, "wb")  # noqa: SIM115 - closed in close()
@@ -109,66 +595,415 @@ class RunLog:
             from bioflex_jsb.cli.common import UsageError
 
             raise UsageError(f"cannot write log {str(p)!r}: {exc.strerror}") from None
-        writer = Writer(stream, chunk_size=64 * 1024, compression=CompressionType.ZSTD)
-        writer.start(profile="", library=f"bioflex-jsb {__version__}")
-        log = cls(p, writer, stream)
-        arguments = {
-            k: (v.text() if hasattr(v, "text") else v)
-            for k, v in vars(args).items()
-            if k != "run"
-        }
-        writer.add_metadata(
-            "bioflex.run",
-            {
-                "command": command,
-                "arguments": json.dumps(arguments, default=str),
-                "wing": json.dumps(build.variant.as_dict()),
-                "mass_basis": build.mass_basis,
-                "bioflex_jsb_version": __version__,
-                "jsbsim_version": _version("jsbsim"),
-                "python": platform.python_version(),
-            },
-        )
+        return cls.local(p, stream, run_metadata(command, args, build))
+
+    @classmethod
+    def local(cls, path: Path, stream, meta: dict[str, str]) -> RunLog:
+        writer = McapFileWriter(stream, library=f"bioflex-jsb {__version__}")
+        log = cls(path, stream, writer)
+        writer.add_metadata(RUN_METADATA, meta)
         return log
 
-    def _channel(self, model: str, group: str) -> int:
-        key = (model, group)
-        if key not in self._channels:
-            self._channels[key] = self._writer.register_channel(
-                topic=f"/bioflex/{model}/{group}",
-                message_encoding="json",
-                schema_id=self._schema_ids[group],
-            )
-        return self._channels[key]
+    # -- channels -----------------------------------------------------------------------
+    def _channel_id(self, model: str, group: str) -> int:
+        if group not in self._schema_ids:
+            schema = SCHEMAS[group]
+            self._schema_ids[group] = self._writer.add_schema(schema["title"], schema)
+        return self._writer.add_channel(topic(model, group), self._schema_ids[group],
+                                        {"model": model})
 
-    def _write(self, model: str, group: str, t_s: float, payload: dict) -> None:
-        cid = self._channel(model, group)
-        seq = self._seq.get(cid, 0)
-        self._seq[cid] = seq + 1
-        ns = int(round(t_s * 1e9))
-        self._writer.add_message(cid, ns, json.dumps(payload).encode(), ns, seq)
+    def _set_origin(self, row: dict[str, float]) -> None:
+        lat0, lon0, h0 = row["latitude_rad"], row["longitude_rad"], row["altitude_m"]
+        s2 = math.sin(lat0) ** 2
+        n_m = _WGS84_A_M / math.sqrt(1.0 - _WGS84_E2 * s2)  # prime vertical radius
+        m_m = n_m * (1.0 - _WGS84_E2) / (1.0 - _WGS84_E2 * s2)  # meridian radius
+        self._origin = (lat0, lon0, h0, (m_m + h0), (n_m + h0) * math.cos(lat0))
+        self._writer.add_metadata(FRAME_METADATA, {
+            "frame": WORLD_FRAME, "axes": "x east, y north, z up [m]",
+            "origin_latitude_rad": repr(lat0), "origin_longitude_rad": repr(lon0),
+            "origin_altitude_m": repr(h0),
+            "projection": "local tangent plane on WGS-84 at the origin (flat Earth)",
+        })
 
+    # -- writing --------------------------------------------------------------------------
     def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
-        """Write one co-simulation sample (a row of the run's channels)."""
-        self._write(model, "rigid_body", t_s, {
-            "t_s": t_s, "u_m_s": row["u"], "alpha_rad": row["alpha"], "q_rad_s": row["q"],
-            "theta_rad": row["theta"], "n_z": row["n_z"], "airspeed_m_s": row["airspeed_m_s"],
-            "altitude_m": row["altitude_m"],
-        })
-        n = sum(1 for k in row if k.startswith("eta") and not k.endswith("_dot"))
-        self._write(model, "modal", t_s, {
-            "t_s": t_s,
-            "eta_rad": [row[f"eta{i + 1}"] for i in range(n)],
-            "eta_dot_rad_s": [row[f"eta{i + 1}_dot"] for i in range(n)],
-        })
-        self._write(model, "modal_loads", t_s, {
-            "t_s": t_s, "lift_n": row["lift_n"], "drag_n": row["drag_n"],
-            "pitch_moment_n_m": row["pitch_moment_n_m"],
-        })
-        self._write(model, "gust", t_s, {"t_s": t_s, "w_g_m_s": row["w_g"]})
+        """Log one co-simulation step (seven messages, one per run topic of ``model``).
+
+        The step's numbers are kept and formatted a chunk at a time (cheaper than per step);
+        the chunk closes every CHUNK_SPAN_S of simulated time or CHUNK_WALL_S of wall time.
+        """
+        ch = self._models.get(model)
+        if ch is None:
+            if self._origin is None:
+                self._set_origin(row)
+            ch = self._models[model] = _ModelChannels(self, model, row)
+        ns = int(round(t_s * 1e9))
+        first = self._pending_first_ns
+        if first is None:
+            self._pending_first_ns = ns
+            self._pending_wall_s = time.monotonic()
+        elif (ns - first >= _CHUNK_SPAN_NS or ns < first
+              or time.monotonic() - self._pending_wall_s >= CHUNK_WALL_S
+              or len(self._pending) >= _MAX_PENDING_STEPS):
+            self.flush()
+            self._pending_first_ns = ns
+            self._pending_wall_s = time.monotonic()
+        self._pending.append((ch, ns, ch.seq, ch.getter(row)))
+        ch.seq += 1
+
+    def _format_pending(self) -> None:
+        """Serialise the kept steps into the chunk in progress.
+
+        Fast path: numbers in fixed width (``% .8e``, 15 characters), so every step of a
+        model is one bytes-formatting of a template holding all seven records, headers
+        included. A step whose numbers do not fit (NaN, infinity, |exponent| ≥ 100) is
+        written by the general path with variable-width numbers and ``null`` for NaN.
+        """
+        if not self._pending:
+            return
+        lat0, lon0, h0, r_north, r_east = self._origin
+        degrees = math.degrees
+        head_pack = _HEAD_TAIL.pack
+        parts: list[bytes] = []
+        index: dict[int, list[tuple[int, int]]] = {}
+        offset = 0
+        for ch, ns, seq, v in self._pending:
+            nr, nm = ch.n_rigid, ch.n_rigid + ch.n_modal
+            lift, drag, moment, w_g, elevator, throttle, lat, lon, phi, theta, psi = v[nm:]
+            h = v[ch.i_altitude]
+            east = (lon - lon0) * r_east
+            north = (lat - lat0) * r_north
+            up = h - h0
+            sec, nsec = divmod(ns, 1_000_000_000)
+            hd = head_pack(seq, ns, ns).decode("latin-1")
+            qx, qy, qz, qw = enu_quaternion(phi, theta, psi)
+            values = (hd, *v[:nr], hd, *v[nr:nm], hd, lift, drag, moment,
+                      hd, w_g, hd, elevator, throttle, hd, sec, nsec, east, north, up,
+                      qx, qy, qz, qw, hd, sec, nsec, degrees(lat), degrees(lon), h)
+            blob = (ch.step_template % values).encode("latin-1")
+            if len(blob) == ch.step_size:
+                offsets = ch.offsets
+            else:
+                blob, offsets = ch.general_step(values)
+            for cid, off in zip(ch.id_list, offsets, strict=True):
+                entries = index.get(cid)
+                if entries is None:
+                    entries = index[cid] = []
+                entries.append((ns, offset + off))
+            parts.append(blob)
+            offset += len(blob)
+        self._pending.clear()
+        self._writer.append_block(b"".join(parts), index)
+
+    def prediction(self, model: str, history) -> None:
+        """Log the LTI prediction ``history`` (a ``TimeHistory`` of the linear model of
+        ``model``) on ``/bioflex/<model>/lti_prediction``, one message per sample."""
+        cid = self._channel_id(model, "lti_prediction")
+        etas = sorted((k for k in history.channels if k.startswith("eta") and k[3:].isdigit()),
+                      key=lambda k: int(k[3:]))
+        zeros = [0.0] * len(history.time_s)
+
+        def col(name):
+            return history.channels[name] if name in history.channels else zeros
+
+        cols = [col(c) for c in ("u", "alpha", "q", "theta", "n_z")]
+        eta_cols = [history.channels[k] for k in etas]
+        w = self._writer
+        for k, t in enumerate(history.time_s):
+            t_s = float(t)
+            payload = {}
+            for name, c in zip(("du_m_s", "dalpha_rad", "q_rad_s", "dtheta_rad", "n_z"), cols,
+                               strict=True):
+                payload[name] = _finite_or_none(float(c[k]))
+            payload["eta_rad"] = [_finite_or_none(float(c[k])) for c in eta_cols]
+            ns = int(round(t_s * 1e9))
+            w.append(cid, ns, k, json.dumps(payload).encode())
+            if w.chunk_bytes() >= CHUNK_MAX_BYTES:
+                w.close_chunk()
+        w.close_chunk()
+
+    def flush(self) -> None:
+        """Write the kept steps as a chunk and hand it to the operating system."""
+        with _signals_deferred():
+            self._format_pending()
+            self._writer.close_chunk()
+        self._pending_first_ns = None
 
     def close(self) -> None:
+        """Finish the file (summary, indexes, footer) and close it; safe to call twice."""
         if not self.closed:
-            self._writer.finish()
-            self._stream.close()
-            self.closed = True
+            try:
+                self.flush()
+                self._writer.finish()
+            finally:
+                self._stream.close()
+                self.closed = True
+
+
+_CHUNK_SPAN_NS = int(CHUNK_SPAN_S * 1e9)
+_MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~1.2 kB per step)
+
+
+def _finite_or_none(v: float):
+    return v if math.isfinite(v) else None
+
+
+def run_metadata(command: str, args, build) -> dict[str, str]:
+    """The ``bioflex.run`` metadata record: everything needed to repeat the run."""
+    arguments = {k: (v.text() if hasattr(v, "text") else v)
+                 for k, v in vars(args).items() if k != "run"}
+    gust = getattr(args, "gust", None)
+    meta = {
+        "command": command,
+        "arguments": json.dumps(arguments, default=str),
+        "argv": json.dumps(rerun_argv(command, arguments)) if command == "gust" else "",
+        "wing": build.variant.name,
+        "wing_variant": json.dumps(build.variant.as_dict(), default=str),
+        "overrides": json.dumps(dict(build.model.coefficients.overrides), default=str),
+        "mass_basis": build.mass_basis,
+        "speed_m_s": repr(getattr(args, "speed", None)),
+        "gust": gust.text() if gust is not None else "",
+        "gust_seed": str(getattr(gust, "seed", "")),
+        "models": ",".join(getattr(args, "models", ()) or ()),
+        "dt_s": repr(getattr(args, "dt", None)),
+        "time_base": "log and publish times are simulation time [ns from the run start]",
+        "bioflex_jsb_version": __version__,
+        "jsbsim_version": _version("jsbsim"),
+        "mcap_version": _version("mcap"),
+        "python": platform.python_version(),
+    }
+    return meta
+
+
+def rerun_argv(command: str, arguments: dict) -> list[str]:
+    """The ``bioflex-jsb`` argument list (without --out/--plot/--json) of a logged run."""
+    if command != "gust":
+        raise ValueError(f"only gust runs can be repeated, this log was written by {command!r}")
+    argv = ["gust", "--wing", str(arguments["wing"]),
+            "--mass-basis", str(arguments["mass_basis"]),
+            "--speed", repr(float(arguments["speed"])),
+            "--gust", str(arguments["gust"]),
+            "--duration", repr(float(arguments["duration"])),
+            "--gust-start", repr(float(arguments["gust_start"])),
+            "--dt", repr(float(arguments["dt"])),
+            "--models", ",".join(arguments["models"])]
+    return argv
+
+
+# ---------------------------------------------------------------------------- reading
+
+
+class LogError(Exception):
+    """A file that is not a readable, finished MCAP log (one line, for the user)."""
+
+
+def check_file(path: str | Path) -> Path:
+    """``path`` as a Path if it is an existing file starting with the MCAP magic."""
+    p = Path(path)
+    if not p.exists():
+        raise LogError(f"{str(p)!r}: no such file")
+    if not p.is_file():
+        raise LogError(f"{str(p)!r} is not a file")
+    with open(p, "rb") as f:
+        head = f.read(len(MAGIC))
+    if head != MAGIC:
+        raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
+    return p
+
+
+def _truncated(p: Path) -> LogError:
+    return LogError(
+        f"{str(p)!r} is truncated (the writer was killed before finishing it); recover the "
+        f"complete chunks with: bioflex-jsb info {str(p)!r} --recover FIXED.mcap"
+    )
+
+
+@contextmanager
+def open_reader(path: str | Path):
+    """An indexed ``mcap`` reader of a finished log, with its summary; LogError otherwise."""
+    from mcap.reader import make_reader
+
+    p = check_file(path)
+    with open(p, "rb") as f:
+        f.seek(0, 2)
+        size = f.tell()
+        if size < 2 * len(MAGIC) + 29:
+            raise _truncated(p)
+        f.seek(size - len(MAGIC))
+        if f.read(len(MAGIC)) != MAGIC:
+            raise _truncated(p)
+        f.seek(0)
+        try:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+        except Exception as exc:  # the mcap package raises several types on bad files
+            raise LogError(f"{str(p)!r}: unreadable MCAP summary ({exc})") from None
+        if summary is None:
+            raise _truncated(p)
+        yield reader, summary
+
+
+def read_metadata(reader) -> dict[str, dict[str, str]]:
+    try:
+        return {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    except Exception as exc:
+        raise LogError(f"unreadable metadata ({exc})") from None
+
+
+def iter_json(reader, topics: list[str] | None = None) -> Iterator[tuple[str, int, dict]]:
+    """(topic, log time [ns], decoded JSON) of every message, in log-time order."""
+    try:
+        for _schema, channel, message in reader.iter_messages(topics=topics,
+                                                              log_time_order=True):
+            yield channel.topic, message.log_time, json.loads(message.data)
+    except LogError:
+        raise
+    except Exception as exc:
+        raise LogError(f"unreadable message data ({exc})") from None
+
+
+def summarise(path: str | Path) -> dict:
+    """Channels (topic, schema, count), duration, chunks and metadata of a finished log."""
+    with open_reader(path) as (reader, summary):
+        stats = summary.statistics
+        counts = dict(stats.channel_message_counts) if stats else {}
+        channels = []
+        for cid, ch in sorted(summary.channels.items()):
+            schema = summary.schemas.get(ch.schema_id)
+            channels.append({"topic": ch.topic, "schema": schema.name if schema else "",
+                             "encoding": ch.message_encoding, "messages": counts.get(cid, 0)})
+        start = stats.message_start_time if stats else 0
+        end = stats.message_end_time if stats else 0
+        meta = read_metadata(reader)
+        return {
+            "file": str(path),
+            "library": reader.get_header().library,
+            "channels": channels,
+            "messages": stats.message_count if stats else sum(counts.values()),
+            "chunks": len(summary.chunk_indexes),
+            "start_s": start * 1e-9,
+            "end_s": end * 1e-9,
+            "duration_s": (end - start) * 1e-9,
+            "metadata": meta,
+        }
+
+
+def histories(path: str | Path) -> tuple[list, dict[str, str]]:
+    """The runs of a log rebuilt as TimeHistory objects (JSBSim runs, then LTI predictions),
+    and its ``bioflex.run`` metadata."""
+    import numpy as np
+
+    from bioflex_jsb.simulation.results import TimeHistory
+
+    with open_reader(path) as (reader, summary):
+        meta = read_metadata(reader).get(RUN_METADATA, {})
+        wanted = [ch.topic for ch in summary.channels.values()
+                  if ch.topic.rsplit("/", 1)[-1] in ("rigid_body", "modal", "gust",
+                                                      "lti_prediction")]
+        cols: dict[tuple[str, str], dict[str, list]] = {}
+        for top, ns, msg in iter_json(reader, wanted):
+            _, _, model, group = top.split("/", 3)
+            key = (model, "lti" if group == "lti_prediction" else "run")
+            d = cols.setdefault(key, {})
+            if group == "rigid_body" or group == "lti_prediction":
+                d.setdefault("time_s", []).append(ns * 1e-9)
+                for name, field in (("u", "du_m_s"), ("alpha", "dalpha_rad"), ("q", "q_rad_s"),
+                                    ("theta", "dtheta_rad"), ("n_z", "n_z")):
+                    d.setdefault(name, []).append(msg.get(field))
+                if group == "lti_prediction":
+                    for i, v in enumerate(msg.get("eta_rad") or []):
+                        d.setdefault(f"eta{i + 1}", []).append(v)
+            elif group == "modal":
+                for i, v in enumerate(msg["eta_rad"]):
+                    d.setdefault(f"eta{i + 1}", []).append(v)
+            elif group == "gust":
+                d.setdefault("w_g", []).append(msg["w_g_m_s"])
+    units = {"u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-",
+             "w_g": "m/s"}
+    runs = []
+    for (model, kind), d in sorted(cols.items(), key=lambda kv: kv[0][1] == "lti"):
+        t = np.asarray(d.pop("time_s", []), dtype=float)
+        n = len(t)
+        channels = {k: np.asarray([np.nan if x is None else x for x in v[:n]], dtype=float)
+                    for k, v in d.items() if len(v) >= n}
+        run = TimeHistory(model, t, channels,
+                          {k: units.get(k, "rad") for k in channels}, {})
+        if kind == "lti":
+            run.meta.update(label=f"LTI {model}", linestyle="--")
+        runs.append(run)
+    return runs, meta
+
+
+def messages_by_topic(path: str | Path) -> dict[str, list[tuple[int, dict]]]:
+    """Every message of a finished log, per topic, in log-time order."""
+    out: dict[str, list[tuple[int, dict]]] = {}
+    with open_reader(path) as (reader, _summary):
+        for top, ns, msg in iter_json(reader):
+            out.setdefault(top, []).append((ns, msg))
+    return out
+
+
+def recover(path: str | Path, out: str | Path) -> dict:
+    """Copy every complete record of a (killed) log into a finished, indexed file ``out``.
+
+    Reads ``path`` sequentially with the ``mcap`` package's non-indexed stream reader
+    (checking each chunk's CRC) and stops at the first incomplete or damaged record.
+    Returns counts and the last log time kept [s].
+    """
+    from mcap.records import Channel as _Channel
+    from mcap.records import Chunk as _Chunk
+    from mcap.records import Message
+    from mcap.records import Schema as _Schema
+    from mcap.stream_reader import StreamReader, breakup_chunk
+    from mcap.writer import CompressionType, Writer
+
+    p = check_file(path)
+    dst = Path(out)
+    if dst.resolve() == p.resolve():
+        raise LogError("--recover must name a new file, not the log itself")
+    schemas: dict[int, int] = {}
+    channels: dict[int, int] = {}
+    n_messages, last_ns, stop = 0, None, "end of file"
+    try:
+        fout = open(dst, "wb")  # noqa: SIM115 - closed below
+    except OSError as exc:
+        raise LogError(f"cannot write {str(dst)!r}: {exc.strerror}") from None
+    with open(p, "rb") as fin, fout:
+        writer = Writer(fout, chunk_size=1024 * 1024, compression=CompressionType.ZSTD)
+        writer.start(profile="", library=f"bioflex-jsb {__version__} (recovered)")
+
+        def handle(record) -> None:
+            nonlocal n_messages, last_ns
+            if isinstance(record, _Schema):
+                if record.id not in schemas:
+                    schemas[record.id] = writer.register_schema(record.name, record.encoding,
+                                                                record.data)
+            elif isinstance(record, _Channel):
+                if record.id not in channels:
+                    channels[record.id] = writer.register_channel(
+                        record.topic, record.message_encoding,
+                        schemas.get(record.schema_id, 0), dict(record.metadata))
+            elif isinstance(record, Message):
+                writer.add_message(channels[record.channel_id], record.log_time, record.data,
+                                   record.publish_time, record.sequence)
+                n_messages += 1
+                last_ns = record.log_time if last_ns is None else max(last_ns, record.log_time)
+            elif isinstance(record, Metadata):
+                writer.add_metadata(record.name, dict(record.metadata))
+
+        records = StreamReader(fin, emit_chunks=True, validate_crcs=True).records
+        try:
+            for record in records:
+                if isinstance(record, _Chunk):
+                    inner = breakup_chunk(record, validate_crc=True)  # whole chunk or nothing
+                    for r in inner:
+                        handle(r)
+                else:
+                    handle(record)
+        except Exception as exc:  # truncated or damaged tail: keep what came before
+            stop = f"{type(exc).__name__} {exc}".strip()
+        writer.finish()
+    return {"file": str(p), "out": str(dst), "messages": n_messages,
+            "channels": len(channels),
+            "last_time_s": None if last_ns is None else last_ns * 1e-9, "stopped_at": stop}
+

@@ -1,0 +1,66 @@
+"""``bioflex-jsb info``: what an MCAP log holds; recovery of a log whose writer was killed."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from bioflex_jsb.cli.common import UsageError, print_json
+
+HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels (topic,
+schema, message count), the number of messages and chunks, the time span [s of simulation
+time] and the metadata records (the run's command and arguments, wing, gust, time step,
+versions). Read through the mcap package's indexed reader. A log whose writer was killed
+(SIGKILL, power loss) has no summary; --recover FIXED.mcap copies every complete chunk of it
+into a new, finished file (at most the last chunk, 0.5 s of simulated time, is lost)."""
+
+
+def register(sub) -> None:
+    p = sub.add_parser("info", help="channels, counts, duration and metadata of an MCAP log",
+                       description=HELP)
+    p.add_argument("file", metavar="FILE.mcap", help="the log")
+    p.add_argument("--recover", metavar="FIXED.mcap",
+                   help="write the complete records of a truncated FILE.mcap to FIXED.mcap")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.adapters.mcap_log import LogError, recover, summarise
+
+    try:
+        if args.recover:
+            result = recover(args.file, args.recover)
+        else:
+            result = summarise(args.file)
+    except LogError as exc:
+        raise UsageError(str(exc)) from None
+    if args.json:
+        print_json(result)
+    elif args.recover:
+        last = result["last_time_s"]
+        print(f"recovered {result['messages']} messages on {result['channels']} channels "
+              f"into {result['out']}" + (f", up to t = {last:.3f} s" if last is not None else "")
+              + f" (read stopped at: {result['stopped_at']})")
+    else:
+        print_summary(result)
+    return 0
+
+
+def print_summary(s: dict) -> None:
+    print(f"{s['file']}: {s['messages']} messages in {s['chunks']} chunks, "
+          f"t = {s['start_s']:.3f} … {s['end_s']:.3f} s ({s['duration_s']:.3f} s), "
+          f"written by {s['library']}")
+    width = max([len(c["topic"]) for c in s["channels"]] + [5])
+    print(f"{'topic':<{width}}  {'schema':<24} {'messages':>8}")
+    for c in s["channels"]:
+        print(f"{c['topic']:<{width}}  {c['schema']:<24} {c['messages']:>8}")
+    for name, record in s["metadata"].items():
+        print(f"metadata {name}:")
+        for key, value in record.items():
+            if value.startswith(("{", "[")):
+                try:
+                    value = json.dumps(json.loads(value), separators=(", ", ": "))
+                except ValueError:
+                    pass
+            print(f"  {key}: {value}")

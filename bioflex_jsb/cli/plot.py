@@ -1,0 +1,50 @@
+"""``bioflex-jsb plot``: time histories of the runs in an MCAP log."""
+
+from __future__ import annotations
+
+import argparse
+
+from bioflex_jsb.cli.common import UsageError, print_json
+
+HELP = """Draw the time histories logged in FILE.mcap (every wing model's run, and the LTI
+prediction where one was logged): airspeed perturbation u [m/s], angle of attack alpha
+[deg], pitch rate q [deg/s], pitch angle theta [deg], load factor n_z [-] and the first
+modal coordinate eta1 [deg], against simulation time [s]. Read through the mcap package."""
+
+
+def register(sub) -> None:
+    p = sub.add_parser("plot", help="time histories of an MCAP log", description=HELP)
+    p.add_argument("file", metavar="FILE.mcap", help="the log")
+    p.add_argument("--out", metavar="FILE.png", default=None,
+                   help="the figure (default: FILE.png beside the log)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from bioflex_jsb.adapters.mcap_log import LogError, histories
+
+    try:
+        runs, meta = histories(args.file)
+    except LogError as exc:
+        raise UsageError(str(exc)) from None
+    if not runs or all(len(r.time_s) == 0 for r in runs):
+        raise UsageError(f"{args.file!r} holds no bioflex run topics to plot")
+    out = args.out or str(Path(args.file).with_suffix(".png"))
+    title = (f"{meta.get('wing', '?')} wing, {meta.get('speed_m_s', '?')} m/s, "
+             f"gust {meta.get('gust', '?')}" if meta else Path(args.file).name)
+    from bioflex_jsb.adapters import plotting
+
+    try:
+        plotting.time_histories(runs, out, title)
+    except OSError as exc:
+        raise UsageError(f"cannot write plot {out!r}: {exc.strerror}") from None
+    if args.json:
+        print_json({"file": args.file, "plot": out,
+                    "runs": [{"model": r.model, "label": str(r.meta.get("label", r.model)),
+                              "samples": len(r.time_s)} for r in runs]})
+    else:
+        print(f"time histories of {len(runs)} run(s) written to {out}")
+    return 0

@@ -1,0 +1,334 @@
+"""MCAP logs: contents, independent readers, interruption (SIGINT, SIGKILL), reading back."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bioflex_jsb import cli
+from bioflex_jsb.adapters import mcap_log
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+ROOT = Path(__file__).resolve().parents[1]
+JS_CHECK = ROOT / "tests" / "js" / "check_mcap.cjs"
+RUN_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
+NEW_COMMANDS = ("info", "plot", "rerun")
+
+
+def main(argv: list[str]) -> int:
+    """``bioflex_jsb.cli.main`` with the log commands registered (a no-op once they are)."""
+    missing = tuple(m for m in NEW_COMMANDS if m not in cli.COMMAND_MODULES)
+    saved = cli.COMMAND_MODULES
+    cli.COMMAND_MODULES = saved + missing
+    try:
+        return cli.main(argv)
+    finally:
+        cli.COMMAND_MODULES = saved
+
+
+@pytest.fixture(scope="module")
+def gust_log(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("log") / "run.mcap"
+    status = cli.main(["gust", "--duration", "1", "--models", "coupled", "--out", str(path),
+                       "--json"])
+    assert status == 0
+    return path
+
+
+STEPS_1S = int(round(1.0 / DEFAULT_DT_S))
+
+
+def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
+    return mcap_log.messages_by_topic(path)
+
+
+def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
+    info = mcap_log.summarise(gust_log)
+    counts = {c["topic"]: c["messages"] for c in info["channels"]}
+    assert counts == {mcap_log.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    schemas = {c["topic"]: c["schema"] for c in info["channels"]}
+    assert schemas["/bioflex/coupled/pose"] == "foxglove.FrameTransform"
+    assert schemas["/bioflex/coupled/location"] == "foxglove.LocationFix"
+    assert info["duration_s"] == pytest.approx((STEPS_1S - 1) * DEFAULT_DT_S, abs=1e-9)
+    run = info["metadata"][mcap_log.RUN_METADATA]
+    assert run["command"] == "gust" and run["wing"] == "optimised"
+    assert run["gust"] == "sharp:3" and run["gust_seed"] == "0"
+    assert float(run["dt_s"]) == DEFAULT_DT_S and run["jsbsim_version"] != "unknown"
+    assert json.loads(run["argv"])[:1] == ["gust"]
+    # chunks close every CHUNK_SPAN_S of simulated time: what a SIGKILL can lose
+    assert info["chunks"] == math.ceil(1.0 / mcap_log.CHUNK_SPAN_S)
+
+
+def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
+    msgs = read_all(gust_log)
+    for group in RUN_GROUPS:
+        schema = mcap_log.SCHEMAS[group]
+        for _ns, m in msgs[mcap_log.topic("coupled", group)][:3]:
+            assert set(m) <= set(schema["properties"]), group
+    pose = msgs["/bioflex/coupled/pose"]
+    ns0, p0 = pose[0]
+    assert set(p0) == {"timestamp", "parent_frame_id", "child_frame_id", "translation",
+                       "rotation"}
+    assert p0["parent_frame_id"] == "world" and p0["child_frame_id"] == "coupled_body"
+    assert p0["translation"] == {"x": 0.0, "y": 0.0, "z": 0.0}  # the ENU origin
+    ns, p = pose[-1]
+    assert p["timestamp"]["sec"] * 10**9 + p["timestamp"]["nsec"] == ns
+    q = p["rotation"]
+    assert math.isclose(math.sqrt(sum(v * v for v in q.values())), 1.0, abs_tol=1e-7)
+    # flying north (ψ ≈ 0) at 15 m/s for 1 s: the aircraft moved ~15 m north, not east
+    assert 13.0 < p["translation"]["y"] < 17.0 and abs(p["translation"]["x"]) < 0.5
+    fix = msgs["/bioflex/coupled/location"][-1][1]
+    assert set(fix) == {"timestamp", "frame_id", "latitude", "longitude", "altitude",
+                        "position_covariance", "position_covariance_type"}
+    assert 44.9 < fix["latitude"] < 45.1 and len(fix["position_covariance"]) == 9
+    rigid = msgs["/bioflex/coupled/rigid_body"]
+    assert [m["airspeed_m_s"] for _, m in rigid[:1]] == [pytest.approx(15.0, abs=1e-6)]
+    gust = [m["w_g_m_s"] for _, m in msgs["/bioflex/coupled/gust"]]
+    assert max(gust) == pytest.approx(3.0)
+
+
+def test_enu_quaternion_matches_the_rotation_matrix():
+    rng = np.random.default_rng(1)
+    for phi, theta, psi in rng.uniform(-1.2, 1.2, size=(20, 3)):
+        x, y, z, w = mcap_log.enu_quaternion(phi, theta, psi)
+        r_q = np.array([
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ])
+        cf, sf, ct, st, cp, sp = (np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta),
+                                  np.cos(psi), np.sin(psi))
+        # body FRD → NED (aerospace 3-2-1), then NED → ENU and FLU → FRD
+        r_ned_frd = np.array([
+            [ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp],
+            [ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp],
+            [-st, sf * ct, cf * ct],
+        ])
+        ned_to_enu = np.array([[0, 1, 0], [1, 0, 0], [0, 0, -1]])
+        flu_to_frd = np.diag([1, -1, -1])
+        assert np.allclose(r_q, ned_to_enu @ r_ned_frd @ flu_to_frd, atol=1e-12)
+
+
+def _node_checker(tmp_path_factory):
+    node, npm = shutil.which("node"), shutil.which("npm")
+    if not node or not npm:
+        pytest.skip("node/npm are not installed: the @mcap/core check cannot run")
+    where = tmp_path_factory.mktemp("mcapjs")
+    (where / "package.json").write_text('{"name": "mcap-check", "private": true}\n')
+    done = subprocess.run([npm, "install", "--no-audit", "--no-fund", "@mcap/core",
+                           "@foxglove/wasm-zstd"], cwd=where, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    shutil.copy(JS_CHECK, where / JS_CHECK.name)
+
+    def check(path: Path) -> dict:
+        out = subprocess.run([node, JS_CHECK.name, str(path)], cwd=where, capture_output=True,
+                             text=True, timeout=120)
+        assert out.returncode == 0, out.stderr
+        return json.loads(out.stdout)
+
+    return check
+
+
+@pytest.fixture(scope="module")
+def node_check(tmp_path_factory):
+    return _node_checker(tmp_path_factory)
+
+
+def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
+    result = node_check(gust_log)
+    expected = {mcap_log.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    assert result["counts"] == expected  # read through the chunk indexes, CRCs checked
+    assert result["statistics"] == expected
+    assert result["dataCrcOk"] is True and result["ordered"] is True
+    assert result["schemas"]["/bioflex/coupled/location"] == "foxglove.LocationFix"
+
+
+def test_pymcap_cli_doctor(gust_log):
+    exe = shutil.which("pymcap-cli")
+    if exe is None:
+        pytest.fail("pymcap-cli is missing: install the test extra (pip install '.[test]')")
+    out = subprocess.run([exe, "doctor", str(gust_log)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "passed" in out.stdout and "error" not in out.stdout.lower()
+
+
+def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
+    assert main(["info", str(gust_log), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["messages"] == STEPS_1S * len(RUN_GROUPS)
+    png = tmp_path / "run.png"
+    assert main(["plot", str(gust_log), "--out", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    assert "written to" in capsys.readouterr().out
+    again = tmp_path / "again.mcap"
+    assert main(["rerun", str(gust_log), "--out", str(again), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["equal"] is True and result["first_difference"] is None
+    assert result["command"][1:3] == ["gust", "--wing"]
+    assert mcap_log.summarise(again)["messages"] == STEPS_1S * len(RUN_GROUPS)
+
+
+def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
+    from bioflex_jsb.cli.rerun import compare_logs
+
+    same = compare_logs(str(gust_log), str(gust_log), 1e-8)
+    assert same["equal"] and same["messages"] == STEPS_1S * len(RUN_GROUPS)
+    other = tmp_path / "other.mcap"
+    assert cli.main(["gust", "--duration", "1", "--models", "coupled", "--gust", "sharp:2",
+                     "--out", str(other), "--json"]) == 0
+    capsys.readouterr()
+    diff = compare_logs(str(gust_log), str(other), 1e-8)
+    assert not diff["equal"] and "/bioflex/coupled/" in diff["first_difference"]
+
+
+@pytest.mark.parametrize("command", ["info", "plot", "rerun"])
+def test_bad_files_exit_2_with_one_line(command, gust_log, tmp_path, capsys):
+    truncated = tmp_path / "cut.mcap"
+    truncated.write_bytes(gust_log.read_bytes()[:20_000])
+    text = tmp_path / "text.mcap"
+    text.write_text("not a log\n")
+    extra = ["--out", str(tmp_path / "x.mcap")] if command == "rerun" else []
+    for bad, words in ((tmp_path / "missing.mcap", "no such file"),
+                       (text, "not an MCAP file"), (truncated, "--recover")):
+        assert main([command, str(bad), *extra]) == 2
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1 and words in err, err
+
+
+def test_non_finite_numbers_are_written_as_null(tmp_path):
+    row = {k: 0.01 for k in ("u", "alpha", "q", "theta", "w_g", "latitude_rad",
+                             "longitude_rad", "phi_rad", "theta_rad", "psi_rad", "p_rad_s",
+                             "r_rad_s", "elevator_rad", "throttle", "lift_n", "drag_n",
+                             "pitch_moment_n_m", "eta1", "eta1_dot")}
+    row.update(n_z=1.0, airspeed_m_s=15.0, altitude_m=100.0)
+    log = _bare_log(tmp_path / "nan.mcap")
+    log.sample("coupled", 0.0, row)
+    log.sample("coupled", 0.01, {**row, "eta1": float("nan"), "lift_n": float("inf"),
+                                 "u": 1e-300})
+    log.close()
+    msgs = read_all(tmp_path / "nan.mcap")
+    assert msgs["/bioflex/coupled/modal"][1][1]["eta_rad"] == [None]
+    assert msgs["/bioflex/coupled/modal_loads"][1][1]["lift_n"] is None
+    assert msgs["/bioflex/coupled/rigid_body"][1][1]["du_m_s"] == 1e-300
+    assert msgs["/bioflex/coupled/rigid_body"][0][1]["du_m_s"] == 0.01
+
+
+def _bare_log(path: Path) -> mcap_log.RunLog:
+    stream = open(path, "wb")  # noqa: SIM115 - closed by RunLog.close
+    return mcap_log.RunLog(path, stream, mcap_log.McapFileWriter(stream, "test"))
+
+
+def test_lti_prediction_channel(tmp_path, node_check):
+    from bioflex_jsb.simulation.results import TimeHistory
+
+    t = np.arange(50) * 0.01
+    hist = TimeHistory("coupled", t, {"u": np.sin(t), "alpha": t, "q": t, "theta": t,
+                                      "n_z": 1 + t, "eta1": t, "eta2": -t}, {}, {})
+    log = _bare_log(tmp_path / "lti.mcap")
+    log.prediction("coupled", hist)
+    log.close()
+    msgs = read_all(tmp_path / "lti.mcap")["/bioflex/coupled/lti_prediction"]
+    assert len(msgs) == 50 and msgs[10][1]["eta_rad"] == [pytest.approx(0.1), -0.1]
+    assert node_check(tmp_path / "lti.mcap")["counts"] == {
+        "/bioflex/coupled/lti_prediction": 50}
+
+
+def _env():
+    return {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH",
+                                                                                "")}
+
+
+# A gust run that reports each logged step's time on stdout (to know what was flown).
+DRIVER = """
+import sys
+from bioflex_jsb import cli
+from bioflex_jsb.adapters import mcap_log
+original = mcap_log.RunLog.sample
+def sample(self, model, t_s, row):
+    original(self, model, t_s, row)
+    sys.stdout.write(repr(t_s) + "\\n")
+    sys.stdout.flush()
+mcap_log.RunLog.sample = sample
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def _start_run(path: Path, until_s: float):
+    proc = subprocess.Popen(
+        [sys.executable, "-c", DRIVER, "gust", "--duration", "20", "--models", "coupled",
+         "--out", str(path), "--json"],
+        cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    last = None
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        last = float(line)
+        if last >= until_s:
+            return proc, last
+    proc.kill()
+    pytest.fail(f"the run did not reach t = {until_s} s (last {last})")
+
+
+def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
+    path = tmp_path / "int.mcap"
+    proc, _ = _start_run(path, until_s=2.0)
+    proc.send_signal(signal.SIGINT)
+    rest, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    flown = [float(x) for x in rest.split()[:-1] if _is_number(x)]
+    msgs = read_all(path)
+    rigid = msgs["/bioflex/coupled/rigid_body"]
+    n = len(rigid)
+    assert n >= int(2.0 / DEFAULT_DT_S)
+    # every step, none skipped, the same count on every topic, through @mcap/core too
+    assert [ns for ns, _ in rigid] == [round(k * DEFAULT_DT_S * 1e9) for k in range(n)]
+    if flown:
+        assert rigid[-1][0] * 1e-9 == pytest.approx(flown[-1], abs=1e-9)
+    counts = node_check(path)["counts"]
+    assert counts == {mcap_log.topic("coupled", g): n for g in RUN_GROUPS}
+    assert "interrupted" in err and "holds every step" in err
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, capsys):
+    path = tmp_path / "killed.mcap"
+    # killed just before a chunk closes (chunks span [k, k+1) × CHUNK_SPAN_S): the worst case
+    proc, _ = _start_run(path, until_s=3.0 + 0.9 * mcap_log.CHUNK_SPAN_S)
+    proc.kill()
+    rest, _err = proc.communicate(timeout=60)
+    sampled = [float(x) for x in rest.split() if _is_number(x)]
+    last_flown_s = sampled[-1] if sampled else 3.0 + 0.9 * mcap_log.CHUNK_SPAN_S
+    # the killed log has no summary: info says how to recover it
+    assert main(["info", str(path)]) == 2
+    assert "--recover" in capsys.readouterr().err
+    fixed = tmp_path / "fixed.mcap"
+    assert main(["info", str(path), "--recover", str(fixed), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    lost_s = last_flown_s - report["last_time_s"]
+    print(f"SIGKILL at t = {last_flown_s:.3f} s simulated: recovered up to "
+          f"{report['last_time_s']:.3f} s, lost {lost_s:.3f} s")
+    assert 0.0 <= lost_s <= mcap_log.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
+    counts = node_check(fixed)["counts"]
+    n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
+    assert counts == {mcap_log.topic("coupled", g): n for g in RUN_GROUPS}
