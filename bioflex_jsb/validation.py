@@ -94,7 +94,9 @@ def trend_rows(speeds_m_s=(15.0, 20.0), mass_basis: str = DEFAULT_MASS_BASIS) ->
     return rows
 
 
-def flutter_rows(range_m_s=(5.0, 30.0), mass_basis: str = DEFAULT_MASS_BASIS) -> list[eigen.FlutterResult]:
+def flutter_rows(
+    range_m_s=(5.0, 30.0), mass_basis: str = DEFAULT_MASS_BASIS
+) -> list[eigen.FlutterResult]:
     """Flutter search of every named variant."""
     return [
         eigen.find_flutter(build_wing(v, mass_basis=mass_basis).model, range_m_s)

@@ -106,8 +106,9 @@ def base_channels(n_modes: int) -> dict[str, str]:
         "theta_rad": "rad", "psi_rad": "rad", "p_rad_s": "rad/s", "r_rad_s": "rad/s",
         "elevator_rad": "rad", "throttle": "-",
     }
-    for i in range(n_modes):
+    for i in range(n_modes):  # order matters: the loop writes η_1..η_n, then η̇_1..η̇_n
         units[f"eta{i + 1}"] = "rad"
+    for i in range(n_modes):
         units[f"eta{i + 1}_dot"] = "rad/s"
     return units
 
@@ -155,28 +156,33 @@ def run_gust(
     k = 0
     write_reactions = airframe.external_reaction_writer()  # nodes looked up once
     step = airframe.step
+    get = {name: node.get_double_value for name, node in nodes.items()}
+    names = list(units)
+    columns = [data[name] for name in names]
+
+    def sense(t: float):
+        """Write the gust at ``t`` to JSBSim's wind and return the flow the wing sees then,
+        from the airframe's state and that wind, as JSBSim's FGAuxiliary computes it."""
+        w_g = gust.vertical_m_s(t)
+        wind_down_fps = -w_g * U.FT_PER_M
+        wind_node.set_double_value(wind_down_fps)
+        theta, phi = get["theta"](), get["phi"]()
+        # air-relative body velocity: subtract the NED wind seen in body axes
+        ua = get["u"]() + wind_down_fps * math.sin(theta)
+        va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
+        wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
+        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+        rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        flow = FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt)
+        return flow, w_g, theta, phi
+
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop
+            flow, w_g, theta, phi = sense(0.0)
             for k in range(n_steps):
                 t = k * dt
-                w_g = gust.vertical_m_s(t)
-                wind_down_fps = -w_g * U.FT_PER_M
-                wind_node.set_double_value(wind_down_fps)
-                u = nodes["u"].get_double_value()
-                v = nodes["v"].get_double_value()
-                w = nodes["w"].get_double_value()
-                theta = nodes["theta"].get_double_value()
-                phi = nodes["phi"].get_double_value()
-                # air-relative body velocity: subtract the NED wind seen in body axes
-                ua = u + wind_down_fps * math.sin(theta)
-                va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
-                wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
-                alpha = math.atan2(wa, ua)
-                vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
-                rho = nodes["rho"].get_double_value() * U.KG_M3_PER_SLUG_FT3
-                q_rate = nodes["q"].get_double_value()
-                flow = FlowState(alpha, q_rate, vt, 0.5 * rho * vt * vt)
                 loads = mw.loads(flow)
+                alpha = flow.alpha_rad
                 ca, sa = math.cos(alpha), math.sin(alpha)
                 write_reactions(
                     loads.lift_n * ca + loads.drag_n * sa,
@@ -184,41 +190,26 @@ def run_gust(
                     loads.pitch_moment_n_m,
                 )
                 step()
-                row = {
-                    "u": vt - setup.speed_m_s,
-                    "alpha": alpha - trim.alpha_rad,
-                    "q": q_rate,
-                    "theta": theta - theta0,
-                    "n_z": nodes["nz"].get_double_value(),
-                    "w_g": w_g,
-                    "airspeed_m_s": vt,
-                    "altitude_m": nodes["h"].get_double_value() * U.M_PER_FT,
-                    "latitude_rad": nodes["lat"].get_double_value(),
-                    "longitude_rad": nodes["lon"].get_double_value(),
-                    "phi_rad": phi,
-                    "theta_rad": theta,
-                    "psi_rad": nodes["psi"].get_double_value(),
-                    "p_rad_s": nodes["p"].get_double_value(),
-                    "r_rad_s": nodes["r"].get_double_value(),
-                    "elevator_rad": nodes["elevator"].get_double_value(),
-                    "throttle": nodes["throttle"].get_double_value(),
-                    "lift_n": loads.lift_n,
-                    "drag_n": loads.drag_n,
-                    "pitch_moment_n_m": loads.pitch_moment_n_m,
-                }
-                for i in range(wing.n_modes):
-                    row[f"eta{i + 1}"] = float(mw.eta[i])
-                    row[f"eta{i + 1}_dot"] = float(mw.eta_dot[i])
-                for name, value in row.items():
-                    data[name][k] = value
+                values = (
+                    flow.airspeed_m_s - setup.speed_m_s, alpha - trim.alpha_rad, flow.q_rad_s,
+                    theta - theta0, get["nz"](), w_g, flow.airspeed_m_s,
+                    get["h"]() * U.M_PER_FT,
+                    loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
+                    get["lat"](), get["lon"](), phi, theta, get["psi"](), get["p"](),
+                    get["r"](), get["elevator"](), get["throttle"](),
+                    *mw.eta, *mw.eta_dot,
+                )
+                for column, value in zip(columns, values, strict=True):
+                    column[k] = value
                 if on_sample is not None:
-                    on_sample(k, t, row)
+                    on_sample(k, t, dict(zip(names, values, strict=True)))
                 stall_steps += alpha > alpha_peak
-                stopped = _check_range(row, t, alpha, alpha_min, alpha_max, wing.n_modes,
-                                       nodes["agl"].get_double_value())
+                stopped = _check_range(values, names, t, alpha, alpha_min, alpha_max, mw.eta,
+                                       get["agl"]())
                 if stopped:
                     break
-                mw.step(flow)
+                mw.step(flow)  # over [t_k, t_k+1] with the flow of t_k held
+                flow, w_g, theta, phi = sense(t + dt)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
         stopped = f"interrupted at t = {k * dt:.3f} s"
@@ -249,18 +240,18 @@ def run_gust(
     return run
 
 
-def _check_range(row, t, alpha, alpha_min, alpha_max, n_modes, agl_ft) -> str | None:
+def _check_range(values, names, t, alpha, alpha_min, alpha_max, eta, agl_ft) -> str | None:
     """Why the run must stop at this sample, or None."""
-    bad = [name for name, value in row.items() if not math.isfinite(value)]
-    if bad:
-        return f"the state became non-finite ({bad[0]}) at t = {t:.3f} s"
+    if not all(map(math.isfinite, values)):
+        bad = next(n for n, v in zip(names, values, strict=True) if not math.isfinite(v))
+        return f"the state became non-finite ({bad}) at t = {t:.3f} s"
     if not alpha_min <= alpha <= alpha_max:
         return (
             f"angle of attack {math.degrees(alpha):.1f} deg left the aerodynamic model "
             f"({math.degrees(alpha_min):.0f}..{math.degrees(alpha_max):.0f} deg, deep stall) "
             f"at t = {t:.3f} s"
         )
-    etas = [abs(row[f"eta{i + 1}"]) for i in range(n_modes)]
+    etas = [abs(e) for e in eta]
     if etas and max(etas) > ETA_LIMIT_RAD:
         i = int(np.argmax(etas))
         return (
