@@ -23,6 +23,10 @@ COMMAND_MODULES = (
     "export",
     "gust",
     "compare",
+    "export_jsbsim",
+    "info",
+    "plot",
+    "rerun",
     "bench",
 )
 

@@ -8,11 +8,13 @@ import time
 from bioflex_jsb.cli.common import UsageError, positive_float, print_json
 
 HELP = """Time bare JSBSim (the same airframe and time step, no Python in the loop beyond the
-step call) and the co-simulation (JSBSim + modal wing, coupled model, reading the flow and
-writing the loads every step) in the same process, interleaved --repeat times, and print
-microseconds per step of each and their ratio (median over repeats). Also the cost of MCAP
-logging every step (log_ratio = logged / unlogged co-simulation). Machines are shared and
-noisy: compare the ratios, not the absolute times."""
+step call), the co-simulation (JSBSim + Python modal wing, coupled model, reading the flow and
+writing the loads every step), the co-simulation with MCAP logging, and the native XML wing
+(JSBSim alone, the wing exported as JSBSim systems), all at the co-simulation's default step,
+interleaved --repeat times in one process. Prints microseconds per step (median over
+repeats) and the ratios: ratio = co-simulation / bare, log_ratio = logged / unlogged
+co-simulation, native_ratio = native / bare. Machines are shared and noisy: compare the
+ratios, not the absolute times."""
 
 
 def register(sub) -> None:
@@ -32,18 +34,21 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.jsbsim_export import bench_native
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe
     from bioflex_jsb.adapters.mcap_log import RunLog
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
     from bioflex_jsb.simulation.gusts import parse_gust
+    from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
     if args.steps < 10 or args.repeat < 1:
         raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
     airframe = Airframe()
-    build = build_wing(VARIANTS["original"])
+    airframe.set_dt(DEFAULT_DT_S)
+    build = build_wing(VARIANTS["optimised"])
     dt = airframe.dt_s
     setup = RunSetup(args.speed, parse_gust("sharp:0.3"), duration_s=args.steps * dt,
-                     gust_start_s=0.5 * args.steps * dt)
+                     gust_start_s=0.5 * args.steps * dt, dt_s=dt)
 
     def bare() -> float:
         airframe.trim(args.speed)
@@ -61,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"benchmark run stopped: {run.stopped}")
         return elapsed / len(run.time_s)
 
-    bare_t, cosim_t, logged_t = [], [], []
+    bare_t, cosim_t, logged_t, native_t = [], [], [], []
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(args.repeat):
             bare_t.append(bare())
@@ -71,13 +76,16 @@ def run(args: argparse.Namespace) -> int:
                 logged_t.append(cosim(log))
             finally:
                 log.close()
-    b, c, lg = (statistics.median(x) * 1e6 for x in (bare_t, cosim_t, logged_t))
+            native_t.append(bench_native(args.steps, "optimised", args.speed) * 1e-6)
+    b, c, lg, nat = (statistics.median(x) * 1e6 for x in (bare_t, cosim_t, logged_t, native_t))
     payload = {
         "bare_us_per_step": b,
         "cosim_us_per_step": c,
         "ratio": c / b,
         "logged_us_per_step": lg,
         "log_ratio": lg / c,
+        "native_us_per_step": nat,
+        "native_ratio": nat / b,
         "dt_s": dt,
         "steps": args.steps,
         "repeat": args.repeat,
@@ -89,4 +97,5 @@ def run(args: argparse.Namespace) -> int:
         print(f"bare JSBSim        {b:8.1f} µs/step")
         print(f"co-simulation      {c:8.1f} µs/step   ratio {c / b:5.2f}")
         print(f"co-sim + MCAP log  {lg:8.1f} µs/step   log_ratio {lg / c:5.2f}")
+        print(f"native XML wing    {nat:8.1f} µs/step   native_ratio {nat / b:5.2f}")
     return 0
