@@ -1,0 +1,549 @@
+"""Campaign files and their cases (pure: parsing, validation, expansion, case ids, columns).
+
+A campaign is a TOML file (``docs/sweeps.md``)::
+
+    name = "example"
+    metrics = ["gust", "flutter", "eigenvalues", "coefficients"]
+
+    [run]                       # settings shared by every case
+    duration_s = 5.0
+    gust_start_s = 0.5
+
+    [axes]                      # lists, or ranges {start, stop, step} / {start, stop, num}
+    wings = ["original", "optimised"]
+    speeds_m_s = [15.0, 18.0]
+    gusts = ["sharp:3", "dryden:1:100"]
+    seeds = [1, 2]              # turbulence seeds (dryden / vonkarman gusts only)
+    models = ["coupled", "qsd"]
+
+The cases are the Cartesian product of the axes. Every case has a stable id: a hash of
+everything that determines its result (the wing's full definition, speed, gust, model, run
+settings and metrics), so a rerun with ``--resume`` recognises finished cases whatever their
+order or the campaign file they came from. Errors are :class:`CampaignError`, one line that
+names the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import tomllib
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from bioflex_jsb.flight_dynamics.lti import MODELS
+from bioflex_jsb.flight_dynamics.wing_model import (
+    DEFAULT_MASS_BASIS,
+    DEFAULT_N_MODES,
+    MASS_BASES,
+    VARIANTS,
+    VariantError,
+    WingVariant,
+    load_variant_file,
+)
+from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
+MAX_CASES = 1_000_000
+MAX_DT_S = 0.02  # as the gust command: coarser co-simulation steps are refused
+
+METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
+TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
+RUN_KEYS = {"duration_s", "gust_start_s", "dt_s", "mass_basis", "flutter_range_m_s"}
+AXIS_KEYS = {"wings", "x_inertial_frac", "x_elastic_frac", "speeds_m_s", "gusts", "seeds",
+             "models"}
+RANGE_KEYS = {"start", "stop", "step", "num"}
+TURBULENCE = ("dryden", "vonkarman")
+
+# Modes whose eigenvalues the "eigenvalues" metric records (NaN where a model has no such
+# mode: the rigid and QSD models have no aeroelastic modes).
+EIGEN_MODES = ("short_period", "phugoid") + tuple(
+    f"aeroelastic_{i + 1}" for i in range(DEFAULT_N_MODES)
+)
+
+
+class CampaignError(ValueError):
+    """A campaign file that cannot be used; the one-line message names the key."""
+
+
+# ---------------------------------------------------------------------------------------
+# Result columns
+# ---------------------------------------------------------------------------------------
+# name -> type ("str", "float", "int"); None is allowed in every column.
+INPUT_COLUMNS: dict[str, str] = {
+    "case_id": "str",
+    "case_index": "int",
+    "wing": "str",
+    "x_inertial_frac": "float",
+    "x_elastic_frac": "float",
+    "pinned_c_eta1_q1": "float",
+    "speed_m_s": "float",
+    "gust": "str",
+    "gust_kind": "str",
+    "gust_amplitude_m_s": "float",
+    "gust_length_m": "float",
+    "seed": "int",
+    "model": "str",
+    "duration_s": "float",
+    "gust_start_s": "float",
+    "dt_s": "float",
+    "mass_basis": "str",
+}
+STATUS_COLUMNS: dict[str, str] = {
+    "status": "str",  # ok | diverged (the gust run left the valid range) | failed
+    "error": "str",
+}
+METRIC_COLUMNS: dict[str, dict[str, str]] = {
+    "gust": {
+        "peak_du_m_s": "float",
+        "peak_dalpha_rad": "float",
+        "peak_dq_rad_s": "float",
+        "peak_dtheta_rad": "float",
+        "peak_dn_z": "float",
+        "overshoot": "float",
+        "settling_time_s": "float",
+        "time_beyond_stall_s": "float",
+        "time_flown_s": "float",
+    },
+    "flutter": {
+        "flutter_speed_m_s": "float",
+        "flutter_mode": "str",
+        "flutter_frequency_rad_s": "float",
+        "flutter_kind": "str",
+    },
+    "eigenvalues": {
+        f"{mode}_{part}": "float"
+        for mode in EIGEN_MODES
+        for part in ("re_rad_s", "im_rad_s", "damping", "frequency_rad_s")
+    },
+    "coefficients": {
+        "c_eta1_q1": "float",
+        "c_eta1_q1_physical": "float",
+        "e_shift_frac": "float",
+        **{f"mode{i + 1}_frequency_hz": "float" for i in range(DEFAULT_N_MODES)},
+    },
+}
+# Where and when a case ran: differs between runs of the same case, so comparisons of
+# results tables leave these out (:data:`RUN_INFO_COLUMNS`).
+RUN_INFO_COLUMNS: dict[str, str] = {
+    "worker": "str",
+    "started_unix_s": "float",
+    "wall_time_s": "float",
+}
+
+
+def result_columns(metrics: Sequence[str]) -> dict[str, str]:
+    """Every column of a results table for ``metrics``, in order, with its type."""
+    cols = dict(INPUT_COLUMNS)
+    cols.update(STATUS_COLUMNS)
+    for m in METRICS:
+        if m in metrics:
+            cols.update(METRIC_COLUMNS[m])
+    cols.update(RUN_INFO_COLUMNS)
+    return cols
+
+
+# ---------------------------------------------------------------------------------------
+# Cases
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RunSettings:
+    """Settings shared by every case: gust-run duration and gust start [s], co-simulation
+    step [s], mass basis, flutter search range [m/s]."""
+
+    duration_s: float = 5.0
+    gust_start_s: float = 0.5
+    dt_s: float = DEFAULT_DT_S
+    mass_basis: str = DEFAULT_MASS_BASIS
+    flutter_range_m_s: tuple[float, float] = (5.0, 40.0)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One point of a campaign: a wing at a speed through a gust, as one model."""
+
+    index: int
+    wing: WingVariant
+    speed_m_s: float
+    gust: str  # command-line form, seed included for turbulence
+    model: str
+    settings: RunSettings
+    metrics: tuple[str, ...]
+    case_id: str = ""
+
+    def inputs(self) -> dict[str, Any]:
+        """The input columns of this case's row."""
+        g = parse_gust(self.gust)
+        return {
+            "case_id": self.case_id,
+            "case_index": self.index,
+            "wing": self.wing.name,
+            "x_inertial_frac": self.wing.x_inertial_frac,
+            "x_elastic_frac": self.wing.x_elastic_frac,
+            "pinned_c_eta1_q1": self.wing.pinned_c_eta1_q1,
+            "speed_m_s": self.speed_m_s,
+            "gust": self.gust,
+            "gust_kind": g.kind,
+            "gust_amplitude_m_s": g.amplitude_m_s,
+            "gust_length_m": g.length_m,
+            "seed": g.seed if g.kind in TURBULENCE else None,
+            "model": self.model,
+            "duration_s": self.settings.duration_s,
+            "gust_start_s": self.settings.gust_start_s,
+            "dt_s": self.settings.dt_s,
+            "mass_basis": self.settings.mass_basis,
+        }
+
+
+def _wing_identity(wing: WingVariant) -> dict[str, Any]:
+    """The wing's definition for hashing; a modes file enters by its content, not its path."""
+    d = wing.as_dict()
+    d.pop("description", None)
+    if wing.modes_file:
+        try:
+            d["modes_file"] = hashlib.sha256(Path(wing.modes_file).read_bytes()).hexdigest()
+        except OSError:
+            pass  # the build will fail and record the case as failed
+    return d
+
+
+def case_id(case: Case) -> str:
+    """Stable id of ``case``: 16 hex digits of the SHA-256 of its inputs."""
+    payload = {
+        "v": CASE_ID_VERSION,
+        "wing": _wing_identity(case.wing),
+        "speed_m_s": case.speed_m_s,
+        "gust": case.gust,
+        "model": case.model,
+        "settings": dataclasses.asdict(case.settings),
+        "metrics": sorted(case.metrics),
+    }
+    text = json.dumps(payload, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def failed_row(case: Case, error: str) -> dict[str, Any]:
+    """The row of a case that produced no result (every metric None)."""
+    row: dict[str, Any] = {name: None for name in result_columns(case.metrics)}
+    row.update(case.inputs())
+    row["status"] = "failed"
+    row["error"] = " ".join(str(error).split())  # one line
+    return row
+
+
+@dataclass(frozen=True)
+class Campaign:
+    name: str
+    description: str
+    metrics: tuple[str, ...]
+    settings: RunSettings
+    wings: tuple[WingVariant, ...]
+    speeds_m_s: tuple[float, ...]
+    gusts: tuple[str, ...]
+    models: tuple[str, ...]
+    source: str = ""
+
+    def cases(self) -> list[Case]:
+        """The Cartesian product wings × speeds × gusts × models, with ids."""
+        out: list[Case] = []
+        for wing in self.wings:
+            for speed in self.speeds_m_s:
+                for gust in self.gusts:
+                    for model in self.models:
+                        c = Case(len(out), wing, speed, gust, model, self.settings,
+                                 self.metrics)
+                        out.append(dataclasses.replace(c, case_id=case_id(c)))
+        return out
+
+    @property
+    def n_cases(self) -> int:
+        return len(self.wings) * len(self.speeds_m_s) * len(self.gusts) * len(self.models)
+
+    def columns(self) -> dict[str, str]:
+        return result_columns(self.metrics)
+
+
+# ---------------------------------------------------------------------------------------
+# Parsing
+# ---------------------------------------------------------------------------------------
+def load_campaign(path: str | Path) -> Campaign:
+    """Read and check a campaign file; :class:`CampaignError` (one line) if it is bad."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CampaignError(f"campaign file {str(p)!r} not found") from None
+    except OSError as exc:
+        raise CampaignError(f"campaign file {str(p)!r} cannot be read: {exc.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CampaignError(f"{p.name}: not valid TOML: {exc}") from None
+    return parse_campaign(data, source=p.name, base_dir=p.parent, default_name=p.stem)
+
+
+def _is_number(v: Any) -> bool:
+    return not isinstance(v, bool) and isinstance(v, int | float) and math.isfinite(v)
+
+
+def _unknown(table: dict, allowed: set[str], where: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        key = f"{where}.{unknown[0]}" if where else unknown[0]
+        raise CampaignError(f"{key}: unknown key; accepted: {', '.join(sorted(allowed))}")
+
+
+def _number(v: Any, key: str, unit: str, positive: bool = False, minimum: float | None = None,
+            maximum: float | None = None) -> float:
+    if not _is_number(v):
+        raise CampaignError(f"{key}: must be a number in {unit}, got {v!r}")
+    x = float(v)
+    if positive and x <= 0.0:
+        raise CampaignError(f"{key}: must be > 0 {unit}, got {v!r}")
+    if minimum is not None and x < minimum:
+        raise CampaignError(f"{key}: must be ≥ {minimum:g} {unit}, got {v!r}")
+    if maximum is not None and x > maximum:
+        raise CampaignError(f"{key}: must be ≤ {maximum:g} {unit}, got {v!r}")
+    return x
+
+
+def _values(v: Any, key: str, integer: bool = False) -> list:
+    """An axis: a non-empty list, or a range table {start, stop, step | num} (stop included)."""
+    if isinstance(v, dict):
+        _unknown(v, RANGE_KEYS, key)
+        for k in ("start", "stop"):
+            if k not in v:
+                raise CampaignError(f"{key}.{k}: missing; a range is {{start, stop, step}} or "
+                                    "{start, stop, num}")
+        start = _number(v["start"], f"{key}.start", "the axis unit")
+        stop = _number(v["stop"], f"{key}.stop", "the axis unit")
+        if stop < start:
+            raise CampaignError(f"{key}: empty axis (stop {stop:g} < start {start:g})")
+        if "step" in v and "num" in v:
+            raise CampaignError(f"{key}: give step or num, not both")
+        if "num" in v:
+            num = v["num"]
+            if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+                raise CampaignError(f"{key}.num: must be a whole number ≥ 1, got {num!r}")
+            if num == 1:
+                values = [start]
+            else:
+                values = [start + (stop - start) * k / (num - 1) for k in range(num)]
+        else:
+            step = v.get("step", 1 if integer else None)
+            if step is None:
+                raise CampaignError(f"{key}: a range needs step or num")
+            step = _number(step, f"{key}.step", "the axis unit", positive=True)
+            n = int(math.floor((stop - start) / step + 1e-9)) + 1
+            if n > MAX_CASES:
+                raise CampaignError(f"{key}: {n} values is too many (step too small)")
+            values = [start + k * step for k in range(n)]
+        values = [round(x, 12) for x in values]
+        if integer:
+            if not all(float(x).is_integer() for x in values):
+                raise CampaignError(f"{key}: must give whole numbers")
+            values = [int(x) for x in values]
+        return values
+    if not isinstance(v, list):
+        raise CampaignError(f"{key}: must be a list or a range table {{start, stop, step}}, "
+                            f"got {v!r}")
+    if not v:
+        raise CampaignError(f"{key}: empty axis; give at least one value")
+    return list(v)
+
+
+def _unique(values: list, key: str) -> list:
+    seen = []
+    for x in values:
+        if x in seen:
+            raise CampaignError(f"{key}: {x!r} appears twice")
+        seen.append(x)
+    return seen
+
+
+def parse_campaign(
+    data: dict, source: str = "campaign", base_dir: Path | None = None,
+    default_name: str = "campaign",
+) -> Campaign:
+    """Check a parsed campaign mapping and build the :class:`Campaign`."""
+    _unknown(data, TOP_KEYS, "")
+    name = data.get("name", default_name)
+    if not isinstance(name, str) or not name.strip():
+        raise CampaignError(f"name: must be a non-empty string, got {name!r}")
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise CampaignError("description: must be a string")
+
+    metrics_raw = data.get("metrics", ["gust"])
+    if not isinstance(metrics_raw, list):
+        raise CampaignError(f"metrics: must be a list of {', '.join(METRICS)}")
+    if not metrics_raw:
+        raise CampaignError(f"metrics: empty; give some of {', '.join(METRICS)}")
+    for m in metrics_raw:
+        if m not in METRICS:
+            raise CampaignError(f"metrics: unknown metric {m!r}; accepted: {', '.join(METRICS)}")
+    metrics = tuple(m for m in METRICS if m in metrics_raw)
+
+    settings = _settings(data.get("run", {}))
+
+    axes = data.get("axes")
+    if not isinstance(axes, dict):
+        raise CampaignError("axes: missing table [axes] (wings, speeds_m_s, gusts, seeds, "
+                            "models)")
+    _unknown(axes, AXIS_KEYS, "axes")
+
+    wings = _wings(axes, base_dir)
+
+    if "speeds_m_s" not in axes:
+        raise CampaignError("axes.speeds_m_s: missing; give the airspeeds [m/s]")
+    speeds = [_number(v, f"axes.speeds_m_s[{i}]", "m/s", positive=True, maximum=100.0)
+              for i, v in enumerate(_values(axes["speeds_m_s"], "axes.speeds_m_s"))]
+    speeds = _unique(speeds, "axes.speeds_m_s")
+
+    gusts = _gusts(axes, metrics)
+
+    models_raw = _values(axes.get("models", ["coupled"]), "axes.models")
+    for i, m in enumerate(models_raw):
+        if m not in MODELS:
+            raise CampaignError(
+                f"axes.models[{i}]: unknown model {m!r}; accepted: {', '.join(MODELS)}")
+    models = _unique(models_raw, "axes.models")
+
+    n = len(wings) * len(speeds) * len(gusts) * len(models)
+    if n > MAX_CASES:
+        raise CampaignError(f"axes: {n} cases is more than {MAX_CASES}")
+    return Campaign(name.strip(), description, metrics, settings, tuple(wings), tuple(speeds),
+                    tuple(gusts), tuple(models), source)
+
+
+def _settings(run: Any) -> RunSettings:
+    if not isinstance(run, dict):
+        raise CampaignError("run: must be a table [run]")
+    _unknown(run, RUN_KEYS, "run")
+    d = RunSettings()
+    duration = _number(run.get("duration_s", d.duration_s), "run.duration_s", "s",
+                       positive=True, maximum=600.0)
+    start = _number(run.get("gust_start_s", d.gust_start_s), "run.gust_start_s", "s",
+                    minimum=0.0)
+    if start >= duration:
+        raise CampaignError(f"run.gust_start_s: {start:g} s must be before the end of the run "
+                            f"(run.duration_s {duration:g} s)")
+    dt = _number(run.get("dt_s", d.dt_s), "run.dt_s", "s", positive=True, maximum=MAX_DT_S)
+    basis = run.get("mass_basis", d.mass_basis)
+    if basis not in MASS_BASES:
+        raise CampaignError(f"run.mass_basis: unknown mass basis {basis!r}; accepted: "
+                            f"{', '.join(MASS_BASES)}")
+    fr = run.get("flutter_range_m_s", list(d.flutter_range_m_s))
+    if not isinstance(fr, list) or len(fr) != 2 or not all(_is_number(x) for x in fr) \
+            or not 0.0 < fr[0] < fr[1]:
+        raise CampaignError(f"run.flutter_range_m_s: must be [low, high] with 0 < low < high "
+                            f"m/s, got {fr!r}")
+    return RunSettings(duration, start, dt, basis, (float(fr[0]), float(fr[1])))
+
+
+def _wings(axes: dict, base_dir: Path | None) -> list[WingVariant]:
+    wings: list[WingVariant] = []
+    if "wings" in axes:
+        for i, w in enumerate(_values(axes["wings"], "axes.wings")):
+            key = f"axes.wings[{i}]"
+            if not isinstance(w, str):
+                raise CampaignError(f"{key}: must be a wing name or a variant file, got {w!r}")
+            if w.endswith(".toml"):
+                path = Path(w)
+                if base_dir is not None and not path.is_absolute():
+                    path = base_dir / path
+                try:
+                    wings.append(load_variant_file(path))
+                except VariantError as exc:
+                    raise CampaignError(f"{key}: {exc}") from None
+            elif w in VARIANTS:
+                wings.append(VARIANTS[w])
+            else:
+                raise CampaignError(f"{key}: unknown wing {w!r}; accepted: "
+                                    f"{', '.join(VARIANTS)} or a variant file (.toml)")
+    has_xi, has_xe = "x_inertial_frac" in axes, "x_elastic_frac" in axes
+    if has_xi != has_xe:
+        missing = "axes.x_elastic_frac" if has_xi else "axes.x_inertial_frac"
+        raise CampaignError(f"{missing}: missing; axis positions need both x_inertial_frac "
+                            "and x_elastic_frac")
+    if has_xi:
+        grids = {}
+        for key in ("x_inertial_frac", "x_elastic_frac"):
+            values = _values(axes[key], f"axes.{key}")
+            grids[key] = _unique(
+                [_number(v, f"axes.{key}[{i}]", "(fraction of the chord)", minimum=0.0,
+                         maximum=1.0) for i, v in enumerate(values)], f"axes.{key}")
+        for xi in grids["x_inertial_frac"]:
+            for xe in grids["x_elastic_frac"]:
+                wings.append(axis_variant(xi, xe))
+    if not wings:
+        raise CampaignError("axes.wings: missing; give axes.wings or axes.x_inertial_frac and "
+                            "axes.x_elastic_frac")
+    names = [w.name for w in wings]
+    for n in names:
+        if names.count(n) > 1:
+            raise CampaignError(f"axes.wings: wing {n!r} appears twice")
+    return wings
+
+
+def axis_variant(x_inertial_frac: float, x_elastic_frac: float) -> WingVariant:
+    """The original wing with its axes moved to these chord fractions, unpinned (the strip
+    model's physical coefficients)."""
+    return dataclasses.replace(
+        VARIANTS["original"],
+        name=f"xI{x_inertial_frac:g}-xE{x_elastic_frac:g}",
+        x_inertial_frac=float(x_inertial_frac),
+        x_elastic_frac=float(x_elastic_frac),
+        pinned_c_eta1_q1=None,
+        published_c_eta1_q1=None,
+        description="axis positions of a campaign",
+    )
+
+
+def _gusts(axes: dict, metrics: tuple[str, ...]) -> list[str]:
+    if "gust" not in metrics:
+        for key in ("gusts", "seeds"):
+            if key in axes:
+                raise CampaignError(f"axes.{key}: given but metrics has no 'gust' (no gust "
+                                    "runs)")
+        return ["none"]
+    if "gusts" not in axes:
+        raise CampaignError("axes.gusts: missing; give the gusts (sharp:A, 1cos:A:L, "
+                            "dryden:S:L, vonkarman:S:L)")
+    specs = []
+    for i, g in enumerate(_values(axes["gusts"], "axes.gusts")):
+        key = f"axes.gusts[{i}]"
+        if not isinstance(g, str):
+            raise CampaignError(f"{key}: must be a gust string such as 'sharp:3', got {g!r}")
+        try:
+            specs.append((key, g, parse_gust(g)))
+        except GustSpecError as exc:
+            raise CampaignError(f"{key}: {exc}") from None
+    seeds = None
+    if "seeds" in axes:
+        seeds = _values(axes["seeds"], "axes.seeds", integer=True)
+        for i, s in enumerate(seeds):
+            if isinstance(s, bool) or not isinstance(s, int) or s < 0:
+                raise CampaignError(f"axes.seeds[{i}]: must be a whole number ≥ 0, got {s!r}")
+        seeds = _unique(seeds, "axes.seeds")
+        if not any(spec.kind in TURBULENCE for _, _, spec in specs):
+            raise CampaignError("axes.seeds: given but no gust is turbulence (dryden, "
+                                "vonkarman)")
+    out: list[str] = []
+    for key, text, spec in specs:
+        if spec.kind in TURBULENCE:
+            if seeds is not None:
+                if len(text.split(":")) == 4:
+                    raise CampaignError(f"{key}: {text!r} names a seed and axes.seeds is given; "
+                                        "give one or the other")
+                out.extend(dataclasses.replace(spec, seed=s).text() for s in seeds)
+            else:
+                out.append(spec.text())
+        else:
+            out.append(spec.text())
+    return _unique(out, "axes.gusts")
