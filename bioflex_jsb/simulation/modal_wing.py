@@ -136,8 +136,8 @@ class ModalWing:
         self._b_alpha = s_ref * cb / self._m * self._c_alpha
         self._b_q = s_ref * cb**2 / (2.0 * self._m) * self._c_q
         self._b_0 = s_ref * cb * self._c_0 / self._m
-        self.eta = np.zeros(n)
-        self.eta_dot = np.zeros(n)
+        self._x = np.zeros(2 * n)  # [Δη, Δη̇]
+        self._load_x = np.hstack([self._load_eta, np.zeros_like(self._load_eta)])
         self._key: tuple[float, float] | None = None
         self._phi = self._gamma = None
 
@@ -166,8 +166,17 @@ class ModalWing:
         aug[:n2, :n2] = a
         aug[:n2, n2:] = np.eye(n2)
         e = expm(aug * self.dt_s)
-        self._phi = e[:n2, :n2]
-        self._psi_lower = np.ascontiguousarray(e[:n2, n2 + self.n_modes :])
+        n = self.n_modes
+        phi, psi_lower = e[:n2, :n2], e[:n2, n2 + n :]
+        zeros = np.zeros((n, n))
+        # One matrix for the step: rows [Φ; Ψ K_a; Ψ D_a] act on x, columns of ``_inputs`` on
+        # the per-unit flow forcing (Q Δα, Q q / V, ΔQ).
+        self._stack = np.vstack([
+            phi,
+            psi_lower @ np.hstack([self._k_aero, zeros]),
+            psi_lower @ np.hstack([zeros, self._d_aero]),
+        ])
+        self._input_cols = psi_lower @ np.column_stack([self._b_alpha, self._b_q, self._b_0])
         self._key = (q_pa, v_m_s)
 
     def _advance(self, flow: FlowState) -> None:
@@ -183,16 +192,30 @@ class ModalWing:
         ):
             self._reference(q_pa, v)
         q_r, v_r = self._key
-        eta, eta_dot = self.eta, self.eta_dot
-        forcing = (
-            (q_pa - q_r) * (self._k_aero @ eta)
-            + (q_pa / v - q_r / v_r) * (self._d_aero @ eta_dot)
-            + (q_pa * (flow.alpha_rad - self.trim.alpha_rad)) * self._b_alpha
-            + (q_pa / v * flow.q_rad_s) * self._b_q
-            + (q_pa - self.trim.dynamic_pressure_pa) * self._b_0
-        )
-        x = self._phi @ np.concatenate([eta, eta_dot]) + self._psi_lower @ forcing
-        self.eta, self.eta_dot = x[: self.n_modes], x[self.n_modes :]
+        m = 2 * self.n_modes
+        y = self._stack @ self._x
+        f = (q_pa * (flow.alpha_rad - self.trim.alpha_rad), q_pa / v * flow.q_rad_s,
+             q_pa - self.trim.dynamic_pressure_pa)
+        self._x = (y[:m] + (q_pa - q_r) * y[m : 2 * m] + (q_pa / v - q_r / v_r) * y[2 * m :]
+                   + self._input_cols @ f)
+
+    @property
+    def eta(self) -> np.ndarray:
+        """Modal coordinates Δη [rad] (perturbations from the static deformation at trim)."""
+        return self._x[: self.n_modes]
+
+    @eta.setter
+    def eta(self, value) -> None:
+        self._x = np.concatenate([np.asarray(value, dtype=float), self._x[self.n_modes :]])
+
+    @property
+    def eta_dot(self) -> np.ndarray:
+        """Modal rates Δη̇ [rad/s]."""
+        return self._x[self.n_modes :]
+
+    @eta_dot.setter
+    def eta_dot(self, value) -> None:
+        self._x = np.concatenate([self._x[: self.n_modes], np.asarray(value, dtype=float)])
 
     def _inputs(self, flow: FlowState) -> np.ndarray:
         return np.array(
@@ -225,9 +248,9 @@ class ModalWing:
             self.eta = self.quasi_static_eta(flow)
         qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
         rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
-        coeffs = self._load_eta @ self.eta + self._load_etadot @ self.eta_dot * rate
-        lift, drag, moment = qs * coeffs
-        return WingLoads(float(lift), float(drag), float(moment))
+        self._load_x[:, self.n_modes :] = self._load_etadot * rate  # rates scale with c̄/2V
+        lift, drag, moment = (self._load_x @ self._x).tolist()
+        return WingLoads(qs * lift, qs * drag, qs * moment)
 
     def tip_twist_rad(self, tip_twist_per_mode: np.ndarray) -> float:
         """Elastic tip twist Σ θ_i(b/2) Δη_i [rad], positive leading edge up."""
