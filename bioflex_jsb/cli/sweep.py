@@ -107,8 +107,10 @@ def run(args: argparse.Namespace) -> int:
                 summary = run_sweep(todo, store, executor, total=len(cases), on_row=on_row)
         else:
             summary = run_sweep([], store, executor, total=len(cases))
-    except _executor_errors() as exc:
+    except (*_executor_errors(), StoreError) as exc:
         raise UsageError(str(exc)) from None
+    except OSError as exc:  # the results output failed mid-sweep (disk full, removed, ...)
+        raise UsageError(f"--out {str(out)!r}: cannot write: {exc.strerror or exc}") from None
     finally:
         if bar is not None:
             bar.close()

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import os
+import tempfile
 import time
 import uuid
 from pathlib import Path
@@ -41,6 +42,21 @@ def open_store(path: str | Path, columns: dict[str, str], resume: bool):
 def _exists_error(p: Path) -> StoreError:
     return StoreError(f"--out {str(p)!r} exists; add --resume to complete it, or choose "
                       "another --out")
+
+
+def _check_writable(path: Path) -> None:
+    """Refuse an output whose nearest existing folder cannot be written (before any run)."""
+    folder = path if path.is_dir() else path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    try:
+        if not folder.is_dir():
+            raise NotADirectoryError(20, "not a directory")
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise StoreError(f"--out {str(path)!r}: cannot write in {str(folder)!r}: "
+                         f"{exc.strerror}") from None
 
 
 def _text(value: Any) -> str:
@@ -70,16 +86,17 @@ class CsvStore:
             if not resume:
                 raise _exists_error(path)
             self._recover()
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            new = not path.exists() or path.stat().st_size == 0
-            self._fh = open(path, "a", newline="", encoding="utf-8")  # noqa: SIM115
-        except OSError as exc:
-            raise StoreError(f"--out {str(path)!r}: cannot write: {exc.strerror}") from None
-        self._writer = csv.DictWriter(self._fh, fieldnames=list(columns))
+        _check_writable(path)
+        self._fh = None  # opened with the first row: a sweep that never starts leaves no file
+        self._writer = None
+
+    def _open(self) -> None:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        new = not self.path.exists() or self.path.stat().st_size == 0
+        self._fh = open(self.path, "a", newline="", encoding="utf-8")  # noqa: SIM115
+        self._writer = csv.DictWriter(self._fh, fieldnames=list(self.columns))
         if new:
             self._writer.writeheader()
-            self._fh.flush()
 
     def _recover(self) -> None:
         data = self.path.read_bytes()
@@ -98,11 +115,13 @@ class CsvStore:
             self.done_ids = {r[k] for r in reader if len(r) == len(header)}
 
     def append(self, row: dict[str, Any]) -> None:
+        if self._fh is None:
+            self._open()
         self._writer.writerow({k: _text(row.get(k)) for k in self.columns})
         self._fh.flush()
 
     def close(self) -> None:
-        if not self._fh.closed:
+        if self._fh is not None and not self._fh.closed:
             self._fh.close()
 
 
@@ -140,10 +159,7 @@ class ParquetStore:
                                          "campaign (other metrics?); choose another --out")
                     table = pq.read_table(path, columns=["case_id"], schema=self.schema)
                     self.done_ids = set(table.column("case_id").to_pylist())
-        try:
-            path.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise StoreError(f"--out {str(path)!r}: cannot write: {exc.strerror}") from None
+        _check_writable(path)
 
     def _parts(self) -> list[Path]:
         return sorted(self.path.glob("part-*.parquet"))
@@ -154,6 +170,7 @@ class ParquetStore:
         table = pa.Table.from_pylist(
             [{k: r.get(k) for k in self.columns} for r in rows], schema=self.schema
         )
+        self.path.mkdir(parents=True, exist_ok=True)
         final = self.path / f"{stem}.parquet"
         tmp = self.path / f".{stem}.parquet.tmp"
         self._pq.write_table(table, tmp)
@@ -166,7 +183,7 @@ class ParquetStore:
 
     def close(self) -> None:
         """Compact the part files into one (new file first, then the old ones go)."""
-        parts = self._parts()
+        parts = self._parts() if self.path.is_dir() else []
         if len(parts) <= 1:
             return
         rows = read_results(self.path, self.columns)
