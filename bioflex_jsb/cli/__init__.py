@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "info",
     "plot",
     "rerun",
+    "sweep",
     "bench",
 )
 
