@@ -23,8 +23,8 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
 
 
-def positive_float(label: str, unit: str):
-    """argparse type: a finite number > 0, e.g. ``positive_float('speed', 'm/s')``."""
+def finite_float(label: str, unit: str):
+    """argparse type: any finite number, e.g. an altitude (may be negative)."""
 
     def parse(text: str) -> float:
         try:
@@ -33,7 +33,28 @@ def positive_float(label: str, unit: str):
             raise argparse.ArgumentTypeError(
                 f"{label} must be a number in {unit}, got {text!r}"
             ) from None
-        if not math.isfinite(value) or value <= 0.0:
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(
+                f"{label} must be a finite number in {unit}, got {text!r}"
+            )
+        return value
+
+    parse.__name__ = label
+    return parse
+
+
+def positive_float(label: str, unit: str):
+    """argparse type: a finite number > 0, e.g. ``positive_float('speed', 'm/s')``."""
+    finite = finite_float(label, unit)
+
+    def parse(text: str) -> float:
+        try:
+            value = finite(text)
+        except argparse.ArgumentTypeError:
+            if not _is_number(text):
+                raise  # not a number at all: finite_float's message
+            value = math.nan  # nan or inf
+        if not value > 0.0:
             raise argparse.ArgumentTypeError(
                 f"{label} must be a finite number > 0 {unit}, got {text!r}"
             )
@@ -41,6 +62,14 @@ def positive_float(label: str, unit: str):
 
     parse.__name__ = label
     return parse
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def print_json(payload: Any) -> None:

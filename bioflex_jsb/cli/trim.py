@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from bioflex_jsb.cli.common import UsageError, positive_float, print_json
+from bioflex_jsb.cli.common import UsageError, finite_float, positive_float, print_json
 
 HELP = """Trim the rigid JSBSim airframe for wings-level, constant-altitude flight with
 JSBSim's own trim routine. Units: --speed is the true airspeed in m/s, --altitude the
@@ -15,26 +15,6 @@ the elevator also as a fraction -1..1 of its travel and the throttle as 0..1 of 
 maximum shaft power. With --json, angles are in rad (keys ending in _rad), residual
 accelerations in m/s^2 and rad/s^2. A speed the aircraft cannot fly (below the stall speed,
 beyond the motor's thrust) ends with a one-line reason and exit status 2."""
-
-
-def finite_float(label: str, unit: str):
-    """argparse type: any finite number, e.g. an altitude (may be negative)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(
-                f"{label} must be a number in {unit}, got {text!r}"
-            ) from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(
-                f"{label} must be a finite number in {unit}, got {text!r}"
-            )
-        return value
-
-    parse.__name__ = label
-    return parse
 
 
 def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:

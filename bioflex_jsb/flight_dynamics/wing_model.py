@@ -19,7 +19,6 @@ m_i as Table B2 reads literally, which doubles every H term. Every output names 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
@@ -36,6 +35,7 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
 )
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, MODAL_DAMPING_RATIO, Planform
+from bioflex_jsb.tomlfile import read_toml
 
 MASS_BASES = ("paper", "consistent")
 DEFAULT_MASS_BASIS = "consistent"
@@ -216,16 +216,7 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
 def load_variant_file(path: str | Path) -> WingVariant:
     """Read a TOML variant file; :class:`VariantError` with a one-line reason if bad."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise VariantError(f"variant file {str(p)!r} not found") from None
-    except OSError as exc:
-        raise VariantError(f"variant file {str(p)!r} cannot be read: {exc.strerror}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise VariantError(f"variant file {str(p)!r} is not valid TOML: {exc}") from None
+    data = read_toml(p, "variant file", VariantError)
     return variant_from_mapping(data, str(p), p.parent)
 
 

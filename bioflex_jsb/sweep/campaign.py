@@ -29,7 +29,6 @@ import dataclasses
 import hashlib
 import json
 import math
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +46,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
 )
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.tomlfile import read_toml
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
 MAX_CASES = 1_000_000
@@ -274,16 +274,7 @@ class Campaign:
 def load_campaign(path: str | Path) -> Campaign:
     """Read and check a campaign file; :class:`CampaignError` (one line) if it is bad."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CampaignError(f"campaign file {str(p)!r} not found") from None
-    except OSError as exc:
-        raise CampaignError(f"campaign file {str(p)!r} cannot be read: {exc.strerror}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignError(f"{p.name}: not valid TOML: {exc}") from None
+    data = read_toml(p, "campaign file", CampaignError)
     return parse_campaign(data, source=p.name, base_dir=p.parent, default_name=p.stem)
 
 
