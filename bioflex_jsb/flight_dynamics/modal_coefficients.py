@@ -16,10 +16,10 @@ centre per unit η_i is w_i(y) = e θ_i − φ_i, the virtual-work term of Table
 All integrals are over the whole span, −b/2..b/2 (Table B1), i.e. twice the starboard
 integral for the symmetric modes used here.
 
-Typos of the paper that matter here (docs/decisions.md, "Paper typos"): none in Table B1
-itself; Table B2's H_iu divides by m_i (the paper prints m); C_u^Q = 0 (incompressible).
-Derivatives that the paper uses but does not define: C_Dη_i = 2 k C_L0 C_Lη_i and
-C_Dη̇_i = 2 k C_L0 C_Lη̇_i (induced drag of the extra lift, parabolic polar).
+The coefficients here do not depend on the flight condition; the trim-dependent ones
+(C_Dη, C_0^Q) and the dimensional Table B2 derivatives are formed in
+:mod:`bioflex_jsb.flight_dynamics.lti`. Table B1 itself needed no correction
+(docs/decisions.md, "Paper typos", item 6).
 """
 
 from __future__ import annotations
