@@ -12,55 +12,63 @@ perturbations from the static deformation at trim, generalised forces from the c
 ``external_reactions`` (body axes: modal-lift = ΔL cos α + ΔD sin α, modal-drag =
 ΔD cos α − ΔL sin α), converted once from SI with :mod:`bioflex_jsb.units`.
 
-Integration (``coupled``): exact discretisation scheduled on dynamic pressure
------------------------------------------------------------------------------------
-The state x = [Δη, Δη̇] advances once per JSBSim step by
+Integration (``coupled``): ModalWing's scheme, reference flow renewed at 5 % changes
+--------------------------------------------------------------------------------------
+The state x = [Δη, Δη̇] advances once per JSBSim step exactly as ``ModalWing._advance``:
 
-    x_{k+1} = Φ(Q) x_k + Ψ(Q) f_k,    Φ(Q) = e^{A(Q, V_ref(Q)) Δt},  Ψ(Q) = ∫_0^Δt e^{A τ} dτ B,
+    x_{k+1} = Φ_r x_k + Ψ_r g_k,   g = (Q − Q_r) K_a Δη + (Q/V − Q_r/V_r) D_a Δη̇
+                                       + Q Δα b_α + (Q/V) q b_q + (Q − Q_0) b_0,
 
-with A the modal system matrix of ``ModalWing`` at dynamic pressure Q and V_ref(Q) =
-sqrt(2Q/ρ_ref) (ρ_ref: the export density, ISA sea level), and the input held over the step:
+with Φ_r = e^{A_r Δt}, Ψ_r = ∫_0^Δt e^{A_r τ} dτ at the reference flow (Q_r, V_r), which is
+renewed (Q_r ← Q, V_r ← V) when Q or V moves by more than :data:`REFRESH_REL` (ModalWing's
+default, 5 %) — the same reference points as the co-simulation. The renewal is a JSBSim
+channel run only when needed (``<channel execute="bioflex/modal/renew">``): its 54 table
+lookups (Φ_r, Ψ_r against Q, rows every 0.5 m/s of V_ref(Q) = sqrt(2Q/ρ_ref) up to
+:data:`GRID_SPEED_MAX_M_S`, computed here with ``scipy.linalg.expm``, linearly interpolated
+by JSBSim) are latched into properties; a normal step is a few products and sums with no
+table. Q_r/V_r is taken as Q_r/V_ref(Q_r), the table's, so away from ρ_ref the correction
+term also carries the density difference.
 
-    f = (Q/V − Q/V_ref(Q)) D_a Δη̇ + Q Δα b_α + (Q/V) q b_q + (Q − Q_0) b_0.
+The step is computed row by row in place (:func:`in_place_step`: the tabulated coefficients
+are rewritten so that row k reads the rows already overwritten), so JSBSim needs neither
+temporaries nor a commit. Exact at the reference flow for any step: the third mode
+(≈ 107 Hz, ω Δt = 0.7 at 1/960 s, 5.6 at 1/120 s) has no stability limit.
 
-Φ and Ψ are computed here with ``scipy.linalg.expm`` on a grid of Q (uniform in V_ref, 0 to
-:data:`GRID_SPEED_MAX_M_S`) and written as JSBSim tables in Q, linearly interpolated by
-JSBSim. At the grid points the update is exact for any step, so the third mode (≈ 107 Hz,
-ω Δt = 1.4 at 1/480 s, 5.6 at 1/120 s) has no stability limit; between grid points the
-interpolation error of Φ is printed by ``export-jsbsim --json`` (``phi_interp_error``). The
-first term of f corrects for density away from ρ_ref (Q/V = ρV/2 differs from
-Q/V_ref(Q) only when ρ ≠ ρ_ref); at the reference density it is zero. This is ``ModalWing``'s
-scheme with the reference flow renewed every step instead of at 5 % changes, so the two agree
-to the reference-renewal error.
+Φ and Ψ hold for ONE step, the exported ``dt_s`` (default 1/960 s, the co-simulation's
+step; ``--dt`` for others). ``bioflex/modal/active`` is 1 only when ``simulation/dt``
+equals it. While it is 0 (JSBSim's initial-condition run and trim suspend integration with
+dt = 0, or a host running another step) only the channel ``execute="bioflex/modal/idle"``
+runs: it latches the trim reference α_0, Q_0 from JSBSim's air data, holds the modal state
+and loads at zero and clears the reference flow (renewed at the first active step, as
+ModalWing's first step).
 
-Φ and Ψ hold for ONE step, the exported ``dt_s`` (default 1/480 s, the co-simulation's
-step; ``--dt`` for others). The system compares ``simulation/dt`` with it every step:
-``bioflex/modal/active`` is 1 only when they agree. While it is 0 (JSBSim's initial-condition
-run and trim suspend integration with dt = 0, or a host running another step) the modal state
-is held at zero (no modal loads: the trim is the rigid airframe's, as in the co-simulation)
-and the trim reference α_0, Q_0 is latched from the current flow; so every trim re-references
-the perturbations, and the step after a trim starts from the trimmed flow.
+Flow: JSBSim's air data of the previous step (``aero/alpha-rad``, ``velocities/vt-fps``;
+Q = ρV²/2) — the state the co-simulation reads — and, in a step where the down wind
+changed, the same quantities recomputed from ``velocities/{u,v,w}-aero-fps`` with this
+step's change of the wind (the co-simulation writes the wind before the step); ``ifthen``
+evaluates only that branch, so steady wind costs nothing extra.
 
 ``qsd``: Δη = K(Q)⁻¹ [Q Δα b_α + (Q/V) q b_q + (Q − Q_0) b_0], K(Q) = diag(ω²) − Q K_a, with
 K(Q)⁻¹ tabulated on the same grid; Δη̇ = 0.
 
 Order inside a JSBSim step: JSBSim runs its systems after integrating the state and before
-the aerodynamics and the external reactions, and the systems read the flow (``aero/qbar-psf``,
-``aero/alpha-rad``, ``velocities/vt-fps``, ``velocities/q-rad_sec``) computed at the end of
-the previous step. The loads of step k come from Δη_k in that flow; then Δη_{k+1} is computed
-from the same flow, as in the co-simulation (its one-step coupling lag included). A wind
-change reaches the wing one step after it reaches the rigid aerodynamics (the co-simulation
-feeds both in the same step); at 1/480 s this is far below the 1 % equivalence (tests).
+the aerodynamics and the external reactions, and the systems read the flow computed at the
+end of the previous step (with this step's wind change, above). The loads of step k come
+from Δη_k in that flow; then Δη_{k+1} is computed from the same flow, as in the
+co-simulation (its one-step coupling lag included). The loads: lift and pitching moment;
+the modal drag is k₂ = 2kC_L0 times the modal lift, so the body-axis forces are the lift
+times (cos α + k₂ sin α) and (k₂ cos α − sin α).
 
 Properties (all under ``bioflex/modal/``): ``eta<i>``, ``eta<i>-dot`` [rad, rad/s] (state),
-``alpha0-rad``, ``qbar0-pa`` (latched trim reference), ``active``, ``enabled`` (set 0 to fly
-the rigid airframe with the same file), ``lift-n``, ``drag-n``, ``pitch-n_m`` (wind-axis
-loads, SI).
+``alpha0-rad``, ``qbar0-pa`` (latched trim reference), ``qbar-ref-pa``, ``vt-ref-m_s``
+(reference flow), ``active``, ``enabled`` (set 0 to fly the rigid airframe with the same
+file), ``lift-n``, ``pitch-n_m`` (wind-axis loads, SI; ``qsd`` also ``drag-n``).
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import math
 import re
 import sys
@@ -77,8 +85,8 @@ from bioflex_jsb.adapters import airframe_xml
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import PROPULSION, RIGID_AERODYNAMICS
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, ModalWing
 
 EXPORT_MODELS = ("coupled", "qsd")
 PREFIX = "bioflex/modal"
@@ -96,8 +104,14 @@ FIG21_GUST_START_S = 0.5
 FIG21_DURATION_S = 5.0
 FIG21_SCRIPT = "scripts/fig21_native.xml"
 FIG21_OUTPUT = "fig21_native.csv"
+FIG21_IC = "fig21_trim"
+# Airframe held at the trim while the propellers spin up to the trim RPM [s] (the physical
+# rotor's time constant is ≈ 0.3 s: 5 s leaves the RPM within 1e-7 of the trim's).
+FIG21_SETTLE_S = 5.0
 # |simulation/dt − dt_s| below this fraction of dt_s counts as the exported step.
 DT_MATCH_REL = 1e-6
+# Relative change of Q or V that renews the reference flow: ModalWing's default.
+REFRESH_REL = float(inspect.signature(ModalWing).parameters["refresh_rel"].default)
 
 
 class ExportError(ValueError):
@@ -210,6 +224,27 @@ def qsd_schedule(nums: ModalNumbers, rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3)
     qs = q_grid_pa(rho_ref)
     inv = [np.linalg.inv(np.diag(nums.omega**2) - q * nums.k_aero) for q in qs]
     return qs, np.array(inv)
+
+
+def in_place_step(phi: np.ndarray, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Coefficients (C, D) of x⁺ = Φ x + Ψ g computed row by row in place: row k of the
+    update reads v = [x⁺_0 … x⁺_{k−1}, x_k … x_{N−1}] (the rows before it already
+    overwritten) and x⁺_k = C[k]·v + D[k]·g equals row k of Φ x + Ψ g exactly (the rows
+    already written are solved back for the old state; Φ is near the identity, so the
+    leading blocks are well conditioned). No temporaries and no commit step in JSBSim."""
+    n2 = phi.shape[0]
+    c = np.zeros_like(phi)
+    d = np.zeros_like(psi)
+    for k in range(n2):
+        if k == 0:
+            c[k], d[k] = phi[k], psi[k]
+            continue
+        inv = np.linalg.inv(phi[:k, :k])
+        left = phi[k, :k] @ inv
+        c[k, :k] = left
+        c[k, k:] = phi[k, k:] - left @ phi[:k, k:]
+        d[k] = psi[k] - left @ psi[:k]
+    return c, d
 
 
 def interpolation_error(
@@ -338,7 +373,10 @@ def render_system(spec: ExportSpec) -> str:
         f"({spec.speed_m_s:g} m/s), reference density {spec.rho_ref:g} kg/m3.")
     eta = [_p(f"eta{i + 1}") for i in range(n)]
     etad = [_p(f"eta{i + 1}-dot") for i in range(n)]
-    for name in eta + (etad if spec.model == "coupled" else []):
+    if spec.model == "coupled":
+        _coupled_system(root, spec, nums, eta, etad)
+        return _serialise(root)
+    for name in eta:
         _el(root, "property", name, value="0")
     _el(root, "property", _p("alpha0-rad"), value="0")
     _el(root, "property", _p("qbar0-pa"), value="0")
@@ -375,11 +413,8 @@ def render_system(spec: ExportSpec) -> str:
     _prop(d, _p("qbar0-pa"))
 
     ch = _el(root, "channel", name="Modal wing")
-    if spec.model == "qsd":
-        _qsd_state(ch, spec, nums, eta)
-    _loads(ch, spec, nums, eta, etad if spec.model == "coupled" else [])
-    if spec.model == "coupled":
-        _coupled_update(ch, spec, nums, eta, etad)
+    _qsd_state(ch, spec, nums, eta)
+    _loads(ch, spec, nums, eta, [])
     _comment(ch, "this step's down wind, for the next step's change")
     g = _el(ch, "pure_gain", name=_p("wind-down-store"))
     _el(g, "input", "atmosphere/wind-down-fps")
@@ -434,6 +469,57 @@ def _flow(ch: ET.Element) -> None:
     q = _el(fn, "quotient")
     _prop(q, _p("qbar-pa"))
     _prop(q, _p("vt-m_s"))
+
+
+def _flow_fast(ch: ET.Element) -> None:
+    """α, V, Q, Q/V of this step, as :func:`_flow`, but JSBSim's own air data (``aero/*``,
+    the same formulas) when the down wind did not change since the previous step: the
+    body-axis correction is evaluated only in steps where the wind changed (``ifthen``
+    evaluates one branch)."""
+    fn = _fcs(ch, _p("wind-changed"), "1 when the down wind changed since the previous step")
+    ne = _el(fn, "nq")
+    _prop(ne, "atmosphere/wind-down-fps")
+    _prop(ne, _p("wind-down-prev-fps"))
+
+    def dwd(p):
+        d = _el(p, "difference")
+        _prop(d, "atmosphere/wind-down-fps")
+        _prop(d, _p("wind-down-prev-fps"))
+
+    cos_t = lambda p: _prop(_el(p, "cos"), "attitude/theta-rad")  # noqa: E731
+    sin_t = lambda p: _prop(_el(p, "sin"), "attitude/theta-rad")  # noqa: E731
+    cos_f = lambda p: _prop(_el(p, "cos"), "attitude/phi-rad")  # noqa: E731
+    sin_f = lambda p: _prop(_el(p, "sin"), "attitude/phi-rad")  # noqa: E731
+    terms = {"u": [(1.0, sin_t)], "v": [(-1.0, sin_f, cos_t)], "w": [(-1.0, cos_f, cos_t)]}
+
+    def air(parent, axis):
+        s = _el(parent, "sum")
+        _prop(s, f"velocities/{axis}-aero-fps")
+        for sign, *factors in terms[axis]:
+            _product(s, sign, dwd, *factors)
+
+    fn = _fcs(ch, _p("alpha-rad"), "angle of attack against the air, gust included [rad]")
+    ift = _el(fn, "ifthen")
+    _prop(ift, _p("wind-changed"))
+    at = _el(ift, "atan2")
+    air(at, "w")
+    air(at, "u")
+    _prop(ift, "aero/alpha-rad")
+    fn = _fcs(ch, _p("vt-m_s"), "true airspeed V [m/s] (at least 1 ft/s: no division by 0)")
+    m = _el(_product(fn, U.M_PER_FT), "max")
+    ift = _el(m, "ifthen")
+    _prop(ift, _p("wind-changed"))
+    s = _el(_el(ift, "sqrt"), "sum")
+    for axis in "uvw":
+        p = _el(s, "pow")
+        air(p, axis)
+        _value(p, 2.0)
+    _prop(ift, "velocities/vt-fps")
+    _value(m, 1.0)
+    fn = _fcs(ch, _p("qbar-pa"), "dynamic pressure Q = rho V^2/2 [Pa]")
+    _product(fn, 0.5 * U.KG_M3_PER_SLUG_FT3, "atmosphere/rho-slugs_ft3", _p("vt-m_s"), _p("vt-m_s"))
+    fn = _fcs(ch, _p("q-over-v"), "Q/V [Pa s/m]")
+    _product(fn, 0.5 * U.KG_M3_PER_SLUG_FT3, "atmosphere/rho-slugs_ft3", _p("vt-m_s"))
 
 
 def _value_el(x: float) -> ET.Element:
@@ -499,40 +585,183 @@ def _loads(ch, spec: ExportSpec, nums: ModalNumbers, eta: list[str], etad: list[
     _product(fn, U.LBF_FT_PER_N_M, _p("pitch-n_m"))
 
 
-def _coupled_update(ch, spec: ExportSpec, nums: ModalNumbers, eta, etad) -> None:
+def _assign(ch: ET.Element, name: str, description: str, value, outputs: list[str]) -> None:
+    """One fcs_function writing ``value`` (property name or number) to every output."""
+    comp = _el(ch, "fcs_function", name=name)
+    _el(comp, "description", description)
+    fn = _el(comp, "function")
+    if isinstance(value, str):
+        _prop(fn, value)
+    else:
+        _value(fn, value)
+    for out in outputs:
+        _el(comp, "output", out)
+
+
+def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalNumbers, eta, etad) -> None:
+    """Channels of the coupled model (module docstring): mode, trim reference (idle only),
+    flow, reference renewal (only when the flow moved past ``REFRESH_REL``), step."""
     n = nums.n
-    _comment(ch, "generalised forcing held over the step [1/s2] (density correction + inputs)")
-    fn_names = [_p(f"f{i + 1}") for i in range(n)]
-    c_rv = math.sqrt(spec.rho_ref / 2.0)
-    for i in range(n):
-        s = _el(_fcs(ch, fn_names[i], f"forcing of mode {i + 1} [1/s2]"), "sum")
-        if any(nums.d_aero[i]):
-            def dqv(p):
-                d = _el(p, "difference")
-                _prop(d, _p("q-over-v"))
-                _product(d, c_rv, lambda pp: _prop(_el(pp, "sqrt"), _p("qbar-pa")))
-            inner = _product(s, dqv)
-            _linear(_el(inner, "sum"), list(zip(nums.d_aero[i], etad, strict=True)))
-        _forcing_terms(s, nums, i)
-    qs, phis, psis = schedule(nums, spec.dt_s, spec.rho_ref)
-    _comment(ch, f"exact step of {_num(spec.dt_s)} s: x+ = Phi(Q) x + Psi(Q) f (tables in Q)")
     state = eta + etad
-    nxt = [f"{s}-next" for s in state]
+    coef_phi = [[_p(f"phi-{k + 1}-{j + 1}") for j in range(2 * n)] for k in range(2 * n)]
+    coef_psi = [[_p(f"psi-{k + 1}-{m + 1}") for m in range(n)] for k in range(2 * n)]
+    for name in state:
+        _el(root, "property", name, value="0")
+    for name in ("alpha0-rad", "qbar0-pa", "qbar-ref-pa", "vt-ref-m_s", "q-over-v-ref",
+                 "renew", "idle", "wind-down-prev-fps"):  # fmt: skip
+        _el(root, "property", _p(name), value="0")
+    _el(root, "property", _p("enabled"), value="1")
+    for row in coef_phi + coef_psi:
+        for name in row:
+            _el(root, "property", name, value="0")
+    qs, phis, psis = schedule(nums, spec.dt_s, spec.rho_ref)
+    steps = [in_place_step(phi, psi) for phi, psi in zip(phis, psis, strict=True)]
+    phis = np.array([c for c, _ in steps])
+    psis = np.array([d for _, d in steps])
+
+    ch = _el(root, "channel", name="Modal wing mode")
+    fn = _fcs(ch, _p("active"), "1 when simulation/dt is the exported step, else 0 (IC, trim)")
+    ift = _el(fn, "ifthen")
+    lt = _el(ift, "lt")
+    diff = _el(_el(lt, "abs"), "difference")
+    _prop(diff, "simulation/dt")
+    _value(diff, spec.dt_s)
+    _value(lt, DT_MATCH_REL * spec.dt_s)
+    _value(ift, 1.0)
+    _value(ift, 0.0)
+    fn = _fcs(ch, _p("idle-flag"), "1 while not active", output=_p("idle"))
+    d = _el(fn, "difference")
+    _value(d, 1.0)
+    _prop(d, _p("active"))
+
+    ch = _el(root, "channel", name="Modal wing trim reference", execute=_p("idle"))
+    _comment(ch, "while not active (IC, trim, another step): the trim reference latched from "
+                 "the flow, the modal state and loads held at zero, the reference flow reset")
+    _assign(ch, _p("alpha0-latch"), "trim angle of attack [rad]", "aero/alpha-rad",
+            [_p("alpha0-rad")])
+    fn = _fcs(ch, _p("qbar0-latch"), "trim dynamic pressure [Pa]", output=_p("qbar0-pa"))
+    _product(fn, U.PA_PER_PSF, "aero/qbar-psf")
+    _assign(ch, _p("reset"), "modal state, loads and reference flow to zero", 0.0,
+            state + [_p("qbar-ref-pa"), _p("vt-ref-m_s"), _p("renew"), _p("lift-n"),
+                     _p("pitch-n_m")]
+            + [airframe_xml.external_property(x)
+               for x in ("modal-lift", "modal-drag", "modal-pitch")])
+    _assign(ch, _p("wind-down-hold"), "down wind [ft/s], for the first active step's change",
+            "atmosphere/wind-down-fps", [_p("wind-down-prev-fps")])
+
+    ch = _el(root, "channel", name="Modal wing flow", execute=_p("active"))
+    _flow_fast(ch)
+    fn = _fcs(ch, _p("renew-test"), f"1 when Q or V moved by more than {REFRESH_REL:g} of the "
+              "reference flow (ModalWing's renewal)", output=_p("renew"))
+    orr = _el(fn, "or")
+    for cur, ref in (("qbar-pa", "qbar-ref-pa"), ("vt-m_s", "vt-ref-m_s")):
+        gt = _el(orr, "gt")
+        d = _el(_el(gt, "abs"), "difference")
+        _prop(d, _p(cur))
+        _prop(d, _p(ref))
+        _product(gt, REFRESH_REL, _p(ref))
+
+    ch = _el(root, "channel", name="Modal wing reference renewal", execute=_p("renew"))
+    _comment(ch, f"exact step of {_num(spec.dt_s)} s at the new reference flow: "
+                 "Phi = e^(A dt), Psi (tables in Q; run only at a renewal)")
+    _assign(ch, _p("qbar-ref-latch"), "reference Q [Pa]", _p("qbar-pa"), [_p("qbar-ref-pa")])
+    _assign(ch, _p("vt-ref-latch"), "reference V [m/s]", _p("vt-m_s"), [_p("vt-ref-m_s")])
+    fn = _fcs(ch, _p("q-over-v-ref-latch"), "Q_r/V_ref(Q_r) of the tables [Pa s/m]",
+              output=_p("q-over-v-ref"))
+    _product(fn, math.sqrt(spec.rho_ref / 2.0), lambda p: _prop(_el(p, "sqrt"), _p("qbar-pa")))
     for k in range(2 * n):
-        fn = _fcs(ch, nxt[k], f"{state[k].rsplit('/', 1)[1]} after the step")
-        s = _el(fn, "sum")
+        for j, name in enumerate(coef_phi[k]):
+            fn = _fcs(ch, f"{name}-table", f"Phi[{k + 1},{j + 1}]", output=name)
+            _table(fn, _p("qbar-pa"), qs, phis[:, k, j])
+        for m_, name in enumerate(coef_psi[k]):
+            fn = _fcs(ch, f"{name}-table", f"Psi[{k + 1},{m_ + 1}]", output=name)
+            _table(fn, _p("qbar-pa"), qs, psis[:, k, m_])
+
+    ch = _el(root, "channel", name="Modal wing", execute=_p("active"))
+    _loads_fused(ch, nums, eta, etad)
+    _comment(ch, "forcing held over the step [1/s2]: aerodynamic change since the reference "
+                 "flow (Q - Q_r) K_a eta + (Q/V - Q_r/V_r) D_a etadot, and the flow inputs")
+    fn = _fcs(ch, _p("dqbar-ref-pa"), "Q - Q_r [Pa]")
+    d = _el(fn, "difference")
+    _prop(d, _p("qbar-pa"))
+    _prop(d, _p("qbar-ref-pa"))
+    has_d = bool(np.any(nums.d_aero))
+    if has_d:
+        fn = _fcs(ch, _p("dq-over-v-ref"), "Q/V - Q_r/V_r [Pa s/m]")
+        d = _el(fn, "difference")
+        _prop(d, _p("q-over-v"))
+        _prop(d, _p("q-over-v-ref"))
+    fn = _fcs(ch, _p("q-dalpha"), "Q (alpha - alpha_0) [Pa rad]")
+    d = _el(_product(fn, _p("qbar-pa")), "difference")
+    _prop(d, _p("alpha-rad"))
+    _prop(d, _p("alpha0-rad"))
+    fn = _fcs(ch, _p("q-over-v-q"), "(Q/V) q [Pa rad/m]")
+    _product(fn, _p("q-over-v"), "velocities/q-rad_sec")
+    fn = _fcs(ch, _p("dqbar-pa"), "Q - Q_0 [Pa]")
+    d = _el(fn, "difference")
+    _prop(d, _p("qbar-pa"))
+    _prop(d, _p("qbar0-pa"))
+    g = [_p(f"f{i + 1}") for i in range(n)]
+    for i in range(n):
+        s = _el(_fcs(ch, g[i], f"forcing of mode {i + 1} [1/s2]"), "sum")
+        _linear(_el(_product(s, _p("dqbar-ref-pa")), "sum"),
+                list(zip(nums.k_aero[i], eta, strict=True)))
+        if has_d and any(nums.d_aero[i]):
+            _linear(_el(_product(s, _p("dq-over-v-ref")), "sum"),
+                    list(zip(nums.d_aero[i], etad, strict=True)))
+        _linear(s, [(nums.b_alpha[i], _p("q-dalpha")), (nums.b_q[i], _p("q-over-v-q")),
+                    (nums.b_0[i], _p("dqbar-pa"))])
+    _comment(ch, "x+ = Phi x + Psi f, row by row in place (coefficients rewritten for the rows "
+                 "already updated; in_place_step)")
+    for k in range(2 * n):
+        s = _el(_fcs(ch, f"{state[k]}-step", f"{state[k].rsplit('/', 1)[1]} after the step",
+                     output=state[k]), "sum")
         for j in range(2 * n):
-            row = phis[:, k, j]
-            _product(s, lambda p, row=row: _table(p, _p("qbar-pa"), qs, row), state[j])
-        for m in range(n):
-            row = psis[:, k, m]
-            _product(s, lambda p, row=row: _table(p, _p("qbar-pa"), qs, row), fn_names[m])
-    _comment(ch, "commit the step; held at zero while not active (IC, trim, other time step)")
-    for k in range(2 * n):
-        g = _el(ch, "pure_gain", name=f"{state[k]}-commit")
-        _el(g, "input", nxt[k])
-        _el(g, "gain", _p("active"))
-        _el(g, "output", state[k])
+            _product(s, coef_phi[k][j], state[j])
+        for m_ in range(n):
+            _product(s, coef_psi[k][m_], g[m_])
+    _comment(ch, "this step's down wind, for the next step's change")
+    _assign(ch, _p("wind-down-store"), "down wind of this step [ft/s]",
+            "atmosphere/wind-down-fps", [_p("wind-down-prev-fps")])
+
+def _loads_fused(ch, nums: ModalNumbers, eta, etad) -> None:
+    """Lift and pitching moment of the modal state (wind axes, SI), the drag being k2 times
+    the lift (C_D_eta = 2 k C_L0 C_L_eta), into the external reactions in body axes."""
+    s_ref, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
+    k2 = float(nums.load_eta[1, 0] / nums.load_eta[0, 0]) if nums.load_eta[0, 0] else 0.0
+    if not (np.allclose(nums.load_eta[1], k2 * nums.load_eta[0])
+            and np.allclose(nums.load_etadot[1], k2 * nums.load_etadot[0])):
+        raise ExportError("the modal drag is not proportional to the modal lift")
+    _comment(ch, "incremental loads: Q S (C_eta eta + C_etadot etadot cbar/(2V)), SI; "
+                 f"drag = {_num(k2)} lift")
+    for r, name, text in ((0, "lift-n", "lift, up, normal to the air velocity [N]"),
+                          (2, "pitch-n_m", "pitching moment about the CG, nose up [N m]")):
+        prod = _el(_fcs(ch, _p(name), text), "product")
+        _prop(prod, _p("enabled"))
+        total = _el(prod, "sum")
+        if any(nums.load_eta[r]):
+            _linear(_el(_product(total, _p("qbar-pa")), "sum"),
+                    [(s_ref * c, e) for c, e in zip(nums.load_eta[r], eta, strict=True)])
+        if any(nums.load_etadot[r]):
+            _linear(_el(_product(total, _p("q-over-v")), "sum"),
+                    [(s_ref * cb / 2.0 * c, e)
+                     for c, e in zip(nums.load_etadot[r], etad, strict=True)])
+    _comment(ch, "into the airframe's external reactions, body axes, JSBSim units")
+    cos_a = lambda p: _prop(_el(p, "cos"), _p("alpha-rad"))  # noqa: E731
+    sin_a = lambda p: _prop(_el(p, "sin"), _p("alpha-rad"))  # noqa: E731
+    for name, a, b in (("modal-lift", (1.0, cos_a), (k2, sin_a)),
+                       ("modal-drag", (k2, cos_a), (-1.0, sin_a))):
+        fn = _fcs(ch, _p(f"{name}-lbs"), f"{name} force [lbs]",
+                  output=airframe_xml.external_property(name))
+        s = _el(_product(fn, U.LBF_PER_N, _p("lift-n")), "sum")
+        for coef, f in (a, b):
+            if coef == 1.0:
+                f(s)
+            else:
+                _product(s, coef, f)
+    fn = _fcs(ch, _p("modal-pitch-lbsft"), "modal-pitch moment [lbs ft]",
+              output=airframe_xml.external_property("modal-pitch"))
+    _product(fn, U.LBF_FT_PER_N_M, _p("pitch-n_m"))
 
 
 def _collapse(parent: ET.Element) -> None:
@@ -612,55 +841,109 @@ def _modal_aircraft(text: str, sysname: str, spec: ExportSpec) -> str:
     )
 
 
-def _zero_thrust_advance_ratio() -> float:
-    j, ct, _ = airframe_xml.propeller_tables(PROPULSION)
-    k = int(np.argmax(ct <= 0.0))
-    return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
+@dataclass(frozen=True)
+class TrimState:
+    """The flying aircraft's trimmed state and controls, JSBSim units, for an IC file."""
+
+    ic: dict[str, tuple[str, float]]  # IC element → (unit, value)
+    controls: dict[str, float]  # control command property → value
 
 
-def spin_up_throttle(speed_m_s: float, dt_s: float) -> float:
-    """Throttle that brings the rotors from rest to windmilling RPM at ``speed_m_s`` in one
-    step of ``dt_s`` (JSBSim's trim needs a turning propeller; as the Python adapter does)."""
-    n = PROPULSION.rotor_count
-    omega = 2.0 * math.pi * speed_m_s / (_zero_thrust_advance_ratio() * PROPULSION.prop_diameter_m)
-    inertia = PROPULSION.rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
-    power = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
-    return min(1.0, omega * inertia / (power * dt_s))
+def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> TrimState:
+    """Trim of the Fig. 21 case by :meth:`Airframe.trim` (the co-simulation's trim: same
+    integrators and step), read from the flying instance."""
+    from bioflex_jsb.adapters.cosim import INTEGRATORS
+    from bioflex_jsb.adapters.jsbsim_fdm import _TRIM_CONTROLS, Airframe
+
+    af = Airframe()
+    for name, value in INTEGRATORS.items():
+        af[name] = value
+    af.set_dt(dt_s)
+    af.trim(P.SECTION5_AIRSPEED_M_S)
+    ic = {
+        "ubody": ("FT/SEC", af["velocities/u-fps"]),
+        "vbody": ("FT/SEC", af["velocities/v-fps"]),
+        "wbody": ("FT/SEC", af["velocities/w-fps"]),
+        "p": ("RAD/SEC", af["velocities/p-rad_sec"]),
+        "q": ("RAD/SEC", af["velocities/q-rad_sec"]),
+        "r": ("RAD/SEC", af["velocities/r-rad_sec"]),
+        "elevation": ("FT", af["position/terrain-elevation-asl-ft"]),
+        "altitudeMSL": ("FT", af["position/h-sl-ft"]),
+        "phi": ("RAD", af["attitude/phi-rad"]),
+        "theta": ("RAD", af["attitude/theta-rad"]),
+        "psi": ("RAD", af["attitude/psi-rad"]),
+        "latitude": ("RAD", af["position/lat-geod-rad"]),
+        "longitude": ("RAD", af["position/long-gc-rad"]),
+    }
+    names = _TRIM_CONTROLS + tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(af.engine_count))
+    return TrimState(ic, {name: af[name] for name in names})
 
 
-def render_fig21_script(dt_s: float = DEFAULT_DT_S) -> str:
-    """Text of ``scripts/fig21_native.xml``: the Fig. 21 case in the plain JSBSim program."""
+def _trim_num(x: float) -> str:
+    """Trim values to 10 significant digits (regeneration stays byte-stable)."""
+    x = float(x)
+    return "0" if abs(x) < 1e-13 else f"{x:.10g}"
+
+
+def render_fig21_initial_condition(state: TrimState) -> str:
+    """Text of ``aircraft/bioflex_optimised/fig21_trim.xml``: the trimmed state."""
+    root = ET.Element("initialize", name=FIG21_IC)
+    root.append(ET.Comment(f" trim at {P.SECTION5_AIRSPEED_M_S:g} m/s, ISA sea level, by "
+                           "Airframe.trim (bioflex_jsb.adapters.jsbsim_fdm); JSBSim reads "
+                           "<elevation> before <altitudeMSL> "))
+    for name, (unit, value) in state.ic.items():
+        _el(root, name, _trim_num(value), unit=unit)
+    _el(root, "running", "-1")
+    ET.indent(root, space="  ")
+    return ('<?xml version="1.0" encoding="utf-8"?>\n'
+            "<!-- GENERATED by bioflex_jsb.adapters.jsbsim_export: do not edit. -->\n"
+            + ET.tostring(root, encoding="unicode", short_empty_elements=True) + "\n")
+
+
+def render_fig21_script(state: TrimState, dt_s: float = DEFAULT_DT_S) -> str:
+    """Text of ``scripts/fig21_native.xml``: the Fig. 21 case in the plain JSBSim program.
+
+    JSBSim's own trim cannot trim the flying aircraft (physical rotor inertia: module
+    docstring of jsbsim_fdm), so the script starts from the Python trim written as an initial
+    condition (:func:`render_fig21_initial_condition`), sets the trim controls, holds the
+    airframe (integrators off) for ``FIG21_SETTLE_S`` while the propellers spin up to their
+    trim RPM, then flies with the co-simulation's integrators; the gust comes
+    ``FIG21_GUST_START_S`` later."""
+    from bioflex_jsb.adapters.cosim import INTEGRATORS
+
     craft = aircraft_name(FIG21_VARIANT)
     amp = P.SECTION5_GUST_AMPLITUDE_M_S
     speed = P.SECTION5_AIRSPEED_M_S
-    if abs(speed - airframe_xml.INIT_SPEED_M_S) > 1e-9:
-        raise ExportError("the Fig. 21 speed differs from the initial condition's")
-    t_trim = dt_s  # one spin-up step, then JSBSim's full trim
-    t_gust = t_trim + FIG21_GUST_START_S
+    t_fly = FIG21_SETTLE_S
+    t_gust = t_fly + FIG21_GUST_START_S
     root = ET.Element("runscript", name="bioflex Fig. 21, native modal wing")
     _el(root, "description",
         f"Optimised wing at {speed:g} m/s through a {amp:g} m/s sharp-edged vertical gust "
         f"{FIG21_GUST_START_S:g} s after the trim (paper Fig. 21), the modal wing flown by "
-        f"JSBSim ({system_name(FIG21_VARIANT)}). Run: jsbsim --root=REPO --script={FIG21_SCRIPT}. "
-        f"Writes {FIG21_OUTPUT} (one row per step) in the working directory.")
-    _el(root, "use", aircraft=craft, initialize=airframe_xml.INIT_FILE)
+        f"JSBSim ({system_name(FIG21_VARIANT)}). Run: jsbsim --root=REPO --script={FIG21_SCRIPT} "
+        f"--simulation-rate={_num(1.0 / dt_s)} (the console program of jsbsim 1.3.3 replaces "
+        "the script's dt by its own, 1/120 s by default, at which the wing stays rigid: "
+        f"{PREFIX}/active = 0). Writes {FIG21_OUTPUT} (one row per step) in the JSBSim root, "
+        "or in --outputpath. Trimmed state "
+        f"from {FIG21_IC}.xml; the airframe is held for the first {t_fly:g} s (propeller "
+        f"spin-up to the trim RPM); the flight starts at t = {t_fly:g} s.")
+    _el(root, "use", aircraft=craft, initialize=FIG21_IC)
     run = _el(root, "run", start="0", end=_num(t_gust + FIG21_DURATION_S - FIG21_GUST_START_S),
               dt=_num(dt_s))
-    for name, value in (("simulation/integrator/rate/rotational", 3),
-                        ("simulation/integrator/rate/translational", 3),
-                        ("simulation/integrator/position/rotational", 3),
-                        ("simulation/integrator/position/translational", 3)):
-        _el(run, "property", name, value=str(value))
-    ev = _el(run, "event", name="propeller spin-up")
-    _el(ev, "description", "one step of throttle from rest to windmilling RPM (trim needs it)")
+    ev = _el(run, "event", name="trim controls, airframe held")
+    _el(ev, "description", "trim controls of the Python trim; JSBSim's integrators of the "
+                           "airframe state off (0): the state stays at the trim while the "
+                           "propellers spin up to the trim RPM")
     _el(ev, "condition", "simulation/sim-time-sec ge 0")
-    for i in range(PROPULSION.rotor_count):
-        _el(ev, "set", name=f"fcs/throttle-cmd-norm[{i}]",
-            value=_num(spin_up_throttle(speed, dt_s)))
-    ev = _el(run, "event", name="trim")
-    _el(ev, "description", "JSBSim full trim (the modal wing re-latches its trim reference)")
-    _el(ev, "condition", f"simulation/sim-time-sec ge {_num(t_trim - 0.5 * dt_s)}")
-    _el(ev, "set", name="simulation/do_simple_trim", value="1")
+    for name, value in state.controls.items():
+        _el(ev, "set", name=name, value=_trim_num(value))
+    for name in INTEGRATORS:
+        _el(ev, "set", name=name, value="0")
+    ev = _el(run, "event", name="fly")
+    _el(ev, "description", "airframe released: the co-simulation's integrators")
+    _el(ev, "condition", f"simulation/sim-time-sec ge {_num(t_fly - 0.5 * dt_s)}")
+    for name, value in INTEGRATORS.items():
+        _el(ev, "set", name=name, value=str(value))
     ev = _el(run, "event", name="gust")
     _el(ev, "description", f"sharp-edged gust, {amp:g} m/s up (wind-down = -w_g)")
     _el(ev, "condition", f"simulation/sim-time-sec ge {_num(t_gust - 0.5 * dt_s)}")
@@ -668,7 +951,8 @@ def render_fig21_script(dt_s: float = DEFAULT_DT_S) -> str:
     out = _el(root, "output", name=FIG21_OUTPUT, type="CSV", rate=_num(1.0 / dt_s))
     for prop in ("velocities/vt-fps", "velocities/u-fps", "velocities/w-fps",
                  "velocities/q-rad_sec", "attitude/theta-rad", "aero/alpha-rad",
-                 "atmosphere/wind-down-fps", _p("eta1"), _p("eta2"), _p("eta3"), _p("active")):
+                 "atmosphere/wind-down-fps", "propulsion/engine[0]/propeller-rpm",
+                 _p("eta1"), _p("eta2"), _p("eta3"), _p("active")):
         _el(out, "property", prop)
     ET.indent(root, space="  ")
     body = ET.tostring(root, encoding="unicode", short_empty_elements=True)
@@ -702,7 +986,10 @@ def repository_files() -> dict[str, str]:
     for name in REPOSITORY_VARIANTS:
         spec = ExportSpec(build_wing(VARIANTS[name]).model, name)
         files.update(render_aircraft_files(spec, include_shared=False))
-    files[FIG21_SCRIPT] = render_fig21_script()
+    state = fig21_trim_state()
+    files[f"aircraft/{aircraft_name(FIG21_VARIANT)}/{FIG21_IC}.xml"] = (
+        render_fig21_initial_condition(state))
+    files[FIG21_SCRIPT] = render_fig21_script(state)
     return files
 
 

@@ -11,7 +11,7 @@ HELP = """Write a JSBSim root under --out DIR: systems/bioflex_modal_<wing>.xml 
 integrated by JSBSim: exact discrete step scheduled on dynamic pressure, loads into the
 airframe's external reactions) and aircraft/bioflex_<wing>/ (the bioflex airframe including
 it, with its trim companion). Fly it with `jsbsim --root=DIR --aircraft=bioflex_<wing>`. The
-system holds for one time step, --dt [s] (default 1/480 s); the trim lift coefficient is that
+system holds for one time step, --dt [s] (default 1/960 s); the trim lift coefficient is that
 of level flight at --speed [m/s]. See docs/native.md."""
 
 
