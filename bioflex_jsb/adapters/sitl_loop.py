@@ -1,0 +1,359 @@
+"""The SITL loop: the co-simulation of ``cosim.run_gust`` paced to the wall clock.
+
+The same step as :func:`bioflex_jsb.adapters.cosim.run_gust` (gust → wind, flow from the
+airframe state, modal loads into ``external_reactions``, JSBSim step, modal step), on the
+``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml``, see
+:mod:`bioflex_jsb.adapters.autopilot_xml`) keeps it flying level on its own, for as long as
+asked (or until stopped).
+
+Pacing: step k is due at wall time W_0 + (t_k − t_0)/speedup. The loop sleeps until a step is
+due and runs late steps at once (catch-up); the *pacing error* of a step is its start minus
+its due time [s] (:class:`PacingStats`; ``sitl_p99_ms`` in ``bioflex-jsb bench``). A loop
+more than :data:`RESYNC_S` behind (a stall: debugger, swapped-out process) starts a new
+schedule from now instead of racing to catch up; the number of such resyncs is reported.
+Changing the time scale (parameter ``SIM_SPEEDUP``) starts a new schedule too.
+
+The MAVLink link (:mod:`bioflex_jsb.adapters.mavlink_link`) is serviced every
+:data:`LINK_PERIOD_S` of simulated time (≥ 50 Hz of wall time up to a speed-up of 4); its
+reads are bounded per call, so a flood costs at most a fixed time per call.
+
+Parameters a ground station sees (:class:`SitlParameters`, all REAL32 in MAVLink):
+
+=============== =========================================================================
+AP_ENABLE       1: autopilot engaged (altitude and heading hold); 0: controls at trim
+AP_LOITER       1: loiter circle at a fixed bank instead of heading hold
+AP_ALT_M        altitude held [m above sea level]
+AP_HDG_RAD      heading held [rad, from north, clockwise]
+GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up]
+GUST_LEN_M      length of that gust [m]
+GUST_TRIG       write 1: the gust starts now; reads 1 while it blows, then 0
+WING_COUPLED    1: the elastic wing's modal loads act (coupled); 0: rigid wing
+SIM_SPEEDUP     simulated seconds per wall-clock second
+=============== =========================================================================
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.adapters.autopilot_xml import SITL_AIRCRAFT
+from bioflex_jsb.adapters.cosim import ALPHA_TABLE_RANGE_RAD, INTEGRATORS, base_channels
+from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+from bioflex_jsb.adapters.mavlink_link import VehicleState
+from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, FlowState, ModalWing, TrimReference
+
+LINK_PERIOD_S = 1.0 / 200.0  # simulated time between link services [s]
+RESYNC_S = 0.25  # a loop this far behind its schedule starts a new one [s]
+SLEEP_MARGIN_S = 50e-6  # steps due within this are started at once (sleep overshoot)
+MANUAL_TIMEOUT_S = 1.0  # manual input older than this [wall s] gives control back
+SPEEDUP_RANGE = (0.1, 50.0)
+ETA_LIMIT_RAD = 0.52  # as cosim: beyond it the linear modal model is meaningless
+
+
+@dataclass
+class PacingStats:
+    """Step start minus due time [s] of every paced step, and the resyncs."""
+
+    errors_s: list[float] = field(default_factory=list)
+    resyncs: int = 0
+
+    def percentile_ms(self, q: float) -> float:
+        if not self.errors_s:
+            return math.nan
+        return float(np.percentile(np.abs(np.asarray(self.errors_s)), q) * 1e3)
+
+    def summary(self) -> dict[str, float]:
+        return {"p50_ms": self.percentile_ms(50), "p99_ms": self.percentile_ms(99),
+                "max_ms": self.percentile_ms(100), "steps": len(self.errors_s),
+                "resyncs": self.resyncs}
+
+
+class SitlParameters:
+    """The parameter set of the module docstring; ``set`` applies to the running sim."""
+
+    names = ("AP_ENABLE", "AP_LOITER", "AP_ALT_M", "AP_HDG_RAD", "GUST_AMP_MS", "GUST_LEN_M",
+             "GUST_TRIG", "WING_COUPLED", "SIM_SPEEDUP")
+
+    def __init__(self, sim: SitlSim) -> None:
+        self._sim = sim
+
+    def get(self, name: str) -> float:
+        s = self._sim
+        return float({
+            "AP_ENABLE": s.airframe["ap/engage"],
+            "AP_LOITER": s.airframe["ap/loiter"],
+            "AP_ALT_M": s.airframe["ap/altitude-hold-m"],
+            "AP_HDG_RAD": s.airframe["ap/heading-hold-rad"],
+            "GUST_AMP_MS": s.gust_amplitude_m_s,
+            "GUST_LEN_M": s.gust_length_m,
+            "GUST_TRIG": 1.0 if s.gust_active else 0.0,
+            "WING_COUPLED": 1.0 if s.wing.model == "coupled" else 0.0,
+            "SIM_SPEEDUP": s.speedup,
+        }[name])
+
+    def set(self, name: str, value: float) -> float:
+        s = self._sim
+        if not math.isfinite(value):
+            raise ValueError(f"{name}: not a finite number")
+        if name in ("AP_ENABLE", "AP_LOITER", "WING_COUPLED", "GUST_TRIG"):
+            if value not in (0.0, 1.0):
+                raise ValueError(f"{name} must be 0 or 1")
+        if name == "AP_ENABLE":
+            s.airframe["ap/engage"] = value
+        elif name == "AP_LOITER":
+            s.airframe["ap/loiter"] = value
+        elif name == "AP_ALT_M":
+            lo, hi = s.altitude_hold_range_m
+            if not lo <= value <= hi:
+                raise ValueError(f"AP_ALT_M must be in {lo:g}..{hi:g} m")
+            s.airframe["ap/altitude-hold-m"] = value
+        elif name == "AP_HDG_RAD":
+            s.airframe["ap/heading-hold-rad"] = math.remainder(value, 2.0 * math.pi)
+        elif name == "GUST_AMP_MS":
+            if abs(value) > 5.0:
+                raise ValueError("GUST_AMP_MS must be within ±5 m/s")
+            s.gust_amplitude_m_s = value
+        elif name == "GUST_LEN_M":
+            if not 1.0 <= value <= 500.0:
+                raise ValueError("GUST_LEN_M must be in 1..500 m")
+            s.gust_length_m = value
+        elif name == "GUST_TRIG":
+            if value == 1.0:
+                s.trigger_gust()
+        elif name == "WING_COUPLED":
+            s.set_wing_model("coupled" if value == 1.0 else "rigid")
+        elif name == "SIM_SPEEDUP":
+            lo, hi = SPEEDUP_RANGE
+            if not lo <= value <= hi:
+                raise ValueError(f"SIM_SPEEDUP must be in {lo:g}..{hi:g}")
+            s.speedup = value
+            s.resync = True
+        else:
+            raise KeyError(name)
+        return self.get(name)
+
+
+class SitlSim:
+    """The co-simulation state between steps: airframe (trimmed, autopilot engaged), modal
+    wing, the gust in progress."""
+
+    def __init__(self, wing_model, modes, model: str = "coupled", speed_m_s: float = 15.0,
+                 altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S, speedup: float = 1.0,
+                 airframe: Airframe | None = None) -> None:
+        self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
+        a = self.airframe
+        a.set_external_reactions()
+        for name, value in INTEGRATORS.items():
+            a[name] = value
+        a.set_dt(dt_s)
+        a["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
+        self.trim = a.trim(speed_m_s, altitude_m)
+        self.speed_m_s = speed_m_s
+        self.dt_s = a.dt_s
+        self.speedup = float(speedup)
+        self.resync = False
+        self._nodes = {k: a.property_node(v) for k, v in _READ.items()}
+        self._get = {k: n.get_double_value for k, n in self._nodes.items()}
+        self._wind = a.property_node("atmosphere/wind-down-fps")
+        self._write_reactions = a.external_reaction_writer()
+        rho0 = self._get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        cond = level_flight_condition(speed_m_s)
+        ref = TrimReference(self.trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cond.cl_trim)
+        self.wing = ModalWing(wing_model, ref, model=model, dt_s=self.dt_s)
+        self.n_modes = wing_model.n_modes
+        twist = np.asarray(modes.twist_rad, dtype=float)
+        tip = int(np.argmax(np.abs(np.asarray(modes.stations_m, dtype=float))))
+        self._tip_twist_per_mode = np.abs(twist[:, tip]) / np.max(np.abs(twist), axis=1)
+        self.h0_m = self._get["h"]() * U.M_PER_FT
+        self.altitude_hold_range_m = (self.h0_m - 250.0, self.h0_m + 1000.0)
+        a["ap/theta-trim-rad"] = self.trim.theta_rad
+        a["ap/altitude-hold-m"] = self.h0_m
+        a["ap/heading-hold-rad"] = self._get["psi"]()
+        a["ap/engage"] = 1.0
+        self.gust_amplitude_m_s = 1.0
+        self.gust_length_m = 30.0
+        self._gust: GustField | None = None
+        self._gust_end_s = 0.0
+        self.t_s = 0.0
+        self.k = 0
+        self.units = base_channels(self.n_modes)
+        self.names = list(self.units)
+        self._manual_wall_s: float | None = None
+        self.stopped: str | None = None
+        self._flow, self._w_g, self._theta, self._phi = self._sense(0.0)
+
+    # -- commands from the link -------------------------------------------------------------
+    @property
+    def gust_active(self) -> bool:
+        return self._gust is not None and self.t_s < self._gust_end_s
+
+    def trigger_gust(self) -> None:
+        """Start the 1-cosine gust (GUST_AMP_MS, GUST_LEN_M) now."""
+        if self.gust_amplitude_m_s == 0.0:
+            return
+        try:
+            spec = parse_gust(f"1cos:{self.gust_amplitude_m_s!r}:{self.gust_length_m!r}")
+        except GustSpecError as exc:
+            raise ValueError(str(exc)) from None
+        self._gust = GustField(spec, self.speed_m_s, self.t_s, self.t_s + 60.0, self.dt_s)
+        self._gust_end_s = self.t_s + self.gust_length_m / self.speed_m_s
+
+    def set_wing_model(self, model: str) -> None:
+        if model != self.wing.model:
+            self.wing.model = model
+            self.wing.eta = np.zeros(self.n_modes)  # the coupled wing starts undeformed
+            self.wing.eta_dot = np.zeros(self.n_modes)
+
+    def manual(self, pitch: float | None, roll: float | None) -> None:
+        """Stick increments on the trim (−1..1; pitch + = nose down), or None: release."""
+        a = self.airframe
+        if pitch is None or roll is None:
+            a["ap/manual"] = 0.0
+            self._manual_wall_s = None
+            return
+        a["ap/manual-elevator-norm"] = pitch
+        a["ap/manual-aileron-norm"] = roll
+        a["ap/manual"] = 1.0
+        self._manual_wall_s = time.monotonic()
+
+    # -- the step -----------------------------------------------------------------------
+    def _sense(self, t: float):
+        w_g = self._gust.vertical_m_s(t) if self._gust is not None else 0.0
+        wind_down_fps = -w_g * U.FT_PER_M
+        self._wind.set_double_value(wind_down_fps)
+        get = self._get
+        theta, phi = get["theta"](), get["phi"]()
+        ua = get["u"]() + wind_down_fps * math.sin(theta)
+        va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
+        wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
+        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+        rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        return FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), w_g, theta, phi
+
+    def step(self) -> tuple:
+        """One co-simulation step (as ``run_gust``); returns the logged row's values (in
+        ``self.names`` order) and sets ``self.stopped`` when the run left its valid range."""
+        flow, mw, get = self._flow, self.wing, self._get
+        loads = mw.loads(flow)
+        alpha = flow.alpha_rad
+        ca, sa = math.cos(alpha), math.sin(alpha)
+        self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
+                              loads.drag_n * ca - loads.lift_n * sa, loads.pitch_moment_n_m)
+        self.airframe.step()
+        values = (
+            flow.airspeed_m_s - self.speed_m_s, alpha - self.trim.alpha_rad, flow.q_rad_s,
+            self._theta - self.trim.theta_rad, get["nz"](), self._w_g, flow.airspeed_m_s,
+            get["h"]() * U.M_PER_FT, loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
+            get["lat"](), get["lon"](), self._phi, self._theta, get["psi"](), get["p"](),
+            get["r"](), get["elevator"](), get["throttle"](), *mw.eta, *mw.eta_dot,
+        )
+        self.stopped = _check(values, self.t_s, alpha, mw.eta, get["agl"]())
+        mw.step(flow)
+        self.k += 1
+        self.t_s = self.k * self.dt_s
+        self._flow, self._w_g, self._theta, self._phi = self._sense(self.t_s)
+        if self._manual_wall_s is not None and \
+                time.monotonic() - self._manual_wall_s > MANUAL_TIMEOUT_S:
+            self.manual(None, None)
+        return values
+
+    def vehicle_state(self) -> VehicleState:
+        get, a = self._get, self.airframe
+        h = get["h"]() * U.M_PER_FT
+        eta = self.wing.eta
+        named = {f"eta{i + 1}": float(eta[i]) for i in range(min(3, self.n_modes))}
+        named["tip_twist"] = self.wing.tip_twist_rad(self._tip_twist_per_mode)
+        return VehicleState(
+            time_s=self.t_s, roll_rad=self._phi, pitch_rad=self._theta, yaw_rad=get["psi"](),
+            p_rad_s=get["p"](), q_rad_s=get["q"](), r_rad_s=get["r"](),
+            latitude_rad=get["lat"](), longitude_rad=get["lon"](), altitude_m=h,
+            relative_altitude_m=h - self.h0_m,
+            v_north_m_s=get["vn"]() * U.M_PER_FT, v_east_m_s=get["ve"]() * U.M_PER_FT,
+            v_down_m_s=get["vd"]() * U.M_PER_FT, airspeed_m_s=self._flow.airspeed_m_s,
+            throttle=get["throttle"](), named=named,
+            autopilot=a["ap/engage"] == 1.0, manual=a["ap/manual"] == 1.0,
+        )
+
+
+_READ = {
+    "u": "velocities/u-fps", "v": "velocities/v-fps", "w": "velocities/w-fps",
+    "q": "velocities/q-rad_sec", "p": "velocities/p-rad_sec", "r": "velocities/r-rad_sec",
+    "theta": "attitude/theta-rad", "phi": "attitude/phi-rad", "psi": "attitude/psi-rad",
+    "rho": "atmosphere/rho-slugs_ft3", "nz": "accelerations/Nz", "h": "position/h-sl-ft",
+    "agl": "position/h-agl-ft", "lat": "position/lat-geod-rad", "lon": "position/long-gc-rad",
+    "vn": "velocities/v-north-fps", "ve": "velocities/v-east-fps", "vd": "velocities/v-down-fps",
+    "elevator": "fcs/elevator-pos-rad", "throttle": "fcs/throttle-pos-norm",
+}
+
+
+def _check(values, t: float, alpha: float, eta, agl_ft: float) -> str | None:
+    """Why the run must stop (as cosim's range check), or None."""
+    if not all(map(math.isfinite, values)):
+        return f"the state became non-finite at t = {t:.3f} s"
+    lo, hi = ALPHA_TABLE_RANGE_RAD
+    if not lo <= alpha <= hi:
+        return (f"angle of attack {math.degrees(alpha):.1f} deg left the aerodynamic model at "
+                f"t = {t:.3f} s")
+    if len(eta) and float(np.max(np.abs(eta))) > ETA_LIMIT_RAD:
+        return f"a wing mode diverged (|eta| > {ETA_LIMIT_RAD} rad) at t = {t:.3f} s"
+    if agl_ft <= 0.0:
+        return f"the aircraft reached the ground at t = {t:.3f} s"
+    return None
+
+
+def run_paced(
+    sim: SitlSim,
+    duration_s: float | None,
+    link=None,
+    on_sample: Callable[[float, str, tuple], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    clock: Callable[[], float] = time.perf_counter,
+    sleep: Callable[[float], None] = time.sleep,
+) -> PacingStats:
+    """Fly ``sim`` paced to the wall clock for ``duration_s`` simulated seconds (None: until
+    ``should_stop()`` or a stop of the run; Ctrl-C raises KeyboardInterrupt). ``link``: a
+    :class:`~bioflex_jsb.adapters.mavlink_link.MavlinkLink`, serviced every LINK_PERIOD_S;
+    ``on_sample(t_s, model, values)`` after every step (logging)."""
+    stats = PacingStats()
+    errors = stats.errors_s
+    dt = sim.dt_s
+    n_end = None if duration_s is None else sim.k + int(round(duration_s / dt))
+    link_every = max(1, int(round(LINK_PERIOD_S / dt)))
+    wall0, k0, speedup = clock(), sim.k, sim.speedup
+    with sim.airframe.capturing():
+        while n_end is None or sim.k < n_end:
+            if sim.resync or sim.speedup != speedup:
+                sim.resync = False
+                wall0, k0, speedup = clock(), sim.k, sim.speedup
+            due = wall0 + (sim.k - k0) * dt / speedup
+            now = clock()
+            if due - now > SLEEP_MARGIN_S:
+                sleep(due - now - SLEEP_MARGIN_S * 0.5)
+                now = clock()
+                while now < due - SLEEP_MARGIN_S:  # woke early: wait the rest
+                    now = clock()
+            late = now - due
+            if late > RESYNC_S:
+                stats.resyncs += 1
+                wall0, k0 = now, sim.k
+                late = 0.0
+            errors.append(late)
+            t = sim.t_s
+            values = sim.step()
+            if on_sample is not None:
+                on_sample(t, sim.wing.model, values)
+            if sim.stopped:
+                break
+            if link is not None and sim.k % link_every == 0:
+                link.service(sim.vehicle_state())
+            if should_stop is not None and sim.k % link_every == 0 and should_stop():
+                break
+    return stats
