@@ -317,11 +317,14 @@ def run_paced(
     should_stop: Callable[[], bool] | None = None,
     clock: Callable[[], float] = time.perf_counter,
     sleep: Callable[[float], None] = time.sleep,
+    idle: Callable[[float], None] | None = None,
 ) -> PacingStats:
     """Fly ``sim`` paced to the wall clock for ``duration_s`` simulated seconds (None: until
     ``should_stop()`` or a stop of the run; Ctrl-C raises KeyboardInterrupt). ``link``: a
     :class:`~bioflex_jsb.adapters.mavlink_link.MavlinkLink`, serviced every LINK_PERIOD_S;
-    ``on_sample(t_s, model, values)`` after every step (logging)."""
+    ``on_sample(t_s, model, values)`` after every step (logging); ``idle(slack_s)`` when the
+    next step is not due for ``slack_s`` [s] (a place for work that may wait, such as writing
+    a log chunk, without delaying a step)."""
     stats = PacingStats()
     errors = stats.errors_s
     dt = sim.dt_s
@@ -335,6 +338,9 @@ def run_paced(
                 wall0, k0, speedup = clock(), sim.k, sim.speedup
             due = wall0 + (sim.k - k0) * dt / speedup
             now = clock()
+            if idle is not None and due - now > SLEEP_MARGIN_S:
+                idle(due - now)
+                now = clock()
             if due - now > SLEEP_MARGIN_S:
                 sleep(due - now - SLEEP_MARGIN_S * 0.5)
                 now = clock()
