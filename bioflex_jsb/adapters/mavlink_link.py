@@ -371,12 +371,13 @@ class MavlinkLink:
             return 0
         good = 0
         for msg in msgs:
-            if msg.get_type() == "BAD_DATA":
+            name = msg.get_type()
+            # unknown message ids carry no checkable CRC (no CRC_EXTRA): noise, not MAVLink
+            if name == "BAD_DATA" or name.startswith("UNKNOWN"):
                 self.stats.bad += 1
                 continue
             good += 1
             self.stats.received += 1
-            name = msg.get_type()
             self.stats.by_type[name] = self.stats.by_type.get(name, 0) + 1
             peer.last_seen = time.monotonic()
             try:
