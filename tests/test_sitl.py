@@ -349,3 +349,11 @@ def test_cli_sitl_runs_and_logs(tmp_path, monkeypatch, capsys):
 
     info = summarise(out)
     assert info is not None and out.stat().st_size > 10000
+
+
+def test_measure_pacing_for_bench():
+    from bioflex_jsb.adapters.sitl_loop import measure_pacing
+
+    r = measure_pacing(0.5)
+    assert r["steps"] == 480 and r["resyncs"] == 0
+    assert 0.0 <= r["p50_ms"] <= r["p99_ms"] <= PACING_TARGET_MS

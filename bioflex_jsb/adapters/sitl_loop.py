@@ -363,3 +363,23 @@ def run_paced(
             if should_stop is not None and sim.k % link_every == 0 and should_stop():
                 break
     return stats
+
+
+def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "optimised",
+                   speed_m_s: float = 15.0, mavlink: str = "udpin:127.0.0.1:0") -> dict:
+    """Pacing error of a real-time SITL run (for ``bioflex-jsb bench``: ``sitl_p50_ms``,
+    ``sitl_p99_ms``): ``duration_s`` simulated seconds of the coupled wing at ``speedup``,
+    with the MAVLink link serviced as in a session (default: listening on a loopback port,
+    telemetry at its default rates, 50 Hz ATTITUDE). Returns :meth:`PacingStats.summary`
+    ([ms] and counts) with ``dt_s`` and ``speedup``."""
+    from bioflex_jsb.adapters.mavlink_link import MavlinkLink
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    build = build_wing(VARIANTS[wing])
+    sim = SitlSim(build.model, build.modes, speed_m_s=speed_m_s, speedup=speedup)
+    link = MavlinkLink(mavlink, SitlParameters(sim), sim.manual)
+    try:
+        stats = run_paced(sim, duration_s, link)
+    finally:
+        link.close()
+    return {**stats.summary(), "dt_s": sim.dt_s, "speedup": speedup}
