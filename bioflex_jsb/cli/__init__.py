@@ -22,6 +22,7 @@ COMMAND_MODULES = (
     "flutter",
     "export",
     "gust",
+    "sitl",
     "compare",
     "export_jsbsim",
     "info",
