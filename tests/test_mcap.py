@@ -255,12 +255,15 @@ DRIVER = """
 import sys
 from bioflex_jsb import cli
 from bioflex_jsb.adapters import mcap_log
-original = mcap_log.RunLog.sample
-def sample(self, model, t_s, row):
-    original(self, model, t_s, row)
-    sys.stdout.write(repr(t_s) + "\\n")
-    sys.stdout.flush()
-mcap_log.RunLog.sample = sample
+original = mcap_log.RunLog.sampler
+def sampler(self, model, names):
+    write = original(self, model, names)
+    def sample(k, t_s, values):
+        write(k, t_s, values)
+        sys.stdout.write(repr(t_s) + "\\n")
+        sys.stdout.flush()
+    return sample
+mcap_log.RunLog.sampler = sampler
 sys.exit(cli.main(sys.argv[1:]))
 """
 
@@ -332,3 +335,40 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     counts = node_check(fixed)["counts"]
     n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
     assert counts == {mcap_log.topic("coupled", g): n for g in RUN_GROUPS}
+
+
+def test_fixed_width_numbers_match_printf():
+    """The vectorised "% .8e" formatting equals Python's, and flags what does not fit."""
+    rng = np.random.default_rng(7)
+    x = np.concatenate([rng.standard_normal(20000) * 10.0 ** rng.integers(-120, 120, 20000),
+                        [0.0, -0.0, 1.0, -1.0, 10.0, 1e-5, 9.9999999949, 9.99999999e99,
+                         1e100, 1e-99, 1e-100, 5e-324, 1.7e308, np.nan, np.inf, -np.inf]])
+    chars, ok = mcap_log.fixed_e(x)
+    for v, c, fits in zip(x.tolist(), chars, ok.tolist(), strict=True):
+        text = format(v, " .8e")
+        assert fits == (len(text) == 15 and math.isfinite(v)), v
+        if fits:
+            assert c.tobytes().decode() == text
+    n = np.array([0, 7, 10, 999_999_999, 1_234_567_890])
+    assert [c.tobytes().decode() for c in mcap_log.fixed_d(n)] == [f"{i:10d}" for i in n]
+
+
+def test_dict_and_tuple_samples_write_the_same_messages(tmp_path):
+    from bioflex_jsb.adapters.cosim import base_channels
+
+    names = list(base_channels(2))
+    rng = np.random.default_rng(3)
+    rows = [tuple(rng.standard_normal(len(names)) * 0.1) for _ in range(700)]
+    rows = [r[:7] + (100.0 + r[7],) + r[8:] for r in rows]  # altitude_m
+    a, b = _bare_log(tmp_path / "a.mcap"), _bare_log(tmp_path / "b.mcap")
+    write = a.sampler("coupled", names)
+    for k, r in enumerate(rows):
+        write(k, k / 960, r)
+        b.sample("coupled", k / 960, dict(zip(names, r, strict=True)))
+    a.close()
+    b.close()
+    ma, mb = read_all(tmp_path / "a.mcap"), read_all(tmp_path / "b.mcap")
+    assert ma == mb and len(ma["/bioflex/coupled/rigid_body"]) == 700
+    first = ma["/bioflex/coupled/modal"][5][1]
+    assert first["eta_rad"][1] == pytest.approx(rows[5][names.index("eta2")], rel=1e-8)
+    assert mcap_log.summarise(tmp_path / "a.mcap")["chunks"] == 2  # 0.5 s of steps each

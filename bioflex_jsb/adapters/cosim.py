@@ -118,12 +118,13 @@ def run_gust(
     wing: ElasticWingModel,
     model: str,
     setup: RunSetup,
-    on_sample: Callable[[int, float, dict[str, float]], None] | None = None,
+    on_sample: Callable[[int, float, tuple[float, ...]], None] | None = None,
     trim: TrimResult | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd).
 
-    ``on_sample(k, t_s, values)`` is called after every step (logging, progress). A run that
+    ``on_sample(k, t_s, values)`` is called after every step (logging, progress), ``values``
+    the step's numbers as a tuple in the order of ``base_channels(wing.n_modes)``. A run that
     leaves the valid range stops: the returned history holds every step up to then and its
     ``stopped`` field says why. ``trim``: the airframe was just trimmed to this (skip it).
     """
@@ -202,7 +203,7 @@ def run_gust(
                 for column, value in zip(columns, values, strict=True):
                     column[k] = value
                 if on_sample is not None:
-                    on_sample(k, t, dict(zip(names, values, strict=True)))
+                    on_sample(k, t, values)
                 stall_steps += alpha > alpha_peak
                 stopped = _check_range(values, names, t, alpha, alpha_min, alpha_max, mw.eta,
                                        get["agl"]())

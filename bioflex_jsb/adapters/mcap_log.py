@@ -28,9 +28,10 @@ and JSBSim versions) and ``bioflex.world_frame`` (the ENU origin).
 Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_WALL_S` of
 wall time, or 4096 steps) and written to the operating system at once, so a process killed
 hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed file
-from the complete chunks of such a log. A step's numbers are kept as a tuple and formatted
-when its chunk closes, all seven records of a step by one string formatting (fixed-width
-numbers, so record lengths and index offsets are known in advance).
+from the complete chunks of such a log. A step's numbers are kept as the tuple the run hands
+over (:meth:`RunLog.sampler`) and a chunk's steps are formatted at once, vectorised, in
+fixed-width numbers (:func:`fixed_e`), so record lengths and index offsets are known in
+advance (``docs/logging.md``, Overhead).
 
 The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
 the 20 % overhead budget allows at seven messages per step); every record other than the
@@ -42,7 +43,6 @@ from __future__ import annotations
 
 import json
 import math
-import operator
 import platform
 import signal
 import struct
@@ -50,8 +50,10 @@ import time
 import zlib
 from collections.abc import Iterator
 from contextlib import contextmanager
+from itertools import chain
 from pathlib import Path
 
+import numpy as np
 from mcap.data_stream import RecordBuilder
 from mcap.records import (
     Channel,
@@ -83,7 +85,6 @@ _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE = 0x03, 0x04, 0x05
 _OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
 NUMBER = "%.9g"  # numbers of the general path: 9 significant digits (relative ≤ 5e-10)
 _MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
-_HEAD_TAIL = struct.Struct("<IQQ")  # sequence, log time, publish time of a message record
 FIXED_NUMBER = "% .8e"  # fixed-width numbers of the fast path (same 9 significant digits)
 _WGS84_A_M = 6378137.0
 _WGS84_E2 = 6.69437999014e-3
@@ -271,11 +272,12 @@ def _signals_deferred():
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def _message_index(channel_id: int, entries: list[tuple[int, int]]) -> bytes:
-    """A Message Index record (opcode 0x07): channel id, then (log time, offset) pairs."""
+def _message_index(channel_id: int, entries) -> bytes:
+    """A Message Index record (opcode 0x07): channel id, then (log time, offset) pairs
+    (``entries``: an (n, 2) integer array)."""
     n = len(entries)
-    flat = [x for pair in entries for x in pair]
-    return struct.pack(f"<BQHI{2 * n}Q", 0x07, 6 + 16 * n, channel_id, 16 * n, *flat)
+    return (struct.pack("<BQHI", 0x07, 6 + 16 * n, channel_id, 16 * n)
+            + np.ascontiguousarray(entries, dtype="<u8").tobytes())
 
 
 def _record_bytes(record) -> bytes:
@@ -287,11 +289,12 @@ def _record_bytes(record) -> bytes:
 class McapFileWriter:
     """A chunked, indexed MCAP writer built for many small messages per step.
 
-    Messages go into the chunk in progress with :meth:`append` (cheap: one ``struct`` pack and
-    a bytearray append); the chunk is closed by the caller's policy (:meth:`chunk_due`), and
-    each closed chunk is compressed, written with its message indexes and flushed to the
-    operating system. :meth:`finish` writes the summary (schemas, channels, statistics, chunk
-    and metadata indexes, summary offsets) and the footer with its CRC.
+    Messages go into the chunk in progress one at a time with :meth:`append` or as whole
+    serialised blocks with :meth:`append_block` (the index entries as arrays); the chunk is
+    closed by the caller's policy, and each closed chunk is compressed, written with its
+    message indexes and flushed to the operating system. :meth:`finish` writes the summary
+    (schemas, channels, statistics, chunk and metadata indexes, summary offsets) and the
+    footer with its CRC.
     """
 
     def __init__(self, stream, library: str) -> None:
@@ -310,10 +313,11 @@ class McapFileWriter:
         self._start_ns: int | None = None
         self._end_ns = 0
         self._n_messages = 0
-        self._buf = bytearray()
+        self._parts: list[bytes] = []  # the chunk in progress
+        self._size = 0
+        # per channel: (log time, offset) tuples of single messages, arrays of blocks
         self._index: dict[int, list[tuple[int, int]]] = {}
-        self.chunk_opened_wall_s = time.monotonic()
-        self.chunk_first_ns: int | None = None
+        self._blocks: dict[int, list[np.ndarray]] = {}
         self.finished = False
         self._write(MAGIC + _record_bytes(Header(profile="", library=library)))
 
@@ -334,6 +338,7 @@ class McapFileWriter:
                           schema_id=schema_id, metadata=metadata)
         self._channels.append(channel)
         self._index[channel.id] = []
+        self._blocks[channel.id] = []
         self._counts[channel.id] = 0
         self._write(_record_bytes(channel))
         return channel.id
@@ -346,73 +351,68 @@ class McapFileWriter:
 
     def append(self, channel_id: int, log_ns: int, sequence: int, data: bytes) -> None:
         """One message into the chunk in progress (log time = publish time = ``log_ns``)."""
-        buf = self._buf
-        self._index[channel_id].append((log_ns, len(buf)))
-        buf += _MSG_HEADER.pack(_OP_MESSAGE, 22 + len(data), channel_id, sequence, log_ns,
-                                log_ns) + data
-        if self.chunk_first_ns is None:
-            self.chunk_first_ns = log_ns
+        record = _MSG_HEADER.pack(_OP_MESSAGE, 22 + len(data), channel_id, sequence, log_ns,
+                                  log_ns) + data
+        self._index[channel_id].append((log_ns, self._size))
+        self._parts.append(record)
+        self._size += len(record)
 
-    def append_step(self, log_ns: int, sequence: int, messages) -> None:
-        """Several messages of one log time: ``messages`` holds (channel id, data) pairs.
-
-        The index entries go in first and the bytes last, in one bytearray extension, so an
-        interrupt in between leaves entries past the end of the chunk, which
-        :meth:`close_chunk` drops (the chunk never indexes a message it does not hold).
-        """
-        buf = self._buf
-        offset = len(buf)
-        index = self._index
-        pack = _MSG_HEADER.pack
-        parts = []
-        for cid, data in messages:
-            index[cid].append((log_ns, offset))
-            size = len(data)
-            parts.append(pack(_OP_MESSAGE, 22 + size, cid, sequence, log_ns, log_ns))
-            parts.append(data)
-            offset += 31 + size
-        buf += b"".join(parts)
-        if self.chunk_first_ns is None:
-            self.chunk_first_ns = log_ns
-
-    def append_block(self, block: bytes, index: dict[int, list[tuple[int, int]]]) -> None:
-        """Messages already serialised: ``index`` maps channel id to (log time, offset in
-        ``block``) of each. Callers hold signals (see RunLog.flush)."""
-        base = len(self._buf)
+    def append_block(self, block: bytes, index: dict[int, np.ndarray]) -> None:
+        """Message records already serialised: ``index`` maps a channel id to the (n, 2)
+        array of (log time, offset in ``block``) of its messages. Callers hold signals
+        (see RunLog.flush)."""
+        base = self._size
         for cid, entries in index.items():
-            if base:
-                entries = [(t, o + base) for t, o in entries]
-            self._index[cid].extend(entries)
-            first = entries[0][0]
-            if self.chunk_first_ns is None or first < self.chunk_first_ns:
-                self.chunk_first_ns = first
-        self._buf += block
+            if len(entries):
+                if base:
+                    entries = entries + np.array([0, base], dtype=entries.dtype)
+                self._blocks[cid].append(entries)
+        self._parts.append(block)
+        self._size += len(block)
 
     def chunk_bytes(self) -> int:
-        return len(self._buf)
+        return self._size
 
     def close_chunk(self) -> None:
         """Compress and write the chunk in progress with its message indexes; flush."""
         with _signals_deferred():
             self._close_chunk()
 
+    def _entries(self, cid: int, n: int) -> np.ndarray | None:
+        """The chunk's (log time, offset) entries of channel ``cid``, in offset order, without
+        any past the chunk's ``n`` bytes (a message interrupted before its bytes)."""
+        parts = self._blocks[cid]
+        if self._index[cid]:
+            parts = [*parts, np.array(self._index[cid], dtype=np.int64).reshape(-1, 2)]
+        if not parts:
+            return None
+        entries = parts[0] if len(parts) == 1 else np.concatenate(parts)
+        if len(parts) > 1:
+            entries = entries[np.argsort(entries[:, 1], kind="stable")]
+        entries = entries[entries[:, 1] < n]
+        return entries if len(entries) else None
+
     def _close_chunk(self) -> None:
-        data = bytes(self._buf)
+        data = b"".join(self._parts)  # the block itself when there is one
         n = len(data)
         indexes = {}
-        for cid, entries in self._index.items():
-            while entries and entries[-1][1] >= n:  # a message interrupted before its bytes
-                entries.pop()
-            if entries:
+        for cid in self._index:
+            entries = self._entries(cid, n)
+            if entries is not None:
                 indexes[cid] = entries
-        self.chunk_opened_wall_s = time.monotonic()
-        self.chunk_first_ns = None
+            self._index[cid].clear()
+            self._blocks[cid].clear()
+        self._parts = []
+        self._size = 0
         if not indexes:
-            self._buf = bytearray()
             return
-        # each channel's entries are in log-time order (steps, then predictions, in order)
-        start = min(e[0][0] for e in indexes.values())
-        end = max(e[-1][0] for e in indexes.values())
+        start = int(min(e[:, 0].min() for e in indexes.values()))
+        end = int(max(e[:, 0].max() for e in indexes.values()))
+        for cid, entries in indexes.items():
+            self._counts[cid] += len(entries)
+            self._n_messages += len(entries)
+        self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
+        self._end_ns = max(self._end_ns, end)
         compressed = self._compress(data)
         chunk = _record_bytes(Chunk(compression=COMPRESSION, data=compressed,
                                     message_start_time=start, message_end_time=end,
@@ -423,18 +423,11 @@ class McapFileWriter:
         for cid, entries in indexes.items():
             offsets[cid] = chunk_start + len(chunk) + len(index_bytes)
             index_bytes += _message_index(cid, entries)
-            self._counts[cid] += len(entries)
-            self._n_messages += len(entries)
         self._chunk_indexes.append(ChunkIndex(
             message_start_time=start, message_end_time=end, chunk_start_offset=chunk_start,
             chunk_length=len(chunk), message_index_offsets=offsets,
             message_index_length=len(index_bytes), compression=COMPRESSION,
             compressed_size=len(compressed), uncompressed_size=n))
-        self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
-        self._end_ns = max(self._end_ns, end)
-        self._buf = bytearray()
-        for entries in self._index.values():
-            entries.clear()
         self._write(chunk + bytes(index_bytes))
         self._stream.flush()
 
@@ -479,21 +472,107 @@ class McapFileWriter:
             self.finished = True
 
 
-class _ModelChannels:
-    """Channel ids and message templates of one wing model."""
+# Look-up tables of the vectorised formatting: the characters of 0000 … 9999 as one 4-byte
+# word each, of 00 … 99 as one 2-byte word; powers of ten 1e-400 … 1e400 (0 and inf beyond).
+_CHARS4 = np.frombuffer(b"".join(b"%04d" % i for i in range(10000)), dtype="<u4")
+_CHARS2 = np.frombuffer(b"".join(b"%02d" % i for i in range(100)), dtype="<u2")
+with np.errstate(all="ignore"):
+    _POW10 = 10.0 ** np.arange(-400, 401)
+_P0 = 400  # index of 1e0 in _POW10
+# "% .8e" text: sign, lead digit, '.', 8 digits (two words of 4), 'e', exponent sign, 2 digits
+_E15 = np.dtype({"names": ["sign", "lead", "dot", "upper", "lower", "e", "esign", "exp"],
+                 "formats": ["u1", "u1", "u1", "<u4", "<u4", "u1", "u1", "<u2"],
+                 "offsets": [0, 1, 2, 3, 7, 11, 12, 13], "itemsize": 15})
 
-    def __init__(self, log: RunLog, model: str, row: dict[str, float]) -> None:
-        n = sum(1 for k in row if k.startswith("eta") and not k.endswith("_dot"))
+
+def fixed_e(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` formatted as ``"% .8e" % x`` does, all at once: (characters, shape x.shape +
+    (15,), uint8; True where the number fits that width, i.e. finite with |exponent| < 100).
+
+    The mantissa is rounded from x × 10^(8−e) in binary floating point: the 9th significant
+    digit can differ from correct rounding only when x lies within a few 1e-16 (relative) of
+    a half-way point, an error far below the format's own resolution of 5e-9.
+    """
+    shape = x.shape
+    x = np.ravel(x)
+    a = np.abs(x)
+    with np.errstate(all="ignore"):
+        finite = np.isfinite(a)
+        a = np.where(finite, a, 0.0)
+        _, b = np.frexp(a)  # a = f × 2^b, f in [0.5, 1): 10^e ≤ a < 10^(e+1) for e below
+        e = ((b.astype(np.int64) - 1) * 78913) >> 18  # ⌊(b − 1) log10 2⌋ (or one less)
+        np.clip(e, -_P0 + 9, _P0 - 9, out=e)
+        e += a >= _POW10[e + (_P0 + 1)]
+        m = np.rint(a * _POW10[(_P0 + 8) - e])
+        nonzero = a > 0
+        for _ in range(2):  # 10^k is inexact beyond 1e22; rounding may carry to 1e9
+            hi = m >= 1e9
+            lo = nonzero & (m < 1e8)
+            if not (hi.any() or lo.any()):
+                break
+            fix = hi | lo
+            e[fix] += hi[fix].astype(np.int64) - lo[fix]
+            m[fix] = np.rint(a[fix] * _POW10[(_P0 + 8) - e[fix]])
+    ok = finite & (np.abs(e) < 100) & (m < 1e9) & (~nonzero | (m >= 1e8))
+    if not ok.all():
+        m[~ok] = 0
+        e[~ok] = 0
+    e[~nonzero] = 0
+    m = m.astype(np.int32)  # < 1e9
+    lead, rest = np.divmod(m, np.int32(100_000_000))
+    upper, lower = np.divmod(rest, np.int32(10_000))
+    out = np.empty(len(x), dtype=_E15)
+    out["sign"] = np.where(np.signbit(x), 45, 32)  # '-' or ' '
+    out["lead"] = lead + 48
+    out["dot"] = 46  # '.'
+    out["upper"] = _CHARS4[upper]
+    out["lower"] = _CHARS4[lower]
+    out["e"] = 101  # 'e'
+    out["esign"] = np.where(e < 0, 45, 43)  # '-' or '+'
+    out["exp"] = _CHARS2[np.abs(e)]
+    return out.view(np.uint8).reshape(shape + (15,)), ok.reshape(shape)
+
+
+_DIGITS10 = 10 ** np.arange(9, -1, -1, dtype=np.int64)  # place values of a 10-digit integer
+
+
+def fixed_d(n: np.ndarray) -> np.ndarray:
+    """Non-negative integers (< 1e10) formatted as ``"%10d" % n`` does: shape n.shape + (10,)."""
+    n = n[..., None]
+    out = ((n // _DIGITS10) % 10 + 48).astype(np.uint8)
+    out[(n < _DIGITS10) & (_DIGITS10 > 1)] = 32  # leading zeros are spaces
+    return out
+
+
+class _ModelChannels:
+    """Channel ids and the fixed-width byte layout of one step of one wing model.
+
+    A step is seven message records (rigid_body … location) back to back; with every number
+    in fixed width (floats ``% .8e``, 15 characters; the integer seconds and nanoseconds
+    ``%10d``) each record has a fixed length, so a chunk's steps are one (steps × bytes)
+    array: the layout with the numbers' characters written into their columns.
+    """
+
+    def __init__(self, log: RunLog, model: str, names) -> None:
+        self.names = tuple(names)
+        col = {name: i for i, name in enumerate(self.names)}
+        n = sum(1 for k in self.names if k.startswith("eta") and not k.endswith("_dot"))
         self.ids = {g: log._channel_id(model, g) for g in GROUPS if g != "lti_prediction"}
         self.seq = 0
-        optional = [f for f, _ in _RIGID_OPTIONAL if f in row]
-        self.rigid_keys = [k for _, k, _ in _RIGID_FIELDS] + optional
-        self.modal_keys = [f"eta{i + 1}" for i in range(n)] + [f"eta{i + 1}_dot"
-                                                               for i in range(n)]
+        optional = [f for f, _ in _RIGID_OPTIONAL if f in col]
+        rigid_keys = [k for _, k, _ in _RIGID_FIELDS] + optional
+        modal_keys = [f"eta{i + 1}" for i in range(n)] + [f"eta{i + 1}_dot" for i in range(n)]
+        # the raw columns copied as they are, in message order
+        self.copy_cols = np.array([col[k] for k in (
+            *rigid_keys, *modal_keys, "lift_n", "drag_n", "pitch_moment_n_m", "w_g",
+            "elevator_rad", "throttle")], dtype=np.intp)
+        self.i_lat, self.i_lon = col["latitude_rad"], col["longitude_rad"]
+        self.i_alt = col["altitude_m"]
+        self.i_att = [col["phi_rad"], col["theta_rad"], col["psi_rad"]]
         rigid_fields = [f for f, _, _ in _RIGID_FIELDS] + optional
         eta = ",".join(["%s"] * n)
         frame = body_frame(model)
-        # JSON templates, "%s" for each number; format() turns them into "%.10g" ones
+        # JSON templates, "%s" for each number (pose and location: sec and nsec first)
         templates_s = {
             "rigid_body": "{" + ",".join(f'"{f}":%s' for f in rigid_fields) + "}",
             "modal": f'{{"eta_rad":[{eta}],"eta_dot_rad_s":[{eta}]}}',
@@ -510,56 +589,125 @@ class _ModelChannels:
         order = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
         self.id_list = [self.ids[g] for g in order]
         self.templates_s = [templates_s[g] for g in order]
-        self.counts = [t.count("%s") for t in self.templates_s]
-        # fixed-width JSON: numbers "% .8e" (15 characters), integers "%10d"
-        fixed = [t.replace('"sec":%s,"nsec":%s', '"sec":%10d,"nsec":%10d')
-                 .replace("%s", FIXED_NUMBER) for t in self.templates_s]
-        self.step_template = ""  # str (latin-1 bytes): str formatting of floats is faster
-        self.offsets = []
-        offset = 0
-        for cid, t, n in zip(self.id_list, fixed, self.counts, strict=True):
-            size = len(t % ((0,) * n))  # every number and integer has its fixed width
-            head = struct.pack("<BQH", _OP_MESSAGE, 22 + size, cid).decode("latin-1")
-            self.step_template += head.replace("%", "%%") + "%s" + t
-            self.offsets.append(offset)
-            offset += 31 + size
-        self.step_size = offset
-        self.n_rigid = len(self.rigid_keys)
-        self.n_modal = len(self.modal_keys)
-        self.i_altitude = self.rigid_keys.index("altitude_m")
-        self.getter = operator.itemgetter(  # the row values one step keeps
-            *self.rigid_keys, *self.modal_keys, "lift_n", "drag_n", "pitch_moment_n_m", "w_g",
-            "elevator_rad", "throttle", "latitude_rad", "longitude_rad", "phi_rad", "theta_rad",
-            "psi_rad")
+        self.n_ints = [2 if g in ("pose", "location") else 0 for g in order]
+        self.n_floats = [t.count("%s") - k for t, k in zip(self.templates_s, self.n_ints,
+                                                           strict=True)]
+        layout = bytearray()
+        float_at, int_at, head_at, self.offsets = [], [], [], []
+        for cid, tpl, n_int in zip(self.id_list, self.templates_s, self.n_ints, strict=True):
+            pieces = tpl.encode().split(b"%s")
+            size = sum(map(len, pieces)) + 10 * n_int + 15 * (len(pieces) - 1 - n_int)
+            self.offsets.append(len(layout))
+            layout += struct.pack("<BQH", _OP_MESSAGE, 22 + size, cid)
+            head_at.append(len(layout))
+            layout += bytes(20)  # sequence, log time, publish time
+            for i, piece in enumerate(pieces):
+                layout += piece
+                if i < len(pieces) - 1:
+                    at = int_at if i < n_int else float_at
+                    width = 10 if i < n_int else 15
+                    at.append(len(layout))
+                    layout += b" " * width
+        self.layout = np.frombuffer(bytes(layout), dtype=np.uint8)
+        self.step_size = len(layout)
+        self.float_at, self.int_at, self.head_at = float_at, int_at, head_at
+        self.offsets = np.array(self.offsets, dtype=np.int64)
 
+    def floats(self, v: np.ndarray, origin) -> np.ndarray:
+        """The float fields of each step (rows of the raw values ``v``), in record order."""
+        lat0, lon0, h0, r_north, r_east = origin
+        lat, lon, h = v[:, self.i_lat], v[:, self.i_lon], v[:, self.i_alt]
+        qx, qy, qz, qw = enu_quaternion(*(v[:, i] for i in self.i_att))
+        return np.column_stack([
+            v[:, self.copy_cols], (lon - lon0) * r_east, (lat - lat0) * r_north, h - h0,
+            qx, qy, qz, qw, np.degrees(lat), np.degrees(lon), h])
 
-    def general_step(self, values: tuple) -> tuple[bytes, list[int]]:
+    def general_step(self, head: bytes, floats, ints) -> bytes:
         """The seven records of a step in variable width; non-finite numbers become null."""
-        parts, offsets, offset, k = [], [], 0, 0
-        for cid, tpl, n in zip(self.id_list, self.templates_s, self.counts, strict=True):
-            head = values[k].encode("latin-1")
-            nums = values[k + 1:k + 1 + n]
-            k += 1 + n
-            data = (tpl % tuple(x if isinstance(x, int) else _json_number(x)
-                                for x in nums)).encode()
+        parts, kf, ki = [], 0, 0
+        for cid, tpl, nf, ni in zip(self.id_list, self.templates_s, self.n_floats,
+                                    self.n_ints, strict=True):
+            nums = [*ints[ki:ki + ni], *(_json_number(x) for x in floats[kf:kf + nf])]
+            kf += nf
+            ki += ni
+            data = (tpl % tuple(nums)).encode()
             parts.append(struct.pack("<BQH", _OP_MESSAGE, 22 + len(data), cid) + head + data)
-            offsets.append(offset)
-            offset += 31 + len(data)
-        return b"".join(parts), offsets
+        return b"".join(parts)
+
+    def format(self, t_s, rows, seq0: int, origin) -> tuple[bytes, dict[int, np.ndarray]]:
+        """The message records of the steps ``rows`` (value tuples in :attr:`names` order)
+        at times ``t_s`` [s] and their index entries ((log time, offset) per channel).
+
+        Vectorised: every number of the chunk is formatted by :func:`fixed_e` at once and
+        written into the step layout; a step with a number that does not fit (NaN,
+        infinity, |exponent| ≥ 100) is written by :meth:`general_step` instead.
+        """
+        n = len(rows)
+        v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(self.names))
+        v = v.reshape(n, len(self.names))
+        ns = np.rint(np.asarray(t_s, dtype=float) * 1e9).astype(np.int64)
+        f = self.floats(v, origin)
+        chars, ok = fixed_e(f.T)  # (field, step, character): each field's block contiguous
+        ok = ok.T
+        sec, nsec = np.divmod(ns, 1_000_000_000)
+        ints = np.column_stack([sec, nsec, sec, nsec])
+        int_chars = fixed_d(ints.T)
+        head = np.empty((n, 20), dtype=np.uint8)
+        head[:, :4] = (seq0 + np.arange(n)).astype("<u4").view(np.uint8).reshape(n, 4)
+        head[:, 4:12] = ns.astype("<u8").view(np.uint8).reshape(n, 8)
+        head[:, 12:] = head[:, 4:12]
+        out = np.empty((n, self.step_size), dtype=np.uint8)
+        out[:] = self.layout
+        for j, at in enumerate(self.float_at):
+            out[:, at:at + 15] = chars[j]
+        for j, at in enumerate(self.int_at):
+            out[:, at:at + 10] = int_chars[j]
+        for at in self.head_at:
+            out[:, at:at + 20] = head
+        good = ok.all(axis=1)
+        if good.all():
+            block = out.tobytes()
+            starts = np.arange(n, dtype=np.int64) * self.step_size
+        else:  # variable-width steps among the fixed ones
+            parts, starts, offset = [], [], 0
+            for i in range(n):
+                b = (out[i].tobytes() if good[i] else
+                     self.general_step(head[i].tobytes(), f[i].tolist(), ints[i].tolist()))
+                parts.append(b)
+                starts.append(offset)
+                offset += len(b)
+            block = b"".join(parts)
+            starts = np.array(starts, dtype=np.int64)
+        index = {}
+        for j, cid in enumerate(self.id_list):
+            if good.all():
+                offs = starts + self.offsets[j]
+            else:  # record j's offset within each step, from the record lengths
+                offs = np.array([_record_offset(block, s, j) for s in starts], dtype=np.int64)
+            index[cid] = np.column_stack([ns, offs])
+        return block, index
 
 
-def enu_quaternion(roll_rad: float, pitch_rad: float, yaw_rad: float) -> tuple[float, ...]:
-    """(x, y, z, w) of the FLU body frame in the ENU world frame from NED Euler angles.
+def _record_offset(block: bytes, start: int, j: int) -> int:
+    """The offset of the ``j``-th record of the step at ``start`` in ``block``."""
+    for _ in range(j):
+        start += 9 + struct.unpack_from("<Q", block, start + 1)[0]
+    return start
+
+
+def enu_quaternion(roll_rad, pitch_rad, yaw_rad) -> tuple:
+    """(x, y, z, w) of the FLU body frame in the ENU world frame from NED Euler angles
+    (numbers or arrays).
 
     NED/FRD Euler angles (φ right wing down, θ nose up, ψ clockwise from north) become the
     ENU/FLU angles roll φ, pitch −θ, yaw π/2 − ψ; the quaternion is their Z-Y-X product.
     """
-    hr = 0.5 * roll_rad
-    hp = -0.5 * pitch_rad
-    hy = 0.5 * (0.5 * math.pi - yaw_rad)
-    cr, sr = math.cos(hr), math.sin(hr)
-    cp, sp = math.cos(hp), math.sin(hp)
-    cy, sy = math.cos(hy), math.sin(hy)
+    hr = 0.5 * np.asarray(roll_rad, dtype=float)
+    hp = -0.5 * np.asarray(pitch_rad, dtype=float)
+    hy = 0.5 * (0.5 * math.pi - np.asarray(yaw_rad, dtype=float))
+    cr, sr = np.cos(hr), np.sin(hr)
+    cp, sp = np.cos(hp), np.sin(hp)
+    cy, sy = np.cos(hy), np.sin(hy)
     return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
             cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
 
@@ -580,9 +728,13 @@ class RunLog:
         self._schema_ids: dict[str, int] = {}
         self._models: dict[str, _ModelChannels] = {}
         self._origin: tuple[float, float, float, float, float] | None = None
-        self._pending: list[tuple[_ModelChannels, int, int, tuple]] = []
-        self._pending_first_ns: int | None = None
-        self._pending_wall_s = 0.0
+        # the steps of the chunk in progress: one model's, times [s] and value tuples
+        self._ts: list[float] = []
+        self._rows: list[tuple] = []
+        self._pending: _ModelChannels | None = None
+        self._first_t = 0.0
+        self._due_t = -math.inf  # the chunk closes at this simulated time …
+        self._due_wall = 0.0  # … or at this wall (monotonic) time
         self.closed = False
 
     @classmethod
@@ -612,8 +764,15 @@ class RunLog:
         return self._writer.add_channel(topic(model, group), self._schema_ids[group],
                                         {"model": model})
 
-    def _set_origin(self, row: dict[str, float]) -> None:
-        lat0, lon0, h0 = row["latitude_rad"], row["longitude_rad"], row["altitude_m"]
+    def _model(self, model: str, names) -> _ModelChannels:
+        ch = self._models.get(model)
+        if ch is None:
+            ch = self._models[model] = _ModelChannels(self, model, names)
+        elif ch.names != tuple(names):
+            raise ValueError(f"the {model} samples changed their channels")
+        return ch
+
+    def _set_origin(self, lat0: float, lon0: float, h0: float) -> None:
         s2 = math.sin(lat0) ** 2
         n_m = _WGS84_A_M / math.sqrt(1.0 - _WGS84_E2 * s2)  # prime vertical radius
         m_m = n_m * (1.0 - _WGS84_E2) / (1.0 - _WGS84_E2 * s2)  # meridian radius
@@ -626,74 +785,69 @@ class RunLog:
         })
 
     # -- writing --------------------------------------------------------------------------
-    def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
-        """Log one co-simulation step (seven messages, one per run topic of ``model``).
+    def sampler(self, model: str, names):
+        """The per-step logging callback of ``model``: ``f(k, t_s, values)`` logs one
+        co-simulation step (seven messages, one per run topic), ``values`` being a tuple in
+        the order of ``names`` (the channel names, e.g. ``cosim.base_channels``; they must
+        include the run channels of ``docs/logging.md``). Usable as ``run_gust``'s
+        ``on_sample``.
 
-        The step's numbers are kept and formatted a chunk at a time (cheaper than per step);
-        the chunk closes every CHUNK_SPAN_S of simulated time or CHUNK_WALL_S of wall time.
+        A step costs two list appends: the numbers are formatted a chunk at a time; the
+        chunk closes every CHUNK_SPAN_S of simulated time or CHUNK_WALL_S of wall time.
         """
+        ch = self._model(model, names)
+        ts_append, rows_append = self._ts.append, self._rows.append
+        monotonic = time.monotonic
+
+        rows = self._rows
+
+        def sample(k: int, t_s: float, values: tuple) -> None:
+            if (self._pending is not ch or not self._first_t <= t_s < self._due_t
+                    or monotonic() >= self._due_wall or len(rows) >= _MAX_PENDING_STEPS):
+                self._next_chunk(ch, t_s)
+            ts_append(t_s)
+            rows_append(values)
+
+        return sample
+
+    def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
+        """Log one step given as a dict of channel values (slower than :meth:`sampler`)."""
         ch = self._models.get(model)
         if ch is None:
-            if self._origin is None:
-                self._set_origin(row)
-            ch = self._models[model] = _ModelChannels(self, model, row)
-        ns = int(round(t_s * 1e9))
-        first = self._pending_first_ns
-        if first is None:
-            self._pending_first_ns = ns
-            self._pending_wall_s = time.monotonic()
-        elif (ns - first >= _CHUNK_SPAN_NS or ns < first
-              or time.monotonic() - self._pending_wall_s >= CHUNK_WALL_S
-              or len(self._pending) >= _MAX_PENDING_STEPS):
+            ch = self._model(model, tuple(row))
+        if (self._pending is not ch or not self._first_t <= t_s < self._due_t
+                or time.monotonic() >= self._due_wall or len(self._rows) >= _MAX_PENDING_STEPS):
+            self._next_chunk(ch, t_s)
+        self._ts.append(t_s)
+        self._rows.append(tuple([row[k] for k in ch.names]))
+
+    def _next_chunk(self, ch: _ModelChannels, t_s: float) -> None:
+        """Close the chunk in progress (if any) and start one for ``ch`` at ``t_s``."""
+        if self._rows:
             self.flush()
-            self._pending_first_ns = ns
-            self._pending_wall_s = time.monotonic()
-        self._pending.append((ch, ns, ch.seq, ch.getter(row)))
-        ch.seq += 1
+        self._pending = ch
+        self._first_t = t_s
+        # closes at the first step ≥ CHUNK_SPAN_S later (as in ns; a step's time is
+        # rounded to ns), or after _MAX_PENDING_STEPS steps, or CHUNK_WALL_S of wall time
+        self._due_t = t_s + CHUNK_SPAN_S - 0.5e-9
+        self._due_wall = time.monotonic() + CHUNK_WALL_S
 
     def _format_pending(self) -> None:
-        """Serialise the kept steps into the chunk in progress.
-
-        Fast path: numbers in fixed width (``% .8e``, 15 characters), so every step of a
-        model is one bytes-formatting of a template holding all seven records, headers
-        included. A step whose numbers do not fit (NaN, infinity, |exponent| ≥ 100) is
-        written by the general path with variable-width numbers and ``null`` for NaN.
-        """
-        if not self._pending:
+        """Serialise the kept steps into the chunk in progress (see _ModelChannels.format)."""
+        ch, rows, ts = self._pending, self._rows, self._ts
+        n = len(rows)  # an interrupt between the two appends leaves one time more
+        if ch is None or not n:
+            rows.clear()
+            ts.clear()
             return
-        lat0, lon0, h0, r_north, r_east = self._origin
-        degrees = math.degrees
-        head_pack = _HEAD_TAIL.pack
-        parts: list[bytes] = []
-        index: dict[int, list[tuple[int, int]]] = {}
-        offset = 0
-        for ch, ns, seq, v in self._pending:
-            nr, nm = ch.n_rigid, ch.n_rigid + ch.n_modal
-            lift, drag, moment, w_g, elevator, throttle, lat, lon, phi, theta, psi = v[nm:]
-            h = v[ch.i_altitude]
-            east = (lon - lon0) * r_east
-            north = (lat - lat0) * r_north
-            up = h - h0
-            sec, nsec = divmod(ns, 1_000_000_000)
-            hd = head_pack(seq, ns, ns).decode("latin-1")
-            qx, qy, qz, qw = enu_quaternion(phi, theta, psi)
-            values = (hd, *v[:nr], hd, *v[nr:nm], hd, lift, drag, moment,
-                      hd, w_g, hd, elevator, throttle, hd, sec, nsec, east, north, up,
-                      qx, qy, qz, qw, hd, sec, nsec, degrees(lat), degrees(lon), h)
-            blob = (ch.step_template % values).encode("latin-1")
-            if len(blob) == ch.step_size:
-                offsets = ch.offsets
-            else:
-                blob, offsets = ch.general_step(values)
-            for cid, off in zip(ch.id_list, offsets, strict=True):
-                entries = index.get(cid)
-                if entries is None:
-                    entries = index[cid] = []
-                entries.append((ns, offset + off))
-            parts.append(blob)
-            offset += len(blob)
-        self._pending.clear()
-        self._writer.append_block(b"".join(parts), index)
+        if self._origin is None:
+            first = rows[0]
+            self._set_origin(first[ch.i_lat], first[ch.i_lon], first[ch.i_alt])
+        block, index = ch.format(ts[:n], rows, ch.seq, self._origin)
+        ch.seq += n
+        rows.clear()
+        ts.clear()
+        self._writer.append_block(block, index)
 
     def prediction(self, model: str, history) -> None:
         """Log the LTI prediction ``history`` (a ``TimeHistory`` of the linear model of
@@ -727,7 +881,7 @@ class RunLog:
         with _signals_deferred():
             self._format_pending()
             self._writer.close_chunk()
-        self._pending_first_ns = None
+        self._pending = None
 
     def close(self) -> None:
         """Finish the file (summary, indexes, footer) and close it; safe to call twice."""
@@ -740,7 +894,6 @@ class RunLog:
                 self.closed = True
 
 
-_CHUNK_SPAN_NS = int(CHUNK_SPAN_S * 1e9)
 _MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~1.2 kB per step)
 
 

@@ -82,7 +82,7 @@ def progress_bar(total: int, label: str):
 
 def fly(args, build, models, log=None):
     """Run each model (all of them, also after one stops); return (runs, stop messages)."""
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.cosim import RunSetup, base_channels, run_gust
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
 
     setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
@@ -99,13 +99,16 @@ def fly(args, build, models, log=None):
         for model in models:
             steps = int(round(args.duration / args.dt))
             bar = progress_bar(steps, f"{build.variant.name} {model}")
-            on_sample = None
-            if bar is not None or log is not None:
-                def on_sample(k, t, row, bar=bar, model=model, steps=steps):
-                    if bar is not None and k % 50 == 0:
+            write = (log.sampler(model, base_channels(build.model.n_modes))
+                     if log is not None else None)
+            if bar is None:
+                on_sample = write
+            else:
+                def on_sample(k, t, values, bar=bar, write=write, steps=steps):
+                    if k % 50 == 0:
                         bar.update(min(50, steps - bar.n))
-                    if log is not None:
-                        log.sample(model, t, row)
+                    if write is not None:
+                        write(k, t, values)
             run = run_gust(airframe, build.model, model, setup, on_sample)
             if bar is not None:
                 bar.close()

@@ -114,7 +114,7 @@ def _flutter(case: Case, build):
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.cosim import RunSetup, base_channels, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics
 
@@ -134,8 +134,7 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         log = RunLog.open(Path(log_dir) / f"{case.case_id}.mcap", command="sweep", args=args,
                           build=build)
 
-        def on_sample(k, t, sample, log=log, model=case.model):
-            log.sample(model, t, sample)
+        on_sample = log.sampler(case.model, base_channels(build.model.n_modes))
 
     try:
         run = run_gust(airframe(), build.model, case.model, setup, on_sample)
