@@ -759,15 +759,21 @@ def render_all() -> dict[str, str]:
     }
 
 
-def write_all(root_dir: Path) -> list[Path]:
-    """Write every generated file under ``root_dir`` (a JSBSim root); return the paths."""
+def write_files(files: dict[str, str], root_dir: Path) -> list[Path]:
+    """Write generated ``files`` (path relative to the JSBSim root → text) under
+    ``root_dir``; return the paths. Raises OSError when the directory cannot be written."""
     written = []
-    for rel, text in render_all().items():
+    for rel, text in files.items():
         path = Path(root_dir) / rel
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")
         written.append(path)
     return written
+
+
+def write_all(root_dir: Path) -> list[Path]:
+    """Write every generated file under ``root_dir`` (a JSBSim root); return the paths."""
+    return write_files(render_all(), root_dir)
 
 
 def default_output_root() -> Path:

@@ -198,13 +198,8 @@ def render_all() -> dict[str, str]:
 
 
 def write_all(root_dir: Path) -> list[Path]:
-    written = []
-    for rel, text in render_all().items():
-        path = Path(root_dir) / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-        written.append(path)
-    return written
+    """Write the SITL files under ``root_dir`` (a JSBSim root); return the paths."""
+    return AX.write_files(render_all(), root_dir)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -95,6 +95,23 @@ _READ = {
 }
 
 
+def air_flow(get: dict, wind_down_fps: float) -> tuple[FlowState, float, float]:
+    """The flow the wing sees, from the airframe's state and the NED vertical wind
+    ``wind_down_fps`` [ft/s, down], as JSBSim's FGAuxiliary computes it for this step.
+
+    ``get`` maps u, v, w [ft/s], theta, phi [rad], q [rad/s] and rho [slug/ft³] to the
+    JSBSim property readers. Returns (flow in SI, θ [rad], φ [rad]).
+    """
+    theta, phi = get["theta"](), get["phi"]()
+    # air-relative body velocity: subtract the NED wind seen in body axes
+    ua = get["u"]() + wind_down_fps * math.sin(theta)
+    va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
+    wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
+    vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+    rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
+    return FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), theta, phi
+
+
 def base_channels(n_modes: int) -> dict[str, str]:
     """Channel names of a gust run and their units."""
     units = {
@@ -167,14 +184,7 @@ def run_gust(
         w_g = gust.vertical_m_s(t)
         wind_down_fps = -w_g * U.FT_PER_M
         wind_node.set_double_value(wind_down_fps)
-        theta, phi = get["theta"](), get["phi"]()
-        # air-relative body velocity: subtract the NED wind seen in body axes
-        ua = get["u"]() + wind_down_fps * math.sin(theta)
-        va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
-        wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
-        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
-        rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
-        flow = FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt)
+        flow, theta, phi = air_flow(get, wind_down_fps)
         return flow, w_g, theta, phi
 
     try:

@@ -969,13 +969,7 @@ def render_fig21_script(state: TrimState, dt_s: float = DEFAULT_DT_S) -> str:
 def export(spec: ExportSpec, out_dir: Path, include_shared: bool = True) -> list[Path]:
     """Write the system and aircraft files under the JSBSim root ``out_dir``; paths written.
     Raises OSError when the directory cannot be written."""
-    written = []
-    for rel, text in render_aircraft_files(spec, include_shared).items():
-        path = Path(out_dir) / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-        written.append(path)
-    return written
+    return airframe_xml.write_files(render_aircraft_files(spec, include_shared), out_dir)
 
 
 def repository_files() -> dict[str, str]:
@@ -994,13 +988,8 @@ def repository_files() -> dict[str, str]:
 
 
 def write_repository(root: Path) -> list[Path]:
-    written = []
-    for rel, text in repository_files().items():
-        path = Path(root) / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-        written.append(path)
-    return written
+    """Write :func:`repository_files` under the JSBSim root ``root``; return the paths."""
+    return airframe_xml.write_files(repository_files(), root)
 
 
 # ======================================================================================

@@ -43,12 +43,17 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.adapters.autopilot_xml import SITL_AIRCRAFT
-from bioflex_jsb.adapters.cosim import ALPHA_TABLE_RANGE_RAD, INTEGRATORS, base_channels
+from bioflex_jsb.adapters.cosim import (
+    ALPHA_TABLE_RANGE_RAD,
+    INTEGRATORS,
+    air_flow,
+    base_channels,
+)
 from bioflex_jsb.adapters.jsbsim_fdm import Airframe
 from bioflex_jsb.adapters.mavlink_link import VehicleState
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, FlowState, ModalWing, TrimReference
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, ModalWing, TrimReference
 
 LINK_PERIOD_S = 1.0 / 200.0  # simulated time between link services [s]
 RESYNC_S = 0.25  # a loop this far behind its schedule starts a new one [s]
@@ -229,14 +234,8 @@ class SitlSim:
         w_g = self._gust.vertical_m_s(t) if self._gust is not None else 0.0
         wind_down_fps = -w_g * U.FT_PER_M
         self._wind.set_double_value(wind_down_fps)
-        get = self._get
-        theta, phi = get["theta"](), get["phi"]()
-        ua = get["u"]() + wind_down_fps * math.sin(theta)
-        va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
-        wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
-        vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
-        rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
-        return FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), w_g, theta, phi
+        flow, theta, phi = air_flow(self._get, wind_down_fps)
+        return flow, w_g, theta, phi
 
     def step(self) -> tuple:
         """One co-simulation step (as ``run_gust``); returns the logged row's values (in
