@@ -255,15 +255,12 @@ DRIVER = """
 import sys
 from bioflex_jsb import cli
 from bioflex_jsb.adapters import mcap_log
-original = mcap_log.RunLog.sampler
-def sampler(self, model, names):
-    write = original(self, model, names)
-    def sample(k, t_s, values):
-        write(k, t_s, values)
-        sys.stdout.write(repr(t_s) + "\\n")
-        sys.stdout.flush()
-    return sample
-mcap_log.RunLog.sampler = sampler
+original = mcap_log.TableRecorder.step
+def step(self, k):
+    original(self, k)
+    sys.stdout.write(repr(float(self._time_s[k])) + "\\n")
+    sys.stdout.flush()
+mcap_log.TableRecorder.step = step
 sys.exit(cli.main(sys.argv[1:]))
 """
 
@@ -317,11 +314,11 @@ def _is_number(text: str) -> bool:
 def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, capsys):
     path = tmp_path / "killed.mcap"
     # killed just before a chunk closes (chunks span [k, k+1) × CHUNK_SPAN_S): the worst case
-    proc, _ = _start_run(path, until_s=3.0 + 0.9 * mcap_log.CHUNK_SPAN_S)
+    proc, _ = _start_run(path, until_s=7.9 * mcap_log.CHUNK_SPAN_S)
     proc.kill()
     rest, _err = proc.communicate(timeout=60)
     sampled = [float(x) for x in rest.split() if _is_number(x)]
-    last_flown_s = sampled[-1] if sampled else 3.0 + 0.9 * mcap_log.CHUNK_SPAN_S
+    last_flown_s = sampled[-1] if sampled else 7.9 * mcap_log.CHUNK_SPAN_S
     # the killed log has no summary: info says how to recover it
     assert main(["info", str(path)]) == 2
     assert "--recover" in capsys.readouterr().err
@@ -353,22 +350,50 @@ def test_fixed_width_numbers_match_printf():
     assert [c.tobytes().decode() for c in mcap_log.fixed_d(n)] == [f"{i:10d}" for i in n]
 
 
-def test_dict_and_tuple_samples_write_the_same_messages(tmp_path):
+def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
     from bioflex_jsb.adapters.cosim import base_channels
 
-    names = list(base_channels(2))
+    names = tuple(base_channels(2))
     rng = np.random.default_rng(3)
-    rows = [tuple(rng.standard_normal(len(names)) * 0.1) for _ in range(700)]
-    rows = [r[:7] + (100.0 + r[7],) + r[8:] for r in rows]  # altitude_m
+    table = rng.standard_normal((1000, len(names))) * 0.1
+    table[:, names.index("altitude_m")] += 100.0
+    time_s = np.arange(1000) / 960
     a, b = _bare_log(tmp_path / "a.mcap"), _bare_log(tmp_path / "b.mcap")
-    write = a.sampler("coupled", names)
-    for k, r in enumerate(rows):
-        write(k, k / 960, r)
-        b.sample("coupled", k / 960, dict(zip(names, r, strict=True)))
+    recorder = a.recorder("coupled")
+    recorder.start(names, time_s, table)
+    for k in range(1000):
+        recorder.step(k)
+        b.sample("coupled", time_s[k], dict(zip(names, table[k].tolist(), strict=True)))
+    recorder.stop(1000)
     a.close()
     b.close()
     ma, mb = read_all(tmp_path / "a.mcap"), read_all(tmp_path / "b.mcap")
-    assert ma == mb and len(ma["/bioflex/coupled/rigid_body"]) == 700
+    assert ma == mb and len(ma["/bioflex/coupled/rigid_body"]) == 1000
     first = ma["/bioflex/coupled/modal"][5][1]
-    assert first["eta_rad"][1] == pytest.approx(rows[5][names.index("eta2")], rel=1e-8)
-    assert mcap_log.summarise(tmp_path / "a.mcap")["chunks"] == 2  # 0.5 s of steps each
+    assert first["eta_rad"][1] == pytest.approx(table[5, names.index("eta2")], rel=1e-8)
+    # a chunk every CHUNK_SPAN_S of simulated time (864 steps at 960 Hz): 2 for 1000 steps
+    assert mcap_log.summarise(tmp_path / "a.mcap")["chunks"] == 2
+
+
+def test_recorder_writes_each_complete_row_once_whatever_stops_the_run(tmp_path):
+    """Rows reach the file as soon as their chunk is complete, each once: stop(n) after a
+    failure writes the rest, a second stop or a stop at the chunk boundary adds nothing."""
+    from bioflex_jsb.adapters.cosim import base_channels
+
+    names = tuple(base_channels(1))
+    n_rows = 1000
+    table = np.zeros((n_rows, len(names)))
+    table[:, 0] = np.arange(n_rows)  # u: the row number, to find every row in the file
+    time_s = np.arange(n_rows) / 960
+    log = _bare_log(tmp_path / "r.mcap")
+    rec = log.recorder("coupled")
+    rec.start(names, time_s, table)
+    for k in range(900):
+        rec.step(k)
+    # the first chunk (864 rows) was written when its last row completed, before stop
+    assert log._writer._n_messages == 864 * 7
+    rec.stop(900)  # the loop failed after row 899
+    rec.stop(900)
+    log.close()
+    rows = read_all(tmp_path / "r.mcap")["/bioflex/coupled/rigid_body"]
+    assert [m["du_m_s"] for _, m in rows] == list(range(900))

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -72,6 +73,24 @@ class RunSetup:
     gust_start_s: float = 0.5
     altitude_m: float = 0.0
     dt_s: float = DEFAULT_DT_S
+
+
+class StepRecorder(Protocol):
+    """Something that keeps a run's steps as they complete (an MCAP log), reading them from
+    the run's own table rather than being handed each step's numbers.
+
+    ``start`` is called once before the first step with the channel names, the times [s] of
+    every step the run may take and the (steps × channels) table the run fills row by row
+    (units: ``base_channels``); ``step(k)`` after row k is complete; ``stop(n)`` once at
+    the end, however the run ends (finished, stopped, interrupted, failed), with the number
+    of complete rows.
+    """
+
+    def start(self, names: tuple[str, ...], time_s: np.ndarray, table: np.ndarray) -> None: ...
+
+    def step(self, k: int) -> None: ...
+
+    def stop(self, n: int) -> None: ...
 
 
 _READ = {
@@ -137,12 +156,14 @@ def run_gust(
     setup: RunSetup,
     on_sample: Callable[[int, float, tuple[float, ...]], None] | None = None,
     trim: TrimResult | None = None,
+    recorder: StepRecorder | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd).
 
-    ``on_sample(k, t_s, values)`` is called after every step (logging, progress), ``values``
-    the step's numbers as a tuple in the order of ``base_channels(wing.n_modes)``. A run that
-    leaves the valid range stops: the returned history holds every step up to then and its
+    ``on_sample(k, t_s, values)`` is called after every step (progress), ``values`` the
+    step's numbers as a tuple in the order of ``base_channels(wing.n_modes)``; ``recorder``
+    (a log) reads the steps from the run's table (:class:`StepRecorder`). A run that leaves
+    the valid range stops: the returned history holds every step up to then and its
     ``stopped`` field says why. ``trim``: the airframe was just trimmed to this (skip it).
     """
     airframe.set_external_reactions()  # the trim is the rigid airframe's: no modal loads
@@ -163,7 +184,8 @@ def run_gust(
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))
     units = base_channels(wing.n_modes)
-    data = {name: np.full(n_steps, np.nan) for name in units}
+    names = tuple(units)
+    table = np.full((n_steps, len(names)), np.nan)  # row k: step k, columns in names' order
     time_s = np.arange(n_steps) * dt
     theta0 = trim.theta_rad
     alpha_min, alpha_max = ALPHA_TABLE_RANGE_RAD
@@ -175,8 +197,10 @@ def run_gust(
     write_reactions = airframe.external_reaction_writer()  # nodes looked up once
     step = airframe.step
     get = {name: node.get_double_value for name, node in nodes.items()}
-    names = list(units)
-    columns = [data[name] for name in names]
+    done = 0  # complete rows of the table
+    if recorder is not None:
+        recorder.start(names, time_s, table)
+        record = recorder.step
 
     def sense(t: float):
         """Write the gust at ``t`` to JSBSim's wind and return the flow the wing sees then,
@@ -210,8 +234,10 @@ def run_gust(
                     get["r"](), get["elevator"](), get["throttle"](),
                     *mw.eta, *mw.eta_dot,
                 )
-                for column, value in zip(columns, values, strict=True):
-                    column[k] = value
+                table[k] = values
+                done = k + 1
+                if recorder is not None:
+                    record(k)
                 if on_sample is not None:
                     on_sample(k, t, values)
                 stall_steps += alpha > alpha_peak
@@ -223,14 +249,16 @@ def run_gust(
                 flow, w_g, theta, phi = sense(t + dt)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
-        stopped = f"interrupted at t = {k * dt:.3f} s"
-        k -= 1  # sample k was not completed
-    airframe.set_external_reactions()  # leave no modal loads behind for the next user
-    n = max(k + 1, 0)
+        stopped = f"interrupted at t = {done * dt:.3f} s"
+    finally:
+        airframe.set_external_reactions()  # leave no modal loads behind for the next user
+        if recorder is not None:
+            recorder.stop(done)  # also when the loop failed: keep every complete step
+    n = done
     run = TimeHistory(
         model=model,
         time_s=time_s[:n],
-        channels={name: arr[:n] for name, arr in data.items()},
+        channels={name: table[:n, i].copy() for i, name in enumerate(names)},
         units=units,
         meta={
             "source": "jsbsim-cosim",

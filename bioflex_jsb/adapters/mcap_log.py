@@ -27,11 +27,11 @@ and JSBSim versions) and ``bioflex.world_frame`` (the ENU origin).
 
 Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_WALL_S` of
 wall time, or 4096 steps) and written to the operating system at once, so a process killed
-hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed file
-from the complete chunks of such a log. A step's numbers are kept as the tuple the run hands
-over (:meth:`RunLog.sampler`) and a chunk's steps are formatted at once, vectorised, in
-fixed-width numbers (:func:`fixed_e`), so record lengths and index offsets are known in
-advance (``docs/logging.md``, Overhead).
+hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed
+file from the complete chunks of such a log. A gust run is logged from the run's own table
+of steps (:meth:`RunLog.recorder`, nothing copied per step) and a chunk's steps are
+formatted at once, vectorised, in fixed-width numbers (:func:`fixed_e`), so record lengths and index
+offsets are known in advance (``docs/logging.md``, Overhead).
 
 The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
 the 20 % overhead budget allows at seven messages per step); every record other than the
@@ -57,7 +57,6 @@ import numpy as np
 from mcap.data_stream import RecordBuilder
 from mcap.records import (
     Channel,
-    Chunk,
     ChunkIndex,
     DataEnd,
     Header,
@@ -71,8 +70,10 @@ from mcap.records import (
 from bioflex_jsb import __version__
 
 MAGIC = b"\x89MCAP0\r\n"
-CHUNK_SPAN_S = 0.5  # simulated time per chunk [s]: the most a SIGKILL can lose
-CHUNK_WALL_S = 1.0  # wall time per chunk [s] (runs slower than real time, SITL sessions)
+# simulated time per chunk [s]: the most a SIGKILL can lose (with one step, < 1 s); long
+# chunks spread the fixed cost of writing one (≈ 0.7 ms measured in a run) over more steps
+CHUNK_SPAN_S = 0.9
+CHUNK_WALL_S = 0.9  # wall time per chunk [s] (runs slower than real time, SITL sessions)
 CHUNK_MAX_BYTES = 4 * 1024 * 1024  # uncompressed chunk size limit [bytes]
 COMPRESSION = "zstd"
 RUN_METADATA = "bioflex.run"
@@ -81,7 +82,7 @@ WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
           "lti_prediction")
 
-_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE = 0x03, 0x04, 0x05
+_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 0x03, 0x04, 0x05, 0x06
 _OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
 NUMBER = "%.9g"  # numbers of the general path: 9 significant digits (relative ≤ 5e-10)
 _MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
@@ -301,8 +302,13 @@ class McapFileWriter:
         import zstandard
 
         self._stream = stream
-        # level 1: twice as fast as the default 3 and as small on these JSON chunks
-        self._compress = zstandard.ZstdCompressor(level=1).compress
+        # zstd's level 1 with a small hash table and window and long minimum matches: the
+        # chunks repeat one step's layout every ~1.4 kB, so recent long matches are all it
+        # needs; measured on a gust-run chunk: 0.75 ms and 9.2:1 against level 1's 1.04 ms
+        # and 7.9:1 and the default level 3's 1.6 ms and 7.0:1
+        self._compress = zstandard.ZstdCompressor(
+            compression_params=zstandard.ZstdCompressionParameters.from_level(
+                1, window_log=17, hash_log=11, min_match=7)).compress
         self._crc = 0
         self._offset = 0
         self._schemas: list[Schema] = []
@@ -393,7 +399,8 @@ class McapFileWriter:
         return entries if len(entries) else None
 
     def _close_chunk(self) -> None:
-        data = b"".join(self._parts)  # the block itself when there is one
+        parts = self._parts
+        data = parts[0] if len(parts) == 1 else b"".join(parts)  # no copy of a lone block
         n = len(data)
         indexes = {}
         for cid in self._index:
@@ -413,22 +420,33 @@ class McapFileWriter:
             self._n_messages += len(entries)
         self._start_ns = start if self._start_ns is None else min(self._start_ns, start)
         self._end_ns = max(self._end_ns, end)
+        # the message indexes do not depend on where the chunk lands: serialised here
+        index_records = [(cid, _message_index(cid, entries)) for cid, entries in indexes.items()]
+        self._write_chunk(data, index_records, start, end)
+
+    def _write_chunk(self, data, index_records: list[tuple[int, bytes]], start: int,
+                     end: int) -> None:
+        """Compress ``data`` and write it as a Chunk record (opcode 0x06) followed by its
+        Message Index records, and hand it to the operating system."""
+        n = len(data)
         compressed = self._compress(data)
-        chunk = _record_bytes(Chunk(compression=COMPRESSION, data=compressed,
-                                    message_start_time=start, message_end_time=end,
-                                    uncompressed_crc=zlib.crc32(data), uncompressed_size=n))
+        crc = zlib.crc32(data)
+        name = COMPRESSION.encode()
+        body = struct.pack(f"<QQQII{len(name)}sQ", start, end, n, crc, len(name), name,
+                           len(compressed))
+        header = struct.pack("<BQ", _OP_CHUNK, len(body) + len(compressed)) + body
+        chunk_length = len(header) + len(compressed)
         chunk_start = self._offset
-        offsets = {}
-        index_bytes = bytearray()
-        for cid, entries in indexes.items():
-            offsets[cid] = chunk_start + len(chunk) + len(index_bytes)
-            index_bytes += _message_index(cid, entries)
+        offsets, at = {}, chunk_start + chunk_length
+        for cid, record in index_records:
+            offsets[cid] = at
+            at += len(record)
         self._chunk_indexes.append(ChunkIndex(
             message_start_time=start, message_end_time=end, chunk_start_offset=chunk_start,
-            chunk_length=len(chunk), message_index_offsets=offsets,
-            message_index_length=len(index_bytes), compression=COMPRESSION,
+            chunk_length=chunk_length, message_index_offsets=offsets,
+            message_index_length=at - chunk_start - chunk_length, compression=COMPRESSION,
             compressed_size=len(compressed), uncompressed_size=n))
-        self._write(chunk + bytes(index_bytes))
+        self._write(b"".join([header, compressed, *(r for _, r in index_records)]))
         self._stream.flush()
 
     def finish(self) -> None:
@@ -485,9 +503,11 @@ _E15 = np.dtype({"names": ["sign", "lead", "dot", "upper", "lower", "e", "esign"
                  "offsets": [0, 1, 2, 3, 7, 11, 12, 13], "itemsize": 15})
 
 
-def fixed_e(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def fixed_e(x: np.ndarray, out: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``x`` formatted as ``"% .8e" % x`` does, all at once: (characters, shape x.shape +
     (15,), uint8; True where the number fits that width, i.e. finite with |exponent| < 100).
+    ``out``: a work array of at least ``x.size`` elements of dtype ``_E15`` to write into
+    (reused from chunk to chunk, so its memory is not faulted in anew each time).
 
     The mantissa is rounded from x × 10^(8−e) in binary floating point: the 9th significant
     digit can differ from correct rounding only when x lies within a few 1e-16 (relative) of
@@ -501,7 +521,7 @@ def fixed_e(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a = np.where(finite, a, 0.0)
         _, b = np.frexp(a)  # a = f × 2^b, f in [0.5, 1): 10^e ≤ a < 10^(e+1) for e below
         e = ((b.astype(np.int64) - 1) * 78913) >> 18  # ⌊(b − 1) log10 2⌋ (or one less)
-        np.clip(e, -_P0 + 9, _P0 - 9, out=e)
+        # (no clip needed: e in [-324, 308] keeps both _POW10 indices below in range)
         e += a >= _POW10[e + (_P0 + 1)]
         m = np.rint(a * _POW10[(_P0 + 8) - e])
         nonzero = a > 0
@@ -521,27 +541,41 @@ def fixed_e(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m = m.astype(np.int32)  # < 1e9
     lead, rest = np.divmod(m, np.int32(100_000_000))
     upper, lower = np.divmod(rest, np.int32(10_000))
-    out = np.empty(len(x), dtype=_E15)
-    out["sign"] = np.where(np.signbit(x), 45, 32)  # '-' or ' '
+    out = np.empty(len(x), dtype=_E15) if out is None else out[:len(x)]
+    out["sign"] = np.signbit(x).view(np.uint8) * np.uint8(13) + np.uint8(32)  # '-' or ' '
     out["lead"] = lead + 48
     out["dot"] = 46  # '.'
     out["upper"] = _CHARS4[upper]
     out["lower"] = _CHARS4[lower]
     out["e"] = 101  # 'e'
-    out["esign"] = np.where(e < 0, 45, 43)  # '-' or '+'
+    out["esign"] = (e < 0).view(np.uint8) * np.uint8(2) + np.uint8(43)  # '-' or '+'
     out["exp"] = _CHARS2[np.abs(e)]
     return out.view(np.uint8).reshape(shape + (15,)), ok.reshape(shape)
 
 
 _DIGITS10 = 10 ** np.arange(9, -1, -1, dtype=np.int64)  # place values of a 10-digit integer
+_SPACES4 = np.frombuffer(b"    ", dtype="<u4")[0]
 
 
 def fixed_d(n: np.ndarray) -> np.ndarray:
-    """Non-negative integers (< 1e10) formatted as ``"%10d" % n`` does: shape n.shape + (10,)."""
-    n = n[..., None]
-    out = ((n // _DIGITS10) % 10 + 48).astype(np.uint8)
-    out[(n < _DIGITS10) & (_DIGITS10 > 1)] = 32  # leading zeros are spaces
-    return out
+    """Non-negative integers (< 1e10) formatted as ``"%10d" % n`` does: shape n.shape + (10,).
+
+    Three table look-ups per number (digits 2 + 4 + 4, :data:`_CHARS4`), then the leading
+    zeros become spaces.
+    """
+    shape = n.shape
+    n = np.ravel(n).astype(np.int64)
+    top, rest = np.divmod(n, 100_000_000)
+    mid, low = np.divmod(rest, 10_000)
+    out = np.empty((len(n), 3), dtype="<u4")  # characters 0-3 (2 used), 2-5, 6-9 of "%010d"
+    out[:, 0] = _CHARS4[top]
+    out[:, 1] = _CHARS4[mid]
+    out[:, 2] = _CHARS4[low]
+    chars = out.view(np.uint8)[:, 2:]  # drop the two leading digits of the top group (0)
+    # the number of leading zeros: 10 − digits (a zero has one digit)
+    lead = 10 - np.maximum(np.searchsorted(_DIGITS10[::-1], n, side="right"), 1)
+    chars = chars - (np.arange(10) < lead[:, None]).view(np.uint8) * np.uint8(16)  # '0' → ' '
+    return chars.reshape(shape + (10,))
 
 
 class _ModelChannels:
@@ -612,6 +646,23 @@ class _ModelChannels:
         self.step_size = len(layout)
         self.float_at, self.int_at, self.head_at = float_at, int_at, head_at
         self.offsets = np.array(self.offsets, dtype=np.int64)
+        # where the characters go: one structured copy per kind writes every column of a
+        # chunk at once (fields at the layout's columns ← fields of the packed source)
+        def fields(at, width, packed_offsets, packed_size):
+            names = [f"f{j}" for j in range(len(at))]
+            return (np.dtype({"names": names, "formats": [f"V{width}"] * len(at),
+                              "offsets": list(at), "itemsize": self.step_size}),
+                    np.dtype({"names": names, "formats": [f"V{width}"] * len(at),
+                              "offsets": packed_offsets, "itemsize": packed_size}))
+
+        nf, ni = len(float_at), len(int_at)
+        self._float_dst, self._float_src = fields(float_at, 15, [15 * j for j in range(nf)],
+                                                  15 * nf)
+        self._int_dst, self._int_src = fields(int_at, 10, [10 * j for j in range(ni)], 10 * ni)
+        # every record of a step has the same header tail (sequence, log and publish time)
+        self._head_dst, self._head_src = fields(head_at, 20, [0] * len(head_at), 20)
+        empty = np.empty((0, self.step_size), dtype=np.uint8)
+        self._space = (empty, None)
 
     def floats(self, v: np.ndarray, origin) -> np.ndarray:
         """The float fields of each step (rows of the raw values ``v``), in record order."""
@@ -634,49 +685,59 @@ class _ModelChannels:
             parts.append(struct.pack("<BQH", _OP_MESSAGE, 22 + len(data), cid) + head + data)
         return b"".join(parts)
 
-    def format(self, t_s, rows, seq0: int, origin) -> tuple[bytes, dict[int, np.ndarray]]:
-        """The message records of the steps ``rows`` (value tuples in :attr:`names` order)
+    def _workspace(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """The (steps × bytes) layout array and the fixed_e work array for ``n`` steps,
+        kept from chunk to chunk: the layout's constant characters stay in place and no
+        fresh memory is faulted in at every chunk. (A chunk's block is compressed before the
+        next chunk is formatted: RunLog closes the chunk right after formatting it.)"""
+        out, work = self._space
+        if len(out) < n:
+            size = max(n, 2 * len(out), 256)
+            out = np.empty((size, self.step_size), dtype=np.uint8)
+            out[:] = self.layout
+            work = np.empty(size * len(self.float_at), dtype=_E15)
+            self._space = (out, work)
+        return out[:n], work
+
+    def format(self, t_s, v: np.ndarray, seq0: int, origin) -> tuple[memoryview,
+                                                                    dict[int, np.ndarray]]:
+        """The message records of the steps ``v`` (steps × channels in :attr:`names` order)
         at times ``t_s`` [s] and their index entries ((log time, offset) per channel).
 
         Vectorised: every number of the chunk is formatted by :func:`fixed_e` at once and
         written into the step layout; a step with a number that does not fit (NaN,
-        infinity, |exponent| ≥ 100) is written by :meth:`general_step` instead.
+        infinity, |exponent| ≥ 100) is written by :meth:`general_step` instead. The block
+        returned may be a view of a work array that the next chunk reuses.
         """
-        n = len(rows)
-        v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(self.names))
-        v = v.reshape(n, len(self.names))
+        n = len(v)
         ns = np.rint(np.asarray(t_s, dtype=float) * 1e9).astype(np.int64)
         f = self.floats(v, origin)
-        chars, ok = fixed_e(f.T)  # (field, step, character): each field's block contiguous
-        ok = ok.T
+        out, work = self._workspace(n)
+        chars, ok = fixed_e(f, work)  # (step, field, character)
         sec, nsec = np.divmod(ns, 1_000_000_000)
-        ints = np.column_stack([sec, nsec, sec, nsec])
-        int_chars = fixed_d(ints.T)
+        int_chars = fixed_d(np.column_stack([sec, nsec, sec, nsec]))  # pose, location
         head = np.empty((n, 20), dtype=np.uint8)
         head[:, :4] = (seq0 + np.arange(n)).astype("<u4").view(np.uint8).reshape(n, 4)
         head[:, 4:12] = ns.astype("<u8").view(np.uint8).reshape(n, 8)
         head[:, 12:] = head[:, 4:12]
-        out = np.empty((n, self.step_size), dtype=np.uint8)
-        out[:] = self.layout
-        for j, at in enumerate(self.float_at):
-            out[:, at:at + 15] = chars[j]
-        for j, at in enumerate(self.int_at):
-            out[:, at:at + 10] = int_chars[j]
-        for at in self.head_at:
-            out[:, at:at + 20] = head
+        out.view(self._float_dst)[:, 0] = chars.reshape(n, -1).view(self._float_src)[:, 0]
+        out.view(self._int_dst)[:, 0] = (np.ascontiguousarray(int_chars).reshape(n, -1)
+                                         .view(self._int_src)[:, 0])
+        out.view(self._head_dst)[:, 0] = head.view(self._head_src)[:, 0]
         good = ok.all(axis=1)
         if good.all():
-            block = out.tobytes()
+            block = memoryview(out).cast("B")
             starts = np.arange(n, dtype=np.int64) * self.step_size
         else:  # variable-width steps among the fixed ones
             parts, starts, offset = [], [], 0
             for i in range(n):
                 b = (out[i].tobytes() if good[i] else
-                     self.general_step(head[i].tobytes(), f[i].tolist(), ints[i].tolist()))
+                     self.general_step(head[i].tobytes(), f[i].tolist(),
+                                       [sec[i], nsec[i], sec[i], nsec[i]]))
                 parts.append(b)
                 starts.append(offset)
                 offset += len(b)
-            block = b"".join(parts)
+            block = memoryview(b"".join(parts))
             starts = np.array(starts, dtype=np.int64)
         index = {}
         for j, cid in enumerate(self.id_list):
@@ -785,33 +846,17 @@ class RunLog:
         })
 
     # -- writing --------------------------------------------------------------------------
-    def sampler(self, model: str, names):
-        """The per-step logging callback of ``model``: ``f(k, t_s, values)`` logs one
-        co-simulation step (seven messages, one per run topic), ``values`` being a tuple in
-        the order of ``names`` (the channel names, e.g. ``cosim.base_channels``; they must
-        include the run channels of ``docs/logging.md``). Usable as ``run_gust``'s
-        ``on_sample``.
-
-        A step costs two list appends: the numbers are formatted a chunk at a time; the
-        chunk closes every CHUNK_SPAN_S of simulated time or CHUNK_WALL_S of wall time.
-        """
-        ch = self._model(model, names)
-        ts_append, rows_append = self._ts.append, self._rows.append
-        monotonic = time.monotonic
-
-        rows = self._rows
-
-        def sample(k: int, t_s: float, values: tuple) -> None:
-            if (self._pending is not ch or not self._first_t <= t_s < self._due_t
-                    or monotonic() >= self._due_wall or len(rows) >= _MAX_PENDING_STEPS):
-                self._next_chunk(ch, t_s)
-            ts_append(t_s)
-            rows_append(values)
-
-        return sample
+    def recorder(self, model: str) -> TableRecorder:
+        """A recorder of the run of ``model`` for ``cosim.run_gust(..., recorder=)``: it logs
+        every step (seven messages, one per run topic) from the run's own table, a chunk at
+        a time, so a step costs the run one call and a comparison."""
+        return TableRecorder(self, model)
 
     def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
-        """Log one step given as a dict of channel values (slower than :meth:`sampler`)."""
+        """Log one step given as a dict of channel values (a loop without a table, such as
+        the SITL loop; a run of ``run_gust`` is logged faster by :meth:`recorder`). The
+        steps are kept and formatted a chunk at a time; the chunk closes every CHUNK_SPAN_S
+        of simulated time or CHUNK_WALL_S of wall time."""
         ch = self._models.get(model)
         if ch is None:
             ch = self._model(model, tuple(row))
@@ -843,7 +888,8 @@ class RunLog:
         if self._origin is None:
             first = rows[0]
             self._set_origin(first[ch.i_lat], first[ch.i_lon], first[ch.i_alt])
-        block, index = ch.format(ts[:n], rows, ch.seq, self._origin)
+        v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(ch.names))
+        block, index = ch.format(ts[:n], v.reshape(n, len(ch.names)), ch.seq, self._origin)
         ch.seq += n
         rows.clear()
         ts.clear()
@@ -895,6 +941,67 @@ class RunLog:
 
 
 _MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~1.2 kB per step)
+_WALL_CHECK_MASK = 63  # a recorder looks at the wall clock every 64 steps
+
+
+class TableRecorder:
+    """Logs a run's steps from the table the run fills (``cosim.StepRecorder``).
+
+    The steps of a chunk are rows [k0, k_end) of the table, k_end the first step at least
+    CHUNK_SPAN_S after step k0 (as the chunks of :meth:`RunLog.sample`), at most
+    _MAX_PENDING_STEPS rows; the chunk is written as soon as its last row is complete, or
+    when CHUNK_WALL_S of wall time have passed since it began (checked every 64 steps).
+    Writing a chunk holds SIGINT/SIGTERM, so an interrupt never logs a row twice or not at
+    all; :meth:`stop` writes the rows left.
+    """
+
+    def __init__(self, log: RunLog, model: str) -> None:
+        self._log = log
+        self._model = model
+        self._ch: _ModelChannels | None = None
+        self._time_s = self._table = None
+        self._k0 = 0
+        self._last_k = -1
+        self._due_wall = math.inf
+
+    def start(self, names, time_s: np.ndarray, table: np.ndarray) -> None:
+        log = self._log
+        log.flush()  # steps kept for another model go first
+        self._ch = log._model(self._model, names)
+        self._time_s, self._table = time_s, table
+        self._begin(0)
+
+    def _begin(self, k0: int) -> None:
+        t = self._time_s
+        self._k0 = k0
+        if k0 >= len(t):
+            self._last_k = len(t)
+            return
+        k_end = int(np.searchsorted(t, t[k0] + CHUNK_SPAN_S - 0.5e-9, side="left"))
+        self._last_k = min(max(k_end, k0 + 1), k0 + _MAX_PENDING_STEPS, len(t)) - 1
+        self._due_wall = time.monotonic() + CHUNK_WALL_S
+
+    def step(self, k: int) -> None:
+        if k >= self._last_k or (not k & _WALL_CHECK_MASK
+                                 and time.monotonic() >= self._due_wall):
+            self._write(k + 1)
+
+    def stop(self, n: int) -> None:
+        if self._ch is not None and n > self._k0:
+            self._write(n)
+
+    def _write(self, n: int) -> None:
+        """Write rows [k0, n) as a chunk and begin the next at n."""
+        log, ch, k0 = self._log, self._ch, self._k0
+        with _signals_deferred():
+            rows = self._table[k0:n]
+            if log._origin is None:
+                log._set_origin(*rows[0, [ch.i_lat, ch.i_lon, ch.i_alt]].tolist())
+            block, index = ch.format(self._time_s[k0:n], rows, ch.seq, log._origin)
+            ch.seq += n - k0
+            log._writer.append_block(block, index)
+            log._writer.close_chunk()
+            self._begin(n)
 
 
 def _finite_or_none(v: float):

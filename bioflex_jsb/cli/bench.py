@@ -34,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     import tempfile
     from pathlib import Path
 
-    from bioflex_jsb.adapters.cosim import RunSetup, base_channels, run_gust
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
     from bioflex_jsb.adapters.jsbsim_export import bench_native
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe
     from bioflex_jsb.adapters.mcap_log import RunLog
@@ -58,11 +58,10 @@ def run(args: argparse.Namespace) -> int:
         return (time.perf_counter() - t0) / args.steps
 
     def cosim(log=None) -> float:
-        names = base_channels(build.model.n_modes)
-        on_sample = log.sampler("coupled", names) if log else None
+        recorder = log.recorder("coupled") if log else None
         trim = airframe.trim(args.speed)  # outside the timing, as for bare()
         t0 = time.perf_counter()
-        run = run_gust(airframe, build.model, "coupled", setup, on_sample, trim=trim)
+        run = run_gust(airframe, build.model, "coupled", setup, trim=trim, recorder=recorder)
         elapsed = time.perf_counter() - t0
         if run.stopped:
             raise UsageError(f"benchmark run stopped: {run.stopped}")

@@ -82,7 +82,7 @@ def progress_bar(total: int, label: str):
 
 def fly(args, build, models, log=None):
     """Run each model (all of them, also after one stops); return (runs, stop messages)."""
-    from bioflex_jsb.adapters.cosim import RunSetup, base_channels, run_gust
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
 
     setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
@@ -99,17 +99,13 @@ def fly(args, build, models, log=None):
         for model in models:
             steps = int(round(args.duration / args.dt))
             bar = progress_bar(steps, f"{build.variant.name} {model}")
-            write = (log.sampler(model, base_channels(build.model.n_modes))
-                     if log is not None else None)
-            if bar is None:
-                on_sample = write
-            else:
-                def on_sample(k, t, values, bar=bar, write=write, steps=steps):
+            recorder = log.recorder(model) if log is not None else None
+            on_sample = None
+            if bar is not None:
+                def on_sample(k, t, values, bar=bar, steps=steps):
                     if k % 50 == 0:
                         bar.update(min(50, steps - bar.n))
-                    if write is not None:
-                        write(k, t, values)
-            run = run_gust(airframe, build.model, model, setup, on_sample)
+            run = run_gust(airframe, build.model, model, setup, on_sample, recorder=recorder)
             if bar is not None:
                 bar.close()
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,

@@ -114,7 +114,7 @@ def _flutter(case: Case, build):
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
-    from bioflex_jsb.adapters.cosim import RunSetup, base_channels, run_gust
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics
 
@@ -122,7 +122,7 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     setup = RunSetup(case.speed_m_s, parse_gust(case.gust), s.duration_s, s.gust_start_s,
                      dt_s=s.dt_s)
     log = None
-    on_sample = None
+    recorder = None
     if log_dir:
         from bioflex_jsb.adapters.mcap_log import RunLog
 
@@ -134,10 +134,10 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         log = RunLog.open(Path(log_dir) / f"{case.case_id}.mcap", command="sweep", args=args,
                           build=build)
 
-        on_sample = log.sampler(case.model, base_channels(build.model.n_modes))
+        recorder = log.recorder(case.model)
 
     try:
-        run = run_gust(airframe(), build.model, case.model, setup, on_sample)
+        run = run_gust(airframe(), build.model, case.model, setup, recorder=recorder)
     finally:
         if log is not None:
             log.close()
