@@ -12,7 +12,7 @@ schema, message count), the number of messages and chunks, the time span [s of s
 time] and the metadata records (the run's command and arguments, wing, gust, time step,
 versions). Read through the mcap package's indexed reader. A log whose writer was killed
 (SIGKILL, power loss) has no summary; --recover FIXED.mcap copies every complete chunk of it
-into a new, finished file (at most the last chunk, 0.5 s of simulated time, is lost)."""
+into a new, finished file (at most the last chunk, 0.9 s of simulated time, is lost)."""
 
 
 def register(sub) -> None:
