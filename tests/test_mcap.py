@@ -193,6 +193,52 @@ def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
     assert not diff["equal"] and "/bioflex/coupled/" in diff["first_difference"]
 
 
+def test_compare_logs_the_run_and_the_lti_prediction_and_reruns(tmp_path, capsys):
+    out = tmp_path / "cmp.mcap"
+    assert main(["compare", "--duration", "1", "--out", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["out"] == str(out)
+    msgs = read_all(out)
+    run = msgs["/bioflex/coupled/rigid_body"]
+    lti = msgs["/bioflex/coupled/lti_prediction"]
+    assert len(run) == len(lti) == STEPS_1S
+    assert [ns for ns, _ in lti] == [ns for ns, _ in run]
+    # small gust: the linear prediction follows the nonlinear run (compare's own check)
+    dq = max(abs(m["q_rad_s"]) for _, m in run)
+    assert dq > 1e-3
+    assert max(abs(a["q_rad_s"] - b["q_rad_s"]) for (_, a), (_, b) in zip(run, lti,
+                                                                          strict=True)) < 0.2 * dq
+    again = tmp_path / "cmp2.mcap"
+    assert main(["rerun", str(out), "--out", str(again), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["equal"] and result["command"][1] == "compare"
+
+
+def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
+    from bioflex_jsb.cli.common import LOG_DIR_ENV_VAR
+
+    folder = tmp_path / "deep" / "logs"
+    monkeypatch.setenv(LOG_DIR_ENV_VAR, str(folder))
+    args = ["gust", "--duration", "0.2", "--gust-start", "0.1", "--models", "rigid", "--json"]
+    assert main(args) == 0
+    first = json.loads(capsys.readouterr().out)["out"]
+    assert main(args) == 0
+    second = json.loads(capsys.readouterr().out)["out"]
+    logs = sorted(folder.glob("gust-optimised-*.mcap"))
+    assert {str(p) for p in logs} == {first, second} and first != second
+    assert mcap_log.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(RUN_GROUPS)
+    assert main([*args, "--no-log"]) == 0
+    assert json.loads(capsys.readouterr().out)["out"] is None
+    assert len(list(folder.iterdir())) == 2
+    assert main([*args, "--no-log", "--out", str(tmp_path / "x.mcap")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "contradict" in err
+    (tmp_path / "file").write_text("")
+    monkeypatch.setenv(LOG_DIR_ENV_VAR, str(tmp_path / "file" / "logs"))
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "--no-log" in err
+
+
 @pytest.mark.parametrize("command", ["info", "plot", "rerun"])
 def test_bad_files_exit_2_with_one_line(command, gust_log, tmp_path, capsys):
     truncated = tmp_path / "cut.mcap"

@@ -1016,7 +1016,8 @@ def run_metadata(command: str, args, build) -> dict[str, str]:
     meta = {
         "command": command,
         "arguments": json.dumps(arguments, default=str),
-        "argv": json.dumps(rerun_argv(command, arguments)) if command == "gust" else "",
+        "argv": (json.dumps(rerun_argv(command, arguments))
+                 if command in REPEATABLE_COMMANDS else ""),
         "wing": build.variant.name,
         "wing_variant": json.dumps(build.variant.as_dict(), default=str),
         "overrides": json.dumps(dict(build.model.coefficients.overrides), default=str),
@@ -1024,7 +1025,8 @@ def run_metadata(command: str, args, build) -> dict[str, str]:
         "speed_m_s": repr(getattr(args, "speed", None)),
         "gust": gust.text() if gust is not None else "",
         "gust_seed": str(getattr(gust, "seed", "")),
-        "models": ",".join(getattr(args, "models", ()) or ()),
+        "models": ",".join(getattr(args, "models", None)
+                           or ((args.model,) if hasattr(args, "model") else ())),
         "dt_s": repr(getattr(args, "dt", None)),
         "time_base": "log and publish times are simulation time [ns from the run start]",
         "bioflex_jsb_version": __version__,
@@ -1035,19 +1037,26 @@ def run_metadata(command: str, args, build) -> dict[str, str]:
     return meta
 
 
+REPEATABLE_COMMANDS = ("gust", "sweep", "compare")
+
+
 def rerun_argv(command: str, arguments: dict) -> list[str]:
-    """The ``bioflex-jsb`` argument list (without --out/--plot/--json) of a logged run."""
-    if command != "gust":
-        raise ValueError(f"only gust runs can be repeated, this log was written by {command!r}")
-    argv = ["gust", "--wing", str(arguments["wing"]),
-            "--mass-basis", str(arguments["mass_basis"]),
-            "--speed", repr(float(arguments["speed"])),
-            "--gust", str(arguments["gust"]),
-            "--duration", repr(float(arguments["duration"])),
-            "--gust-start", repr(float(arguments["gust_start"])),
-            "--dt", repr(float(arguments["dt"])),
-            "--models", ",".join(arguments["models"])]
-    return argv
+    """The ``bioflex-jsb`` argument list (without --out/--plot/--json) of a logged run:
+    a ``gust`` run, a ``sweep`` case (repeated as the gust run it is) or a ``compare``."""
+    if command not in REPEATABLE_COMMANDS:
+        raise ValueError(f"only gust runs, sweep cases and comparisons can be repeated; this "
+                         f"log was written by {command!r} (a SITL session follows the wall "
+                         "clock and its ground station)")
+    common = ["--wing", str(arguments["wing"]),
+              "--mass-basis", str(arguments["mass_basis"]),
+              "--speed", repr(float(arguments["speed"])),
+              "--gust", str(arguments["gust"]),
+              "--duration", repr(float(arguments["duration"])),
+              "--gust-start", repr(float(arguments["gust_start"])),
+              "--dt", repr(float(arguments["dt"]))]
+    if command == "compare":
+        return ["compare", *common, "--model", str(arguments["model"])]
+    return ["gust", *common, "--models", ",".join(arguments["models"])]
 
 
 # ---------------------------------------------------------------------------- reading

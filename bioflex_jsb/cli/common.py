@@ -118,3 +118,42 @@ def wing_from_args(args: argparse.Namespace):
         raise UsageError(str(exc)) from None
     except ValueError as exc:  # modal-file and modal-data errors name their field
         raise UsageError(f"wing {args.wing!r}: {exc}") from None
+
+
+LOG_DIR_ENV_VAR = "BIOFLEX_LOG_DIR"  # where runs write their logs by default (else ./logs)
+
+
+def add_log_arguments(parser: argparse.ArgumentParser) -> None:
+    """--out and --no-log: every run writes an MCAP log unless told not to."""
+    parser.add_argument(
+        "--out", metavar="RUN.mcap",
+        help="MCAP log of every step (default: logs/<command>-<wing>-<UTC time>.mcap, the "
+        f"directory from ${LOG_DIR_ENV_VAR} when set; docs/logging.md)")
+    parser.add_argument("--no-log", action="store_true", help="write no MCAP log")
+
+
+def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
+    """The log file a run writes: --out, else a new file in the log directory (created);
+    None with --no-log. A directory that cannot be created is a UsageError."""
+    import os
+    import time
+    from pathlib import Path
+
+    if getattr(args, "no_log", False):
+        if args.out:
+            raise UsageError("--out and --no-log contradict each other; give one")
+        return None
+    if args.out:
+        return args.out
+    folder = Path(os.environ.get(LOG_DIR_ENV_VAR) or "logs")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError(f"cannot create the log directory {str(folder)!r}: {exc.strerror}; "
+                         "give --out FILE.mcap or --no-log") from None
+    stem = f"{command}-{Path(wing).stem}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
+    path, n = folder / f"{stem}.mcap", 1
+    while path.exists():
+        n += 1
+        path = folder / f"{stem}-{n}.mcap"
+    return str(path)

@@ -9,7 +9,9 @@ import sys
 from bioflex_jsb.cli.common import (
     EXIT_DIVERGED,
     UsageError,
+    add_log_arguments,
     add_wing_arguments,
+    log_path,
     models_list,
     positive_float,
     print_json,
@@ -25,7 +27,8 @@ overshoot of alpha past trim after its first peak [% of that peak]; and the sett
 [s] until |alpha - trim| stays within 5 % of its peak. Gusts are vertical, positive up:
 sharp:AMPLITUDE_m_s, 1cos:AMPLITUDE_m_s:LENGTH_m, dryden:SIGMA_m_s:SCALE_m[:SEED],
 vonkarman:SIGMA_m_s:SCALE_m[:SEED]. With no arguments: the optimised wing at 15 m/s through
-a 3 m/s sharp-edged gust (the paper's Fig. 21 case), all three models."""
+a 3 m/s sharp-edged gust (the paper's Fig. 21 case), all three models. Every step of every
+run is logged to an MCAP file (topics and units: docs/logging.md; --out, --no-log)."""
 
 
 def gust_type(text: str):
@@ -56,7 +59,7 @@ def register(sub) -> None:
     add_run_arguments(p, "sharp:3")
     p.add_argument("--models", type=models_list, default=("rigid", "coupled", "qsd"),
                    help="comma-separated subset of rigid,coupled,qsd (default: all three)")
-    p.add_argument("--out", metavar="RUN.mcap", help="write every step of every run to RUN.mcap")
+    add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="time histories to FILE.png (default gust.png when run without --json)")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -80,12 +83,8 @@ def progress_bar(total: int, label: str):
     return tqdm(total=total, desc=label, unit="step", leave=False, file=sys.stderr)
 
 
-def fly(args, build, models, log=None):
-    """Run each model (all of them, also after one stops); return (runs, stop messages)."""
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
-
-    setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
+def check_run_arguments(args) -> None:
+    """The run arguments that argparse cannot check alone (before any file is written)."""
     if args.dt > 0.02:
         raise UsageError(f"--dt {args.dt:g} s is too coarse; accepted: up to 0.02 s")
     if args.gust_start >= args.duration:
@@ -93,6 +92,15 @@ def fly(args, build, models, log=None):
             f"--gust-start {args.gust_start:g} s must be before the end of the run "
             f"(--duration {args.duration:g} s)"
         )
+
+
+def fly(args, build, models, log=None):
+    """Run each model (all of them, also after one stops); return (runs, stop messages)."""
+    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
+
+    check_run_arguments(args)
+    setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
     runs, stops = [], []
     try:
         airframe = Airframe()
@@ -126,7 +134,9 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.simulation.results import gust_metrics
 
     build = wing_from_args(args)
+    check_run_arguments(args)
     log = None
+    args.out = log_path(args, "gust", args.wing)
     if args.out:
         from bioflex_jsb.adapters.mcap_log import RunLog
 

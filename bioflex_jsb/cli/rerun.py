@@ -8,11 +8,12 @@ import sys
 
 from bioflex_jsb.cli.common import UsageError, print_json
 
-HELP = """Repeat the gust run recorded in FILE.mcap from its metadata record bioflex.run (wing,
-mass basis, speed, gust and seed, duration, gust start, time step, models), writing the new
-log to --out, and compare the two logs message by message (every topic, log time and number;
-numbers agree when within --rtol relative or 1e-12 absolute). Exit status 0 when they agree,
-1 when they differ (the first difference is printed), 2 for a bad file."""
+HELP = """Repeat the gust run, sweep case or comparison recorded in FILE.mcap from its metadata
+record bioflex.run (wing, mass basis, speed, gust and seed, duration, gust start, time step,
+models), writing the new log to --out, and compare the two logs message by message (every
+topic, log time and number; numbers agree when within --rtol relative or 1e-12 absolute).
+Exit status 0 when they agree, 1 when they differ (the first difference is printed), 2 for a
+bad file."""
 
 ABS_TOL = 1e-12
 
@@ -30,7 +31,13 @@ def register(sub) -> None:
 
 def argv_from_log(path: str) -> list[str]:
     """The bioflex-jsb argument list (without --out) that repeats the logged run."""
-    from bioflex_jsb.adapters.mcap_log import RUN_METADATA, LogError, open_reader, read_metadata
+    from bioflex_jsb.adapters.mcap_log import (
+        REPEATABLE_COMMANDS,
+        RUN_METADATA,
+        LogError,
+        open_reader,
+        read_metadata,
+    )
 
     try:
         with open_reader(path) as (reader, _summary):
@@ -39,9 +46,9 @@ def argv_from_log(path: str) -> list[str]:
         raise UsageError(str(exc)) from None
     if meta is None:
         raise UsageError(f"{path!r} has no {RUN_METADATA} metadata record; nothing to repeat")
-    if meta.get("command") != "gust":
-        raise UsageError(f"{path!r} was written by {meta.get('command')!r}; only gust runs "
-                         "can be repeated")
+    if meta.get("command") not in REPEATABLE_COMMANDS:
+        raise UsageError(f"{path!r} was written by {meta.get('command')!r}; only gust runs, "
+                         "sweep cases and comparisons can be repeated")
     try:
         argv = json.loads(meta["argv"])
     except (KeyError, ValueError):
