@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -240,13 +241,21 @@ def test_live_session_handshakes_telemetry_parameters(build):
         av = wait_for(c, "AUTOPILOT_VERSION")
         assert av.capabilities & M.MAV_PROTOCOL_CAPABILITY_MAVLINK2
 
-        # timesync and ping
+        # timesync (the vehicle's clock is the simulated time, as time_boot_ms) and ping
         c.mav.timesync_send(0, 123456789)
         ts = wait_for(c, "TIMESYNC", cond=lambda m: m.ts1 == 123456789)
-        assert ts.tc1 > 0
+        assert ts.tc1 > 0 and abs(ts.tc1 * 1e-9 - sim.t_s) < 0.5
         c.mav.ping_send(42, 7, 0, 0)
         ping = wait_for(c, "PING", cond=lambda m: m.seq == 7)
         assert ping.time_usec == 42 and ping.target_system == 255
+
+        # MAVLink FTP: no file server, so a NAK (UnknownCommand) to the request's sequence + 1
+        open_ro = struct.pack("<HBBBBBBI", 10, 3, 4, 13, 0, 0, 0, 0) + b"@PARAM/param.pck"
+        c.mav.file_transfer_protocol_send(0, 1, 1, list(open_ro.ljust(251, b"\0")))
+        ftp = wait_for(c, "FILE_TRANSFER_PROTOCOL")
+        seq, session_id, opcode, size, req_opcode = struct.unpack("<HBBBB", bytes(ftp.payload[:6]))
+        assert (seq, session_id, opcode, size, req_opcode) == (11, 3, 129, 1, 4)
+        assert ftp.payload[12] == 7 and ftp.target_system == 255
 
         # message rates: ATTITUDE to 5 Hz by interval, VFR_HUD off by data stream
         c.mav.command_long_send(1, 1, M.MAV_CMD_SET_MESSAGE_INTERVAL, 0,

@@ -24,11 +24,33 @@ never blocks (sends that would block are dropped; a TCP client whose backlog exc
 
 Units: :class:`VehicleState` is SI (rad, m, m/s); conversion to MAVLink's integer units
 (degE7, mm, cm/s, cdeg) happens here only.
+
+Time base: the vehicle's clock is the *simulated* time t [s] since the start of the run, not
+the wall clock: ``time_boot_ms`` = ⌊1000 t⌋ (ATTITUDE, GLOBAL_POSITION_INT,
+NAMED_VALUE_FLOAT), GPS_RAW_INT ``time_usec`` = ⌊10⁶ t⌋, and TIMESYNC answers with t in ns.
+A message carries the state at exactly that t (after the step that ended at t), so a
+message with ``time_boot_ms`` = m matches the MCAP log's step at a time in [m, m + 1) ms:
+its attitude and airspeed exactly; the log's position, heading and body rates p, r of a
+step are read at the end of that step (as in ``cosim.run_gust``), so those match the
+step one time step (1/960 s) earlier. With ``--speedup N`` this clock runs N times faster
+than the wall clock.
+
+Signing (``signing_key``, :func:`read_signing_key`): MAVLink 2 message signing with one
+32-byte secret. Everything sent is signed (link id 0, timestamps from the wall clock in
+10 µs since 2015-01-01 UTC, as the MAVLink signing spec asks); a received message is
+accepted only with a valid signature whose timestamp is newer than the last one of its
+stream (link id, system, component) and not more than 60 s older than the link's own
+time (replay protection, shared by all peers of the link). Unsigned or wrongly signed
+messages are dropped (counted in ``LinkStats.rejected_signature``) except RADIO_STATUS,
+which radios send unsigned. A peer whose messages are all rejected is never added
+(``udpin``), so it gets no telemetry either.
 """
 
 from __future__ import annotations
 
 import errno
+import hashlib
+import hmac
 import ipaddress
 import math
 import socket
@@ -37,6 +59,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Protocol
 
 from pymavlink.dialects.v20 import common as mavlink
@@ -72,12 +95,83 @@ _STREAMS = {
 }
 _STREAMS[M.MAV_DATA_STREAM_ALL] = tuple(m for ids in _STREAMS.values() for m in ids)
 MAX_RATE_HZ = 200.0
+SIGNING_KEY_BYTES = 32
+SIGNING_EPOCH_UNIX_S = 1420070400  # 2015-01-01T00:00:00Z: origin of signing timestamps
+SIGNING_STREAM_AGE_10US = 60 * 100_000  # a new stream may be this much older (60 s)
+UNSIGNED_ALLOWED = frozenset({M.MAVLINK_MSG_ID_RADIO_STATUS})  # radios cannot sign
+# MAVLink FTP (FILE_TRANSFER_PROTOCOL payload header): opcodes and error codes used here
+FTP_OP_TERMINATE_SESSION = 1
+FTP_OP_RESET_SESSIONS = 2
+FTP_OP_ACK = 128
+FTP_OP_NAK = 129
+FTP_ERR_UNKNOWN_COMMAND = 7
 CAPABILITIES = (M.MAV_PROTOCOL_CAPABILITY_MAVLINK2 | M.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
                 | M.MAV_PROTOCOL_CAPABILITY_MISSION_INT | M.MAV_PROTOCOL_CAPABILITY_COMMAND_INT)
 
 
 class LinkError(Exception):
-    """A malformed or unusable endpoint; one line for the user."""
+    """A malformed or unusable endpoint or signing key; one line for the user."""
+
+
+def read_signing_key(path: str | Path) -> bytes:
+    """The 32-byte MAVLink 2 signing secret in the file ``path``: 64 hexadecimal digits
+    (surrounding white space ignored). MAVProxy's ``signing key P`` (and ``signing setup
+    P``) signs with SHA-256 of the passphrase P, so its key file is ``python -c "import
+    hashlib; print(hashlib.sha256(b'P').hexdigest())" > key.hex``. LinkError (one line)
+    when the file is missing, unreadable, or does not hold exactly 32 bytes of hex, or
+    holds the all-zero key (which means "signing off" in MAVLink)."""
+    where = f"signing key {str(path)!r}"
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as exc:
+        raise LinkError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("ascii").strip()
+    except UnicodeDecodeError:
+        raise LinkError(f"{where}: expected {2 * SIGNING_KEY_BYTES} hexadecimal digits, "
+                        "found binary data") from None
+    if len(text) != 2 * SIGNING_KEY_BYTES:
+        raise LinkError(f"{where}: expected {2 * SIGNING_KEY_BYTES} hexadecimal digits "
+                        f"({SIGNING_KEY_BYTES} bytes), found {len(text)} characters")
+    try:
+        key = bytes.fromhex(text)
+    except ValueError:
+        raise LinkError(f"{where}: not hexadecimal (expected {2 * SIGNING_KEY_BYTES} digits "
+                        "0-9, a-f)") from None
+    if not any(key):
+        raise LinkError(f"{where}: the all-zero key means 'no signing' in MAVLink; use a "
+                        "random key")
+    return key
+
+
+def signing_time_10us(unix_s: float | None = None) -> int:
+    """MAVLink signing timestamp: 10 µs units since 2015-01-01 UTC (wall clock)."""
+    now = time.time() if unix_s is None else unix_s
+    return int(max(now - SIGNING_EPOCH_UNIX_S, 0.0) * 100_000)
+
+
+class _Parser(mavlink.MAVLink):
+    """pymavlink's MAVLink 2 parser with a stricter signature check: the stream's timestamp
+    is recorded only once the signature is right (pymavlink records it first, so a forged
+    packet with a far-future timestamp would lock the real sender's stream out)."""
+
+    def check_signature(self, msgbuf, srcSystem: int, srcComponent: int) -> bool:
+        sig = self.signing
+        expected = hashlib.sha256(sig.secret_key + bytes(msgbuf[:-6])).digest()[:6]
+        if not hmac.compare_digest(expected, bytes(msgbuf[-6:])):
+            return False
+        link_id = msgbuf[-13]
+        stamp = int.from_bytes(bytes(msgbuf[-12:-6]), "little")
+        stream = (link_id, srcSystem, srcComponent)
+        last = sig.stream_timestamps.get(stream)
+        if last is not None:
+            if stamp <= last:
+                return False  # replayed or reordered
+        elif stamp + SIGNING_STREAM_AGE_10US < sig.timestamp:
+            return False  # a new stream, but too old
+        sig.stream_timestamps[stream] = stamp
+        sig.timestamp = max(sig.timestamp, stamp)
+        return True
 
 
 @dataclass(frozen=True)
@@ -167,6 +261,7 @@ class LinkStats:
     bad: int = 0  # bad-CRC / unparseable chunks
     datagrams: int = 0
     bytes_dropped: int = 0  # read but not parsed (over the per-call budget)
+    rejected_signature: int = 0  # unsigned, wrongly signed or replayed (signing on)
     sent: int = 0
     send_dropped: int = 0
     by_type: dict[str, int] = field(default_factory=dict)
@@ -175,11 +270,10 @@ class LinkStats:
 class _Peer:
     """One conversation: its own parser (stream state), and for TCP its socket."""
 
-    def __init__(self, addr, sock: socket.socket | None = None) -> None:
+    def __init__(self, addr, parser: mavlink.MAVLink, sock: socket.socket | None = None) -> None:
         self.addr = addr
         self.sock = sock
-        self.parser = mavlink.MAVLink(None, srcSystem=SYSTEM_ID, srcComponent=COMPONENT_ID)
-        self.parser.robust_parsing = True
+        self.parser = parser
         self.backlog = bytearray()
         self.last_seen = time.monotonic()
 
@@ -188,13 +282,25 @@ class MavlinkLink:
     """The vehicle's MAVLink link (module docstring). Call :meth:`service` from the loop."""
 
     def __init__(self, endpoint: Endpoint | str, params: Parameters,
-                 on_manual: Callable[[float | None, float | None], None] | None = None) -> None:
+                 on_manual: Callable[[float | None, float | None], None] | None = None,
+                 signing_key: bytes | None = None) -> None:
         self.endpoint = parse_endpoint(endpoint) if isinstance(endpoint, str) else endpoint
         self.params = params
         self.on_manual = on_manual  # (pitch, roll) in -1..1; (None, None): released
         self.stats = LinkStats()
         self._mav = mavlink.MAVLink(None, srcSystem=SYSTEM_ID, srcComponent=COMPONENT_ID)
-        self._t0_ns = time.monotonic_ns()
+        self._rx_signing: mavlink.MAVLinkSigning | None = None
+        if signing_key is not None:
+            if len(signing_key) != SIGNING_KEY_BYTES:
+                raise LinkError(f"a MAVLink signing key has {SIGNING_KEY_BYTES} bytes, "
+                                f"not {len(signing_key)}")
+            key = bytes(signing_key)
+            tx = self._mav.signing
+            tx.secret_key, tx.sign_outgoing, tx.link_id = key, True, 0
+            tx.timestamp = signing_time_10us()
+            rx = self._rx_signing = mavlink.MAVLinkSigning()  # shared by every peer's parser
+            rx.secret_key, rx.timestamp = key, tx.timestamp
+            rx.allow_unsigned_callback = lambda _mav, msg_id: msg_id in UNSIGNED_ALLOWED
         self.intervals_s = {mid: 1.0 / hz for mid, hz in DEFAULT_RATES_HZ.items()}
         self._next_due: dict[int, float] = {}
         self._param_queue: deque[int] = deque()
@@ -226,13 +332,24 @@ class MavlinkLink:
                 finally:
                     probe.close()
                 s.bind((local, 0))
-                self._peers.append(_Peer((ep.host, ep.port)))
+                self._peers.append(_Peer((ep.host, ep.port), self._new_parser()))
             s.setblocking(False)
             self._udp = s
         except OSError as exc:
             verb = "send to" if ep.kind == "udpout" else "listen on"
             raise LinkError(f"cannot {verb} {ep.text()}: "
                             f"{exc.strerror or exc}") from None
+
+    def _new_parser(self) -> mavlink.MAVLink:
+        parser = _Parser(None, srcSystem=SYSTEM_ID, srcComponent=COMPONENT_ID)
+        parser.robust_parsing = True
+        if self._rx_signing is not None:
+            parser.signing = self._rx_signing
+        return parser
+
+    @property
+    def signing(self) -> bool:
+        return self._rx_signing is not None
 
     @property
     def local_address(self) -> tuple[str, int]:
@@ -253,6 +370,9 @@ class MavlinkLink:
         self._peers.clear()
 
     def _send(self, msg) -> None:
+        if self._rx_signing is not None:  # signing timestamps follow the wall clock
+            sig = self._mav.signing
+            sig.timestamp = max(sig.timestamp, signing_time_10us())
         data = msg.pack(self._mav)
         self.stats.sent += 1
         if self._udp is not None:
@@ -342,7 +462,7 @@ class MavlinkLink:
             budget -= len(chunk)
             peer = next((p for p in self._peers if p.addr == addr), None)
             if peer is None:
-                peer = _Peer(addr)  # known only once it sends valid MAVLink
+                peer = _Peer(addr, self._new_parser())  # known once it sends valid MAVLink
                 if self._handle_bytes(peer, chunk, state) and len(self._peers) < MAX_PEERS \
                         and self.endpoint.kind == "udpin":
                     self._peers.append(peer)
@@ -360,13 +480,13 @@ class MavlinkLink:
                 continue
             conn.setblocking(False)
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._peers.append(_Peer(addr, conn))
+            self._peers.append(_Peer(addr, self._new_parser(), conn))
 
     def _handle_bytes(self, peer: _Peer, data: bytes, state: VehicleState) -> int:
         try:
             msgs = peer.parser.parse_buffer(data) or []
         except Exception:  # noqa: BLE001 - a codec error on hostile input: drop the bytes
-            peer.parser = _Peer(None).parser
+            peer.parser = self._new_parser()
             self.stats.bad += 1
             return 0
         good = 0
@@ -375,6 +495,8 @@ class MavlinkLink:
             # unknown message ids carry no checkable CRC (no CRC_EXTRA): noise, not MAVLink
             if name == "BAD_DATA" or name.startswith("UNKNOWN"):
                 self.stats.bad += 1
+                if name == "BAD_DATA" and "signature" in str(getattr(msg, "reason", "")):
+                    self.stats.rejected_signature += 1
                 continue
             good += 1
             self.stats.received += 1
@@ -430,9 +552,12 @@ class MavlinkLink:
                 self._send(self._mav.mission_ack_encode(
                     msg.get_srcSystem(), msg.get_srcComponent(), result, msg.mission_type))
         elif t == "TIMESYNC":
-            if msg.tc1 == 0:
-                self._send(self._mav.timesync_encode(time.monotonic_ns() - self._t0_ns,
+            if msg.tc1 == 0:  # a request: answer with the vehicle's (simulated) clock [ns]
+                self._send(self._mav.timesync_encode(max(1, int(state.time_s * 1e9)),
                                                      msg.ts1))
+        elif t == "FILE_TRANSFER_PROTOCOL":
+            if msg.target_system == SYSTEM_ID and msg.target_component in (0, COMPONENT_ID):
+                self._ftp_reply(msg)
         elif t == "PING":
             if msg.target_system == 0 and msg.target_component == 0:
                 self._send(self._mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(),
@@ -454,6 +579,25 @@ class MavlinkLink:
                 else:
                     self.on_manual(_clip_unit((pitch - 1500) / 500.0),
                                    _clip_unit((roll - 1500) / 500.0))
+
+    def _ftp_reply(self, msg) -> None:
+        """The vehicle has no MAVLink FTP server: every request gets a NAK (UnknownCommand),
+        session ends an ACK, so a ground station that tries FTP first (MAVProxy fetches its
+        parameters that way) falls back to the parameter protocol at once."""
+        payload = bytes(msg.payload)
+        if len(payload) < 12:
+            return
+        seq = int.from_bytes(payload[0:2], "little")
+        session, opcode = payload[2], payload[3]
+        if opcode in (FTP_OP_TERMINATE_SESSION, FTP_OP_RESET_SESSIONS):
+            reply, data = FTP_OP_ACK, b""
+        else:
+            reply, data = FTP_OP_NAK, bytes([FTP_ERR_UNKNOWN_COMMAND])
+        header = struct.pack("<HBBBBBBI", (seq + 1) & 0xFFFF, session, reply, len(data),
+                             opcode, 0, 0, 0)
+        body = (header + data).ljust(251, b"\0")
+        self._send(self._mav.file_transfer_protocol_encode(
+            msg.target_network, msg.get_srcSystem(), msg.get_srcComponent(), body))
 
     def _set_rate(self, mid: int, hz: float) -> None:
         if mid == M.MAVLINK_MSG_ID_HEARTBEAT:
@@ -501,7 +645,7 @@ class MavlinkLink:
 
     def _send_message(self, mid: int, s: VehicleState) -> None:
         mav = self._mav
-        boot_ms = int(s.time_s * 1000.0) & 0xFFFFFFFF
+        boot_ms = int(s.time_s * 1000.0 + 1e-6) & 0xFFFFFFFF  # ⌊1000 t⌋ (+1 ns: k·dt rounding)
         if mid == M.MAVLINK_MSG_ID_HEARTBEAT:
             mode = M.MAV_MODE_FLAG_SAFETY_ARMED | M.MAV_MODE_FLAG_STABILIZE_ENABLED
             mode |= M.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED if s.manual else 0
@@ -514,8 +658,11 @@ class MavlinkLink:
                        | M.MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE
                        | M.MAV_SYS_STATUS_SENSOR_GPS | M.MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL
                        | M.MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION)
-            self._send(mav.sys_status_encode(sensors, sensors, sensors, 0, 16800, -1, -1,
-                                             0, 0, 0, 0, 0, 0))
+            # health also says "no geofence breach" (there is no fence: MAVProxy reads a
+            # missing health bit as a breach)
+            self._send(mav.sys_status_encode(sensors, sensors,
+                                             sensors | M.MAV_SYS_STATUS_GEOFENCE, 0, 16800,
+                                             -1, -1, 0, 0, 0, 0, 0, 0))
         elif mid == M.MAVLINK_MSG_ID_ATTITUDE:
             self._send(mav.attitude_encode(boot_ms, s.roll_rad, s.pitch_rad, s.yaw_rad,
                                            s.p_rad_s, s.q_rad_s, s.r_rad_s))
@@ -529,7 +676,7 @@ class MavlinkLink:
             vg = math.hypot(s.v_north_m_s, s.v_east_m_s)
             cog = math.atan2(s.v_east_m_s, s.v_north_m_s)
             self._send(mav.gps_raw_int_encode(
-                int(s.time_s * 1e6), M.GPS_FIX_TYPE_3D_FIX, _deg_e7(s.latitude_rad),
+                int(s.time_s * 1e6 + 1e-3), M.GPS_FIX_TYPE_3D_FIX, _deg_e7(s.latitude_rad),
                 _deg_e7(s.longitude_rad), _i32(s.altitude_m * 1000.0), 80, 120,
                 min(int(vg * 100.0), 65534), _heading_cdeg(cog), 12))
         elif mid == M.MAVLINK_MSG_ID_VFR_HUD:

@@ -29,7 +29,13 @@ run from the ground station (docs in bioflex_jsb/adapters/sitl_loop.py). --mavli
 udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:14550),
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
 simulated seconds, or until Ctrl-C. Prints the pacing error (step start minus its wall-clock
-due time: p50, p99 [ms])."""
+due time: p50, p99 [ms]). The vehicle's MAVLink clock (time_boot_ms) is the simulated time
+since the start, the time axis of the --out log. --signing-key FILE turns on MAVLink 2
+signing: FILE holds the 32-byte secret as 64 hexadecimal digits (to share it with MAVProxy's
+"signing key P", the SHA-256 of the passphrase P: python -c "import hashlib;
+print(hashlib.sha256(b'P').hexdigest())");
+the vehicle then signs all it sends and ignores unsigned or wrongly signed messages
+(except RADIO_STATUS)."""
 
 
 def register(sub) -> None:
@@ -47,6 +53,9 @@ def register(sub) -> None:
                    help="simulated time [s] (default: until Ctrl-C)")
     p.add_argument("--speedup", type=positive_float("speed-up", "x"), default=1.0,
                    help="simulated seconds per wall-clock second (default 1, 0.1..50)")
+    p.add_argument("--signing-key", metavar="FILE",
+                   help="MAVLink 2 signing key file: 64 hex digits (32 bytes); sign what is "
+                   "sent, accept only signed messages")
     p.add_argument("--out", metavar="RUN.mcap", help="write every step to RUN.mcap")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=run)
@@ -54,7 +63,12 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.adapters.jsbsim_fdm import FdmError
-    from bioflex_jsb.adapters.mavlink_link import LinkError, MavlinkLink, parse_endpoint
+    from bioflex_jsb.adapters.mavlink_link import (
+        LinkError,
+        MavlinkLink,
+        parse_endpoint,
+        read_signing_key,
+    )
     from bioflex_jsb.adapters.sitl_loop import (
         SPEEDUP_RANGE,
         SitlParameters,
@@ -67,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--speedup {args.speedup:g} is outside {lo:g}..{hi:g}")
     try:
         endpoint = parse_endpoint(args.mavlink)
+        key = None if args.signing_key is None else read_signing_key(args.signing_key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
     build = wing_from_args(args)
@@ -76,7 +91,8 @@ def run(args: argparse.Namespace) -> int:
     except (FdmError, ValueError) as exc:
         raise UsageError(str(exc)) from None
     try:
-        link = MavlinkLink(endpoint, SitlParameters(sim), on_manual=sim.manual)
+        link = MavlinkLink(endpoint, SitlParameters(sim), on_manual=sim.manual,
+                           signing_key=key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
     log = None
@@ -101,8 +117,9 @@ def run(args: argparse.Namespace) -> int:
 
     host, port = link.local_address
     if not args.json:
-        print(f"bioflex-jsb sitl: MAVLink 2 on {endpoint.text()} (local {host}:{port}), "
-              f"{args.speedup:g}x real time; Ctrl-C stops", file=sys.stderr)
+        print(f"bioflex-jsb sitl: MAVLink 2 on {endpoint.text()} (local {host}:{port}"
+              f"{', signed' if key else ''}), {args.speedup:g}x real time; Ctrl-C stops",
+              file=sys.stderr)
     interrupted = False
     try:
         stats = run_paced(sim, args.duration, link, on_sample, idle=idle)
@@ -118,7 +135,9 @@ def run(args: argparse.Namespace) -> int:
         "steps": sim.k,
         "pacing": stats.summary() if stats else None,
         "link": {"received": link.stats.received, "bad": link.stats.bad,
-                 "sent": link.stats.sent, "datagrams": link.stats.datagrams},
+                 "rejected_signature": link.stats.rejected_signature,
+                 "sent": link.stats.sent, "datagrams": link.stats.datagrams,
+                 "signing": link.signing},
         "stopped": sim.stopped,
         "out": args.out,
     }
