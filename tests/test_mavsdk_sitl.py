@@ -1,0 +1,263 @@
+"""MAVSDK (PyPI ``mavsdk`` 4.x: the MAVSDK C++ library through its C wrapper, an independent
+MAVLink codec) against ``bioflex-jsb sitl --duration 20`` on loopback, checked against the
+run's MCAP log.
+
+How the values are matched to the log. The vehicle's MAVLink clock is the simulated time
+(``mavlink_link`` module docstring): an ATTITUDE with ``time_boot_ms`` = m carries the state
+of the step at a time in [m, m + 1) ms, which MAVSDK passes on as ``timestamp_us`` = 1000 m.
+GLOBAL_POSITION_INT and VFR_HUD reach MAVSDK's Position and FixedwingMetrics without a
+timestamp; they are sent in the same link service as an ATTITUDE or between two, so their
+time lies between the timestamps of the ATTITUDE callbacks just before and just after them.
+The log's position and heading of a step are those at its end (one step, 1/960 s, later), so
+every window starts one step earlier. A MAVSDK value must lie within the range of the
+logged values over its window, widened by the tolerance of its transport:
+
+* attitude [deg]: float32 in ATTITUDE (rad); MAVSDK forms its EulerAngle through a float32
+  quaternion, whose round trip alone moves an angle by up to ≈ 3e-5 deg (a few float32 steps
+  of 1 rad); the log's 9 significant digits are far finer; ATT_TOL_DEG = 1e-4;
+* latitude/longitude [deg]: degE7 integers (±0.5e-7 deg) and the log's 9 significant
+  digits of 45.xxxxxxx deg (±0.5e-7 deg); LATLON_TOL_DEG = 1.5e-7 (1.7 cm);
+* altitude [m]: integer mm (±0.5 mm) in float32; ALT_TOL_M = 1e-3;
+* airspeed [m/s]: float32 in VFR_HUD and in MAVSDK (≤ 1e-6 m/s at 16 m/s); 1e-5.
+
+The same comparison with the MAVSDK times shifted by 50 ms must fail during the turn: the
+check resolves the time alignment.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+from mavsdk import ComponentType, Configuration, Mavsdk
+from mavsdk.plugins.mission_raw import MissionRaw
+from mavsdk.plugins.param import Param
+from mavsdk.plugins.telemetry import Telemetry
+
+from bioflex_jsb.adapters.mcap_log import messages_by_topic, topic
+from bioflex_jsb.adapters.sitl_loop import SitlParameters
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+DURATION_S = 20.0  # the issue's `bioflex-jsb sitl --duration 20`
+SPEEDUP = 2.0  # 10 s of wall time; telemetry rates are wall-clock rates, unchanged
+HEADING_RAD = math.radians(60.0)  # AP_HDG_RAD set over MAVSDK: a 60 deg turn
+GUST_AMP_MS = 2.5
+ATT_TOL_DEG = 1e-4
+LATLON_TOL_DEG = 1.5e-7
+ALT_TOL_M = 1e-3
+AIRSPEED_TOL_M_S = 1e-5
+SHIFT_S = 0.05  # the misalignment the check must detect
+
+
+def free_udp_port() -> int:
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+class Recorder:
+    """MAVSDK telemetry callbacks, in the order they arrive."""
+
+    def __init__(self) -> None:
+        self.events: list[tuple[str, object]] = []
+        self._lock = threading.Lock()
+
+    def callback(self, kind: str):
+        def on_value(value, _user_data):
+            with self._lock:
+                self.events.append((kind, value))
+        return on_value
+
+    def snapshot(self) -> list[tuple[str, object]]:
+        with self._lock:
+            return list(self.events)
+
+    def last_attitude_s(self) -> float:
+        for kind, v in reversed(self.snapshot()):
+            if kind == "attitude":
+                return v.timestamp_us * 1e-6
+        return math.nan
+
+
+class LogSeries:
+    """The coupled run of the log as arrays over its step times [s]."""
+
+    def __init__(self, path) -> None:
+        msgs = messages_by_topic(path)
+        rigid = msgs[topic("coupled", "rigid_body")]
+        loc = msgs[topic("coupled", "location")]
+        gust = msgs[topic("coupled", "gust")]
+        self.t_s = np.array([ns for ns, _ in rigid], dtype=float) * 1e-9
+        col = {k: np.array([m[k] for _, m in rigid], dtype=float)
+               for k in ("roll_rad", "pitch_rad", "yaw_rad", "airspeed_m_s", "altitude_m")}
+        self.deg = {k: np.degrees(col[f"{k}_rad"]) for k in ("roll", "pitch", "yaw")}
+        self.airspeed_m_s = col["airspeed_m_s"]
+        self.altitude_m = col["altitude_m"]
+        self.lat_deg = np.array([m["latitude"] for _, m in loc], dtype=float)
+        self.lon_deg = np.array([m["longitude"] for _, m in loc], dtype=float)
+        self.w_g_m_s = np.array([m["w_g_m_s"] for _, m in gust], dtype=float)
+        assert len(self.lat_deg) == len(self.t_s) == len(self.w_g_m_s)
+
+    def miss(self, value: float, series: np.ndarray, t0_s: float, t1_s: float,
+             period: float | None = None) -> tuple[float, float] | None:
+        """(distance of ``value`` outside the range of ``series`` over [t0, t1], distance to
+        the nearest logged value there), or None when the log has no step in the window."""
+        i0 = np.searchsorted(self.t_s, t0_s - 1e-9, side="left")
+        i1 = np.searchsorted(self.t_s, t1_s + 1e-9, side="right")
+        if i1 <= i0:
+            return None
+        d = value - series[i0:i1]
+        if period is not None:
+            d = (d + 0.5 * period) % period - 0.5 * period
+        outside = 0.0 if d.min() <= 0.0 <= d.max() else float(np.min(np.abs(d)))
+        return outside, float(np.min(np.abs(d)))
+
+
+def compare(log: LogSeries, events, shift_s: float = 0.0) -> dict[str, list[tuple]]:
+    """Per quantity, (outside, nearest, tolerance, time [s]) of every MAVSDK sample."""
+    dt = DEFAULT_DT_S
+    out: dict[str, list[tuple]] = {k: [] for k in (
+        "roll", "pitch", "yaw", "latitude", "longitude", "altitude", "airspeed")}
+
+    def add(name, value, series, t0, t1, tol, period=None):
+        r = log.miss(value, series, t0 + shift_s, t1 + shift_s, period)
+        if r is not None:
+            out[name].append((*r, tol, t0))
+
+    att_times = [(i, v.timestamp_us * 1e-6) for i, (k, v) in enumerate(events)
+                 if k == "attitude"]
+    for k, v in events:  # attitude: its own time_boot_ms
+        if k != "attitude":
+            continue
+        m = v.timestamp_us * 1e-6
+        t0, t1 = m - dt, m + 1e-3
+        add("roll", v.roll_deg, log.deg["roll"], t0, t1, ATT_TOL_DEG)
+        add("pitch", v.pitch_deg, log.deg["pitch"], t0, t1, ATT_TOL_DEG)
+        add("yaw", v.yaw_deg, log.deg["yaw"], t0, t1, ATT_TOL_DEG, period=360.0)
+    idx = np.array([i for i, _ in att_times])
+    stamps = np.array([m for _, m in att_times])
+    for i, (k, v) in enumerate(events):
+        if k not in ("position", "fixedwing"):
+            continue
+        j = np.searchsorted(idx, i)
+        if j == 0 or j == len(idx):
+            continue  # no ATTITUDE on one side: no bracket
+        t0, t1 = stamps[j - 1] - dt, stamps[j] + 1e-3
+        if k == "position":
+            add("latitude", v.latitude_deg, log.lat_deg, t0, t1, LATLON_TOL_DEG)
+            add("longitude", v.longitude_deg, log.lon_deg, t0, t1, LATLON_TOL_DEG)
+            add("altitude", v.absolute_altitude_m, log.altitude_m, t0, t1, ALT_TOL_M)
+        else:
+            add("airspeed", v.airspeed_m_s, log.airspeed_m_s, t0, t1, AIRSPEED_TOL_M_S)
+    return out
+
+
+def test_mavsdk_flies_with_the_sitl_vehicle_and_matches_the_log(tmp_path):
+    port = free_udp_port()
+    out = tmp_path / "run.mcap"
+    mavsdk = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))
+    proc = None
+    try:
+        assert mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}").name == "SUCCESS"
+        wall0 = time.monotonic()
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "bioflex_jsb", "sitl", "--duration", str(DURATION_S),
+             "--speedup", str(SPEEDUP), "--mavlink", f"udpout:127.0.0.1:{port}",
+             "--out", str(out), "--json"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+        vehicle = mavsdk.first_autopilot(20.0)
+        assert vehicle is not None, "MAVSDK saw no autopilot"
+        assert vehicle.is_connected() and vehicle.has_autopilot()
+        assert vehicle.get_system_id() == 1 and 1 in vehicle.component_ids()
+
+        rec = Recorder()
+        telemetry = Telemetry(vehicle)
+        telemetry.subscribe_attitude_euler(rec.callback("attitude"), None)
+        telemetry.subscribe_position(rec.callback("position"), None)
+        telemetry.subscribe_fixedwing_metrics(rec.callback("fixedwing"), None)
+
+        # parameters: the whole list, then sets that change the run
+        param = Param(vehicle)
+        listed = {p.name: p.value for p in param.get_all_params().float_params}
+        assert set(listed) == set(SitlParameters.names)
+        assert listed["SIM_SPEEDUP"] == SPEEDUP and listed["WING_COUPLED"] == 1.0
+        assert listed["GUST_TRIG"] == 0.0 and listed["AP_ENABLE"] == 1.0
+        param.set_param_float("AP_HDG_RAD", HEADING_RAD)
+        assert param.get_param_float("AP_HDG_RAD") == pytest.approx(HEADING_RAD, rel=1e-6)
+        param.set_param_float("GUST_AMP_MS", GUST_AMP_MS)
+        deadline = time.monotonic() + 2.0
+        while math.isnan(rec.last_attitude_s()) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        before_trigger_s = rec.last_attitude_s()
+        param.set_param_float("GUST_TRIG", 1.0)
+        time.sleep(0.1)
+        after_trigger_s = rec.last_attitude_s()
+
+        # the mission: empty
+        assert MissionRaw(vehicle).download_mission() == []
+
+        stdout, stderr = proc.communicate(timeout=DURATION_S / SPEEDUP + 60.0)
+        wall_s = time.monotonic() - wall0
+        assert proc.returncode == 0, stderr
+        events = rec.snapshot()
+    finally:
+        if proc is not None and proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+        mavsdk.destroy()
+
+    summary = json.loads(stdout)
+    assert summary["simulated_s"] == pytest.approx(DURATION_S, abs=0.01)
+    assert summary["stopped"] is None
+    log = LogSeries(out)
+    assert log.t_s[-1] == pytest.approx(DURATION_S, abs=0.01)
+
+    # the parameters set over MAVSDK changed the run
+    assert abs(log.deg["yaw"][0]) < 0.5
+    assert abs(math.remainder(log.deg["yaw"][-1] - math.degrees(HEADING_RAD), 360.0)) < 2.0
+    blowing = np.flatnonzero(log.w_g_m_s != 0.0)
+    assert len(blowing) > 0, "GUST_TRIG set over MAVSDK started no gust"
+    assert float(log.w_g_m_s.max()) == pytest.approx(GUST_AMP_MS, rel=1e-3)
+    gust_start_s = log.t_s[blowing[0]]
+    assert before_trigger_s - 0.01 <= gust_start_s <= after_trigger_s + 0.01, (
+        before_trigger_s, gust_start_s, after_trigger_s)
+
+    # telemetry over the whole run, at MAVLink's default rates (wall clock)
+    kinds = [k for k, _ in events]
+    n_att, n_pos, n_fw = (kinds.count(k) for k in ("attitude", "position", "fixedwing"))
+    assert n_att >= 200 and n_pos >= 40 and n_fw >= 40, (n_att, n_pos, n_fw)
+    stamps = [v.timestamp_us for k, v in events if k == "attitude"]
+    assert stamps == sorted(stamps) and all(s % 1000 == 0 for s in stamps)
+    assert stamps[-1] * 1e-6 > 0.8 * DURATION_S  # the MAVLink clock is the simulated time
+
+    result = compare(log, events)
+    report = {}
+    for name, rows in result.items():
+        assert len(rows) >= 0.9 * (n_att if name in ("roll", "pitch", "yaw") else
+                                   (n_pos if name != "airspeed" else n_fw)) - 2, name
+        bad = [r for r in rows if r[0] > r[2]]
+        report[name] = (len(rows), max(r[1] for r in rows), max(r[0] for r in rows))
+        assert not bad, f"{name}: {len(bad)} of {len(rows)} MAVSDK values off the log, " \
+                        f"first (outside, nearest, tol, t) = {bad[0]}"
+    print(f"\nMAVSDK vs MCAP log ({wall_s:.1f} s wall): name: samples, max |diff| to the "
+          "nearest logged step in the window, max outside the window's range")
+    for name, (n, nearest, outside) in report.items():
+        print(f"  {name}: {n}, {nearest:.3g}, {outside:.3g}")
+
+    # the same check with the times 50 ms off fails (the turn moves roll/yaw fast enough)
+    shifted = compare(log, events, shift_s=SHIFT_S)
+    for name, share in (("roll", 0.2), ("yaw", 0.2), ("latitude", 0.9)):
+        off = sum(r[0] > r[2] for r in shifted[name])
+        print(f"  times shifted {SHIFT_S * 1e3:.0f} ms: {name}: {off} of {len(shifted[name])} "
+              "off the log")
+        assert off >= share * len(shifted[name]), (name, off)
