@@ -8,9 +8,10 @@ of the step at a time in [m, m + 1) ms, which MAVSDK passes on as ``timestamp_us
 GLOBAL_POSITION_INT and VFR_HUD reach MAVSDK's Position and FixedwingMetrics without a
 timestamp; they are sent in the same link service as an ATTITUDE or between two, so their
 time lies between the timestamps of the ATTITUDE callbacks just before and just after them.
-The log's position and heading of a step are those at its end (one step, 1/960 s, later), so
-every window starts one step earlier. A MAVSDK value must lie within the range of the
-logged values over its window, widened by the tolerance of its transport:
+Log rows and MAVLink messages are snapshots of the same instants (the state JSBSim reached
+at the end of a step, logged as the next step's row), so the windows are not widened. A
+MAVSDK value must lie within the range of the logged values over its window, widened by the
+tolerance of its transport:
 
 * attitude [deg]: float32 in ATTITUDE (rad); MAVSDK forms its EulerAngle through a float32
   quaternion, whose round trip alone moves an angle by up to ≈ 3e-5 deg (a few float32 steps
@@ -43,7 +44,6 @@ from mavsdk.plugins.telemetry import Telemetry
 
 from bioflex_jsb.adapters.mcap_log import messages_by_topic, topic
 from bioflex_jsb.adapters.sitl_loop import SitlParameters
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 DURATION_S = 20.0  # the issue's `bioflex-jsb sitl --duration 20`
 SPEEDUP = 2.0  # 10 s of wall time; telemetry rates are wall-clock rates, unchanged
@@ -124,7 +124,6 @@ class LogSeries:
 
 def compare(log: LogSeries, events, shift_s: float = 0.0) -> dict[str, list[tuple]]:
     """Per quantity, (outside, nearest, tolerance, time [s]) of every MAVSDK sample."""
-    dt = DEFAULT_DT_S
     out: dict[str, list[tuple]] = {k: [] for k in (
         "roll", "pitch", "yaw", "latitude", "longitude", "altitude", "airspeed")}
 
@@ -139,7 +138,7 @@ def compare(log: LogSeries, events, shift_s: float = 0.0) -> dict[str, list[tupl
         if k != "attitude":
             continue
         m = v.timestamp_us * 1e-6
-        t0, t1 = m - dt, m + 1e-3
+        t0, t1 = m, m + 1e-3
         add("roll", v.roll_deg, log.deg["roll"], t0, t1, ATT_TOL_DEG)
         add("pitch", v.pitch_deg, log.deg["pitch"], t0, t1, ATT_TOL_DEG)
         add("yaw", v.yaw_deg, log.deg["yaw"], t0, t1, ATT_TOL_DEG, period=360.0)
@@ -151,7 +150,7 @@ def compare(log: LogSeries, events, shift_s: float = 0.0) -> dict[str, list[tupl
         j = np.searchsorted(idx, i)
         if j == 0 or j == len(idx):
             continue  # no ATTITUDE on one side: no bracket
-        t0, t1 = stamps[j - 1] - dt, stamps[j] + 1e-3
+        t0, t1 = stamps[j - 1], stamps[j] + 1e-3
         if k == "position":
             add("latitude", v.latitude_deg, log.lat_deg, t0, t1, LATLON_TOL_DEG)
             add("longitude", v.longitude_deg, log.lon_deg, t0, t1, LATLON_TOL_DEG)

@@ -93,6 +93,17 @@ def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
     assert 44.9 < fix["latitude"] < 45.1 and len(fix["position_covariance"]) == 9
     rigid = msgs["/bioflex/coupled/rigid_body"]
     assert [m["airspeed_m_s"] for _, m in rigid[:1]] == [pytest.approx(15.0, abs=1e-6)]
+    # the whole rigid-body state, one snapshot per step: before the gust (no wind) the
+    # inertial speed is the airspeed, α = trim + Δα, the flight is symmetric (β = 0) and the
+    # load factor is that of the trim
+    first = rigid[0][1]
+    assert {"alpha_rad", "beta_rad", "v_north_m_s", "v_east_m_s", "v_down_m_s"} <= set(first)
+    speed = math.sqrt(sum(first[k] ** 2 for k in ("v_north_m_s", "v_east_m_s", "v_down_m_s")))
+    assert speed == pytest.approx(first["airspeed_m_s"], rel=1e-6)
+    assert first["dalpha_rad"] == pytest.approx(0.0, abs=1e-6) and abs(first["beta_rad"]) < 1e-6
+    assert first["n_z"] == pytest.approx(1.0, abs=1e-3)
+    assert first["v_north_m_s"] == pytest.approx(15.0 * math.cos(first["alpha_rad"]
+                                                                 - first["pitch_rad"]), rel=1e-4)
     gust = [m["w_g_m_s"] for _, m in msgs["/bioflex/coupled/gust"]]
     assert max(gust) == pytest.approx(3.0)
 

@@ -3,12 +3,13 @@
 Per JSBSim step k (time t_k, airframe state x_k):
 
 1. the gust w_g(t_k) is written to JSBSim's wind (``atmosphere/wind-down-fps`` = −w_g);
-2. the flow at the wing (α, V, Q against the air, q) is computed from x_k and that wind, the
-   same way JSBSim's FGAuxiliary computes it for this step;
+2. the airframe's state x_k is read in one snapshot (:func:`sense_state`: attitude, rates,
+   position, velocities, n_z, controls) with the flow at the wing (α, β, V, Q against the
+   air, q) computed from x_k and that wind, the same way JSBSim's FGAuxiliary computes it;
 3. the wing's loads from its state η_k in that flow go into ``external_reactions``
    (lift/drag turned from wind to body axes with α_k);
-4. JSBSim runs one step (x_k → x_{k+1}); the sample at t_k is logged (n_z is JSBSim's for
-   this step's forces);
+4. JSBSim runs one step (x_k → x_{k+1}); the row of t_k (the snapshot of 2, the loads of 3,
+   η_k and η̇_k: :func:`row_values`) is stored and logged;
 5. the wing advances η_k → η_{k+1} with the flow of step k held (exact discretisation).
 
 So the loads of step k use the modal state reached with the flow of step k−1: a one-step lag
@@ -21,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -111,24 +112,73 @@ _READ = {
     "r": "velocities/r-rad_sec",
     "elevator": "fcs/elevator-pos-rad",
     "throttle": "fcs/throttle-pos-norm",
+    "vn": "velocities/v-north-fps",
+    "ve": "velocities/v-east-fps",
+    "vd": "velocities/v-down-fps",
 }
 
 
-def air_flow(get: dict, wind_down_fps: float) -> tuple[FlowState, float, float]:
-    """The flow the wing sees, from the airframe's state and the NED vertical wind
+class Sensed(NamedTuple):
+    """The airframe at one instant, as the wing and the logs see it (SI; aerospace frames:
+    NED Euler angles, FRD body rates, NED velocities; ``docs/conventions.md``). ``flow``:
+    the air data at the wing with the current wind (α, q, V, Q); β likewise against the
+    air."""
+
+    flow: FlowState
+    theta_rad: float
+    phi_rad: float
+    psi_rad: float
+    beta_rad: float
+    p_rad_s: float
+    r_rad_s: float
+    n_z: float
+    altitude_m: float
+    latitude_rad: float
+    longitude_rad: float
+    v_north_m_s: float
+    v_east_m_s: float
+    v_down_m_s: float
+    elevator_rad: float
+    throttle: float
+
+
+def sense_state(get: dict, wind_down_fps: float) -> Sensed:
+    """The airframe's state now and the flow the wing sees with the NED vertical wind
     ``wind_down_fps`` [ft/s, down], as JSBSim's FGAuxiliary computes it for this step.
 
-    ``get`` maps u, v, w [ft/s], theta, phi [rad], q [rad/s] and rho [slug/ft³] to the
-    JSBSim property readers. Returns (flow in SI, θ [rad], φ [rad]).
+    ``get`` maps the keys of ``_READ`` to JSBSim property readers. Everything is read at
+    the same instant: the state JSBSim reached at the end of its last step (its n_z is
+    that of this state), so a logged row is one consistent snapshot.
     """
     theta, phi = get["theta"](), get["phi"]()
     # air-relative body velocity: subtract the NED wind seen in body axes
     ua = get["u"]() + wind_down_fps * math.sin(theta)
     va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
     wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
-    vt = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT
+    vt_fps = math.sqrt(ua * ua + va * va + wa * wa)
+    vt = vt_fps * U.M_PER_FT
     rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
-    return FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), theta, phi
+    m = U.M_PER_FT
+    return Sensed(
+        FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), theta, phi,
+        get["psi"](), math.asin(va / vt_fps) if vt_fps > 0.0 else 0.0, get["p"](), get["r"](),
+        get["nz"](), get["h"]() * m, get["lat"](), get["lon"](), get["vn"]() * m,
+        get["ve"]() * m, get["vd"]() * m, get["elevator"](), get["throttle"]())
+
+
+def row_values(s: Sensed, w_g_m_s: float, loads, wing: ModalWing, trim, speed_m_s: float
+               ) -> tuple[float, ...]:
+    """The logged row of one step (``base_channels`` order): the snapshot ``s`` at t_k, the
+    gust then, the wing loads applied over the step and the modal state η_k, η̇_k."""
+    f = s.flow
+    return (
+        f.airspeed_m_s - speed_m_s, f.alpha_rad - trim.alpha_rad, f.q_rad_s,
+        s.theta_rad - trim.theta_rad, s.n_z, w_g_m_s, f.airspeed_m_s, s.altitude_m,
+        loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
+        s.latitude_rad, s.longitude_rad, s.phi_rad, s.theta_rad, s.psi_rad, s.p_rad_s,
+        s.r_rad_s, s.elevator_rad, s.throttle, f.alpha_rad, s.beta_rad, s.v_north_m_s,
+        s.v_east_m_s, s.v_down_m_s, *wing.eta, *wing.eta_dot,
+    )
 
 
 def base_channels(n_modes: int) -> dict[str, str]:
@@ -141,6 +191,8 @@ def base_channels(n_modes: int) -> dict[str, str]:
         "latitude_rad": "rad", "longitude_rad": "rad", "phi_rad": "rad",
         "theta_rad": "rad", "psi_rad": "rad", "p_rad_s": "rad/s", "r_rad_s": "rad/s",
         "elevator_rad": "rad", "throttle": "-",
+        "alpha_rad": "rad", "beta_rad": "rad", "v_north_m_s": "m/s", "v_east_m_s": "m/s",
+        "v_down_m_s": "m/s",
     }
     for i in range(n_modes):  # order matters: the loop writes η_1..η_n, then η̇_1..η̇_n
         units[f"eta{i + 1}"] = "rad"
@@ -187,7 +239,6 @@ def run_gust(
     names = tuple(units)
     table = np.full((n_steps, len(names)), np.nan)  # row k: step k, columns in names' order
     time_s = np.arange(n_steps) * dt
-    theta0 = trim.theta_rad
     alpha_min, alpha_max = ALPHA_TABLE_RANGE_RAD
     alpha_peak = alpha_peak_rad()
     stall_steps = 0
@@ -203,19 +254,19 @@ def run_gust(
         record = recorder.step
 
     def sense(t: float):
-        """Write the gust at ``t`` to JSBSim's wind and return the flow the wing sees then,
-        from the airframe's state and that wind, as JSBSim's FGAuxiliary computes it."""
+        """Write the gust at ``t`` to JSBSim's wind and return it and the airframe's state
+        with the flow the wing sees then (:func:`sense_state`)."""
         w_g = gust.vertical_m_s(t)
         wind_down_fps = -w_g * U.FT_PER_M
         wind_node.set_double_value(wind_down_fps)
-        flow, theta, phi = air_flow(get, wind_down_fps)
-        return flow, w_g, theta, phi
+        return w_g, sense_state(get, wind_down_fps)
 
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop
-            flow, w_g, theta, phi = sense(0.0)
+            w_g, state = sense(0.0)
             for k in range(n_steps):
                 t = k * dt
+                flow = state.flow
                 loads = mw.loads(flow)
                 alpha = flow.alpha_rad
                 ca, sa = math.cos(alpha), math.sin(alpha)
@@ -225,15 +276,7 @@ def run_gust(
                     loads.pitch_moment_n_m,
                 )
                 step()
-                values = (
-                    flow.airspeed_m_s - setup.speed_m_s, alpha - trim.alpha_rad, flow.q_rad_s,
-                    theta - theta0, get["nz"](), w_g, flow.airspeed_m_s,
-                    get["h"]() * U.M_PER_FT,
-                    loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
-                    get["lat"](), get["lon"](), phi, theta, get["psi"](), get["p"](),
-                    get["r"](), get["elevator"](), get["throttle"](),
-                    *mw.eta, *mw.eta_dot,
-                )
+                values = row_values(state, w_g, loads, mw, trim, setup.speed_m_s)
                 table[k] = values
                 done = k + 1
                 if recorder is not None:
@@ -246,7 +289,7 @@ def run_gust(
                 if stopped:
                     break
                 mw.step(flow)  # over [t_k, t_k+1] with the flow of t_k held
-                flow, w_g, theta, phi = sense(t + dt)
+                w_g, state = sense(t + dt)
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
         stopped = f"interrupted at t = {done * dt:.3f} s"

@@ -46,8 +46,9 @@ from bioflex_jsb.adapters.autopilot_xml import SITL_AIRCRAFT
 from bioflex_jsb.adapters.cosim import (
     ALPHA_TABLE_RANGE_RAD,
     INTEGRATORS,
-    air_flow,
     base_channels,
+    row_values,
+    sense_state,
 )
 from bioflex_jsb.adapters.jsbsim_fdm import Airframe
 from bioflex_jsb.adapters.mavlink_link import VehicleState
@@ -193,7 +194,7 @@ class SitlSim:
         self.names = list(self.units)
         self._manual_wall_s: float | None = None
         self.stopped: str | None = None
-        self._flow, self._w_g, self._theta, self._phi = self._sense(0.0)
+        self._w_g, self._state = self._sense(0.0)
 
     # -- commands from the link -------------------------------------------------------------
     @property
@@ -234,31 +235,25 @@ class SitlSim:
         w_g = self._gust.vertical_m_s(t) if self._gust is not None else 0.0
         wind_down_fps = -w_g * U.FT_PER_M
         self._wind.set_double_value(wind_down_fps)
-        flow, theta, phi = air_flow(self._get, wind_down_fps)
-        return flow, w_g, theta, phi
+        return w_g, sense_state(self._get, wind_down_fps)
 
     def step(self) -> tuple:
         """One co-simulation step (as ``run_gust``); returns the logged row's values (in
         ``self.names`` order) and sets ``self.stopped`` when the run left its valid range."""
-        flow, mw, get = self._flow, self.wing, self._get
+        state, mw, get = self._state, self.wing, self._get
+        flow = state.flow
         loads = mw.loads(flow)
         alpha = flow.alpha_rad
         ca, sa = math.cos(alpha), math.sin(alpha)
         self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
                               loads.drag_n * ca - loads.lift_n * sa, loads.pitch_moment_n_m)
         self.airframe.step()
-        values = (
-            flow.airspeed_m_s - self.speed_m_s, alpha - self.trim.alpha_rad, flow.q_rad_s,
-            self._theta - self.trim.theta_rad, get["nz"](), self._w_g, flow.airspeed_m_s,
-            get["h"]() * U.M_PER_FT, loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
-            get["lat"](), get["lon"](), self._phi, self._theta, get["psi"](), get["p"](),
-            get["r"](), get["elevator"](), get["throttle"](), *mw.eta, *mw.eta_dot,
-        )
+        values = row_values(state, self._w_g, loads, mw, self.trim, self.speed_m_s)
         self.stopped = _check(values, self.t_s, alpha, mw.eta, get["agl"]())
         mw.step(flow)
         self.k += 1
         self.t_s = self.k * self.dt_s
-        self._flow, self._w_g, self._theta, self._phi = self._sense(self.t_s)
+        self._w_g, self._state = self._sense(self.t_s)
         if self._manual_wall_s is not None and \
                 time.monotonic() - self._manual_wall_s > MANUAL_TIMEOUT_S:
             self.manual(None, None)
@@ -271,12 +266,13 @@ class SitlSim:
         named = {f"eta{i + 1}": float(eta[i]) for i in range(min(3, self.n_modes))}
         named["tip_twist"] = self.wing.tip_twist_rad(self._tip_twist_per_mode)
         return VehicleState(
-            time_s=self.t_s, roll_rad=self._phi, pitch_rad=self._theta, yaw_rad=get["psi"](),
+            time_s=self.t_s, roll_rad=self._state.phi_rad, pitch_rad=self._state.theta_rad,
+            yaw_rad=get["psi"](),
             p_rad_s=get["p"](), q_rad_s=get["q"](), r_rad_s=get["r"](),
             latitude_rad=get["lat"](), longitude_rad=get["lon"](), altitude_m=h,
             relative_altitude_m=h - self.h0_m,
             v_north_m_s=get["vn"]() * U.M_PER_FT, v_east_m_s=get["ve"]() * U.M_PER_FT,
-            v_down_m_s=get["vd"]() * U.M_PER_FT, airspeed_m_s=self._flow.airspeed_m_s,
+            v_down_m_s=get["vd"]() * U.M_PER_FT, airspeed_m_s=self._state.flow.airspeed_m_s,
             throttle=get["throttle"](), named=named,
             autopilot=a["ap/engage"] == 1.0, manual=a["ap/manual"] == 1.0,
         )

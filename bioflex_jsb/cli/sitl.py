@@ -8,7 +8,9 @@ import sys
 from bioflex_jsb.cli.common import (
     EXIT_DIVERGED,
     UsageError,
+    add_log_arguments,
     add_wing_arguments,
+    log_path,
     positive_float,
     print_json,
     wing_from_args,
@@ -30,11 +32,11 @@ udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:1
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
 simulated seconds, or until Ctrl-C. Prints the pacing error (step start minus its wall-clock
 due time: p50, p99 [ms]). The vehicle's MAVLink clock (time_boot_ms) is the simulated time
-since the start, the time axis of the --out log. --signing-key FILE turns on MAVLink 2
-signing: FILE holds the 32-byte secret as 64 hexadecimal digits (to share it with MAVProxy's
-"signing key P", the SHA-256 of the passphrase P: python -c "import hashlib;
-print(hashlib.sha256(b'P').hexdigest())");
-the vehicle then signs all it sends and ignores unsigned or wrongly signed messages
+since the start, the time axis of the MCAP log that every session writes (--out, --no-log).
+--signing-key FILE turns on MAVLink 2 signing: FILE holds the 32-byte secret as 64
+hexadecimal digits (to share it with MAVProxy's "signing key P", the SHA-256 of the
+passphrase P: python -c "import hashlib; print(hashlib.sha256(b'P').hexdigest())"); the
+vehicle then signs all it sends and ignores unsigned or wrongly signed messages
 (except RADIO_STATUS)."""
 
 
@@ -56,7 +58,7 @@ def register(sub) -> None:
     p.add_argument("--signing-key", metavar="FILE",
                    help="MAVLink 2 signing key file: 64 hex digits (32 bytes); sign what is "
                    "sent, accept only signed messages")
-    p.add_argument("--out", metavar="RUN.mcap", help="write every step to RUN.mcap")
+    add_log_arguments(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=run)
 
@@ -97,6 +99,11 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     log = None
     on_sample = idle = None
+    try:
+        args.out = log_path(args, "sitl", args.wing)
+    except UsageError:
+        link.close()
+        raise
     if args.out:
         from bioflex_jsb.adapters.mcap_log import RunLog
 
