@@ -3,7 +3,7 @@
 Per JSBSim step k (time t_k, airframe state x_k):
 
 1. the gust w_g(t_k) is written to JSBSim's wind (``atmosphere/wind-down-fps`` = −w_g);
-2. the airframe's state x_k is read in one snapshot (:func:`sense_state`: attitude, rates,
+2. the airframe's state x_k is read in one snapshot (:func:`state_reader`: attitude, rates,
    position, velocities, n_z, controls) with the flow at the wing (α, β, V, Q against the
    air, q) computed from x_k and that wind, the same way JSBSim's FGAuxiliary computes it;
 3. the wing's loads from its state η_k in that flow go into ``external_reactions``
@@ -142,42 +142,51 @@ class Sensed(NamedTuple):
     throttle: float
 
 
-def sense_state(get: dict, wind_down_fps: float) -> Sensed:
-    """The airframe's state now and the flow the wing sees with the NED vertical wind
-    ``wind_down_fps`` [ft/s, down], as JSBSim's FGAuxiliary computes it for this step.
+def state_reader(get: dict) -> Callable[[float], Sensed]:
+    """``read(wind_down_fps)``: the airframe's state now and the flow the wing sees with the
+    NED vertical wind ``wind_down_fps`` [ft/s, down], as JSBSim's FGAuxiliary computes it.
 
-    ``get`` maps the keys of ``_READ`` to JSBSim property readers. Everything is read at
-    the same instant: the state JSBSim reached at the end of its last step (its n_z is
-    that of this state), so a logged row is one consistent snapshot.
+    ``get`` maps the keys of ``_READ`` to JSBSim property readers (bound once, here, for
+    the per-step call). Everything is read at the same instant: the state JSBSim reached at
+    the end of its last step (its n_z is that of this state), so a logged row is one
+    consistent snapshot.
     """
-    theta, phi = get["theta"](), get["phi"]()
-    # air-relative body velocity: subtract the NED wind seen in body axes
-    ua = get["u"]() + wind_down_fps * math.sin(theta)
-    va = get["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
-    wa = get["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
-    vt_fps = math.sqrt(ua * ua + va * va + wa * wa)
-    vt = vt_fps * U.M_PER_FT
-    rho = get["rho"]() * U.KG_M3_PER_SLUG_FT3
-    m = U.M_PER_FT
-    return Sensed(
-        FlowState(math.atan2(wa, ua), get["q"](), vt, 0.5 * rho * vt * vt), theta, phi,
-        get["psi"](), math.asin(va / vt_fps) if vt_fps > 0.0 else 0.0, get["p"](), get["r"](),
-        get["nz"](), get["h"]() * m, get["lat"](), get["lon"](), get["vn"]() * m,
-        get["ve"]() * m, get["vd"]() * m, get["elevator"](), get["throttle"]())
+    g_u, g_v, g_w, g_q = get["u"], get["v"], get["w"], get["q"]
+    g_theta, g_phi, g_psi, g_p, g_r = get["theta"], get["phi"], get["psi"], get["p"], get["r"]
+    g_rho, g_nz, g_h, g_lat, g_lon = get["rho"], get["nz"], get["h"], get["lat"], get["lon"]
+    g_vn, g_ve, g_vd = get["vn"], get["ve"], get["vd"]
+    g_elevator, g_throttle = get["elevator"], get["throttle"]
+    m_per_ft, rho_si = U.M_PER_FT, U.KG_M3_PER_SLUG_FT3
+    sin, cos, make = math.sin, math.cos, tuple.__new__
+
+    def read(wind_down_fps: float) -> Sensed:
+        theta, phi = g_theta(), g_phi()
+        # air-relative body velocity: subtract the NED wind seen in body axes
+        ua = g_u() + wind_down_fps * sin(theta)
+        va = g_v() - wind_down_fps * sin(phi) * cos(theta)
+        wa = g_w() - wind_down_fps * cos(phi) * cos(theta)
+        vt_fps = math.sqrt(ua * ua + va * va + wa * wa)
+        vt = vt_fps * m_per_ft
+        flow = FlowState(math.atan2(wa, ua), g_q(), vt, 0.5 * g_rho() * rho_si * vt * vt)
+        return make(Sensed, (
+            flow, theta, phi, g_psi(), math.asin(va / vt_fps) if vt_fps > 0.0 else 0.0,
+            g_p(), g_r(), g_nz(), g_h() * m_per_ft, g_lat(), g_lon(), g_vn() * m_per_ft,
+            g_ve() * m_per_ft, g_vd() * m_per_ft, g_elevator(), g_throttle()))
+
+    return read
 
 
 def row_values(s: Sensed, w_g_m_s: float, loads, wing: ModalWing, trim, speed_m_s: float
                ) -> tuple[float, ...]:
     """The logged row of one step (``base_channels`` order): the snapshot ``s`` at t_k, the
     gust then, the wing loads applied over the step and the modal state η_k, η̇_k."""
-    f = s.flow
+    f, theta, phi, psi, beta, p, r, n_z, h, lat, lon, vn, ve, vd, elevator, throttle = s
+    alpha, v = f.alpha_rad, f.airspeed_m_s
     return (
-        f.airspeed_m_s - speed_m_s, f.alpha_rad - trim.alpha_rad, f.q_rad_s,
-        s.theta_rad - trim.theta_rad, s.n_z, w_g_m_s, f.airspeed_m_s, s.altitude_m,
-        loads.lift_n, loads.drag_n, loads.pitch_moment_n_m,
-        s.latitude_rad, s.longitude_rad, s.phi_rad, s.theta_rad, s.psi_rad, s.p_rad_s,
-        s.r_rad_s, s.elevator_rad, s.throttle, f.alpha_rad, s.beta_rad, s.v_north_m_s,
-        s.v_east_m_s, s.v_down_m_s, *wing.eta, *wing.eta_dot,
+        v - speed_m_s, alpha - trim.alpha_rad, f.q_rad_s, theta - trim.theta_rad, n_z,
+        w_g_m_s, v, h, loads.lift_n, loads.drag_n, loads.pitch_moment_n_m, lat, lon, phi,
+        theta, psi, p, r, elevator, throttle, alpha, beta, vn, ve, vd, *wing.eta,
+        *wing.eta_dot,
     )
 
 
@@ -248,6 +257,7 @@ def run_gust(
     write_reactions = airframe.external_reaction_writer()  # nodes looked up once
     step = airframe.step
     get = {name: node.get_double_value for name, node in nodes.items()}
+    read_state = state_reader(get)
     done = 0  # complete rows of the table
     if recorder is not None:
         recorder.start(names, time_s, table)
@@ -255,11 +265,11 @@ def run_gust(
 
     def sense(t: float):
         """Write the gust at ``t`` to JSBSim's wind and return it and the airframe's state
-        with the flow the wing sees then (:func:`sense_state`)."""
+        with the flow the wing sees then (:func:`state_reader`)."""
         w_g = gust.vertical_m_s(t)
         wind_down_fps = -w_g * U.FT_PER_M
         wind_node.set_double_value(wind_down_fps)
-        return w_g, sense_state(get, wind_down_fps)
+        return w_g, read_state(wind_down_fps)
 
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop

@@ -48,7 +48,7 @@ from bioflex_jsb.adapters.cosim import (
     INTEGRATORS,
     base_channels,
     row_values,
-    sense_state,
+    state_reader,
 )
 from bioflex_jsb.adapters.jsbsim_fdm import Airframe
 from bioflex_jsb.adapters.mavlink_link import VehicleState
@@ -168,6 +168,7 @@ class SitlSim:
         self.resync = False
         self._nodes = {k: a.property_node(v) for k, v in _READ.items()}
         self._get = {k: n.get_double_value for k, n in self._nodes.items()}
+        self._read_state = state_reader(self._get)
         self._wind = a.property_node("atmosphere/wind-down-fps")
         self._write_reactions = a.external_reaction_writer()
         rho0 = self._get["rho"]() * U.KG_M3_PER_SLUG_FT3
@@ -235,7 +236,7 @@ class SitlSim:
         w_g = self._gust.vertical_m_s(t) if self._gust is not None else 0.0
         wind_down_fps = -w_g * U.FT_PER_M
         self._wind.set_double_value(wind_down_fps)
-        return w_g, sense_state(self._get, wind_down_fps)
+        return w_g, self._read_state(wind_down_fps)
 
     def step(self) -> tuple:
         """One co-simulation step (as ``run_gust``); returns the logged row's values (in
