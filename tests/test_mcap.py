@@ -250,6 +250,16 @@ def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     assert len(err.strip().splitlines()) == 1 and "--no-log" in err
 
 
+def test_output_into_a_closed_pipe_is_no_traceback(gust_log):
+    """`bioflex-jsb info run.mcap | head -1`: the reader leaves before the output is written."""
+    proc = subprocess.Popen([sys.executable, "-m", "bioflex_jsb", "info", str(gust_log)],
+                            cwd=ROOT, env=_env(), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.close()  # before the interpreter has even started
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141 and "Traceback" not in err and err == ""
+
+
 @pytest.mark.parametrize("command", ["info", "plot", "rerun"])
 def test_bad_files_exit_2_with_one_line(command, gust_log, tmp_path, capsys):
     truncated = tmp_path / "cut.mcap"
