@@ -98,11 +98,13 @@ def test_round_trip_of_beam_modes(tmp_path, units):
 def test_shipped_example_is_current():
     shipped = read_modal_file(EXAMPLE)
     model = example_modes()
-    # The example is written with repr() floats in mm: 1e-12 relative covers the mm → m
-    # conversion; a stale example (after a recalibration) differs by far more.
+    # The example is written with repr() floats in mm: 1e-10 relative covers the mm → m
+    # conversion and the eigen-solution's last digits, which differ between LAPACK builds
+    # (1.9e-12 measured on one machine); a stale example (after a recalibration) differs by
+    # far more.
     for name in ("frequencies_rad_s", "generalised_masses_kg_m2", "bending_m", "twist_rad",
                  "stations_m"):
-        np.testing.assert_allclose(getattr(shipped, name), getattr(model, name), rtol=1e-12,
+        np.testing.assert_allclose(getattr(shipped, name), getattr(model, name), rtol=1e-10,
                                    atol=1e-15, err_msg=name)
 
 

@@ -196,6 +196,7 @@ class SitlSim:
         self._manual_wall_s: float | None = None
         self.stopped: str | None = None
         self._w_g, self._state = self._sense(0.0)
+        self.wing.prepare(self._state.flow)
 
     # -- commands from the link -------------------------------------------------------------
     @property
@@ -243,15 +244,16 @@ class SitlSim:
         ``self.names`` order) and sets ``self.stopped`` when the run left its valid range."""
         state, mw, get = self._state, self.wing, self._get
         flow = state.flow
+        eta, eta_dot = mw.eta, mw.eta_dot
+        mw.step(flow)  # η_k → η_{k+1} with the flow of t_k held, as run_gust
         loads = mw.loads(flow)
         alpha = flow.alpha_rad
         ca, sa = math.cos(alpha), math.sin(alpha)
         self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
                               loads.drag_n * ca - loads.lift_n * sa, loads.pitch_moment_n_m)
         self.airframe.step()
-        values = row_values(state, self._w_g, loads, mw, self.trim, self.speed_m_s)
+        values = row_values(state, self._w_g, loads, eta, eta_dot, self.trim, self.speed_m_s)
         self.stopped = _check(values, self.t_s, alpha, mw.eta, get["agl"]())
-        mw.step(flow)
         self.k += 1
         self.t_s = self.k * self.dt_s
         self._w_g, self._state = self._sense(self.t_s)

@@ -20,17 +20,23 @@ airspeed instead of trim values, so the loads are nonlinear in airspeed):
 
 Integration (``coupled``): exact discretisation with the inputs held over the step
 (zero-order hold). With A(Q, V), B(Q, V) the modal system matrices and (Q_r, V_r) a
-reference flow, x_{k+1} = Φ_r x_k + Ψ_r [(A(Q,V) − A_r) x_k + B(Q,V) f_k], Φ_r = e^{A_r Δt},
-Ψ_r = ∫_0^Δt e^{A_r τ} dτ. It is exact at the reference flow for any step, so the
-structural dynamics up to the third mode (107 Hz, ω Δt = 5.6 at 1/120 s) are integrated
-without a stability limit; only the change of the aerodynamic stiffness and damping since
-the reference (a few per cent of ω²) is held over the step. The reference is renewed when
-Q or V moves by more than ``refresh_rel`` (default 5 %).
+reference flow,
 
-Coupling lag: the loads applied during airframe step k come from the modal state at the
-start of the step, which was advanced with the flow of step k−1: a one-step lag in the
-α → η → load path, removed by halving the step (see tests/test_cosim_convergence.py).
-``qsd`` has no lag: Δη is the quasi-static solution of the current flow.
+    x_{k+1} = [Φ_r + (Q − Q_r) ∂Φ/∂Q + (Q/V − Q_r/V_r) ∂Φ/∂(Q/V)] x_k + Ψ_r B(Q, V) f_k,
+
+Φ_r = e^{A_r Δt}, Ψ_r = ∫_0^Δt e^{A_r τ} dτ, and ∂Φ the Fréchet derivatives of the
+exponential along ∂A/∂Q and ∂A/∂(Q/V) (``scipy.linalg.expm_frechet``): exact at the
+reference flow for any step, so the structural dynamics up to the third mode (107 Hz,
+ω Δt = 5.6 at 1/120 s) are integrated without a stability limit, and exact to first order
+in the change of the aerodynamic stiffness and damping since the reference (a few per cent
+of ω²). The reference is renewed when Q or V moves by more than ``refresh_rel`` (default
+5 %): at the co-simulation's step that changes η₁ by < 0.05 % against a step exact at every
+step's flow (holding Ψ_r ΔA x_k over the step instead, a first-order treatment, was 2 % off
+in the Fig. 21 case; tests/test_gusts_and_modal_wing.py).
+
+Timing in the co-simulation (``adapters/cosim.py``): the wing advances with the flow of t_k
+first and the loads of the new state η_{k+1} go with JSBSim's step k, whose forces belong to
+t_{k+1}: no coupling lag. ``qsd`` takes Δη as the quasi-static solution of the flow of t_k.
 """
 
 from __future__ import annotations
@@ -38,18 +44,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
+from scipy.linalg import expm, expm_frechet
 
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
 
 WING_MODELS = ("rigid", "coupled", "qsd")
-# Default co-simulation step [s]. The coupling lag of one step (module docstring) is a
-# first-order error; at 960 Hz (31 samples per period of the first wing mode, 9 of the
-# third) a 0.3 m/s sharp-edged gust at 15 m/s gives the LTI model's η_1 to 4 % NRMSE
-# (8 % at 480 Hz) and peak responses within 1 % of a run at half the step
-# (tests/test_cosim.py). JSBSim's aircraft default, 1/120 s, leaves 4 samples per period.
+# Default co-simulation step [s]: 31 samples per period of the first wing mode (in vacuo), 9
+# of the third. The Fig. 21 run at this step is within 1 % NRMSE of the same run at a quarter
+# of it on u, α, q, θ and η₁ (tests/test_cosim.py). JSBSim's aircraft default, 1/120 s,
+# leaves 4 samples per period.
 DEFAULT_DT_S = 1.0 / 960.0
 
 
@@ -159,7 +164,9 @@ class ModalWing:
         return a, b
 
     def _reference(self, q_pa: float, v_m_s: float) -> None:
-        """Exact discretisation at (Q_r, V_r): Φ = e^{A dt}, Ψ = ∫_0^dt e^{A τ} dτ."""
+        """Exact discretisation at (Q_r, V_r): Φ = e^{A dt}, Ψ = ∫_0^dt e^{A τ} dτ, and the
+        first-order change of Φ per unit change of Q and of Q/V (Fréchet derivatives of the
+        exponential along ∂A/∂Q and ∂A/∂(Q/V))."""
         a, _ = self._matrices(q_pa, v_m_s)
         n2 = a.shape[0]
         aug = np.zeros((2 * n2, 2 * n2))
@@ -169,20 +176,26 @@ class ModalWing:
         n = self.n_modes
         phi, psi_lower = e[:n2, :n2], e[:n2, n2 + n :]
         zeros = np.zeros((n, n))
-        # One matrix for the step: rows [Φ; Ψ K_a; Ψ D_a] act on x, columns of ``_inputs`` on
-        # the per-unit flow forcing (Q Δα, Q q / V, ΔQ).
+        d_a_dq = np.block([[zeros, zeros], [self._k_aero, zeros]])
+        d_a_dqv = np.block([[zeros, zeros], [zeros, self._d_aero]])
+        # One matrix for the step: rows [Φ; ∂Φ/∂Q; ∂Φ/∂(Q/V)] act on x, columns of
+        # ``_inputs`` on the per-unit flow forcing (Q Δα, Q q / V, ΔQ).
         self._stack = np.vstack([
             phi,
-            psi_lower @ np.hstack([self._k_aero, zeros]),
-            psi_lower @ np.hstack([zeros, self._d_aero]),
+            expm_frechet(a * self.dt_s, d_a_dq * self.dt_s, compute_expm=False),
+            expm_frechet(a * self.dt_s, d_a_dqv * self.dt_s, compute_expm=False),
         ])
         self._input_cols = psi_lower @ np.column_stack([self._b_alpha, self._b_q, self._b_0])
         self._key = (q_pa, v_m_s)
 
+    def prepare(self, flow: FlowState) -> None:
+        """Compute the step's matrices for ``flow`` now (the first step would otherwise do
+        it): for real-time loops, so the first paced step costs what the others do."""
+        if self.model == "coupled":
+            self._reference(flow.dynamic_pressure_pa, flow.airspeed_m_s)
+
     def _advance(self, flow: FlowState) -> None:
-        """x ← Φ_r x + Ψ_r [(A(Q,V) − A_r) x + B(Q,V) f]: exact at the reference flow, the
-        small change of the aerodynamic stiffness and damping since then held over the step.
-        """
+        """x ← [Φ_r + ΔQ ∂Φ/∂Q + Δ(Q/V) ∂Φ/∂(Q/V)] x + Ψ_r B(Q,V) f (module docstring)."""
         q_pa, v = flow.dynamic_pressure_pa, flow.airspeed_m_s
         key = self._key
         if (
