@@ -559,11 +559,6 @@ def _flow_functions(root: ET.Element) -> tuple[str, str, str]:
     fn = _el(root, "function", name=prev, type="post")
     _el(fn, "description", "down wind of this step, read by the next step [ft/s]")
     _prop(fn, "atmosphere/wind-down-fps")
-    fn = _el(root, "function", name=_p("wind-changed"))
-    _el(fn, "description", "1 when the down wind changed since the previous step")
-    ne = _el(fn, "nq")
-    _prop(ne, "atmosphere/wind-down-fps")
-    _prop(ne, prev)
 
     def dwd(p):
         d = _el(p, "difference")
@@ -610,7 +605,9 @@ def _flow_functions(root: ET.Element) -> tuple[str, str, str]:
         fn = _el(root, "function", name=_p(name))
         _el(fn, "description", text)
         ift = _el(fn, "ifthen")
-        _prop(ift, _p("wind-changed"))
+        ne = _el(ift, "nq")  # the down wind changed since the previous step
+        _prop(ne, "atmosphere/wind-down-fps")
+        _prop(ne, prev)
         corrected(ift)
         _prop(ift, steady)
         names.append(_p(name))
@@ -815,11 +812,11 @@ def modal_wing_aerodynamics(nums: ModalNumbers, co: LeapfrogCoefficients) -> dic
     s_ref, qbar, ci2vel = P.REFERENCE_AREA_M2, "aero/qbar-psf", "aero/ci2vel"
 
     def loads(fn: ET.Element, r: int, gain: float) -> None:
-        total = _el(_product(fn, gain, _p("enabled"), qbar), "sum")
+        total = _el(_product(fn, _p("enabled"), qbar), "sum")
         for rate, c in ((False, nums.load_eta[r]), (True, nums.load_etadot[r])):
             terms = []
             for i in range(n):
-                c_i = U.PA_PER_PSF * s_ref * c[i]
+                c_i = gain * U.PA_PER_PSF * s_ref * c[i]
                 terms += [(c_i, y_rate[i]) if rate else (c_i * co.eta_rate[i], y_eta[i])]
             if any(t for t, _ in terms):
                 _linear(_el(_product(total, ci2vel), "sum") if rate else total, terms)

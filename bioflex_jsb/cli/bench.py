@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     import tempfile
     from pathlib import Path
 
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.adapters.cosim import INTEGRATORS, RunSetup, run_gust
     from bioflex_jsb.adapters.jsbsim_export import native_airframe
     from bioflex_jsb.adapters.jsbsim_fdm import Airframe
     from bioflex_jsb.adapters.mcap_log import RunLog
@@ -65,6 +65,9 @@ def run(args: argparse.Namespace) -> int:
         return timed(airframe)
 
     native = native_airframe("optimised")
+    for af in (airframe, native):  # every timing with the co-simulation's integrators
+        for name, value in INTEGRATORS.items():
+            af[name] = value
 
     def cosim(log=None) -> float:
         recorder = log.recorder("coupled") if log else None
