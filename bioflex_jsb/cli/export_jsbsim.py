@@ -13,7 +13,7 @@ and aircraft/bioflex_<wing>/ (the bioflex airframe including it, the modal loads
 aerodynamics, with its trim companion). Fly it with `jsbsim --root=DIR
 --aircraft=bioflex_<wing>`. The system holds for one time step, --dt [s] (default 1/960 s; a
 step at which the integration's eigenvalues are more than 1 % off the exact ones up to 40 m/s
-is refused, with the largest step that is not); the trim lift coefficient and the reference
+is refused, naming a halved step that is not); the trim lift coefficient and the reference
 flow of the exact part are those of level flight at --speed [m/s]. See docs/native.md."""
 
 
