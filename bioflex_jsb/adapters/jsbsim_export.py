@@ -71,7 +71,8 @@ K(Q)⁻¹ tabulated against Q (rows every 0.5 m/s of V up to :data:`GRID_SPEED_M
 Δη̇ = 0; its loads go through the airframe's external reactions (body axes).
 
 Properties (all under ``bioflex/modal/``), ``coupled``: ``eta<i>``, ``eta<i>-dot`` [rad,
-rad/s] (functions of the stored ``y-eta<i>``, ``y-eta<i>-dot``), ``alpha0-rad``, ``qbar0-pa``
+rad/s] (functions of the stored ``y-eta<i>-scaled`` = y_η/c_i, c_i = Φ_s[0,1]/Φ_s[1,1] ≈ Δt,
+and ``y-eta<i>-dot``), ``alpha0-rad``, ``qbar0-pa``
 (latched trim reference), ``active``, ``idle``, ``enabled`` (set 0 to fly the rigid airframe
 with the same file); the loads are ``aero/bioflex/modal-lift-lbs``, ``aero/force/modal-lift``,
 ``aero/force/modal-drag`` [lbs] and ``aero/moment/modal-pitch`` [lbs ft].
