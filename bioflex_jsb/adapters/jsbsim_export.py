@@ -303,8 +303,8 @@ def leapfrog_matrix(nums: ModalNumbers, co: LeapfrogCoefficients, q_pa: float,
 
 
 def _continuous_eigenvalues(m: np.ndarray, dt_s: float) -> np.ndarray:
-    lam = np.log(np.linalg.eigvals(m).astype(complex)) / dt_s
-    return lam[np.argsort(-lam.imag)]
+    """λ = ln(μ)/Δt [1/s] of the eigenvalues μ of the step matrix ``m``."""
+    return np.log(np.linalg.eigvals(m).astype(complex)) / dt_s
 
 
 def leapfrog_eigen_error(nums: ModalNumbers, co: LeapfrogCoefficients,
@@ -396,6 +396,8 @@ def _combination(parent: ET.Element, terms: list[tuple[float, str]], lead=None,
         _prop(q, prop)
         _value(q, (1.0 if first else -1.0) / float(coef))
         first = False
+    if minus and first:  # nothing added yet: subtract from 0
+        _value(d, 0.0)
     for prop in minus:
         _prop(d, prop)
     if len(d) == 0:  # nothing to add: the value 0
@@ -404,26 +406,23 @@ def _combination(parent: ET.Element, terms: list[tuple[float, str]], lead=None,
     return d
 
 
+def _over(x, inverse):
+    """Builder of x / ``inverse`` (a property name, or a builder), the product of x and the
+    quantity whose inverse that is (:func:`_flow_functions`)."""
+    def build(parent: ET.Element) -> None:
+        q = _el(parent, "quotient")
+        x(q)
+        if callable(inverse):
+            inverse(q)
+        else:
+            _prop(q, inverse)
+    return build
+
+
 def _times(x, factor: str):
     """Builder of x·factor as x / (1/factor) (no pointer copies: :func:`_combination`);
     a factor of 0 gives 1/0 = HUGE_VAL in JSBSim and so 0, as the product would."""
-    def build(parent: ET.Element) -> None:
-        q = _el(parent, "quotient")
-        x(q)
-        inv = _el(q, "quotient")
-        _value(inv, 1.0)
-        _prop(inv, factor)
-    return build
-
-
-def _over(x, inverse: str):
-    """Builder of x / ``inverse``, the product of x and the quantity whose inverse that
-    property holds (:func:`_flow_functions`)."""
-    def build(parent: ET.Element) -> None:
-        q = _el(parent, "quotient")
-        x(q)
-        _prop(q, inverse)
-    return build
+    return _over(x, _over(lambda p: _value(p, 1.0), factor))
 
 
 def _table(parent: ET.Element, var: str, xs: np.ndarray, ys: np.ndarray) -> None:
@@ -472,9 +471,7 @@ class ExportSpec:
         ok = self.dt_s
         for _ in range(12):
             ok /= 2.0
-            q = 0.5 * self.rho_ref * self.speed_m_s**2
-            co = leapfrog_coefficients(nums, ok, q, q / self.speed_m_s)
-            if leapfrog_eigen_error(nums, co)[0] <= EIGEN_REL_TOL:
+            if leapfrog_eigen_error(nums, self.leapfrog(nums, ok))[0] <= EIGEN_REL_TOL:
                 break
         raise ExportError(
             f"time step {self.dt_s:.6g} s is too coarse for wing {self.variant!r}: the "
@@ -485,10 +482,12 @@ class ExportSpec:
     def cl_trim(self) -> float:
         return level_flight_condition(self.speed_m_s, self.rho_ref).cl_trim
 
-    def leapfrog(self, nums: ModalNumbers) -> LeapfrogCoefficients:
-        """The coupled model's step, its exact part at the export speed's flow."""
+    def leapfrog(self, nums: ModalNumbers, dt_s: float | None = None) -> LeapfrogCoefficients:
+        """The coupled model's step of ``dt_s`` [s] (default the exported step), its exact
+        part at the export speed's flow."""
         q = 0.5 * self.rho_ref * self.speed_m_s**2
-        return leapfrog_coefficients(nums, self.dt_s, q, q / self.speed_m_s)
+        return leapfrog_coefficients(nums, self.dt_s if dt_s is None else dt_s, q,
+                                     q / self.speed_m_s)
 
 
 def render_system(spec: ExportSpec) -> str:
@@ -755,7 +754,7 @@ def _assign(ch: ET.Element, name: str, description: str, value, outputs: list[st
 def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalNumbers, eta, etad) -> None:
     """The coupled model (module docstring): ``active``/``idle`` as system functions, the trim
     reference channel (idle only), the leapfrog step channel (active only). The loads are
-    functions of the external reactions (:func:`modal_wing_reactions`)."""
+    functions of the airframe's aerodynamics (:func:`modal_wing_aerodynamics`)."""
     n = nums.n
     co = spec.leapfrog(nums)
     y_eta, y_rate = _stored_state(n)
@@ -863,8 +862,9 @@ def modal_wing_aerodynamics(nums: ModalNumbers, co: LeapfrogCoefficients) -> dic
     keyed by where they go (``functions``: before the first axis; ``LIFT``, ``DRAG``,
     ``PITCH``: into those axes).
 
-    Loads of the modal state at the time of JSBSim's forces, x = Φ_h⁻¹ y (y: the stored
-    half-step state after this step's update): ΔL = Q S (C_L_η·η + C_L_η̇·η̇ c̄/(2V)) in the
+    Loads of the stored state y = Φ_h x after this step's update, the structural state half
+    a step into the interval over which JSBSim applies the forces it computes (module
+    docstring), η and η̇ read as its two parts: ΔL = Q S (C_L_η·η + C_L_η̇·η̇ c̄/(2V)) in the
     LIFT axis, the drag k₂ ΔL (k₂ = 2kC_L0, C_D_η = k₂ C_L_η) in the DRAG axis, ΔM = Q S c̄
     (C_m_η·η + C_m_η̇·η̇ c̄/(2V)) in the PITCH axis (about the aerodynamic reference point,
     which is the CG); Q and c̄/(2V) JSBSim's air data of this step; × ``enabled``. The lift
