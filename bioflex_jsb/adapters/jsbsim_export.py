@@ -867,7 +867,7 @@ def modal_wing_aerodynamics(nums: ModalNumbers, co: LeapfrogCoefficients) -> dic
     docstring), η and η̇ read as its two parts: ΔL = Q S (C_L_η·η + C_L_η̇·η̇ c̄/(2V)) in the
     LIFT axis, the drag k₂ ΔL (k₂ = 2kC_L0, C_D_η = k₂ C_L_η) in the DRAG axis, ΔM = Q S c̄
     (C_m_η·η + C_m_η̇·η̇ c̄/(2V)) in the PITCH axis (about the aerodynamic reference point,
-    which is the CG); Q and c̄/(2V) JSBSim's air data of this step; × ``enabled``. The lift
+    which is the CG); Q and V JSBSim's air data of this step; × ``enabled``. The lift
     is an aerodynamics function evaluated once per step (``aero/bioflex/modal-lift-lbs``),
     read by the LIFT and DRAG axes."""
     n = nums.n
@@ -876,14 +876,17 @@ def modal_wing_aerodynamics(nums: ModalNumbers, co: LeapfrogCoefficients) -> dic
     if not (np.allclose(nums.load_eta[1], k2 * nums.load_eta[0])
             and np.allclose(nums.load_etadot[1], k2 * nums.load_etadot[0])):
         raise ExportError("the modal drag is not proportional to the modal lift")
-    s_ref, qbar, ci2vel = P.REFERENCE_AREA_M2, "aero/qbar-psf", "aero/ci2vel"
+    s_ref, qbar = P.REFERENCE_AREA_M2, "aero/qbar-psf"
+    # c̄/(2V) from this step's airspeed: JSBSim updates aero/ci2vel only after the
+    # aerodynamics' own functions have run, so it would be the previous step's
+    half_chord_ft = 0.5 * P.MEAN_AERODYNAMIC_CHORD_M * U.FT_PER_M
 
     def loads(fn: ET.Element, r: int, gain: float) -> None:
         c = gain * U.PA_PER_PSF * s_ref
         disp = [(c * nums.load_eta[r, i] * co.eta_rate[i], y_eta[i]) for i in range(n)]
-        rate = [(c * nums.load_etadot[r, i], y_rate[i]) for i in range(n)]
-        lead = _times(lambda q: _combination(q, rate), ci2vel) if any(a for a, _ in rate) \
-            else None
+        rate = [(c * half_chord_ft * nums.load_etadot[r, i], y_rate[i]) for i in range(n)]
+        lead = (_over(lambda q: _combination(q, rate), "velocities/vt-fps")
+                if any(a for a, _ in rate) else None)
         total = lambda p: _combination(p, disp, lead=lead)  # noqa: E731
         _times(_times(total, qbar), _p("enabled"))(fn)
 
