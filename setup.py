@@ -2,7 +2,7 @@
 
 JSBSim looks for ``aircraft/`` and ``systems/`` under one root directory. In a checkout they
 sit at the repository's top level; in an installed wheel they are copied to
-``bioflex_jsb/jsbsim_root/`` so that ``bioflex_jsb.adapters.jsbsim_fdm`` finds them there.
+``bioflex_jsb/jsbsim_root/`` so that ``bioflex_jsb.runtime.fdm`` finds them there.
 All other metadata is in pyproject.toml.
 """
 

@@ -18,13 +18,13 @@ import argparse
 import math
 from pathlib import Path
 
-from bioflex_jsb.adapters import plotting
-from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+from bioflex_jsb.drivers.gust import RunSetup, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustSpec
 from bioflex_jsb.simulation.results import gust_metrics
+from bioflex_jsb.sinks import plotting
 
 METRICS = (  # name, unit scale, label, paper's expectation for the elastic/forward wing
     ("peak_du_m_s", 1.0, "peak Δu [m/s]", "lower"),

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from bioflex_jsb.aerodynamics import lifting_line as ll
+from bioflex_jsb.aerodynamics import vortex_lattice as ll
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
 
 TWO_PI = 2.0 * math.pi

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import units as U
-from bioflex_jsb.adapters import airframe_xml as X
-from bioflex_jsb.adapters import jsbsim_fdm
+from bioflex_jsb.generators import airframe as X
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import POST_STALL, PROPULSION, RIGID_AERODYNAMICS
+from bioflex_jsb.runtime import fdm as jsbsim_fdm
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -39,7 +39,7 @@ def test_committed_files_are_the_generated_rendering():
     }
     for rel, text in rendered.items():
         committed = (REPO / rel).read_text(encoding="utf-8")
-        assert committed == text, f"{rel} is stale: run python -m bioflex_jsb.adapters.airframe_xml"
+        assert committed == text, f"{rel} is stale: run python -m bioflex_jsb.generators.airframe"
 
 
 def test_write_all_writes_a_loadable_root(tmp_path):

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from bioflex_jsb import cli
-from bioflex_jsb.adapters import jsbsim_fdm
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.runtime import fdm as jsbsim_fdm
 
 
 def _run(capsys, argv):

@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-from bioflex_jsb.adapters.jsbsim_fdm import Airframe
 from bioflex_jsb.cli import main
+from bioflex_jsb.drivers.gust import RunSetup, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 

@@ -15,9 +15,9 @@ import time
 
 import pytest
 
-from bioflex_jsb.adapters.mavlink_link import MavlinkLink
-from bioflex_jsb.adapters.sitl_loop import SitlParameters
+from bioflex_jsb.drivers.sitl import SitlParameters
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.links.mavlink import MavlinkLink
 from tests.test_sitl import Session, make_sim
 
 PASSPHRASE = "elastic-wing-sitl"

@@ -42,8 +42,8 @@ from mavsdk.plugins.mission_raw import MissionRaw
 from mavsdk.plugins.param import Param
 from mavsdk.plugins.telemetry import Telemetry
 
-from bioflex_jsb.adapters.mcap_log import messages_by_topic, topic
-from bioflex_jsb.adapters.sitl_loop import SitlParameters
+from bioflex_jsb.drivers.sitl import SitlParameters
+from bioflex_jsb.sinks.mcap_log import messages_by_topic, topic
 
 DURATION_S = 20.0  # the issue's `bioflex-jsb sitl --duration 20`
 SPEEDUP = 2.0  # 10 s of wall time; telemetry rates are wall-clock rates, unchanged

@@ -1,4 +1,4 @@
-"""The modal wing exported as JSBSim systems (bioflex_jsb.adapters.jsbsim_export)."""
+"""The modal wing exported as JSBSim systems (bioflex_jsb.generators.native_wing)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bioflex_jsb.adapters import jsbsim_export as J
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.generators import native_wing as J
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -18,7 +18,7 @@ def test_repository_files_are_up_to_date():
     """systems/, aircraft/bioflex_<variant>/ and the Fig. 21 script are the exporter's output."""
     stale = [rel for rel, text in J.repository_files().items()
              if not (REPO / rel).is_file() or (REPO / rel).read_text(encoding="utf-8") != text]
-    assert not stale, f"regenerate with python -m bioflex_jsb.adapters.jsbsim_export: {stale}"
+    assert not stale, f"regenerate with python -m bioflex_jsb.generators.native_wing: {stale}"
 
 
 def _spec(variant, **kw):
@@ -75,7 +75,7 @@ def test_a_step_too_coarse_for_the_wing_is_refused_with_one_that_is_not():
 
 
 def test_exported_aircraft_loads_in_jsbsim_without_warnings():
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.runtime.fdm import Airframe
 
     af = Airframe(root=REPO, aircraft=J.aircraft_name("original"))
     assert af.warnings == []
@@ -88,8 +88,8 @@ def test_native_xml_matches_the_cosimulation(variant, amplitude):
     """Same sharp gust at 15 m/s, 3 s: native XML vs Python co-simulation (measured: at most
     0.3 % for the original wing; η₁ of the optimised wing 0.72 % at 0.3 m/s, 0.75 % at 3 m/s,
     the other channels ≤ 0.53 %)."""
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import nrmse
 
@@ -111,7 +111,7 @@ def test_native_xml_matches_the_cosimulation(variant, amplitude):
 def test_published_modal_state_is_the_state_at_the_current_time():
     """``bioflex/modal/eta<i>`` (functions evaluated when read) are Φ_h⁻¹ of the stored
     half-step state, and the loads in the aerodynamics are those of the stored state."""
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.runtime.fdm import Airframe
 
     af = Airframe(root=REPO, aircraft=J.aircraft_name("optimised"))
     af.set_dt(J.DEFAULT_DT_S)
@@ -158,9 +158,9 @@ def test_fig21_script_runs_in_the_console_program(tmp_path):
     import subprocess
     import sys
 
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.parameters import prototype as P
+    from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import nrmse
 
@@ -218,7 +218,7 @@ def _cli(argv):
 def test_cli_writes_a_loadable_root(tmp_path, capsys, model, craft):
     import json
 
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.runtime.fdm import Airframe
 
     assert _cli(["export-jsbsim", "--wing", "elastic-forward", "--model", model,
                  "--out", str(tmp_path), "--json"]) == 0

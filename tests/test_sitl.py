@@ -19,10 +19,10 @@ from pymavlink import mavutil  # noqa: E402  (the test's own ground station)
 from pymavlink.dialects.v20 import common as M  # noqa: E402
 
 import bioflex_jsb.cli as cli  # noqa: E402
-from bioflex_jsb.adapters import autopilot_xml  # noqa: E402
-from bioflex_jsb.adapters.mavlink_link import LinkError, MavlinkLink, parse_endpoint  # noqa: E402
-from bioflex_jsb.adapters.sitl_loop import SitlParameters, SitlSim, run_paced  # noqa: E402
+from bioflex_jsb.drivers.sitl import SitlParameters, SitlSim, run_paced  # noqa: E402
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing  # noqa: E402
+from bioflex_jsb.generators import autopilot as autopilot_xml  # noqa: E402
+from bioflex_jsb.links.mavlink import LinkError, MavlinkLink, parse_endpoint  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 PACING_TARGET_MS = 2.0  # issue 6: p99 of the step start against the wall clock
@@ -133,7 +133,7 @@ def test_cli_port_in_use_exit_2(monkeypatch, capsys):
 def test_generated_autopilot_files_are_in_step():
     for rel, text in autopilot_xml.render_all().items():
         assert (ROOT / rel).read_text(encoding="utf-8") == text, (
-            f"{rel} is stale: run python -m bioflex_jsb.adapters.autopilot_xml")
+            f"{rel} is stale: run python -m bioflex_jsb.generators.autopilot")
 
 
 def test_autopilot_holds_altitude_and_turns_to_a_heading(build):
@@ -360,14 +360,14 @@ def test_cli_sitl_runs_and_logs(tmp_path, monkeypatch, capsys):
 
     summary = json.loads(capsys.readouterr().out)
     assert summary["simulated_s"] == pytest.approx(1.5, abs=0.01)
-    from bioflex_jsb.adapters.mcap_log import summarise
+    from bioflex_jsb.sinks.mcap_log import summarise
 
     info = summarise(out)
     assert info is not None and out.stat().st_size > 10000
 
 
 def test_measure_pacing_for_bench():
-    from bioflex_jsb.adapters.sitl_loop import measure_pacing
+    from bioflex_jsb.drivers.sitl import measure_pacing
 
     r = measure_pacing(0.5)
     assert r["steps"] == 480 and r["resyncs"] == 0

@@ -11,14 +11,14 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as M
 
-from bioflex_jsb.adapters.mavlink_link import (
+from bioflex_jsb.drivers.sitl import SitlParameters
+from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.links.mavlink import (
     LinkError,
     MavlinkLink,
     read_signing_key,
     signing_time_10us,
 )
-from bioflex_jsb.adapters.sitl_loop import SitlParameters
-from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from tests.test_sitl import Session, make_sim, run_cli
 
 KEY = hashlib.sha256(b"bioflex signing test").digest()

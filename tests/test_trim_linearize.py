@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import units as U
-from bioflex_jsb.adapters import jsbsim_fdm
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
+from bioflex_jsb.runtime import fdm as jsbsim_fdm
 
 REPO = Path(__file__).resolve().parents[1]
 SPEEDS_M_S = (10.0, 12.5, 15.0, 20.0, 25.0)  # the trim sweep

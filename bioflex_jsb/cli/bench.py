@@ -38,13 +38,13 @@ def run(args: argparse.Namespace) -> int:
     import tempfile
     from pathlib import Path
 
-    from bioflex_jsb.adapters.cosim import INTEGRATORS, RunSetup, run_gust
-    from bioflex_jsb.adapters.jsbsim_export import native_airframe
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
-    from bioflex_jsb.adapters.mcap_log import RunLog
+    from bioflex_jsb.drivers.gust import INTEGRATORS, RunSetup, run_gust
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.generators.native_wing import native_airframe
+    from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+    from bioflex_jsb.sinks.mcap_log import RunLog
 
     if args.steps < 10 or args.repeat < 1:
         raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
                 native_t.append(timed(native))
                 native_pairs.append(native_t[-1] / pair_bare)
     b, c, lg, nat = (statistics.median(x) * 1e6 for x in (bare_t, cosim_t, logged_t, native_t))
-    from bioflex_jsb.adapters.sitl_loop import measure_pacing
+    from bioflex_jsb.drivers.sitl import measure_pacing
 
     sitl = measure_pacing(duration_s=2.0)  # real time, coupled wing, MAVLink link serviced
     payload = {

@@ -45,10 +45,10 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
     from bioflex_jsb.flight_dynamics.lti import build_state_space
-    from bioflex_jsb.flight_dynamics.response import simulate
     from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+    from bioflex_jsb.runtime.fdm import Airframe, FdmError
+    from bioflex_jsb.simulation.lti_response import simulate
     from bioflex_jsb.simulation.results import nrmse
 
     build = wing_from_args(args)
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     args.out = log_path(args, "compare", args.wing)
     log = None
     if args.out:
-        from bioflex_jsb.adapters.mcap_log import RunLog
+        from bioflex_jsb.sinks.mcap_log import RunLog
 
         log = RunLog.open(args.out, command="compare", args=args, build=build)
     try:
@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
         k = int(np.argmax(diff))
         worst[c] = {"max_abs_difference": float(diff[k]), "at_time_s": float(nonlinear.time_s[k])}
     if args.plot:
-        from bioflex_jsb.adapters import plotting
+        from bioflex_jsb.sinks import plotting
 
         try:
             plotting.time_histories([nonlinear, linear], args.plot,

@@ -15,7 +15,7 @@ from bioflex_jsb.cli.common import (
 HELP = """Write the rigid, coupled (Eq. 4) or QSD (Eq. 9-10) model at --speed [m/s] to a .npz
 or .mat file: matrices A, B, C, D and the names and units of states (u [m/s], alpha [rad],
 q [rad/s], theta [rad], eta_i [rad], eta_i_dot [rad/s]), input (w_g [m/s], up) and
-outputs. In Python, bioflex_jsb.adapters.export.to_python_control gives a python-control
+outputs. In Python, bioflex_jsb.sinks.model_export.to_python_control gives a python-control
 StateSpace with the same names."""
 
 
@@ -31,9 +31,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters.export import write_state_space
     from bioflex_jsb.flight_dynamics.lti import build_state_space
     from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+    from bioflex_jsb.sinks.model_export import write_state_space
 
     build = wing_from_args(args)
     ss = build_state_space(args.model, level_flight_condition(args.speed), build.model)

@@ -18,7 +18,7 @@ flow of the exact part are those of level flight at --speed [m/s]. See docs/nati
 
 
 def register(sub) -> None:
-    from bioflex_jsb.adapters.jsbsim_export import EXPORT_MODELS
+    from bioflex_jsb.generators.native_wing import EXPORT_MODELS
     from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
     p = sub.add_parser("export-jsbsim", help="write the modal wing as JSBSim systems",
@@ -36,7 +36,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters import jsbsim_export as J
+    from bioflex_jsb.generators import native_wing as J
 
     build = wing_from_args(args)
     out = Path(args.out)

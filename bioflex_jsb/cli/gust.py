@@ -96,8 +96,8 @@ def check_run_arguments(args) -> None:
 
 def fly(args, build, models, log=None):
     """Run each model (all of them, also after one stops); return (runs, stop messages)."""
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe, FdmError
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.runtime.fdm import Airframe, FdmError
 
     check_run_arguments(args)
     setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     log = None
     args.out = log_path(args, "gust", args.wing)
     if args.out:
-        from bioflex_jsb.adapters.mcap_log import RunLog
+        from bioflex_jsb.sinks.mcap_log import RunLog
 
         log = RunLog.open(args.out, command="gust", args=args, build=build)
     try:
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         summary[r.model]["time_beyond_stall_s"] = r.meta["time_beyond_stall_s"]
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     if plot:
-        from bioflex_jsb.adapters import plotting
+        from bioflex_jsb.sinks import plotting
 
         try:
             plotting.time_histories(

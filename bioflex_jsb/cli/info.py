@@ -26,7 +26,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters.mcap_log import LogError, recover, summarise
+    from bioflex_jsb.sinks.mcap_log import LogError, recover, summarise
 
     try:
         if args.recover:

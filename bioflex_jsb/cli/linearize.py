@@ -46,8 +46,7 @@ def linearization_payload(lin) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters import jsbsim_fdm
-
+    from bioflex_jsb.runtime import fdm as jsbsim_fdm
     airframe = load_airframe(args)
     try:
         lin = airframe.linearize(args.speed, args.altitude)

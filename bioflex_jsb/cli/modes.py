@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _plot(args, build) -> None:
-    from bioflex_jsb.adapters import plotting
+    from bioflex_jsb.sinks import plotting
 
     top = max(25.0, max(args.speed))
     grid = np.arange(5.0, top + 1e-9, 0.5)

@@ -24,7 +24,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from bioflex_jsb.adapters.mcap_log import LogError, histories
+    from bioflex_jsb.sinks.mcap_log import LogError, histories
 
     try:
         runs, meta = histories(args.file)
@@ -35,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or str(Path(args.file).with_suffix(".png"))
     title = (f"{meta.get('wing', '?')} wing, {meta.get('speed_m_s', '?')} m/s, "
              f"gust {meta.get('gust', '?')}" if meta else Path(args.file).name)
-    from bioflex_jsb.adapters import plotting
+    from bioflex_jsb.sinks import plotting
 
     try:
         plotting.time_histories(runs, out, title)

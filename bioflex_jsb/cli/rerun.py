@@ -31,7 +31,7 @@ def register(sub) -> None:
 
 def argv_from_log(path: str) -> list[str]:
     """The bioflex-jsb argument list (without --out) that repeats the logged run."""
-    from bioflex_jsb.adapters.mcap_log import (
+    from bioflex_jsb.sinks.mcap_log import (
         REPEATABLE_COMMANDS,
         RUN_METADATA,
         LogError,
@@ -72,7 +72,7 @@ def _differs(a, b, rtol: float) -> bool:
 
 def compare_logs(old: str, new: str, rtol: float) -> dict:
     """Message-by-message comparison of two logs (topics, counts, log times, numbers)."""
-    from bioflex_jsb.adapters.mcap_log import LogError, messages_by_topic
+    from bioflex_jsb.sinks.mcap_log import LogError, messages_by_topic
 
     try:
         a, b = messages_by_topic(old), messages_by_topic(new)
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from bioflex_jsb import cli
-    from bioflex_jsb.adapters.mcap_log import check_file
+    from bioflex_jsb.sinks.mcap_log import check_file
 
     argv = argv_from_log(args.file)
     try:

@@ -27,7 +27,7 @@ N simulated seconds per second) and stream it as a MAVLink 2 vehicle (system 1, 
 fixed wing) to a ground station: QGroundControl, MAVProxy, MAVSDK. A simple autopilot
 (JSBSim systems: altitude/pitch hold on the elevator, heading/roll hold on the ailerons)
 keeps it in level flight; parameters AP_*, GUST_*, WING_COUPLED and SIM_SPEEDUP change the
-run from the ground station (docs in bioflex_jsb/adapters/sitl_loop.py). --mavlink:
+run from the ground station (docs in bioflex_jsb/drivers/sitl.py). --mavlink:
 udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:14550),
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
 simulated seconds, or until Ctrl-C. Prints the pacing error (step start minus its wall-clock
@@ -64,19 +64,19 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters.jsbsim_fdm import FdmError
-    from bioflex_jsb.adapters.mavlink_link import (
-        LinkError,
-        MavlinkLink,
-        parse_endpoint,
-        read_signing_key,
-    )
-    from bioflex_jsb.adapters.sitl_loop import (
+    from bioflex_jsb.drivers.sitl import (
         SPEEDUP_RANGE,
         SitlParameters,
         SitlSim,
         run_paced,
     )
+    from bioflex_jsb.links.mavlink import (
+        LinkError,
+        MavlinkLink,
+        parse_endpoint,
+        read_signing_key,
+    )
+    from bioflex_jsb.runtime.fdm import FdmError
 
     lo, hi = SPEEDUP_RANGE
     if not lo <= args.speedup <= hi:
@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         link.close()
         raise
     if args.out:
-        from bioflex_jsb.adapters.mcap_log import RunLog
+        from bioflex_jsb.sinks.mcap_log import RunLog
 
         log = RunLog.open(args.out, command="sitl", args=args, build=build)
         names = sim.names

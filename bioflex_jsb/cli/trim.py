@@ -40,8 +40,7 @@ def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
 
 def load_airframe(args: argparse.Namespace):
     """The JSBSim airframe the options name; adapter errors become UsageError."""
-    from bioflex_jsb.adapters import jsbsim_fdm
-
+    from bioflex_jsb.runtime import fdm as jsbsim_fdm
     aircraft = args.aircraft or jsbsim_fdm.DEFAULT_AIRCRAFT
     try:
         return jsbsim_fdm.load_airframe(args.jsbsim_root, aircraft)
@@ -57,7 +56,7 @@ def register(sub) -> None:
 
 
 def trim_payload(result) -> dict:
-    """JSON form of a :class:`~bioflex_jsb.adapters.jsbsim_fdm.TrimResult` (SI, rad)."""
+    """JSON form of a :class:`~bioflex_jsb.runtime.fdm.TrimResult` (SI, rad)."""
     return {
         "speed_m_s": result.speed_m_s,
         "altitude_m": result.altitude_m,
@@ -75,8 +74,7 @@ def trim_payload(result) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.adapters import jsbsim_fdm
-
+    from bioflex_jsb.runtime import fdm as jsbsim_fdm
     airframe = load_airframe(args)
     try:
         result = airframe.trim(args.speed, args.altitude)

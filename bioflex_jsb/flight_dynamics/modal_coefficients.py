@@ -145,7 +145,7 @@ class SpanwiseGeometry:
 def spanwise_geometry(aero, planform, x_elastic_frac: np.ndarray, modal_stations_m: np.ndarray):
     """Combine the lifting-line strips with the elastic-axis line of the structure.
 
-    ``aero`` is a :class:`bioflex_jsb.aerodynamics.lifting_line.SpanwiseAerodynamics`,
+    ``aero`` is a :class:`bioflex_jsb.aerodynamics.vortex_lattice.SpanwiseAerodynamics`,
     ``planform`` a :class:`bioflex_jsb.parameters.wing.Planform`, ``x_elastic_frac`` the
     elastic-axis chord fraction at ``modal_stations_m``.
     """

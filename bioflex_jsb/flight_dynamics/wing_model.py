@@ -236,7 +236,7 @@ class WingBuild:
 
     variant: WingVariant
     modes: object  # bioflex_jsb.structures.modal_data.ModalData
-    aero: object  # bioflex_jsb.aerodynamics.lifting_line.SpanwiseAerodynamics
+    aero: object  # bioflex_jsb.aerodynamics.vortex_lattice.SpanwiseAerodynamics
     model: ElasticWingModel
     mass_basis: str
     physical_c_eta1_q1: float
@@ -260,7 +260,7 @@ class WingBuild:
 
 @lru_cache(maxsize=4)
 def _aero(planform: Planform):
-    from bioflex_jsb.aerodynamics.lifting_line import solve_spanwise_aerodynamics
+    from bioflex_jsb.aerodynamics.vortex_lattice import solve_spanwise_aerodynamics
 
     return solve_spanwise_aerodynamics(planform)
 

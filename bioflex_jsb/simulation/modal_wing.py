@@ -1,6 +1,6 @@
 """The modal wing of the co-simulation: one step of the elastic wing, no I/O.
 
-Each airframe step the co-simulation loop (``bioflex_jsb.adapters.cosim``) hands the wing the
+Each airframe step the co-simulation loop (``bioflex_jsb.drivers.gust``) hands the wing the
 flow state it reads from JSBSim (:class:`FlowState`), takes the incremental loads
 (:class:`WingLoads`) and writes them into the airframe's external reactions.
 
@@ -34,7 +34,7 @@ of ω²). The reference is renewed when Q or V moves by more than ``refresh_rel`
 step's flow (holding Ψ_r ΔA x_k over the step instead, a first-order treatment, was 2 % off
 in the Fig. 21 case; tests/test_gusts_and_modal_wing.py).
 
-Timing in the co-simulation (``adapters/cosim.py``): the wing advances with the flow of t_k
+Timing in the co-simulation (``drivers/gust.py``): the wing advances with the flow of t_k
 first and the loads of the new state η_{k+1} go with JSBSim's step k, whose forces belong to
 t_{k+1}: no coupling lag. ``qsd`` takes Δη as the quasi-static solution of the flow of t_k.
 """

@@ -25,7 +25,7 @@ from bioflex_jsb.sweep.campaign import Case, failed_row
 from bioflex_jsb.sweep.evaluate import run_case
 
 CONNECT_TIMEOUT_S = 10.0
-WORKER_IMPORTS = ("bioflex_jsb.sweep.evaluate", "bioflex_jsb.adapters.cosim")
+WORKER_IMPORTS = ("bioflex_jsb.sweep.evaluate", "bioflex_jsb.drivers.gust")
 
 
 class DaskUnavailable(RuntimeError):

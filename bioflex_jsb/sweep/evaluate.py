@@ -2,7 +2,7 @@
 
 This is the code both executors (local processes, Dask) ship to their workers. It builds
 the wing (cached per process), computes the LTI metrics and flies the gust run through
-JSBSim (``bioflex_jsb.adapters.cosim``).
+JSBSim (``bioflex_jsb.drivers.gust``).
 
 Each case loads its own :class:`Airframe`. Reusing one airframe per worker would save the
 load (≈ 4 ms, against 0.3-1 s for a case) but JSBSim's trim starts from the state the
@@ -32,7 +32,7 @@ _FLUTTER_CACHE: dict[tuple, Any] = {}
 
 def airframe():
     """A freshly loaded JSBSim airframe (see the module docstring for why not reused)."""
-    from bioflex_jsb.adapters.jsbsim_fdm import Airframe
+    from bioflex_jsb.runtime.fdm import Airframe
 
     return Airframe()
 
@@ -114,7 +114,7 @@ def _flutter(case: Case, build):
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
-    from bioflex_jsb.adapters.cosim import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics
 
@@ -124,7 +124,7 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     log = None
     recorder = None
     if log_dir:
-        from bioflex_jsb.adapters.mcap_log import RunLog
+        from bioflex_jsb.sinks.mcap_log import RunLog
 
         Path(log_dir).mkdir(parents=True, exist_ok=True)
         # the gust command's argument names, so the log's run metadata reads the same

@@ -21,7 +21,7 @@ from typing import Any
 from bioflex_jsb.sweep.campaign import Case, failed_row
 from bioflex_jsb.sweep.evaluate import run_case
 
-PRELOAD = ["bioflex_jsb.sweep.evaluate", "bioflex_jsb.adapters.cosim"]
+PRELOAD = ["bioflex_jsb.sweep.evaluate", "bioflex_jsb.drivers.gust"]
 # One BLAS/OpenMP thread per worker process, as Dask's nanny sets for its workers
 # (distributed.nanny.pre-spawn-environ): no oversubscription of the cores, and the same
 # LAPACK code path, so eigenvalues agree to the last bit between the two executors.

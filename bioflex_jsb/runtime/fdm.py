@@ -23,7 +23,7 @@ Trim
 :meth:`Airframe.trim` uses JSBSim's own trim routine, ``FGFDMExec::DoTrim`` in *full* mode
 (α, throttle and elevator for u̇, ẇ, q̇; bank, aileron, rudder and sideslip for the lateral
 accelerations): wings-level, constant-altitude flight at the requested true airspeed. The
-propulsion is a contra-rotating pair (see :mod:`bioflex_jsb.adapters.airframe_xml`): JSBSim's
+propulsion is a contra-rotating pair (see :mod:`bioflex_jsb.generators.airframe`): JSBSim's
 trim drives both motors' throttles together, the reaction torques cancel, and the lateral
 controls come out at zero. When it fails, :class:`TrimError` carries one line naming the
 control that ran out (throttle at 1, elevator at a stop, α at the stall limit) or the
@@ -107,7 +107,7 @@ import jsbsim
 import numpy as np
 
 from bioflex_jsb import units as U
-from bioflex_jsb.adapters import airframe_xml
+from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
 
 ROOT_ENV_VAR = "BIOFLEX_JSBSIM_ROOT"
@@ -220,7 +220,7 @@ def locate_root(root: str | os.PathLike | None = None, aircraft: str = DEFAULT_A
     tried = ", ".join(repr(str(p)) for p in candidate_roots())
     hint = f"set {ROOT_ENV_VAR} or pass a JSBSim root"
     if aircraft == DEFAULT_AIRCRAFT:
-        hint += " (python -m bioflex_jsb.adapters.airframe_xml writes the bioflex files)"
+        hint += " (python -m bioflex_jsb.generators.airframe writes the bioflex files)"
     raise AircraftLoadError(
         f"cannot find the JSBSim files of {aircraft!r} (aircraft/ and systems/) in {tried}; " + hint
     )
@@ -838,7 +838,7 @@ class Airframe:
         pitch_moment_n_m: float = 0.0,
         roll_moment_n_m: float = 0.0,
     ) -> None:
-        """Set the external-reaction hooks (see :mod:`bioflex_jsb.adapters.airframe_xml`).
+        """Set the external-reaction hooks (see :mod:`bioflex_jsb.generators.airframe`).
 
         lift_n: force along body −z (up) [N]; drag_n: along body −x (aft) [N];
         pitch_moment_n_m: about body +y, nose up [N·m]; roll_moment_n_m: about body +x,

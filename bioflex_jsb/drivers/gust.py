@@ -28,11 +28,11 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from bioflex_jsb import units as U
-from bioflex_jsb.adapters.airframe_xml import alpha_peak_rad
-from bioflex_jsb.adapters.jsbsim_fdm import Airframe, TrimResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.generators.airframe import alpha_peak_rad
 from bioflex_jsb.parameters.airframe import POST_STALL
+from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, FlowState, ModalWing, TrimReference
 from bioflex_jsb.simulation.results import TimeHistory

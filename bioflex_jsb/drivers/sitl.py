@@ -1,9 +1,9 @@
 """The SITL loop: the co-simulation of ``cosim.run_gust`` paced to the wall clock.
 
-The same step as :func:`bioflex_jsb.adapters.cosim.run_gust` (gust → wind, flow from the
+The same step as :func:`bioflex_jsb.drivers.gust.run_gust` (gust → wind, flow from the
 airframe state, modal loads into ``external_reactions``, JSBSim step, modal step), on the
 ``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml``, see
-:mod:`bioflex_jsb.adapters.autopilot_xml`) keeps it flying level on its own, for as long as
+:mod:`bioflex_jsb.generators.autopilot`) keeps it flying level on its own, for as long as
 asked (or until stopped).
 
 Pacing: step k is due at wall time W_0 + (t_k − t_0)/speedup. The loop sleeps until a step is
@@ -13,7 +13,7 @@ more than :data:`RESYNC_S` behind (a stall: debugger, swapped-out process) start
 schedule from now instead of racing to catch up; the number of such resyncs is reported.
 Changing the time scale (parameter ``SIM_SPEEDUP``) starts a new schedule too.
 
-The MAVLink link (:mod:`bioflex_jsb.adapters.mavlink_link`) is serviced every
+The MAVLink link (:mod:`bioflex_jsb.links.mavlink`) is serviced every
 :data:`LINK_PERIOD_S` of simulated time (≥ 50 Hz of wall time up to a speed-up of 4); its
 reads are bounded per call, so a flood costs at most a fixed time per call.
 
@@ -42,17 +42,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bioflex_jsb import units as U
-from bioflex_jsb.adapters.autopilot_xml import SITL_AIRCRAFT
-from bioflex_jsb.adapters.cosim import (
+from bioflex_jsb.drivers.gust import (
     ALPHA_TABLE_RANGE_RAD,
     INTEGRATORS,
     base_channels,
     row_values,
     state_reader,
 )
-from bioflex_jsb.adapters.jsbsim_fdm import Airframe
-from bioflex_jsb.adapters.mavlink_link import VehicleState
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.generators.autopilot import SITL_AIRCRAFT
+from bioflex_jsb.links.mavlink import VehicleState
+from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, ModalWing, TrimReference
 
@@ -319,7 +319,7 @@ def run_paced(
 ) -> PacingStats:
     """Fly ``sim`` paced to the wall clock for ``duration_s`` simulated seconds (None: until
     ``should_stop()`` or a stop of the run; Ctrl-C raises KeyboardInterrupt). ``link``: a
-    :class:`~bioflex_jsb.adapters.mavlink_link.MavlinkLink`, serviced every LINK_PERIOD_S;
+    :class:`~bioflex_jsb.links.mavlink.MavlinkLink`, serviced every LINK_PERIOD_S;
     ``on_sample(t_s, model, values)`` after every step (logging); ``idle(slack_s)`` when the
     next step is not due for ``slack_s`` [s] (a place for work that may wait, such as writing
     a log chunk, without delaying a step)."""
@@ -370,8 +370,8 @@ def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "o
     with the MAVLink link serviced as in a session (default: listening on a loopback port,
     telemetry at its default rates, 50 Hz ATTITUDE). Returns :meth:`PacingStats.summary`
     ([ms] and counts) with ``dt_s`` and ``speedup``."""
-    from bioflex_jsb.adapters.mavlink_link import MavlinkLink
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.links.mavlink import MavlinkLink
 
     build = build_wing(VARIANTS[wing])
     sim = SitlSim(build.model, build.modes, speed_m_s=speed_m_s, speedup=speedup)
