@@ -28,7 +28,7 @@ def _spec(variant, **kw):
 @pytest.mark.parametrize("variant", J.REPOSITORY_VARIANTS)
 def test_coupled_step_is_within_1_percent_of_the_exact_dynamics_at_the_default_step(variant):
     spec = _spec(variant)
-    nums = J.modal_numbers(spec.wing, spec.cl_trim)
+    nums = J.modal_matrices(spec.wing, spec.cl_trim)
     assert nums.omega[2] * spec.dt_s > 0.4  # ω₃Δt = 0.47-0.70: not over-resolved
     err, _ = J.leapfrog_eigen_error(nums, spec.leapfrog(nums))
     assert err <= J.EIGEN_REL_TOL  # 0.12-0.91 % over 0-40 m/s (docs/native.md)
@@ -39,7 +39,7 @@ def test_structure_alone_is_integrated_exactly_at_any_step():
     the in-vacuo modes to rounding, also at 1/120 s (ω₃ Δt = 5.6)."""
     from scipy.linalg import expm
 
-    nums = J.modal_numbers(build_wing(VARIANTS["optimised"]).model, 0.5)
+    nums = J.modal_matrices(build_wing(VARIANTS["optimised"]).model, 0.5)
     for dt in (J.DEFAULT_DT_S, 1.0 / 120.0):
         co = J.leapfrog_coefficients(nums, dt)
         # the stored state is y = Φ_h x: compare in x
@@ -58,7 +58,7 @@ def test_splitting_is_second_order():
     from scipy.linalg import expm
 
     spec = _spec("optimised")
-    nums = J.modal_numbers(spec.wing, spec.cl_trim)
+    nums = J.modal_matrices(spec.wing, spec.cl_trim)
     q = 0.5 * spec.rho_ref * 25.0**2  # away from the reference, so the diagonal splits too
     errors = []
     for dt in (J.DEFAULT_DT_S, J.DEFAULT_DT_S / 2):
@@ -119,7 +119,7 @@ def test_published_modal_state_is_the_state_at_the_current_time():
     af["atmosphere/wind-down-fps"] = -3.0
     af.run(40)
     spec = _spec("optimised")
-    nums = J.modal_numbers(spec.wing, spec.cl_trim)
+    nums = J.modal_matrices(spec.wing, spec.cl_trim)
     co = spec.leapfrog(nums)
     for i in range(3):
         y = np.array([af[f"bioflex/modal/y-eta{i + 1}-scaled"] * co.eta_rate[i],

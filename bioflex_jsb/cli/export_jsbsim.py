@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         written = J.export(spec, out)
     except OSError as exc:
         raise UsageError(f"cannot write into {args.out!r}: {exc.strerror or exc}") from None
-    nums = J.modal_numbers(spec.wing, spec.cl_trim)
+    nums = J.modal_matrices(spec.wing, spec.cl_trim)
     info = {
         "out": str(out),
         "aircraft": J.aircraft_name(spec.variant, spec.model),

@@ -89,23 +89,26 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.linalg import expm
 
 from bioflex_jsb import units as U
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS
+from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for the checks)
+    GRID_SPEED_MAX_M_S,
+    GRID_SPEED_STEP_M_S,
+    LeapfrogCoefficients,
+    leapfrog_coefficients,
+    leapfrog_eigen_error,
+    leapfrog_matrix,
+    leapfrog_step,
+)
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 EXPORT_MODELS = ("coupled", "qsd")
 PREFIX = "bioflex/modal"
-# Q grid of the tables: uniform in V_ref = sqrt(2Q/ρ_ref) from 0 to this speed [m/s], the
-# aircraft's speed range with margin (Table 1 flies 10-25 m/s); JSBSim holds the end values
-# beyond it.
-GRID_SPEED_MAX_M_S = 40.0
-GRID_SPEED_STEP_M_S = 0.5
 # Named variants written into the repository's systems/ and aircraft/ (coupled model).
 REPOSITORY_VARIANTS = ("original", "optimised", "inertial-forward", "elastic-forward",
                        "inertial-backward", "elastic-backward")  # fmt: skip
@@ -155,178 +158,17 @@ def system_name(variant: str, model: str = "coupled") -> str:
 # ======================================================================================
 
 
-@dataclass(frozen=True)
-class ModalNumbers:
-    """The modal wing in per-unit form (SI), as ``ModalWing`` builds it."""
-
-    n: int
-    omega: np.ndarray  # [rad/s]
-    zeta: np.ndarray
-    k_aero: np.ndarray  # (n, n) generalised acceleration per unit Q per rad [1/(Pa s²)]
-    d_aero: np.ndarray  # (n, n) per unit Q/V per rad/s [m/(Pa s²)]... per (Pa·s/m)
-    b_alpha: np.ndarray  # per unit Q per rad
-    b_q: np.ndarray  # per unit Q/V per rad/s
-    b_0: np.ndarray  # per unit ΔQ
-    load_eta: np.ndarray  # (3, n) [C_L, C_D, C_m·c̄ (m)] per rad
-    load_etadot: np.ndarray  # (3, n) per unit η̇·c̄/(2V)
-
-    def a_matrix(self, q_pa: float, q_over_v: float) -> np.ndarray:
-        n = self.n
-        k = np.diag(self.omega**2) - q_pa * self.k_aero
-        d = np.diag(2.0 * self.zeta * self.omega) - q_over_v * self.d_aero
-        return np.block([[np.zeros((n, n)), np.eye(n)], [-k, -d]])
-
-    def discrete(self, q_pa: float, q_over_v: float, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-        """Φ (2n×2n) and Ψ (2n×n, the η̈-forcing columns) of one step."""
-        a = self.a_matrix(q_pa, q_over_v)
-        n2 = a.shape[0]
-        aug = np.zeros((2 * n2, 2 * n2))
-        aug[:n2, :n2] = a
-        aug[:n2, n2:] = np.eye(n2)
-        e = expm(aug * dt_s)
-        return e[:n2, :n2], e[:n2, n2 + self.n :]
-
-
-def modal_numbers(wing: ElasticWingModel, cl_trim: float) -> ModalNumbers:
-    """Per-unit modal matrices of ``wing`` with the trim lift coefficient ``cl_trim``."""
-    c = wing.coefficients
-    s, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
-    m = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
-    c_alpha = np.asarray(c.c_alpha_q, dtype=float)
-    alpha_wing = cl_trim / wing.wing_lift_slope_per_rad
-    c_0 = alpha_wing * c_alpha + wing.cm_ac * np.asarray(c.c_mac_q, dtype=float)
-    k2 = 2.0 * RIGID_AERODYNAMICS.k_induced * cl_trim
-    c_l_eta, c_l_etadot = np.asarray(c.c_l_eta, float), np.asarray(c.c_l_etadot, float)
-    return ModalNumbers(
-        n=wing.n_modes,
-        omega=np.asarray(wing.frequencies_rad_s, dtype=float),
-        zeta=np.asarray(wing.damping_ratios, dtype=float),
-        k_aero=(s * cb / m)[:, None] * np.asarray(c.c_eta_q, dtype=float),
-        d_aero=(s * cb**2 / (2.0 * m))[:, None] * np.asarray(c.c_etadot_q, dtype=float),
-        b_alpha=s * cb / m * c_alpha,
-        b_q=s * cb**2 / (2.0 * m) * np.asarray(c.c_q_q, dtype=float),
-        b_0=s * cb * c_0 / m,
-        load_eta=np.vstack([c_l_eta, k2 * c_l_eta, np.asarray(c.c_m_eta, float) * cb]),
-        load_etadot=np.vstack([c_l_etadot, k2 * c_l_etadot, np.asarray(c.c_m_etadot, float) * cb]),
-    )
-
-
 def q_grid_pa(rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3) -> np.ndarray:
     """Dynamic pressures of the table rows [Pa] (uniform in V_ref)."""
     v = np.arange(0.0, GRID_SPEED_MAX_M_S + 0.5 * GRID_SPEED_STEP_M_S, GRID_SPEED_STEP_M_S)
     return 0.5 * rho_ref * v**2
 
 
-def qsd_schedule(nums: ModalNumbers, rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3):
+def qsd_schedule(nums: ModalMatrices, rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3):
     """(Q grid, K(Q)⁻¹ stack) of the QSD model's tables."""
     qs = q_grid_pa(rho_ref)
     inv = [np.linalg.inv(np.diag(nums.omega**2) - q * nums.k_aero) for q in qs]
     return qs, np.array(inv)
-
-
-@dataclass(frozen=True)
-class LeapfrogCoefficients:
-    """Numbers of the coupled model's step (module docstring), per mode i, SI.
-
-    The exactly integrated part of mode i is A_i = [[0, 1], [−k_i, −c_i]] with the structure
-    and the mode's own aerodynamic stiffness and damping at the reference flow:
-    k_i = ω_i² − Q_r K_a[i, i], c_i = 2ζ_iω_i − (Q_r/V_r) D_a[i, i]. ``half_inv``: Φ_h⁻¹
-    of mode i (2×2), Φ_h = e^{A_i Δt/2}: x_k = Φ_h⁻¹ y_k, the state at t_k from the stored
-    half-step state. ``rate_eta``, ``rate_rate``: Φ_s[1, 0], Φ_s[1, 1] of Φ_s = e^{A_i Δt};
-    ``kick``: Φ_s[1, 1] Δt, the gain of the rest of the acceleration in the new rate;
-    ``eta_eta``, ``eta_rate``: the displacement row rewritten to read the new rate
-    (Φ_s[0, 0] − Φ_s[0, 1] Φ_s[1, 0] / Φ_s[1, 1], Φ_s[0, 1] / Φ_s[1, 1])."""
-
-    dt_s: float
-    q_ref_pa: float
-    q_over_v_ref: float  # [Pa s/m]
-    half_inv: np.ndarray  # (n, 2, 2)
-    rate_eta: np.ndarray  # (n,)  [1/s]
-    rate_rate: np.ndarray  # (n,)
-    kick: np.ndarray  # (n,)  [s]
-    eta_eta: np.ndarray  # (n,)
-    eta_rate: np.ndarray  # (n,)  [s]
-
-
-def leapfrog_coefficients(nums: ModalNumbers, dt_s: float, q_ref_pa: float = 0.0,
-                          q_over_v_ref: float = 0.0) -> LeapfrogCoefficients:
-    """Φ_s = e^{A_i Δt}, Φ_h = e^{A_i Δt/2} of each mode's exactly integrated part at the
-    reference flow (Q_r [Pa], Q_r/V_r [Pa s/m]) and the in-place rows built from them."""
-    half_inv, full = [], []
-    for i, (w, z) in enumerate(zip(nums.omega, nums.zeta, strict=True)):
-        k = w**2 - q_ref_pa * nums.k_aero[i, i]
-        c = 2.0 * z * w - q_over_v_ref * nums.d_aero[i, i]
-        a = np.array([[0.0, 1.0], [-k, -c]])
-        half_inv.append(expm(-a * dt_s / 2.0))
-        full.append(expm(a * dt_s))
-    f = np.array(full)
-    return LeapfrogCoefficients(
-        dt_s=float(dt_s),
-        q_ref_pa=float(q_ref_pa),
-        q_over_v_ref=float(q_over_v_ref),
-        half_inv=np.array(half_inv),
-        rate_eta=f[:, 1, 0],
-        rate_rate=f[:, 1, 1],
-        kick=f[:, 1, 1] * dt_s,
-        eta_eta=f[:, 0, 0] - f[:, 0, 1] * f[:, 1, 0] / f[:, 1, 1],
-        eta_rate=f[:, 0, 1] / f[:, 1, 1],
-    )
-
-
-def leapfrog_step(nums: ModalNumbers, co: LeapfrogCoefficients, y: np.ndarray, q_pa: float,
-                  q_over_v: float, inputs: np.ndarray) -> np.ndarray:
-    """One step of the stored state y = [η (n), η̇ (n)] in the order the JSBSim system
-    computes it (rates first, in mode order, each reading the rates already updated; then the
-    displacements from the new rates). ``inputs``: the flow forcing b_α QΔα + b_q (Q/V) q +
-    b_0 ΔQ per mode [1/s²]. The Python mirror of the XML, for the checks."""
-    n = nums.n
-    y = np.array(y, dtype=float)
-    eta, rate = y[:n], y[n:]
-    eta_old = eta.copy()
-    for i in range(n):
-        acc = (q_pa * nums.k_aero[i] @ eta_old - co.q_ref_pa * nums.k_aero[i, i] * eta_old[i]
-               + q_over_v * nums.d_aero[i] @ rate - co.q_over_v_ref * nums.d_aero[i, i] * rate[i]
-               + inputs[i])
-        rate[i] = co.rate_eta[i] * eta_old[i] + co.rate_rate[i] * rate[i] + co.kick[i] * acc
-    for i in range(n):
-        eta[i] = co.eta_eta[i] * eta_old[i] + co.eta_rate[i] * rate[i]
-    return y
-
-
-def leapfrog_matrix(nums: ModalNumbers, co: LeapfrogCoefficients, q_pa: float,
-                    q_over_v: float) -> np.ndarray:
-    """The step of :func:`leapfrog_step` with no flow input as a (2n×2n) matrix."""
-    n2 = 2 * nums.n
-    zero = np.zeros(nums.n)
-    return np.column_stack([leapfrog_step(nums, co, e, q_pa, q_over_v, zero)
-                            for e in np.eye(n2)])
-
-
-def _continuous_eigenvalues(m: np.ndarray, dt_s: float) -> np.ndarray:
-    """λ = ln(μ)/Δt [1/s] of the eigenvalues μ of the step matrix ``m``."""
-    return np.log(np.linalg.eigvals(m).astype(complex)) / dt_s
-
-
-def leapfrog_eigen_error(nums: ModalNumbers, co: LeapfrogCoefficients,
-                         speed_max_m_s: float = GRID_SPEED_MAX_M_S,
-                         rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3) -> tuple[float, float]:
-    """(largest relative error of the step's eigenvalues against the exact e^{A(Q, V) Δt},
-    the speed [m/s] where it is largest) over level flight at ``rho_ref`` from 0 to
-    ``speed_max_m_s`` in 0.5 m/s steps. Eigenvalues compared as λ = ln(μ)/Δt [1/s], each
-    exact one against the nearest of the step's."""
-    dt_s = co.dt_s
-    worst, where = 0.0, 0.0
-    for v in np.arange(0.0, speed_max_m_s + 1e-9, GRID_SPEED_STEP_M_S):
-        q = 0.5 * rho_ref * v * v
-        qv = q / v if v > 0 else 0.0
-        exact = _continuous_eigenvalues(expm(nums.a_matrix(q, qv) * dt_s), dt_s)
-        step = _continuous_eigenvalues(leapfrog_matrix(nums, co, q, qv), dt_s)
-        if not np.all(np.isfinite(step)):
-            return math.inf, float(v)
-        err = max(np.min(np.abs(step - e)) / abs(e) for e in exact)
-        if err > worst:
-            worst, where = float(err), float(v)
-    return worst, where
 
 
 # ======================================================================================
@@ -464,7 +306,7 @@ class ExportSpec:
     def _check_step(self) -> None:
         """Refuse a step at which the coupled step is not within :data:`EIGEN_REL_TOL` of the
         exact dynamics over 0..GRID_SPEED_MAX_M_S (module docstring)."""
-        nums = modal_numbers(self.wing, self.cl_trim)
+        nums = modal_matrices(self.wing, self.cl_trim)
         err, at = leapfrog_eigen_error(nums, self.leapfrog(nums))
         if err <= EIGEN_REL_TOL:
             return
@@ -482,7 +324,7 @@ class ExportSpec:
     def cl_trim(self) -> float:
         return level_flight_condition(self.speed_m_s, self.rho_ref).cl_trim
 
-    def leapfrog(self, nums: ModalNumbers, dt_s: float | None = None) -> LeapfrogCoefficients:
+    def leapfrog(self, nums: ModalMatrices, dt_s: float | None = None) -> LeapfrogCoefficients:
         """The coupled model's step of ``dt_s`` [s] (default the exported step), its exact
         part at the export speed's flow."""
         q = 0.5 * self.rho_ref * self.speed_m_s**2
@@ -492,7 +334,7 @@ class ExportSpec:
 
 def render_system(spec: ExportSpec) -> str:
     """Text of ``systems/bioflex_modal_<variant>.xml``."""
-    nums = modal_numbers(spec.wing, spec.cl_trim)
+    nums = modal_matrices(spec.wing, spec.cl_trim)
     n = nums.n
     root = ET.Element("system", name=system_name(spec.variant, spec.model))
     _el(root, "description",
@@ -681,14 +523,14 @@ def _value_el(x: float) -> ET.Element:
     return e
 
 
-def _forcing_terms(fn_sum: ET.Element, nums: ModalNumbers, i: int) -> None:
+def _forcing_terms(fn_sum: ET.Element, nums: ModalMatrices, i: int) -> None:
     """Q Δα b_α + (Q/V) q b_q + ΔQ b_0 for mode i (SI generalised acceleration)."""
     _product(fn_sum, float(nums.b_alpha[i]), _p("qbar-pa"), _p("dalpha-rad"))
     _product(fn_sum, float(nums.b_q[i]), _p("q-over-v"), "velocities/q-rad_sec")
     _product(fn_sum, float(nums.b_0[i]), _p("dqbar-pa"))
 
 
-def _qsd_state(ch, spec: ExportSpec, nums: ModalNumbers, eta: list[str]) -> None:
+def _qsd_state(ch, spec: ExportSpec, nums: ModalMatrices, eta: list[str]) -> None:
     n = nums.n
     _comment(ch, "quasi-static deformation: eta = K(Q)^-1 r, K(Q) = diag(w^2) - Q K_a (tables)")
     for i in range(n):
@@ -706,7 +548,7 @@ def _qsd_state(ch, spec: ExportSpec, nums: ModalNumbers, eta: list[str]) -> None
             _product(s, lambda p, row=row: _table(p, _p("qbar-pa"), qs, row), _p(f"r{j + 1}"))
 
 
-def _loads(ch, spec: ExportSpec, nums: ModalNumbers, eta: list[str], etad: list[str]) -> None:
+def _loads(ch, spec: ExportSpec, nums: ModalMatrices, eta: list[str], etad: list[str]) -> None:
     s_ref, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
     _comment(ch, "incremental loads: Q S (C_eta eta + C_etadot etadot cbar/(2V)), wind axes, SI")
     names = (("lift-n", "lift, up, normal to the air velocity [N]"),
@@ -751,7 +593,7 @@ def _assign(ch: ET.Element, name: str, description: str, value, outputs: list[st
         _el(comp, "output", out)
 
 
-def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalNumbers, eta, etad) -> None:
+def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalMatrices, eta, etad) -> None:
     """The coupled model (module docstring): ``active``/``idle`` as system functions, the trim
     reference channel (idle only), the leapfrog step channel (active only). The loads are
     functions of the airframe's aerodynamics (:func:`modal_wing_aerodynamics`)."""
@@ -857,7 +699,7 @@ def _stored_state(n: int) -> tuple[list[str], list[str]]:
             [_p(f"y-eta{i + 1}-dot") for i in range(n)])
 
 
-def modal_wing_aerodynamics(nums: ModalNumbers, co: LeapfrogCoefficients) -> dict[str, str]:
+def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients) -> dict[str, str]:
     """The native modal wing's loads as JSBSim aerodynamics of the airframe: XML fragments
     keyed by where they go (``functions``: before the first axis; ``LIFT``, ``DRAG``,
     ``PITCH``: into those axes).
@@ -1009,7 +851,7 @@ def _modal_aircraft(text: str, sysname: str, spec: ExportSpec) -> str:
     text, count = _EXTERNAL_REACTIONS.subn("", text)
     if count != 1:
         raise ExportError("the generated airframe has no single <external_reactions>")
-    nums = modal_numbers(spec.wing, spec.cl_trim)
+    nums = modal_matrices(spec.wing, spec.cl_trim)
     parts = modal_wing_aerodynamics(nums, spec.leapfrog(nums))
     m = _FIRST_AXIS.search(text)
     if m is None:

@@ -47,6 +47,7 @@ import numpy as np
 from scipy.linalg import expm, expm_frechet
 
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
 
@@ -117,30 +118,14 @@ class ModalWing:
         self.refresh_rel = float(refresh_rel)
         n = wing.n_modes
         self.n_modes = n
-        c = wing.coefficients
-        self._m = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
-        self._omega = np.asarray(wing.frequencies_rad_s, dtype=float)
-        self._zeta = np.asarray(wing.damping_ratios, dtype=float)
-        self._c_alpha = np.asarray(c.c_alpha_q, dtype=float)
-        self._c_q = np.asarray(c.c_q_q, dtype=float)
-        self._c_eta = np.asarray(c.c_eta_q, dtype=float)
-        self._c_etadot = np.asarray(c.c_etadot_q, dtype=float)
-        alpha_wing = trim.cl_trim / wing.wing_lift_slope_per_rad
-        self._c_0 = alpha_wing * self._c_alpha + wing.cm_ac * np.asarray(c.c_mac_q, dtype=float)
-        k2 = 2.0 * aero.k_induced * trim.cl_trim
-        cb = P.MEAN_AERODYNAMIC_CHORD_M
-        self._load_eta = np.vstack([c.c_l_eta, k2 * c.c_l_eta, c.c_m_eta * cb])
-        self._load_etadot = np.vstack(
-            [c.c_l_etadot, k2 * c.c_l_etadot, c.c_m_etadot * cb]
-        )
+        # the one builder of the modal matrices (shared with the native export)
+        mm = modal_matrices(wing, trim.cl_trim, aero)
+        self.matrices = mm
+        self._load_eta, self._load_etadot = mm.load_eta, mm.load_etadot
         # Per-unit-Q parts of the lower (η̈) rows, so a step needs no matrix assembly:
         # η̈ = −ω²η − 2ζωη̇ + Q·K_a η + (Q/V)·D_a η̇ + Q·b_α Δα + (Q/V)·b_q q + b_0 ΔQ.
-        s_ref, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
-        self._k_aero = (s_ref * cb / self._m)[:, None] * self._c_eta
-        self._d_aero = (s_ref * cb**2 / (2.0 * self._m))[:, None] * self._c_etadot
-        self._b_alpha = s_ref * cb / self._m * self._c_alpha
-        self._b_q = s_ref * cb**2 / (2.0 * self._m) * self._c_q
-        self._b_0 = s_ref * cb * self._c_0 / self._m
+        self._k_aero, self._d_aero = mm.k_aero, mm.d_aero
+        self._forcing = mm.forcing_columns()
         self._x = np.zeros(2 * n)  # [Δη, Δη̇]
         self._load_x = np.hstack([self._load_eta, np.zeros_like(self._load_eta)])
         self._key: tuple[float, float] | None = None
@@ -149,19 +134,8 @@ class ModalWing:
     # -- modal dynamics -------------------------------------------------------------------
     def _matrices(self, q_pa: float, v_m_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Continuous A_e (2n×2n) and B_e (2n×3) for inputs f = [Δα, q, ΔQ]."""
-        n = self.n_modes
-        s, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
-        qsc = q_pa * s * cb / self._m
-        k = np.diag(self._omega**2) - qsc[:, None] * self._c_eta
-        dmp = np.diag(2.0 * self._zeta * self._omega) - (
-            qsc[:, None] * self._c_etadot * cb / (2.0 * v_m_s)
-        )
-        a = np.block([[np.zeros((n, n)), np.eye(n)], [-k, -dmp]])
-        b = np.zeros((2 * n, 3))
-        b[n:, 0] = qsc * self._c_alpha
-        b[n:, 1] = qsc * self._c_q * cb / (2.0 * v_m_s)
-        b[n:, 2] = s * cb * self._c_0 / self._m
-        return a, b
+        mm = self.matrices
+        return mm.a_matrix(q_pa, q_pa / v_m_s), mm.b_matrix(q_pa, q_pa / v_m_s)
 
     def _reference(self, q_pa: float, v_m_s: float) -> None:
         """Exact discretisation at (Q_r, V_r): Φ = e^{A dt}, Ψ = ∫_0^dt e^{A τ} dτ, and the
@@ -185,7 +159,7 @@ class ModalWing:
             expm_frechet(a * self.dt_s, d_a_dq * self.dt_s, compute_expm=False),
             expm_frechet(a * self.dt_s, d_a_dqv * self.dt_s, compute_expm=False),
         ])
-        self._input_cols = psi_lower @ np.column_stack([self._b_alpha, self._b_q, self._b_0])
+        self._input_cols = psi_lower @ self._forcing
         self._key = (q_pa, v_m_s)
 
     def prepare(self, flow: FlowState) -> None:
