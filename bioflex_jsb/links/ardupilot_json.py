@@ -1,0 +1,397 @@
+"""ArduPilot's JSON SITL interface: the simulator side of the protocol and a lock-step server.
+
+ArduPilot SITL started with ``--model JSON:127.0.0.1`` flies a physics model it talks to over
+UDP (``libraries/SITL/SIM_JSON.cpp`` and ``SIM_JSON.h`` of ArduPilot master 90700977c553;
+``libraries/SITL/examples/JSON/readme.md``). This module is the physics side of that link,
+without the physics: it imports neither JSBSim nor the co-simulation. A physics object that
+satisfies :class:`JsonPhysics` is driven one step per servo frame.
+
+ArduPilot → simulator (:func:`parse_servo_packet`): one datagram per SITL frame, little
+endian, to ``127.0.0.1:9002 + 10·instance`` (:func:`instance_port`):
+
+* ``<HHI16H>`` (40 bytes): magic 18458, frame_rate [Hz] (ArduPilot's ``SIM_RATE_HZ``,
+  default 1200), frame_count, 16 PWM values [µs];
+* ``<HHI32H>`` (72 bytes, ArduPilot parameter ``SERVO_32_ENABLE = 1``): magic 29569, the
+  same with 32 PWM values.
+
+Any other datagram is rejected (:class:`ServoPacketError`, counted in
+:class:`ServerStats`) and never answered.
+
+Simulator → ArduPilot (:func:`encode_reply`): ``"\\n" + one line of JSON + "\\n"`` to the
+datagram's source. ArduPilot turns every ``\\n`` into NUL and parses the text between the
+last two NULs; its parser (``JSON::parse_sensors``) looks each key up by substring and reads
+the value exactly two characters after the key's first letter past its end (closing quote
+and colon), so the JSON must be compact (separators ``","`` and ``":"``): a space after a
+colon makes ``sscanf("[%f, %f, %f]")`` miss the ``[``. Key order here is fixed and no key
+is a substring of an earlier one. Booleans would be read with ``strtoull`` (``true`` reads as
+0), so none are sent. Non-finite numbers are refused (``json`` would write ``NaN``).
+
+Fields (:class:`JsonState`, SI, converted by the physics object, not here):
+
+================ ============================================================================
+``timestamp``    physics time [s] (double in ArduPilot; its clock advances by its change)
+``imu.gyro``     body angular rate (p, q, r) [rad/s], body FRD
+``imu.accel_body`` specific force (accelerometer) [m/s²], body FRD; ≈ (0, 0, −9.81) level at
+                 rest
+``position``     position from home (north, east, down) [m], NED (double in ArduPilot)
+``quaternion``   attitude (w, x, y, z), rotates body FRD vectors into NED; used if present
+``attitude``     (roll, pitch, yaw) [rad], 3-2-1 Euler angles body FRD against NED
+``velocity``     velocity over ground (north, east, down) [m/s], NED
+``airspeed``     optional: true airspeed [m/s]; without it ArduPilot computes it from
+                 ``velocity`` with zero wind
+================ ============================================================================
+
+Lock-step rules (:meth:`LockstepServer.handle`), from ``JSON::recv_fdm``: ArduPilot sends
+frame n, waits for the reply and only then sends frame n+1 (its ``frame_counter`` advances
+only on a reply it could parse); without a reply for 1 s it sends frame n again.
+
+* a frame_count greater than the last one: one physics step with the packet's PWM, one
+  reply with the new state (a jump of more than one is counted in ``frames_skipped``);
+* the same frame_count again: the same reply again, no step (ArduPilot's timestamp then
+  does not change, so its clock does not advance either);
+* a smaller frame_count: ArduPilot SITL restarted, so the physics is reset, then stepped
+  once as for a new frame.
+
+ArduPilot adopts 1/Δtimestamp as its frame rate for 0 < Δt < 0.1 s, so the physics may
+step by its own time step; ``frame_rate_hz`` is passed to it for information. frame_count
+is ArduPilot's uint32 and would wrap after 2³² frames (41 days at 1200 Hz); a wrap would be
+taken for a restart.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import select
+import socket
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+# SIM_JSON.h, servo_packet_16 / servo_packet_32: magic, frame_rate, frame_count, pwm[]
+MAGIC_16 = 18458
+MAGIC_32 = 29569
+SERVO_16 = struct.Struct("<HHI16H")
+SERVO_32 = struct.Struct("<HHI32H")
+# SIM_JSON.h, control_port = 9002; SITL adds 10 per instance (-I): 9002, 9012, ...
+BASE_PORT = 9002
+PORT_STEP_PER_INSTANCE = 10
+DEFAULT_HOST = "127.0.0.1"
+# SIM_JSON.h: sensor_buffer[65000] holds the replies; one reply must fit with room to spare.
+MAX_REPLY_BYTES = 32000
+RECV_BYTES = 512  # larger datagrams are truncated and then rejected by their length
+QUATERNION_NORM_TOLERANCE = 1e-3  # ArduPilot's rotation_matrix assumes a unit quaternion
+
+
+class ServoPacketError(ValueError):
+    """A datagram that is not an ArduPilot JSON servo packet; one line.
+
+    ``reason`` is "length" or "magic" (the key of :attr:`ServerStats.by_reason`).
+    """
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason
+
+
+class JsonStateError(ValueError):
+    """A physics state that cannot be sent to ArduPilot; one line."""
+
+
+@dataclass(frozen=True)
+class ServoPacket:
+    """One ArduPilot SITL output frame.
+
+    frame_rate_hz: ArduPilot's physics rate request [Hz] (SIM_RATE_HZ).
+    frame_count: ArduPilot's frame counter (uint32).
+    pwm_us: servo outputs [µs], channel 1 first; 16 or 32 values.
+    """
+
+    frame_rate_hz: int
+    frame_count: int
+    pwm_us: tuple[int, ...]
+
+
+def instance_port(instance: int = 0) -> int:
+    """The UDP port ArduPilot SITL instance ``instance`` (its ``-I``) sends servos to."""
+    if isinstance(instance, bool) or not isinstance(instance, int) or instance < 0:
+        raise ValueError(f"SITL instance must be an integer >= 0, got {instance!r}")
+    port = BASE_PORT + PORT_STEP_PER_INSTANCE * instance
+    if port > 65535:
+        raise ValueError(f"SITL instance {instance} gives port {port} > 65535")
+    return port
+
+
+def parse_servo_packet(data: bytes) -> ServoPacket:
+    """Decode one servo datagram; ServoPacketError (one line) for anything else."""
+    if len(data) == SERVO_16.size:
+        fields, magic_expected = SERVO_16.unpack(data), MAGIC_16
+    elif len(data) == SERVO_32.size:
+        fields, magic_expected = SERVO_32.unpack(data), MAGIC_32
+    else:
+        raise ServoPacketError(
+            f"servo packet of {len(data)} bytes (expected {SERVO_16.size} or {SERVO_32.size})",
+            "length")
+    magic, rate_hz, frame_count = fields[0], fields[1], fields[2]
+    if magic != magic_expected:
+        raise ServoPacketError(
+            f"servo packet of {len(data)} bytes with magic {magic} (expected {magic_expected})",
+            "magic")
+    return ServoPacket(frame_rate_hz=rate_hz, frame_count=frame_count, pwm_us=tuple(fields[3:]))
+
+
+def _vector(name: str, value, length: int) -> tuple[float, ...]:
+    try:
+        out = tuple(float(v) for v in value)
+    except TypeError as exc:
+        raise JsonStateError(f"{name} must be a sequence of {length} numbers: {exc}") from None
+    if len(out) != length:
+        raise JsonStateError(f"{name} must have {length} components, got {len(out)}")
+    if not all(math.isfinite(v) for v in out):
+        raise JsonStateError(f"{name} must be finite, got {out}")
+    return out
+
+
+@dataclass(frozen=True)
+class JsonState:
+    """The state ArduPilot reads after one physics step (SI; frames as named).
+
+    timestamp_s: physics time [s], ≥ 0, non-decreasing between resets.
+    gyro_rad_s: body angular rate (p, q, r) [rad/s], body FRD.
+    accel_body_m_s2: specific force (what an accelerometer reads: acceleration minus
+        gravity) [m/s²], body FRD; (0, 0, −g) level at rest.
+    position_ned_m: position from home (north, east, down) [m], NED.
+    velocity_ned_m_s: velocity over ground (north, east, down) [m/s], NED.
+    quaternion: attitude (w, x, y, z), unit, rotating body-FRD vectors into NED; or None.
+    attitude_rad: (roll, pitch, yaw) [rad], 3-2-1 Euler angles of body FRD against NED; or
+        None. At least one of quaternion and attitude_rad; ArduPilot uses the quaternion
+        when both are sent.
+    airspeed_m_s: true airspeed [m/s] or None (ArduPilot then derives it from the velocity
+        with zero wind, which is wrong in a gust: send it).
+    """
+
+    timestamp_s: float
+    gyro_rad_s: tuple[float, float, float]
+    accel_body_m_s2: tuple[float, float, float]
+    position_ned_m: tuple[float, float, float]
+    velocity_ned_m_s: tuple[float, float, float]
+    quaternion: tuple[float, float, float, float] | None = None
+    attitude_rad: tuple[float, float, float] | None = None
+    airspeed_m_s: float | None = None
+
+    def __post_init__(self) -> None:
+        (t,) = _vector("timestamp_s", (self.timestamp_s,), 1)
+        if t < 0.0:
+            raise JsonStateError(f"timestamp_s must be >= 0, got {t}")
+        object.__setattr__(self, "timestamp_s", t)
+        for name in ("gyro_rad_s", "accel_body_m_s2", "position_ned_m", "velocity_ned_m_s"):
+            object.__setattr__(self, name, _vector(name, getattr(self, name), 3))
+        if self.quaternion is None and self.attitude_rad is None:
+            raise JsonStateError("JsonState needs a quaternion or attitude_rad (or both)")
+        if self.quaternion is not None:
+            q = _vector("quaternion", self.quaternion, 4)
+            norm = math.sqrt(sum(c * c for c in q))
+            if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+                raise JsonStateError(f"quaternion must be a unit quaternion, |q| = {norm:.6g}")
+            object.__setattr__(self, "quaternion", q)
+        if self.attitude_rad is not None:
+            object.__setattr__(self, "attitude_rad", _vector("attitude_rad",
+                                                             self.attitude_rad, 3))
+        if self.airspeed_m_s is not None:
+            (v,) = _vector("airspeed_m_s", (self.airspeed_m_s,), 1)
+            if v < 0.0:
+                raise JsonStateError(f"airspeed_m_s must be >= 0, got {v}")
+            object.__setattr__(self, "airspeed_m_s", v)
+
+
+def encode_reply(state: JsonState) -> bytes:
+    """The datagram answering one servo frame: ``\\n`` + compact JSON + ``\\n`` (ASCII).
+
+    Keys in this order: timestamp, imu (gyro, accel_body), position, quaternion, attitude,
+    velocity, airspeed (the optional ones only when set).
+    """
+    doc: dict[str, object] = {
+        "timestamp": state.timestamp_s,
+        "imu": {"gyro": list(state.gyro_rad_s), "accel_body": list(state.accel_body_m_s2)},
+        "position": list(state.position_ned_m),
+    }
+    if state.quaternion is not None:
+        doc["quaternion"] = list(state.quaternion)
+    if state.attitude_rad is not None:
+        doc["attitude"] = list(state.attitude_rad)
+    doc["velocity"] = list(state.velocity_ned_m_s)
+    if state.airspeed_m_s is not None:
+        doc["airspeed"] = state.airspeed_m_s
+    text = json.dumps(doc, separators=(",", ":"), allow_nan=False)
+    data = ("\n" + text + "\n").encode("ascii")
+    if len(data) > MAX_REPLY_BYTES:  # cannot happen with the fixed fields above
+        raise JsonStateError(f"reply of {len(data)} bytes exceeds {MAX_REPLY_BYTES}")
+    return data
+
+
+class JsonPhysics(Protocol):
+    """What the lock-step server drives: one step per new ArduPilot frame."""
+
+    def reset(self) -> None:
+        """Back to the initial state (ArduPilot SITL restarted); timestamp back to its start."""
+
+    def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
+        """Advance one step with these servo outputs [µs, channel 1 first]."""
+
+    def state(self) -> JsonState:
+        """The state after the last step (or reset)."""
+
+
+# What the server did with a frame (FrameRecord.action).
+STEP = "step"
+RESEND = "resend"
+RESET = "reset"  # physics reset, then one step
+
+
+@dataclass(frozen=True)
+class FrameRecord:
+    """One answered servo frame, for logs (the ``on_frame`` callback).
+
+    action: STEP, RESEND (same reply again, no step) or RESET (reset, then one step).
+    timestamp_s: physics time of the state sent [s].
+    source: (host, port) the packet came from and the reply went to.
+    """
+
+    frame_count: int
+    frame_rate_hz: int
+    pwm_us: tuple[int, ...]
+    action: str
+    timestamp_s: float
+    source: tuple[str, int]
+
+
+@dataclass
+class ServerStats:
+    """Counters of the lock-step server."""
+
+    steps: int = 0  # physics steps (new frames, including those after a reset)
+    resends: int = 0  # repeated frame_count answered again without a step
+    resets: int = 0  # frame_count went backwards: physics reset
+    frames_skipped: int = 0  # frame numbers jumped over (never stepped)
+    rejected: int = 0  # datagrams that were not servo packets (not answered)
+    last_error: str = ""  # the last rejection's reason
+    received: int = 0  # datagrams read
+    by_reason: dict[str, int] = field(default_factory=dict)
+
+
+class LockstepServer:
+    """ArduPilot's JSON physics peer over one UDP socket: one step and one reply per frame.
+
+    Binds ``host:port`` (default 127.0.0.1 and :func:`instance_port` of ``instance``; port 0
+    picks a free port, see :attr:`address`) and replies to each packet's source. The physics
+    is not reset at start: the first frame, whatever its count, is stepped from the state it
+    is in. Exceptions of the physics (a range check of the co-simulation, say) propagate to
+    the caller of :meth:`serve_once` / :meth:`serve`; bad datagrams never do.
+    """
+
+    def __init__(self, physics: JsonPhysics, *, host: str = DEFAULT_HOST,
+                 port: int | None = None, instance: int = 0,
+                 on_frame: Callable[[FrameRecord], None] | None = None) -> None:
+        self.physics = physics
+        self.on_frame = on_frame
+        self.stats = ServerStats()
+        self.last_frame_count: int | None = None
+        self._last_reply: bytes | None = None
+        self._last_time_s = math.nan
+        bind_port = instance_port(instance) if port is None else port
+        if not 0 <= bind_port <= 65535:
+            raise ValueError(f"UDP port must be in 0..65535, got {bind_port}")
+        self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            self._sock.bind((host, bind_port))
+        except OSError as exc:
+            self._sock.close()
+            raise ValueError(f"cannot bind UDP {host}:{bind_port}: {exc.strerror}") from None
+        self._sock.setblocking(False)
+
+    @property
+    def address(self) -> tuple[str, int]:
+        """(host, port) the server listens on."""
+        return self._sock.getsockname()
+
+    def close(self) -> None:
+        self._sock.close()
+
+    def __enter__(self) -> LockstepServer:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+    def _reject(self, reason: str, detail: str) -> None:
+        self.stats.rejected += 1
+        self.stats.by_reason[reason] = self.stats.by_reason.get(reason, 0) + 1
+        self.stats.last_error = detail
+
+    def handle(self, data: bytes, source: tuple[str, int] = ("", 0)) -> bytes | None:
+        """Apply the lock-step rules to one datagram; the reply to send, or None if rejected."""
+        try:
+            packet = parse_servo_packet(data)
+        except ServoPacketError as exc:
+            self._reject(exc.reason, str(exc))
+            return None
+        last = self.last_frame_count
+        if last is not None and packet.frame_count == last and self._last_reply is not None:
+            action = RESEND
+            self.stats.resends += 1
+            reply = self._last_reply
+        else:
+            action = STEP
+            if last is not None and packet.frame_count < last:
+                action = RESET
+                self.stats.resets += 1
+                self.physics.reset()
+            elif last is not None and packet.frame_count > last + 1:
+                self.stats.frames_skipped += packet.frame_count - last - 1
+            self.physics.step(packet.pwm_us, packet.frame_rate_hz)
+            self.stats.steps += 1
+            state = self.physics.state()
+            reply = encode_reply(state)
+            self._last_reply = reply
+            self._last_time_s = state.timestamp_s
+            self.last_frame_count = packet.frame_count
+        if self.on_frame is not None:
+            self.on_frame(FrameRecord(
+                frame_count=packet.frame_count, frame_rate_hz=packet.frame_rate_hz,
+                pwm_us=packet.pwm_us, action=action, timestamp_s=self._last_time_s,
+                source=(str(source[0]), int(source[1]))))
+        return reply
+
+    def serve_once(self, timeout_s: float | None = None) -> bool:
+        """Wait up to ``timeout_s`` [s] (None: forever) for one datagram and answer it.
+
+        True if a datagram was read (answered or rejected), False on timeout.
+        """
+        if timeout_s is not None and timeout_s < 0:
+            raise ValueError(f"timeout_s must be >= 0 or None, got {timeout_s}")
+        readable, _, _ = select.select([self._sock], [], [], timeout_s)
+        if not readable:
+            return False
+        try:
+            data, source = self._sock.recvfrom(RECV_BYTES)
+        except BlockingIOError:
+            return False
+        self.stats.received += 1
+        reply = self.handle(data, source)
+        if reply is not None:
+            try:
+                self._sock.sendto(reply, source)
+            except BlockingIOError:
+                pass  # ArduPilot re-sends the frame after 1 s; it is answered then
+        return True
+
+    def serve(self, should_stop: Callable[[], bool] | None = None,
+              poll_s: float = 0.1) -> None:
+        """Answer datagrams until ``should_stop()`` is true (checked every ``poll_s`` [s] of
+        idle time and after each datagram)."""
+        if poll_s <= 0:
+            raise ValueError(f"poll_s must be > 0, got {poll_s}")
+        while should_stop is None or not should_stop():
+            self.serve_once(poll_s)
+

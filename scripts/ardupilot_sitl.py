@@ -1,0 +1,264 @@
+#!/usr/bin/env python3
+"""Build ArduPlane SITL from an ArduPilot checkout and fly bioflex through it (docs/ardupilot.md).
+
+    python scripts/ardupilot_sitl.py build /path/to/ardupilot [--jobs 1] [--venv DIR]
+    python scripts/ardupilot_sitl.py fly /path/to/ardupilot [--timeout-s 900] [--out DIR]
+
+``build`` runs ``./waf configure --board sitl --no-submodule-update`` and ``./waf plane`` at
+``nice 19`` (the checkout must have its submodules: waf, mavlink + pymavlink, DroneCAN
+DSDL / dronecan_dsdlc / libcanard / pydronecan, littlefs, lwip; ``--disable-networking``
+builds without lwip). ``--venv`` is a virtual environment with the build's Python
+packages (empy==3.3.4, pexpect, future, dronecan, pymavlink); its ``bin`` goes first on PATH.
+
+``fly`` always runs inside a new network namespace with loopback only (ArduPilot's TCP
+ports 5760, 5762, 5763 listen on all interfaces): it re-executes itself under
+``unshare -n`` (as root) or ``unshare -rn`` (as a user), brings ``lo`` up, starts the physics
+(``--physics-cmd``, default the bioflex JSON backend on UDP 9002), starts ArduPlane with
+``bioflex_jsb/data/ardupilot/bioflex_plane.parm``, and flies a takeoff + 4-waypoint + RTL
+mission over MAVLink (pymavlink, TCP 5760). It prints one JSON summary: waypoints reached,
+cross-track error [m], ArduPilot's STATUSTEXT messages, simulated and wall time [s].
+Nothing here is ArduPilot's code; the checkout is only built and run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+PARAM_FILE = REPO / "bioflex_jsb" / "data" / "ardupilot" / "bioflex_plane.parm"
+NETNS_ENV = "BIOFLEX_ARDUPILOT_NETNS"  # set inside the private namespace
+MAVLINK_URL = "tcp:127.0.0.1:5760"  # ArduPilot SITL SERIAL0, instance 0
+# The bioflex side: the co-simulation as ArduPilot's JSON physics (issue 19). The command
+# name is the one the CLI is to get; override with --physics-cmd.
+DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb sitl --autopilot ardupilot "
+                       "--wing optimised --model coupled --gust 1-cosine:2:15 --gust-at 60")
+# Mission (metres from home, NED; altitude above home [m]): a 300 m square flown clockwise.
+TAKEOFF_ALT_M = 40.0  # NAV_TAKEOFF altitude
+TAKEOFF_PITCH_DEG = 12.0  # NAV_TAKEOFF minimum pitch (ArduPlane docs suggest 10..15 deg)
+MISSION_ALT_M = 60.0
+SQUARE_M = ((300.0, 0.0), (300.0, 300.0), (0.0, 300.0), (0.0, 0.0))
+EARTH_RADIUS_M = 6378137.0  # WGS-84 equatorial radius: metres → degrees near home
+
+
+class ScriptError(Exception):
+    """One line for the user."""
+
+
+def build(ap: Path, jobs: int, venv: Path | None, disable_networking: bool) -> None:
+    if not (ap / "waf").is_file() or not (ap / "modules" / "waf").is_dir():
+        raise ScriptError(f"{ap} is not an ArduPilot checkout with its submodules")
+    env = dict(os.environ)
+    if venv is not None:
+        env["PATH"] = f"{venv / 'bin'}{os.pathsep}{env['PATH']}"
+    configure = ["nice", "-n", "19", "./waf", "configure", "--board", "sitl",
+                 "--no-submodule-update"]
+    if disable_networking:
+        configure.append("--disable-networking")
+    for cmd in (configure, ["nice", "-n", "19", "./waf", "plane", f"-j{jobs}"]):
+        print("+", " ".join(cmd), flush=True)
+        if subprocess.run(cmd, cwd=ap, env=env).returncode != 0:
+            raise ScriptError(f"{' '.join(cmd)} failed")
+    print(ap / "build" / "sitl" / "bin" / "arduplane")
+
+
+def _in_private_netns() -> None:
+    """Re-execute this script in a loopback-only network namespace (does not return)."""
+    if shutil.which("unshare") is None or shutil.which("ip") is None:
+        raise ScriptError("fly needs unshare(1) and ip(8) for a loopback-only namespace")
+    flags = "-n" if os.geteuid() == 0 else "-rn"
+    inner = f"ip link set lo up && exec {shlex.join([sys.executable, *sys.argv])}"
+    env = dict(os.environ, **{NETNS_ENV: "1"})
+    os.execvpe("unshare", ["unshare", flags, "sh", "-c", inner], env)
+
+
+def _offset(lat_deg: float, lon_deg: float, north_m: float, east_m: float):
+    lat = lat_deg + math.degrees(north_m / EARTH_RADIUS_M)
+    lon = lon_deg + math.degrees(east_m / (EARTH_RADIUS_M * math.cos(math.radians(lat_deg))))
+    return lat, lon
+
+
+def _mission(mav, home_lat: float, home_lon: float):
+    from pymavlink import mavutil
+
+    m = mavutil.mavlink
+    rel = m.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    items = [(m.MAV_CMD_NAV_WAYPOINT, 0.0, 0.0, 0.0)]  # item 0: home (ArduPilot overwrites it)
+    items.append((m.MAV_CMD_NAV_TAKEOFF, TAKEOFF_PITCH_DEG, 0.0, TAKEOFF_ALT_M))
+    items += [(m.MAV_CMD_NAV_WAYPOINT, n, e, MISSION_ALT_M) for n, e in SQUARE_M]
+    items.append((m.MAV_CMD_NAV_RETURN_TO_LAUNCH, 0.0, 0.0, 0.0))
+    messages = []
+    for seq, (cmd, a, b, alt) in enumerate(items):
+        if cmd == m.MAV_CMD_NAV_TAKEOFF:
+            p1, lat, lon = a, home_lat, home_lon
+        else:
+            p1 = 0.0
+            lat, lon = _offset(home_lat, home_lon, a, b)
+        messages.append(m.MAVLink_mission_item_int_message(
+            mav.target_system, mav.target_component, seq, rel, cmd, 0, 1, p1, 0, 0, 0,
+            int(lat * 1e7), int(lon * 1e7), alt, m.MAV_MISSION_TYPE_MISSION))
+    mav.mav.mission_count_send(mav.target_system, mav.target_component, len(messages),
+                               m.MAV_MISSION_TYPE_MISSION)
+    while True:
+        req = mav.recv_match(type=["MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK"],
+                             blocking=True, timeout=10)
+        if req is None:
+            raise ScriptError("mission upload: no request from ArduPlane in 10 s")
+        if req.get_type() == "MISSION_ACK":
+            if req.type != m.MAV_MISSION_ACCEPTED:
+                raise ScriptError(f"mission upload refused: MISSION_ACK type {req.type}")
+            return len(messages)
+        mav.mav.send(messages[req.seq])
+
+
+def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
+    if os.environ.get(NETNS_ENV) != "1":
+        _in_private_netns()
+    from pymavlink import mavutil
+
+    binary = ap / "build" / "sitl" / "bin" / "arduplane"
+    if not binary.is_file():
+        raise ScriptError(f"{binary} not built: run the build step first")
+    out.mkdir(parents=True, exist_ok=True)
+    procs = []
+    summary: dict = {"statustext": [], "reached": [], "xtrack_m": []}
+    wall0 = time.monotonic()
+    try:
+        with open(out / "physics.log", "w") as plog, open(out / "arduplane.log", "w") as alog:
+            procs.append(subprocess.Popen(shlex.split(physics_cmd), cwd=REPO, stdout=plog,
+                                          stderr=subprocess.STDOUT))
+            procs.append(subprocess.Popen(
+                [str(binary), "--model", "JSON:127.0.0.1", "--speedup", "1", "--slave", "0",
+                 "--defaults", str(PARAM_FILE), "-I0", "--wipe"],
+                cwd=out, stdout=alog, stderr=subprocess.STDOUT))
+            mav = _connect(mavutil, procs)
+            _run_mission(mav, procs, timeout_s, summary)
+    finally:
+        for p in reversed(procs):
+            if p.poll() is None:
+                p.terminate()
+                try:
+                    p.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+    summary["wall_s"] = time.monotonic() - wall0
+    if summary.get("sim_s"):
+        summary["real_time_factor"] = summary["sim_s"] / summary["wall_s"]
+    xt = summary.pop("xtrack_m")
+    if xt:
+        summary["xtrack_max_m"] = max(abs(x) for x in xt)
+        summary["xtrack_rms_m"] = math.sqrt(sum(x * x for x in xt) / len(xt))
+    return summary
+
+
+def _connect(mavutil, procs, timeout_s: float = 60.0):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if any(p.poll() is not None for p in procs):
+            raise ScriptError("the physics or ArduPlane exited at start (see their logs)")
+        try:
+            mav = mavutil.mavlink_connection(MAVLINK_URL, source_system=255)
+        except OSError:
+            time.sleep(1.0)
+            continue
+        if mav.wait_heartbeat(timeout=10) is not None:
+            return mav
+    raise ScriptError(f"no HEARTBEAT on {MAVLINK_URL} within {timeout_s:.0f} s")
+
+
+def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
+    """Wait for a GPS fix and home, upload the mission, AUTO + arm, watch until home."""
+    from pymavlink import mavutil
+
+    m = mavutil.mavlink
+    mav.mav.request_data_stream_send(mav.target_system, mav.target_component,
+                                     m.MAV_DATA_STREAM_ALL, 10, 1)
+    deadline = time.monotonic() + timeout_s
+    state = "wait_gps"
+    home = None
+    n_items = 0
+    sim_s = 0.0
+    asked_home_s = 0.0
+    while time.monotonic() < deadline:
+        if any(p.poll() is not None for p in procs):
+            summary["ended"] = "a process exited"
+            break
+        msg = mav.recv_match(blocking=True, timeout=1.0)
+        if msg is None:
+            continue
+        kind = msg.get_type()
+        if kind == "STATUSTEXT":
+            summary["statustext"].append(msg.text)
+        elif kind == "SYSTEM_TIME":
+            sim_s = msg.time_boot_ms * 1e-3
+        elif kind == "MISSION_ITEM_REACHED":
+            summary["reached"].append(msg.seq)
+        elif kind == "NAV_CONTROLLER_OUTPUT" and state == "auto":
+            summary["xtrack_m"].append(msg.xtrack_error)
+        elif kind == "GPS_RAW_INT" and state == "wait_gps" and msg.fix_type >= 3:
+            state = "wait_ready"
+        elif kind == "HOME_POSITION" and home is None:
+            home = (msg.latitude * 1e-7, msg.longitude * 1e-7)
+        if state == "wait_ready" and home is None and time.monotonic() - asked_home_s > 1.0:
+            asked_home_s = time.monotonic()
+            mav.mav.command_long_send(mav.target_system, mav.target_component,
+                                      m.MAV_CMD_GET_HOME_POSITION, 0, 0, 0, 0, 0, 0, 0, 0)
+        if state == "wait_ready" and home is not None:
+            n_items = _mission(mav, *home)
+            mav.set_mode("AUTO")
+            mav.arducopter_arm()
+            state = "auto"
+        if state == "auto" and summary["reached"] and summary["reached"][-1] >= n_items - 2:
+            # the last square corner reached: RTL follows; watch it arrive and loiter
+            if mav.location().alt is not None and _near_home(mav, home):
+                summary["ended"] = "home reached"
+                break
+    summary["sim_s"] = sim_s
+    summary["mission_items"] = n_items
+
+
+def _near_home(mav, home, radius_m: float = 100.0) -> bool:
+    loc = mav.location()
+    dn = math.radians(loc.lat - home[0]) * EARTH_RADIUS_M
+    de = math.radians(loc.lng - home[1]) * EARTH_RADIUS_M * math.cos(math.radians(home[0]))
+    return math.hypot(dn, de) < radius_m
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("build", help="build ArduPlane SITL in an ArduPilot checkout")
+    b.add_argument("ardupilot", type=Path)
+    b.add_argument("--jobs", type=int, default=1)
+    b.add_argument("--venv", type=Path, default=None)
+    b.add_argument("--disable-networking", action="store_true")
+    f = sub.add_parser("fly", help="fly the mission in a loopback-only network namespace")
+    f.add_argument("ardupilot", type=Path)
+    f.add_argument("--physics-cmd", default=DEFAULT_PHYSICS_CMD)
+    f.add_argument("--timeout-s", type=float, default=900.0)
+    f.add_argument("--out", type=Path, default=Path("ardupilot_run"))
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "build":
+            if args.jobs < 1:
+                raise ScriptError(f"--jobs must be >= 1, got {args.jobs}")
+            build(args.ardupilot.resolve(), args.jobs, args.venv, args.disable_networking)
+        else:
+            print(json.dumps(fly(args.ardupilot.resolve(), args.physics_cmd, args.timeout_s,
+                                 args.out.resolve()), indent=1))
+    except ScriptError as exc:
+        print(f"ardupilot_sitl: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

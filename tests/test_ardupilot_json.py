@@ -1,0 +1,414 @@
+"""ArduPilot JSON SITL link (bioflex_jsb.links.ardupilot_json) against a byte-exact stand-in of
+ArduPilot's side (tests/ardupilot_standin.py), over loopback UDP, without ArduPilot.
+
+The physics is a kinematic aircraft in a coordinated level turn whose IMU, position,
+velocity and attitude are analytically consistent, so the frame checks below (specific
+force + gravity = d(velocity)/dt in NED through ArduPilot's own rotation matrix; gyro =
+the rotation matrix's rate; d(position)/dt = velocity) test what ArduPilot would see.
+No test depends on timing: the server and the stand-in take turns in one thread (UDP
+loopback buffers the datagram in between), except the one that runs ``serve`` in a thread,
+whose only timeouts are failure limits.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import struct
+import threading
+
+import numpy as np
+import pytest
+
+from bioflex_jsb.links import ardupilot_json as aj
+from tests.ardupilot_standin import ArduPilotStandin, dcm_from_euler, dcm_of, parse_sensors
+
+G_M_S2 = 9.80665  # standard gravity, as the fake physics uses it
+DT_S = 1.0 / 960.0  # the co-simulation's step (simulation.modal_wing.DEFAULT_DT_S)
+
+
+def _quaternion_from_euler(roll: float, pitch: float, yaw: float) -> tuple[float, ...]:
+    """(w, x, y, z) of the 3-2-1 rotation body → NED (textbook half-angle products)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
+
+
+class LevelTurn:
+    """Kinematic aircraft: speed V, bank φ, constant altitude, turning right from north at
+    ω = g tanφ / V about a centre R = V/ω east of home. Body rates (0, ω sinφ, ω cosφ) FRD;
+    specific force (0, 0, −g/cosφ) FRD (coordinated: no side force)."""
+
+    def __init__(self, speed_m_s: float = 15.0, bank_rad: float = math.radians(30.0),
+                 altitude_m: float = 100.0, dt_s: float = DT_S, quaternion_order: str = "wxyz"):
+        self.v, self.phi, self.h, self.dt = speed_m_s, bank_rad, altitude_m, dt_s
+        self.omega = G_M_S2 * math.tan(bank_rad) / speed_m_s if bank_rad else 0.0
+        self.quaternion_order = quaternion_order
+        self.steps: list[tuple[tuple[int, ...], int]] = []
+        self.resets = 0
+        self.k = 0
+
+    def reset(self) -> None:
+        self.resets += 1
+        self.k = 0
+
+    def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
+        self.steps.append((pwm_us, frame_rate_hz))
+        self.k += 1
+
+    def state(self) -> aj.JsonState:
+        t = self.k * self.dt
+        psi = self.omega * t
+        if self.omega:
+            r = self.v / self.omega
+            north, east = r * math.sin(psi), r * (1.0 - math.cos(psi))
+        else:
+            north, east = self.v * t, 0.0
+        q = _quaternion_from_euler(self.phi, 0.0, psi)
+        if self.quaternion_order == "xyzw":  # a wrong convention, for the negative control
+            q = (q[1], q[2], q[3], q[0])
+        return aj.JsonState(
+            timestamp_s=t,
+            gyro_rad_s=(0.0, self.omega * math.sin(self.phi), self.omega * math.cos(self.phi)),
+            accel_body_m_s2=(0.0, 0.0, -G_M_S2 / math.cos(self.phi)),
+            position_ned_m=(north, east, -self.h),
+            velocity_ned_m_s=(self.v * math.cos(psi), self.v * math.sin(psi), 0.0),
+            quaternion=q,
+            attitude_rad=(self.phi, 0.0, math.atan2(math.sin(psi), math.cos(psi))),
+            airspeed_m_s=self.v,
+        )
+
+
+@pytest.fixture
+def link():
+    physics = LevelTurn()
+    records: list[aj.FrameRecord] = []
+    server = aj.LockstepServer(physics, port=0, on_frame=records.append)
+    ap = ArduPilotStandin(server.address)
+    yield physics, server, ap, records
+    ap.close()
+    server.close()
+
+
+def _frame(server, ap, pwm):
+    """ArduPilot sends one frame, the server answers it, ArduPilot reads the answer."""
+    ap.send_servos(pwm)
+    assert server.serve_once(timeout_s=5.0)
+    return ap.receive()
+
+
+def _pwm(k: int) -> list[int]:
+    return [1000 + (k + i) % 1000 for i in range(16)]
+
+
+# ---------------------------------------------------------------------------------------
+# Packets and replies
+# ---------------------------------------------------------------------------------------
+
+def test_servo_packets_16_and_32_channels_decode():
+    p16 = struct.pack("<HHI16H", 18458, 1200, 7, *range(1100, 1116))
+    p32 = struct.pack("<HHI32H", 29569, 400, 2**32 - 1, *range(1000, 1032))
+    a, b = aj.parse_servo_packet(p16), aj.parse_servo_packet(p32)
+    assert (a.frame_rate_hz, a.frame_count, a.pwm_us) == (1200, 7, tuple(range(1100, 1116)))
+    assert (b.frame_rate_hz, b.frame_count, b.pwm_us) == (400, 2**32 - 1,
+                                                          tuple(range(1000, 1032)))
+
+
+@pytest.mark.parametrize("data, reason", [
+    (struct.pack("<HHI16H", 29569, 1200, 0, *[1500] * 16), "magic"),  # 32-ch magic, 16 values
+    (struct.pack("<HHI32H", 18458, 1200, 0, *[1500] * 32), "magic"),
+    (struct.pack("<HHI15H", 18458, 1200, 0, *[1500] * 15), "length"),
+    (b"", "length"),
+    (b"\n{}\n", "length"),
+])
+def test_bad_packets_are_rejected_with_one_line(data, reason):
+    with pytest.raises(aj.ServoPacketError) as info:
+        aj.parse_servo_packet(data)
+    assert info.value.reason == reason and "\n" not in str(info.value)
+    assert isinstance(info.value, ValueError)
+
+
+def test_reply_is_newline_compact_json_newline():
+    state = LevelTurn().state()
+    data = aj.encode_reply(state)
+    assert data.startswith(b"\n{") and data.endswith(b"}\n") and data.count(b"\n") == 2
+    assert b" " not in data
+    doc = json.loads(data)
+    assert list(doc) == ["timestamp", "imu", "position", "quaternion", "attitude", "velocity",
+                         "airspeed"]
+    assert list(doc["imu"]) == ["gyro", "accel_body"]
+
+
+@pytest.mark.parametrize("change, text", [
+    ({"gyro_rad_s": (0.0, math.nan, 0.0)}, "finite"),
+    ({"timestamp_s": math.inf}, "finite"),
+    ({"timestamp_s": -1.0}, ">= 0"),
+    ({"quaternion": (1.0, 0.1, 0.0, 0.0)}, "unit"),
+    ({"quaternion": None, "attitude_rad": None}, "quaternion or attitude"),
+    ({"position_ned_m": (0.0, 0.0)}, "3 components"),
+    ({"airspeed_m_s": -1.0}, ">= 0"),
+])
+def test_bad_states_raise_one_line_value_errors(change, text):
+    good = LevelTurn().state()
+    fields = {name: getattr(good, name) for name in good.__dataclass_fields__}
+    fields.update(change)
+    with pytest.raises(ValueError, match=text) as info:
+        aj.JsonState(**fields)
+    assert "\n" not in str(info.value)
+
+
+def test_instance_ports():
+    assert [aj.instance_port(i) for i in (0, 1, 2)] == [9002, 9012, 9022]
+    for bad in (-1, 1.0, True, 7000):
+        with pytest.raises(ValueError):
+            aj.instance_port(bad)
+
+
+# ---------------------------------------------------------------------------------------
+# ArduPilot's parser (the stand-in) reading the replies
+# ---------------------------------------------------------------------------------------
+
+def test_standin_reads_every_field_of_the_reply():
+    state = LevelTurn(dt_s=0.25)
+    state.k = 37
+    s = state.state()
+    parsed = parse_sensors(aj.encode_reply(s).strip(b"\n"))
+    v = parsed.values
+    # timestamp and position are doubles in ArduPilot: exact; the rest are C floats.
+    assert v["timestamp"] == s.timestamp_s and v["position"] == s.position_ned_m
+    for key, ref in (("gyro", s.gyro_rad_s), ("accel_body", s.accel_body_m_s2),
+                     ("quaternion", s.quaternion), ("attitude", s.attitude_rad),
+                     ("velocity", s.velocity_ned_m_s), ("airspeed", (s.airspeed_m_s,))):
+        got = v[key] if isinstance(v[key], tuple) else (v[key],)
+        np.testing.assert_allclose(got, ref, rtol=1e-7, atol=1e-30, err_msg=key)
+    names = {"timestamp", "gyro", "accel_body", "position", "attitude", "quaternion",
+             "velocity", "airspeed"}
+    assert set(v) == names
+
+
+def test_space_after_colon_breaks_arduPilots_parser():
+    """The two-character rule: with json's default separators the vectors do not scan."""
+    s = LevelTurn().state()
+    compact = aj.encode_reply(s).strip(b"\n")
+    spaced = json.dumps(json.loads(compact)).encode()  # separators (', ', ': ')
+    assert parse_sensors(compact).bitmask & 0b1111111 == 0b1111111
+    broken = parse_sensors(spaced)
+    assert "gyro" not in broken.values and "Failed to parse" in broken.message
+    # and ArduPilot then refuses the frame: no attitude parsed, frame counter unchanged
+    ap = ArduPilotStandin(("127.0.0.1", 9))
+    try:
+        assert ap.accept(b"\n" + spaced + b"\n") is None
+        assert ap.frame_counter == 0 and ap.messages == ["Did not receive attitude or quaternion"]
+        assert ap.accept(b"\n" + compact + b"\n") is not None and ap.frame_counter == 1
+    finally:
+        ap.close()
+
+
+def test_standin_follows_the_substring_rule():
+    """ArduPilot finds keys by substring: a key containing 'position' earlier in the line is
+    read as the position (the reason encode_reply fixes its key order)."""
+    line = (b'{"timestamp":1,"imu":{"gyro":[0,0,0],"accel_body":[0,0,-9.8]},'
+            b'"home_position":[5,5,5],"position":[1,2,3],"attitude":[0,0,0],'
+            b'"velocity":[0,0,0]}')
+    assert parse_sensors(line).values["position"] == (5.0, 5.0, 5.0)
+    readme = (b'{"timestamp":2500,"imu":{"gyro":[0,0,0],"accel_body":[0,0,0]},'
+              b'"position":[0,0,0],"attitude":[0,0,0],"velocity":[0,0,0]}')
+    assert parse_sensors(readme).values["timestamp"] == 2500.0
+
+
+# ---------------------------------------------------------------------------------------
+# Lock-step, resend, reset
+# ---------------------------------------------------------------------------------------
+
+def test_one_step_and_one_reply_per_frame(link):
+    physics, server, ap, records = link
+    for k in range(50):
+        parsed = _frame(server, ap, _pwm(k))
+        assert parsed is not None, ap.messages
+        assert parsed.values["timestamp"] == (k + 1) * DT_S
+    assert ap.frame_counter == 50 and len(physics.steps) == 50
+    assert [p for p, _ in physics.steps] == [tuple(_pwm(k)) for k in range(50)]
+    assert {rate for _, rate in physics.steps} == {1200}
+    assert ap.time_now_us == pytest.approx(50 * DT_S * 1e6, rel=1e-12)
+    assert [r.frame_count for r in records] == list(range(50))
+    assert {r.action for r in records} == {aj.STEP}
+    assert records[-1].timestamp_s == 50 * DT_S and records[-1].pwm_us == tuple(_pwm(49))
+    assert records[-1].source == ap.sock.getsockname()
+    assert server.stats.steps == 50 and server.stats.resends == 0
+
+
+def test_repeated_frame_is_answered_again_without_a_step(link):
+    physics, server, ap, records = link
+    for k in range(3):
+        _frame(server, ap, _pwm(k))
+    ap.send_servos(_pwm(3))
+    assert server.serve_once(5.0)
+    first = ap.read_datagram()  # this reply is "lost": ArduPilot never parses it
+    ap.resend()  # 1 s later ArduPilot sends frame 3 again
+    assert server.serve_once(5.0)
+    again = ap.receive()
+    assert again is not None and again.values["timestamp"] == 4 * DT_S
+    assert ap.last_packet and len(physics.steps) == 4 and server.stats.resends == 1
+    ap.resend()
+    assert server.serve_once(5.0)
+    assert ap.read_datagram() == first  # the same bytes every time
+    assert [r.action for r in records[-3:]] == [aj.STEP, aj.RESEND, aj.RESEND]
+    assert records[-1].timestamp_s == records[-2].timestamp_s == 4 * DT_S
+    nxt = _frame(server, ap, _pwm(99))  # the counter moved on after the parsed reply
+    assert nxt is not None and nxt.values["timestamp"] == 5 * DT_S
+    assert physics.steps[-1][0] == tuple(_pwm(99))
+
+
+def test_backward_frame_count_resets_the_physics(link):
+    physics, server, ap, records = link
+    for k in range(20):
+        _frame(server, ap, _pwm(k))
+    ap.restart()  # a new SITL process: frame_count 0 again
+    parsed = _frame(server, ap, _pwm(0))
+    assert physics.resets == 1 and server.stats.resets == 1
+    assert parsed is not None and parsed.values["timestamp"] == DT_S  # reset, then one step
+    assert records[-1].action == aj.RESET and records[-1].frame_count == 0
+    assert ap.physics_resets_seen == 0  # ArduPilot's clock starts again cleanly
+    for k in range(1, 5):
+        _frame(server, ap, _pwm(k))
+    assert ap.time_now_us == pytest.approx(5 * DT_S * 1e6)
+    assert len(physics.steps) == 25 and records[-1].action == aj.STEP
+
+
+def test_skipped_frames_are_counted_and_stepped_once(link):
+    physics, server, ap, _ = link
+    _frame(server, ap, _pwm(0))
+    ap.frame_counter = 4  # frames 1..3 never arrived
+    _frame(server, ap, _pwm(4))
+    assert server.stats.frames_skipped == 3 and len(physics.steps) == 2
+
+
+def test_bad_datagrams_are_counted_never_answered_and_the_link_goes_on(link):
+    physics, server, ap, _ = link
+    _frame(server, ap, _pwm(0))
+    for junk in (b"hello", struct.pack("<HHI16H", 1234, 1200, 1, *[1500] * 16)):
+        ap.send_raw(junk)
+        assert server.serve_once(5.0)
+    assert server.stats.rejected == 2
+    assert server.stats.by_reason == {"length": 1, "magic": 1}
+    assert "1234" in server.stats.last_error
+    parsed = _frame(server, ap, _pwm(1))  # the next datagram the stand-in reads is this one
+    assert parsed is not None and parsed.values["timestamp"] == 2 * DT_S
+    assert len(physics.steps) == 2
+
+
+def test_thirty_two_channels(link):
+    physics, server, _, _ = link
+    ap = ArduPilotStandin(server.address, channels=32, rate_hz=400)
+    try:
+        pwm = list(range(1000, 1032))
+        assert _frame(server, ap, pwm) is not None
+        assert physics.steps[-1] == (tuple(pwm), 400)
+    finally:
+        ap.close()
+
+
+def test_serve_loop_in_a_thread_stops_when_asked():
+    physics = LevelTurn()
+    stop = threading.Event()
+    with aj.LockstepServer(physics, port=0) as server:
+        thread = threading.Thread(target=server.serve, args=(stop.is_set, 0.02), daemon=True)
+        thread.start()
+        ap = ArduPilotStandin(server.address)
+        try:
+            for k in range(30):
+                ap.send_servos(_pwm(k))
+                assert ap.receive() is not None
+        finally:
+            ap.close()
+            stop.set()
+            thread.join(timeout=5.0)
+        assert not thread.is_alive() and len(physics.steps) == 30
+
+
+def test_bind_failure_is_a_one_line_value_error():
+    with aj.LockstepServer(LevelTurn(), port=0) as first:
+        with pytest.raises(ValueError, match="cannot bind") as info:
+            aj.LockstepServer(LevelTurn(), port=first.address[1])
+        assert "\n" not in str(info.value)
+
+
+# ---------------------------------------------------------------------------------------
+# Units and frames as ArduPilot reads them
+# ---------------------------------------------------------------------------------------
+
+def _fly(order: str = "wxyz", frames: int = 200):
+    physics = LevelTurn(quaternion_order=order)
+    with aj.LockstepServer(physics, port=0) as server:
+        ap = ArduPilotStandin(server.address)
+        try:
+            out = []
+            for k in range(frames):
+                parsed = _frame(server, ap, _pwm(k))
+                assert parsed is not None, ap.messages
+                out.append(parsed)
+        finally:
+            ap.close()
+    return physics, out
+
+
+def _frame_errors(parsed) -> dict[str, float]:
+    """Largest inconsistencies of a parsed history, in ArduPilot's frames (central
+    differences over the frames' timestamps)."""
+    t = np.array([p.values["timestamp"] for p in parsed])
+    pos = np.array([p.values["position"] for p in parsed])
+    vel = np.array([p.values["velocity"] for p in parsed])
+    acc_b = np.array([p.values["accel_body"] for p in parsed])
+    gyro = np.array([p.values["gyro"] for p in parsed])
+    dcm = np.array([dcm_of(p) for p in parsed])
+    dt = t[2:] - t[:-2]
+    # specific force rotated to NED plus gravity (NED down) = acceleration over ground
+    acc_ned = np.einsum("kij,kj->ki", dcm[1:-1], acc_b[1:-1]) + [0.0, 0.0, G_M_S2]
+    dv = (vel[2:] - vel[:-2]) / dt[:, None]
+    # d(position)/dt = velocity
+    dp = (pos[2:] - pos[:-2]) / dt[:, None]
+    # Ṙ = R [ω]×  →  [ω]× = Rᵀ Ṙ (body rates in body FRD)
+    rdot = (dcm[2:] - dcm[:-2]) / dt[:, None, None]
+    w = np.einsum("kji,kjl->kil", dcm[1:-1], rdot)
+    omega = np.stack([w[:, 2, 1], w[:, 0, 2], w[:, 1, 0]], axis=1)
+    euler = np.array([dcm_from_euler(*p.values["attitude"]) for p in parsed])
+    return {
+        "accel_m_s2": float(np.abs(acc_ned - dv).max()),
+        "velocity_m_s": float(np.abs(dp - vel[1:-1]).max()),
+        "gyro_rad_s": float(np.abs(omega - gyro[1:-1]).max()),
+        "euler_vs_quaternion": float(np.abs(euler - dcm).max()),
+    }
+
+
+def test_imu_position_velocity_attitude_are_consistent_in_arduPilots_frames():
+    physics, parsed = _fly()
+    err = _frame_errors(parsed)
+    # float32 storage of velocity (15 m/s → 1e-6 m/s) over 2·dt = 2 ms gives ≈ 1e-3 m/s² of
+    # differencing noise; the kinematics themselves are exact to O(dt²).
+    assert err["accel_m_s2"] < 5e-3, err
+    assert err["velocity_m_s"] < 1e-6, err
+    assert err["gyro_rad_s"] < 5e-3, err
+    assert err["euler_vs_quaternion"] < 1e-6, err
+    # the turn is real: 1.1 g of specific force and a yaw rate of 0.38 rad/s are seen
+    last = parsed[-1].values
+    assert last["accel_body"][2] == pytest.approx(-G_M_S2 / math.cos(math.radians(30)), 1e-6)
+    assert math.hypot(*last["gyro"][1:]) == pytest.approx(physics.omega, rel=1e-6)
+    assert physics.omega == pytest.approx(0.3775, abs=1e-4)
+
+
+def test_wrong_quaternion_order_is_caught_by_the_frame_check():
+    """Negative control: (x, y, z, w) instead of ArduPilot's (w, x, y, z)."""
+    _, parsed = _fly(order="xyzw", frames=20)
+    err = _frame_errors(parsed)
+    assert err["accel_m_s2"] > 1.0 and err["euler_vs_quaternion"] > 0.1
+
+
+def test_level_at_rest_reads_minus_g_on_body_z():
+    physics = LevelTurn(speed_m_s=1.0, bank_rad=0.0)
+    physics.v = 0.0
+    parsed = parse_sensors(aj.encode_reply(physics.state()).strip(b"\n"))
+    assert parsed.values["accel_body"] == pytest.approx((0.0, 0.0, -G_M_S2), abs=1e-6)
+    dcm = np.array(dcm_of(parsed))
+    np.testing.assert_allclose(dcm, np.eye(3), atol=1e-7)
