@@ -1,0 +1,14 @@
+"""aeroelasticity: flutter of clamped wings on unsteady strip aerodynamics.
+
+* :mod:`~bioflex_jsb.aeroelasticity.clamped_wing`: the beam's modes with aerodynamic strips
+  (2-D lift slope or the vortex lattice's span loading); the Goland wing's sections;
+* :mod:`~bioflex_jsb.aeroelasticity.strip_aero`: generalised aerodynamic forces, Theodorsen
+  (frequency domain) and Jones/Küssner finite-state (time domain);
+* :mod:`~bioflex_jsb.aeroelasticity.pk`: p-k flutter solution with branch tracking;
+* :mod:`~bioflex_jsb.aeroelasticity.state_space`: eigen-analysis of structure + lag states;
+* :mod:`~bioflex_jsb.aeroelasticity.flutter`: the result, mechanism and the Goland benchmark.
+"""
+
+from bioflex_jsb.aeroelasticity.flutter import FlutterResult, goland_flutter
+
+__all__ = ["FlutterResult", "goland_flutter"]
