@@ -11,6 +11,6 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0):
 
     setup = RunSetup(15.0, parse_gust("sharp:3"), duration_s)
     if model == "native":
-        return J.run_native_gust(Airframe(aircraft=J.aircraft_name("optimised")), setup)
+        return run_gust(Airframe(aircraft=J.aircraft_name("optimised")), None, "native", setup)
     wing = build_wing(VARIANTS["optimised"]).model
     return run_gust(Airframe(), wing, model, setup)

@@ -418,7 +418,7 @@ def test_fixed_width_numbers_match_printf():
 
 
 def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
-    from bioflex_jsb.drivers.gust import base_channels
+    from bioflex_jsb.simulation.channels import channel_units as base_channels
 
     names = tuple(base_channels(2))
     rng = np.random.default_rng(3)
@@ -445,7 +445,7 @@ def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
 def test_recorder_writes_each_complete_row_once_whatever_stops_the_run(tmp_path):
     """Rows reach the file as soon as their chunk is complete, each once: stop(n) after a
     failure writes the rest, a second stop or a stop at the chunk boundary adds nothing."""
-    from bioflex_jsb.drivers.gust import base_channels
+    from bioflex_jsb.simulation.channels import channel_units as base_channels
 
     names = tuple(base_channels(1))
     n_rows = 1000

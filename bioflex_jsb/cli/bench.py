@@ -38,9 +38,10 @@ def run(args: argparse.Namespace) -> int:
     import tempfile
     from pathlib import Path
 
-    from bioflex_jsb.drivers.gust import INTEGRATORS, RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.native import native_airframe
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
-    from bioflex_jsb.generators.native_wing import native_airframe
+    from bioflex_jsb.runtime.coupled_step import configure_airframe
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
@@ -49,9 +50,8 @@ def run(args: argparse.Namespace) -> int:
     if args.steps < 10 or args.repeat < 1:
         raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
     airframe = Airframe()
-    airframe.set_dt(DEFAULT_DT_S)
     build = build_wing(VARIANTS["optimised"])
-    dt = airframe.dt_s
+    dt = DEFAULT_DT_S
     setup = RunSetup(args.speed, parse_gust("sharp:0.3"), duration_s=args.steps * dt,
                      gust_start_s=0.5 * args.steps * dt, dt_s=dt)
 
@@ -65,9 +65,9 @@ def run(args: argparse.Namespace) -> int:
         return timed(airframe)
 
     native = native_airframe("optimised")
-    for af in (airframe, native):  # every timing with the co-simulation's integrators
-        for name, value in INTEGRATORS.items():
-            af[name] = value
+    # every timing with the co-simulation's integrators and step
+    configure_airframe(airframe, DEFAULT_DT_S)
+    configure_airframe(native, DEFAULT_DT_S, modal_hooks=False)
 
     def cosim(log=None) -> float:
         recorder = log.recorder("coupled") if log else None

@@ -1,7 +1,6 @@
-"""The SITL loop: the co-simulation of ``cosim.run_gust`` paced to the wall clock.
+"""The SITL loop: the one coupled step paced to the wall clock.
 
-The same step as :func:`bioflex_jsb.drivers.gust.run_gust` (gust → wind, flow from the
-airframe state, modal loads into ``external_reactions``, JSBSim step, modal step), on the
+The one coupled step (:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`), on the
 ``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml``, see
 :mod:`bioflex_jsb.generators.autopilot`) keeps it flying level on its own, for as long as
 asked (or until stopped).
@@ -42,26 +41,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bioflex_jsb import units as U
-from bioflex_jsb.drivers.gust import (
-    ALPHA_TABLE_RANGE_RAD,
-    INTEGRATORS,
-    base_channels,
-    row_values,
-    state_reader,
-)
-from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.generators.autopilot import SITL_AIRCRAFT
 from bioflex_jsb.links.mavlink import VehicleState
+from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, ModalWing, TrimReference
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 LINK_PERIOD_S = 1.0 / 200.0  # simulated time between link services [s]
 RESYNC_S = 0.25  # a loop this far behind its schedule starts a new one [s]
 SLEEP_MARGIN_S = 50e-6  # steps due within this are started at once (sleep overshoot)
 MANUAL_TIMEOUT_S = 1.0  # manual input older than this [wall s] gives control back
 SPEEDUP_RANGE = (0.1, 50.0)
-ETA_LIMIT_RAD = 0.52  # as cosim: beyond it the linear modal model is meaningless
 
 
 @dataclass
@@ -148,34 +139,29 @@ class SitlParameters:
 
 
 class SitlSim:
-    """The co-simulation state between steps: airframe (trimmed, autopilot engaged), modal
-    wing, the gust in progress."""
+    """The co-simulation state between steps: the one coupled step (airframe trimmed,
+    autopilot engaged, modal wing) and the gust in progress."""
 
     def __init__(self, wing_model, modes, model: str = "coupled", speed_m_s: float = 15.0,
                  altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S, speedup: float = 1.0,
                  airframe: Airframe | None = None) -> None:
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
         a = self.airframe
-        a.set_external_reactions()
-        for name, value in INTEGRATORS.items():
-            a[name] = value
-        a.set_dt(dt_s)
-        a["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
-        self.trim = a.trim(speed_m_s, altitude_m)
+
+        def disengage(af: Airframe) -> None:
+            af["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
+
+        self.core = CoupledStep(a, wing_model, model, speed_m_s, altitude_m, dt_s,
+                                before_trim=disengage)
+        core = self.core
+        self.trim = core.trim
         self.speed_m_s = speed_m_s
-        self.dt_s = a.dt_s
+        self.dt_s = core.dt_s
         self.speedup = float(speedup)
         self.resync = False
-        self._nodes = {k: a.property_node(v) for k, v in _READ.items()}
-        self._get = {k: n.get_double_value for k, n in self._nodes.items()}
-        self._read_state = state_reader(self._get)
-        self._wind = a.property_node("atmosphere/wind-down-fps")
-        self._write_reactions = a.external_reaction_writer()
-        rho0 = self._get["rho"]() * U.KG_M3_PER_SLUG_FT3
-        cond = level_flight_condition(speed_m_s)
-        ref = TrimReference(self.trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cond.cl_trim)
-        self.wing = ModalWing(wing_model, ref, model=model, dt_s=self.dt_s)
-        self.n_modes = wing_model.n_modes
+        self._get = core.get
+        self.wing = core.wing
+        self.n_modes = core.n_modes
         twist = np.asarray(modes.twist_rad, dtype=float)
         tip = int(np.argmax(np.abs(np.asarray(modes.stations_m, dtype=float))))
         self._tip_twist_per_mode = np.abs(twist[:, tip]) / np.max(np.abs(twist), axis=1)
@@ -188,15 +174,24 @@ class SitlSim:
         self.gust_amplitude_m_s = 1.0
         self.gust_length_m = 30.0
         self._gust: GustField | None = None
+        self._gust_start_k = 0
         self._gust_end_s = 0.0
-        self.t_s = 0.0
-        self.k = 0
-        self.units = base_channels(self.n_modes)
-        self.names = list(self.units)
+        self.units = core.units
+        self.names = list(core.names)
         self._manual_wall_s: float | None = None
         self.stopped: str | None = None
-        self._w_g, self._state = self._sense(0.0)
-        self.wing.prepare(self._state.flow)
+        core.prepare(0.0)
+        self._state = core.sense(0.0)
+
+    @property
+    def k(self) -> int:
+        """Steps flown."""
+        return self.core.k
+
+    @property
+    def t_s(self) -> float:
+        """Simulated time now [s]."""
+        return self.core.k * self.dt_s
 
     # -- commands from the link -------------------------------------------------------------
     @property
@@ -211,14 +206,13 @@ class SitlSim:
             spec = parse_gust(f"1cos:{self.gust_amplitude_m_s!r}:{self.gust_length_m!r}")
         except GustSpecError as exc:
             raise ValueError(str(exc)) from None
-        self._gust = GustField(spec, self.speed_m_s, self.t_s, self.t_s + 60.0, self.dt_s)
+        # the gust's own clock starts at this step (step 0 of the field)
+        self._gust = GustField(spec, self.speed_m_s, 0.0, 60.0, self.dt_s)
+        self._gust_start_k = self.k
         self._gust_end_s = self.t_s + self.gust_length_m / self.speed_m_s
 
     def set_wing_model(self, model: str) -> None:
-        if model != self.wing.model:
-            self.wing.model = model
-            self.wing.eta = np.zeros(self.n_modes)  # the coupled wing starts undeformed
-            self.wing.eta_dot = np.zeros(self.n_modes)
+        self.core.set_model(model)
 
     def manual(self, pitch: float | None, roll: float | None) -> None:
         """Stick increments on the trim (−1..1; pitch + = nose down), or None: release."""
@@ -233,41 +227,33 @@ class SitlSim:
         self._manual_wall_s = time.monotonic()
 
     # -- the step -----------------------------------------------------------------------
-    def _sense(self, t: float):
-        w_g = self._gust.vertical_m_s(t) if self._gust is not None else 0.0
-        wind_down_fps = -w_g * U.FT_PER_M
-        self._wind.set_double_value(wind_down_fps)
-        return w_g, self._read_state(wind_down_fps)
-
     def step(self) -> tuple:
-        """One co-simulation step (as ``run_gust``); returns the logged row's values (in
-        ``self.names`` order) and sets ``self.stopped`` when the run left its valid range."""
-        state, mw, get = self._state, self.wing, self._get
-        flow = state.flow
-        eta, eta_dot = mw.eta, mw.eta_dot
-        mw.step(flow)  # η_k → η_{k+1} with the flow of t_k held, as run_gust
-        loads = mw.loads(flow)
-        alpha = flow.alpha_rad
-        ca, sa = math.cos(alpha), math.sin(alpha)
-        self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
-                              loads.drag_n * ca - loads.lift_n * sa, loads.pitch_moment_n_m)
-        self.airframe.step()
-        values = row_values(state, self._w_g, loads, eta, eta_dot, self.trim, self.speed_m_s)
-        self.stopped = _check(values, self.t_s, alpha, mw.eta, get["agl"]())
-        self.k += 1
-        self.t_s = self.k * self.dt_s
-        self._w_g, self._state = self._sense(self.t_s)
+        """One co-simulation step (the one coupled step); returns the logged row's values
+        (in ``self.names`` order) and sets ``self.stopped`` when the run left its valid
+        range."""
+        core = self.core
+        values = core.advance(self._w_g(core.k))
+        self._state = None  # the snapshot of t_k+1 is read when asked for (vehicle_state)
+        self.stopped = core.stopped
         if self._manual_wall_s is not None and \
                 time.monotonic() - self._manual_wall_s > MANUAL_TIMEOUT_S:
             self.manual(None, None)
         return values
 
+    def _w_g(self, k: int) -> float:
+        """The gust [m/s, up] at step ``k``."""
+        gust = self._gust
+        return gust.at_step(k - self._gust_start_k) if gust is not None else 0.0
+
     def vehicle_state(self) -> VehicleState:
+        """The vehicle now (t_k, k steps flown), with the flow of this step's gust."""
         get, a = self._get, self.airframe
+        if self._state is None:
+            self._state = self.core.sense(self._w_g(self.core.k))
         h = get["h"]() * U.M_PER_FT
-        eta = self.wing.eta
+        eta = self.core.eta
         named = {f"eta{i + 1}": float(eta[i]) for i in range(min(3, self.n_modes))}
-        named["tip_twist"] = self.wing.tip_twist_rad(self._tip_twist_per_mode)
+        named["tip_twist"] = float(np.asarray(self._tip_twist_per_mode) @ eta)
         return VehicleState(
             time_s=self.t_s, roll_rad=self._state.phi_rad, pitch_rad=self._state.theta_rad,
             yaw_rad=get["psi"](),
@@ -279,32 +265,6 @@ class SitlSim:
             throttle=get["throttle"](), named=named,
             autopilot=a["ap/engage"] == 1.0, manual=a["ap/manual"] == 1.0,
         )
-
-
-_READ = {
-    "u": "velocities/u-fps", "v": "velocities/v-fps", "w": "velocities/w-fps",
-    "q": "velocities/q-rad_sec", "p": "velocities/p-rad_sec", "r": "velocities/r-rad_sec",
-    "theta": "attitude/theta-rad", "phi": "attitude/phi-rad", "psi": "attitude/psi-rad",
-    "rho": "atmosphere/rho-slugs_ft3", "nz": "accelerations/Nz", "h": "position/h-sl-ft",
-    "agl": "position/h-agl-ft", "lat": "position/lat-geod-rad", "lon": "position/long-gc-rad",
-    "vn": "velocities/v-north-fps", "ve": "velocities/v-east-fps", "vd": "velocities/v-down-fps",
-    "elevator": "fcs/elevator-pos-rad", "throttle": "fcs/throttle-pos-norm",
-}
-
-
-def _check(values, t: float, alpha: float, eta, agl_ft: float) -> str | None:
-    """Why the run must stop (as cosim's range check), or None."""
-    if not all(map(math.isfinite, values)):
-        return f"the state became non-finite at t = {t:.3f} s"
-    lo, hi = ALPHA_TABLE_RANGE_RAD
-    if not lo <= alpha <= hi:
-        return (f"angle of attack {math.degrees(alpha):.1f} deg left the aerodynamic model at "
-                f"t = {t:.3f} s")
-    if len(eta) and float(np.max(np.abs(eta))) > ETA_LIMIT_RAD:
-        return f"a wing mode diverged (|eta| > {ETA_LIMIT_RAD} rad) at t = {t:.3f} s"
-    if agl_ft <= 0.0:
-        return f"the aircraft reached the ground at t = {t:.3f} s"
-    return None
 
 
 def run_paced(

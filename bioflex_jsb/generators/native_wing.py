@@ -105,6 +105,7 @@ from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for th
     leapfrog_matrix,
     leapfrog_step,
 )
+from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 EXPORT_MODELS = ("coupled", "qsd")
@@ -875,36 +876,6 @@ class TrimState:
     controls: dict[str, float]  # control command property → value
 
 
-def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> TrimState:
-    """Trim of the Fig. 21 case by :meth:`Airframe.trim` (the co-simulation's trim: same
-    integrators and step), read from the flying instance."""
-    from bioflex_jsb.drivers.gust import INTEGRATORS
-    from bioflex_jsb.runtime.fdm import _TRIM_CONTROLS, Airframe
-
-    af = Airframe()
-    for name, value in INTEGRATORS.items():
-        af[name] = value
-    af.set_dt(dt_s)
-    af.trim(P.SECTION5_AIRSPEED_M_S)
-    ic = {
-        "ubody": ("FT/SEC", af["velocities/u-fps"]),
-        "vbody": ("FT/SEC", af["velocities/v-fps"]),
-        "wbody": ("FT/SEC", af["velocities/w-fps"]),
-        "p": ("RAD/SEC", af["velocities/p-rad_sec"]),
-        "q": ("RAD/SEC", af["velocities/q-rad_sec"]),
-        "r": ("RAD/SEC", af["velocities/r-rad_sec"]),
-        "elevation": ("FT", af["position/terrain-elevation-asl-ft"]),
-        "altitudeMSL": ("FT", af["position/h-sl-ft"]),
-        "phi": ("RAD", af["attitude/phi-rad"]),
-        "theta": ("RAD", af["attitude/theta-rad"]),
-        "psi": ("RAD", af["attitude/psi-rad"]),
-        "latitude": ("RAD", af["position/lat-geod-rad"]),
-        "longitude": ("RAD", af["position/long-gc-rad"]),
-    }
-    names = _TRIM_CONTROLS + tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(af.engine_count))
-    return TrimState(ic, {name: af[name] for name in names})
-
-
 def _trim_num(x: float) -> str:
     """Trim values to 10 significant digits (regeneration stays byte-stable)."""
     x = float(x)
@@ -935,8 +906,6 @@ def render_fig21_script(state: TrimState, dt_s: float = DEFAULT_DT_S) -> str:
     airframe (integrators off) for ``FIG21_SETTLE_S`` while the propellers spin up to their
     trim RPM, then flies with the co-simulation's integrators; the gust comes
     ``FIG21_GUST_START_S`` later."""
-    from bioflex_jsb.drivers.gust import INTEGRATORS
-
     craft = aircraft_name(FIG21_VARIANT)
     amp = P.SECTION5_GUST_AMPLITUDE_M_S
     speed = P.SECTION5_AIRSPEED_M_S
@@ -998,106 +967,17 @@ def export(spec: ExportSpec, out_dir: Path, include_shared: bool = True) -> list
     return airframe_xml.write_files(render_aircraft_files(spec, include_shared), out_dir)
 
 
-def repository_files() -> dict[str, str]:
-    """Every file this module owns in the repository: path → text."""
+def repository_files(state: TrimState) -> dict[str, str]:
+    """Every file this module owns in the repository: path → text. ``state``: the Fig. 21
+    trim the initial condition and the script start from (a JSBSim trim, computed by the
+    driver :func:`bioflex_jsb.drivers.native.fig21_trim_state`)."""
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 
     files: dict[str, str] = {}
     for name in REPOSITORY_VARIANTS:
         spec = ExportSpec(build_wing(VARIANTS[name]).model, name)
         files.update(render_aircraft_files(spec, include_shared=False))
-    state = fig21_trim_state()
     files[f"aircraft/{aircraft_name(FIG21_VARIANT)}/{FIG21_IC}.xml"] = (
         render_fig21_initial_condition(state))
     files[FIG21_SCRIPT] = render_fig21_script(state)
     return files
-
-
-def write_repository(root: Path) -> list[Path]:
-    """Write :func:`repository_files` under the JSBSim root ``root``; return the paths."""
-    return airframe_xml.write_files(repository_files(), root)
-
-
-# ======================================================================================
-# Running the native aircraft (driven from Python: JSBSim only stepping)
-# ======================================================================================
-
-
-def run_native_gust(airframe, setup, n_modes: int = 3, trim=None):
-    """Fly ``setup`` with a native modal-wing aircraft (an :class:`Airframe` loaded with
-    ``aircraft_name(...)``): Python only writes the gust and steps JSBSim. Channels as the
-    co-simulation's (u, alpha, q, theta, eta<i>, w_g), sampled the same way. The aircraft
-    must have been exported for ``setup.dt_s``."""
-    from bioflex_jsb.drivers.gust import INTEGRATORS
-    from bioflex_jsb.simulation.gusts import GustField
-    from bioflex_jsb.simulation.results import TimeHistory
-
-    for name, value in INTEGRATORS.items():
-        airframe[name] = value
-    airframe.set_dt(setup.dt_s)
-    if trim is None:
-        trim = airframe.trim(setup.speed_m_s, setup.altitude_m)
-    dt = airframe.dt_s
-    gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
-    n_steps = int(round(setup.duration_s / dt))
-    node = airframe.property_node
-    wind = node("atmosphere/wind-down-fps")
-    u_n, v_n, w_n = node("velocities/u-fps"), node("velocities/v-fps"), node("velocities/w-fps")
-    th_n, ph_n, q_n = node("attitude/theta-rad"), node("attitude/phi-rad"), node(
-        "velocities/q-rad_sec")
-    eta_n = [node(_p(f"eta{i + 1}")) for i in range(n_modes)]
-    names = ["u", "alpha", "q", "theta", "w_g"] + [f"eta{i + 1}" for i in range(n_modes)]
-    data = {k: np.full(n_steps, np.nan) for k in names}
-    for k in range(n_steps):
-        w_g = gust.vertical_m_s(k * dt)
-        wd = -w_g * U.FT_PER_M
-        wind.set_double_value(wd)
-        u, v, w = u_n.get_double_value(), v_n.get_double_value(), w_n.get_double_value()
-        th, ph = th_n.get_double_value(), ph_n.get_double_value()
-        ua = u + wd * math.sin(th)
-        va = v - wd * math.sin(ph) * math.cos(th)
-        wa = w - wd * math.cos(ph) * math.cos(th)
-        data["u"][k] = math.sqrt(ua * ua + va * va + wa * wa) * U.M_PER_FT - setup.speed_m_s
-        data["alpha"][k] = math.atan2(wa, ua) - trim.alpha_rad
-        data["q"][k] = q_n.get_double_value()
-        data["theta"][k] = th - trim.theta_rad
-        data["w_g"][k] = w_g
-        for i, e in enumerate(eta_n):
-            data[f"eta{i + 1}"][k] = e.get_double_value()
-        airframe.run(1)
-    units = {"u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "w_g": "m/s"}
-    units.update({f"eta{i + 1}": "rad" for i in range(n_modes)})
-    return TimeHistory(model="native", time_s=np.arange(n_steps) * dt, channels=data,
-                       units=units, meta={"source": "jsbsim-native", "dt_s": dt})
-
-
-_NATIVE: dict[str, object] = {}
-
-
-def native_airframe(variant: str = "original"):
-    """The repository's native modal-wing aircraft of ``variant``, loaded once per process
-    and set to the exported step (an :class:`Airframe`), for ``bioflex-jsb bench``."""
-    from bioflex_jsb.runtime.fdm import Airframe
-
-    craft = aircraft_name(variant)
-    if craft not in _NATIVE:
-        af = Airframe(aircraft=craft)
-        af.set_dt(DEFAULT_DT_S)
-        _NATIVE[craft] = af
-    return _NATIVE[craft]
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m bioflex_jsb.generators.native_wing",
-        description="Regenerate the repository's native modal-wing systems, aircraft and script.",
-    )
-    parser.add_argument("--root", type=Path, default=airframe_xml.default_output_root())
-    args = parser.parse_args(argv)
-    for path in write_repository(args.root):
-        print(path)
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -144,7 +144,7 @@ _INTEGRATOR_PROPERTIES = (
 _INTEGRATOR_NONE = 0
 # Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
 # throttle commands of every engine are added per aircraft.
-_TRIM_CONTROLS = (
+TRIM_CONTROLS = (
     "fcs/elevator-cmd-norm",
     "fcs/aileron-cmd-norm",
     "fcs/rudder-cmd-norm",
@@ -586,7 +586,7 @@ class Airframe:
         for name in ("ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", "ic/alpha-rad"):
             fdm[name] = 0.0
         fdm["ic/vt-fps"] = v * U.FT_PER_M
-        for name in _TRIM_CONTROLS:
+        for name in TRIM_CONTROLS:
             fdm[name] = 0.0
         with _captured(self._log):
             fdm.run_ic()
@@ -666,7 +666,7 @@ class Airframe:
         fdm["ic/p-rad_sec"] = src["velocities/p-rad_sec"]
         fdm["ic/q-rad_sec"] = src["velocities/q-rad_sec"]
         fdm["ic/r-rad_sec"] = src["velocities/r-rad_sec"]
-        controls = _TRIM_CONTROLS + tuple(
+        controls = TRIM_CONTROLS + tuple(
             f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engine_count)
         )
         for name in controls:

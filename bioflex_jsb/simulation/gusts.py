@@ -164,6 +164,8 @@ class GustField:
         self.start_s = float(start_s)
         self._series: np.ndarray | None = None
         self._dt = float(dt_s)
+        # the first step at or after the start (1e-9 of a step absorbs the rounding of start/Δt)
+        self._first_step = max(0, math.ceil(self.start_s / self._dt - 1e-9))
         if spec.kind in ("dryden", "vonkarman"):
             n = int(math.ceil(max(duration_s - start_s, dt_s) / dt_s)) + 2
             n_fft = 1 << max(4, int(math.ceil(math.log2(2 * n))))
@@ -179,6 +181,17 @@ class GustField:
             spectrum = amp * np.exp(1j * phases) * n_fft
             spectrum[0] = 0.0
             self._series = np.fft.irfft(spectrum, n=n_fft)[:n]
+
+    def at_step(self, k: int) -> float:
+        """Upward gust velocity w_g [m/s] at step ``k`` of the run's step ``dt_s``: t_k = k Δt
+        for the closed forms; a sampled series is indexed by step number (its sample 0 at the
+        first step at or after the start), so no rounding of times moves it by a sample."""
+        if self._series is None:
+            return self.vertical_m_s(k * self._dt)
+        j = k - self._first_step
+        if j < 0:
+            return 0.0
+        return float(self._series[min(j, len(self._series) - 1)])
 
     def vertical_m_s(self, t_s: float) -> float:
         """Upward gust velocity w_g at time ``t_s`` [m/s]."""

@@ -1,0 +1,83 @@
+"""The native modal-wing aircraft (the wing in JSBSim's XML): its Fig. 21 trim, its files, and
+the aircraft loaded once for the benchmark.
+
+A native run is :func:`bioflex_jsb.drivers.gust.run_gust` with the model ``native``: the same
+coupled step, with JSBSim flying the wing. Regenerate the repository's native files with
+``python -m bioflex_jsb.drivers.native`` (they need a JSBSim trim, so their writer is a
+driver; the XML itself is :mod:`bioflex_jsb.generators.native_wing`'s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from functools import lru_cache
+from pathlib import Path
+
+from bioflex_jsb.generators import airframe as airframe_xml
+from bioflex_jsb.generators import native_wing as J
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.runtime.coupled_step import configure_airframe
+from bioflex_jsb.runtime.fdm import TRIM_CONTROLS, Airframe
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+
+def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> J.TrimState:
+    """Trim of the Fig. 21 case by :meth:`Airframe.trim` (the co-simulation's trim: same
+    integrators and step), read from the flying instance."""
+    af = Airframe()
+    configure_airframe(af, dt_s)
+    af.trim(P.SECTION5_AIRSPEED_M_S)
+    ic = {
+        "ubody": ("FT/SEC", af["velocities/u-fps"]),
+        "vbody": ("FT/SEC", af["velocities/v-fps"]),
+        "wbody": ("FT/SEC", af["velocities/w-fps"]),
+        "p": ("RAD/SEC", af["velocities/p-rad_sec"]),
+        "q": ("RAD/SEC", af["velocities/q-rad_sec"]),
+        "r": ("RAD/SEC", af["velocities/r-rad_sec"]),
+        "elevation": ("FT", af["position/terrain-elevation-asl-ft"]),
+        "altitudeMSL": ("FT", af["position/h-sl-ft"]),
+        "phi": ("RAD", af["attitude/phi-rad"]),
+        "theta": ("RAD", af["attitude/theta-rad"]),
+        "psi": ("RAD", af["attitude/psi-rad"]),
+        "latitude": ("RAD", af["position/lat-geod-rad"]),
+        "longitude": ("RAD", af["position/long-gc-rad"]),
+    }
+    names = TRIM_CONTROLS + tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(af.engine_count))
+    return J.TrimState(ic, {name: af[name] for name in names})
+
+
+def repository_files() -> dict[str, str]:
+    """The repository's native files (systems, aircraft, the Fig. 21 initial condition and
+    script): path → text."""
+    return J.repository_files(fig21_trim_state())
+
+
+def write_repository(root: Path) -> list[Path]:
+    """Write :func:`repository_files` under the JSBSim root ``root``; return the paths."""
+    return airframe_xml.write_files(repository_files(), root)
+
+
+@lru_cache(maxsize=len(J.REPOSITORY_VARIANTS))
+def native_airframe(variant: str = "original") -> Airframe:
+    """The repository's native modal-wing aircraft of ``variant``, loaded once per process
+    and set to the exported step, for ``bioflex-jsb bench`` (at most one per named wing)."""
+    af = Airframe(aircraft=J.aircraft_name(variant))
+    af.set_dt(DEFAULT_DT_S)
+    return af
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m bioflex_jsb.drivers.native",
+        description="Regenerate the repository's native modal-wing systems, aircraft and script.",
+    )
+    parser.add_argument("--root", type=Path, default=airframe_xml.default_output_root())
+    args = parser.parse_args(argv)
+    for path in write_repository(args.root):
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

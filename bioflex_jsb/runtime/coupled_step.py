@@ -1,0 +1,323 @@
+"""The one coupled step: JSBSim's rigid airframe and the Python modal wing, one step at a time.
+
+Every driver (gust runs, comparisons, SITL, the benchmark, the sweep's evaluator) advances
+the aircraft through :class:`CoupledStep`; nothing else configures the airframe for a run,
+senses the flow, applies the wing's loads or checks the valid range.
+
+Per step k (time t_k = k Δt, airframe state x_k), :meth:`CoupledStep.advance`:
+
+1. writes the gust w_g(t_k) to JSBSim's wind (``atmosphere/wind-down-fps`` = −w_g);
+2. reads the airframe's state x_k in one snapshot (:func:`state_reader`: attitude, rates,
+   position, velocities, n_z, controls) with the flow at the wing (α, β, V, Q against the
+   air, q) computed from x_k and that wind, as JSBSim's FGAuxiliary computes it;
+3. advances the wing η_k → η_{k+1} with that flow held over the step (exact discretisation,
+   :class:`~bioflex_jsb.simulation.modal_wing.ModalWing`) and writes the loads of η_{k+1}
+   in that flow into ``external_reactions`` (lift and drag turned from wind to body axes
+   with α_k);
+4. runs JSBSim's step: it integrates x_k → x_{k+1} and computes the forces of x_{k+1},
+   which it applies over the next step — with the wing's loads of η_{k+1}, the same time,
+   so the elastic loads do not lag the rigid aerodynamics;
+5. builds the row of t_k by channel name (the snapshot of 2, the loads of 3, η_k, η̇_k;
+   :mod:`bioflex_jsb.simulation.channels`) and checks the valid range
+   (:mod:`bioflex_jsb.simulation.limits`); a run out of range sets :attr:`stopped`.
+
+Model ``native``: the wing is JSBSim's own (an aircraft exported by
+:mod:`bioflex_jsb.generators.native_wing`); step 3 is left out and η, η̇ and the loads are
+read from its properties.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+from typing import NamedTuple
+
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.generators.airframe import alpha_peak_rad
+from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
+from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
+from bioflex_jsb.simulation.limits import out_of_range
+from bioflex_jsb.simulation.modal_wing import (
+    DEFAULT_DT_S,
+    WING_MODELS,
+    FlowState,
+    ModalWing,
+    TrimReference,
+    WingLoads,
+)
+
+STEP_MODELS = (*WING_MODELS, "native")
+# The JSBSim properties of a snapshot (JSBSim units, as the names say).
+PROPERTIES: Mapping[str, str] = MappingProxyType({
+    "u": "velocities/u-fps", "v": "velocities/v-fps", "w": "velocities/w-fps",
+    "q": "velocities/q-rad_sec", "p": "velocities/p-rad_sec", "r": "velocities/r-rad_sec",
+    "theta": "attitude/theta-rad", "phi": "attitude/phi-rad", "psi": "attitude/psi-rad",
+    "rho": "atmosphere/rho-slugs_ft3", "nz": "accelerations/Nz", "h": "position/h-sl-ft",
+    "agl": "position/h-agl-ft", "lat": "position/lat-geod-rad", "lon": "position/long-gc-rad",
+    "vn": "velocities/v-north-fps", "ve": "velocities/v-east-fps", "vd": "velocities/v-down-fps",
+    "elevator": "fcs/elevator-pos-rad", "throttle": "fcs/throttle-pos-norm",
+})
+WIND_DOWN = "atmosphere/wind-down-fps"
+# The native wing's published state and loads (bioflex_jsb.generators.native_wing).
+NATIVE_PREFIX = "bioflex/modal"
+NATIVE_LOADS = ("aero/force/modal-lift", "aero/force/modal-drag", "aero/moment/modal-pitch")
+
+
+class Sensed(NamedTuple):
+    """The airframe at one instant, as the wing and the logs see it (SI; aerospace frames:
+    NED Euler angles, FRD body rates, NED velocities; ``docs/conventions.md``). ``flow``:
+    the air data at the wing with the current wind (α, q, V, Q); β likewise against the
+    air."""
+
+    flow: FlowState
+    theta_rad: float
+    phi_rad: float
+    psi_rad: float
+    beta_rad: float
+    p_rad_s: float
+    r_rad_s: float
+    n_z: float
+    altitude_m: float
+    latitude_rad: float
+    longitude_rad: float
+    v_north_m_s: float
+    v_east_m_s: float
+    v_down_m_s: float
+    elevator_rad: float
+    throttle: float
+
+
+def state_reader(get: Mapping[str, Callable[[], float]]) -> Callable[[float], Sensed]:
+    """``read(wind_down_fps)``: the airframe's state now and the flow the wing sees with the
+    NED vertical wind ``wind_down_fps`` [ft/s, down], as JSBSim's FGAuxiliary computes it.
+
+    ``get`` maps the keys of :data:`PROPERTIES` to property readers (bound once, for the
+    per-step call). Everything is read at the same instant: the state JSBSim reached at the
+    end of its last step (its n_z is that of this state), so a row is one snapshot.
+    """
+    g_u, g_v, g_w, g_q = get["u"], get["v"], get["w"], get["q"]
+    g_theta, g_phi, g_psi, g_p, g_r = get["theta"], get["phi"], get["psi"], get["p"], get["r"]
+    g_rho, g_nz, g_h, g_lat, g_lon = get["rho"], get["nz"], get["h"], get["lat"], get["lon"]
+    g_vn, g_ve, g_vd = get["vn"], get["ve"], get["vd"]
+    g_elevator, g_throttle = get["elevator"], get["throttle"]
+    m_per_ft, rho_si = U.M_PER_FT, U.KG_M3_PER_SLUG_FT3
+    sin, cos, make = math.sin, math.cos, tuple.__new__
+
+    def read(wind_down_fps: float) -> Sensed:
+        theta, phi = g_theta(), g_phi()
+        # air-relative body velocity: subtract the NED wind seen in body axes
+        ua = g_u() + wind_down_fps * sin(theta)
+        va = g_v() - wind_down_fps * sin(phi) * cos(theta)
+        wa = g_w() - wind_down_fps * cos(phi) * cos(theta)
+        vt_fps = math.sqrt(ua * ua + va * va + wa * wa)
+        vt = vt_fps * m_per_ft
+        flow = FlowState(math.atan2(wa, ua), g_q(), vt, 0.5 * g_rho() * rho_si * vt * vt)
+        return make(Sensed, (
+            flow, theta, phi, g_psi(), math.asin(va / vt_fps) if vt_fps > 0.0 else 0.0,
+            g_p(), g_r(), g_nz(), g_h() * m_per_ft, g_lat(), g_lon(), g_vn() * m_per_ft,
+            g_ve() * m_per_ft, g_vd() * m_per_ft, g_elevator(), g_throttle()))
+
+    return read
+
+
+def configure_airframe(airframe: Airframe, dt_s: float, modal_hooks: bool = True) -> None:
+    """Set ``airframe`` up for a run at the step ``dt_s`` [s]: no modal loads left in its
+    external reactions (``modal_hooks``: the aircraft has them), the run's integrators, and
+    the step — before a trim, so that JSBSim's multistep integrators and the propeller start
+    from a history at the step they will run with."""
+    if modal_hooks:
+        airframe.set_external_reactions()
+    for name, value in INTEGRATORS.items():
+        airframe[name] = value
+    airframe.set_dt(dt_s)
+
+
+class CoupledStep:
+    """One aircraft (JSBSim airframe + modal wing) advanced one step at a time.
+
+    Args:
+        airframe: the JSBSim airframe (configured here; trimmed unless ``trim`` is given).
+        wing: the elastic wing model (modes, derivatives); None only for ``native``.
+        model: ``rigid`` (no modal loads), ``coupled`` (dynamic modal states), ``qsd``
+            (quasi-static deformation) or ``native`` (the wing is in the aircraft's XML).
+        speed_m_s: trim true airspeed [m/s]; altitude_m: trim altitude [m above sea level].
+        dt_s: the co-simulation (JSBSim) step [s].
+        trim: the airframe was just trimmed to this (skip the trim).
+        before_trim: called with the configured airframe before the trim (e.g. to disengage
+            an autopilot).
+
+    After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
+    run left its valid range (None while it is in range).
+    """
+
+    def __init__(self, airframe: Airframe, wing: ElasticWingModel | None, model: str,
+                 speed_m_s: float, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
+                 trim: TrimResult | None = None,
+                 before_trim: Callable[[Airframe], None] | None = None) -> None:
+        if model not in STEP_MODELS:
+            raise ValueError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
+        native = model == "native"
+        if wing is None and not native:
+            raise ValueError(f"the {model} model needs a wing")
+        self.airframe = airframe
+        self.native = native
+        configure_airframe(airframe, dt_s, modal_hooks=not native)
+        if before_trim is not None:
+            before_trim(airframe)
+        if trim is None:
+            trim = airframe.trim(speed_m_s, altitude_m)
+        self.trim = trim
+        self.speed_m_s = float(speed_m_s)
+        self.dt_s = airframe.dt_s
+        nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()}
+        self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
+        self._read = state_reader(self.get)
+        self._set_wind = airframe.property_node(WIND_DOWN).set_double_value
+        # the reference dynamic pressure is JSBSim's own at trim (same density as the run)
+        rho0 = self.get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        cl_trim = level_flight_condition(speed_m_s).cl_trim
+        self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
+        if native:
+            self.wing = None
+            self.n_modes = _native_mode_count(airframe)
+            get_node = airframe.property_node
+            self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
+                                for i in range(self.n_modes)]
+            self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
+                                   for i in range(self.n_modes)]
+            self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
+        else:
+            self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s)
+            self.n_modes = wing.n_modes
+            self._write_reactions = airframe.external_reaction_writer()
+        self.model = model
+        self.units = channel_units(self.n_modes)
+        self.names = tuple(self.units)
+        self._eta_names, self._etadot_names = eta_names(self.n_modes)
+        self._row = row_getter(self.names)
+        self._agl_m = self.get["agl"]
+        self.alpha_peak_rad = alpha_peak_rad()
+        self.stall_steps = 0  # steps flown beyond the lift peak
+        self.k = 0
+        self.stopped: str | None = None
+        self.sensed: Sensed | None = None  # the snapshot of the last step's start
+        self.w_g_m_s = 0.0
+
+    # -- the wing ---------------------------------------------------------------------------
+    @property
+    def eta(self) -> np.ndarray:
+        """Modal coordinates Δη now [rad]."""
+        if self.native:
+            return np.array([g() for g in self._native_eta])
+        return self.wing.eta
+
+    @property
+    def eta_dot(self) -> np.ndarray:
+        """Modal rates Δη̇ now [rad/s]."""
+        if self.native:
+            return np.array([g() for g in self._native_etadot])
+        return self.wing.eta_dot
+
+    def set_model(self, model: str) -> None:
+        """Switch the Python wing between ``rigid``, ``coupled`` and ``qsd`` mid-run; a wing
+        that becomes coupled starts undeformed."""
+        if self.native or model not in WING_MODELS:
+            raise ValueError(f"cannot switch a {self.model} wing to {model!r}")
+        if model != self.wing.model:
+            self.wing.model = model
+            self.wing.eta = np.zeros(self.n_modes)
+            self.wing.eta_dot = np.zeros(self.n_modes)
+            self.model = model
+
+    def prepare(self, w_g_m_s: float = 0.0) -> None:
+        """Compute the wing's step matrices for the flow now (the first step would do it),
+        for real-time loops: the first paced step then costs what the others do."""
+        self._set_wind(-w_g_m_s * U.FT_PER_M)
+        if not self.native:
+            self.wing.prepare(self._read(-w_g_m_s * U.FT_PER_M).flow)
+
+    def sense(self, w_g_m_s: float) -> Sensed:
+        """Write the vertical gust ``w_g_m_s`` [m/s, up] to JSBSim's wind and read the
+        airframe's snapshot with the flow the wing sees then."""
+        wind_down_fps = -w_g_m_s * U.FT_PER_M
+        self._set_wind(wind_down_fps)
+        return self._read(wind_down_fps)
+
+    # -- the step ---------------------------------------------------------------------------
+    def advance(self, w_g_m_s: float) -> tuple[float, ...]:
+        """Fly step k with the gust ``w_g_m_s`` [m/s, up] at t_k (module docstring); the row
+        of t_k (values in :attr:`names` order). Sets :attr:`stopped` when out of range."""
+        t = self.k * self.dt_s
+        state = self.sense(w_g_m_s)
+        flow = state.flow
+        if self.native:
+            eta, eta_dot = self.eta, self.eta_dot
+            lift_lbf, drag_lbf, moment_lbf_ft = (g() for g in self._native_loads)
+            loads = WingLoads(lift_lbf * U.N_PER_LBF, drag_lbf * U.N_PER_LBF,
+                              moment_lbf_ft * U.N_M_PER_LBF_FT)
+            self.airframe.step()
+            new_eta = self.eta
+        else:
+            mw = self.wing
+            eta, eta_dot = mw.eta, mw.eta_dot
+            mw.step(flow)  # η_k → η_{k+1} over [t_k, t_k+1] with the flow of t_k held
+            loads = mw.loads(flow)
+            alpha = flow.alpha_rad
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
+                                  loads.drag_n * ca - loads.lift_n * sa,
+                                  loads.pitch_moment_n_m)
+            self.airframe.step()
+            new_eta = mw.eta
+        values = self._row(self._row_dict(state, w_g_m_s, loads, eta, eta_dot))
+        self.sensed, self.w_g_m_s = state, w_g_m_s
+        self.k += 1
+        alpha = flow.alpha_rad
+        self.stall_steps += alpha > self.alpha_peak_rad
+        self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
+                                    self._agl_m() * U.M_PER_FT)
+        return values
+
+    def _row_dict(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot) -> dict:
+        """The row of one step by channel name: the snapshot ``s`` at t_k, the gust then,
+        the wing loads applied over the step and the modal state η_k, η̇_k."""
+        f, trim = s.flow, self.trim
+        row = {
+            "u": f.airspeed_m_s - self.speed_m_s, "alpha": f.alpha_rad - trim.alpha_rad,
+            "q": f.q_rad_s, "theta": s.theta_rad - trim.theta_rad, "n_z": s.n_z, "w_g": w_g,
+            "airspeed_m_s": f.airspeed_m_s, "altitude_m": s.altitude_m,
+            "lift_n": loads.lift_n, "drag_n": loads.drag_n,
+            "pitch_moment_n_m": loads.pitch_moment_n_m,
+            "latitude_rad": s.latitude_rad, "longitude_rad": s.longitude_rad,
+            "phi_rad": s.phi_rad, "theta_rad": s.theta_rad, "psi_rad": s.psi_rad,
+            "p_rad_s": s.p_rad_s, "r_rad_s": s.r_rad_s, "elevator_rad": s.elevator_rad,
+            "throttle": s.throttle, "alpha_rad": f.alpha_rad, "beta_rad": s.beta_rad,
+            "v_north_m_s": s.v_north_m_s, "v_east_m_s": s.v_east_m_s,
+            "v_down_m_s": s.v_down_m_s,
+        }
+        for i in range(self.n_modes):
+            row[self._eta_names[i]] = float(eta[i])
+            row[self._etadot_names[i]] = float(eta_dot[i])
+        return row
+
+    def release(self) -> None:
+        """Leave no modal loads behind in the airframe for its next user."""
+        if not self.native:
+            self.airframe.set_external_reactions()
+
+
+def _native_mode_count(airframe: Airframe) -> int:
+    """How many modes the native aircraft publishes (``bioflex/modal/eta<i>``)."""
+    n = 0
+    while True:
+        try:
+            airframe.property_node(f"{NATIVE_PREFIX}/eta{n + 1}")
+        except KeyError:
+            return n
+        n += 1
