@@ -64,6 +64,11 @@ from typing import Protocol
 
 from pymavlink.dialects.v20 import common as mavlink
 
+# What pymavlink's parser raises on bytes that are not MAVLink (hostile or corrupt input):
+# its own MAVError, and the struct/array/decoding errors of a truncated or mangled payload.
+_CODEC_ERRORS = (mavlink.MAVError, struct.error, ValueError, IndexError, KeyError, TypeError,
+                 UnicodeDecodeError, OverflowError)
+
 SYSTEM_ID = 1
 COMPONENT_ID = 1
 MAX_PEERS = 4
@@ -485,7 +490,7 @@ class MavlinkLink:
     def _handle_bytes(self, peer: _Peer, data: bytes, state: VehicleState) -> int:
         try:
             msgs = peer.parser.parse_buffer(data) or []
-        except Exception:  # noqa: BLE001 - a codec error on hostile input: drop the bytes
+        except _CODEC_ERRORS:  # a codec error on hostile input: drop the bytes
             peer.parser = self._new_parser()
             self.stats.bad += 1
             return 0

@@ -64,31 +64,7 @@ companion file (``<name>_trim``) is trimmed and linearized itself, as before. In
 instances the two rotors' gyroscopic moments, equal and opposite, cancel exactly (a
 symmetric gust stays symmetric).
 
-Linearization
--------------
-:meth:`Airframe.linearize` trims, then runs ``jsbsim.FGLinearization``, whose state vector is
-[Vt, α, θ, q, RPM(s), β, φ, p, ψ, r, latitude, longitude, altitude]. It is turned into the
-paper's rigid longitudinal model x_R = [u, α, q, θ] (u the airspeed perturbation [m/s]; α,
-θ [rad]; q [rad/s]) by
-
-* residualising the propeller RPM states r (``Rpm0``, ``Rpm1``: one per rotor of the pair)
-  as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
-  (the RPM settles in ≈ 0.3 s at the physical rotor inertia; JSBSim's state space already
-  re-solves the RPM to steady state at every
-  perturbation, so A_xr is zero to rounding and the thrust change with airspeed is in the u
-  column). The rotors of the contra-rotating pair are identical and identically driven, so a
-  longitudinal perturbation moves their RPMs together: the RPM states are first reduced to
-  their symmetric combination (δRpm0 = δRpm1: columns summed, rows averaged); the
-  antisymmetric one (one rotor faster than the other) is lateral, like β, φ, p, ψ, r, and is
-  dropped with them. JSBSim's own 2×2 RPM block is singular (perturbing Rpm1 changes
-  nothing), the symmetric 1×1 block is not;
-* dropping the lateral states (β, φ, p, ψ, r), decoupled from the longitudinal ones at a
-  wings-level trim, and the position states (latitude, longitude, altitude: the paper's x_R
-  has no altitude; the density gradient over the short period's height change is negligible);
-* converting Vt from ft/s to m/s (rows and columns).
-
-The eigenvalues are labelled by frequency: the two of larger modulus are the short period,
-the two of smaller modulus the phugoid.
+Linearization: :mod:`bioflex_jsb.runtime.linearization` (the reduction to x_R = [u, α, q, θ]).
 """
 
 from __future__ import annotations
@@ -96,10 +72,9 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import re
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
@@ -109,8 +84,27 @@ import numpy as np
 from bioflex_jsb import units as U
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
+from bioflex_jsb.runtime.linearization import reduce_to_rigid
+from bioflex_jsb.runtime.results import (  # noqa: F401  (the runtime's errors and results)
+    RIGID_STATE_UNITS,
+    RIGID_STATES,
+    AircraftLoadError,
+    FdmError,
+    LinearizationError,
+    ModeEigenvalue,
+    RigidLinearization,
+    TrimError,
+    TrimResult,
+    label_modes,
+)
+from bioflex_jsb.runtime.roots import (  # noqa: F401  (where the JSBSim files are)
+    ROOT_ENV_VAR,
+    aircraft_file,
+    candidate_roots,
+    locate_root,
+)
+from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure
 
-ROOT_ENV_VAR = "BIOFLEX_JSBSIM_ROOT"
 DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
 
 # Altitude range accepted for initial conditions [m]: sea level (the paper's Q uses
@@ -122,9 +116,6 @@ SPEED_MAX_M_S = 110.0
 
 # JSBSim's trim modes (FGFDMExec::DoTrim): 0 longitudinal, 1 full.
 TRIM_MODE_FULL = 1
-# A normalised control this close to its stop counts as saturated in the trim diagnosis
-# (JSBSim's trim report prints controls to 2 significant digits).
-SATURATION_MARGIN = 0.01
 # JSBSim's trim tolerances (FGTrimAxis): on udot, wdot [ft/s²] and on qdot, pdot, rdot
 # [rad/s²]; the flying instance, set to the companion's trim, must meet them too.
 TRIM_TOLERANCE_FT_S2 = 1e-3
@@ -159,71 +150,8 @@ _WIND_PROPERTIES = (
 )
 
 
-class FdmError(Exception):
-    """Base of the adapter's errors; the message is always a single line."""
-
-
-class AircraftLoadError(FdmError):
-    """The JSBSim root or aircraft file is missing, malformed or rejected by JSBSim."""
-
-
-class TrimError(FdmError):
-    """JSBSim's trim failed; the message names the saturated control or failed condition."""
-
-
-class LinearizationError(FdmError):
-    """JSBSim's linear model could not be reduced to the rigid longitudinal states."""
-
-
 def _one_line(text: str) -> str:
     return " ".join(str(text).split())
-
-
-# ======================================================================================
-# Locating the JSBSim root
-# ======================================================================================
-
-
-def _package_dir() -> Path:
-    return Path(__file__).resolve().parents[1]
-
-
-def candidate_roots() -> list[Path]:
-    """Default JSBSim roots, in the order they are tried: checkout, then installed wheel."""
-    return [_package_dir().parent, _package_dir() / "jsbsim_root"]
-
-
-def aircraft_file(root: Path, aircraft: str = DEFAULT_AIRCRAFT) -> Path:
-    """Path JSBSim loads for ``aircraft`` under ``root``: aircraft/<name>/<name>.xml."""
-    return Path(root) / "aircraft" / aircraft / f"{aircraft}.xml"
-
-
-def locate_root(root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT) -> Path:
-    """The JSBSim root to use (see the module docstring); raises :class:`AircraftLoadError`."""
-    if root is None and os.environ.get(ROOT_ENV_VAR):
-        root = os.environ[ROOT_ENV_VAR]
-        origin = f"${ROOT_ENV_VAR}"
-    else:
-        origin = "the given JSBSim root"
-    if root is not None:
-        path = Path(root).expanduser().resolve()
-        if not path.is_dir():
-            raise AircraftLoadError(f"{origin} {str(path)!r} is not a directory")
-        if not aircraft_file(path, aircraft).is_file():
-            raise AircraftLoadError(
-                f"no aircraft file {str(aircraft_file(path, aircraft))!r} under {origin}"
-            )
-        return path
-    for path in candidate_roots():
-        if aircraft_file(path, aircraft).is_file() and (path / "systems").is_dir():
-            return path
-    tried = ", ".join(repr(str(p)) for p in candidate_roots())
-    hint = f"set {ROOT_ENV_VAR} or pass a JSBSim root"
-    if aircraft == DEFAULT_AIRCRAFT:
-        hint += " (python -m bioflex_jsb.generators.airframe writes the bioflex files)"
-    raise AircraftLoadError(
-        f"cannot find the JSBSim files of {aircraft!r} (aircraft/ and systems/) in {tried}; " + hint
-    )
 
 
 # ======================================================================================
@@ -276,124 +204,6 @@ def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
         yield logger
     finally:
         jsbsim.set_logger(previous)
-
-
-# ======================================================================================
-# Results
-# ======================================================================================
-
-
-@dataclass(frozen=True)
-class TrimResult:
-    """A converged JSBSim trim: wings-level, constant-altitude flight.
-
-    Attributes:
-        speed_m_s: true airspeed [m/s]; altitude_m: altitude above sea level [m].
-        alpha_rad, theta_rad: angle of attack and pitch attitude [rad] (θ = α in level flight).
-        elevator_norm: elevator position, −1..1 of its travel (+ = trailing edge down).
-        elevator_rad: elevator deflection [rad] (+ = trailing edge down, nose-down moment).
-        throttle: throttle position 0..1 of every motor of the contra-rotating pair
-            (fraction of the maximum shaft power).
-        aileron_norm: aileron position −1..1 (+ = roll right); ≈ 0, the pair's reaction
-            torques cancel.
-        propeller_rpm: speed of one propeller [rev/min] (both turn at the same speed);
-            thrust_n: total thrust of the pair [N].
-        converged: True: JSBSim reported every trim condition within tolerance.
-        residuals: the accelerations left: ``udot_m_s2``, ``wdot_m_s2`` [m/s²],
-            ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²] (of the flying
-            instance, set to the companion's trim; see the module docstring).
-    """
-
-    speed_m_s: float
-    altitude_m: float
-    alpha_rad: float
-    theta_rad: float
-    elevator_norm: float
-    elevator_rad: float
-    throttle: float
-    aileron_norm: float
-    propeller_rpm: float
-    thrust_n: float
-    converged: bool
-    residuals: dict[str, float] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class ModeEigenvalue:
-    """One eigenvalue of a conjugate pair (the one with im ≥ 0), with its mode.
-
-    re, im [rad/s]; damping ζ = −re/|λ| [-]; frequency_rad_s ω_n = |λ| [rad/s].
-    """
-
-    mode: str
-    re: float
-    im: float
-    damping: float
-    frequency_rad_s: float
-
-
-RIGID_STATES = ("u", "alpha", "q", "theta")
-RIGID_STATE_UNITS = ("m/s", "rad", "rad/s", "rad")
-
-
-@dataclass(frozen=True)
-class RigidLinearization:
-    """JSBSim's linear model at a trim, reduced to x_R = [u, α, q, θ] (SI).
-
-    Attributes:
-        speed_m_s: trim airspeed [m/s].
-        trim: the trim it was taken at.
-        a: 4×4 system matrix, states :data:`RIGID_STATES` in :data:`RIGID_STATE_UNITS`
-            (row i: d x_i/dt; e.g. a[0, 1] = ∂u̇/∂α [m/s² per rad]).
-        eigenvalues: one :class:`ModeEigenvalue` per conjugate pair (or real root),
-            short period first.
-        jsbsim_states: JSBSim's full state list the model was reduced from.
-        residualised_states: the states eliminated as quasi-static (propeller RPM).
-    """
-
-    speed_m_s: float
-    trim: TrimResult
-    a: np.ndarray
-    eigenvalues: tuple[ModeEigenvalue, ...]
-    jsbsim_states: tuple[str, ...]
-    residualised_states: tuple[str, ...]
-    states: tuple[str, ...] = RIGID_STATES
-    state_units: tuple[str, ...] = RIGID_STATE_UNITS
-
-    def mode(self, name: str) -> ModeEigenvalue:
-        """The eigenvalue (im ≥ 0) of mode ``name`` ('short_period' or 'phugoid')."""
-        for ev in self.eigenvalues:
-            if ev.mode == name:
-                return ev
-        raise KeyError(f"no {name!r} eigenvalue")
-
-
-def label_modes(eigenvalues: np.ndarray) -> tuple[ModeEigenvalue, ...]:
-    """Label the 4 longitudinal eigenvalues by frequency and keep one per conjugate pair.
-
-    The two of larger modulus are the short period, the two of smaller the phugoid. Complex
-    pairs are reported once (im > 0); real roots each appear (im = 0).
-    """
-    lam = np.asarray(eigenvalues, dtype=complex)
-    if lam.shape != (4,):
-        raise ValueError(f"expected 4 longitudinal eigenvalues, got {lam.shape}")
-    order = np.argsort(-np.abs(lam), kind="stable")
-    out = []
-    for rank, i in enumerate(order):
-        value = lam[i]
-        if value.imag < 0.0:
-            continue
-        modulus = abs(value)
-        out.append(
-            ModeEigenvalue(
-                mode="short_period" if rank < 2 else "phugoid",
-                re=float(value.real),
-                im=float(abs(value.imag)),
-                damping=float(-value.real / modulus) if modulus > 0 else 1.0,
-                frequency_rad_s=float(modulus),
-            )
-        )
-    return tuple(out)
 
 
 # ======================================================================================
@@ -739,69 +549,11 @@ class Airframe:
             },
         )
 
-    # JSBSim's trim report: one line per axis, e.g.
-    # "  Throttle            : 1      udot : -3.68e+01 Tolerance: 1e-03  Failed"
-    _REPORT_LINE = re.compile(
-        r"^\s*(?P<control>[A-Za-z][A-Za-z ]*?)\s*:\s*(?P<value>\S+)\s+(?P<state>\w+)\s*:\s*"
-        r"(?P<residual>\S+)\s+Tolerance:\s*\S+\s+(?P<verdict>Passed|Failed)\s*$",
-        re.MULTILINE,
-    )
-    _UNTRIMMABLE = re.compile(r"Sorry, (?P<state>\w+) doesn't appear to be trimmable")
-
     def _diagnose_trim_failure(self, v: float) -> str:
-        """One line: which control saturated or which condition failed (from JSBSim's
-        trim messages: the 'not trimmable' verdict and the final axis report)."""
+        """One line: which control saturated or which condition failed."""
         text = "\n".join(r.text for r in self._log.records)
-        axes: dict[str, tuple[str, float, float, bool]] = {}
-        for m in self._REPORT_LINE.finditer(text):
-            try:
-                value, residual = float(m["value"]), float(m["residual"])
-            except ValueError:
-                continue
-            axes[m["state"]] = (m["control"], value, residual, m["verdict"] == "Passed")
-        untrimmable = [m["state"] for m in self._UNTRIMMABLE.finditer(text)]
-        where = f"at {v:g} m/s"
-        lo_deg, hi_deg = (math.degrees(a) for a in self.alpha_limits_rad)
-
-        def sign(state: str) -> float:
-            return axes[state][2] if state in axes else 0.0
-
-        def saturated(state: str, limit: float) -> bool:
-            return state in axes and abs(axes[state][1] - limit) <= SATURATION_MARGIN
-
-        if "udot" in untrimmable or saturated("udot", 1.0):
-            if sign("udot") < 0.0 or saturated("udot", 1.0):
-                return (
-                    f"cannot trim {where}: level flight needs more thrust than the motor gives "
-                    "(throttle saturated at 1)"
-                )
-            return f"cannot trim {where}: the aircraft accelerates even at zero throttle"
-        if "wdot" in untrimmable:
-            if sign("wdot") >= 0.0:
-                return (
-                    f"cannot trim {where}: level flight needs an angle of attack beyond the "
-                    f"stall limit {hi_deg:.1f} deg (speed below the stall speed)"
-                )
-            return (
-                f"cannot trim {where}: level flight needs an angle of attack below the "
-                f"negative-stall limit {lo_deg:.1f} deg"
-            )
-        if "qdot" in untrimmable or saturated("qdot", 1.0) or saturated("qdot", -1.0):
-            stop = "nose-down" if sign("qdot") > 0.0 else "nose-up"
-            return (
-                f"cannot trim {where}: the elevator is at its {stop} stop and cannot balance "
-                "the pitching moment"
-            )
-        if untrimmable:
-            return f"cannot trim {where}: JSBSim finds {', '.join(untrimmable)} untrimmable"
-        failed = [f"{s} (by {c.strip().lower()})" for s, (c, _, _, ok) in axes.items() if not ok]
-        if failed:
-            return (
-                f"cannot trim {where}: JSBSim's trim did not converge; out of tolerance: "
-                + ", ".join(failed)
-            )
-        reason = self._first_message(jsbsim.LogLevel.WARN)
-        return f"cannot trim {where}: JSBSim's trim failed" + (f" ({reason})" if reason else "")
+        return diagnose_trim_failure(text, v, self.alpha_limits_rad,
+                                     self._first_message(jsbsim.LogLevel.WARN))
 
     # ---- linearization ----------------------------------------------------------------
     def linearize(self, speed_m_s: float, altitude_m: float = 0.0) -> RigidLinearization:
@@ -905,60 +657,6 @@ class Airframe:
         if node is None:
             raise KeyError(f"JSBSim has no property {name!r}")
         return node
-
-
-# JSBSim state names (FGStateSpace) of the rigid longitudinal model, in x_R order, and
-# the factor from JSBSim's unit to SI.
-_RIGID_JSBSIM = (("Vt", "ft/s", U.M_PER_FT), ("Alpha", "rad", 1.0), ("Q", "rad/s", 1.0),
-                 ("Theta", "rad", 1.0))  # fmt: skip
-_FAST_PREFIXES = ("Rpm", "PropPitch")  # engine states residualised as quasi-static
-_DROPPED = {"Beta", "Phi", "P", "Psi", "R", "Latitude", "Longitude", "Alt"}
-
-
-def reduce_to_rigid(
-    a_full: np.ndarray, names: tuple[str, ...], units: tuple[str, ...]
-) -> tuple[np.ndarray, tuple[str, ...]]:
-    """JSBSim's system matrix → 4×4 A in x_R = [u, α, q, θ], SI (see module docstring).
-
-    Returns the matrix and the names of the residualised (quasi-static) states.
-    """
-    index = {n: i for i, n in enumerate(names)}
-    keep = []
-    scale = []
-    for name, unit, to_si in _RIGID_JSBSIM:
-        if name not in index:
-            raise LinearizationError(f"JSBSim's linear model has no {name!r} state: {names}")
-        if units[index[name]] != unit:
-            raise LinearizationError(
-                f"JSBSim's {name!r} state is in {units[index[name]]!r}, expected {unit!r}"
-            )
-        keep.append(index[name])
-        scale.append(to_si)
-    fast = [i for i, n in enumerate(names) if n.startswith(_FAST_PREFIXES)]
-    unknown = [n for n in names if n not in _DROPPED and not n.startswith(_FAST_PREFIXES)]
-    unknown = [n for n in unknown if n not in {r[0] for r in _RIGID_JSBSIM}]
-    if unknown:
-        raise LinearizationError(f"JSBSim's linear model has unexpected states {unknown}")
-    a_xx = a_full[np.ix_(keep, keep)]
-    if fast:
-        # symmetric combination of identical rotors: one state per prefix (Rpm, PropPitch)
-        groups = sorted({p for n in (names[i] for i in fast) for p in _FAST_PREFIXES
-                         if n.startswith(p)})  # fmt: skip
-        e = np.zeros((len(fast), len(groups)))
-        for row, i in enumerate(fast):
-            e[row, next(g for g, p in enumerate(groups) if names[i].startswith(p))] = 1.0
-        mean = np.linalg.solve(e.T @ e, e.T)  # average over the rotors of each group
-        a_xr = a_full[np.ix_(keep, fast)] @ e
-        a_rx = mean @ a_full[np.ix_(fast, keep)]
-        a_rr = mean @ a_full[np.ix_(fast, fast)] @ e
-        if not np.all(np.isfinite(a_rr)) or np.linalg.cond(a_rr) > 1e12:
-            raise LinearizationError("the propeller RPM block of JSBSim's model is singular")
-        a_xx = a_xx - a_xr @ np.linalg.solve(a_rr, a_rx)
-    s = np.diag(scale)
-    a_si = s @ a_xx @ np.linalg.inv(s)
-    if not np.all(np.isfinite(a_si)):
-        raise LinearizationError("JSBSim's linear model has non-finite entries")
-    return a_si, tuple(names[i] for i in fast)
 
 
 # ======================================================================================

@@ -82,7 +82,7 @@ class DaskExecutor:
         try:
             for module in WORKER_IMPORTS:
                 self.client.run(importlib.import_module, module)
-        except Exception as exc:  # noqa: BLE001 - any worker-side import problem
+        except (ImportError, OSError) as exc:  # the worker's environment, in one line
             self.close()
             raise DaskUnavailable(f"the Dask workers cannot import {module}: "
                                   f"{type(exc).__name__}: {' '.join(str(exc).split())}"
@@ -123,10 +123,9 @@ class DaskExecutor:
                 except KilledWorker as exc:
                     row = failed_row(c, f"worker died running this case, also on retry "
                                         f"(Dask KilledWorker: {exc})")
-                except KeyboardInterrupt:
-                    raise
-                except Exception as exc:  # noqa: BLE001 - recorded as the case's error
-                    row = failed_row(c, f"{type(exc).__name__}: {exc}")
+                # any other exception from a worker is a bug in the evaluation (the physics
+                # stopping a case is a row, not an exception): it propagates with its
+                # traceback
                 fut.release()
                 yield c, row
         finally:

@@ -1,0 +1,86 @@
+"""JSBSim's linear model reduced to the paper's rigid longitudinal states (pure numerics).
+
+:meth:`Airframe.linearize` trims, then runs ``jsbsim.FGLinearization``, whose state vector is
+[Vt, α, θ, q, RPM(s), β, φ, p, ψ, r, latitude, longitude, altitude]. It is turned into the
+paper's rigid longitudinal model x_R = [u, α, q, θ] (u the airspeed perturbation [m/s]; α,
+θ [rad]; q [rad/s]) by
+
+* residualising the propeller RPM states r (``Rpm0``, ``Rpm1``: one per rotor of the pair)
+  as quasi-static: A = A_xx − A_xr A_rr⁻¹ A_rx
+  (the RPM settles in ≈ 0.3 s at the physical rotor inertia; JSBSim's state space already
+  re-solves the RPM to steady state at every
+  perturbation, so A_xr is zero to rounding and the thrust change with airspeed is in the u
+  column). The rotors of the contra-rotating pair are identical and identically driven, so a
+  longitudinal perturbation moves their RPMs together: the RPM states are first reduced to
+  their symmetric combination (δRpm0 = δRpm1: columns summed, rows averaged); the
+  antisymmetric one (one rotor faster than the other) is lateral, like β, φ, p, ψ, r, and is
+  dropped with them. JSBSim's own 2×2 RPM block is singular (perturbing Rpm1 changes
+  nothing), the symmetric 1×1 block is not;
+* dropping the lateral states (β, φ, p, ψ, r), decoupled from the longitudinal ones at a
+  wings-level trim, and the position states (latitude, longitude, altitude: the paper's x_R
+  has no altitude; the density gradient over the short period's height change is negligible);
+* converting Vt from ft/s to m/s (rows and columns).
+
+The eigenvalues are labelled by frequency: the two of larger modulus are the short period,
+the two of smaller modulus the phugoid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.runtime.results import LinearizationError
+
+# JSBSim state names (FGStateSpace) of the rigid longitudinal model, in x_R order, and
+# the factor from JSBSim's unit to SI.
+_RIGID_JSBSIM = (("Vt", "ft/s", U.M_PER_FT), ("Alpha", "rad", 1.0), ("Q", "rad/s", 1.0),
+                 ("Theta", "rad", 1.0))  # fmt: skip
+_FAST_PREFIXES = ("Rpm", "PropPitch")  # engine states residualised as quasi-static
+_DROPPED = {"Beta", "Phi", "P", "Psi", "R", "Latitude", "Longitude", "Alt"}
+
+
+def reduce_to_rigid(
+    a_full: np.ndarray, names: tuple[str, ...], units: tuple[str, ...]
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """JSBSim's system matrix → 4×4 A in x_R = [u, α, q, θ], SI (see module docstring).
+
+    Returns the matrix and the names of the residualised (quasi-static) states.
+    """
+    index = {n: i for i, n in enumerate(names)}
+    keep = []
+    scale = []
+    for name, unit, to_si in _RIGID_JSBSIM:
+        if name not in index:
+            raise LinearizationError(f"JSBSim's linear model has no {name!r} state: {names}")
+        if units[index[name]] != unit:
+            raise LinearizationError(
+                f"JSBSim's {name!r} state is in {units[index[name]]!r}, expected {unit!r}"
+            )
+        keep.append(index[name])
+        scale.append(to_si)
+    fast = [i for i, n in enumerate(names) if n.startswith(_FAST_PREFIXES)]
+    unknown = [n for n in names if n not in _DROPPED and not n.startswith(_FAST_PREFIXES)]
+    unknown = [n for n in unknown if n not in {r[0] for r in _RIGID_JSBSIM}]
+    if unknown:
+        raise LinearizationError(f"JSBSim's linear model has unexpected states {unknown}")
+    a_xx = a_full[np.ix_(keep, keep)]
+    if fast:
+        # symmetric combination of identical rotors: one state per prefix (Rpm, PropPitch)
+        groups = sorted({p for n in (names[i] for i in fast) for p in _FAST_PREFIXES
+                         if n.startswith(p)})  # fmt: skip
+        e = np.zeros((len(fast), len(groups)))
+        for row, i in enumerate(fast):
+            e[row, next(g for g, p in enumerate(groups) if names[i].startswith(p))] = 1.0
+        mean = np.linalg.solve(e.T @ e, e.T)  # average over the rotors of each group
+        a_xr = a_full[np.ix_(keep, fast)] @ e
+        a_rx = mean @ a_full[np.ix_(fast, keep)]
+        a_rr = mean @ a_full[np.ix_(fast, fast)] @ e
+        if not np.all(np.isfinite(a_rr)) or np.linalg.cond(a_rr) > 1e12:
+            raise LinearizationError("the propeller RPM block of JSBSim's model is singular")
+        a_xx = a_xx - a_xr @ np.linalg.solve(a_rr, a_rx)
+    s = np.diag(scale)
+    a_si = s @ a_xx @ np.linalg.inv(s)
+    if not np.all(np.isfinite(a_si)):
+        raise LinearizationError("JSBSim's linear model has non-finite entries")
+    return a_si, tuple(names[i] for i in fast)
