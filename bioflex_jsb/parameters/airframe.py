@@ -214,7 +214,7 @@ class Propulsion:
     """Electric drive: a contra-rotating pair of fixed-pitch propellers on one motor power.
 
     The propeller's thrust and power coefficient tables are computed from this blade
-    geometry by blade-element momentum theory in :mod:`bioflex_jsb.generators.airframe`.
+    geometry by blade-element momentum theory in :mod:`bioflex_jsb.aerodynamics.propeller`.
 
     Contra-rotating pair (DECISION, ``rotor_count`` = 2): the paper's model is longitudinal,
     and a symmetric (vertical) gust must leave the airframe symmetric. A single propeller's

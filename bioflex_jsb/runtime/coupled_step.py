@@ -36,9 +36,9 @@ from typing import NamedTuple
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.aerodynamics.airframe_polars import alpha_peak_rad
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-from bioflex_jsb.generators.airframe import alpha_peak_rad
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS

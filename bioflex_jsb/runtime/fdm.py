@@ -82,6 +82,7 @@ import jsbsim
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.aerodynamics.propeller import propeller_tables
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
 from bioflex_jsb.runtime.linearization import reduce_to_rigid
@@ -251,7 +252,7 @@ def _alpha_limits_rad(path: Path) -> tuple[float, float]:
 @lru_cache(maxsize=1)
 def _zero_thrust_advance_ratio() -> float:
     """J at which the propeller's C_T(J) crosses zero [-] (windmilling)."""
-    j, ct, _ = airframe_xml.propeller_tables(PROPULSION)
+    j, ct, _ = propeller_tables(PROPULSION)
     k = int(np.argmax(ct <= 0.0))
     return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
 

@@ -1,0 +1,137 @@
+"""The one XML writer of the JSBSim file generators: element helpers and serialisation.
+
+Every generator builds an :mod:`xml.etree.ElementTree` tree with an :class:`XmlWriter` (which
+fixes how numbers are written: :func:`num_9g` for the airframe, :func:`num_12g` for the modal
+wing, whose coefficients need more digits, :func:`num_repr` for the autopilot) and writes it
+with :func:`serialise`: the XML declaration, the generator's header comment, the tree indented
+by two spaces, a final newline. The output is deterministic, so the committed files can be
+compared with a fresh rendering byte for byte.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Callable, Iterable
+
+XML_DECLARATION = '<?xml version="1.0" encoding="utf-8"?>\n'
+INDENT = "  "
+
+
+def num_9g(x: float) -> str:
+    """9 significant digits, no negative zero."""
+    s = f"{float(x):.9g}"
+    return "0" if s == "-0" else s
+
+
+def num_12g(x: float) -> str:
+    """12 significant digits, zero (of either sign) as ``0``."""
+    x = float(x)
+    return "0" if x == 0.0 else f"{x:.12g}"
+
+
+def num_repr(x: float) -> str:
+    """The shortest text that reads back as the same double."""
+    return repr(float(x))
+
+
+class XmlWriter:
+    """Element helpers that write numbers with ``number`` (a float → text function).
+
+    Terms of an operation (:meth:`op`): a ``str`` is a ``<property>``, an
+    :class:`~xml.etree.ElementTree.Element` is appended as it is, a callable is called with the
+    operation's element (it builds its argument there), anything else is a number, a
+    ``<value>``."""
+
+    def __init__(self, number: Callable[[float], str]) -> None:
+        self.number = number
+
+    def text(self, x: str | float) -> str:
+        return x if isinstance(x, str) else self.number(x)
+
+    def el(self, parent: ET.Element, tag: str, text: str | float | None = None,
+           **attrib) -> ET.Element:
+        """Child ``<tag>`` of ``parent`` with ``text`` (numbers written by ``number``) and the
+        attributes ``attrib`` (as text)."""
+        e = ET.SubElement(parent, tag, {k: str(v) for k, v in attrib.items()})
+        if text is not None:
+            e.text = self.text(text)
+        return e
+
+    @staticmethod
+    def comment(parent: ET.Element, text: str) -> ET.Comment:
+        """``<!-- text -->`` as the last child of ``parent``."""
+        c = ET.Comment(f" {text} ")
+        parent.append(c)
+        return c
+
+    def prop(self, parent: ET.Element, name: str) -> ET.Element:
+        return self.el(parent, "property", name)
+
+    def value(self, parent: ET.Element, x: float) -> ET.Element:
+        return self.el(parent, "value", float(x))
+
+    def value_element(self, x: float) -> ET.Element:
+        """A detached ``<value>``."""
+        e = ET.Element("value")
+        e.text = self.number(x)
+        return e
+
+    def op(self, parent: ET.Element, tag: str, *terms, **attrib) -> ET.Element:
+        """``<tag>`` with one child per term (class docstring)."""
+        e = self.el(parent, tag, **attrib)
+        for t in terms:
+            if isinstance(t, str):
+                self.prop(e, t)
+            elif isinstance(t, ET.Element):
+                e.append(t)
+            elif callable(t):
+                t(e)
+            else:
+                self.value(e, t)
+        return e
+
+    def node(self, tag: str, *terms) -> ET.Element:
+        """A detached ``<tag>`` with the terms (to nest into a later operation)."""
+        return self.op(ET.Element("holder"), tag, *terms)
+
+    def product(self, parent: ET.Element, *terms) -> ET.Element:
+        return self.op(parent, "product", *terms)
+
+    def table_data(self, parent: ET.Element, rows: Iterable[tuple[float, float]], width: int,
+                   indent: int) -> ET.Element:
+        """``<tableData>`` of two columns, each row on its own line at ``indent`` spaces,
+        right-aligned in ``width`` characters; the closing tag two spaces less indented."""
+        lines = "".join(f"\n{' ' * indent}{self.number(x):>{width}} {self.number(y):>{width}}"
+                        for x, y in rows)
+        return self.el(parent, "tableData", lines + "\n" + " " * (indent - 2))
+
+    def table(self, parent: ET.Element, variable: str, rows: Iterable[tuple[float, float]],
+              width: int) -> ET.Element:
+        """A one-dimensional ``<table>`` of ``variable`` (row lookup), at the depth of a table
+        in an aerodynamics or system function."""
+        t = self.el(parent, "table")
+        self.el(t, "independentVar", variable, lookup="row")
+        self.table_data(t, rows, width, indent=10)
+        return t
+
+
+def collapse(parent: ET.Element) -> None:
+    """Replace every ``<sum>``/``<product>``/``<difference>`` with one argument (and no name)
+    by that argument (JSBSim warns about them)."""
+    for i, child in enumerate(list(parent)):
+        collapse(child)
+        if (child.tag in ("sum", "product", "difference") and len(child) == 1
+                and "name" not in child.attrib):
+            parent.remove(child)
+            parent.insert(i, child[0])
+
+
+def serialise(root: ET.Element, header: str = "", *, collapse_single: bool = False) -> str:
+    """Text of a generated file: the XML declaration, ``header`` (comment lines, each ending in
+    a newline), ``root`` indented by two spaces per level, a final newline.
+    ``collapse_single``: first :func:`collapse` the tree. Indents ``root`` in place."""
+    if collapse_single:
+        collapse(root)
+    ET.indent(root, space=INDENT)
+    body = ET.tostring(root, encoding="unicode", short_empty_elements=True)
+    return XML_DECLARATION + header + body + "\n"
