@@ -113,7 +113,7 @@ def test_issue_reading_of_the_data(strip_model):
 def test_quasi_steady_flutters_early_single_mode(pk_unsteady):
     # With C = 1 the torsion mode's aerodynamic damping is far too small (it vanishes for an
     # axis at mid-chord): the wing flutters in torsion alone at about half the speed
-    # (measured 69.2 m/s, 88.0 rad/s). Same equations in both methods (no lag states):
+    # (measured 64.53 m/s, 87.70 rad/s). Same equations in both methods (no lag states):
     # p-k and eigen-analysis agree to the root-finding tolerance, 1e-6 relative.
     qs = goland_flutter(aero="quasi-steady", method="pk")
     qs_ss = goland_flutter(aero="quasi-steady", method="state-space")

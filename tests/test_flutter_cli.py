@@ -1,0 +1,146 @@
+"""``bioflex-jsb flutter``: the clamped Goland benchmark against its published strip-theory
+result, the paper wings' report, and one-line refusals of combinations not available."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from bioflex_jsb.cli import main
+from bioflex_jsb.parameters import goland as G
+
+
+def run_cli(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(code, err, needle):
+    assert code == 2
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    assert needle in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def goland_json():
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(["flutter", "--wing", "goland", "--clamped", "--aero", "unsteady",
+                     "--json"])
+    return code, json.loads(buf.getvalue())
+
+
+def test_goland_clamped_unsteady_matches_published_strip_theory(goland_json):
+    code, d = goland_json
+    assert code == 0
+    # Published: 137.2 m/s, 70.7 rad/s, the exact strip-theory (Theodorsen, lift slope 2π)
+    # flutter point of Goland, J. Appl. Mech. 12(4), A197-A208 (1945), as tabulated by
+    # Patil, Hodges & Cesnik, J. Aircraft 38(1), 88-94 (2001). Measured (p-k on the exact
+    # C(k), 8.64 kg·m about the elastic axis, ρ = 1.225 kg/m³): 136.96 m/s (−0.2 %),
+    # 70.02 rad/s (−1.0 %). Tolerance: 3 %, the issue's "within a few per cent"
+    # (tests/test_goland.py holds the library to 1 % / 2 %).
+    assert d["flutter_speed_m_s"] == pytest.approx(G.PUBLISHED_FLUTTER_SPEED_M_S, rel=0.03)
+    assert d["frequency_rad_s"] == pytest.approx(G.PUBLISHED_FLUTTER_FREQUENCY_RAD_S,
+                                                 rel=0.03)
+    assert d["published"]["flutter_speed_m_s"] == G.PUBLISHED_FLUTTER_SPEED_M_S
+    assert d["published"]["comparable"] and "Goland (1945)" in d["published"]["source"]
+    assert abs(d["published"]["speed_rel_diff"]) < 0.03
+    # reported: reduced frequency k = ωb/V, mode, mechanism, natural frequencies
+    b = G.CHORD_M / 2
+    assert d["reduced_frequency"] == pytest.approx(
+        d["frequency_rad_s"] * b / d["flutter_speed_m_s"], rel=1e-3)
+    assert d["mechanism"] == "coalescence" and d["kind"] == "flutter"
+    assert {d["mode"], d["partner_mode"]} == {"mode 1 (bending)", "mode 2 (torsion)"}
+    # first three natural frequencies vs published 49.5, 97.0, 248.9 rad/s (Patil, Hodges
+    # & Cesnik 2001); measured −2.7, −1.3, −2.0 %: tolerance 3 % (tests/test_goland.py)
+    for w, ref in zip(d["natural_frequencies_rad_s"][:3],
+                      G.PUBLISHED_NATURAL_FREQUENCIES_RAD_S, strict=True):
+        assert w == pytest.approx(ref, rel=0.03)
+
+
+def test_goland_state_space_and_issue_reading(capsys):
+    # State-space (Jones lag states) within 0.5 % of p-k (tests/test_goland.py), so within
+    # 3 % of the published 137.2 m/s too; the issue's literal reading (8.64 kg·m about the
+    # centre of mass, ρ = 1.02 kg/m³) measured 137.29 m/s, 68.19 rad/s (frequency −3.5 %).
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "goland", "--clamped",
+                           "--method", "state-space", "--json")
+    assert code == 0
+    assert json.loads(out)["flutter_speed_m_s"] == pytest.approx(137.2, rel=0.03)
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "goland", "--clamped",
+                           "--inertia-about", "centre-of-mass", "--density", "1.02", "--json")
+    d = json.loads(out)
+    assert code == 0 and d["inertia_about"] == "centre-of-mass" and d["density_kg_m3"] == 1.02
+    assert d["flutter_speed_m_s"] == pytest.approx(137.2, rel=0.03)
+    assert d["frequency_rad_s"] == pytest.approx(70.7, rel=0.04)
+
+
+def test_goland_quasi_steady_is_not_compared_with_published(capsys):
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "goland", "--clamped", "--aero",
+                           "quasi-steady", "--structural-damping", "0.02", "--json")
+    d = json.loads(out)
+    assert code == 0 and d["aero"] == "quasi-steady" and d["structural_damping"] == 0.02
+    assert d["published"]["comparable"] is False and d["published"]["speed_rel_diff"] is None
+    assert d["flutter_speed_m_s"] < 0.7 * G.PUBLISHED_FLUTTER_SPEED_M_S  # single-mode, early
+    assert d["mechanism"] == "single-mode"
+
+
+def test_goland_text_report(capsys):
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "goland", "--clamped")
+    assert code == 0
+    assert "flutter at 137.0 m/s" in out and "published: 137.2 m/s" in out
+    assert "natural frequencies [rad/s]: 48.15" in out
+
+
+def test_paper_wing_reports_mechanism_and_damping(capsys):
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "elastic-backward", "--json")
+    d = json.loads(out)
+    assert code == 0 and d["clamped"] is False and d["aero"] == "quasi-steady"
+    assert d["structural_damping"] == [0.02, 0.02, 0.02]
+    assert 5.0 < d["flutter_speed_m_s"] < 30.0
+    assert d["mechanism"] in ("coalescence", "single-mode", "static divergence")
+    assert len(d["natural_frequencies_rad_s"]) == 3 and d["reduced_frequency"] > 0.0
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "elastic-backward",
+                           "--structural-damping", "0", "--json")
+    d0 = json.loads(out)
+    assert d0["structural_damping"] == [0.0, 0.0, 0.0]
+    # quasi-steady twist modes have no aerodynamic damping: the assumed ζ sets the speed
+    assert d0["flutter_speed_m_s"] < d["flutter_speed_m_s"]
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["--wing", "goland"], "give --clamped"),
+        (["--wing", "original", "--clamped"], "--clamped is available for the benchmark wing"),
+        (["--wing", "original", "--aero", "unsteady"], "accept --aero quasi-steady"),
+        (["--wing", "original", "--method", "pk"], "accept --method state-space"),
+        (["--wing", "original", "--lift-slope", "vlm"], "--lift-slope is available"),
+        (["--wing", "original", "--inertia-about", "centre-of-mass"],
+         "--inertia-about is available"),
+        (["--wing", "goland", "--clamped", "--aero", "viscous"], "invalid choice"),
+        (["--wing", "goland", "--clamped", "--structural-damping", "1.5"], "0 <= Z < 1"),
+        (["--wing", "goland", "--clamped", "--structural-damping", "x"], "0 <= Z < 1"),
+        (["--wing", "goland", "--clamped", "--density", "0"], "0 < RHO <= 2"),
+        (["--wing", "goland", "--clamped", "--range", "20:900"], "range must satisfy"),
+        (["--wing", "banana"], "valid names: original"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):
+    code, _, err = run_cli(capsys, "flutter", *argv)
+    assert_one_line_error(code, err, needle)
+
+
+def test_help_states_units_and_ranges(capsys):
+    code, out, _ = run_cli(capsys, "flutter", "--help")
+    assert code == 0
+    flat = " ".join(out.split())
+    for text in ("[m/s]", "[rad/s]", "k = omega*b/V", "0 <= Z < 1", "kg/m^3", "goland",
+                 "0 < LOW < HIGH <= 400"):
+        assert text in flat, text
