@@ -1,4 +1,4 @@
-"""The ``bioflex-jsb`` command: a thin layer over the numerical core and the adapters.
+"""The ``bioflex-jsb`` command: one client of the Python API and the drivers.
 
 Every sub-command lives in its own module of this package and exposes
 ``register(subparsers)``; the module's ``run(args) -> int`` does the work. Errors a user can
@@ -13,6 +13,7 @@ import signal
 import sys
 
 from bioflex_jsb.cli.common import EXIT_USAGE, OneLineParser, UsageError
+from bioflex_jsb.errors import InputError
 
 # Sub-command modules, in the order ``--help`` lists them.
 COMMAND_MODULES = (
@@ -23,6 +24,7 @@ COMMAND_MODULES = (
     "export",
     "gust",
     "sitl",
+    "sitl_ardupilot",
     "compare",
     "export_jsbsim",
     "info",
@@ -64,8 +66,9 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, _terminate)  # SIGTERM stops a run like Ctrl-C: logs close
     try:
         return int(args.run(args) or 0)
-    except UsageError as exc:
-        print(f"bioflex-jsb {args.command}: error: {exc}", file=sys.stderr)
+    except (UsageError, InputError) as exc:  # what the user can fix: one line, exit 2
+        print(f"bioflex-jsb {args.command}: error: {' '.join(str(exc).split())}",
+              file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print(f"bioflex-jsb {args.command}: interrupted", file=sys.stderr)

@@ -110,13 +110,14 @@ def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original
 
 def wing_from_args(args: argparse.Namespace):
     """Build the wing named by --wing; any problem becomes a one-line UsageError."""
+    from bioflex_jsb.errors import InputError
     from bioflex_jsb.flight_dynamics.wing_model import VariantError, build_wing, resolve_variant
 
     try:
         return build_wing(resolve_variant(args.wing), mass_basis=args.mass_basis)
-    except VariantError as exc:
-        raise UsageError(str(exc)) from None
-    except ValueError as exc:  # modal-file and modal-data errors name their field
+    except VariantError:
+        raise
+    except InputError as exc:  # modal-file and modal-data errors name their field
         raise UsageError(f"wing {args.wing!r}: {exc}") from None
 
 

@@ -39,8 +39,6 @@ def run(args: argparse.Namespace) -> int:
     ss = build_state_space(args.model, level_flight_condition(args.speed), build.model)
     try:
         write_state_space(ss, args.out)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
     except OSError as exc:
         raise UsageError(f"cannot write {args.out!r}: {exc.strerror}") from None
     info = {"out": args.out, "model": ss.model, "speed_m_s": ss.speed_m_s,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from bioflex_jsb.cli.common import UsageError, print_json
+from bioflex_jsb.cli.common import print_json
 from bioflex_jsb.cli.trim import add_flight_condition_arguments, load_airframe
 
 HELP = """Trim the rigid JSBSim airframe at --speed, linearize it with JSBSim's
@@ -46,12 +46,8 @@ def linearization_payload(lin) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.runtime import fdm as jsbsim_fdm
     airframe = load_airframe(args)
-    try:
-        lin = airframe.linearize(args.speed, args.altitude)
-    except (jsbsim_fdm.FdmError, ValueError) as exc:
-        raise UsageError(str(exc)) from None
+    lin = airframe.linearize(args.speed, args.altitude)
     if args.json:
         print_json(linearization_payload(lin))
         return 0

@@ -74,12 +74,8 @@ def trim_payload(result) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.runtime import fdm as jsbsim_fdm
     airframe = load_airframe(args)
-    try:
-        result = airframe.trim(args.speed, args.altitude)
-    except (jsbsim_fdm.FdmError, ValueError) as exc:
-        raise UsageError(str(exc)) from None
+    result = airframe.trim(args.speed, args.altitude)
     if args.json:
         print_json(trim_payload(result))
         return 0

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
 from bioflex_jsb.parameters import prototype as P
@@ -270,7 +271,7 @@ def find_flutter(
     """
     lo, hi = range_m_s
     if not (0.0 < lo < hi):
-        raise ValueError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
+        raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
     grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
     grid = grid[grid <= hi + 1e-12]
     sweep = track("coupled", grid, wing, density_kg_m3)

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.modal_coefficients import ModalCoefficients
 from bioflex_jsb.flight_dynamics.rigid import (
     RIGID_STATE_UNITS,
@@ -224,7 +225,7 @@ def build_state_space(
     :func:`coupled_blocks`).
     """
     if model not in MODELS:
-        raise ValueError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+        raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
     if model == "rigid":
         a, g = rigid_matrices(rigid_derivatives(condition, aero))
@@ -237,7 +238,7 @@ def build_state_space(
             outputs=RIGID_STATES, output_units=RIGID_STATE_UNITS, **common,
         )
     if wing is None:
-        raise ValueError(f"the {model} model needs an elastic wing")
+        raise InputError(f"the {model} model needs an elastic wing")
     blk = coupled_blocks(wing, condition, aero, a_rr)
     n = wing.n_modes
     e_names, e_units = elastic_state_names(n)

@@ -19,12 +19,15 @@ m_i as Table B2 reads literally, which doubles every H term. Every output names 
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.aerodynamics.vortex_lattice import SpanwiseAerodynamics
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_coefficients import (
     modal_coefficients,
@@ -35,6 +38,7 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
 )
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, MODAL_DAMPING_RATIO, Planform
+from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.tomlfile import read_toml
 
 MASS_BASES = ("paper", "consistent")
@@ -45,7 +49,7 @@ DEFAULT_N_MODES = 3
 CM_AC_SECTION = -0.05
 
 
-class VariantError(ValueError):
+class VariantError(InputError):
     """A wing variant that cannot be built; the message names the field."""
 
 
@@ -235,8 +239,8 @@ class WingBuild:
     """Everything built for one variant: the modes, the strips, and the LTI wing model."""
 
     variant: WingVariant
-    modes: object  # bioflex_jsb.structures.modal_data.ModalData
-    aero: object  # bioflex_jsb.aerodynamics.vortex_lattice.SpanwiseAerodynamics
+    modes: ModalData
+    aero: SpanwiseAerodynamics
     model: ElasticWingModel
     mass_basis: str
     physical_c_eta1_q1: float
@@ -288,7 +292,10 @@ def structural_modes(variant: WingVariant, n_modes: int = DEFAULT_N_MODES):
     return modes.truncated(n_modes)
 
 
-_BUILD_CACHE: dict[tuple, WingBuild] = {}
+# Wings built in this process, most recently used last; bounded so that a long sweep over
+# many variants does not keep every build (each holds its modes and strips: ~100 kB).
+_BUILD_CACHE: OrderedDict[tuple, WingBuild] = OrderedDict()
+BUILD_CACHE_SIZE = 64
 
 
 def build_wing(
@@ -304,9 +311,13 @@ def build_wing(
     if mass_basis not in MASS_BASES:
         raise VariantError(f"unknown mass basis {mass_basis!r}; accepted: {', '.join(MASS_BASES)}")
     key = (repr(sorted(variant.as_dict().items())), n_modes, mass_basis, planform)
-    if key not in _BUILD_CACHE:
-        _BUILD_CACHE[key] = _build(variant, n_modes, mass_basis, planform)
-    return _BUILD_CACHE[key]
+    if key in _BUILD_CACHE:
+        _BUILD_CACHE.move_to_end(key)
+        return _BUILD_CACHE[key]
+    build = _BUILD_CACHE[key] = _build(variant, n_modes, mass_basis, planform)
+    while len(_BUILD_CACHE) > BUILD_CACHE_SIZE:
+        _BUILD_CACHE.popitem(last=False)
+    return build
 
 
 def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planform) -> WingBuild:

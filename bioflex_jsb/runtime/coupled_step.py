@@ -37,6 +37,7 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.aerodynamics.airframe_polars import alpha_peak_rad
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
@@ -161,10 +162,10 @@ class CoupledStep:
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None) -> None:
         if model not in STEP_MODELS:
-            raise ValueError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
+            raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
         native = model == "native"
         if wing is None and not native:
-            raise ValueError(f"the {model} model needs a wing")
+            raise InputError(f"the {model} model needs a wing")
         self.airframe = airframe
         self.native = native
         configure_airframe(airframe, dt_s, modal_hooks=not native)
@@ -228,7 +229,7 @@ class CoupledStep:
         """Switch the Python wing between ``rigid``, ``coupled`` and ``qsd`` mid-run; a wing
         that becomes coupled starts undeformed."""
         if self.native or model not in WING_MODELS:
-            raise ValueError(f"cannot switch a {self.model} wing to {model!r}")
+            raise InputError(f"cannot switch a {self.model} wing to {model!r}")
         if model != self.wing.model:
             self.wing.model = model
             self.wing.eta = np.zeros(self.n_modes)

@@ -83,6 +83,7 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.aerodynamics.propeller import propeller_tables
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
 from bioflex_jsb.runtime.linearization import reduce_to_rigid
@@ -215,9 +216,9 @@ def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
 def _check_speed(speed_m_s: float) -> float:
     v = float(speed_m_s)
     if not math.isfinite(v) or v <= 0.0:
-        raise ValueError(f"airspeed must be a finite number > 0 m/s, got {speed_m_s!r}")
+        raise InputError(f"airspeed must be a finite number > 0 m/s, got {speed_m_s!r}")
     if v > SPEED_MAX_M_S:
-        raise ValueError(
+        raise InputError(
             f"airspeed {v:g} m/s is above {SPEED_MAX_M_S:g} m/s, where the incompressible "
             "aerodynamic model ends"
         )
@@ -228,7 +229,7 @@ def _check_altitude(altitude_m: float) -> float:
     h = float(altitude_m)
     lo, hi = ALTITUDE_RANGE_M
     if not math.isfinite(h) or not lo <= h <= hi:
-        raise ValueError(f"altitude must be between {lo:g} and {hi:g} m, got {altitude_m!r}")
+        raise InputError(f"altitude must be between {lo:g} and {hi:g} m, got {altitude_m!r}")
     return h
 
 
@@ -647,7 +648,7 @@ class Airframe:
         """Set JSBSim's integration time step [s] (kept across trims and linearizations)."""
         dt = float(dt_s)
         if not math.isfinite(dt) or not 0.0 < dt <= 0.1:
-            raise ValueError(f"time step must be in (0, 0.1] s, got {dt_s!r}")
+            raise InputError(f"time step must be in (0, 0.1] s, got {dt_s!r}")
         self._dt_nominal_s = dt
         self._restore_time_step()
 

@@ -6,8 +6,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
 
-class FdmError(Exception):
+
+class FdmError(InputError):
     """Base of the adapter's errors; the message is always a single line."""
 
 

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
+
 GUST_FORMS = (
     "sharp:AMPLITUDE_m_s",
     "1cos:AMPLITUDE_m_s:LENGTH_m",
@@ -36,7 +38,7 @@ GUST_FORMS = (
 MAX_GUST_M_S = 50.0  # beyond this the small-UAV model is meaningless (3x the cruise speed)
 
 
-class GustSpecError(ValueError):
+class GustSpecError(InputError):
     """A gust specification that cannot be used; the message says what is accepted."""
 
 

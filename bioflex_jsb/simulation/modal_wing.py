@@ -42,16 +42,30 @@ t_{k+1}: no coupling lag. ``qsd`` takes Δη as the quasi-static solution of the
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.linalg import expm, expm_frechet
+from threadpoolctl import ThreadpoolController
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
 
 WING_MODELS = ("rigid", "coupled", "qsd")
+
+
+@lru_cache(maxsize=1)
+def _blas_controller() -> ThreadpoolController:
+    """threadpoolctl's view of the loaded BLAS libraries (inspected once per process)."""
+    return ThreadpoolController()
+
+
+def _one_blas_thread():
+    """A context in which BLAS uses one thread (about 10 µs to enter and leave)."""
+    return _blas_controller().limit(limits=1, user_api="blas")
 # Default co-simulation step [s]: 31 samples per period of the first wing mode (in vacuo), 9
 # of the third. The Fig. 21 run at this step is within 1 % NRMSE of the same run at a quarter
 # of it on u, α, q, θ and η₁ (tests/test_cosim.py). JSBSim's aircraft default, 1/120 s,
@@ -108,9 +122,9 @@ class ModalWing:
         refresh_rel: float = 0.05,
     ) -> None:
         if model not in WING_MODELS:
-            raise ValueError(f"unknown wing model {model!r}; accepted: {', '.join(WING_MODELS)}")
+            raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(WING_MODELS)}")
         if not (np.isfinite(dt_s) and dt_s > 0.0):
-            raise ValueError(f"time step must be finite and > 0 s, got {dt_s!r}")
+            raise InputError(f"time step must be finite and > 0 s, got {dt_s!r}")
         self.wing = wing
         self.trim = trim
         self.model = model
@@ -140,7 +154,13 @@ class ModalWing:
     def _reference(self, q_pa: float, v_m_s: float) -> None:
         """Exact discretisation at (Q_r, V_r): Φ = e^{A dt}, Ψ = ∫_0^dt e^{A τ} dτ, and the
         first-order change of Φ per unit change of Q and of Q/V (Fréchet derivatives of the
-        exponential along ∂A/∂Q and ∂A/∂(Q/V))."""
+        exponential along ∂A/∂Q and ∂A/∂(Q/V)). BLAS runs on one thread here: on these
+        12×12 matrices OpenBLAS's default threads only add hand-over costs (a refresh took
+        5-39 ms instead of about 1 ms on a loaded 2-core machine, issue 13)."""
+        with _one_blas_thread():
+            self._compute_reference(q_pa, v_m_s)
+
+    def _compute_reference(self, q_pa: float, v_m_s: float) -> None:
         a, _ = self._matrices(q_pa, v_m_s)
         n2 = a.shape[0]
         aug = np.zeros((2 * n2, 2 * n2))

@@ -13,6 +13,7 @@ import math
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 # What a run can be: a gust run of one or more models, one sweep case (a gust run), a
@@ -21,7 +22,7 @@ RUN_KINDS = ("gust", "sweep", "compare", "sitl", "bench")
 REPEATABLE_KINDS = ("gust", "sweep", "compare")
 
 
-class RunDescriptionError(ValueError):
+class RunDescriptionError(InputError):
     """A run description that cannot describe a run (one line: the field and what is
     accepted)."""
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import StateSpace
 
 FORMATS = (".npz", ".mat")
@@ -25,7 +26,7 @@ def write_state_space(ss: StateSpace, path: str | Path) -> Path:
     """Write ``ss`` with its signal names and units; the suffix picks the format."""
     p = Path(path)
     if p.suffix not in FORMATS:
-        raise ValueError(f"unknown model file type {p.suffix!r}; accepted: {', '.join(FORMATS)}")
+        raise InputError(f"unknown model file type {p.suffix!r}; accepted: {', '.join(FORMATS)}")
     if p.suffix == ".npz":
         np.savez(p, **_arrays(ss))
     else:

@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.linalg import eigh
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.structures.sections import (
     ChordwiseLayup,
@@ -53,7 +54,7 @@ _GAUSS_W = 0.5 * _GAUSS_W
 DEFAULT_N_ELEMENTS = 40
 
 
-class BeamInputError(ValueError):
+class BeamInputError(InputError):
     """Invalid beam section data; the message names the offending field."""
 
 

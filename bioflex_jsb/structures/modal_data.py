@@ -34,6 +34,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
+
 # A mode counts as twist-free when max|twist| · (b/2) is below this fraction of max|bending|
 # ESTIMATE: FE round-off of an exactly uncoupled bending eigenvector is ~1e-15 relative; any
 # real bending–torsion coupling (|x_I − x_E| ≥ 1e-6 chord) gives ratios far above 1e-9.
@@ -45,7 +47,7 @@ TWIST_FREE_RELATIVE_TOLERANCE = 1e-9
 TIP_SIGN_RELATIVE_TOLERANCE = 1e-6
 
 
-class ModalDataError(ValueError):
+class ModalDataError(InputError):
     """Invalid modal data; the message names the offending field."""
 
 

@@ -46,6 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
 
 FORMAT_NAME = "bioflex-jsb-modes"
@@ -70,7 +71,7 @@ _TOP_KEYS = {"format", "format_version", "source", "notes", "units", "stations",
 _MODE_KEYS = {"frequency", "damping_ratio", "generalised_mass", "bending", "twist"}
 
 
-class ModalFileError(ValueError):
+class ModalFileError(InputError):
     """A modal-data file that cannot be used; one-line message naming key and line."""
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import MODELS
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
@@ -67,7 +68,7 @@ EIGEN_MODES = ("short_period", "phugoid") + tuple(
 )
 
 
-class CampaignError(ValueError):
+class CampaignError(InputError):
     """A campaign file that cannot be used; the one-line message names the key."""
 
 
