@@ -5,7 +5,11 @@ from __future__ import annotations
 import json
 import math
 
+import pytest
+
 from bioflex_jsb.cli import main
+
+pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
 
 
 def test_bench_json_has_every_figure(capsys):

@@ -20,6 +20,8 @@ from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.links.mavlink import MavlinkLink
 from tests.test_sitl import Session, make_sim
 
+pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
+
 PASSPHRASE = "elastic-wing-sitl"
 TIMEOUT_S = 40.0
 

@@ -43,7 +43,9 @@ from mavsdk.plugins.param import Param
 from mavsdk.plugins.telemetry import Telemetry
 
 from bioflex_jsb.drivers.sitl import SitlParameters
-from bioflex_jsb.sinks.mcap_log import messages_by_topic, topic
+from bioflex_jsb.sinks.mcap import messages_by_topic, topic
+
+pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
 
 DURATION_S = 20.0  # the issue's `bioflex-jsb sitl --duration 20`
 SPEEDUP = 2.0  # 10 s of wall time; telemetry rates are wall-clock rates, unchanged

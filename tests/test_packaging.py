@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
+
 REPO = Path(__file__).resolve().parents[1]
 
 

@@ -21,6 +21,8 @@ from bioflex_jsb.links.mavlink import (
 )
 from tests.test_sitl import Session, make_sim, run_cli
 
+pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
+
 KEY = hashlib.sha256(b"bioflex signing test").digest()
 WRONG_KEY = hashlib.sha256(b"not the key").digest()
 LINK_ID = 7

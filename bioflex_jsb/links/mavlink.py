@@ -51,7 +51,6 @@ from __future__ import annotations
 import errno
 import hashlib
 import hmac
-import ipaddress
 import math
 import socket
 import struct
@@ -59,10 +58,20 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Protocol
 
 from pymavlink.dialects.v20 import common as mavlink
+
+from bioflex_jsb.links.mavlink_setup import (  # noqa: F401  (the link's set-up and state)
+    SIGNING_EPOCH_UNIX_S,
+    SIGNING_KEY_BYTES,
+    Endpoint,
+    LinkError,
+    Parameters,
+    VehicleState,
+    parse_endpoint,
+    read_signing_key,
+    signing_time_10us,
+)
 
 # What pymavlink's parser raises on bytes that are not MAVLink (hostile or corrupt input):
 # its own MAVError, and the struct/array/decoding errors of a truncated or mangled payload.
@@ -100,8 +109,6 @@ _STREAMS = {
 }
 _STREAMS[M.MAV_DATA_STREAM_ALL] = tuple(m for ids in _STREAMS.values() for m in ids)
 MAX_RATE_HZ = 200.0
-SIGNING_KEY_BYTES = 32
-SIGNING_EPOCH_UNIX_S = 1420070400  # 2015-01-01T00:00:00Z: origin of signing timestamps
 SIGNING_STREAM_AGE_10US = 60 * 100_000  # a new stream may be this much older (60 s)
 UNSIGNED_ALLOWED = frozenset({M.MAVLINK_MSG_ID_RADIO_STATUS})  # radios cannot sign
 # MAVLink FTP (FILE_TRANSFER_PROTOCOL payload header): opcodes and error codes used here
@@ -112,47 +119,6 @@ FTP_OP_NAK = 129
 FTP_ERR_UNKNOWN_COMMAND = 7
 CAPABILITIES = (M.MAV_PROTOCOL_CAPABILITY_MAVLINK2 | M.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
                 | M.MAV_PROTOCOL_CAPABILITY_MISSION_INT | M.MAV_PROTOCOL_CAPABILITY_COMMAND_INT)
-
-
-class LinkError(Exception):
-    """A malformed or unusable endpoint or signing key; one line for the user."""
-
-
-def read_signing_key(path: str | Path) -> bytes:
-    """The 32-byte MAVLink 2 signing secret in the file ``path``: 64 hexadecimal digits
-    (surrounding white space ignored). MAVProxy's ``signing key P`` (and ``signing setup
-    P``) signs with SHA-256 of the passphrase P, so its key file is ``python -c "import
-    hashlib; print(hashlib.sha256(b'P').hexdigest())" > key.hex``. LinkError (one line)
-    when the file is missing, unreadable, or does not hold exactly 32 bytes of hex, or
-    holds the all-zero key (which means "signing off" in MAVLink)."""
-    where = f"signing key {str(path)!r}"
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise LinkError(f"{where}: cannot read it ({exc.strerror or exc})") from None
-    try:
-        text = raw.decode("ascii").strip()
-    except UnicodeDecodeError:
-        raise LinkError(f"{where}: expected {2 * SIGNING_KEY_BYTES} hexadecimal digits, "
-                        "found binary data") from None
-    if len(text) != 2 * SIGNING_KEY_BYTES:
-        raise LinkError(f"{where}: expected {2 * SIGNING_KEY_BYTES} hexadecimal digits "
-                        f"({SIGNING_KEY_BYTES} bytes), found {len(text)} characters")
-    try:
-        key = bytes.fromhex(text)
-    except ValueError:
-        raise LinkError(f"{where}: not hexadecimal (expected {2 * SIGNING_KEY_BYTES} digits "
-                        "0-9, a-f)") from None
-    if not any(key):
-        raise LinkError(f"{where}: the all-zero key means 'no signing' in MAVLink; use a "
-                        "random key")
-    return key
-
-
-def signing_time_10us(unix_s: float | None = None) -> int:
-    """MAVLink signing timestamp: 10 µs units since 2015-01-01 UTC (wall clock)."""
-    now = time.time() if unix_s is None else unix_s
-    return int(max(now - SIGNING_EPOCH_UNIX_S, 0.0) * 100_000)
 
 
 class _Parser(mavlink.MAVLink):
@@ -177,87 +143,6 @@ class _Parser(mavlink.MAVLink):
         sig.stream_timestamps[stream] = stamp
         sig.timestamp = max(sig.timestamp, stamp)
         return True
-
-
-@dataclass(frozen=True)
-class Endpoint:
-    kind: str  # udpout, udpin, tcpin
-    host: str
-    port: int
-
-    def text(self) -> str:
-        return f"{self.kind}:{self.host}:{self.port}"
-
-
-def parse_endpoint(text: str) -> Endpoint:
-    """``udpout:HOST:PORT``, ``udpin:[HOST:]PORT``, ``tcpin:[HOST:]PORT`` (module docstring)."""
-    kind, sep, rest = str(text).partition(":")
-    if not sep or kind not in ("udpout", "udpin", "tcpin"):
-        raise LinkError(f"MAVLink endpoint {text!r}: expected udpout:HOST:PORT, "
-                        "udpin:HOST:PORT or tcpin:HOST:PORT")
-    host, sep, port_text = rest.rpartition(":")
-    if not sep:
-        host, port_text = "", rest
-    host = host.strip() or "127.0.0.1"
-    try:
-        port = int(port_text)
-    except ValueError:
-        raise LinkError(f"MAVLink endpoint {text!r}: port {port_text!r} is not a number") from None
-    lowest = 1 if kind == "udpout" else 0  # listening on port 0: the system picks one
-    if not lowest <= port <= 65535:
-        raise LinkError(f"MAVLink endpoint {text!r}: port {port} is outside {lowest}..65535")
-    if host == "localhost":
-        host = "127.0.0.1"
-    try:
-        addr = ipaddress.IPv4Address(host)
-    except ValueError:
-        raise LinkError(f"MAVLink endpoint {text!r}: host {host!r} is not an IPv4 address "
-                        "(or localhost)") from None
-    if kind == "udpout" and (addr.is_unspecified or addr.is_multicast or str(addr).endswith(
-            ".255")):
-        raise LinkError(f"MAVLink endpoint {text!r}: udpout needs one destination host, "
-                        f"not {host}")
-    return Endpoint(kind, host, port)
-
-
-@dataclass
-class VehicleState:
-    """What the telemetry reports, SI: simulation time [s]; Euler angles [rad]; body rates
-    [rad/s]; latitude/longitude [rad]; altitude above sea level and above the start [m];
-    NED ground velocity [m/s]; true airspeed [m/s]; throttle 0..1; named values (modal
-    states, tip twist) [rad]."""
-
-    time_s: float = 0.0
-    roll_rad: float = 0.0
-    pitch_rad: float = 0.0
-    yaw_rad: float = 0.0
-    p_rad_s: float = 0.0
-    q_rad_s: float = 0.0
-    r_rad_s: float = 0.0
-    latitude_rad: float = 0.0
-    longitude_rad: float = 0.0
-    altitude_m: float = 0.0
-    relative_altitude_m: float = 0.0
-    v_north_m_s: float = 0.0
-    v_east_m_s: float = 0.0
-    v_down_m_s: float = 0.0
-    airspeed_m_s: float = 0.0
-    throttle: float = 0.0
-    named: dict[str, float] = field(default_factory=dict)
-    autopilot: bool = True
-    manual: bool = False
-
-
-class Parameters(Protocol):
-    """The vehicle's parameters: names in a fixed order, float values, validated set."""
-
-    names: tuple[str, ...]
-
-    def get(self, name: str) -> float: ...
-
-    def set(self, name: str, value: float) -> float:
-        """Apply; return the value now in force. ValueError: rejected (value unchanged)."""
-        ...
 
 
 @dataclass
