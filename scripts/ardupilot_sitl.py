@@ -37,10 +37,13 @@ REPO = Path(__file__).resolve().parents[1]
 PARAM_FILE = REPO / "bioflex_jsb" / "data" / "ardupilot" / "bioflex_plane.parm"
 NETNS_ENV = "BIOFLEX_ARDUPILOT_NETNS"  # set inside the private namespace
 MAVLINK_URL = "tcp:127.0.0.1:5760"  # ArduPilot SITL SERIAL0, instance 0
-# The bioflex side: the co-simulation as ArduPilot's JSON physics (issue 19). The command
-# name is the one the CLI is to get; override with --physics-cmd.
-DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb sitl --autopilot ardupilot "
-                       "--wing optimised --model coupled --gust 1-cosine:2:15 --gust-at 60")
+# The bioflex side: the co-simulation as ArduPilot's JSON physics (``bioflex-jsb ardupilot``,
+# bioflex_jsb/drivers/ardupilot.py): the optimised wing, coupled, a 2 m/s 1-cosine gust of
+# 30 m (2 s at 15 m/s) 60 s after the launch; its JSON summary goes to physics.json and its
+# frames to physics.npz in --out. Override with --physics-cmd.
+DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb ardupilot "
+                       "--wing optimised --model coupled --gust 1cos:2:30 --gust-at 60 "
+                       "--summary physics.json --table physics.npz")
 # Mission (metres from home, NED; altitude above home [m]): a 300 m square flown clockwise.
 TAKEOFF_ALT_M = 40.0  # NAV_TAKEOFF altitude
 TAKEOFF_PITCH_DEG = 12.0  # NAV_TAKEOFF minimum pitch (ArduPlane docs suggest 10..15 deg)
@@ -133,8 +136,11 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
     wall0 = time.monotonic()
     try:
         with open(out / "physics.log", "w") as plog, open(out / "arduplane.log", "w") as alog:
-            procs.append(subprocess.Popen(shlex.split(physics_cmd), cwd=REPO, stdout=plog,
-                                          stderr=subprocess.STDOUT))
+            env = dict(os.environ)
+            env["PYTHONPATH"] = os.pathsep.join(
+                p for p in (str(REPO), env.get("PYTHONPATH", "")) if p)
+            procs.append(subprocess.Popen(shlex.split(physics_cmd), cwd=out, stdout=plog,
+                                          stderr=subprocess.STDOUT, env=env))
             procs.append(subprocess.Popen(
                 [str(binary), "--model", "JSON:127.0.0.1", "--speedup", "1", "--slave", "0",
                  "--defaults", str(PARAM_FILE), "-I0", "--wipe"],
@@ -150,6 +156,12 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
                 except subprocess.TimeoutExpired:
                     p.kill()
     summary["wall_s"] = time.monotonic() - wall0
+    physics_summary = out / "physics.json"  # written by bioflex-jsb ardupilot when stopped
+    if physics_summary.is_file():
+        try:
+            summary["physics"] = json.loads(physics_summary.read_text())
+        except ValueError as exc:
+            summary["physics"] = f"unreadable {physics_summary}: {exc}"
     if summary.get("sim_s"):
         summary["real_time_factor"] = summary["sim_s"] / summary["wall_s"]
     xt = summary.pop("xtrack_m")

@@ -1,0 +1,457 @@
+"""ArduPlane flies the co-simulation: the one coupled step as ArduPilot's JSON SITL physics.
+
+:class:`ArduPilotPhysics` is the :class:`~bioflex_jsb.links.ardupilot_json.JsonPhysics` a
+:class:`~bioflex_jsb.links.ardupilot_json.LockstepServer` drives: one
+:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep` step per ArduPilot frame, the servo
+outputs mapped to JSBSim's controls before it and the state converted to ArduPilot's units
+and frames after it (once, here; ``docs/ardupilot.md``).
+
+Channel map (ArduPilot's convention: PWM above trim = roll right, nose up, nose right, more
+thrust; bioflex's JSBSim controls: + elevator = nose down, + rudder = nose left; see
+:data:`CHANNEL_MAP`):
+
+======= ============ ============================ ==========================================
+servo   function     JSBSim property              value (clipped)
+======= ============ ============================ ==========================================
+1       4 aileron    ``fcs/aileron-cmd-norm``     +(pwm − 1500)/500 in [−1, 1]
+2       19 elevator  ``fcs/elevator-cmd-norm``    −(pwm − 1500)/500 in [−1, 1]
+3       70 throttle  ``fcs/throttle-cmd-norm[i]`` (pwm − 1000)/1000 in [0, 1], every engine
+4       21 rudder    ``fcs/rudder-cmd-norm``      −(pwm − 1500)/500 in [−1, 1]
+======= ============ ============================ ==========================================
+
+A channel at 0 µs (ArduPilot sends 0 for a channel it does not drive) reads as its trim
+(1500 µs; throttle 1000 µs). The elevator's trim from the cruise trim
+(``fcs/pitch-trim-cmd-norm``) stays in, like a linkage trimmed on the bench: 1500 µs is the
+elevator that flies level at the trim speed.
+
+Start: at rest on a launcher (the prototype is canister/hand launched). JSBSim's ground
+contact is not used for it: the airframe has only structure contact points (no gear), and
+the modal wing and the trim are undefined at zero airspeed. Instead the physics has three
+phases (:attr:`ArduPilotPhysics.phase`):
+
+* ``rest``: held on the launcher at the trim attitude (wings level, pitch θ_trim, heading
+  north), position (0, 0, 0) from home, velocity 0, airspeed 0, specific force
+  R(θ)ᵀ(0, 0, −g) (level: (0, 0, −g)); JSBSim waits trimmed at the exit speed, unstepped.
+* ``launch``: when ArduPlane's throttle output (servo 3) has been above
+  :data:`LAUNCH_THROTTLE_US` for :data:`LAUNCH_HOLD_S` (armed in AUTO, waiting for the
+  launch at ``TKOFF_THR_IDLE``), a constant push along the trim's velocity (horizontal,
+  north) to the trim (exit) speed ``speed_m_s`` at ``launch_accel_m_s2`` (default 40 m/s²
+  over 0.375 s, a 2.8 m stroke), exact constant-acceleration kinematics: specific force
+  R(θ)ᵀ(a, 0, −g), the push seen by ArduPlane's ``TKOFF_THR_MINACC``.
+* ``flight``: the coupled step, from the trim state at the end of the stroke (the same
+  velocity, position and attitude: the hand-over is continuous).
+
+The ground is put ``launch_height_m`` below the launcher; a run that leaves the valid range
+(the ground, deep stall, a diverged mode: :mod:`bioflex_jsb.simulation.limits`) does not end
+the server: the aircraft is put back on the launcher at rest (re-trimmed, wing undeformed),
+the reason is kept in :attr:`ArduPilotPhysics.stops`, and the time goes on (ArduPilot's
+clock must not go back). ArduPilot restarting (its frame count going back) calls
+:meth:`ArduPilotPhysics.reset`: the same, with the time back to 0.
+
+The state sent (:meth:`ArduPilotPhysics.state`), in flight:
+
+* ``imu.gyro``: ``velocities/p-rad_sec``, ``q-``, ``r-`` (body FRD, against the Earth);
+* ``imu.accel_body``: the specific force at the CG, the non-gravitational forces
+  ``forces/fbx-total-lbs`` … (aerodynamics, propulsion, the elastic wing's
+  ``external_reactions``, ground) over ``inertia/mass-slugs``, in m/s², body FRD; JSBSim
+  computes them during the step for the state the step reached, the one sent;
+* ``position``: north/east from the launch point on the local ellipsoid radii, down =
+  −(h − h_launch) [m];
+* ``velocity``: ``velocities/v-north-fps``, ``v-east-fps``, ``v-down-fps`` [m/s];
+* ``attitude`` (roll, pitch, yaw) and the unit ``quaternion`` (w, x, y, z) body → NED;
+* ``airspeed``: ``velocities/vt-fps`` [m/s], the true airspeed with the gust (JSBSim's, at
+  the state reached with the wind of the step).
+
+Gusts: any :class:`~bioflex_jsb.simulation.gusts.GustSpec`, starting ``gust_at_s`` [s] after
+the launch (flight time), sampled by the coupled step's step number. The first modal
+coordinate's peak during the gust and until :data:`GUST_DECAY_S` after it, and its largest
+change from the gust's start (:attr:`ArduPilotPhysics.gust_report`, [rad]) are measured on
+every step.
+
+Recording: :meth:`ArduPilotPhysics.on_frame` (the server's ``on_frame``) keeps every
+``record_every``-th frame, and every resend and reset, in :attr:`records` (columns
+:attr:`record_names`: time, ArduPilot's frame count, the server's action, the phase, servos
+1–4 [µs], then the coupled step's row in flight, NaN before). The MCAP log of other runs is
+not written here yet.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from bioflex_jsb import units as U
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.links.ardupilot_json import RESEND, RESET, FrameRecord, JsonState
+from bioflex_jsb.runtime.coupled_step import CoupledStep
+from bioflex_jsb.runtime.fdm import Airframe
+from bioflex_jsb.simulation.gusts import GustField, GustSpec
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+G0_M_S2 = 9.80665  # standard gravity: JSBSim's at the airframe's 45° latitude
+# WGS-84, for north/east from latitude/longitude near the launch point
+WGS84_A_M = 6378137.0
+WGS84_E2 = 6.69437999014e-3
+
+PWM_TRIM_US = 1500.0  # SERVOn_TRIM of the surfaces (bioflex_plane.parm)
+PWM_HALF_RANGE_US = 500.0  # SERVOn_MAX − SERVOn_TRIM
+PWM_THROTTLE_MIN_US = 1000.0  # SERVO3_MIN
+PWM_THROTTLE_RANGE_US = 1000.0  # SERVO3_MAX − SERVO3_MIN
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One servo output: ``index`` (0 = servo 1), the JSBSim property, the PWM [µs] that
+    gives 0, the µs per unit of the property, the sign and the clip range."""
+
+    index: int
+    prop: str
+    zero_us: float
+    us_per_unit: float
+    sign: float
+    lo: float
+    hi: float
+
+    def value(self, pwm_us: int) -> float:
+        """The normalised command for ``pwm_us`` [µs] (0 µs: the channel's trim)."""
+        if pwm_us == 0:
+            return min(self.hi, max(self.lo, 0.0))
+        x = self.sign * (pwm_us - self.zero_us) / self.us_per_unit
+        return min(self.hi, max(self.lo, x))
+
+
+CHANNEL_MAP: tuple[Channel, ...] = (
+    Channel(0, "fcs/aileron-cmd-norm", PWM_TRIM_US, PWM_HALF_RANGE_US, +1.0, -1.0, 1.0),
+    Channel(1, "fcs/elevator-cmd-norm", PWM_TRIM_US, PWM_HALF_RANGE_US, -1.0, -1.0, 1.0),
+    Channel(2, "fcs/throttle-cmd-norm", PWM_THROTTLE_MIN_US, PWM_THROTTLE_RANGE_US, +1.0,
+            0.0, 1.0),
+    Channel(3, "fcs/rudder-cmd-norm", PWM_TRIM_US, PWM_HALF_RANGE_US, -1.0, -1.0, 1.0),
+)
+THROTTLE_CHANNEL = 2
+
+# The launch fires when servo 3 has been above this [µs] for LAUNCH_HOLD_S [s]: ArduPlane
+# armed in AUTO at NAV_TAKEOFF holds TKOFF_THR_IDLE (5 % = 1050 µs); disarmed it sends 1000.
+LAUNCH_THROTTLE_US = 1020
+LAUNCH_HOLD_S = 0.5
+DEFAULT_LAUNCH_ACCEL_M_S2 = 40.0  # a canister/bungee push, > TKOFF_THR_MINACC = 15 m/s²
+DEFAULT_LAUNCH_HEIGHT_M = 2.0  # launcher above the ground [m]
+GUST_DECAY_S = 3.0  # the gust's η₁ peak is searched until this long after the gust [s]
+
+REST, LAUNCH, FLIGHT = "rest", "launch", "flight"
+PHASES = (REST, LAUNCH, FLIGHT)
+ACTIONS = ("step", RESEND, RESET)
+RECORD_HEAD = ("time_s", "frame_count", "action", "phase", "servo1_us", "servo2_us",
+               "servo3_us", "servo4_us", "w_g_m_s")
+
+
+def quaternion_from_euler(roll_rad: float, pitch_rad: float,
+                          yaw_rad: float) -> tuple[float, float, float, float]:
+    """(w, x, y, z) rotating body-FRD vectors into NED for the 3-2-1 Euler angles [rad]."""
+    cr, sr = math.cos(0.5 * roll_rad), math.sin(0.5 * roll_rad)
+    cp, sp = math.cos(0.5 * pitch_rad), math.sin(0.5 * pitch_rad)
+    cy, sy = math.cos(0.5 * yaw_rad), math.sin(0.5 * yaw_rad)
+    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
+
+
+def ned_to_body(vec_ned, roll_rad: float, pitch_rad: float, yaw_rad: float):
+    """A NED vector in body FRD axes (the transpose of the 3-2-1 body → NED rotation)."""
+    cr, sr = math.cos(roll_rad), math.sin(roll_rad)
+    cp, sp = math.cos(pitch_rad), math.sin(pitch_rad)
+    cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)
+    n, e, d = vec_ned
+    x = cp * cy * n + cp * sy * e - sp * d
+    y = (sr * sp * cy - cr * sy) * n + (sr * sp * sy + cr * cy) * e + sr * cp * d
+    z = (cr * sp * cy + sr * sy) * n + (cr * sp * sy - sr * cy) * e + cr * cp * d
+    return (x, y, z)
+
+
+@dataclass(frozen=True)
+class Launcher:
+    """The launcher: exit speed = the trim speed; ``accel_m_s2`` [m/s²] horizontal push;
+    ``height_m`` [m] above the ground."""
+
+    accel_m_s2: float = DEFAULT_LAUNCH_ACCEL_M_S2
+    height_m: float = DEFAULT_LAUNCH_HEIGHT_M
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.accel_m_s2) and 5.0 <= self.accel_m_s2 <= 200.0):
+            raise ValueError(f"launch acceleration must be 5..200 m/s^2, got {self.accel_m_s2!r}")
+        if not (math.isfinite(self.height_m) and 0.5 <= self.height_m <= 100.0):
+            raise ValueError(f"launcher height must be 0.5..100 m, got {self.height_m!r}")
+
+
+class ArduPilotPhysics:
+    """The co-simulation as ArduPilot's JSON physics (module docstring).
+
+    Args:
+        airframe: the JSBSim airframe (the bioflex aircraft; for ``native`` the exported
+            native aircraft).
+        wing: the elastic wing (None for ``native``).
+        model: rigid, coupled, qsd or native.
+        speed_m_s: trim and launcher exit speed [m/s].
+        altitude_m: launch altitude [m above sea level, ISA].
+        dt_s: the co-simulation step [s] (ArduPilot adopts 1/dt as its physics rate).
+        gust: the gust (None: still air); gust_at_s: its start [s after the launch].
+        launcher: :class:`Launcher`.
+        record_every: keep every n-th frame in :attr:`records` (0: none).
+    """
+
+    def __init__(self, airframe: Airframe, wing: ElasticWingModel | None, model: str,
+                 speed_m_s: float = 15.0, altitude_m: float = 0.0,
+                 dt_s: float = DEFAULT_DT_S, gust: GustSpec | None = None,
+                 gust_at_s: float = 60.0, launcher: Launcher | None = None,
+                 record_every: int = 8) -> None:
+        if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
+            raise ValueError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
+        if isinstance(record_every, bool) or not isinstance(record_every, int) \
+                or record_every < 0:
+            raise ValueError(f"record_every must be an integer >= 0, got {record_every!r}")
+        self.airframe = airframe
+        self.wing_model = wing
+        self.model = model
+        self.speed_m_s = float(speed_m_s)
+        self.altitude_m = float(altitude_m)
+        self.launcher = launcher or Launcher()
+        self.gust_spec = gust if gust is not None and gust.kind != "none" else None
+        self.gust_at_s = float(gust_at_s)
+        self.record_every = record_every
+        self._controls: list[Callable[[float], None]] = []
+        self.stops: list[dict] = []  # valid-range stops: reason, time [s]
+        self.launches = 0
+        self.restarts = 0  # ArduPilot restarts (reset())
+        self.records: list[tuple[float, ...]] = []
+        self._frames_seen = 0
+        self.core: CoupledStep = None  # type: ignore[assignment]
+        self._new_core(dt_s)
+        self.dt_s = self.core.dt_s
+        self.record_names = RECORD_HEAD + self.core.names
+        self._nan_row = (math.nan,) * len(self.core.names)
+        self._last_row: tuple[float, ...] = self._nan_row
+        self._last_w_g = 0.0
+        self.pwm_us: tuple[int, ...] = ()
+        self.frame_k = 0  # physics frames since the start (or ArduPilot's last restart)
+        self.gust_report: dict[str, float] = {}
+        self._to_rest()
+
+    # -- the aircraft on the launcher / in flight -------------------------------------------
+    def _new_core(self, dt_s: float) -> None:
+        """A fresh coupled step: trimmed at the exit speed, the wing undeformed, the ground
+        ``launcher.height_m`` below; the control writers and the readers of the reply."""
+        if self.core is not None:
+            self.core.release()
+        core = CoupledStep(self.airframe, self.wing_model, self.model, self.speed_m_s,
+                           self.altitude_m, dt_s)
+        self.core = core
+        a = self.airframe
+        node = a.property_node
+        self._h_launch_m = core.get["h"]() * U.M_PER_FT
+        a["position/terrain-elevation-asl-ft"] = (
+            (self._h_launch_m - self.launcher.height_m) * U.FT_PER_M)
+        self._lat0 = core.get["lat"]()
+        self._lon0 = core.get["lon"]()
+        self._theta0 = core.get["theta"]()
+        # the launcher pushes along the trim's velocity over ground (NED): the hand-over to
+        # JSBSim is continuous in velocity and position
+        v_exit = tuple(core.get[c]() * U.M_PER_FT for c in ("vn", "ve", "vd"))
+        speed = math.sqrt(sum(c * c for c in v_exit))
+        self._exit_speed_m_s = speed
+        self._exit_dir = tuple(c / speed for c in v_exit)
+        s2 = math.sin(self._lat0) ** 2
+        r_meridian = WGS84_A_M * (1 - WGS84_E2) / (1 - WGS84_E2 * s2) ** 1.5
+        r_normal = WGS84_A_M / math.sqrt(1 - WGS84_E2 * s2)
+        self._m_per_rad_n = r_meridian + self._h_launch_m
+        self._m_per_rad_e = (r_normal + self._h_launch_m) * math.cos(self._lat0)
+        self._fx, self._fy, self._fz = (node(f"forces/fb{c}-total-lbs").get_double_value
+                                        for c in "xyz")
+        self._mass = node("inertia/mass-slugs").get_double_value
+        self._vt = node("velocities/vt-fps").get_double_value
+        writers = []
+        for ch in CHANNEL_MAP:
+            if ch.index == THROTTLE_CHANNEL:
+                engines = [node(f"{ch.prop}[{i}]").set_double_value
+                           for i in range(a.engine_count)]
+
+                def write(x: float, engines=engines) -> None:
+                    for w in engines:
+                        w(x)
+                writers.append(write)
+            else:
+                writers.append(node(ch.prop).set_double_value)
+        self._controls = writers
+        self.gust = None if self.gust_spec is None else GustField(
+            self.gust_spec, self.speed_m_s, self.gust_at_s, self.gust_at_s + 600.0,
+            core.dt_s)
+        self._gust_steps = (-1, -1)
+        if self.gust_spec is not None:
+            k0 = math.ceil(self.gust_at_s / core.dt_s - 1e-9)
+            length_s = (self.gust_spec.length_m / self.speed_m_s
+                        if self.gust_spec.kind == "1cos" else 600.0)
+            self._gust_steps = (k0, k0 + int(round((length_s + GUST_DECAY_S) / core.dt_s)))
+        core.prepare(0.0)
+
+    def _to_rest(self) -> None:
+        self.phase = REST
+        self._throttle_hold_k = 0  # frames with the throttle above LAUNCH_THROTTLE_US
+        self._stroke_k = 0
+
+    @property
+    def t_s(self) -> float:
+        """Physics time [s] (the reply's timestamp)."""
+        return self.frame_k * self.dt_s
+
+    @property
+    def launch_hold_steps(self) -> int:
+        """Frames of throttle above LAUNCH_THROTTLE_US that fire the launcher."""
+        return max(1, math.ceil(LAUNCH_HOLD_S / self.dt_s - 1e-9))
+
+    @property
+    def stroke_steps(self) -> int:
+        """Steps of the launcher's push (the exit speed is reached exactly at the last)."""
+        return max(1, math.ceil(self._exit_speed_m_s / (self.launcher.accel_m_s2 * self.dt_s)))
+
+    @property
+    def launch_accel_m_s2(self) -> float:
+        """The push actually applied [m/s²]: exit speed over a whole number of steps."""
+        return self._exit_speed_m_s / (self.stroke_steps * self.dt_s)
+
+    @property
+    def stroke_m(self) -> float:
+        """Length of the push [m]."""
+        return 0.5 * self._exit_speed_m_s * self.stroke_steps * self.dt_s
+
+    # -- JsonPhysics ------------------------------------------------------------------------
+    def reset(self) -> None:
+        """ArduPilot restarted: back on the launcher at rest, time 0."""
+        self.restarts += 1
+        self._new_core(self.dt_s)
+        self._to_rest()
+        self.frame_k = 0
+
+    def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
+        """One frame of ``dt_s`` with these servo outputs [µs, servo 1 first]."""
+        self.pwm_us = pwm_us
+        self.frame_k += 1
+        if self.phase == REST:
+            thr = pwm_us[THROTTLE_CHANNEL] if len(pwm_us) > THROTTLE_CHANNEL else 0
+            self._throttle_hold_k = self._throttle_hold_k + 1 if thr > LAUNCH_THROTTLE_US else 0
+            if self._throttle_hold_k >= self.launch_hold_steps:
+                self.phase = LAUNCH
+                self.launches += 1
+                self._stroke_k = 0
+                self._launch_t_s = self.t_s
+            return
+        if self.phase == LAUNCH:
+            self._stroke_k += 1
+            if self._stroke_k >= self.stroke_steps:
+                self.phase = FLIGHT
+            return
+        core = self.core
+        for ch, write in zip(CHANNEL_MAP, self._controls, strict=True):
+            write(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0))
+        k = core.k
+        w_g = self.gust.at_step(k) if self.gust is not None else 0.0
+        self._last_row = core.advance(w_g)
+        self._last_w_g = w_g
+        k0, k1 = self._gust_steps
+        if k0 <= k <= k1:
+            self._track_gust(k, k0)
+        if core.stopped:
+            self.stops.append({"reason": core.stopped, "time_s": self.t_s,
+                               "flight_s": core.k * core.dt_s})
+            self._new_core(self.dt_s)
+            self._to_rest()
+            self._last_row = self._nan_row
+
+    def _track_gust(self, k: int, k0: int) -> None:
+        rep = self.gust_report
+        eta1 = float(self.core.eta[0])
+        if k == k0:
+            rep.clear()
+            rep.update(start_time_s=self.t_s, start_flight_s=k * self.core.dt_s,
+                       eta1_peak_rad=0.0, eta1_peak_time_s=math.nan,
+                       eta1_at_start_rad=eta1, eta1_change_peak_rad=0.0,
+                       w_g_peak_m_s=0.0)
+        if not rep:
+            return
+        if abs(eta1) > abs(rep["eta1_peak_rad"]):
+            rep["eta1_peak_rad"] = eta1
+            rep["eta1_peak_time_s"] = self.t_s
+        change = eta1 - rep["eta1_at_start_rad"]
+        if abs(change) > abs(rep["eta1_change_peak_rad"]):
+            rep["eta1_change_peak_rad"] = change
+        if abs(self._last_w_g) > abs(rep["w_g_peak_m_s"]):
+            rep["w_g_peak_m_s"] = self._last_w_g
+
+    def state(self) -> JsonState:
+        """The state after the last step, in ArduPilot's units and frames."""
+        if self.phase == FLIGHT:
+            return self._flight_state()
+        theta = self._theta0
+        if self.phase == REST:
+            v = s = a = 0.0
+        else:  # constant acceleration a along the exit direction u
+            tau = self._stroke_k * self.dt_s
+            a = self.launch_accel_m_s2
+            v, s = a * tau, 0.5 * a * tau * tau
+        u = self._exit_dir
+        return JsonState(
+            timestamp_s=self.t_s, gyro_rad_s=(0.0, 0.0, 0.0),
+            accel_body_m_s2=ned_to_body((a * u[0], a * u[1], a * u[2] - G0_M_S2),
+                                        0.0, theta, 0.0),
+            position_ned_m=tuple(s * c for c in u), velocity_ned_m_s=tuple(v * c for c in u),
+            quaternion=quaternion_from_euler(0.0, theta, 0.0), attitude_rad=(0.0, theta, 0.0),
+            airspeed_m_s=v)
+
+    def _flight_state(self) -> JsonState:
+        get = self.core.get
+        m = self._mass()
+        k = U.M_PER_FT / m
+        phi, theta = get["phi"](), get["theta"]()
+        psi = math.remainder(get["psi"](), 2.0 * math.pi)
+        s_n, s_e, s_d = (self.stroke_m * c for c in self._exit_dir)
+        north = (get["lat"]() - self._lat0) * self._m_per_rad_n + s_n
+        east = math.remainder(get["lon"]() - self._lon0, 2.0 * math.pi) * self._m_per_rad_e + s_e
+        down = self._h_launch_m - get["h"]() * U.M_PER_FT + s_d
+        f = U.M_PER_FT
+        return JsonState(
+            timestamp_s=self.t_s, gyro_rad_s=(get["p"](), get["q"](), get["r"]()),
+            accel_body_m_s2=(self._fx() * k, self._fy() * k, self._fz() * k),
+            position_ned_m=(north, east, down),
+            velocity_ned_m_s=(get["vn"]() * f, get["ve"]() * f, get["vd"]() * f),
+            quaternion=quaternion_from_euler(phi, theta, psi), attitude_rad=(phi, theta, psi),
+            airspeed_m_s=self._vt() * f)
+
+    # -- recording --------------------------------------------------------------------------
+    def on_frame(self, rec: FrameRecord) -> None:
+        """The server's callback: keep every ``record_every``-th frame, resends and resets."""
+        self._frames_seen += 1
+        n = self.record_every
+        if n == 0 or (rec.action not in (RESEND, RESET) and self._frames_seen % n):
+            return
+        pwm = tuple(float(rec.pwm_us[i]) if i < len(rec.pwm_us) else 0.0 for i in range(4))
+        row = self._last_row if self.phase == FLIGHT else self._nan_row
+        self.records.append((rec.timestamp_s, float(rec.frame_count),
+                             float(ACTIONS.index(rec.action)), float(PHASES.index(self.phase)),
+                             *pwm, self._last_w_g if self.phase == FLIGHT else 0.0, *row))
+
+    def table(self) -> np.ndarray:
+        """:attr:`records` as a (rows × :attr:`record_names`) array."""
+        return np.asarray(self.records, dtype=float).reshape(-1, len(self.record_names))
+
+    def summary(self) -> dict:
+        """Counts, stops and the gust's η₁ peak (SI; JSON-ready)."""
+        return {
+            "model": self.model, "speed_m_s": self.speed_m_s, "altitude_m": self.altitude_m,
+            "dt_s": self.dt_s, "time_s": self.t_s, "phase": self.phase,
+            "flight_s": self.core.k * self.dt_s if self.phase == FLIGHT else 0.0,
+            "launches": self.launches, "restarts": self.restarts, "stops": list(self.stops),
+            "launch_accel_m_s2": self.launch_accel_m_s2, "stroke_m": self.stroke_m,
+            "gust": None if self.gust_spec is None else self.gust_spec.text(),
+            "gust_at_s": self.gust_at_s,
+            "gust_report": {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                            for k, v in self.gust_report.items()},
+        }

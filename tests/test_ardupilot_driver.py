@@ -1,0 +1,285 @@
+"""ArduPlane's JSON physics over the real coupled step (bioflex_jsb.drivers.ardupilot), driven
+by the byte-exact ArduPilot stand-in (tests/ardupilot_standin.py) over loopback UDP.
+
+Checks: lock-step (one step per frame, ArduPilot's counter and clock follow), resend (same
+reply, no step), reset on a backward frame count, the IMU at rest, on the launcher and in
+flight against the simulation's own state and kinematics (specific force + gravity =
+d(velocity)/dt in NED through ArduPilot's rotation matrix; d(position)/dt = velocity), the
+channel map, a valid-range stop putting the aircraft back on the launcher, the gust's η₁
+report and the command line. The server and the stand-in take turns in one thread.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import threading
+
+import numpy as np
+import pytest
+
+from bioflex_jsb import units as U
+from bioflex_jsb.drivers import ardupilot as ad
+from bioflex_jsb.links import ardupilot_json as aj
+from bioflex_jsb.runtime.fdm import Airframe
+from bioflex_jsb.simulation.gusts import parse_gust
+from tests.ardupilot_standin import ArduPilotStandin, dcm_of
+
+G = ad.G0_M_S2
+DISARMED = (1500, 1500, 1000, 1500)  # throttle at SERVO3_MIN
+ARMED_IDLE = (1500, 1500, 1050, 1500)  # TKOFF_THR_IDLE 5 %: fires the launcher
+
+
+@pytest.fixture(scope="module")
+def wing():
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    return build_wing(VARIANTS["optimised"]).model
+
+
+def _physics(wing, **kw):
+    return ad.ArduPilotPhysics(Airframe(), wing, kw.pop("model", "coupled"), **kw)
+
+
+class Link:
+    """A server and a stand-in taking turns: one frame out, one reply in."""
+
+    def __init__(self, physics):
+        self.physics = physics
+        self.server = aj.LockstepServer(physics, port=0, on_frame=physics.on_frame)
+        self.ap = ArduPilotStandin(self.server.address)
+
+    def frame(self, pwm):
+        self.ap.send_servos(pwm)
+        assert self.server.serve_once(5.0)
+        parsed = self.ap.receive()
+        assert parsed is not None, self.ap.messages
+        return parsed
+
+    def close(self):
+        self.ap.close()
+        self.server.close()
+
+
+@pytest.fixture
+def link(wing):
+    lk = Link(_physics(wing))
+    yield lk
+    lk.close()
+
+
+def _ned_accel(parsed):
+    """Specific force rotated to NED by ArduPilot's own DCM, plus gravity [m/s²]."""
+    dcm = dcm_of(parsed)
+    f = parsed.values["accel_body"]
+    a = [sum(dcm[i][j] * f[j] for j in range(3)) for i in range(3)]
+    a[2] += G
+    return a
+
+
+def test_rest_lockstep_and_imu(link):
+    ph = link.physics
+    theta = ph._theta0
+    for n in range(1, 201):
+        p = link.frame(DISARMED)
+        assert link.ap.frame_counter == n and ph.frame_k == n
+        assert p.values["timestamp"] == pytest.approx(n * ph.dt_s, abs=1e-12)
+    assert ph.phase == ad.REST and link.server.stats.steps == 200
+    assert link.ap.time_now_us == pytest.approx(200 * ph.dt_s * 1e6, rel=1e-9)
+    ax, ay, az = p.values["accel_body"]
+    # level at rest: (0, 0, −g) within the launcher's pitch θ_trim (1.8°)
+    assert abs(theta) < math.radians(3.0)
+    assert (ax, ay, az) == pytest.approx((0.0, 0.0, -G), abs=G * math.sin(abs(theta)) + 1e-4)
+    assert ax == pytest.approx(G * math.sin(theta), abs=1e-5)
+    assert math.sqrt(ax * ax + ay * ay + az * az) == pytest.approx(G, rel=1e-6)
+    assert _ned_accel(p) == pytest.approx([0.0, 0.0, 0.0], abs=1e-5)
+    assert p.values["position"] == (0.0, 0.0, 0.0) and p.values["velocity"] == (0, 0, 0)
+    assert p.values["gyro"] == (0.0, 0.0, 0.0) and p.values["airspeed"] == 0.0
+    assert ph.core.k == 0  # JSBSim waits, trimmed, unstepped
+
+
+def test_launch_then_flight_kinematics_against_the_simulation(link):
+    ph = link.physics
+    hold = ph.launch_hold_steps
+    for _ in range(hold):
+        link.frame(ARMED_IDLE)
+    assert ph.phase == ad.LAUNCH and ph.launches == 1
+    prev = None
+    worst_launch = worst_flight = worst_pos = 0.0
+    n_launch = ph.stroke_steps
+    for n in range(n_launch + 300):
+        p = link.frame(ARMED_IDLE)
+        if prev is not None:
+            dt = p.values["timestamp"] - prev.values["timestamp"]
+            vel, vel0 = p.values["velocity"], prev.values["velocity"]
+            pos, pos0 = p.values["position"], prev.values["position"]
+            dv = [(a - b) / dt for a, b in zip(vel, vel0, strict=True)]
+            # constant acceleration on the launcher: the new state's specific force is the
+            # acceleration of the step that reached it; in flight JSBSim's (multistep)
+            # integration makes this true to the step's change of the force
+            expect = _ned_accel(prev) if ph.phase == ad.FLIGHT else _ned_accel(p)
+            err = max(abs(a - b) for a, b in zip(dv, expect, strict=True))
+            v_mid = [(a + b) / 2 for a, b in zip(vel, vel0, strict=True)]
+            dp = [(a - b) / dt for a, b in zip(pos, pos0, strict=True)]
+            worst_pos = max(worst_pos, max(abs(a - b) for a, b in zip(dp, v_mid, strict=True)))
+            if n < n_launch:
+                worst_launch = max(worst_launch, err)
+            else:
+                worst_flight = max(worst_flight, err)
+        if n == n_launch - 2:
+            ax = p.values["accel_body"][0]  # the push seen by TKOFF_THR_MINACC
+            assert ax > ad.DEFAULT_LAUNCH_ACCEL_M_S2 * 0.99
+        prev = p
+    assert ph.phase == ad.FLIGHT and ph.core.k == 300
+    assert worst_launch < 3e-3, worst_launch  # float32 velocities: 1e-6 m/s / dt
+    assert worst_flight < 0.05, worst_flight  # m/s² (JSBSim's Earth model vs ArduPilot's)
+    assert worst_pos < 0.01, worst_pos  # m/s
+    # fields against the simulation's state, units converted once
+    get, v = ph.core.get, p.values
+    assert v["gyro"] == pytest.approx((get["p"](), get["q"](), get["r"]()), abs=1e-6)
+    assert v["velocity"] == pytest.approx(
+        tuple(get[k]() * U.M_PER_FT for k in ("vn", "ve", "vd")), abs=1e-5)
+    assert v["position"][2] == pytest.approx(
+        ph._h_launch_m - get["h"]() * U.M_PER_FT + ph.stroke_m * ph._exit_dir[2], abs=1e-9)
+    assert v["position"][0] == pytest.approx(ph.stroke_m + 300 * ph.dt_s * 15.0, rel=0.01)
+    assert v["airspeed"] == pytest.approx(ph.airframe["velocities/vt-fps"] * U.M_PER_FT,
+                                          rel=1e-6)
+    assert v["attitude"] == pytest.approx((get["phi"](), get["theta"](),
+                                           math.remainder(get["psi"](), 2 * math.pi)),
+                                          abs=1e-6)
+    m = ph.airframe["inertia/mass-slugs"]
+    assert v["accel_body"][2] == pytest.approx(
+        ph.airframe["forces/fbz-total-lbs"] / m * U.M_PER_FT, rel=1e-6)
+    # near trim in flight the accelerometer still reads ≈ gravity's reaction
+    assert math.dist(v["accel_body"], (0.0, 0.0, -G)) < 1.0
+    assert link.ap.frame_counter == hold + n_launch + 300
+    assert len(ph.records) > 0 and ph.table().shape[1] == len(ph.record_names)
+
+
+def test_resend_answers_again_without_a_step(link):
+    ph = link.physics
+    for _ in range(20):
+        link.frame(DISARMED)
+    reply_before = link.server._last_reply
+    k_before = ph.frame_k
+    link.ap.resend()  # the same frame_count again (ArduPilot after 1 s without a reply)
+    assert link.server.serve_once(5.0)
+    data = link.ap.read_datagram()
+    assert data == reply_before and ph.frame_k == k_before
+    assert link.server.stats.resends == 1 and link.server.stats.steps == 20
+    t = link.ap.time_now_us
+    assert link.ap.accept(data) is not None and link.ap.time_now_us == t  # clock holds
+    assert ph.records[-1][2] == ad.ACTIONS.index(aj.RESEND)
+
+
+def test_backward_frame_count_resets_to_the_launcher(link):
+    ph = link.physics
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps + 50):
+        link.frame(ARMED_IDLE)
+    assert ph.phase == ad.FLIGHT
+    link.ap.restart()  # a new SITL process: frame_count from 0 again
+    p = link.frame(DISARMED)
+    assert link.server.stats.resets == 1 and ph.restarts == 1
+    assert ph.phase == ad.REST and ph.core.k == 0 and ph.frame_k == 1
+    assert p.values["timestamp"] == pytest.approx(ph.dt_s)
+    assert p.values["position"] == (0.0, 0.0, 0.0) and p.values["velocity"] == (0, 0, 0)
+    assert np.all(ph.core.eta == 0.0)
+
+
+def test_valid_range_stop_goes_back_to_the_launcher(link):
+    """Full nose-down elevator from a 2 m launcher: the flight leaves the valid range, the
+    server goes on with the aircraft at rest again and the clock keeps running."""
+    ph = link.physics
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps):
+        link.frame(ARMED_IDLE)
+    last_t = 0.0
+    for _ in range(3000):
+        p = link.frame((1500, 1000, 1000, 1500))  # elevator full nose down, idle
+        assert p.values["timestamp"] > last_t
+        last_t = p.values["timestamp"]
+        if ph.stops:
+            break
+    assert ph.stops, "no stop"  # deep stall (α < −30°) or the ground
+    assert ph.phase == ad.REST and ph.restarts == 0
+    p = link.frame(DISARMED)
+    assert p.values["velocity"] == (0, 0, 0) and p.values["timestamp"] > last_t
+    assert ph.airframe["position/h-agl-ft"] * U.M_PER_FT == pytest.approx(2.0, abs=1e-6)
+
+
+def test_channel_map(link):
+    ch = {c.prop: c for c in ad.CHANNEL_MAP}
+    assert ch["fcs/aileron-cmd-norm"].value(2000) == 1.0
+    assert ch["fcs/elevator-cmd-norm"].value(2000) == -1.0  # nose up = − bioflex elevator
+    assert ch["fcs/rudder-cmd-norm"].value(1250) == 0.5
+    assert ch["fcs/throttle-cmd-norm"].value(1500) == 0.5
+    assert ch["fcs/throttle-cmd-norm"].value(2300) == 1.0
+    assert ch["fcs/aileron-cmd-norm"].value(0) == 0.0  # undriven: trim
+    assert ch["fcs/throttle-cmd-norm"].value(0) == 0.0
+    ph = link.physics
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps + 1):
+        link.frame(ARMED_IDLE)
+    link.frame((1750, 1250, 1500, 1600))
+    a = ph.airframe
+    assert a["fcs/aileron-cmd-norm"] == pytest.approx(0.5)
+    assert a["fcs/elevator-cmd-norm"] == pytest.approx(0.5)
+    assert a["fcs/rudder-cmd-norm"] == pytest.approx(-0.2)
+    assert all(a[f"fcs/throttle-cmd-norm[{i}]"] == pytest.approx(0.5)
+               for i in range(a.engine_count))
+
+
+def test_gust_report(wing):
+    ph = _physics(wing, gust=parse_gust("1cos:2:15"), gust_at_s=0.1)
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps + 1100):
+        ph.step(ARMED_IDLE + (0,) * 12, 1200)
+    rep = ph.gust_report
+    assert rep["w_g_peak_m_s"] == pytest.approx(2.0, rel=1e-6)
+    assert rep["start_flight_s"] == pytest.approx(0.1, abs=ph.dt_s)
+    assert abs(rep["eta1_change_peak_rad"]) > 1e-4
+    json.dumps(ph.summary(), allow_nan=False)
+
+
+def test_bad_inputs_are_one_line_errors(wing):
+    with pytest.raises(ValueError, match="launch acceleration"):
+        ad.Launcher(accel_m_s2=1.0)
+    with pytest.raises(ValueError, match="gust start"):
+        _physics(wing, gust_at_s=-1.0)
+    from bioflex_jsb.cli import main
+
+    assert main(["ardupilot", "--gust", "1cos:2"]) == 2
+    assert main(["ardupilot", "--table", "x.csv"]) == 2
+
+
+def test_command_line_runs_and_writes_its_table(tmp_path):
+    from bioflex_jsb.cli import build_parser
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    table, summary = tmp_path / "run.npz", tmp_path / "run.json"
+    args = build_parser().parse_args([
+        "ardupilot", "--port", str(port), "--duration", "0.1", "--table", str(table),
+        "--summary", str(summary), "--record-every", "4"])
+    result = {}
+    th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
+    th.start()
+    ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
+    try:
+        for _ in range(400):
+            if not th.is_alive():
+                break
+            ap.send_servos(DISARMED)
+            try:
+                ap.receive()
+            except TimeoutError:
+                continue
+    finally:
+        ap.close()
+    th.join(10.0)
+    assert result.get("rc") == 0
+    s = json.loads(summary.read_text())
+    assert s["frames"]["steps"] >= 96 and s["phase"] == "rest" and s["stops"] == []
+    with np.load(table) as z:
+        names = list(z["names"])
+        assert names[:3] == ["time_s", "frame_count", "action"]
+        assert z["table"].shape == (s["frames"]["steps"] // 4, len(names))
