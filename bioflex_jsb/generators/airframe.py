@@ -376,6 +376,16 @@ def airframe_tree(
     return root
 
 
+def flight_controls_include(root: ET.Element) -> ET.Element:
+    """The ``<system file="bioflex_flight_controls">`` child of an :func:`airframe_tree`
+    (where derived aircraft include their own systems). Raises ValueError when there is not
+    exactly one."""
+    found = [e for e in root.findall("system") if e.get("file") == SYSTEM_FILE]
+    if len(found) != 1:
+        raise ValueError(f"the airframe tree has {len(found)} <system file={SYSTEM_FILE!r}>")
+    return found[0]
+
+
 def _render_aerodynamics(root: ET.Element, aero: RigidAerodynamics, stall: PostStall) -> None:
     ae = el(root, "aerodynamics")
     lim = el(ae, "alphalimits", unit="DEG")
