@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.drivers.native import native_airframe, repository_files
+from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.generators import native_wing as J
 
 REPO = Path(__file__).resolve().parents[1]

@@ -37,6 +37,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.generators import native_wing as J
+    from bioflex_jsb.generators.native_aircraft import export
 
     build = wing_from_args(args)
     out = Path(args.out)
@@ -47,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     except J.ExportError as exc:
         raise UsageError(str(exc)) from None
     try:
-        written = J.export(spec, out)
+        written = export(spec, out)
     except OSError as exc:
         raise UsageError(f"cannot write into {args.out!r}: {exc.strerror or exc}") from None
     nums = J.modal_matrices(spec.wing, spec.cl_trim)

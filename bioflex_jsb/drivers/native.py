@@ -15,6 +15,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from bioflex_jsb.generators import airframe as airframe_xml
+from bioflex_jsb.generators import native_aircraft as NA
 from bioflex_jsb.generators import native_wing as J
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.runtime.coupled_step import configure_airframe
@@ -22,7 +23,7 @@ from bioflex_jsb.runtime.fdm import TRIM_CONTROLS, Airframe
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 
-def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> J.TrimState:
+def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
     """Trim of the Fig. 21 case by :meth:`Airframe.trim` (the co-simulation's trim: same
     integrators and step), read from the flying instance."""
     af = Airframe()
@@ -44,13 +45,13 @@ def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> J.TrimState:
         "longitude": ("RAD", af["position/long-gc-rad"]),
     }
     names = TRIM_CONTROLS + tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(af.engine_count))
-    return J.TrimState(ic, {name: af[name] for name in names})
+    return NA.TrimState(ic, {name: af[name] for name in names})
 
 
 def repository_files() -> dict[str, str]:
     """The repository's native files (systems, aircraft, the Fig. 21 initial condition and
     script): path → text."""
-    return J.repository_files(fig21_trim_state())
+    return NA.repository_files(fig21_trim_state())
 
 
 def write_repository(root: Path) -> list[Path]:
