@@ -59,21 +59,24 @@ def run_gust(
     wing: ElasticWingModel | None,
     model: str,
     setup: RunSetup,
-    on_sample: Callable[[int, float, tuple[float, ...]], None] | None = None,
+    on_sample: Callable[[int, float, np.ndarray], None] | None = None,
     trim: TrimResult | None = None,
     recorder: StepRecorder | None = None,
+    compiled: bool = True,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
     aircraft with the wing in its XML, ``wing`` then None).
 
-    ``on_sample(k, t_s, values)`` is called after every step (progress), ``values`` the
-    step's row in channel order; ``recorder`` (a log) reads the steps from the run's table
-    (:class:`StepRecorder`). A run that leaves the valid range stops: the returned history
-    holds every step up to then and its ``stopped`` field says why. ``trim``: the airframe
-    was just trimmed to this (skip it).
+    ``on_sample(k, t_s, row)`` is called after every step (progress), ``row`` the step's
+    row of the table (channel order; read it, do not keep it); ``recorder`` (a log) reads
+    the steps from the run's table (:class:`StepRecorder`). A run that leaves the valid
+    range stops: the returned history holds every step up to then and its ``stopped``
+    field says why. ``trim``: the airframe was just trimmed to this (skip it).
+    ``compiled``: the compiled step kernel, or (False) the readable Python step it is
+    tested against.
     """
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m, setup.dt_s,
-                       trim=trim)
+                       trim=trim, compiled=compiled)
     dt = step.dt_s
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))
@@ -86,19 +89,19 @@ def run_gust(
     if recorder is not None:
         recorder.start(names, time_s, table)
         record = recorder.step
-    advance, w_g_at = step.advance, gust.at_step
+    advance_into, w_g_at = step.advance_into, gust.at_step
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop
             for k in range(n_steps):
-                values = advance(w_g_at(k))
-                table[k] = values
+                row = table[k]
+                stop = advance_into(w_g_at(k), row)
                 done = k + 1
                 if recorder is not None:
                     record(k)
                 if on_sample is not None:
-                    on_sample(k, k * dt, values)
-                if step.stopped:
-                    stopped = step.stopped
+                    on_sample(k, k * dt, row)
+                if stop:
+                    stopped = stop
                     break
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True

@@ -40,10 +40,12 @@ from bioflex_jsb.aerodynamics.airframe_polars import alpha_peak_rad
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
-from bioflex_jsb.simulation.limits import out_of_range
+from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD, ETA_LIMIT_RAD, out_of_range
 from bioflex_jsb.simulation.modal_wing import (
     DEFAULT_DT_S,
     WING_MODELS,
@@ -152,6 +154,9 @@ class CoupledStep:
         trim: the airframe was just trimmed to this (skip the trim).
         before_trim: called with the configured airframe before the trim (e.g. to disengage
             an autopilot).
+        compiled: run the per-step numerics as the compiled kernel
+            (:mod:`bioflex_jsb.simulation.step_kernel`); False: the readable Python step, the
+            reference the kernel is tested against. The native model has no wing step.
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -160,7 +165,8 @@ class CoupledStep:
     def __init__(self, airframe: Airframe, wing: ElasticWingModel | None, model: str,
                  speed_m_s: float, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
                  trim: TrimResult | None = None,
-                 before_trim: Callable[[Airframe], None] | None = None) -> None:
+                 before_trim: Callable[[Airframe], None] | None = None,
+                 compiled: bool = True) -> None:
         if model not in STEP_MODELS:
             raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
         native = model == "native"
@@ -204,6 +210,9 @@ class CoupledStep:
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad()
+        self.compiled = bool(compiled) and not native
+        if self.compiled:
+            self._setup_kernel(nodes)
         self.stall_steps = 0  # steps flown beyond the lift peak
         self.k = 0
         self.stopped: str | None = None
@@ -235,6 +244,9 @@ class CoupledStep:
             self.wing.eta = np.zeros(self.n_modes)
             self.wing.eta_dot = np.zeros(self.n_modes)
             self.model = model
+            if self.compiled:
+                self._model_code = K.MODEL_CODES[model]
+                self.wing.prepare_arrays()
 
     def prepare(self, w_g_m_s: float = 0.0) -> None:
         """Compute the wing's step matrices for the flow now (the first step would do it),
@@ -242,6 +254,8 @@ class CoupledStep:
         self._set_wind(-w_g_m_s * U.FT_PER_M)
         if not self.native:
             self.wing.prepare(self._read(-w_g_m_s * U.FT_PER_M).flow)
+            if self.compiled and self.wing._key is not None:
+                self._key[0], self._key[1] = self.wing._key
 
     def sense(self, w_g_m_s: float) -> Sensed:
         """Write the vertical gust ``w_g_m_s`` [m/s, up] to JSBSim's wind and read the
@@ -254,6 +268,9 @@ class CoupledStep:
     def advance(self, w_g_m_s: float) -> tuple[float, ...]:
         """Fly step k with the gust ``w_g_m_s`` [m/s, up] at t_k (module docstring); the row
         of t_k (values in :attr:`names` order). Sets :attr:`stopped` when out of range."""
+        if self.compiled:
+            self.advance_into(w_g_m_s, self._scratch)
+            return tuple(self._scratch.tolist())
         t = self.k * self.dt_s
         state = self.sense(w_g_m_s)
         flow = state.flow
@@ -306,6 +323,72 @@ class CoupledStep:
             row[self._eta_names[i]] = float(eta[i])
             row[self._etadot_names[i]] = float(eta_dot[i])
         return row
+
+    # -- the compiled step ------------------------------------------------------------------
+    def _setup_kernel(self, nodes) -> None:
+        """Bind what the kernel needs once: the property readers in its order, the writers
+        of the reactions, the wing's arrays, the constants and the column of each slot."""
+        mw, mm = self.wing, self.wing.matrices
+        self._getters = tuple(nodes[k].get_double_value for k in K.READ_KEYS)
+        self._reads = np.zeros(len(K.READ_KEYS))
+        self._set_reactions = self.airframe.external_reaction_setters()
+        lo, hi = ALPHA_TABLE_RANGE_RAD
+        self._consts = np.array([U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, P.REFERENCE_AREA_M2,
+                                 P.MEAN_AERODYNAMIC_CHORD_M, U.LBF_PER_N, U.LBF_FT_PER_N_M,
+                                 ETA_LIMIT_RAD, lo, hi, self.alpha_peak_rad])
+        ref = self.reference
+        self._trim_arr = np.array([self.trim.alpha_rad, self.trim.theta_rad,
+                                   ref.dynamic_pressure_pa, self.speed_m_s])
+        slots = K.KERNEL_SLOTS + self._eta_names + self._etadot_names
+        self._cols = np.array([self.names.index(s) for s in slots], dtype=np.int64)
+        self._key = np.array([np.nan, np.nan])
+        self._omega2 = np.asarray(mm.omega, dtype=float) ** 2
+        self._forcing = np.ascontiguousarray(mm.forcing_columns())
+        self._reactions = np.zeros(3)
+        self._out_flow = np.zeros(5)
+        self._scratch = np.zeros(len(self.names))
+        self._model_code = K.MODEL_CODES[mw.model]
+        mw.prepare_arrays()
+
+    def _refresh(self, q_pa: float, v_m_s: float) -> None:
+        mw = self.wing
+        mw._reference(q_pa, v_m_s)
+        self._key[0], self._key[1] = mw._key
+
+    def advance_into(self, w_g_m_s: float, row: np.ndarray) -> str | None:
+        """Fly step k as :meth:`advance` does, writing its row into ``row`` (a table row,
+        channel order); returns :attr:`stopped`."""
+        if not self.compiled:
+            row[:] = self.advance(w_g_m_s)
+            return self.stopped
+        wind_down_fps = -w_g_m_s * U.FT_PER_M
+        self._set_wind(wind_down_fps)
+        reads = self._reads
+        for i, g in enumerate(self._getters):
+            reads[i] = g()
+        mw = self.wing
+        args = (reads, wind_down_fps, w_g_m_s, self._model_code, mw._x, mw._stack,
+                mw._input_cols, self._key, mw.refresh_rel, self._trim_arr, mw._k_aero,
+                self._omega2, self._forcing, mw._load_eta, mw._load_etadot, self._consts,
+                self._cols, row, self._reactions, self._out_flow)
+        status = K.step_kernel(*args)
+        if status == K.NEEDS_REFRESH:
+            self._refresh(self._out_flow[2], self._out_flow[3])
+            args = args[:5] + (mw._stack, mw._input_cols) + args[7:]
+            status = K.step_kernel(*args)
+        r, (set_lift, set_drag, set_pitch) = self._reactions, self._set_reactions
+        set_lift(r[0])
+        set_drag(r[1])
+        set_pitch(r[2])
+        self.airframe.step()
+        k = self.k
+        self.k = k + 1
+        self.stall_steps += self._out_flow[4] > 0.0
+        agl_ft = self._agl_m()
+        if status != K.OK or agl_ft <= 0.0:
+            self.stopped = out_of_range(self.names, row.tolist(), k * self.dt_s,
+                                        self._out_flow[0], mw.eta, agl_ft * U.M_PER_FT)
+        return self.stopped
 
     def release(self) -> None:
         """Leave no modal loads behind in the airframe for its next user."""

@@ -622,6 +622,15 @@ class Airframe:
 
         return write
 
+    def external_reaction_setters(self) -> tuple[Callable[[float], None], ...]:
+        """The raw setters of the modal external reactions, in JSBSim's units, for a
+        compiled loop that converts once itself: (force along body −z [lbf], force along
+        body −x [lbf], pitch moment about body +y [lbf·ft]) — the directions of
+        :meth:`set_external_reactions`."""
+        prop = airframe_xml.external_property
+        return tuple(self.property_node(prop(name)).set_double_value
+                     for name in ("modal-lift", "modal-drag", "modal-pitch"))
+
     def run(self, steps: int = 1) -> None:
         """Advance JSBSim by ``steps`` time steps of its integration step."""
         with _captured(self._log):

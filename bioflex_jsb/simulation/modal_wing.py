@@ -182,6 +182,19 @@ class ModalWing:
         self._input_cols = psi_lower @ self._forcing
         self._key = (q_pa, v_m_s)
 
+    def prepare_arrays(self) -> None:
+        """Give every array the compiled step reads a shape and a contiguous layout (the
+        reference arrays are placeholders until the first refresh; the rates of η̇ are
+        rebound as one contiguous state vector)."""
+        n2 = 2 * self.n_modes
+        if self._key is None:
+            self._stack = np.zeros((3 * n2, n2))
+            self._input_cols = np.zeros((n2, 3))
+        self._x = np.ascontiguousarray(self._x, dtype=float).copy()
+        self._load_eta = np.ascontiguousarray(self._load_eta)
+        self._load_etadot = np.ascontiguousarray(self._load_etadot)
+        self._k_aero = np.ascontiguousarray(self._k_aero)
+
     def prepare(self, flow: FlowState) -> None:
         """Compute the step's matrices for ``flow`` now (the first step would otherwise do
         it): for real-time loops, so the first paced step costs what the others do."""
