@@ -1,22 +1,12 @@
 """JSBSim adapter for the rigid airframe: load, initial conditions, trim, linearization.
 
-This is the only module of bioflex-jsb that imports :mod:`jsbsim`. Everything that crosses
+The runtime package is the only one of bioflex-jsb that imports :mod:`jsbsim`. Everything that crosses
 its boundary is SI (m, s, kg, N, rad); JSBSim's slug-ft-s/degree values are converted here,
 once, with the constants of :mod:`bioflex_jsb.units`.
 
-JSBSim root
------------
-The JSBSim root is the directory holding ``aircraft/`` and ``systems/``. It is, in order:
-
-1. the ``root`` argument, when given;
-2. the directory named by the environment variable ``BIOFLEX_JSBSIM_ROOT``, when set;
-3. a repository checkout: ``aircraft/`` and ``systems/`` beside the ``bioflex_jsb`` package;
-4. an installed wheel: ``bioflex_jsb/jsbsim_root/`` inside the package.
-
-A root named explicitly (1, 2) that lacks the aircraft is an error, never skipped; between
-3 and 4 the first that holds the aircraft file is used; if neither does, the error says where
-it looked. JSBSim's console output (very verbose) is captured, not printed: see
-:attr:`Airframe.load_messages` and :attr:`Airframe.warnings`.
+The JSBSim root (the directory holding ``aircraft/`` and ``systems/``) is found by
+:mod:`bioflex_jsb.runtime.roots`. JSBSim's console output (very verbose) is captured, not
+printed: see :attr:`Airframe.load_messages` and :attr:`Airframe.warnings`.
 
 Trim
 ----
