@@ -17,7 +17,8 @@ import pytest
 
 from bioflex_jsb import cli
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
-from bioflex_jsb.sinks import mcap_log
+from bioflex_jsb.simulation.run import RunDescription
+from bioflex_jsb.sinks import mcap as sink
 
 ROOT = Path(__file__).resolve().parents[1]
 JS_CHECK = ROOT / "tests" / "js" / "check_mcap.cjs"
@@ -49,31 +50,35 @@ STEPS_1S = int(round(1.0 / DEFAULT_DT_S))
 
 
 def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
-    return mcap_log.messages_by_topic(path)
+    return sink.messages_by_topic(path)
 
 
 def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
-    info = mcap_log.summarise(gust_log)
+    info = sink.summarise(gust_log)
     counts = {c["topic"]: c["messages"] for c in info["channels"]}
-    assert counts == {mcap_log.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    assert counts == {sink.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
     schemas = {c["topic"]: c["schema"] for c in info["channels"]}
     assert schemas["/bioflex/coupled/pose"] == "foxglove.FrameTransform"
     assert schemas["/bioflex/coupled/location"] == "foxglove.LocationFix"
     assert info["duration_s"] == pytest.approx((STEPS_1S - 1) * DEFAULT_DT_S, abs=1e-9)
-    run = info["metadata"][mcap_log.RUN_METADATA]
+    run = info["metadata"][sink.RUN_METADATA]
     assert run["command"] == "gust" and run["wing"] == "optimised"
     assert run["gust"] == "sharp:3" and run["gust_seed"] == "0"
     assert float(run["dt_s"]) == DEFAULT_DT_S and run["jsbsim_version"] != "unknown"
-    assert json.loads(run["argv"])[:1] == ["gust"]
+    # the run description, as data: what rerun flies again (no command-line arguments)
+    described = sink.description_from_metadata(run)
+    assert described == RunDescription(kind="gust", wing="optimised", speed_m_s=15.0,
+                                       gust="sharp:3", models=("coupled",), duration_s=1.0)
+    assert "arguments" not in run and "argv" not in run
     # chunks close every CHUNK_SPAN_S of simulated time: what a SIGKILL can lose
-    assert info["chunks"] == math.ceil(1.0 / mcap_log.CHUNK_SPAN_S)
+    assert info["chunks"] == math.ceil(1.0 / sink.CHUNK_SPAN_S)
 
 
 def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
     msgs = read_all(gust_log)
     for group in RUN_GROUPS:
-        schema = mcap_log.SCHEMAS[group]
-        for _ns, m in msgs[mcap_log.topic("coupled", group)][:3]:
+        schema = sink.SCHEMAS[group]
+        for _ns, m in msgs[sink.topic("coupled", group)][:3]:
             assert set(m) <= set(schema["properties"]), group
     pose = msgs["/bioflex/coupled/pose"]
     ns0, p0 = pose[0]
@@ -111,7 +116,7 @@ def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
 def test_enu_quaternion_matches_the_rotation_matrix():
     rng = np.random.default_rng(1)
     for phi, theta, psi in rng.uniform(-1.2, 1.2, size=(20, 3)):
-        x, y, z, w = mcap_log.enu_quaternion(phi, theta, psi)
+        x, y, z, w = sink.enu_quaternion(phi, theta, psi)
         r_q = np.array([
             [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
             [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
@@ -158,7 +163,7 @@ def node_check(tmp_path_factory):
 
 def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
     result = node_check(gust_log)
-    expected = {mcap_log.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    expected = {sink.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
     assert result["counts"] == expected  # read through the chunk indexes, CRCs checked
     assert result["statistics"] == expected
     assert result["dataCrcOk"] is True and result["ordered"] is True
@@ -188,7 +193,7 @@ def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["equal"] is True and result["first_difference"] is None
     assert result["command"][1:3] == ["gust", "--wing"]
-    assert mcap_log.summarise(again)["messages"] == STEPS_1S * len(RUN_GROUPS)
+    assert sink.summarise(again)["messages"] == STEPS_1S * len(RUN_GROUPS)
 
 
 def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
@@ -236,7 +241,7 @@ def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     second = json.loads(capsys.readouterr().out)["out"]
     logs = sorted(folder.glob("gust-optimised-*.mcap"))
     assert {str(p) for p in logs} == {first, second} and first != second
-    assert mcap_log.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(RUN_GROUPS)
+    assert sink.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(RUN_GROUPS)
     assert main([*args, "--no-log"]) == 0
     assert json.loads(capsys.readouterr().out)["out"] is None
     assert len(list(folder.iterdir())) == 2
@@ -292,9 +297,9 @@ def test_non_finite_numbers_are_written_as_null(tmp_path):
     assert msgs["/bioflex/coupled/rigid_body"][0][1]["du_m_s"] == 0.01
 
 
-def _bare_log(path: Path) -> mcap_log.RunLog:
+def _bare_log(path: Path) -> sink.RunLog:
     stream = open(path, "wb")  # noqa: SIM115 - closed by RunLog.close
-    return mcap_log.RunLog(path, stream, mcap_log.McapFileWriter(stream, "test"))
+    return sink.RunLog(path, stream, sink.McapFileWriter(stream, "test"))
 
 
 def test_lti_prediction_channel(tmp_path, node_check):
@@ -321,13 +326,13 @@ def _env():
 DRIVER = """
 import sys
 from bioflex_jsb import cli
-from bioflex_jsb.sinks import mcap_log
-original = mcap_log.TableRecorder.step
+from bioflex_jsb.sinks import mcap as sink
+original = sink.TableRecorder.step
 def step(self, k):
     original(self, k)
     sys.stdout.write(repr(float(self._time_s[k])) + "\\n")
     sys.stdout.flush()
-mcap_log.TableRecorder.step = step
+sink.TableRecorder.step = step
 sys.exit(cli.main(sys.argv[1:]))
 """
 
@@ -366,7 +371,7 @@ def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
     if flown:
         assert rigid[-1][0] * 1e-9 == pytest.approx(flown[-1], abs=1e-9)
     counts = node_check(path)["counts"]
-    assert counts == {mcap_log.topic("coupled", g): n for g in RUN_GROUPS}
+    assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
     assert "interrupted" in err and "holds every step" in err
 
 
@@ -381,11 +386,11 @@ def _is_number(text: str) -> bool:
 def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, capsys):
     path = tmp_path / "killed.mcap"
     # killed just before a chunk closes (chunks span [k, k+1) × CHUNK_SPAN_S): the worst case
-    proc, _ = _start_run(path, until_s=7.9 * mcap_log.CHUNK_SPAN_S)
+    proc, _ = _start_run(path, until_s=7.9 * sink.CHUNK_SPAN_S)
     proc.kill()
     rest, _err = proc.communicate(timeout=60)
     sampled = [float(x) for x in rest.split() if _is_number(x)]
-    last_flown_s = sampled[-1] if sampled else 7.9 * mcap_log.CHUNK_SPAN_S
+    last_flown_s = sampled[-1] if sampled else 7.9 * sink.CHUNK_SPAN_S
     # the killed log has no summary: info says how to recover it
     assert main(["info", str(path)]) == 2
     assert "--recover" in capsys.readouterr().err
@@ -395,10 +400,10 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     lost_s = last_flown_s - report["last_time_s"]
     print(f"SIGKILL at t = {last_flown_s:.3f} s simulated: recovered up to "
           f"{report['last_time_s']:.3f} s, lost {lost_s:.3f} s")
-    assert 0.0 <= lost_s <= mcap_log.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
+    assert 0.0 <= lost_s <= sink.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
     counts = node_check(fixed)["counts"]
     n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
-    assert counts == {mcap_log.topic("coupled", g): n for g in RUN_GROUPS}
+    assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
 
 
 def test_fixed_width_numbers_match_printf():
@@ -407,14 +412,14 @@ def test_fixed_width_numbers_match_printf():
     x = np.concatenate([rng.standard_normal(20000) * 10.0 ** rng.integers(-120, 120, 20000),
                         [0.0, -0.0, 1.0, -1.0, 10.0, 1e-5, 9.9999999949, 9.99999999e99,
                          1e100, 1e-99, 1e-100, 5e-324, 1.7e308, np.nan, np.inf, -np.inf]])
-    chars, ok = mcap_log.fixed_e(x)
+    chars, ok = sink.fixed_e(x)
     for v, c, fits in zip(x.tolist(), chars, ok.tolist(), strict=True):
         text = format(v, " .8e")
         assert fits == (len(text) == 15 and math.isfinite(v)), v
         if fits:
             assert c.tobytes().decode() == text
     n = np.array([0, 7, 10, 999_999_999, 1_234_567_890])
-    assert [c.tobytes().decode() for c in mcap_log.fixed_d(n)] == [f"{i:10d}" for i in n]
+    assert [c.tobytes().decode() for c in sink.fixed_d(n)] == [f"{i:10d}" for i in n]
 
 
 def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
@@ -439,7 +444,7 @@ def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
     first = ma["/bioflex/coupled/modal"][5][1]
     assert first["eta_rad"][1] == pytest.approx(table[5, names.index("eta2")], rel=1e-8)
     # a chunk every CHUNK_SPAN_S of simulated time (864 steps at 960 Hz): 2 for 1000 steps
-    assert mcap_log.summarise(tmp_path / "a.mcap")["chunks"] == 2
+    assert sink.summarise(tmp_path / "a.mcap")["chunks"] == 2
 
 
 def test_recorder_writes_each_complete_row_once_whatever_stops_the_run(tmp_path):
@@ -464,3 +469,124 @@ def test_recorder_writes_each_complete_row_once_whatever_stops_the_run(tmp_path)
     log.close()
     rows = read_all(tmp_path / "r.mcap")["/bioflex/coupled/rigid_body"]
     assert [m["du_m_s"] for _, m in rows] == list(range(900))
+
+
+# --------------------------------------------------------------- run descriptions and errors
+
+def _legacy_copy(src: Path, dst: Path) -> None:
+    """``src`` rewritten as a log of before run descriptions: its bioflex.run record holds
+    only the command, its argparse arguments and the argument list that repeats it."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+
+    with open(src, "rb") as f, open(dst, "wb") as out:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        meta = sink.read_metadata(reader)[sink.RUN_METADATA]
+        d = sink.description_from_metadata(meta)
+        argv = ["gust", "--wing", d.wing, "--mass-basis", d.mass_basis, "--speed",
+                repr(d.speed_m_s), "--gust", d.gust, "--duration", repr(d.duration_s),
+                "--gust-start", repr(d.gust_start_s), "--dt", repr(d.dt_s), "--models",
+                ",".join(d.models)]
+        legacy = {k: v for k, v in meta.items() if k != "description"}
+        legacy.update(command="gust", argv=json.dumps(argv), arguments=json.dumps(
+            {"wing": d.wing, "speed": d.speed_m_s, "gust": d.gust, "models": list(d.models)}))
+        w = Writer(out, compression=CompressionType.ZSTD)
+        w.start(profile="", library="bioflex-jsb 0.old")
+        schemas = {sid: w.register_schema(s.name, s.encoding, s.data)
+                   for sid, s in summary.schemas.items()}
+        channels = {cid: w.register_channel(c.topic, c.message_encoding,
+                                            schemas[c.schema_id], dict(c.metadata))
+                    for cid, c in summary.channels.items()}
+        w.add_metadata(sink.RUN_METADATA, legacy)
+        for _schema, channel, message in reader.iter_messages(log_time_order=True):
+            w.add_message(channels[channel.id], message.log_time, message.data,
+                          message.publish_time, message.sequence)
+        w.finish()
+
+
+def test_old_logs_without_a_description_stay_readable_and_rerunnable(gust_log, tmp_path,
+                                                                         capsys):
+    old = tmp_path / "old.mcap"
+    _legacy_copy(gust_log, old)
+    meta = sink.summarise(old)["metadata"][sink.RUN_METADATA]
+    assert "description" not in meta and sink.description_from_metadata(meta) is None
+    assert main(["info", str(old)]) == 0
+    assert "argv" in capsys.readouterr().out
+    again = tmp_path / "again.mcap"
+    assert main(["rerun", str(old), "--out", str(again), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["equal"] is True and result["command"][1] == "gust"
+    # the repeated run is a new log: it records its description
+    new_meta = sink.summarise(again)["metadata"][sink.RUN_METADATA]
+    assert sink.description_from_metadata(new_meta).models == ("coupled",)
+
+
+def _described_log(path: Path, description: RunDescription) -> None:
+    log = sink.RunLog.open(path, description, {"name": "optimised"}, {})
+    log.close()
+
+
+def test_rerun_refuses_a_sitl_session_and_a_bad_description_with_one_line(tmp_path, capsys):
+    sitl = tmp_path / "sitl.mcap"
+    _described_log(sitl, RunDescription(kind="sitl", wing="optimised", speed_m_s=15.0,
+                                        gust="none", models=("coupled",)))
+    assert main(["rerun", str(sitl), "--out", str(tmp_path / "x.mcap")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "SITL" in err, err
+    bad = tmp_path / "bad.mcap"
+    stream = open(bad, "wb")  # noqa: SIM115 - closed by RunLog.close
+    sink.RunLog.local(bad, stream, {"description": json.dumps(
+        {"kind": "gust", "wing": "optimised", "speed_m_s": -1.0})}).close()
+    assert main(["rerun", str(bad), "--out", str(tmp_path / "y.mcap")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "speed_m_s" in err, err
+    with pytest.raises(sink.LogError, match="not JSON"):
+        sink.description_from_metadata({"description": "{"})
+
+
+def test_rerun_flies_the_description_it_reads(tmp_path):
+    from bioflex_jsb.cli.rerun import argv_for
+
+    d = RunDescription(kind="sweep", wing="optimised", speed_m_s=16.5, gust="1cos:2:10",
+                       models=("qsd",), duration_s=0.5, gust_start_s=0.1, dt_s=0.002,
+                       mass_basis="paper", extra={"case_id": "c1"})
+    path = tmp_path / "case.mcap"
+    _described_log(path, d)
+    meta = sink.summarise(path)["metadata"][sink.RUN_METADATA]
+    assert sink.description_from_metadata(meta) == d
+    assert meta["wing"] == "optimised" and meta["gust"] == "1cos:2:10"
+    assert argv_for(d) == ["gust", "--wing", "optimised", "--mass-basis", "paper",
+                           "--speed", "16.5", "--gust", "1cos:2:10", "--duration", "0.5",
+                           "--gust-start", "0.1", "--dt", "0.002", "--models", "qsd"]
+    cmp = RunDescription(kind="compare", wing="optimised", speed_m_s=15.0, models=("rigid",))
+    assert argv_for(cmp)[0] == "compare" and argv_for(cmp)[-2:] == ["--model", "rigid"]
+
+
+def test_a_log_that_cannot_be_written_is_the_sinks_own_one_line_error(tmp_path, capsys):
+    where = tmp_path / "missing" / "run.mcap"
+    d = RunDescription(kind="gust", wing="optimised", speed_m_s=15.0)
+    with pytest.raises(sink.LogWriteError) as caught:
+        sink.RunLog.open(where, d)
+    assert isinstance(caught.value, OSError) and "cannot write log" in str(caught.value)
+    assert main(["gust", "--duration", "0.1", "--gust-start", "0.05", "--models", "rigid",
+                 "--out", str(where), "--json"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "cannot write log" in err, err
+
+
+SINK_AND_LOG_COMMANDS = [*sorted((ROOT / "bioflex_jsb" / "sinks" / "mcap").glob("*.py")),
+                         *(ROOT / "bioflex_jsb" / "cli" / f"{m}.py"
+                           for m in ("gust", "compare", "rerun", "info", "plot")),
+                         ROOT / "bioflex_jsb" / "sweep" / "evaluate.py"]
+
+
+@pytest.mark.parametrize("path", SINK_AND_LOG_COMMANDS, ids=lambda p: p.name)
+def test_no_blanket_except_and_the_sink_knows_no_cli(path):
+    import re
+
+    text = path.read_text()
+    assert not re.search(r"except\s*(\(\s*)?(Base)?Exception\b|except\s*:", text), path
+    if "sinks" in path.parts:
+        assert "bioflex_jsb.cli" not in text and "UsageError" not in text \
+            and not re.search(r"^\s*(import|from) argparse", text, re.M), path

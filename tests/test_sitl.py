@@ -356,7 +356,7 @@ def test_cli_sitl_runs_and_logs(tmp_path, monkeypatch, capsys):
 
     summary = json.loads(capsys.readouterr().out)
     assert summary["simulated_s"] == pytest.approx(1.5, abs=0.01)
-    from bioflex_jsb.sinks.mcap_log import summarise
+    from bioflex_jsb.sinks.mcap import summarise
 
     info = summarise(out)
     assert info is not None and out.stat().st_size > 10000

@@ -45,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
-    from bioflex_jsb.sinks.mcap_log import RunLog
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks.mcap import RunLog
 
     if args.steps < 10 or args.repeat < 1:
         raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
@@ -84,7 +85,10 @@ def run(args: argparse.Namespace) -> int:
         for i in range(args.repeat):
             bare_t.append(bare())
             cosim_t.append(cosim())
-            log = RunLog.open(Path(tmp) / f"bench{i}.mcap", "bench", args, build)
+            log = RunLog.open(Path(tmp) / f"bench{i}.mcap", RunDescription(
+                kind="bench", wing="optimised", speed_m_s=args.speed, gust="sharp:0.3",
+                models=("coupled",), duration_s=setup.duration_s,
+                gust_start_s=setup.gust_start_s, dt_s=dt), build.variant.as_dict())
             try:
                 logged_t.append(cosim(log))
             finally:

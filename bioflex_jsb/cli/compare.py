@@ -14,7 +14,14 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
-from bioflex_jsb.cli.gust import Interrupted, add_run_arguments, check_run_arguments, fly
+from bioflex_jsb.cli.gust import (
+    Interrupted,
+    add_run_arguments,
+    check_run_arguments,
+    fly,
+    open_log,
+    run_description,
+)
 
 HELP = """Fly --gust through the nonlinear JSBSim co-simulation and through the linear model of
 Eq. (4) with its gust input G (same wing model, same time grid, same gust samples) and
@@ -56,9 +63,7 @@ def run(args: argparse.Namespace) -> int:
     args.out = log_path(args, "compare", args.wing)
     log = None
     if args.out:
-        from bioflex_jsb.sinks.mcap_log import RunLog
-
-        log = RunLog.open(args.out, command="compare", args=args, build=build)
+        log = open_log(args.out, run_description(args, "compare", (args.model,)), build)
     try:
         try:
             runs, stops = fly(args, build, (args.model,), log)

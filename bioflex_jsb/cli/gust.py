@@ -94,6 +94,29 @@ def check_run_arguments(args) -> None:
         )
 
 
+def run_description(args, kind: str, models):
+    """The :class:`~bioflex_jsb.simulation.run.RunDescription` of a ``gust`` (``compare``)
+    run from its checked arguments: what the log records and ``rerun`` flies again."""
+    from bioflex_jsb.simulation.run import RunDescription
+
+    return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
+                          gust=args.gust.text(), models=tuple(models),
+                          duration_s=args.duration, gust_start_s=args.gust_start,
+                          dt_s=args.dt, mass_basis=args.mass_basis)
+
+
+def open_log(path: str, description, build):
+    """The MCAP log of the run ``description`` with the wing ``build`` (its variant and
+    overrides as plain data); a file that cannot be written is a one-line UsageError."""
+    from bioflex_jsb.sinks.mcap import LogWriteError, RunLog
+
+    try:
+        return RunLog.open(path, description, wing_variant=build.variant.as_dict(),
+                           overrides=dict(build.model.coefficients.overrides))
+    except LogWriteError as exc:
+        raise UsageError(str(exc)) from None
+
+
 def fly(args, build, models, log=None):
     """Run each model (all of them, also after one stops); return (runs, stop messages)."""
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
@@ -123,9 +146,7 @@ def fly(args, build, models, log=None):
                 raise Interrupted(runs)
             if run.stopped:
                 stops.append(f"{model} run stopped: {run.stopped}")
-    except FdmError as exc:
-        raise UsageError(str(exc)) from None
-    except ValueError as exc:
+    except FdmError as exc:  # the airframe cannot load or trim at --speed
         raise UsageError(str(exc)) from None
     return runs, stops
 
@@ -138,9 +159,7 @@ def run(args: argparse.Namespace) -> int:
     log = None
     args.out = log_path(args, "gust", args.wing)
     if args.out:
-        from bioflex_jsb.sinks.mcap_log import RunLog
-
-        log = RunLog.open(args.out, command="gust", args=args, build=build)
+        log = open_log(args.out, run_description(args, "gust", args.models), build)
     try:
         runs, stops = fly(args, build, args.models, log)
     except Interrupted as stop:

@@ -26,14 +26,14 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.sinks.mcap_log import LogError, recover, summarise
+    from bioflex_jsb.sinks.mcap import LogError, LogWriteError, recover, summarise
 
     try:
         if args.recover:
             result = recover(args.file, args.recover)
         else:
             result = summarise(args.file)
-    except LogError as exc:
+    except (LogError, LogWriteError) as exc:  # unreadable log, unwritable --recover file
         raise UsageError(str(exc)) from None
     if args.json:
         print_json(result)

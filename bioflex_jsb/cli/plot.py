@@ -24,7 +24,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from bioflex_jsb.sinks.mcap_log import LogError, histories
+    from bioflex_jsb.sinks.mcap import LogError, histories
 
     try:
         runs, meta = histories(args.file)

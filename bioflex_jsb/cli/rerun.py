@@ -15,7 +15,7 @@ topic, log time and number; numbers agree when within --rtol relative or 1e-12 a
 Exit status 0 when they agree, 1 when they differ (the first difference is printed), 2 for a
 bad file."""
 
-ABS_TOL = 1e-12
+LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold an argv
 
 
 def register(sub) -> None:
@@ -29,12 +29,36 @@ def register(sub) -> None:
     p.set_defaults(run=run)
 
 
+def argv_for(description) -> list[str]:
+    """The bioflex-jsb argument list (without --out/--plot/--json) that flies the run
+    ``description`` (a :class:`~bioflex_jsb.simulation.run.RunDescription`) again: a gust
+    run, a sweep case (as the gust run it is) or a comparison."""
+    d = description
+    if not d.repeatable:
+        raise UsageError(f"the log was written by {d.kind!r}; only gust runs, sweep cases and "
+                         "comparisons can be repeated (a SITL session follows the wall clock "
+                         "and its ground station)")
+    if d.altitude_m != 0.0:
+        raise UsageError(f"the logged run flew at {d.altitude_m:g} m; gust and compare fly "
+                         "at sea level only")
+    common = ["--wing", d.wing, "--mass-basis", d.mass_basis,
+              "--speed", repr(float(d.speed_m_s)), "--gust", d.gust,
+              "--duration", repr(float(d.duration_s)),
+              "--gust-start", repr(float(d.gust_start_s)), "--dt", repr(float(d.dt_s))]
+    if d.kind == "compare":
+        if len(d.models) != 1:
+            raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")
+        return ["compare", *common, "--model", d.models[0]]
+    return ["gust", *common, "--models", ",".join(d.models)]
+
+
 def argv_from_log(path: str) -> list[str]:
-    """The bioflex-jsb argument list (without --out) that repeats the logged run."""
-    from bioflex_jsb.sinks.mcap_log import (
-        REPEATABLE_COMMANDS,
+    """The bioflex-jsb argument list (without --out) that repeats the logged run: from the
+    run description the log records, or (logs written before descriptions) its ``argv``."""
+    from bioflex_jsb.sinks.mcap import (
         RUN_METADATA,
         LogError,
+        description_from_metadata,
         open_reader,
         read_metadata,
     )
@@ -46,7 +70,19 @@ def argv_from_log(path: str) -> list[str]:
         raise UsageError(str(exc)) from None
     if meta is None:
         raise UsageError(f"{path!r} has no {RUN_METADATA} metadata record; nothing to repeat")
-    if meta.get("command") not in REPEATABLE_COMMANDS:
+    try:
+        description = description_from_metadata(meta)
+    except LogError as exc:
+        raise UsageError(f"{path!r}: {exc}") from None
+    if description is not None:
+        return argv_for(description)
+    return legacy_argv(path, meta)
+
+
+def legacy_argv(path: str, meta: dict[str, str]) -> list[str]:
+    """The argument list an old log (``arguments``/``argv`` metadata, no description)
+    recorded."""
+    if meta.get("command") not in LEGACY_REPEATABLE:
         raise UsageError(f"{path!r} was written by {meta.get('command')!r}; only gust runs, "
                          "sweep cases and comparisons can be repeated")
     try:
@@ -58,58 +94,25 @@ def argv_from_log(path: str) -> list[str]:
     return argv
 
 
-def _differs(a, b, rtol: float) -> bool:
-    if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() != b.keys() or any(_differs(a[k], b[k], rtol) for k in a)
-    if isinstance(a, list) and isinstance(b, list):
-        return len(a) != len(b) or any(_differs(x, y, rtol) for x, y in zip(a, b, strict=True))
-    if isinstance(a, bool) or isinstance(b, bool) or isinstance(a, str) or a is None:
-        return a != b
-    if isinstance(a, int | float) and isinstance(b, int | float):
-        return abs(a - b) > max(ABS_TOL, rtol * max(abs(a), abs(b)))
-    return a != b
-
-
 def compare_logs(old: str, new: str, rtol: float) -> dict:
-    """Message-by-message comparison of two logs (topics, counts, log times, numbers)."""
-    from bioflex_jsb.sinks.mcap_log import LogError, messages_by_topic
+    """Message-by-message comparison of two logs
+    (:func:`bioflex_jsb.sinks.mcap.compare.compare_logs`); an unreadable log is a
+    UsageError."""
+    from bioflex_jsb.sinks.mcap import LogError
+    from bioflex_jsb.sinks.mcap import compare_logs as compare
 
     try:
-        a, b = messages_by_topic(old), messages_by_topic(new)
+        return compare(old, new, rtol)
     except LogError as exc:
         raise UsageError(str(exc)) from None
-    result = {"equal": True, "messages": sum(len(v) for v in a.values()), "topics": len(a),
-              "first_difference": None}
-    if a.keys() != b.keys():
-        result.update(equal=False, first_difference=(
-            f"topics differ: {sorted(set(a) ^ set(b))}"))
-        return result
-    for topic_name in sorted(a):
-        ma, mb = a[topic_name], b[topic_name]
-        if len(ma) != len(mb):
-            result.update(equal=False, first_difference=(
-                f"{topic_name}: {len(ma)} messages in the original, {len(mb)} in the rerun"))
-            return result
-        for (ta, xa), (tb, xb) in zip(ma, mb, strict=True):
-            if ta != tb or _differs(xa, xb, rtol):
-                result.update(equal=False, first_difference=(
-                    f"{topic_name} at t = {ta * 1e-9:.6f} s: {json.dumps(xa)} != "
-                    f"{json.dumps(xb)}"))
-                return result
-    return result
 
 
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from bioflex_jsb import cli
-    from bioflex_jsb.sinks.mcap_log import check_file
 
-    argv = argv_from_log(args.file)
-    try:
-        check_file(args.file)
-    except Exception as exc:  # LogError
-        raise UsageError(str(exc)) from None
+    argv = argv_from_log(args.file)  # also checks that the file is a finished log
     if Path(args.out).resolve() == Path(args.file).resolve():
         raise UsageError("--out must name a new file, not the original log")
     import contextlib

@@ -105,9 +105,21 @@ def run(args: argparse.Namespace) -> int:
         link.close()
         raise
     if args.out:
-        from bioflex_jsb.sinks.mcap_log import RunLog
+        from bioflex_jsb.cli.gust import open_log
+        from bioflex_jsb.simulation.run import RunDescription
 
-        log = RunLog.open(args.out, command="sitl", args=args, build=build)
+        # a session follows its ground station: the description says how it began
+        description = RunDescription(
+            kind="sitl", wing=args.wing, speed_m_s=args.speed, gust="none",
+            models=(args.model,), mass_basis=args.mass_basis,
+            **({} if args.duration is None else {"duration_s": args.duration}),
+            extra={"until_stopped": args.duration is None, "speedup": args.speedup,
+                   "mavlink": endpoint.text(), "signed": key is not None})
+        try:
+            log = open_log(args.out, description, build)
+        except UsageError:
+            link.close()
+            raise
         names = sim.names
 
         pending = [0]

@@ -21,7 +21,6 @@ import math
 import os
 import socket
 import time
-from argparse import Namespace
 from pathlib import Path
 from typing import Any
 
@@ -48,13 +47,25 @@ def _num(x: Any) -> float | None:
     return x if math.isfinite(x) else None
 
 
+def case_errors() -> tuple[type[Exception], ...]:
+    """What a case can fail with that is a result, not a bug: a validated-input problem
+    (InputError: the airframe cannot trim, e.g. below the stall speed; a wing, gust or run
+    description that is not valid), a singular matrix at an extreme design point, a log
+    that cannot be written (OSError)."""
+    import numpy as np
+
+    from bioflex_jsb.errors import InputError
+
+    return (InputError, np.linalg.LinAlgError, OSError)
+
+
 def run_case(case: Case, log_dir: str | None = None) -> dict[str, Any]:
     """Run ``case``; the returned row has every column of the campaign's results table."""
     started = time.time()
     t0 = time.perf_counter()
     try:
         row = _evaluate(case, log_dir)
-    except Exception as exc:  # noqa: BLE001 - recorded as the case's error
+    except case_errors() as exc:  # recorded as the case's error; anything else is a bug
         row = failed_row(case, f"{type(exc).__name__}: {exc}")
     row["worker"] = worker_name()
     row["started_unix_s"] = started
@@ -113,6 +124,19 @@ def _flutter(case: Case, build):
     return _FLUTTER_CACHE[key]
 
 
+def case_description(case: Case):
+    """The run description of ``case``'s gust run (what its log records; ``rerun`` flies it
+    again as the gust run it is)."""
+    from bioflex_jsb.simulation.gusts import parse_gust
+    from bioflex_jsb.simulation.run import RunDescription
+
+    s = case.settings
+    return RunDescription(kind="sweep", wing=case.wing.name, speed_m_s=case.speed_m_s,
+                          gust=parse_gust(case.gust).text(), models=(case.model,),
+                          duration_s=s.duration_s, gust_start_s=s.gust_start_s,
+                          dt_s=s.dt_s, mass_basis=s.mass_basis, extra={"case_id": case.case_id})
+
+
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
@@ -124,16 +148,12 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     log = None
     recorder = None
     if log_dir:
-        from bioflex_jsb.sinks.mcap_log import RunLog
+        from bioflex_jsb.sinks.mcap import RunLog
 
         Path(log_dir).mkdir(parents=True, exist_ok=True)
-        # the gust command's argument names, so the log's run metadata reads the same
-        args = Namespace(wing=case.wing.name, mass_basis=s.mass_basis, speed=case.speed_m_s,
-                         gust=setup.gust, duration=s.duration_s, gust_start=s.gust_start_s,
-                         dt=s.dt_s, models=(case.model,), case_id=case.case_id)
-        log = RunLog.open(Path(log_dir) / f"{case.case_id}.mcap", command="sweep", args=args,
-                          build=build)
-
+        log = RunLog.open(Path(log_dir) / f"{case.case_id}.mcap", case_description(case),
+                          wing_variant=build.variant.as_dict(),
+                          overrides=dict(build.model.coefficients.overrides))
         recorder = log.recorder(case.model)
 
     try:

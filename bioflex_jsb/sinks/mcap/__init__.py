@@ -1,0 +1,90 @@
+"""MCAP logs of runs: writing (every step of a run), reading back, recovering a killed log.
+
+This is the only package that imports ``mcap``. Topics (JSON messages with JSON schemas;
+``<model>`` is ``rigid``, ``coupled`` or ``qsd``; units in every field name and in the schema
+descriptions; the full table is in ``docs/logging.md``):
+
+* ``/bioflex/<model>/rigid_body`` (``bioflex.RigidBody``): perturbations from trim, the
+  absolute attitude, body rates, airspeed, load factor, altitude (the position is on
+  ``pose`` and ``location``);
+* ``/bioflex/<model>/modal`` (``bioflex.Modal``): modal coordinates η [rad], rates η̇ [rad/s];
+* ``/bioflex/<model>/modal_loads`` (``bioflex.ModalLoads``): the elastic wing's loads applied;
+* ``/bioflex/<model>/gust`` (``bioflex.Gust``): the vertical gust w_g [m/s, up];
+* ``/bioflex/<model>/controls`` (``bioflex.Controls``): elevator [rad], throttle [-];
+* ``/bioflex/<model>/pose`` (``foxglove.FrameTransform``): ``world`` → ``<model>_body``;
+* ``/bioflex/<model>/location`` (``foxglove.LocationFix``): latitude, longitude [deg], altitude;
+* ``/bioflex/<model>/lti_prediction`` (``bioflex.LtiPrediction``): the linear model's response
+  to the same gust, where one ran alongside (:meth:`RunLog.prediction`).
+
+Frames: ``world`` is a local East-North-Up frame [m] whose origin is the aircraft's position
+at the first sample of the file (flat-Earth tangent plane on the WGS-84 ellipsoid);
+``<model>_body`` is the body frame with x forward, y to port (left), z up (FLU, as Foxglove and
+ROS expect). Log and publish times are simulation time [ns from the run's start].
+
+Metadata records: ``bioflex.run`` (the run description,
+:class:`~bioflex_jsb.simulation.run.RunDescription`, as JSON, which ``rerun`` flies again;
+readable copies of its wing, speed, gust and seed, models and time step; the wing variant and
+overrides; package, JSBSim and mcap versions: :mod:`.metadata`) and ``bioflex.world_frame``
+(the ENU origin).
+
+Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_WALL_S` of
+wall time, or 4096 steps) and written to the operating system at once, so a process killed
+hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed
+file from the complete chunks of such a log. A gust run is logged from the run's own table
+of steps (:meth:`RunLog.recorder`, nothing copied per step) and a chunk's steps are
+formatted at once, vectorised, in fixed-width numbers (:func:`fixed_e`), so record lengths and index
+offsets are known in advance (``docs/logging.md``, Overhead).
+
+The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
+the 20 % overhead budget allows at seven messages per step); every record other than the
+messages in a chunk is serialised with the ``mcap`` package's record classes, and the files are
+checked by independent readers in the tests (``@mcap/core``, ``pymcap-cli doctor``).
+
+Modules: :mod:`.schemas` (topics, frames, JSON schemas), :mod:`.writer` (the MCAP file
+writer), :mod:`.formatting` (a chunk's steps as fixed-width records), :mod:`.log`
+(:class:`RunLog`, :class:`TableRecorder`), :mod:`.metadata` (the ``bioflex.run`` record),
+:mod:`.reader` (summaries, messages, time histories), :mod:`.recover`, :mod:`.compare`
+(two logs message by message), :mod:`.errors`. A sink takes a run description and the run's
+data, never command-line arguments, and raises its own one-line errors
+(:class:`LogError`, :class:`LogWriteError`), which the CLI reports.
+"""
+
+from bioflex_jsb.sinks.mcap.compare import compare_logs
+from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError
+from bioflex_jsb.sinks.mcap.formatting import enu_quaternion, fixed_d, fixed_e
+from bioflex_jsb.sinks.mcap.log import RunLog, TableRecorder
+from bioflex_jsb.sinks.mcap.metadata import description_from_metadata, run_metadata
+from bioflex_jsb.sinks.mcap.reader import (
+    check_file,
+    histories,
+    messages_by_topic,
+    open_reader,
+    read_metadata,
+    summarise,
+)
+from bioflex_jsb.sinks.mcap.recover import recover
+from bioflex_jsb.sinks.mcap.schemas import (
+    FRAME_METADATA,
+    GROUPS,
+    RUN_METADATA,
+    SCHEMAS,
+    WORLD_FRAME,
+    body_frame,
+    topic,
+)
+from bioflex_jsb.sinks.mcap.writer import (
+    CHUNK_MAX_BYTES,
+    CHUNK_SPAN_S,
+    CHUNK_WALL_S,
+    MAGIC,
+    McapFileWriter,
+)
+
+__all__ = [
+    "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "FRAME_METADATA", "GROUPS", "MAGIC",
+    "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError", "McapFileWriter",
+    "RunLog", "TableRecorder", "body_frame", "check_file", "compare_logs",
+    "description_from_metadata", "enu_quaternion", "fixed_d", "fixed_e", "histories",
+    "messages_by_topic", "open_reader", "read_metadata", "recover", "run_metadata",
+    "summarise", "topic",
+]

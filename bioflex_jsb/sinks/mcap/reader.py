@@ -1,0 +1,161 @@
+"""Reading finished MCAP logs back: summaries, messages, time histories, run metadata.
+
+Read through the ``mcap`` package's indexed reader; a file that is missing, not MCAP,
+truncated or damaged is a :class:`LogError` with one line for the user.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
+from bioflex_jsb.sinks.mcap.schemas import RUN_METADATA
+from bioflex_jsb.sinks.mcap.writer import MAGIC
+
+
+def check_file(path: str | Path) -> Path:
+    """``path`` as a Path if it is an existing file starting with the MCAP magic."""
+    p = Path(path)
+    if not p.exists():
+        raise LogError(f"{str(p)!r}: no such file")
+    if not p.is_file():
+        raise LogError(f"{str(p)!r} is not a file")
+    with open(p, "rb") as f:
+        head = f.read(len(MAGIC))
+    if head != MAGIC:
+        raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
+    return p
+
+
+def _truncated(p: Path) -> LogError:
+    return LogError(
+        f"{str(p)!r} is truncated (the writer was killed before finishing it); recover the "
+        f"complete chunks with: bioflex-jsb info {str(p)!r} --recover FIXED.mcap"
+    )
+
+
+@contextmanager
+def open_reader(path: str | Path):
+    """An indexed ``mcap`` reader of a finished log, with its summary; LogError otherwise."""
+    from mcap.reader import make_reader
+
+    p = check_file(path)
+    with open(p, "rb") as f:
+        f.seek(0, 2)
+        size = f.tell()
+        if size < 2 * len(MAGIC) + 29:
+            raise _truncated(p)
+        f.seek(size - len(MAGIC))
+        if f.read(len(MAGIC)) != MAGIC:
+            raise _truncated(p)
+        f.seek(0)
+        try:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+        except bad_data_errors() as exc:
+            raise LogError(f"{str(p)!r}: unreadable MCAP summary ({exc})") from None
+        if summary is None:
+            raise _truncated(p)
+        yield reader, summary
+
+
+def read_metadata(reader) -> dict[str, dict[str, str]]:
+    try:
+        return {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    except bad_data_errors() as exc:
+        raise LogError(f"unreadable metadata ({exc})") from None
+
+
+def iter_json(reader, topics: list[str] | None = None) -> Iterator[tuple[str, int, dict]]:
+    """(topic, log time [ns], decoded JSON) of every message, in log-time order."""
+    try:
+        for _schema, channel, message in reader.iter_messages(topics=topics,
+                                                              log_time_order=True):
+            yield channel.topic, message.log_time, json.loads(message.data)
+    except bad_data_errors() as exc:
+        raise LogError(f"unreadable message data ({exc})") from None
+
+
+def summarise(path: str | Path) -> dict:
+    """Channels (topic, schema, count), duration, chunks and metadata of a finished log."""
+    with open_reader(path) as (reader, summary):
+        stats = summary.statistics
+        counts = dict(stats.channel_message_counts) if stats else {}
+        channels = []
+        for cid, ch in sorted(summary.channels.items()):
+            schema = summary.schemas.get(ch.schema_id)
+            channels.append({"topic": ch.topic, "schema": schema.name if schema else "",
+                             "encoding": ch.message_encoding, "messages": counts.get(cid, 0)})
+        start = stats.message_start_time if stats else 0
+        end = stats.message_end_time if stats else 0
+        meta = read_metadata(reader)
+        return {
+            "file": str(path),
+            "library": reader.get_header().library,
+            "channels": channels,
+            "messages": stats.message_count if stats else sum(counts.values()),
+            "chunks": len(summary.chunk_indexes),
+            "start_s": start * 1e-9,
+            "end_s": end * 1e-9,
+            "duration_s": (end - start) * 1e-9,
+            "metadata": meta,
+        }
+
+
+def histories(path: str | Path) -> tuple[list, dict[str, str]]:
+    """The runs of a log rebuilt as TimeHistory objects (JSBSim runs, then LTI predictions),
+    and its ``bioflex.run`` metadata."""
+    import numpy as np
+
+    from bioflex_jsb.simulation.results import TimeHistory
+
+    with open_reader(path) as (reader, summary):
+        meta = read_metadata(reader).get(RUN_METADATA, {})
+        wanted = [ch.topic for ch in summary.channels.values()
+                  if ch.topic.rsplit("/", 1)[-1] in ("rigid_body", "modal", "gust",
+                                                      "lti_prediction")]
+        cols: dict[tuple[str, str], dict[str, list]] = {}
+        for top, ns, msg in iter_json(reader, wanted):
+            _, _, model, group = top.split("/", 3)
+            key = (model, "lti" if group == "lti_prediction" else "run")
+            d = cols.setdefault(key, {})
+            if group == "rigid_body" or group == "lti_prediction":
+                d.setdefault("time_s", []).append(ns * 1e-9)
+                for name, field in (("u", "du_m_s"), ("alpha", "dalpha_rad"), ("q", "q_rad_s"),
+                                    ("theta", "dtheta_rad"), ("n_z", "n_z")):
+                    d.setdefault(name, []).append(msg.get(field))
+                if group == "lti_prediction":
+                    for i, v in enumerate(msg.get("eta_rad") or []):
+                        d.setdefault(f"eta{i + 1}", []).append(v)
+            elif group == "modal":
+                for i, v in enumerate(msg["eta_rad"]):
+                    d.setdefault(f"eta{i + 1}", []).append(v)
+            elif group == "gust":
+                d.setdefault("w_g", []).append(msg["w_g_m_s"])
+    units = {"u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-",
+             "w_g": "m/s"}
+    runs = []
+    for (model, kind), d in sorted(cols.items(), key=lambda kv: kv[0][1] == "lti"):
+        t = np.asarray(d.pop("time_s", []), dtype=float)
+        n = len(t)
+        channels = {k: np.asarray([np.nan if x is None else x for x in v[:n]], dtype=float)
+                    for k, v in d.items() if len(v) >= n}
+        run = TimeHistory(model, t, channels,
+                          {k: units.get(k, "rad") for k in channels}, {})
+        if kind == "lti":
+            run.meta.update(label=f"LTI {model}", linestyle="--")
+        runs.append(run)
+    return runs, meta
+
+
+def messages_by_topic(path: str | Path) -> dict[str, list[tuple[int, dict]]]:
+    """Every message of a finished log, per topic, in log-time order."""
+    out: dict[str, list[tuple[int, dict]]] = {}
+    with open_reader(path) as (reader, _summary):
+        for top, ns, msg in iter_json(reader):
+            out.setdefault(top, []).append((ns, msg))
+    return out
+

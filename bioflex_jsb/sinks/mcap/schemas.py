@@ -1,0 +1,172 @@
+"""Topics, frames and JSON schemas of the MCAP logs (``docs/logging.md`` has the table).
+
+``<model>`` is ``rigid``, ``coupled`` or ``qsd``; units are in every field name and in the
+schema descriptions.
+"""
+
+from __future__ import annotations
+
+RUN_METADATA = "bioflex.run"
+FRAME_METADATA = "bioflex.world_frame"
+WORLD_FRAME = "world"
+GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
+          "lti_prediction")
+
+
+def topic(model: str, group: str) -> str:
+    """The topic of ``group`` (one of :data:`GROUPS`) for the wing ``model``."""
+    return f"/bioflex/{model}/{group}"
+
+
+def body_frame(model: str) -> str:
+    return f"{model}_body"
+
+
+def _num(description: str) -> dict:
+    return {"type": "number", "description": description}
+
+
+_TIME = {
+    "type": "object",
+    "title": "time",
+    "description": "simulation time since the start of the run",
+    "properties": {"sec": {"type": "integer", "minimum": 0, "description": "whole seconds [s]"},
+                   "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999,
+                            "description": "nanoseconds [ns]"}},
+}
+
+# Fields of rigid_body, in message order: (field, row key, description).
+_RIGID_FIELDS = (
+    ("du_m_s", "u", "airspeed perturbation from trim [m/s]"),
+    ("dalpha_rad", "alpha", "angle-of-attack perturbation from trim, against the air [rad]"),
+    ("dtheta_rad", "theta", "pitch-angle perturbation from trim [rad]"),
+    ("airspeed_m_s", "airspeed_m_s", "true airspeed [m/s]"),
+    ("n_z", "n_z", "load factor, up, 1 in level flight [-]"),
+    ("roll_rad", "phi_rad", "roll angle φ, right wing down positive (NED Euler) [rad]"),
+    ("pitch_rad", "theta_rad", "pitch angle θ, nose up positive (NED Euler) [rad]"),
+    ("yaw_rad", "psi_rad", "heading ψ, clockwise from north (NED Euler) [rad]"),
+    ("p_rad_s", "p_rad_s", "roll rate about body x (forward) [rad/s]"),
+    ("q_rad_s", "q", "pitch rate about body y (starboard), nose up [rad/s]"),
+    ("r_rad_s", "r_rad_s", "yaw rate about body z (down) [rad/s]"),
+    ("altitude_m", "altitude_m", "altitude above sea level [m]"),
+)
+# Fields logged only when the run provides them (row key = field name).
+_RIGID_OPTIONAL = (
+    ("alpha_rad", "angle of attack against the air [rad]"),
+    ("beta_rad", "sideslip angle, wind from starboard positive [rad]"),
+    ("v_north_m_s", "inertial velocity, north [m/s]"),
+    ("v_east_m_s", "inertial velocity, east [m/s]"),
+    ("v_down_m_s", "inertial velocity, down [m/s]"),
+)
+
+SCHEMAS: dict[str, dict] = {
+    "rigid_body": {
+        "title": "bioflex.RigidBody",
+        "description": "Airframe state after each step; perturbations (d…) are from the trim "
+        "at the run start. The position is on the pose topic (world frame, local ENU) and "
+        "the location topic (WGS-84); the time is the message's log time.",
+        "type": "object",
+        "properties": {
+            **{f: _num(d) for f, _, d in _RIGID_FIELDS},
+            **{f: _num(d) for f, d in _RIGID_OPTIONAL},
+        },
+    },
+    "modal": {
+        "title": "bioflex.Modal",
+        "description": "Modal coordinates of the elastic wing (perturbations from trim); "
+        "modes normalised on twist, positive leading edge up (docs/conventions.md).",
+        "type": "object",
+        "properties": {
+            "eta_rad": {"type": "array", "items": {"type": "number"},
+                        "description": "η_i, element i is mode i+1 [rad]"},
+            "eta_dot_rad_s": {"type": "array", "items": {"type": "number"},
+                              "description": "η̇_i, element i is mode i+1 [rad/s]"},
+        },
+    },
+    "modal_loads": {
+        "title": "bioflex.ModalLoads",
+        "description": "Incremental loads of the elastic wing applied to the airframe.",
+        "type": "object",
+        "properties": {
+            "lift_n": _num("lift, up, normal to the air velocity [N]"),
+            "drag_n": _num("drag, aft, along the air velocity [N]"),
+            "pitch_moment_n_m": _num("pitching moment about the CG, nose up [N*m]"),
+        },
+    },
+    "gust": {
+        "title": "bioflex.Gust",
+        "description": "Wind field applied to the airframe (vertical gust only).",
+        "type": "object",
+        "properties": {
+            "w_g_m_s": _num("vertical gust velocity, up [m/s] (JSBSim wind-down = -w_g)"),
+        },
+    },
+    "controls": {
+        "title": "bioflex.Controls",
+        "description": "Control inputs (held at trim in gust runs).",
+        "type": "object",
+        "properties": {
+            "elevator_rad": _num("elevator deflection, trailing edge down positive [rad]"),
+            "throttle": _num("throttle, 0 to 1 [-]"),
+        },
+    },
+    "pose": {
+        "title": "foxglove.FrameTransform",
+        "description": "Aircraft pose: transform from the parent frame `world` (local ENU, "
+        "origin at the first sample of the file) to the child frame `<model>_body` (x "
+        "forward, y left, z up).",
+        "type": "object",
+        "properties": {
+            "timestamp": _TIME,
+            "parent_frame_id": {"type": "string", "description": "parent frame (world)"},
+            "child_frame_id": {"type": "string", "description": "child frame (<model>_body)"},
+            "translation": {
+                "type": "object", "title": "foxglove.Vector3",
+                "description": "body origin (CG) in the world frame [m]",
+                "properties": {"x": _num("east [m]"), "y": _num("north [m]"),
+                               "z": _num("up [m]")},
+            },
+            "rotation": {
+                "type": "object", "title": "foxglove.Quaternion",
+                "description": "rotation of the body frame in the world frame [-]",
+                "properties": {"x": _num("x [-]"), "y": _num("y [-]"), "z": _num("z [-]"),
+                               "w": _num("w [-]")},
+            },
+        },
+    },
+    "location": {
+        "title": "foxglove.LocationFix",
+        "description": "Aircraft position on the WGS-84 ellipsoid (exact, from the simulation).",
+        "type": "object",
+        "properties": {
+            "timestamp": _TIME,
+            "frame_id": {"type": "string", "description": "frame at the position (body)"},
+            "latitude": _num("geodetic latitude [deg]"),
+            "longitude": _num("longitude [deg]"),
+            "altitude": _num("altitude above sea level [m]"),
+            "position_covariance": {
+                "type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9,
+                "description": "ENU position covariance, row-major [m^2] (zero: exact)"},
+            "position_covariance_type": {
+                "type": "integer", "enum": [0, 1, 2, 3],
+                "description": "0 unknown, 1 approximated, 2 diagonal known, 3 known"},
+        },
+    },
+    "lti_prediction": {
+        "title": "bioflex.LtiPrediction",
+        "description": "Response of the linear model (Eq. 4) to the same gust samples, as "
+        "perturbations from trim.",
+        "type": "object",
+        "properties": {
+            "du_m_s": _num("airspeed perturbation [m/s]"),
+            "dalpha_rad": _num("angle-of-attack perturbation, against the air [rad]"),
+            "q_rad_s": _num("pitch rate [rad/s]"),
+            "dtheta_rad": _num("pitch-angle perturbation [rad]"),
+            "n_z": _num("load factor [-]"),
+            "eta_rad": {"type": "array", "items": {"type": "number"},
+                        "description": "modal coordinates, element i is mode i+1 [rad]"},
+        },
+    },
+}
+for _s in SCHEMAS.values():
+    _s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
