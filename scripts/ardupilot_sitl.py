@@ -199,6 +199,11 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
     n_items = 0
     sim_s = 0.0
     asked_home_s = 0.0
+    armed = False
+    arm_sent_s = 0.0
+    current_seq = -1
+    legs: dict[int, float] = {}  # mission item -> largest |cross-track error| on its leg [m]
+    track = []  # (sim time [s], north [m], east [m], alt above home [m], mission item)
     while time.monotonic() < deadline:
         if any(p.poll() is not None for p in procs):
             summary["ended"] = "a process exited"
@@ -213,8 +218,24 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
             sim_s = msg.time_boot_ms * 1e-3
         elif kind == "MISSION_ITEM_REACHED":
             summary["reached"].append(msg.seq)
+            summary.setdefault("reached_at_s", []).append(sim_s)
+        elif kind == "MISSION_CURRENT":
+            current_seq = msg.seq
+        elif kind == "HEARTBEAT" and msg.get_srcSystem() == mav.target_system:
+            armed = bool(msg.base_mode & m.MAV_MODE_FLAG_SAFETY_ARMED)
+            if armed and "armed_at_s" not in summary:
+                summary["armed_at_s"] = sim_s
+        elif kind == "GLOBAL_POSITION_INT" and state == "auto" and home is not None:
+            dn = math.radians(msg.lat * 1e-7 - home[0]) * EARTH_RADIUS_M
+            de = (math.radians(msg.lon * 1e-7 - home[1]) * EARTH_RADIUS_M
+                  * math.cos(math.radians(home[0])))
+            track.append((sim_s, dn, de, msg.relative_alt * 1e-3, current_seq))
         elif kind == "NAV_CONTROLLER_OUTPUT" and state == "auto":
-            summary["xtrack_m"].append(msg.xtrack_error)
+            # the square's legs only (items 3..5 fly from corner to corner; item 2 from the
+            # end of the take-off)
+            if 2 <= current_seq <= 1 + len(SQUARE_M):
+                summary["xtrack_m"].append(msg.xtrack_error)
+                legs[current_seq] = max(legs.get(current_seq, 0.0), abs(msg.xtrack_error))
         elif kind == "GPS_RAW_INT" and state == "wait_gps" and msg.fix_type >= 3:
             state = "wait_ready"
         elif kind == "HOME_POSITION" and home is None:
@@ -227,7 +248,12 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
             n_items = _mission(mav, *home)
             mav.set_mode("AUTO")
             mav.arducopter_arm()
+            arm_sent_s = time.monotonic()
             state = "auto"
+        if state == "auto" and not armed and time.monotonic() - arm_sent_s > 5.0:
+            mav.set_mode("AUTO")  # pre-arm checks (EKF, GPS) may refuse at first: again
+            mav.arducopter_arm()
+            arm_sent_s = time.monotonic()
         if state == "auto" and summary["reached"] and summary["reached"][-1] >= n_items - 2:
             # the last square corner reached: RTL follows; watch it arrive and loiter
             if mav.location().alt is not None and _near_home(mav, home):
@@ -235,6 +261,8 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
                 break
     summary["sim_s"] = sim_s
     summary["mission_items"] = n_items
+    summary["xtrack_max_by_item_m"] = {str(k): v for k, v in sorted(legs.items())}
+    summary["track"] = track[::10]  # ≈ 1 s apart at the 10 Hz stream
 
 
 def _near_home(mav, home, radius_m: float = 100.0) -> bool:
