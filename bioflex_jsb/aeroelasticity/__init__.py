@@ -6,7 +6,9 @@
   (frequency domain) and Jones/Küssner finite-state (time domain);
 * :mod:`~bioflex_jsb.aeroelasticity.pk`: p-k flutter solution with branch tracking;
 * :mod:`~bioflex_jsb.aeroelasticity.state_space`: eigen-analysis of structure + lag states;
-* :mod:`~bioflex_jsb.aeroelasticity.flutter`: the result, mechanism and the Goland benchmark.
+* :mod:`~bioflex_jsb.aeroelasticity.flutter`: the result, mechanism and the Goland benchmark;
+* :mod:`~bioflex_jsb.aeroelasticity.free_aircraft`: the paper's free aircraft, Eq. (4) with
+  unsteady strips (named Jones lag states), its flutter and the six-wing table.
 """
 
 from bioflex_jsb.aeroelasticity.flutter import FlutterResult, goland_flutter

@@ -38,10 +38,12 @@ right half plane in --range. Reports the speed [m/s], the frequency of the cross
 the mechanism (coalescence with another branch and which, single-mode, or static
 divergence) and the wind-off natural frequencies [rad/s]; null when nothing crosses.
 
-Paper wings (free aircraft, Eq. 4): quasi-steady strips (the paper's), eigen-analysis
-(--method state-space) scanned in 0.1 m/s steps and bisected to 0.01 m/s (printed to
-0.1 m/s); the phugoid is left out, as in the paper. Not available for them yet: --clamped,
---aero unsteady, --method pk, --lift-slope, --inertia-about.
+Paper wings (free aircraft, Eq. 4): --aero quasi-steady (default; the paper's strips) or
+unsteady (Theodorsen strips with two Jones lag states per strip added to Eq. 4;
+docs/aeroelasticity.md), eigen-analysis (--method state-space) scanned in 0.1 m/s steps
+from 2 m/s with mode tracking and bisected (printed to 0.1 m/s); the phugoid is left out,
+as in the paper; with unsteady strips also the wing's divergence speed with the body held.
+Not available for them: --clamped, --method pk, --lift-slope, --inertia-about.
 
 --wing goland --clamped: the Goland cantilever (semi-span 6.096 m, chord 1.8288 m; data and
 published results with citations in bioflex_jsb/parameters/goland.py), published strip
@@ -100,7 +102,7 @@ def register(sub) -> None:
     p.add_argument("--aero", choices=AERO_CHOICES, default=None,
                    help="strip aerodynamics: unsteady (Theodorsen C(k); Jones lag states in "
                    "state-space) or quasi-steady (C = 1); default unsteady for --clamped, "
-                   "quasi-steady (the paper's, the only one yet) for paper wings")
+                   "quasi-steady (the paper's) for paper wings")
     p.add_argument("--method", choices=METHOD_CHOICES, default=None,
                    help="pk (frequency domain, --clamped only) or state-space "
                    "(eigen-analysis with mode tracking); default pk for --clamped, "
@@ -141,10 +143,6 @@ def check_combination(args: argparse.Namespace) -> None:
         raise UsageError(f"--clamped is available for the benchmark wing "
                          f"{', '.join(BENCHMARK_WINGS)} only; paper wings are analysed as the "
                          "free aircraft (drop --clamped)")
-    if args.aero == "unsteady":
-        raise UsageError("--aero unsteady is available with --wing goland --clamped only "
-                         "(the free aircraft's unsteady model does not exist yet); paper "
-                         "wings accept --aero quasi-steady")
     if args.method == "pk":
         raise UsageError("--method pk is available with --wing goland --clamped only; paper "
                          "wings accept --method state-space")
@@ -242,6 +240,8 @@ def paper_payload(args: argparse.Namespace) -> dict:
         model = replace(model, damping_ratios=np.full(model.n_modes, args.structural_damping))
     rho = P.SEA_LEVEL_DENSITY_KG_M3 if args.density is None else args.density
     lo, hi = args.range or PAPER_DEFAULT_RANGE_M_S
+    if args.aero == "unsteady":
+        return paper_unsteady_payload(args, build, model, rho, (lo, hi))
     res = eigen.find_flutter(model, (lo, hi), density_kg_m3=rho)
     payload = res.as_dict()
     mech, partner = None, None
@@ -268,23 +268,18 @@ def paper_payload(args: argparse.Namespace) -> dict:
     return payload
 
 
-# DEFINITION (free aircraft): the unstable branch has "coalesced" with another when, at the
-# crossing, their frequencies differ by less than this fraction of the unstable one's. The
-# clamped rule (separation against the wind-off one) does not carry over: the free
-# aircraft's short period starts near 0 rad/s and its first aeroelastic mode softens by
-# 40 % before flutter, which halves their separation without any approach (measured:
-# elastic-backward at 15.4 m/s, 82.8 vs 15.1 rad/s).
-COALESCENCE_RELATIVE_GAP = 0.25
-
-
 def paper_mechanism(model, res, density_kg_m3: float) -> tuple[str, str | None]:
-    """Mechanism of the free aircraft's crossing: static divergence (a real root),
-    coalescence (:data:`COALESCENCE_RELATIVE_GAP`) with the nearest tracked branch, or
-    single-mode. The phugoid is left out as in the search."""
+    """Mechanism of the free aircraft's crossing by the rule of
+    :class:`bioflex_jsb.aeroelasticity.free_aircraft.FreeFlutter` (static divergence,
+    body-freedom, coalescence within ``COALESCENCE_RELATIVE_GAP``, single-mode), on the
+    tracked roots of :func:`bioflex_jsb.flight_dynamics.eigen.track` at the crossing."""
+    from bioflex_jsb.aeroelasticity.free_aircraft import COALESCENCE_RELATIVE_GAP
     from bioflex_jsb.flight_dynamics import eigen
 
     if res.kind == "divergence":
         return "static divergence", None
+    if res.mode in eigen.RIGID_LABELS:
+        return "body-freedom", None
     v = float(res.flutter_speed_m_s)
     grid = np.unique(np.append(np.arange(min(2.0, v), v, 0.1), v))
     last = eigen.track("coupled", grid, model, density_kg_m3).at(len(grid) - 1)
@@ -296,6 +291,44 @@ def paper_mechanism(model, res, density_kg_m3: float) -> tuple[str, str | None]:
     if gaps[nearest] < COALESCENCE_RELATIVE_GAP:
         return "coalescence", nearest
     return "single-mode", None
+
+
+def paper_unsteady_payload(args, build, model, rho: float, range_m_s) -> dict:
+    """The free aircraft on unsteady strips (Eq. 4 + Jones lag states,
+    :mod:`bioflex_jsb.aeroelasticity.free_aircraft`)."""
+    from bioflex_jsb.aeroelasticity.free_aircraft import free_flutter
+    from bioflex_jsb.parameters import prototype as P
+
+    res = free_flutter(build, aero="unsteady", structural_damping=args.structural_damping,
+                       range_m_s=range_m_s, density_kg_m3=rho)
+    b = P.MEAN_AERODYNAMIC_CHORD_M / 2.0
+    speed = res.speed_m_s
+    kind = None
+    if res.mechanism is not None:
+        kind = "divergence" if res.mechanism == "static divergence" else "flutter"
+    return {
+        "wing": build.variant.name,
+        "flutter_speed_m_s": None if speed is None else round(speed, 1),
+        "mode": res.mode,
+        "frequency_rad_s": res.frequency_rad_s,
+        "kind": kind,
+        "range_m_s": list(range_m_s),
+        "clamped": False,
+        "aero": "unsteady",
+        "method": "state-space",
+        "structural_damping": [float(z) for z in model.damping_ratios],
+        "density_kg_m3": rho,
+        "reduced_frequency": None if speed is None else round(
+            res.frequency_rad_s * b / speed, 4),
+        "semichord_m": b,
+        "mechanism": res.mechanism,
+        "partner_mode": res.partner_mode,
+        "wing_divergence_speed_m_s": None if res.wing_divergence_speed_m_s is None else round(
+            res.wing_divergence_speed_m_s, 2),
+        "natural_frequencies_rad_s": [round(float(w), 2) for w in model.frequencies_rad_s],
+        "mass_basis": build.mass_basis,
+        "overrides": dict(model.coefficients.overrides),
+    }
 
 
 def text_report(p: dict) -> str:
@@ -329,4 +362,7 @@ def text_report(p: dict) -> str:
         lines.append(line)
     if p.get("divergence_speed_m_s") is not None:
         lines.append(f"  static divergence at {p['divergence_speed_m_s']:.1f} m/s")
+    if p.get("wing_divergence_speed_m_s") is not None:
+        lines.append(f"  wing divergence with the body held at "
+                     f"{p['wing_divergence_speed_m_s']:.1f} m/s")
     return "\n".join(lines)

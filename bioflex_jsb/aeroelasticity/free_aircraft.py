@@ -1,0 +1,520 @@
+"""Unsteady strip aerodynamics for the paper's free aircraft: Eq. (4) with named lag states.
+
+The paper's elastic wing (Eq. 3, Table B1) carries quasi-steady strips: lift
+L_qs = ½ρV² C_lα c · α_qs at each strip's aerodynamic centre, with the angle
+
+    α_qs = α + Σ θ_i η_i + Σ φ_i η̇_i / V − d q / V      (d = x_cg − x_ac, AC ahead of CG),
+
+and work arms (e θ_i − φ_i) on mode i and d on the pitching moment (e = x_E − x_ac, after
+the C_η1^Q1 pin's shift). This module adds to Eq. (4), strip by strip (the lattice's own
+strips, starboard half doubled: symmetric modes), the difference between Theodorsen's
+loads and those quasi-steady ones:
+
+* circulatory: L_c = ½ρV C_lα c · [C(k) w_¾], with the three-quarter-chord upwash of the
+  section's own kinematics (physical chord: x_¾ = x_le + ¾ c),
+
+      w_¾ = V(α + Σ θ_i η_i) + Σ [φ_i + (x_¾ − x_E) θ_i] η̇_i − (x_cg − x_¾) q,
+
+  and C(k) by R. T. Jones's two exponentials (Wagner's function; Jones 1940, NACA Rep. 681),
+  i.e. two lag states per strip (named ``lag1[k]``, ``lag2[k]``, units m/s):
+  ẋ_j = −β_j V/b x_j + A_j β_j V/b w_¾ and C w_¾ → (1 − A_1 − A_2) w_¾ + x_1 + x_2.
+  The increment L_c − L_qs is applied with the paper's arms (e θ_i − φ_i, d), so in a
+  steady state (no rates, lags at rest) it vanishes: trim, the static deflection and the
+  divergence speed are the paper model's.
+* non-circulatory (apparent mass, thin aerofoil, about the physical elastic axis
+  a = 2 x_E,frac − 1 semichords aft of mid-chord): Theodorsen's L_nc and M_nc on the
+  section's heave acceleration ḧ_E = u_0(α̇ − q) − (x_cg − x_E) q̇ + Σ φ_i η̈_i (down) and
+  pitch α_s with α̇_s = q + Σ θ_i η̇_i, α̈_s = q̇ + Σ θ_i η̈_i; applied with physical arms.
+
+Rigid rows: the strips' lift and moment about the CG enter Ż/M like Table B2's elastic
+rows (Δα̇ = ΔZ/(m u_0), Δq̇ = ΔM/I_yy + M_ẇ ΔZ/m, Δu̇ = the induced drag of the lift
+increment, 2 k C_L0 ΔL); generalised forces over the m_i of the wing model's mass basis.
+The accelerations the apparent mass brings (α̇, q̇, η̈) are moved to the left:
+(I − R F_ẋ) ẋ = (A_4 + R F_x) x. The gust input stays the paper's (quasi-steady; no
+Küssner states yet). Strips are normal to y: the outer panel's sweep is not corrected for.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq, linear_sum_assignment
+
+from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
+from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
+from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
+from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
+from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
+
+AERO_MODELS = ("quasi-steady", "unsteady")
+# DEFINITION (free aircraft; bioflex_jsb.cli.flutter uses it for both models): coalescence
+# when another branch's frequency is within this fraction of the unstable one's at the
+# crossing. The clamped rule (separation against the wind-off one) does not carry over: the
+# short period starts near 0 rad/s and the first aeroelastic mode softens by 40 % before it
+# flutters, halving their separation without any approach (elastic-backward, quasi-steady,
+# 15.4 m/s: 82.8 vs 15.1 rad/s).
+COALESCENCE_RELATIVE_GAP = 0.25
+EXCLUDED = ("phugoid",)
+
+
+@dataclass(frozen=True)
+class StripGeometry:
+    """Per-strip data of a built paper wing (starboard strips; ``weights_m`` whole span)."""
+
+    weights_m: np.ndarray
+    chord_m: np.ndarray
+    cl_alpha_c_m: np.ndarray
+    e_m: np.ndarray  # x_E − x_ac after the pin's shift (the paper's arm)
+    d_m: np.ndarray  # x_cg − x_ac (the paper's arm)
+    d_e_m: np.ndarray  # x_cg − x_E (physical)
+    d_34_m: np.ndarray  # x_cg − x_¾ (physical)
+    e_34_m: np.ndarray  # x_¾ − x_E (physical)
+    a: np.ndarray  # physical elastic axis, semichords aft of mid-chord
+    phi: np.ndarray  # (n, K) bending per unit η (down) [m]
+    theta: np.ndarray  # (n, K) twist per unit η (LE up) [rad]
+
+
+def strip_geometry(build, planform=DEFAULT_PLANFORM) -> StripGeometry:
+    """The η → (h, α) per-strip projection of a :class:`WingBuild` (its modes sampled at the
+    lattice's strips) and the strips' arms."""
+    modes = build.modes
+    strips = spanwise_geometry(build.aero, planform, modes.x_elastic_frac, modes.stations_m)
+    pinned = shifted(strips, build.e_shift_frac * planform.chord_m)
+    y = strips.stations_m
+    c = strips.chord_m
+    xe_frac = np.interp(y, modes.stations_m, np.asarray(modes.x_elastic_frac, dtype=float))
+    x_le = planform.leading_edge_x_at(y)
+    x_e = x_le + xe_frac * c
+    x_34 = x_le + 0.75 * c
+    phi = np.array([np.interp(y, modes.stations_m, b) for b in modes.bending_m])
+    theta = np.array([np.interp(y, modes.stations_m, t) for t in modes.twist_rad])
+    return StripGeometry(
+        weights_m=2.0 * strips.weights_m, chord_m=c, cl_alpha_c_m=strips.cl_alpha_c_m,
+        e_m=pinned.e_m, d_m=strips.d_m, d_e_m=planform.x_cg_m - x_e,
+        d_34_m=planform.x_cg_m - x_34, e_34_m=x_34 - x_e, a=2.0 * xe_frac - 1.0,
+        phi=phi, theta=theta,
+    )
+
+
+def with_damping(build, structural_damping: float | None):
+    """The build's ElasticWingModel, with every mode's ζ set when given."""
+    model = build.model
+    if structural_damping is None:
+        return model
+    return replace(model, damping_ratios=np.full(model.n_modes, float(structural_damping)))
+
+
+@dataclass(frozen=True, eq=False)
+class DescriptorSystem:
+    """E ẋ = A x + B w_g before E is inverted (states as :func:`unsteady_state_space`).
+
+    Its rows and columns without u, α, q, θ are the clamped wing's aeroelastic system: the
+    body's accelerations only reach the modes through E's off-diagonal blocks."""
+
+    e: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    base: StateSpace
+    states: tuple[str, ...]
+    state_units: tuple[str, ...]
+
+
+def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float | None = None,
+                         density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                         geometry: StripGeometry | None = None) -> StateSpace:
+    """Eq. (4) of ``build`` (a WingBuild) at ``speed_m_s`` with unsteady strips
+    (module docstring): states u, α, q, θ, η, η̇, then lag1[k], lag2[k] [m/s].
+    ``geometry`` replaces :func:`strip_geometry` (tests: its ``e_m`` must be the one the
+    build's Table B1 coefficients were computed with)."""
+    d = unsteady_descriptor(build, speed_m_s, structural_damping=structural_damping,
+                            density_kg_m3=density_kg_m3, geometry=geometry)
+    a = np.linalg.solve(d.e, d.a)
+    b_in = np.linalg.solve(d.e, d.b)
+    n_all = a.shape[0]
+    notes = dict(d.base.notes, aero="unsteady", lag_states=n_all - d.base.n_states,
+                 gust="quasi-steady (paper's G_R, G_E)")
+    return StateSpace(model="coupled-unsteady", speed_m_s=float(speed_m_s), a=a, b=b_in,
+                      c=np.eye(n_all), d=np.zeros((n_all, 1)), states=d.states,
+                      state_units=d.state_units, inputs=d.base.inputs,
+                      input_units=d.base.input_units, outputs=d.states,
+                      output_units=d.state_units, notes=notes)
+
+
+def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | None = None,
+                        density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                        geometry: StripGeometry | None = None) -> DescriptorSystem:
+    """The :class:`DescriptorSystem` of :func:`unsteady_state_space`."""
+    model = with_damping(build, structural_damping)
+    cond = level_flight_condition(float(speed_m_s), density_kg_m3)
+    base = build_state_space("coupled", cond, model)
+    g = strip_geometry(build) if geometry is None else geometry
+    n, k_strips = model.n_modes, g.chord_m.size
+    n0 = 4 + 2 * n
+    n_all = n0 + 2 * k_strips
+    v, rho = float(speed_m_s), float(density_kg_m3)
+    b = 0.5 * g.chord_m
+    ia, iq = 1, 2
+    ie = slice(4, 4 + n)
+    ied = slice(4 + n, 4 + 2 * n)
+    lag = [slice(n0 + j * k_strips, n0 + (j + 1) * k_strips) for j in range(2)]
+    amp, beta = JONES_WAGNER.amplitudes, JONES_WAGNER.exponents
+
+    def rows() -> np.ndarray:
+        return np.zeros((k_strips, n_all))
+
+    # three-quarter-chord upwash [m/s] and the paper's angle × V [m/s]
+    w34 = rows()
+    w34[:, ia] = v
+    w34[:, iq] = -g.d_34_m
+    w34[:, ie] = v * g.theta.T
+    w34[:, ied] = (g.phi + g.e_34_m * g.theta).T
+    wqs = rows()
+    wqs[:, ia] = v
+    wqs[:, iq] = -g.d_m
+    wqs[:, ie] = v * g.theta.T
+    wqs[:, ied] = g.phi.T
+    half = 0.5 * rho * v * g.cl_alpha_c_m[:, None]
+    l_c = half * (1.0 - sum(amp)) * w34
+    for j in range(2):
+        l_c[:, lag[j]] += np.diag(half[:, 0])
+    dl_circ = l_c - half * wqs  # circulatory increment [N/m] on x
+    # apparent mass: heave acceleration (down), pitch rate and acceleration, on x and ẋ
+    hdd_x, hdd_xd = rows(), rows()
+    hdd_x[:, iq] = -v
+    hdd_xd[:, ia] = v
+    hdd_xd[:, iq] = -g.d_e_m
+    hdd_xd[:, ied] = g.phi.T
+    ad_x = rows()
+    ad_x[:, iq] = 1.0
+    ad_x[:, ied] = g.theta.T
+    add_xd = ad_x.copy()
+    ad_x_only = ad_x  # α̇_s in x; α̈_s = the same row on ẋ
+    pb2 = (math.pi * rho * b**2)[:, None]
+    ba = (b * g.a)[:, None]
+    l_nc_x = pb2 * (hdd_x + v * ad_x_only)
+    l_nc_xd = pb2 * (hdd_xd - ba * add_xd)
+    m_nc_x = pb2 * (ba * hdd_x - v * (b * (0.5 - g.a))[:, None] * ad_x_only)
+    m_nc_xd = pb2 * (ba * hdd_xd - (b**2 * (0.125 + g.a**2))[:, None] * add_xd)
+    w = g.weights_m
+
+    def loads(dl_c, l_nc, m_nc):
+        """Z [N], M about CG [N·m], Q_i [N·m] of the strip increments (rows on x or ẋ)."""
+        z = -(w @ (dl_c + l_nc))
+        m = (w * g.d_m) @ dl_c + w @ (m_nc + g.d_e_m[:, None] * l_nc)
+        q = ((g.e_m * g.theta - g.phi) * w) @ dl_c + (-(g.phi * w) @ l_nc
+                                                      + (g.theta * w) @ m_nc)
+        return z, m, q
+
+    zx, mx, qx = loads(dl_circ, l_nc_x, m_nc_x)
+    zxd, mxd, qxd = loads(np.zeros_like(dl_circ), l_nc_xd, m_nc_xd)
+    mass, iyy = MASS_PROPERTIES.mass_kg, MASS_PROPERTIES.iyy_kg_m2
+    rd = rigid_derivatives(cond, RIGID_AERODYNAMICS)
+    mi = np.asarray(model.generalised_masses_kg_m2, dtype=float)
+    k_ind = RIGID_AERODYNAMICS.k_induced
+
+    def rates(z, m, q) -> np.ndarray:
+        """Rows of ẋ from loads: u̇, α̇, q̇ and η̈ (θ̇, η̇ kinematic rows untouched)."""
+        out = np.zeros((n_all, n_all))
+        out[0] = 2.0 * k_ind * cond.cl_trim * z / mass
+        out[ia] = z / (mass * v)
+        out[iq] = m / iyy + rd.m_wdot * z / mass
+        out[ied] = q / mi[:, None]
+        return out
+
+    a_full = np.zeros((n_all, n_all))
+    a_full[:n0, :n0] = base.a
+    a_full += rates(zx, mx, qx)
+    for j in range(2):
+        rate = beta[j] * v / b
+        a_full[lag[j], lag[j]] -= np.diag(rate)
+        a_full[lag[j]] += amp[j] * rate[:, None] * w34
+    e_mat = np.eye(n_all) - rates(zxd, mxd, qxd)
+    b_in = np.zeros((n_all, 1))
+    b_in[:n0] = base.b
+    names = base.states + tuple(f"lag{j + 1}[{k}]" for j in range(2) for k in range(k_strips))
+    units = base.state_units + ("m/s",) * (2 * k_strips)
+    return DescriptorSystem(e_mat, a_full, b_in, base, names, units)
+
+
+def _quasi_steady_a(build, v, zeta, rho):
+    cond = level_flight_condition(float(v), rho)
+    return build_state_space("coupled", cond, with_damping(build, zeta)).a
+
+
+def _system(build, v, aero, zeta, rho) -> np.ndarray:
+    if aero == "unsteady":
+        return unsteady_state_space(build, v, structural_damping=zeta, density_kg_m3=rho).a
+    return _quasi_steady_a(build, v, zeta, rho)
+
+
+def _mac(v1, v2):
+    num = np.abs(v1.conj().T @ v2) ** 2
+    den = np.outer(np.sum(np.abs(v1) ** 2, 0), np.sum(np.abs(v2) ** 2, 0))
+    return num / den
+
+
+MECHANISMS = ("coalescence", "single-mode", "body-freedom", "static divergence")
+
+
+def wing_divergence_speed_m_s(build, *, density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                              range_m_s: tuple[float, float] = (2.0, 60.0)) -> float | None:
+    """Speed [m/s] at which the wing's static stiffness in the aircraft, A_EE = −ω² + H_η
+    of Eq. (4), first becomes singular (its divergence with the body held); None in range.
+    The same for both aerodynamic models (the unsteady increments vanish in a steady state)."""
+    from bioflex_jsb.flight_dynamics.lti import coupled_blocks
+
+    def det(v):
+        return float(np.linalg.det(coupled_blocks(build.model,
+                                                  level_flight_condition(v, density_kg_m3)).a_ee))
+
+    grid = np.arange(range_m_s[0], range_m_s[1] + 0.25, 0.5)
+    signs = np.sign([det(v) for v in grid])
+    flips = np.flatnonzero(signs[1:] != signs[:-1])
+    if flips.size == 0:
+        return None
+    k = int(flips[0])
+    return float(brentq(det, grid[k], grid[k + 1], xtol=1e-4))
+
+
+@dataclass(frozen=True, eq=False)
+class FreeTrack:
+    """Tracked roots of the free aircraft: ``eigenvalues[k, j]`` at ``speeds_m_s[k]``,
+    ``labels[j]`` (the quasi-steady Eq. 4's names at the first speed; ``lag`` otherwise)."""
+
+    speeds_m_s: np.ndarray
+    eigenvalues: np.ndarray
+    labels: tuple[str, ...]
+    last_vectors: np.ndarray
+
+    def mode(self, k: int, name: str) -> complex:
+        """The root called ``name`` at grid point ``k`` (upper one of a pair, or the less
+        stable of a real pair)."""
+        lam = self.eigenvalues[k][[i for i, lab in enumerate(self.labels) if lab == name]]
+        upper = lam[lam.imag > 1e-6]
+        return complex(upper[0] if upper.size else lam[np.argmax(lam.real)])
+
+
+def track_free(build, speeds_m_s, *, aero: str = "unsteady",
+               structural_damping: float | None = None,
+               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+               stop_when_unstable_from: float | None = None) -> FreeTrack:
+    """Eigenvalues over increasing ``speeds_m_s``, labels carried by eigenvector
+    correlation (MAC) + eigenvalue continuity (as :mod:`bioflex_jsb.flight_dynamics.eigen`);
+    with ``stop_when_unstable_from`` the scan ends at the first speed ≥ it with an
+    unstable non-phugoid root."""
+    from bioflex_jsb.flight_dynamics import eigen
+
+    if aero not in AERO_MODELS:
+        raise ValueError(f"aero must be one of {AERO_MODELS}, not {aero!r}")
+    speeds = np.asarray(speeds_m_s, dtype=float)
+    ref = eigen.track("coupled", speeds[:1], with_damping(build, structural_damping),
+                      density_kg_m3)
+    labels: list[str] = []
+    out, done = [], []
+    prev_lam = prev_vec = None
+    for v in speeds:
+        lam, vec = np.linalg.eig(_system(build, v, aero, structural_damping, density_kg_m3))
+        if prev_lam is None:
+            r = ref.eigenvalues[0]
+            cost = np.abs(r[:, None] - lam[None, :]) / (1.0 + np.abs(r[:, None]))
+            rows_, cols = linear_sum_assignment(cost)
+            chosen = list(cols[np.argsort(rows_)])
+            rest = [i for i in range(lam.size) if i not in chosen]
+            order = np.array(chosen + rest)
+            labels = list(ref.labels) + ["lag"] * len(rest)
+        else:
+            order = _match(prev_lam, prev_vec, lam, vec)
+        prev_lam, prev_vec = lam[order], vec[:, order]
+        out.append(prev_lam)
+        done.append(v)
+        if stop_when_unstable_from is not None and v >= stop_when_unstable_from - 1e-12:
+            considered = np.array([lab not in EXCLUDED for lab in labels])
+            if prev_lam[considered].real.max() > GROWTH_TOL_1_S:
+                break
+    return FreeTrack(np.array(done), np.array(out), tuple(labels), prev_vec)
+
+
+def _match(prev_lam, prev_vec, lam, vec) -> np.ndarray:
+    cost = (1.0 - _mac(prev_vec, vec)) + np.abs(prev_lam[:, None] - lam[None, :]) / (
+        1.0 + np.abs(prev_lam)[:, None])
+    rows_, cols = linear_sum_assignment(cost)
+    return cols[np.argsort(rows_)]
+
+
+GROWTH_TOL_1_S = 1e-9  # a root is unstable when Re λ exceeds this [1/s]
+
+
+@dataclass(frozen=True)
+class FreeFlutter:
+    """First instability of the free aircraft (phugoid left out, as in the paper).
+
+    mechanism: ``static divergence`` (real root), ``body-freedom`` (a rigid-body branch, the
+    short period, goes unstable: the rigid aircraft's does not, so the wing drives it),
+    ``coalescence`` (an elastic branch within :data:`COALESCENCE_RELATIVE_GAP` of another
+    branch's frequency; partner named) or ``single-mode``.
+    """
+
+    wing: str
+    aero: str
+    structural_damping: float | None
+    speed_m_s: float | None
+    frequency_rad_s: float | None
+    mode: str | None
+    mechanism: str | None
+    partner_mode: str | None
+    range_m_s: tuple[float, float]
+    wing_divergence_speed_m_s: float | None = None
+
+    def as_dict(self) -> dict:
+        from dataclasses import asdict
+
+        d = asdict(self)
+        d["range_m_s"] = list(self.range_m_s)
+        return d
+
+
+def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | None = None,
+                 range_m_s: tuple[float, float] = (5.0, 40.0), step_m_s: float = 0.1,
+                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> FreeFlutter:
+    """Scan from 2 m/s in ``step_m_s`` (:func:`track_free`), bisect the first crossing of
+    a non-phugoid root into the right half plane to 1e-3 m/s."""
+    from bioflex_jsb.flight_dynamics.eigen import RIGID_LABELS
+
+    lo, hi = range_m_s
+    grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
+    grid = grid[grid <= hi + 1e-12]
+    zeta = structural_damping
+    tr = track_free(build, grid, aero=aero, structural_damping=zeta,
+                    density_kg_m3=density_kg_m3, stop_when_unstable_from=lo)
+    v_div = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3)
+    labels = tr.labels
+    considered = np.array([lab not in EXCLUDED for lab in labels])
+    last = tr.eigenvalues[-1]
+    base = dict(wing=build.variant.name, aero=aero, structural_damping=zeta,
+                range_m_s=(lo, hi), wing_divergence_speed_m_s=v_div)
+    if last[considered].real.max() <= GROWTH_TOL_1_S or tr.speeds_m_s[-1] < lo - 1e-12:
+        return FreeFlutter(speed_m_s=None, frequency_rad_s=None, mode=None, mechanism=None,
+                           partner_mode=None, **base)
+    if len(tr.speeds_m_s) < 2 or tr.speeds_m_s[-2] < lo - 1e-12:
+        v_f, lam_f = float(tr.speeds_m_s[-1]), last
+    else:
+        p_lam = tr.eigenvalues[-2]
+        lam0, vec0 = np.linalg.eig(_system(build, tr.speeds_m_s[-2], aero, zeta,
+                                           density_kg_m3))
+        same = np.abs(p_lam[:, None] - lam0[None, :])
+        rows_, cols = linear_sum_assignment(same)
+        p_vec = vec0[:, cols[np.argsort(rows_)]]  # the labelled roots' vectors
+
+        def continued(vv):
+            lam, vec = np.linalg.eig(_system(build, vv, aero, zeta, density_kg_m3))
+            return lam[_match(p_lam, p_vec, lam, vec)]
+
+        v_f = float(brentq(lambda vv: continued(vv)[considered].real.max() - GROWTH_TOL_1_S,
+                           float(tr.speeds_m_s[-2]), float(tr.speeds_m_s[-1]), xtol=1e-3))
+        lam_f = continued(v_f)
+    j = int(np.argmax(np.where(considered, lam_f.real, -np.inf)))
+    omega = abs(lam_f[j].imag)
+    mech, partner = _mechanism(labels, lam_f, j, omega, RIGID_LABELS)
+    return FreeFlutter(speed_m_s=v_f, frequency_rad_s=float(omega), mode=labels[j],
+                       mechanism=mech, partner_mode=partner, **base)
+
+
+def _mechanism(labels, lam, j, omega, rigid_labels):
+    if omega < 1e-6:
+        return "static divergence", None
+    if labels[j] in rigid_labels:
+        return "body-freedom", None
+    gaps = {}
+    for i, lab in enumerate(labels):
+        if lab in EXCLUDED or lab == labels[j] or lab == "lag" or lam[i].imag <= 0.0:
+            continue
+        gaps[lab] = abs(lam[i].imag - omega) / omega
+    partner = min(gaps, key=gaps.get) if gaps else None
+    if partner is not None and gaps[partner] < COALESCENCE_RELATIVE_GAP:
+        return "coalescence", partner
+    return "single-mode", None
+
+
+# --------------------------------------------------------------------------------------
+# Section 4 re-analysed: the six named wings, quasi-steady vs unsteady
+# --------------------------------------------------------------------------------------
+PAPER_STATEMENT = {  # what the paper states (Section 4; scripts/paper_tables.py)
+    "original": "no flutter up to 25 m/s; Table 3 coupled SP -5.3+8.5j (15), -7.0+10.9j (20)",
+    "optimised": "no flutter up to 25 m/s",
+    "inertial-forward": "no flutter up to 25 m/s; Table 6 coupled SP -5.0+7.2j (15), "
+                        "-6.3+8.1j (20)",
+    "elastic-forward": "no flutter up to 25 m/s",
+    "inertial-backward": "body-freedom flutter above 20 m/s (short period + 1st aeroelastic)",
+    "elastic-backward": "body-freedom flutter above 20 m/s (short period + 1st aeroelastic)",
+}
+
+
+def section4_table(zetas=(0.0, 0.02), speeds=(15.0, 20.0)) -> list[dict]:
+    """Per named wing and aerodynamic model: the short-period and first aeroelastic roots at
+    ``speeds`` (ζ = 0.02) and the flutter point at each ζ in ``zetas`` (5-40 m/s)."""
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    rows = []
+    grid = np.arange(2.0, max(speeds) + 0.125, 0.25)
+    for name, variant in VARIANTS.items():
+        build = build_wing(variant)
+        for aero in AERO_MODELS:
+            tr = track_free(build, grid, aero=aero, structural_damping=0.02)
+            roots = {}
+            for v in speeds:
+                k = int(np.argmin(np.abs(tr.speeds_m_s - v)))
+                roots[f"{v:g}"] = {m: [tr.mode(k, m).real, tr.mode(k, m).imag]
+                                   for m in ("short_period", "aeroelastic_1")}
+            flutter = {f"{z:g}": free_flutter(build, aero=aero, structural_damping=z).as_dict()
+                       for z in zetas}
+            rows.append({"wing": name, "aero": aero, "roots": roots, "flutter": flutter,
+                         "paper": PAPER_STATEMENT[name]})
+    return rows
+
+
+def _print_table(rows: list[dict]) -> None:
+    def root(r):
+        return f"{r[0]:.2f}{r[1]:+.2f}j"
+
+    def fl(f):
+        if f["speed_m_s"] is None:
+            return "none <= 40"
+        return (f"{f['speed_m_s']:.2f} m/s {f['frequency_rad_s']:.1f} rad/s "
+                f"{f['mode']} {f['mechanism']}")
+
+    for r in rows:
+        print(f"{r['wing']:18} {r['aero']:12} SP15 {root(r['roots']['15']['short_period']):>14}"
+              f" AE1_15 {root(r['roots']['15']['aeroelastic_1']):>15}"
+              f" SP20 {root(r['roots']['20']['short_period']):>14}"
+              f" AE1_20 {root(r['roots']['20']['aeroelastic_1']):>15}")
+        for z, f in r["flutter"].items():
+            print(f"{'':31} zeta {z:>4}: {fl(f)}")
+        print(f"{'':31} paper: {r['paper']}")
+
+
+def main(argv=None) -> int:
+    import argparse
+    import json
+    import sys
+
+    parser = argparse.ArgumentParser(
+        description="Section 4 re-analysed: six named wings, quasi-steady vs unsteady strips "
+        "(docs/aeroelasticity.md). Roots [rad/s] at 15, 20 m/s with zeta 0.02; flutter "
+        "5-40 m/s at zeta 0 and 0.02.")
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args(argv)
+    rows = section4_table()
+    if args.json:
+        json.dump(rows, sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print_table(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
