@@ -89,17 +89,17 @@ def run_gust(
     if recorder is not None:
         recorder.start(names, time_s, table)
         record = recorder.step
-    advance_into, w_g_at = step.advance_into, gust.at_step
+    advance_into = step.stepper()  # the step, bound once (compiled or Python)
+    w_g = gust.samples(n_steps).tolist()  # the gust by step number [m/s, up]
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop
             for k in range(n_steps):
-                row = table[k]
-                stop = advance_into(w_g_at(k), row)
+                stop = advance_into(w_g[k], table, k)
                 done = k + 1
                 if recorder is not None:
                     record(k)
                 if on_sample is not None:
-                    on_sample(k, k * dt, row)
+                    on_sample(k, k * dt, table[k])
                 if stop:
                     stopped = stop
                     break

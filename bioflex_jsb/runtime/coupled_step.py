@@ -213,7 +213,7 @@ class CoupledStep:
         self.compiled = bool(compiled) and not native
         if self.compiled:
             self._setup_kernel(nodes)
-        self.stall_steps = 0  # steps flown beyond the lift peak
+        self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
         self.k = 0
         self.stopped: str | None = None
         self.sensed: Sensed | None = None  # the snapshot of the last step's start
@@ -245,8 +245,9 @@ class CoupledStep:
             self.wing.eta_dot = np.zeros(self.n_modes)
             self.model = model
             if self.compiled:
-                self._model_code = K.MODEL_CODES[model]
+                self._views["model"][0] = K.MODEL_CODES[model]
                 self.wing.prepare_arrays()
+                self._fast = None  # rebind: the wing's state array was replaced
 
     def prepare(self, w_g_m_s: float = 0.0) -> None:
         """Compute the wing's step matrices for the flow now (the first step would do it),
@@ -255,7 +256,7 @@ class CoupledStep:
         if not self.native:
             self.wing.prepare(self._read(-w_g_m_s * U.FT_PER_M).flow)
             if self.compiled and self.wing._key is not None:
-                self._key[0], self._key[1] = self.wing._key
+                self._load_reference()
 
     def sense(self, w_g_m_s: float) -> Sensed:
         """Write the vertical gust ``w_g_m_s`` [m/s, up] to JSBSim's wind and read the
@@ -269,8 +270,8 @@ class CoupledStep:
         """Fly step k with the gust ``w_g_m_s`` [m/s, up] at t_k (module docstring); the row
         of t_k (values in :attr:`names` order). Sets :attr:`stopped` when out of range."""
         if self.compiled:
-            self.advance_into(w_g_m_s, self._scratch)
-            return tuple(self._scratch.tolist())
+            self.advance_into(w_g_m_s, self._scratch, 0)
+            return tuple(self._scratch[0].tolist())
         t = self.k * self.dt_s
         state = self.sense(w_g_m_s)
         flow = state.flow
@@ -297,7 +298,7 @@ class CoupledStep:
         self.sensed, self.w_g_m_s = state, w_g_m_s
         self.k += 1
         alpha = flow.alpha_rad
-        self.stall_steps += alpha > self.alpha_peak_rad
+        self._stall_steps += alpha > self.alpha_peak_rad
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
                                     self._agl_m() * U.M_PER_FT)
         return values
@@ -324,71 +325,118 @@ class CoupledStep:
             row[self._etadot_names[i]] = float(eta_dot[i])
         return row
 
+    @property
+    def stall_steps(self) -> int:
+        """Steps flown with α beyond the lift peak."""
+        if self.compiled:
+            return int(self._views["stall_steps"][0])
+        return self._stall_steps
+
     # -- the compiled step ------------------------------------------------------------------
     def _setup_kernel(self, nodes) -> None:
         """Bind what the kernel needs once: the property readers in its order, the writers
-        of the reactions, the wing's arrays, the constants and the column of each slot."""
+        of the reactions, the wing's arrays packed into one parameter array, and the table
+        column of each of its slots (by channel name)."""
         mw, mm = self.wing, self.wing.matrices
         self._getters = tuple(nodes[k].get_double_value for k in K.READ_KEYS)
-        self._reads = np.zeros(len(K.READ_KEYS))
         self._set_reactions = self.airframe.external_reaction_setters()
+        lay = K.layout(self.n_modes)
+        self._params = np.zeros(sum(size for _, size in lay.values()))
+        self._views = {name: self._params[o:o + size] for name, (o, size) in lay.items()}
         lo, hi = ALPHA_TABLE_RANGE_RAD
-        self._consts = np.array([U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, P.REFERENCE_AREA_M2,
-                                 P.MEAN_AERODYNAMIC_CHORD_M, U.LBF_PER_N, U.LBF_FT_PER_N_M,
-                                 ETA_LIMIT_RAD, lo, hi, self.alpha_peak_rad])
-        ref = self.reference
-        self._trim_arr = np.array([self.trim.alpha_rad, self.trim.theta_rad,
-                                   ref.dynamic_pressure_pa, self.speed_m_s])
+        v = self._views
+        v["consts"][:] = (U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, P.REFERENCE_AREA_M2,
+                          P.MEAN_AERODYNAMIC_CHORD_M, U.LBF_PER_N, U.LBF_FT_PER_N_M,
+                          ETA_LIMIT_RAD, lo, hi, self.alpha_peak_rad)
+        v["trim"][:] = (self.trim.alpha_rad, self.trim.theta_rad,
+                        self.reference.dynamic_pressure_pa, self.speed_m_s)
+        v["key"][:] = np.nan  # no reference yet: the first step computes it
+        v["k_aero"][:] = np.ravel(mm.k_aero)
+        v["omega2"][:] = np.asarray(mm.omega, dtype=float) ** 2
+        v["forcing"][:] = np.ravel(mm.forcing_columns())
+        v["load_eta"][:] = np.ravel(mm.load_eta)
+        v["load_etadot"][:] = np.ravel(mm.load_etadot)
+        v["refresh_rel"][0] = mw.refresh_rel
+        v["model"][0] = K.MODEL_CODES[mw.model]
+        self._reactions, self._out_flow = v["reactions"], v["out_flow"]
         slots = K.KERNEL_SLOTS + self._eta_names + self._etadot_names
         self._cols = np.array([self.names.index(s) for s in slots], dtype=np.int64)
-        self._key = np.array([np.nan, np.nan])
-        self._omega2 = np.asarray(mm.omega, dtype=float) ** 2
-        self._forcing = np.ascontiguousarray(mm.forcing_columns())
-        self._reactions = np.zeros(3)
-        self._out_flow = np.zeros(5)
-        self._scratch = np.zeros(len(self.names))
-        self._model_code = K.MODEL_CODES[mw.model]
+        self._scratch = np.zeros((1, len(self.names)))
+        self._fast = None
         mw.prepare_arrays()
+        if mw._key is not None:
+            self._load_reference()
 
-    def _refresh(self, q_pa: float, v_m_s: float) -> None:
-        mw = self.wing
-        mw._reference(q_pa, v_m_s)
-        self._key[0], self._key[1] = mw._key
+    def _load_reference(self) -> None:
+        """Copy the wing's reference step (after a refresh) into the parameter array."""
+        mw, v = self.wing, self._views
+        v["stack"][:] = np.ravel(mw._stack)
+        v["input_cols"][:] = np.ravel(mw._input_cols)
+        v["key"][:] = mw._key
 
-    def advance_into(self, w_g_m_s: float, row: np.ndarray) -> str | None:
-        """Fly step k as :meth:`advance` does, writing its row into ``row`` (a table row,
-        channel order); returns :attr:`stopped`."""
+    def advance_into(self, w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+        """Fly step k as :meth:`advance` does, writing its row into ``table[k]`` (a run's
+        table, channel order); returns :attr:`stopped`."""
         if not self.compiled:
-            row[:] = self.advance(w_g_m_s)
+            table[k] = self.advance(w_g_m_s)
             return self.stopped
-        wind_down_fps = -w_g_m_s * U.FT_PER_M
-        self._set_wind(wind_down_fps)
-        reads = self._reads
-        for i, g in enumerate(self._getters):
-            reads[i] = g()
-        mw = self.wing
-        args = (reads, wind_down_fps, w_g_m_s, self._model_code, mw._x, mw._stack,
-                mw._input_cols, self._key, mw.refresh_rel, self._trim_arr, mw._k_aero,
-                self._omega2, self._forcing, mw._load_eta, mw._load_etadot, self._consts,
-                self._cols, row, self._reactions, self._out_flow)
-        status = K.step_kernel(*args)
-        if status == K.NEEDS_REFRESH:
-            self._refresh(self._out_flow[2], self._out_flow[3])
-            args = args[:5] + (mw._stack, mw._input_cols) + args[7:]
-            status = K.step_kernel(*args)
-        r, (set_lift, set_drag, set_pitch) = self._reactions, self._set_reactions
-        set_lift(r[0])
-        set_drag(r[1])
-        set_pitch(r[2])
-        self.airframe.step()
-        k = self.k
-        self.k = k + 1
-        self.stall_steps += self._out_flow[4] > 0.0
-        agl_ft = self._agl_m()
-        if status != K.OK or agl_ft <= 0.0:
-            self.stopped = out_of_range(self.names, row.tolist(), k * self.dt_s,
-                                        self._out_flow[0], mw.eta, agl_ft * U.M_PER_FT)
-        return self.stopped
+        if self._fast is None:
+            self._fast = self._bind_fast_step()
+        return self._fast(w_g_m_s, table, k)
+
+    def stepper(self):
+        """``step(w_g_m_s, table, k) -> stopped``: :meth:`advance_into` bound once, for a
+        driver's loop."""
+        if not self.compiled:
+            return self.advance_into
+        if self._fast is None:
+            self._fast = self._bind_fast_step()
+        return self._fast
+
+    def _bind_fast_step(self):
+        """The compiled path of :meth:`advance_into` as a closure over everything it uses,
+        bound once (each attribute lookup saved is ~40 ns of a ~10 µs step)."""
+        params, cols = self._params, self._cols
+        x = self.wing._x  # updated in place by the kernel
+        # the snapshot's readers as locals, called in one tuple literal: the cheapest way
+        # from Python into the kernel (a list into the array costs 0.5 µs more per step)
+        (g_u, g_v, g_w, g_q, g_p, g_r, g_theta, g_phi, g_psi, g_rho, g_nz, g_h, g_agl, g_lat,
+         g_lon, g_vn, g_ve, g_vd, g_elevator, g_throttle) = self._getters
+        kernel, needs_refresh, ok = K.step_kernel, K.NEEDS_REFRESH, K.OK
+        set_wind, jsbsim_step, agl = self._set_wind, self.airframe.step_function(), self._agl_m
+        set_lift, set_drag, set_pitch = self._set_reactions
+        reactions, out_flow = self._reactions, self._out_flow
+        ft_per_m = U.FT_PER_M
+
+        def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+            wind_down_fps = -w_g_m_s * ft_per_m
+            set_wind(wind_down_fps)
+            reads = (g_u(), g_v(), g_w(), g_q(), g_p(), g_r(), g_theta(), g_phi(), g_psi(),
+                     g_rho(), g_nz(), g_h(), g_agl(), g_lat(), g_lon(), g_vn(), g_ve(), g_vd(),
+                     g_elevator(), g_throttle())
+            status = kernel(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
+            if status == needs_refresh:
+                self._renew_reference()
+                status = kernel(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
+            set_lift(reactions[0])
+            set_drag(reactions[1])
+            set_pitch(reactions[2])
+            jsbsim_step()
+            step_k = self.k  # steps flown (``k`` is the table row)
+            self.k = step_k + 1
+            agl_ft = agl()
+            if status != ok or agl_ft <= 0.0:
+                self.stopped = out_of_range(self.names, table[k].tolist(), step_k * self.dt_s,
+                                            out_flow[0], self.wing.eta, agl_ft * U.M_PER_FT)
+                return self.stopped
+            return None
+
+        return fast
+
+    def _renew_reference(self) -> None:
+        """The flow moved beyond the wing's reference: renew it (off the hot path)."""
+        self.wing._reference(self._out_flow[2], self._out_flow[3])
+        self._load_reference()
 
     def release(self) -> None:
         """Leave no modal loads behind in the airframe for its next user."""

@@ -638,6 +638,11 @@ class Airframe:
         per-step loop inside ``with airframe.capturing():``."""
         self._fdm.run()
 
+    def step_function(self) -> Callable[[], bool]:
+        """JSBSim's own one-step call, for a compiled loop inside ``capturing()`` (what
+        :meth:`step` calls, without the Python method around it)."""
+        return self._fdm.run
+
     @property
     def dt_s(self) -> float:
         """JSBSim's integration time step [s]."""

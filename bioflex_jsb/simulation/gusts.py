@@ -184,6 +184,24 @@ class GustField:
             spectrum[0] = 0.0
             self._series = np.fft.irfft(spectrum, n=n_fft)[:n]
 
+    def samples(self, n_steps: int) -> np.ndarray:
+        """w_g [m/s, up] at steps 0 … n_steps − 1 (:meth:`at_step` of each), as an array."""
+        k = np.arange(n_steps)
+        if self._series is not None:
+            j = k - self._first_step
+            out = self._series[np.clip(j, 0, len(self._series) - 1)]
+            return np.where(j < 0, 0.0, out)
+        tau = k * self._dt - self.start_s
+        kind = self.spec.kind
+        if kind == "none":
+            return np.zeros(n_steps)
+        if kind == "sharp":
+            return np.where(tau < 0.0, 0.0, self.spec.amplitude_m_s)
+        x = tau * self.speed_m_s
+        phase = 2.0 * math.pi * x / self.spec.length_m
+        shape = 0.5 * self.spec.amplitude_m_s * (1.0 - np.cos(phase))
+        return np.where((tau < 0.0) | (x > self.spec.length_m), 0.0, shape)
+
     def at_step(self, k: int) -> float:
         """Upward gust velocity w_g [m/s] at step ``k`` of the run's step ``dt_s``: t_k = k Δt
         for the closed forms; a sampled series is indexed by step number (its sample 0 at the

@@ -42,22 +42,64 @@ NON_FINITE = 10
 ALPHA_OUT = 11
 ETA_OUT = 12
 
-@numba.njit(cache=True, fastmath=False, nogil=True)
-def step_kernel(reads, wind_down_fps, w_g, model, x, stack, input_cols, key, refresh_rel,
-                trim, k_aero, omega2, forcing, load_eta, load_etadot, consts, cols, row,
-                reactions, out_flow):
-    """One step of the wing (module docstring). Arrays in SI unless named otherwise.
+N_CONSTS = 10
 
-    reads: the snapshot in :data:`READ_KEYS` order (JSBSim units); wind_down_fps: the NED
-    down wind written for this step [ft/s]; w_g: the gust [m/s, up]; model: :data:`MODEL_CODES`;
-    x: [Δη, Δη̇] (updated in place to η_{k+1}); stack, input_cols, key: the reference step
+
+def layout(n_modes: int) -> dict[str, tuple[int, int]]:
+    """Where each block sits in the flat parameter array of :func:`step_kernel` for
+    ``n_modes`` modes: name → (offset, length). One array instead of a dozen arguments,
+    because the compiled function's call checks the type of every argument (about 0.1 µs
+    each)."""
+    n, n2 = n_modes, 2 * n_modes
+    sizes = (("stack", 3 * n2 * n2), ("input_cols", n2 * 3), ("key", 2), ("trim", 4),
+             ("k_aero", n * n), ("omega2", n), ("forcing", n * 3), ("load_eta", 3 * n),
+             ("load_etadot", 3 * n), ("consts", N_CONSTS), ("refresh_rel", 1), ("model", 1),
+             ("reactions", 3), ("out_flow", 4), ("stall_steps", 1), ("scratch", n2))
+    out, offset = {}, 0
+    for name, size in sizes:
+        out[name] = (offset, size)
+        offset += size
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
+    """One step of the wing (module docstring), writing row ``k`` of ``table``.
+
+    reads: the snapshot in :data:`READ_KEYS` order (a tuple; JSBSim units); params: the flat array
+    of :func:`layout` — stack, input_cols, key: the reference step
     (:meth:`ModalWing._compute_reference`) and its (Q_r [Pa], V_r [m/s]); trim: α_0 [rad],
     θ_0 [rad], Q_0 [Pa], V_0 [m/s]; k_aero, omega2, forcing: the QSD terms; load_eta,
     load_etadot: (3, n) loads per unit Q S; consts: ft→m, slug/ft³→kg/m³, S [m²], c̄ [m],
-    N→lbf, N·m→lbf·ft, η limit [rad], α min, α max, α peak [rad]; cols: the table column of
-    each slot; row: the table row, filled; reactions: body-axis modal reactions written to
-    JSBSim [lbf, lbf, lbf·ft]; out_flow: α [rad], q [rad/s], Q [Pa], V [m/s], beyond-stall
-    flag. Returns a status code."""
+    N→lbf, N·m→lbf·ft, η limit [rad], α min, α max, α peak [rad]; refresh_rel; model
+    (:data:`MODEL_CODES`); out: reactions (body axes, written to JSBSim [lbf, lbf, lbf·ft])
+    and out_flow (α [rad], q [rad/s], Q [Pa], V [m/s]), the count of steps beyond the lift
+    peak, a scratch block; x: [Δη, Δη̇]
+    (updated in place to η_{k+1}); cols: the table column of each slot; wind_down_fps: the
+    NED down wind written for this step [ft/s]; w_g: the gust [m/s, up]. Returns a status
+    code."""
+    n2 = x.shape[0]
+    n = n2 // 2
+    # offsets of the blocks (layout()); blocks are read by flat index, with no array views
+    o_stack = 0
+    o_in = o_stack + 3 * n2 * n2
+    o_key = o_in + n2 * 3
+    o_trim = o_key + 2
+    o_ka = o_trim + 4
+    o_w2 = o_ka + n * n
+    o_fc = o_w2 + n
+    o_le = o_fc + n * 3
+    o_ld = o_le + 3 * n
+    o_c = o_ld + 3 * n
+    o_rr = o_c + N_CONSTS
+    o_out = o_rr + 2
+    o_scratch = o_out + 8
+    consts = params[o_c:o_c + N_CONSTS]
+    refresh_rel = params[o_rr]
+    model = int(params[o_rr + 1])
+    key0, key1 = params[o_key], params[o_key + 1]
+    trim = params[o_trim:o_trim + 4]
+    row = table[k]
     m_per_ft, rho_si, s_ref, cbar = consts[0], consts[1], consts[2], consts[3]
     u, v, w, q = reads[0], reads[1], reads[2], reads[3]
     theta, phi = reads[6], reads[7]
@@ -69,12 +111,11 @@ def step_kernel(reads, wind_down_fps, w_g, model, x, stack, input_cols, key, ref
     vt = vt_fps * m_per_ft
     alpha = math.atan2(wa, ua)
     qbar = 0.5 * reads[9] * rho_si * vt * vt
-    out_flow[0], out_flow[1], out_flow[2], out_flow[3] = alpha, q, qbar, vt
-    n2 = x.shape[0]
-    n = n2 // 2
+    params[o_out + 3], params[o_out + 4] = alpha, q
+    params[o_out + 5], params[o_out + 6] = qbar, vt
     # (written as "not within" so that the NaN key of a wing with no reference yet refreshes)
-    if model == 1 and not (abs(qbar - key[0]) <= refresh_rel * abs(key[0])
-                           and abs(vt - key[1]) <= refresh_rel * abs(key[1])):
+    if model == 1 and not (abs(qbar - key0) <= refresh_rel * abs(key0)
+                           and abs(vt - key1) <= refresh_rel * abs(key1)):
         return NEEDS_REFRESH
     # the row's modal state: η_k, η̇_k (before the step)
     base = len(cols) - 2 * n
@@ -85,24 +126,27 @@ def step_kernel(reads, wind_down_fps, w_g, model, x, stack, input_cols, key, ref
     f2 = qbar - trim[2]
     lift = drag = moment = 0.0
     if model == 1:
-        q_r, v_r = key[0], key[1]
-        dq, dqv = qbar - q_r, qbar / vt - q_r / v_r
-        x_new = np.empty(n2)
+        dq, dqv = qbar - key0, qbar / vt - key0 / key1
+        s1, s2 = n2 * n2, 2 * n2 * n2  # the ∂Φ/∂Q and ∂Φ/∂(Q/V) blocks of the stack
         for i in range(n2):
             acc = 0.0
+            r = o_stack + i * n2
             for j in range(n2):
-                acc += (stack[i, j] + dq * stack[n2 + i, j] + dqv * stack[2 * n2 + i, j]) * x[j]
-            x_new[i] = acc + input_cols[i, 0] * f0 + input_cols[i, 1] * f1 + input_cols[i, 2] * f2
+                acc += (params[r + j] + dq * params[r + s1 + j] + dqv * params[r + s2 + j]) * x[j]
+            c = o_in + 3 * i
+            params[o_scratch + i] = (acc + params[c] * f0 + params[c + 1] * f1
+                                     + params[c + 2] * f2)
         for i in range(n2):
-            x[i] = x_new[i]
+            x[i] = params[o_scratch + i]
     elif model == 2:
         kq = np.empty((n, n))
         rhs = np.empty(n)
         for i in range(n):
             for j in range(n):
-                kq[i, j] = -qbar * k_aero[i, j]
-            kq[i, i] += omega2[i]
-            rhs[i] = forcing[i, 0] * f0 + forcing[i, 1] * f1 + forcing[i, 2] * f2
+                kq[i, j] = -qbar * params[o_ka + n * i + j]
+            kq[i, i] += params[o_w2 + i]
+            c = o_fc + 3 * i
+            rhs[i] = params[c] * f0 + params[c + 1] * f1 + params[c + 2] * f2
         eta_qs = np.linalg.solve(kq, rhs)
         for i in range(n):
             x[i] = eta_qs[i]
@@ -111,15 +155,16 @@ def step_kernel(reads, wind_down_fps, w_g, model, x, stack, input_cols, key, ref
         rate = cbar / (2.0 * vt)
         l0 = l1 = l2 = 0.0
         for i in range(n):
-            l0 += load_eta[0, i] * x[i] + load_etadot[0, i] * rate * x[n + i]
-            l1 += load_eta[1, i] * x[i] + load_etadot[1, i] * rate * x[n + i]
-            l2 += load_eta[2, i] * x[i] + load_etadot[2, i] * rate * x[n + i]
+            e, ed = x[i], rate * x[n + i]
+            l0 += params[o_le + i] * e + params[o_ld + i] * ed
+            l1 += params[o_le + n + i] * e + params[o_ld + n + i] * ed
+            l2 += params[o_le + 2 * n + i] * e + params[o_ld + 2 * n + i] * ed
         qs = qbar * s_ref
         lift, drag, moment = qs * l0, qs * l1, qs * l2
     ca, sa = math.cos(alpha), math.sin(alpha)
-    reactions[0] = (lift * ca + drag * sa) * consts[4]
-    reactions[1] = (drag * ca - lift * sa) * consts[4]
-    reactions[2] = moment * consts[5]
+    params[o_out] = (lift * ca + drag * sa) * consts[4]
+    params[o_out + 1] = (drag * ca - lift * sa) * consts[4]
+    params[o_out + 2] = moment * consts[5]
     # the row of t_k, by slot (KERNEL_SLOTS)
     vals = (vt - trim[3], alpha - trim[0], q, theta - trim[1], reads[10], w_g, vt,
             reads[11] * m_per_ft, lift, drag, moment, reads[13], reads[14], phi, theta,
@@ -128,7 +173,8 @@ def step_kernel(reads, wind_down_fps, w_g, model, x, stack, input_cols, key, ref
             reads[15] * m_per_ft, reads[16] * m_per_ft, reads[17] * m_per_ft)
     for s in range(len(vals)):
         row[cols[s]] = vals[s]
-    out_flow[4] = 1.0 if alpha > consts[9] else 0.0
+    if alpha > consts[9]:
+        params[o_out + 7] += 1.0  # steps beyond the lift peak
     for c in range(len(cols)):
         if not math.isfinite(row[cols[c]]):
             return NON_FINITE
