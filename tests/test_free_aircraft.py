@@ -110,3 +110,22 @@ def test_forward_axes_do_not_flutter_unsteady():
     r = free_flutter(build_wing(VARIANTS["inertial-forward"]), aero="unsteady",
                      structural_damping=0.0, range_m_s=(5.0, 25.0))
     assert r.speed_m_s is None and r.mechanism is None
+
+
+def test_kussner_gust_states():
+    # gust=True: the wing's gust lift through Küssner's function, ψ(0) = 0 (Sears & Sparks,
+    # Σ A_j = 1): at the onset of a step gust the modes feel no force, where the paper's
+    # G_E is the whole strip lift (descriptor B's η̈ rows vanish to 1e-12 of G_E); in the
+    # steady state the response is the paper's again (1e-10).
+    build = build_wing(VARIANTS["elastic-backward"])
+    d = unsteady_descriptor(build, 15.0, gust=True)
+    n = build.model.n_modes
+    rows = slice(4 + n, 4 + 2 * n)
+    assert np.max(np.abs(d.b[rows])) < 1e-12 * np.max(np.abs(d.base.b[rows]))
+    assert d.states[-1].startswith("kussner2[")
+    assert len(d.states) == 10 + 4 * strip_geometry(build).chord_m.size
+    ss = unsteady_state_space(build, 15.0, gust=True)
+    qs = build_state_space("coupled", level_flight_condition(15.0), build.model)
+    x_u = np.linalg.solve(ss.a, -ss.b)[:qs.n_states, 0]
+    x_q = np.linalg.solve(qs.a, -qs.b)[:, 0]
+    assert np.max(np.abs(x_u - x_q)) < 1e-10 * np.max(np.abs(x_q))

@@ -30,8 +30,11 @@ Rigid rows: the strips' lift and moment about the CG enter Ż/M like Table B2's 
 rows (Δα̇ = ΔZ/(m u_0), Δq̇ = ΔM/I_yy + M_ẇ ΔZ/m, Δu̇ = the induced drag of the lift
 increment, 2 k C_L0 ΔL); generalised forces over the m_i of the wing model's mass basis.
 The accelerations the apparent mass brings (α̇, q̇, η̈) are moved to the left:
-(I − R F_ẋ) ẋ = (A_4 + R F_x) x. The gust input stays the paper's (quasi-steady; no
-Küssner states yet). Strips are normal to y: the outer panel's sweep is not corrected for.
+(I − R F_ẋ) ẋ = (A_4 + R F_x) x. Gust: by default the paper's input (G_R, G_E: the gust
+lift at once); ``gust=True`` replaces the wing strips' share by Küssner's function (Sears &
+Sparks's two exponentials, states ``kussner1[k]``, ``kussner2[k]`` [m/s]; the gust reaches
+every strip at once, no penetration along the chord of the aircraft; the tail's share stays
+the paper's). Strips are normal to y: the outer panel's sweep is not corrected for.
 """
 
 from __future__ import annotations
@@ -42,7 +45,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
-from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
+from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER, SEARS_SPARKS_KUSSNER
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
@@ -125,18 +128,22 @@ class DescriptorSystem:
 
 def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float | None = None,
                          density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
-                         geometry: StripGeometry | None = None) -> StateSpace:
+                         geometry: StripGeometry | None = None,
+                         gust: bool = False) -> StateSpace:
     """Eq. (4) of ``build`` (a WingBuild) at ``speed_m_s`` with unsteady strips
-    (module docstring): states u, α, q, θ, η, η̇, then lag1[k], lag2[k] [m/s].
+    (module docstring): states u, α, q, θ, η, η̇, then lag1[k], lag2[k] [m/s]; with
+    ``gust`` also kussner1[k], kussner2[k] [m/s]: the wing's gust lift through Küssner's
+    function (Sears & Sparks's two exponentials) instead of the paper's instantaneous one.
     ``geometry`` replaces :func:`strip_geometry` (tests: its ``e_m`` must be the one the
     build's Table B1 coefficients were computed with)."""
     d = unsteady_descriptor(build, speed_m_s, structural_damping=structural_damping,
-                            density_kg_m3=density_kg_m3, geometry=geometry)
+                            density_kg_m3=density_kg_m3, geometry=geometry, gust=gust)
     a = np.linalg.solve(d.e, d.a)
     b_in = np.linalg.solve(d.e, d.b)
     n_all = a.shape[0]
     notes = dict(d.base.notes, aero="unsteady", lag_states=n_all - d.base.n_states,
-                 gust="quasi-steady (paper's G_R, G_E)")
+                 gust="Küssner (Sears & Sparks) on the wing's strips" if gust
+                 else "quasi-steady (paper's G_R, G_E)")
     return StateSpace(model="coupled-unsteady", speed_m_s=float(speed_m_s), a=a, b=b_in,
                       c=np.eye(n_all), d=np.zeros((n_all, 1)), states=d.states,
                       state_units=d.state_units, inputs=d.base.inputs,
@@ -146,7 +153,8 @@ def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float |
 
 def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | None = None,
                         density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
-                        geometry: StripGeometry | None = None) -> DescriptorSystem:
+                        geometry: StripGeometry | None = None,
+                        gust: bool = False) -> DescriptorSystem:
     """The :class:`DescriptorSystem` of :func:`unsteady_state_space`."""
     model = with_damping(build, structural_damping)
     cond = level_flight_condition(float(speed_m_s), density_kg_m3)
@@ -154,13 +162,13 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
     g = strip_geometry(build) if geometry is None else geometry
     n, k_strips = model.n_modes, g.chord_m.size
     n0 = 4 + 2 * n
-    n_all = n0 + 2 * k_strips
+    n_all = n0 + (4 if gust else 2) * k_strips
     v, rho = float(speed_m_s), float(density_kg_m3)
     b = 0.5 * g.chord_m
     ia, iq = 1, 2
     ie = slice(4, 4 + n)
     ied = slice(4 + n, 4 + 2 * n)
-    lag = [slice(n0 + j * k_strips, n0 + (j + 1) * k_strips) for j in range(2)]
+    lag = [slice(n0 + j * k_strips, n0 + (j + 1) * k_strips) for j in range(4 if gust else 2)]
     amp, beta = JONES_WAGNER.amplitudes, JONES_WAGNER.exponents
 
     def rows() -> np.ndarray:
@@ -218,7 +226,7 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
 
     def rates(z, m, q) -> np.ndarray:
         """Rows of ẋ from loads: u̇, α̇, q̇ and η̈ (θ̇, η̇ kinematic rows untouched)."""
-        out = np.zeros((n_all, n_all))
+        out = np.zeros((n_all, z.size))
         out[0] = 2.0 * k_ind * cond.cl_trim * z / mass
         out[ia] = z / (mass * v)
         out[iq] = m / iyy + rd.m_wdot * z / mass
@@ -236,7 +244,22 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
     b_in = np.zeros((n_all, 1))
     b_in[:n0] = base.b
     names = base.states + tuple(f"lag{j + 1}[{k}]" for j in range(2) for k in range(k_strips))
-    units = base.state_units + ("m/s",) * (2 * k_strips)
+    if gust:
+        # wing's gust lift: ½ρV C_lα c Σ x_g (Küssner) instead of ½ρV C_lα c w_g (paper),
+        # on the paper's arms; Sears & Sparks: Σ A_j = 1, no direct term
+        kamp, kbeta = SEARS_SPARKS_KUSSNER.amplitudes, SEARS_SPARKS_KUSSNER.exponents
+        dl_g = rows()
+        for j in range(2):
+            dl_g[:, lag[2 + j]] += np.diag(half[:, 0])
+            rate = kbeta[j] * v / b
+            a_full[lag[2 + j], lag[2 + j]] -= np.diag(rate)
+            b_in[lag[2 + j], 0] += kamp[j] * rate
+        zero = np.zeros_like(dl_g)
+        a_full += rates(*loads(dl_g, zero, zero))
+        dl_w = -half  # (K, 1): minus the paper's instantaneous gust lift per m/s
+        b_in += rates(*loads(dl_w, np.zeros_like(dl_w), np.zeros_like(dl_w)))
+        names += tuple(f"kussner{j + 1}[{k}]" for j in range(2) for k in range(k_strips))
+    units = base.state_units + ("m/s",) * (len(names) - len(base.states))
     return DescriptorSystem(e_mat, a_full, b_in, base, names, units)
 
 
