@@ -158,3 +158,21 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
         n += 1
         path = folder / f"{stem}-{n}.mcap"
     return str(path)
+
+
+def check_output(path: str, force: bool, what: str, ours=None) -> None:
+    """Refuse to replace an existing file at ``path`` (a user's file is never overwritten
+    without ``--force``): a UsageError naming it, unless ``force`` or ``ours(path)`` says it
+    is a file bioflex-jsb wrote itself of this kind (e.g. a PNG with our Software tag). A
+    directory or a special file is refused even with ``--force``."""
+    from pathlib import Path
+
+    p = Path(path)
+    if not p.exists() and not p.is_symlink():
+        return
+    if not p.is_file():
+        raise UsageError(f"{what} {path!r} exists and is not a regular file; give another name")
+    if force or (ours is not None and ours(p)):
+        return
+    raise UsageError(f"{what} {path!r} already exists; give another name or --force to "
+                     "replace it")
