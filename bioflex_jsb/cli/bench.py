@@ -3,132 +3,136 @@
 from __future__ import annotations
 
 import argparse
-import time
 
 from bioflex_jsb.cli.common import UsageError, positive_float, print_json
 
-# Back-to-back (bare, native) timings per repeat, from one trim (module HELP).
-NATIVE_PAIRS = 5
+STEPS_RANGE = (100, 100_000)
+REPEAT_RANGE = (1, 50)
+SITL_SECONDS_RANGE = (0.0, 3600.0)
+SPEEDUP_RANGE = (0.1, 50.0)
 
-HELP = """Time bare JSBSim (the same airframe and time step, no Python in the loop beyond the
-step call), the co-simulation (JSBSim + Python modal wing, coupled model, reading the flow and
-writing the loads every step), the co-simulation with MCAP logging, and the native XML wing
-(JSBSim alone, the wing exported as JSBSim systems), all at the co-simulation's default step,
-interleaved --repeat times in one process. Prints microseconds per step (median over
-repeats) and the ratios: ratio = co-simulation / bare, log_ratio = logged / unlogged
-co-simulation, native_ratio = native / bare (the median of the ratios of native runs each timed
-right after a bare one, 5 pairs per repeat); and the SITL pacing error (step start against
-the wall clock, p50 and p99 over 2 s of real time). Machines are shared and noisy: compare
-the ratios, not the absolute times."""
+HELP = """Time bare JSBSim (the same airframe and step, no Python beyond the step call), the
+co-simulation (JSBSim + the compiled coupled step: flow, modal wing, loads, range checks), the
+co-simulation with its MCAP log, the readable Python step, and the native XML wing (JSBSim
+alone, the wing exported as JSBSim systems), all at the co-simulation's default step (1/960 s),
+interleaved --repeat times in one process. Per-step costs are separated from fixed per-run
+costs by timing every run at --steps and twice --steps. Ratios (median of interleaved pairs,
+with min and max): ratio = co-simulation / bare, logged_ratio = logged co-simulation / bare,
+log_ratio = logged / unlogged, native_ratio = native / bare, python_ratio = Python step / bare.
+Also: µs per step through sharp:0.3, sharp:3 and Dryden gusts (a large gust renews the wing's
+reference step more often), the cost of one reference renewal [ms], the step kernel's cold
+compile and cached load [s], and the SITL pacing error (step start against the wall clock,
+p50/p99 [ms] and resyncs) over --sitl-seconds of simulated time at --sitl-speedup. Machines
+are shared and noisy: compare the ratios, not the absolute times."""
+
+
+def _int_in(label: str, lo: int, hi: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{label} must be a whole number in {lo}..{hi}, "
+                                             f"got {text!r}") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{label} must be in {lo}..{hi}, got {value}")
+        return value
+
+    return parse
 
 
 def register(sub) -> None:
     p = sub.add_parser("bench", help="µs per step: bare JSBSim vs co-simulation",
                        description=HELP)
-    p.add_argument("--steps", type=int, default=1200, help="steps per timing (default 1200)")
-    p.add_argument("--repeat", type=int, default=9, help="interleaved repeats (default 9)")
+    p.add_argument("--steps", type=_int_in("--steps", *STEPS_RANGE), default=1200,
+                   help=f"steps of the shorter timing, {STEPS_RANGE[0]}..{STEPS_RANGE[1]} "
+                   "(default 1200; the longer one is twice that)")
+    p.add_argument("--repeat", type=_int_in("--repeat", *REPEAT_RANGE), default=5,
+                   help=f"interleaved repeats, {REPEAT_RANGE[0]}..{REPEAT_RANGE[1]} (default 5)")
     p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
-                   help="trim airspeed [m/s]")
+                   help="trim airspeed [m/s], 5..40 (default 15)")
+    p.add_argument("--sitl-seconds", type=float, default=2.0,
+                   help="simulated seconds of the SITL pacing run, 0..3600 (0: skip; default 2)")
+    p.add_argument("--sitl-speedup", type=positive_float("SITL speed-up", ""), default=1.0,
+                   help="SITL speed-up of the pacing run, 0.1..50 (default 1)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    import statistics
-    import tempfile
-    from pathlib import Path
-
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
-    from bioflex_jsb.drivers.native import native_airframe
+    from bioflex_jsb.drivers import bench
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
-    from bioflex_jsb.runtime.coupled_step import configure_airframe
-    from bioflex_jsb.runtime.fdm import Airframe
-    from bioflex_jsb.simulation.gusts import parse_gust
-    from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
-    from bioflex_jsb.simulation.run import RunDescription
-    from bioflex_jsb.sinks.mcap import RunLog
 
-    if args.steps < 10 or args.repeat < 1:
-        raise UsageError("--steps must be ≥ 10 and --repeat ≥ 1")
-    airframe = Airframe()
+    if not 5.0 <= args.speed <= 40.0:
+        raise UsageError(f"--speed {args.speed:g} m/s is outside 5..40 m/s")
+    lo, hi = SITL_SECONDS_RANGE
+    if not lo <= args.sitl_seconds <= hi:
+        raise UsageError(f"--sitl-seconds {args.sitl_seconds:g} is outside {lo:g}..{hi:g} s")
+    lo, hi = SPEEDUP_RANGE
+    if not lo <= args.sitl_speedup <= hi:
+        raise UsageError(f"--sitl-speedup {args.sitl_speedup:g} is outside {lo:g}..{hi:g}")
     build = build_wing(VARIANTS["optimised"])
-    dt = DEFAULT_DT_S
-    setup = RunSetup(args.speed, parse_gust("sharp:0.3"), duration_s=args.steps * dt,
-                     gust_start_s=0.5 * args.steps * dt, dt_s=dt)
+    compile_s = bench.compile_cost_s()
+    sb = bench.StepBench(build, args.speed, args.steps)
+    try:
+        figures = sb.measure(args.repeat, progress=_progress(args))
+    except bench.BenchmarkStopped as exc:
+        raise UsageError(str(exc)) from None
+    finally:
+        sb.close()
+    payload = {**figures, "refresh_ms": bench.refresh_cost_ms(build),
+               "kernel_compile_s": compile_s, "dt_s": bench.DEFAULT_DT_S, "steps": args.steps,
+               "repeat": args.repeat}
+    if args.sitl_seconds > 0.0:
+        from bioflex_jsb.drivers.sitl import measure_pacing
 
-    def timed(af) -> float:
-        t0 = time.perf_counter()
-        af.run(args.steps)
-        return (time.perf_counter() - t0) / args.steps
-
-    def bare() -> float:
-        airframe.trim(args.speed)
-        return timed(airframe)
-
-    native = native_airframe("optimised")
-    # every timing with the co-simulation's integrators and step
-    configure_airframe(airframe, DEFAULT_DT_S)
-    configure_airframe(native, DEFAULT_DT_S, modal_hooks=False)
-
-    def cosim(log=None) -> float:
-        recorder = log.recorder("coupled") if log else None
-        trim = airframe.trim(args.speed)  # outside the timing, as for bare()
-        t0 = time.perf_counter()
-        run = run_gust(airframe, build.model, "coupled", setup, trim=trim, recorder=recorder)
-        elapsed = time.perf_counter() - t0
-        if run.stopped:
-            raise UsageError(f"benchmark run stopped: {run.stopped}")
-        return elapsed / len(run.time_s)
-
-    bare_t, cosim_t, logged_t, native_t, native_pairs = [], [], [], [], []
-    with tempfile.TemporaryDirectory() as tmp:
-        for i in range(args.repeat):
-            bare_t.append(bare())
-            cosim_t.append(cosim())
-            log = RunLog.open(Path(tmp) / f"bench{i}.mcap", RunDescription(
-                kind="bench", wing="optimised", speed_m_s=args.speed, gust="sharp:0.3",
-                models=("coupled",), duration_s=setup.duration_s,
-                gust_start_s=setup.gust_start_s, dt_s=dt), build.variant.as_dict())
-            try:
-                logged_t.append(cosim(log))
-            finally:
-                log.close()
-            # native against bare timed back to back, NATIVE_PAIRS times from one trim each:
-            # native_ratio is the median of the pairs' ratios (the machine's load changes
-            # less within a pair than across the repeat)
-            airframe.trim(args.speed)
-            native.trim(args.speed)
-            for _ in range(NATIVE_PAIRS):
-                pair_bare = timed(airframe)
-                native_t.append(timed(native))
-                native_pairs.append(native_t[-1] / pair_bare)
-    b, c, lg, nat = (statistics.median(x) * 1e6 for x in (bare_t, cosim_t, logged_t, native_t))
-    from bioflex_jsb.drivers.sitl import measure_pacing
-
-    sitl = measure_pacing(duration_s=2.0)  # real time, coupled wing, MAVLink link serviced
-    payload = {
-        "bare_us_per_step": b,
-        "cosim_us_per_step": c,
-        "ratio": c / b,
-        "logged_us_per_step": lg,
-        "log_ratio": lg / c,
-        "native_us_per_step": nat,
-        "native_ratio": statistics.median(native_pairs),
-        "sitl_p50_ms": sitl["p50_ms"],
-        "sitl_p99_ms": sitl["p99_ms"],
-        "dt_s": dt,
-        "steps": args.steps,
-        "repeat": args.repeat,
-    }
+        payload["sitl"] = measure_pacing(duration_s=args.sitl_seconds,
+                                         speedup=args.sitl_speedup)
     if args.json:
         print_json(payload)
     else:
-        print(f"time step {dt:.5f} s, {args.steps} steps × {args.repeat} repeats (median)")
-        print(f"bare JSBSim        {b:8.1f} µs/step")
-        print(f"co-simulation      {c:8.1f} µs/step   ratio {c / b:5.2f}")
-        print(f"co-sim + MCAP log  {lg:8.1f} µs/step   log_ratio {lg / c:5.2f}")
-        print(f"native XML wing    {nat:8.1f} µs/step   native_ratio "
-              f"{statistics.median(native_pairs):5.2f} (median of back-to-back pairs)")
-        print(f"SITL pacing        p50 {sitl['p50_ms']:.3f} ms, p99 {sitl['p99_ms']:.3f} ms "
-              "(step start against the wall clock, 2 s real time)")
+        _print(payload)
     return 0
+
+
+def _progress(args):
+    """A progress bar over the repeats on a terminal (the benchmark takes minutes)."""
+    import sys
+
+    if args.json or not sys.stderr.isatty():
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=args.repeat, desc="bench", unit="repeat", leave=False, file=sys.stderr)
+
+
+def _print(p: dict) -> None:
+    us = p["us_per_step"]
+
+    def spread(d: dict) -> str:
+        return f"{d['median']:6.2f}  [{d['min']:.2f} .. {d['max']:.2f}]"
+
+    print(f"time step {p['dt_s']:.6f} s; per-step costs from runs of {p['steps']} and "
+          f"{2 * p['steps']} steps, {p['repeat']} interleaved repeats (median [min .. max])")
+    print(f"bare JSBSim          {us['bare']['median']:8.2f} µs/step")
+    print(f"co-simulation        {us['cosim']['median']:8.2f} µs/step   ratio        "
+          f"{spread(p['ratio'])}")
+    print(f"  with its MCAP log  {us['logged']['median']:8.2f} µs/step   logged_ratio "
+          f"{spread(p['logged_ratio'])}   log_ratio {spread(p['log_ratio'])}")
+    print(f"  Python step        {us['python']['median']:8.2f} µs/step   python_ratio "
+          f"{spread(p['python_ratio'])}")
+    print(f"native XML wing      {us['native']['median']:8.2f} µs/step   native_ratio "
+          f"{spread(p['native_ratio'])}")
+    for gust, d in p["cosim_us_per_step_by_gust"].items():
+        print(f"co-simulation, {gust:18s} {d['median']:8.2f} µs/step")
+    f = p["fixed_ms_per_run"]
+    print(f"fixed cost per run: co-simulation {f['cosim']['median']:.2f} ms, logged "
+          f"{f['logged']['median']:.2f} ms")
+    print(f"reference renewal of the wing: {p['refresh_ms']['median']:.3f} ms "
+          f"(max {p['refresh_ms']['max']:.3f} ms)")
+    c = p["kernel_compile_s"]
+    print(f"step kernel: cold compile {c['cold']:.2f} s (once per machine), cached load "
+          f"{c['cached']:.2f} s")
+    if "sitl" in p:
+        s = p["sitl"]
+        print(f"SITL pacing ({s['speedup']:g}x): p50 {s['p50_ms']:.3f} ms, p99 "
+              f"{s['p99_ms']:.3f} ms, resyncs {s['resyncs']}")
