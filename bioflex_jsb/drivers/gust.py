@@ -63,6 +63,7 @@ def run_gust(
     trim: TrimResult | None = None,
     recorder: StepRecorder | None = None,
     compiled: bool = True,
+    aero: str = "quasi-steady",
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
     aircraft with the wing in its XML, ``wing`` then None).
@@ -76,7 +77,7 @@ def run_gust(
     tested against.
     """
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m, setup.dt_s,
-                       trim=trim, compiled=compiled)
+                       trim=trim, compiled=compiled, aero=aero)
     dt = step.dt_s
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))

@@ -56,6 +56,7 @@ from bioflex_jsb.simulation.modal_wing import (
 )
 
 STEP_MODELS = (*WING_MODELS, "native")
+AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
 # The JSBSim properties of a snapshot (JSBSim units, as the names say).
 PROPERTIES: Mapping[str, str] = MappingProxyType({
     "u": "velocities/u-fps", "v": "velocities/v-fps", "w": "velocities/w-fps",
@@ -166,7 +167,11 @@ class CoupledStep:
                  speed_m_s: float, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
-                 compiled: bool = True) -> None:
+                 compiled: bool = True, aero: str = "quasi-steady") -> None:
+        if aero not in AERO_MODELS:
+            raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
+        if aero != "quasi-steady":
+            raise InputError("aero='unsteady' is not in the co-simulation step yet")
         if model not in STEP_MODELS:
             raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
         native = model == "native"
