@@ -36,7 +36,8 @@ def test_modes_json_matches_table3_within_10_percent(capsys):
         names = [m["mode"] for m in res["modes"]]
         assert "short_period" in names and "phugoid" in names
         for m in res["modes"]:
-            assert set(m) == {"mode", "re", "im", "damping", "frequency_rad_s"}
+            assert set(m) == {"mode", "re", "im", "damping", "frequency_rad_s", "stable",
+                              "branch"}
             assert m["im"] >= 0.0
         if res["model"] == "coupled":
             assert {"aeroelastic_1", "aeroelastic_2", "aeroelastic_3"} <= set(names)
@@ -78,16 +79,18 @@ def test_export_npz_keeps_names_and_matrices(capsys, tmp_path):
     assert code == 0
     d = np.load(path)
     assert list(d["states"][:4]) == ["u", "alpha", "q", "theta"]
-    assert d["A"].shape == (10, 10) and d["B"].shape == (10, 1)
+    assert d["A"].shape == (10, 10) and d["B"].shape == (10, 3)
+    assert list(d["inputs"]) == ["w_g", "elevator", "throttle"]
+    assert list(d["outputs"][-2:]) == ["n_z", "tip_twist"]
 
 
 @pytest.mark.parametrize(
     "argv, needle",
     [
         (["modes", "--wing", "banana", "--speed", "15"], "valid names: original"),
-        (["modes", "--wing", "original", "--speed", "0"], "speed must be"),
-        (["modes", "--wing", "original", "--speed", "-3"], "speed must be"),
-        (["modes", "--wing", "original", "--speed", "nan"], "speed must be"),
+        (["modes", "--wing", "original", "--speed", "0"], "outside 5..40 m/s"),
+        (["modes", "--wing", "original", "--speed", "-3"], "outside 5..40 m/s"),
+        (["modes", "--wing", "original", "--speed", "nan"], "outside 5..40 m/s"),
         (["modes", "--wing", "original", "--speed", "fast"], "speed must be a number"),
         (["modes", "--speed", "15", "--models", "rigid,elastic"], "unknown model"),
         (["flutter", "--range", "40:5"], "range must satisfy"),
@@ -120,7 +123,7 @@ def test_malformed_variant_files(capsys, tmp_path, text, needle):
 
 def test_variant_file_changes_the_model(capsys, tmp_path):
     f = tmp_path / "stiff.toml"
-    f.write_text("x_elastic_frac = 0.20\nx_inertial_frac = 0.22\n")
+    f.write_text('x_elastic_frac = 0.20\nx_inertial_frac = 0.22\npin_c_eta1_q1 = "physical"\n')
     code, out, _ = run_cli(capsys, "modes", "--wing", str(f), "--speed", "20", "--json",
                            "--models", "coupled")
     sp = next(m for m in json.loads(out)["results"][0]["modes"] if m["mode"] == "short_period")

@@ -5,6 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 
+from bioflex_jsb.cli.case import (
+    DEFAULT_GUST,
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    add_force_argument,
+    check_plot_path,
+)
 from bioflex_jsb.cli.common import (
     EXIT_DIVERGED,
     UsageError,
@@ -23,28 +30,38 @@ from bioflex_jsb.cli.gust import (
     run_description,
 )
 
-HELP = """Fly --gust through the nonlinear JSBSim co-simulation and through the linear model of
-Eq. (4) with its gust input G (same wing model, same time grid, same gust samples) and
+HELP = f"""Fly --gust through the nonlinear JSBSim co-simulation and through the linear model
+of Eq. (4) with its gust input G (same wing model, same time grid, same gust samples) and
 report, per channel, the normalised RMS difference NRMSE = RMS(linear - nonlinear) /
-RMS(nonlinear) [-] for u, alpha, q, theta and eta1. The linear model's rigid block A_RR is
-JSBSim's own linearization of the airframe at the same trim, so the two differ only by the
-nonlinearity. Small gusts (sharp:0.3 at 15 m/s) agree to a few per cent; large ones show
-where the linear model leaves the nonlinear one (the largest error and when it occurs). The
-MCAP log holds every step of the nonlinear run and the linear model's response on
+RMS(nonlinear) [-] for u, alpha, q, theta and eta1, and the largest difference with its unit
+and time. The linear model's rigid block A_RR is JSBSim's own linearization of the airframe
+at the same trim, so the two differ only by the nonlinearity. With no arguments: the
+{DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s through {DEFAULT_GUST} (the paper's Fig. 21
+case, as for gust); small gusts (--gust sharp:0.3) agree to a few per cent, large ones show
+where the linear model leaves the nonlinear one. A nonlinear run that diverges has no NRMSE
+(null in --json) and the command exits with status 3. Valid ranges: as for gust. The MCAP log
+holds every step of the nonlinear run and the linear model's response on
 /bioflex/<model>/lti_prediction (docs/logging.md; --out, --no-log)."""
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
+# The table's unit of each channel's largest difference, and its factor from SI.
+DISPLAY_UNITS = {"u": ("m/s", 1.0), "alpha": ("deg", 57.29577951308232),
+                 "q": ("deg/s", 57.29577951308232), "theta": ("deg", 57.29577951308232),
+                 "eta1": ("deg", 57.29577951308232)}
 
 
 def register(sub) -> None:
     p = sub.add_parser("compare", help="LTI model vs nonlinear run on the same gust",
                        description=HELP)
-    add_wing_arguments(p)
-    add_run_arguments(p, "sharp:0.3")
+    add_wing_arguments(p, default=DEFAULT_WING)
+    add_run_arguments(p, DEFAULT_GUST)
     p.add_argument("--model", choices=("coupled", "qsd", "rigid"), default="coupled",
                    help="wing model of both runs (default coupled)")
-    p.add_argument("--plot", metavar="FILE.png", help="overlay of both time histories")
     add_log_arguments(p)
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="overlay of both time histories, NRMSE in the legends (.png, .pdf, "
+                   ".svg; an existing file is replaced only if bioflex-jsb wrote it)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -60,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
 
     build = wing_from_args(args)
     check_run_arguments(args)
+    check_plot_path(args.plot, args.force)
     args.out = log_path(args, "compare", args.wing)
     log = None
     if args.out:
@@ -84,40 +102,63 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if log is not None:
             log.close()
-    linear.meta.update(label=f"LTI {args.model}", linestyle="--")
-    nonlinear.meta.update(label=f"JSBSim {args.model}")
+    linear.meta.update(label=f"LTI {args.model} (Eq. 4)", linestyle="--", color="tab:orange",
+                       linewidth=1.6)
+    nonlinear.meta.update(label=f"JSBSim {args.model}", color="tab:blue", linestyle="-",
+                          linewidth=2.2)
     channels = [c for c in CHANNELS if c in linear.channels and c in nonlinear.channels]
-    errors = {c: nrmse(nonlinear[c], linear[c]) for c in channels}
-    worst = {}
+    diverged = nonlinear.stopped is not None
+    errors: dict[str, float | None] = {}
+    worst: dict[str, dict[str, object]] = {}
     for c in channels:
+        unit = nonlinear.units.get(c, linear.units.get(c, ""))
+        if diverged:  # a diverging run is no reference: no error to report
+            errors[c] = None
+            worst[c] = {"max_abs_difference": None, "unit": unit, "at_time_s": None}
+            continue
+        errors[c] = nrmse(nonlinear[c], linear[c])
         diff = np.abs(linear[c] - nonlinear[c])
         k = int(np.argmax(diff))
-        worst[c] = {"max_abs_difference": float(diff[k]), "at_time_s": float(nonlinear.time_s[k])}
+        worst[c] = {"max_abs_difference": float(diff[k]), "unit": unit,
+                    "at_time_s": float(nonlinear.time_s[k])}
     if args.plot:
         from bioflex_jsb.sinks import plotting
 
         try:
-            plotting.time_histories([nonlinear, linear], args.plot,
-                                    f"{build.variant.name}: LTI vs JSBSim, {args.gust.text()}")
+            plotting.time_histories(
+                [nonlinear, linear], args.plot,
+                f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}: "
+                f"LTI (Eq. 4) vs JSBSim, {args.model} model",
+                nrmse=None if diverged else errors)
         except OSError as exc:
             raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None
     payload = {
         "wing": build.variant.name, "speed_m_s": args.speed, "gust": args.gust.text(),
         "model": args.model, "mass_basis": build.mass_basis,
         "overrides": dict(build.model.coefficients.overrides),
-        "nrmse": errors, "worst": worst, "stopped": stops,
+        "nrmse": errors, "worst": worst, "stopped": stops, "diverged": diverged,
+        "divergence_time_s": nonlinear.stop_time_s,
         "duration_s": float(nonlinear.time_s[-1]) if len(nonlinear.time_s) else 0.0,
-        "out": args.out,
+        "plot": args.plot, "out": args.out,
     }
     if args.json:
         print_json(payload)
     else:
         print(f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}, "
               f"{args.model} model: LTI (Eq. 4) vs nonlinear JSBSim run")
-        print(f"{'channel':<8} {'NRMSE':>8} {'max |diff|':>12} {'at t [s]':>9}")
-        for c in channels:
-            print(f"{c:<8} {errors[c]:8.4f} {worst[c]['max_abs_difference']:12.5f} "
-                  f"{worst[c]['at_time_s']:9.3f}")
+        if diverged:
+            print(f"the nonlinear run diverged at t = {nonlinear.stop_time_s:.3f} s: no "
+                  "comparison (NRMSE null); see the reason below")
+        else:
+            print(f"{'channel':<8} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} {'at t [s]':>9}")
+            for c in channels:
+                unit, scale = DISPLAY_UNITS.get(c, (worst[c]["unit"], 1.0))
+                print(f"{c:<8} {errors[c]:9.4f} {worst[c]['max_abs_difference'] * scale:11.5f} "
+                      f"{unit:<6} {worst[c]['at_time_s']:9.3f}")
+            print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
+                  "largest difference and when it occurs")
+        if args.plot:
+            print(f"time histories written to {args.plot}")
         if args.out:
             print(f"log written to {args.out}")
     if stops:

@@ -1,52 +1,97 @@
-"""``bioflex-jsb export``: write the LTI model with named states and units."""
+"""``bioflex-jsb export``: write the LTI model with named states, inputs, outputs and units."""
 
 from __future__ import annotations
 
 import argparse
 
+from bioflex_jsb.cli.case import (
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    SPEED_RANGE_TEXT,
+    add_force_argument,
+    airspeed,
+    speed_help,
+)
 from bioflex_jsb.cli.common import (
     UsageError,
     add_wing_arguments,
-    positive_float,
+    check_output,
     print_json,
     wing_from_args,
 )
 
-HELP = """Write the rigid, coupled (Eq. 4) or QSD (Eq. 9-10) model at --speed [m/s] to a .npz
-or .mat file: matrices A, B, C, D and the names and units of states (u [m/s], alpha [rad],
-q [rad/s], theta [rad], eta_i [rad], eta_i_dot [rad/s]), input (w_g [m/s], up) and
-outputs. In Python, bioflex_jsb.sinks.model_export.to_python_control gives a python-control
-StateSpace with the same names."""
+HELP = f"""Write the rigid, coupled (Eq. 4) or QSD (Eq. 9-10) model at --speed [m/s] to a .npz
+or .mat file: matrices A, B, C, D and the names and units of its signals. States: u [m/s],
+alpha [rad], q [rad/s], theta [rad], eta_i [rad], eta_i_dot [rad/s] (QSD: the four rigid
+states). Inputs: w_g [m/s] (vertical gust, up), elevator [rad] (+ trailing edge down) and
+throttle [-] (fraction of the motor's maximum shaft power). Outputs: the states (QSD: and
+its quasi-static eta_i [rad]), n_z [-] (load-factor perturbation, up; q is the pitch rate)
+and tip_twist [rad] (wing tip section twist, leading edge up). The file's "metadata" entry
+(JSON text) records the wing, speed, mass basis, aerodynamic model and overrides. Read it
+back in Python with bioflex_jsb.sinks.model_export.read_state_space(path), or as a
+python-control StateSpace with to_python_control(path) (pip install ".[control]").
+Valid range: --speed {SPEED_RANGE_TEXT}. Default: the {DEFAULT_WING} wing at
+{DEFAULT_SPEED_M_S:g} m/s (the paper's Fig. 21 case). An existing --out is replaced only if
+it is a model file bioflex-jsb wrote, else give --force."""
 
 
 def register(sub) -> None:
     p = sub.add_parser("export", help="write the LTI model to .npz or .mat", description=HELP)
-    add_wing_arguments(p)
-    p.add_argument("--speed", type=positive_float("speed", "m/s"), required=True,
-                   help="trim airspeed [m/s]")
-    p.add_argument("--model", choices=("rigid", "coupled", "qsd"), default="coupled")
-    p.add_argument("--out", required=True, metavar="FILE.npz|FILE.mat")
+    add_wing_arguments(p, default=DEFAULT_WING)
+    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
+                   help="trim " + speed_help())
+    p.add_argument("--model", choices=("rigid", "coupled", "qsd"), default="coupled",
+                   help="which linear model (default coupled)")
+    p.add_argument("--out", required=True, metavar="FILE.npz|FILE.mat",
+                   help="the model file (required)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print what was written as JSON")
     p.set_defaults(run=run)
 
 
+def _is_our_model(path) -> bool:
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.sinks.model_export import read_state_space
+
+    try:
+        return str(read_state_space(path).notes.get("software", "")).startswith("bioflex-jsb")
+    except InputError:
+        return False
+
+
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb import __version__
     from bioflex_jsb.flight_dynamics.lti import build_state_space
     from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-    from bioflex_jsb.sinks.model_export import write_state_space
+    from bioflex_jsb.sinks.model_export import FORMATS, write_state_space
 
+    if not args.out.endswith(FORMATS):
+        raise UsageError(f"unknown model file type of {args.out!r}; accepted: "
+                         f"{', '.join(FORMATS)}")
+    check_output(args.out, args.force, "model file", ours=_is_our_model)
     build = wing_from_args(args)
-    ss = build_state_space(args.model, level_flight_condition(args.speed), build.model)
+    ss = build_state_space(args.model, level_flight_condition(args.speed), build.model,
+                           controls=True)
+    metadata = {"software": f"bioflex-jsb {__version__}", "wing": build.variant.name,
+                "wing_variant": build.variant.as_dict(), "speed_m_s": args.speed,
+                "mass_basis": build.mass_basis, "model": args.model,
+                "altitude_m": 0.0, "overrides": dict(build.model.coefficients.overrides)}
     try:
-        write_state_space(ss, args.out)
+        write_state_space(ss, args.out, metadata)
     except OSError as exc:
         raise UsageError(f"cannot write {args.out!r}: {exc.strerror}") from None
-    info = {"out": args.out, "model": ss.model, "speed_m_s": ss.speed_m_s,
+    info = {"out": args.out, "model": ss.model, "wing": build.variant.name,
+            "speed_m_s": ss.speed_m_s, "mass_basis": build.mass_basis,
             "states": list(ss.states), "inputs": list(ss.inputs),
+            "input_units": list(ss.input_units), "outputs": list(ss.outputs),
+            "output_units": list(ss.output_units),
+            "aerodynamics": ss.notes.get("aerodynamics"),
             "overrides": dict(build.model.coefficients.overrides)}
     if args.json:
         print_json(info)
     else:
         print(f"{ss.model} model of wing {build.variant.name} at {ss.speed_m_s:g} m/s "
-              f"({len(ss.states)} states) written to {args.out}")
+              f"(mass basis {build.mass_basis}; {len(ss.states)} states; inputs "
+              f"{', '.join(f'{n} [{u}]' for n, u in zip(ss.inputs, ss.input_units, strict=True))};"
+              f" {len(ss.outputs)} outputs incl. n_z, tip_twist) written to {args.out}")
     return 0

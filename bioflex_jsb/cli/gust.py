@@ -6,6 +6,18 @@ import argparse
 import math
 import sys
 
+from bioflex_jsb.cli.case import (
+    DEFAULT_GUST,
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    MAX_DURATION_S,
+    SPEED_RANGE_TEXT,
+    add_force_argument,
+    airspeed,
+    check_plot_path,
+    check_run_length,
+    speed_help,
+)
 from bioflex_jsb.cli.common import (
     EXIT_DIVERGED,
     UsageError,
@@ -19,16 +31,22 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
-HELP = """Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic wing
-as each of --models (rigid: wing loads off; coupled: dynamic modal states; qsd: quasi-static
-deformation) and summarise each run: peak perturbations of airspeed u [m/s], angle of attack
-alpha [deg], pitch rate q [deg/s], pitch angle theta [deg] and load factor n_z [-]; the
-overshoot of alpha past trim after its first peak [% of that peak]; and the settling time
-[s] until |alpha - trim| stays within 5 % of its peak. Gusts are vertical, positive up:
-sharp:AMPLITUDE_m_s, 1cos:AMPLITUDE_m_s:LENGTH_m, dryden:SIGMA_m_s:SCALE_m[:SEED],
-vonkarman:SIGMA_m_s:SCALE_m[:SEED]. With no arguments: the optimised wing at 15 m/s through
-a 3 m/s sharp-edged gust (the paper's Fig. 21 case), all three models. Every step of every
-run is logged to an MCAP file (topics and units: docs/logging.md; --out, --no-log)."""
+HELP = f"""Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic
+wing as each of --models (rigid: wing loads off; coupled: dynamic modal states; qsd:
+quasi-static deformation) and summarise each run: peak perturbations of airspeed u [m/s],
+angle of attack alpha [deg], pitch rate q [deg/s], pitch angle theta [deg] and load factor
+n_z [-]. A discrete gust (sharp, 1cos) adds the overshoot of alpha past trim after its first
+peak [% of that peak] and the settling time [s] until |alpha - trim| stays within 5 % of its
+peak ("-": not settled by the end of the run); turbulence (dryden, vonkarman) adds the RMS
+of each perturbation instead. A run that leaves the valid range (a diverging wing mode, the
+angle of attack beyond the aerodynamic tables) shows "diverged" with the time and mode of
+its divergence instead of metrics, in the table and in --json (null metrics), and the
+command exits with status 3. Gusts are vertical, positive up: sharp:AMPLITUDE_m_s,
+1cos:AMPLITUDE_m_s:LENGTH_m, dryden:SIGMA_m_s:SCALE_m[:SEED], vonkarman:SIGMA_m_s:SCALE_m[:SEED].
+Valid ranges: --speed {SPEED_RANGE_TEXT}; --duration up to {MAX_DURATION_S:g} s; --dt up to 0.02 s.
+With no arguments: the {DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s through {DEFAULT_GUST}
+(the paper's Fig. 21 case), all three models. Every step of every run is logged to an MCAP
+file (topics and units: docs/logging.md; --out, --no-log)."""
 
 
 def gust_type(text: str):
@@ -40,13 +58,13 @@ def gust_type(text: str):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def add_run_arguments(p: argparse.ArgumentParser, default_gust: str) -> None:
-    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
-                   help="trim airspeed [m/s] (default 15, the paper's cruise)")
+def add_run_arguments(p: argparse.ArgumentParser, default_gust: str = DEFAULT_GUST) -> None:
+    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
+                   help="trim " + speed_help())
     p.add_argument("--gust", type=gust_type, default=gust_type(default_gust),
                    help=f"gust specification (default {default_gust}); see above")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=5.0,
-                   help="simulated time [s] (default 5)")
+                   help=f"simulated time [s], up to {MAX_DURATION_S:g} (default 5)")
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
                    help="time the gust starts [s] (default 0.5)")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
@@ -55,13 +73,16 @@ def add_run_arguments(p: argparse.ArgumentParser, default_gust: str) -> None:
 
 def register(sub) -> None:
     p = sub.add_parser("gust", help="nonlinear gust runs (rigid, coupled, QSD)", description=HELP)
-    add_wing_arguments(p, default="optimised")
-    add_run_arguments(p, "sharp:3")
+    add_wing_arguments(p, default=DEFAULT_WING)
+    add_run_arguments(p)
     p.add_argument("--models", type=models_list, default=("rigid", "coupled", "qsd"),
                    help="comma-separated subset of rigid,coupled,qsd (default: all three)")
     add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
-                   help="time histories to FILE.png (default gust.png when run without --json)")
+                   help="time histories to FILE.png (.png, .pdf, .svg; default gust.png when "
+                   "run without --json; an existing file is replaced only if bioflex-jsb "
+                   "wrote it, else give --force)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -75,18 +96,38 @@ class Interrupted(Exception):
 
 
 def progress_bar(total: int, label: str):
-    """A tqdm bar on a terminal, nothing otherwise (so pipes and CI stay clean)."""
+    """A tqdm bar on a terminal, nothing otherwise (so pipes and CI stay clean).
+
+    The bar writes to its own duplicate of the terminal's file descriptor: during a run
+    JSBSim's output is captured (file descriptors 1 and 2 point at a capture file), and a bar
+    on ``sys.stderr`` would be captured with it and never seen."""
     if not sys.stderr.isatty():
         return None
+    import os
+
     from tqdm import tqdm
 
-    return tqdm(total=total, desc=label, unit="step", leave=False, file=sys.stderr)
+    stream = os.fdopen(os.dup(sys.stderr.fileno()), "w", buffering=1, encoding="utf-8",
+                       errors="replace")
+    bar = tqdm(total=total, desc=label, unit="step", leave=False, file=stream,
+               mininterval=0.2, unit_scale=True)
+    bar.stream = stream  # closed with the bar: close_bar
+    return bar
+
+
+def close_bar(bar) -> None:
+    """Close a :func:`progress_bar` and its terminal stream."""
+    if bar is None:
+        return
+    bar.close()
+    bar.stream.close()
 
 
 def check_run_arguments(args) -> None:
     """The run arguments that argparse cannot check alone (before any file is written)."""
     if args.dt > 0.02:
         raise UsageError(f"--dt {args.dt:g} s is too coarse; accepted: up to 0.02 s")
+    check_run_length(args.duration, args.dt)
     if args.gust_start >= args.duration:
         raise UsageError(
             f"--gust-start {args.gust_start:g} s must be before the end of the run "
@@ -134,11 +175,13 @@ def fly(args, build, models, log=None):
             on_sample = None
             if bar is not None:
                 def on_sample(k, t, values, bar=bar, steps=steps):
-                    if k % 50 == 0:
-                        bar.update(min(50, steps - bar.n))
-            run = run_gust(airframe, build.model, model, setup, on_sample, recorder=recorder)
-            if bar is not None:
-                bar.close()
+                    if k % 50 == 49 or k == steps - 1:
+                        bar.update(k + 1 - bar.n)
+            try:
+                run = run_gust(airframe, build.model, model, setup, on_sample,
+                               recorder=recorder)
+            finally:
+                close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)
@@ -156,6 +199,8 @@ def run(args: argparse.Namespace) -> int:
 
     build = wing_from_args(args)
     check_run_arguments(args)
+    plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
+    check_plot_path(plot, args.force)
     log = None
     args.out = log_path(args, "gust", args.wing)
     if args.out:
@@ -173,9 +218,8 @@ def run(args: argparse.Namespace) -> int:
             log.close()
     summary = {}
     for r in runs:
-        summary[r.model] = gust_metrics(r, args.gust_start).as_dict()
+        summary[r.model] = gust_metrics(r, args.gust_start).as_json()
         summary[r.model]["time_beyond_stall_s"] = r.meta["time_beyond_stall_s"]
-    plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     if plot:
         from bioflex_jsb.sinks import plotting
 
@@ -194,6 +238,7 @@ def run(args: argparse.Namespace) -> int:
             "mass_basis": build.mass_basis,
             "overrides": dict(build.model.coefficients.overrides),
             "summary": summary,
+            "diverged": [r.model for r in runs if r.stopped is not None],
             "stopped": stops,
             "plot": plot,
             "out": args.out,
@@ -211,18 +256,39 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cell(value, scale: float, width: int, digits: int = 3) -> str:
+    return f"{'-':>{width}}" if value is None else f"{value * scale:{width}.{digits}f}"
+
+
 def print_summary(build, args, summary) -> None:
+    """The table of :func:`run`: one row per model (docstring of GustMetrics)."""
     deg = 180.0 / math.pi
     print(f"wing {build.variant.name}, {args.speed:g} m/s, gust {args.gust.text()} "
           f"(mass basis {build.mass_basis})")
-    head = (f"{'model':<8} {'Δu [m/s]':>9} {'Δα [deg]':>9} {'Δq [deg/s]':>11} {'Δθ [deg]':>9} "
-            f"{'Δn_z [-]':>9} {'overshoot':>10} {'settling [s]':>13}")
-    print(head)
+    turbulence = any(m["kind"] == "turbulence" for m in summary.values())
+    tail = (f"{'rms Δα [deg]':>13} {'rms Δn_z [-]':>13}" if turbulence
+            else f"{'overshoot':>10} {'settling [s]':>13}")
+    print(f"{'model':<8} {'Δu [m/s]':>9} {'Δα [deg]':>9} {'Δq [deg/s]':>11} {'Δθ [deg]':>9} "
+          f"{'Δn_z [-]':>9} {tail}")
     for model, m in summary.items():
-        settle = "-" if m["settling_time_s"] is None else f"{m['settling_time_s']:.2f}"
-        print(f"{model:<8} {m['peak_du_m_s']:9.3f} {m['peak_dalpha_rad'] * deg:9.3f} "
-              f"{m['peak_dq_rad_s'] * deg:11.3f} {m['peak_dtheta_rad'] * deg:9.3f} "
-              f"{m['peak_dn_z']:9.3f} {100 * m['overshoot']:9.1f}% {settle:>13}")
+        if m["diverged"]:
+            print(f"{model:<8} diverged at t = {m['divergence_time_s']:.3f} s "
+                  f"({m['divergence_mode']}): no response metrics (see below)")
+            continue
+        row = (f"{model:<8} {_cell(m['peak_du_m_s'], 1.0, 9)} "
+               f"{_cell(m['peak_dalpha_rad'], deg, 9)} {_cell(m['peak_dq_rad_s'], deg, 11)} "
+               f"{_cell(m['peak_dtheta_rad'], deg, 9)} {_cell(m['peak_dn_z'], 1.0, 9)} ")
+        if turbulence:
+            row += f"{_cell(m['rms_dalpha_rad'], deg, 13)} {_cell(m['rms_dn_z'], 1.0, 13)}"
+        else:
+            over = "-" if m["overshoot"] is None else f"{100 * m['overshoot']:.1f}%"
+            row += f"{over:>10} {_cell(m['settling_time_s'], 1.0, 13, 2)}"
+        print(row)
+    print("peaks: largest |perturbation from trim| after the gust start; "
+          + ("rms: root mean square after the gust start (turbulence has no overshoot or "
+             "settling time)" if turbulence else
+             "overshoot: of α past trim after its first peak [% of that peak]; settling: "
+             "until |Δα| stays within 5 % of its peak, '-' = not settled by the end of the run"))
     for model, m in summary.items():
         if m["time_beyond_stall_s"] > 0.0:
             print(f"note: {model}: angle of attack beyond the lift peak for "

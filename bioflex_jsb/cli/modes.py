@@ -6,29 +6,49 @@ import argparse
 
 import numpy as np
 
+from bioflex_jsb.cli.case import (
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    SPEED_MAX_M_S,
+    SPEED_MIN_M_S,
+    SPEED_RANGE_TEXT,
+    add_force_argument,
+    airspeed,
+    check_plot_path,
+)
 from bioflex_jsb.cli.common import (
     UsageError,
     add_wing_arguments,
     models_list,
-    positive_float,
     print_json,
     wing_from_args,
 )
 from bioflex_jsb.flight_dynamics import eigen
 
-HELP = """Eigenvalues of the linear models at each --speed, every mode labelled by identity
-(short_period, phugoid, aeroelastic_1..3). Labels follow each mode through a speed sweep
-from 2 m/s by eigenvector correlation, so crossings do not swap them. Units: speeds in m/s;
-eigenvalues (re, im) and frequencies in rad/s; damping ratio dimensionless. One entry per
-conjugate pair (im >= 0); real roots are listed with im = 0."""
+PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
+
+HELP = f"""Eigenvalues of the linear models (the paper's Eq. 4: analytic rigid block A_RR from the
+Table B2 derivatives, quasi-steady Table B1 wing terms) at each --speed, every mode labelled
+by identity (short_period, phugoid, aeroelastic_1..3). Labels follow each mode through a
+speed sweep from 2 m/s by eigenvector correlation, so crossings do not swap them. A root in
+the right half plane is marked UNSTABLE (JSON: "stable": false); an unstable real root is a
+static divergence and is labelled "divergence", with the branch it was tracked on (e.g.
+short_period) beside it. Units: speeds in m/s; eigenvalues (re, im) and frequencies in
+rad/s; damping ratio dimensionless. One entry per conjugate pair (im >= 0); real roots are
+listed with im = 0. Valid range: --speed {SPEED_RANGE_TEXT}; the linear models are defined
+below the speed at which the aircraft can trim (the phugoid of the linear model goes unstable
+there). Default: the {DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s (the paper's Fig. 21
+case). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization of the
+airframe), which includes the thrust's change with airspeed; see its --help."""
 
 
 def register(sub) -> None:
     p = sub.add_parser("modes", help="labelled eigenvalues of the LTI models", description=HELP)
-    add_wing_arguments(p)
+    add_wing_arguments(p, default=DEFAULT_WING)
     p.add_argument(
-        "--speed", type=positive_float("speed", "m/s"), action="append", required=True,
-        metavar="V", help="airspeed [m/s]; repeat for several speeds",
+        "--speed", type=airspeed, action="append", metavar="V",
+        help=f"airspeed [m/s], {SPEED_MIN_M_S:g}..{SPEED_MAX_M_S:g}; repeat for several "
+        f"speeds (default {DEFAULT_SPEED_M_S:g})",
     )
     p.add_argument(
         "--models", type=models_list, default=("rigid", "coupled", "qsd"),
@@ -37,51 +57,67 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--plot", metavar="FILE.png",
-        help="draw root loci from 5 m/s to the largest --speed (at least 25 m/s) to FILE.png",
+        help=f"draw root loci from {SPEED_MIN_M_S:g} m/s to the largest --speed (at least "
+        f"{PLOT_TOP_M_S:g} m/s) to FILE.png (.png, .pdf, .svg; an existing file is replaced "
+        "only if bioflex-jsb wrote it)",
     )
+    add_force_argument(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    speeds = args.speed or [DEFAULT_SPEED_M_S]
+    check_plot_path(args.plot, args.force)
     build = wing_from_args(args)
     results = []
     for model in args.models:
-        sets = eigen.modes_at(model, args.speed, None if model == "rigid" else build.model)
+        sets = eigen.modes_at(model, speeds, None if model == "rigid" else build.model)
         results.extend(sets)
     payload = {
         "wing": build.variant.name,
         "mass_basis": build.mass_basis,
         "overrides": dict(build.model.coefficients.overrides),
         "results": [s.as_dict() for s in results],
+        "unstable": [{"speed_m_s": s.speed_m_s, "model": s.model, "mode": m.mode,
+                      "branch": m.branch, "re": m.re, "im": m.im}
+                     for s in results for m in s.modes if m.unstable],
+        "plot": args.plot,
     }
     if args.plot:
-        _plot(args, build)
+        _plot(args, build, speeds)
     if args.json:
         print_json(payload)
         return 0
     print(f"wing {build.variant.name}  (mass basis {build.mass_basis}"
           + (f", overrides {payload['overrides']}" if payload["overrides"] else "") + ")")
     print(f"{'V [m/s]':>8} {'model':<8} {'mode':<14} {'re [rad/s]':>11} {'im [rad/s]':>11} "
-          f"{'damping':>8} {'ω_n [rad/s]':>12}")
+          f"{'damping':>8} {'ω_n [rad/s]':>12}  stability")
     for s in results:
         for m in s.modes:
+            note = "UNSTABLE" if m.unstable else "stable"
+            if m.branch != m.mode:
+                note += f" (real root of the {m.branch} branch)"
             print(f"{s.speed_m_s:8.2f} {s.model:<8} {m.mode:<14} {m.re:11.3f} {m.im:11.3f} "
-                  f"{m.damping:8.3f} {m.frequency_rad_s:12.3f}")
+                  f"{m.damping:8.3f} {m.frequency_rad_s:12.3f}  {note}")
+    n_bad = len(payload["unstable"])
+    if n_bad:
+        print(f"{n_bad} unstable root(s): Re λ > 0 (damping < 0); a real one is a static "
+              "divergence, a complex one a flutter or an unstable oscillation")
     if args.plot:
         print(f"root loci written to {args.plot}")
     return 0
 
 
-def _plot(args, build) -> None:
+def _plot(args, build, speeds) -> None:
     from bioflex_jsb.sinks import plotting
 
-    top = max(25.0, max(args.speed))
-    grid = np.arange(5.0, top + 1e-9, 0.5)
+    top = max(PLOT_TOP_M_S, max(speeds))
+    grid = np.arange(SPEED_MIN_M_S, top + 1e-9, 0.5)
     sweeps = []
     for model in args.models:
-        full = eigen.track(model, np.concatenate([np.arange(2.0, 5.0, 0.5), grid]),
+        full = eigen.track(model, np.concatenate([np.arange(2.0, SPEED_MIN_M_S, 0.5), grid]),
                            None if model == "rigid" else build.model)
-        k0 = int(np.searchsorted(full.speeds_m_s, 5.0))
+        k0 = int(np.searchsorted(full.speeds_m_s, SPEED_MIN_M_S))
         sweeps.append(eigen.Sweep(model, full.speeds_m_s[k0:], full.eigenvalues[k0:],
                                   full.labels, full.eigenvectors[k0:], full.wing,
                                   full.density_kg_m3))

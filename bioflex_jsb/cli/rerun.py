@@ -18,13 +18,28 @@ bad file."""
 LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold an argv
 
 
+def tolerance(text: str) -> float:
+    """argparse type: a relative tolerance, a finite number 0 <= rtol < 1."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"rtol must be a number, got {text!r}") from None
+    if not (math.isfinite(value) and 0.0 <= value < 1.0):
+        raise argparse.ArgumentTypeError(
+            f"rtol must be a finite number with 0 <= rtol < 1 (a relative tolerance), "
+            f"got {text!r}")
+    return value
+
+
 def register(sub) -> None:
     p = sub.add_parser("rerun", help="repeat the run of an MCAP log and compare",
                        description=HELP)
     p.add_argument("file", metavar="FILE.mcap", help="the log of the original run")
     p.add_argument("--out", metavar="NEW.mcap", required=True, help="log of the repeated run")
-    p.add_argument("--rtol", type=float, default=1e-8,
-                   help="relative tolerance of the comparison [-] (default 1e-8)")
+    p.add_argument("--rtol", type=tolerance, default=1e-8,
+                   help="relative tolerance of the comparison [-], 0 <= rtol < 1 (default 1e-8)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 

@@ -5,23 +5,26 @@ from __future__ import annotations
 import argparse
 import math
 
-from bioflex_jsb.cli.common import UsageError, finite_float, positive_float, print_json
+from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S, SPEED_RANGE_TEXT, airspeed, speed_help
+from bioflex_jsb.cli.common import UsageError, finite_float, print_json
 
-HELP = """Trim the rigid JSBSim airframe for wings-level, constant-altitude flight with
+HELP = f"""Trim the rigid JSBSim airframe for wings-level, constant-altitude flight with
 JSBSim's own trim routine. Units: --speed is the true airspeed in m/s, --altitude the
 height above sea level in m (standard atmosphere; default 0 m, rho = 1.225 kg/m^3). The
 table gives angles in degrees (alpha, theta, elevator; + elevator = trailing edge down),
 the elevator also as a fraction -1..1 of its travel and the throttle as 0..1 of the motor's
 maximum shaft power. With --json, angles are in rad (keys ending in _rad), residual
-accelerations in m/s^2 and rad/s^2. A speed the aircraft cannot fly (below the stall speed,
-beyond the motor's thrust) ends with a one-line reason and exit status 2."""
+accelerations in m/s^2 and rad/s^2. Valid range: --speed {SPEED_RANGE_TEXT}, default
+{DEFAULT_SPEED_M_S:g} (the paper's cruise); a speed in it that the aircraft cannot fly (below
+the stall speed, beyond the motor's thrust at about 32 m/s) ends with a one-line reason and
+exit status 2."""
 
 
 def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
     """--speed, --altitude and the JSBSim model options shared by trim and linearize."""
     p.add_argument(
-        "--speed", type=positive_float("speed", "m/s"), required=True, metavar="V",
-        help="true airspeed [m/s]",
+        "--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
+        help="true " + speed_help(),
     )  # fmt: skip
     p.add_argument(
         "--altitude", type=finite_float("altitude", "m"), default=0.0, metavar="M",

@@ -22,20 +22,37 @@ from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_cond
 from bioflex_jsb.parameters import prototype as P
 
 RIGID_LABELS = ("short_period", "phugoid")
-IMAG_TOL_RAD_S = 1e-6
-EXCLUDED_FROM_FLUTTER = ("phugoid",)  # below this |Im λ| a root is reported as real [rad/s]
+IMAG_TOL_RAD_S = 1e-6  # below this |Im λ| a root is reported as real [rad/s]
+EXCLUDED_FROM_FLUTTER = ("phugoid",)
+UNSTABLE_RE_RAD_S = 1e-9  # a root with Re λ above this is unstable [1/s] (find_flutter's tol)
+# The name of an unstable real root: a static divergence, whatever branch it was tracked on
+# (a real root at +39.5 rad/s is not a "short period" with damping -1). Its Mode keeps the
+# tracked identity in ``branch``.
+DIVERGENCE_LABEL = "divergence"
 
 
 @dataclass(frozen=True)
 class Mode:
     """One eigenvalue with its mode identity.
 
-    ``re``, ``im`` [rad/s]; ``damping`` ζ = −re/|λ| [-]; ``frequency_rad_s`` ω_n = |λ|.
+    ``re``, ``im`` [rad/s]; ``damping`` ζ = −re/|λ| [-]; ``frequency_rad_s`` ω_n = |λ|;
+    ``branch``: the identity tracked through the speed sweep (short_period, phugoid,
+    aeroelastic_i), the same as ``mode`` except for an unstable real root, whose ``mode`` is
+    ``divergence``; ``unstable``: Re λ > :data:`UNSTABLE_RE_RAD_S`.
     """
 
     mode: str
     re: float
     im: float
+    branch: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.branch:
+            object.__setattr__(self, "branch", self.mode)
+
+    @property
+    def unstable(self) -> bool:
+        return self.re > UNSTABLE_RE_RAD_S
 
     @property
     def eigenvalue(self) -> complex:
@@ -57,6 +74,8 @@ class Mode:
             "im": self.im,
             "damping": self.damping,
             "frequency_rad_s": self.frequency_rad_s,
+            "stable": not self.unstable,
+            "branch": self.branch,
         }
 
 
@@ -69,8 +88,11 @@ class ModeSet:
     modes: tuple[Mode, ...]
 
     def get(self, name: str) -> Mode:
-        """The mode called ``name`` (for a real pair, the less stable root)."""
-        found = [m for m in self.modes if m.mode == name]
+        """The mode called ``name`` (for a real pair, the less stable root); failing that, the
+        root tracked on the branch ``name`` (e.g. the ``divergence`` root that the short
+        period turned into)."""
+        found = [m for m in self.modes if m.mode == name] or [
+            m for m in self.modes if m.branch == name]
         if not found:
             raise KeyError(f"no mode {name!r} at {self.speed_m_s} m/s ({self.model})")
         return max(found, key=lambda m: m.re)
@@ -121,7 +143,8 @@ def _collapse(speed: float, model: str, labels: Sequence[str], lam: np.ndarray) 
             modes.append(Mode(name, float(r.real), float(abs(r.imag))))
         else:
             for r in sorted(roots, key=lambda z: z.real):
-                modes.append(Mode(name, float(r.real), 0.0))
+                label = DIVERGENCE_LABEL if r.real > UNSTABLE_RE_RAD_S else name
+                modes.append(Mode(label, float(r.real), 0.0, branch=name))
     return ModeSet(speed, model, tuple(modes))
 
 

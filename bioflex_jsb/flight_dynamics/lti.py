@@ -4,6 +4,12 @@ State order (named in every :class:`StateSpace`):
     x = [u, α, q, θ, η_1 … η_n, η̇_1 … η̇_n]
     u [m/s], α [rad], q [rad/s], θ [rad], η_i [rad] (modes normalised on twist), η̇_i [rad/s].
 Input: w_g [m/s], vertical gust velocity, positive **upward** (raises α by w_g/u_0).
+With ``controls=True`` (:func:`build_state_space`, what ``bioflex-jsb export`` writes) also
+the elevator δe [rad] (JSBSim's sign: + trailing edge down, nose down) and the throttle δt
+[-] (fraction of the motor's maximum shaft power), and the outputs n_z [-] (load-factor
+perturbation, positive up; n_z = 1 + this) and tip_twist [rad] (the wing's tip section
+twist, positive leading edge up, Σ θ_i(tip) η_i) beside the states (q is the pitch rate
+[rad/s]).
 
 Equations used, with the corrections listed in docs/decisions.md ("Paper typos"):
 
@@ -41,7 +47,8 @@ MODELS = ("rigid", "coupled", "qsd")
 class StateSpace:
     """ẋ = A x + B u, y = C x + D u with named signals and units.
 
-    ``model`` is ``rigid``, ``coupled`` or ``qsd``; ``speed_m_s`` the trim airspeed.
+    ``model`` is ``rigid``, ``coupled`` or ``qsd``; ``speed_m_s`` the trim airspeed;
+    ``notes`` what the model was built from (wing, overrides, aerodynamic model, …).
     """
 
     model: str
@@ -85,6 +92,7 @@ class ElasticWingModel:
     coefficients: ModalCoefficients
     wing_lift_slope_per_rad: float
     cm_ac: float
+    tip_twist_per_eta: np.ndarray | None = None  # θ_i at the tip per unit η_i [rad/rad]
 
     @property
     def n_modes(self) -> int:
@@ -211,21 +219,153 @@ def elastic_state_names(n: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
     return names, units
 
 
+CONTROL_INPUTS = ("elevator", "throttle")
+CONTROL_INPUT_UNITS = ("rad", "-")
+AERODYNAMIC_MODEL = ("quasi-steady: Table B1/B2 derivatives (strip/vortex-lattice spanwise "
+                     "loading), the paper's Eq. (4); analytic rigid block (flight_dynamics/rigid.py)")
+
+
+def control_columns(condition: FlightCondition, aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+                    mass_kg: float = MASS_PROPERTIES.mass_kg,
+                    iyy_kg_m2: float = MASS_PROPERTIES.iyy_kg_m2) -> np.ndarray:
+    """B columns of the rigid states [u, α, q, θ] for the elevator [rad] and the throttle [-].
+
+    Elevator: the tail's lift C_Lδe and moment C_mδe (the pitch row also through M_ẇ Z_δe)
+    and the induced drag of that lift, 2 k C_L0 C_Lδe; the tail does not load the wing's
+    modes. Throttle: X_δt = ∂T/∂δt / m at the trim airspeed with the propeller RPM
+    quasi-static (:func:`thrust_per_throttle_n`); the thrust line passes through the centre
+    of gravity (no moment). Units: per rad of elevator, per unit throttle.
+    """
+    u0 = condition.speed_m_s
+    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+    cb = P.MEAN_AERODYNAMIC_CHORD_M
+    z_de = -aero.cl_delta_e_per_rad * qs / mass_kg
+    x_de = -2.0 * aero.k_induced * condition.cl_trim * aero.cl_delta_e_per_rad * qs / mass_kg
+    m_de = aero.cm_delta_e_per_rad * qs * cb / iyy_kg_m2
+    m_wdot = aero.cm_alphadot_per_rad * qs * cb**2 / (2.0 * iyy_kg_m2 * u0**2)
+    x_dt = thrust_per_throttle_n(condition) / mass_kg
+    return np.array([[x_de, x_dt], [z_de / u0, 0.0], [m_de + m_wdot * z_de, 0.0], [0.0, 0.0]])
+
+
+def _drive(condition: FlightCondition):
+    """(thrust(J, V) [N], power(J, V) [W], trim J [-]) of the drive at ``condition``: the
+    propeller's C_T(J), C_P(J) tables (linear interpolation, as JSBSim's) with n = V/(J D),
+    trimmed where the thrust equals the drag C_D Q S; trim J None if the tables cannot."""
+    from scipy.optimize import brentq
+
+    from bioflex_jsb.aerodynamics.propeller import propeller_tables
+    from bioflex_jsb.parameters.airframe import PROPULSION
+
+    j_tab, ct_tab, cp_tab = _propeller_tables_cached(propeller_tables)
+    rho, d = condition.density_kg_m3, PROPULSION.prop_diameter_m
+    drag = condition.cd_trim * condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+
+    def thrust(j: float, v: float) -> float:
+        return float(np.interp(j, j_tab, ct_tab)) * rho * (v / (j * d)) ** 2 * d**4
+
+    def power(j: float, v: float) -> float:
+        return float(np.interp(j, j_tab, cp_tab)) * rho * (v / (j * d)) ** 3 * d**5
+
+    j_lo = float(j_tab[1])
+    j_hi = float(j_tab[np.nonzero(ct_tab <= 0.0)[0][0]]) if np.any(ct_tab <= 0.0) \
+        else float(j_tab[-1])
+    v0 = condition.speed_m_s
+    try:
+        j_trim = brentq(lambda j: thrust(j, v0) - drag, j_lo, j_hi)
+    except ValueError:
+        j_trim = None
+    return thrust, power, j_trim, (j_lo, j_hi)
+
+
+def thrust_per_throttle_n(condition: FlightCondition) -> float:
+    """∂T/∂δt [N per unit throttle] at the level-flight trim ``condition``, airspeed held,
+    RPM in equilibrium (shaft power = δt × PROPULSION.motor_max_shaft_power_w):
+    P_max (∂T/∂J)/(∂P/∂J) (:func:`_drive`); NaN if the propeller cannot trim there."""
+    from bioflex_jsb.parameters.airframe import PROPULSION
+
+    thrust, power, j, _ = _drive(condition)
+    if j is None:
+        return float("nan")
+    v, h = condition.speed_m_s, 1e-4
+    dt_dj = (thrust(j + h, v) - thrust(j - h, v)) / (2 * h)
+    dp_dj = (power(j + h, v) - power(j - h, v)) / (2 * h)
+    return float(PROPULSION.motor_max_shaft_power_w * dt_dj / dp_dj)
+
+
+def thrust_speed_derivative_n_s_m(condition: FlightCondition) -> float:
+    """∂T/∂V [N per m/s] at constant throttle (shaft power) and equilibrium RPM at the trim
+    ``condition``: the fixed-pitch propeller's thrust falls as the airspeed rises. Table B2,
+    and so the analytic A_RR, leave it out (thrust speed-independent); JSBSim's
+    linearization has it (``bioflex-jsb linearize``). NaN if the propeller cannot trim."""
+    from scipy.optimize import brentq
+
+    thrust, power, j0, (j_lo, j_hi) = _drive(condition)
+    if j0 is None:
+        return float("nan")
+    v0 = condition.speed_m_s
+    p0 = power(j0, v0)
+    out = []
+    for v in (v0 * (1 + 1e-4), v0 * (1 - 1e-4)):
+        j = brentq(lambda jj, v=v: power(jj, v) - p0, j_lo, j_hi)
+        out.append(thrust(j, v))
+    return float((out[0] - out[1]) / (2e-4 * v0))
+
+
+_TABLES: list = []
+
+
+def _propeller_tables_cached(make):
+    if not _TABLES:
+        _TABLES.append(make())
+    return _TABLES[0]
+
+
+def _with_outputs(ss: StateSpace, a_alpha_row: np.ndarray, b_alpha_row: np.ndarray,
+                  tip_rows: tuple[np.ndarray, np.ndarray] | None) -> StateSpace:
+    """``ss`` with the outputs n_z [-] and tip_twist [rad] appended (see the module
+    docstring): Δn_z = u_0 (q − α̇)/g from the inertial α̇ of the α row (in level flight the
+    α row has no gravity term)."""
+    g = P.STANDARD_GRAVITY_M_S2
+    u0 = ss.speed_m_s
+    iq = ss.states.index("q")
+    e_q = np.zeros(ss.n_states)
+    e_q[iq] = 1.0
+    c_rows = [u0 / g * (e_q - a_alpha_row)]
+    d_rows = [-u0 / g * b_alpha_row]
+    names, units = ["n_z"], ["-"]
+    if tip_rows is not None:
+        c_rows.append(tip_rows[0])
+        d_rows.append(tip_rows[1])
+        names.append("tip_twist")
+        units.append("rad")
+    return StateSpace(
+        model=ss.model, speed_m_s=ss.speed_m_s, a=ss.a, b=ss.b,
+        c=np.vstack([ss.c, *c_rows]), d=np.vstack([ss.d, *d_rows]),
+        states=ss.states, state_units=ss.state_units, inputs=ss.inputs,
+        input_units=ss.input_units, outputs=ss.outputs + tuple(names),
+        output_units=ss.output_units + tuple(units), notes=ss.notes,
+    )
+
+
 def build_state_space(
     model: str,
     condition: FlightCondition,
     wing: ElasticWingModel | None = None,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     a_rr: np.ndarray | None = None,
+    controls: bool = False,
 ) -> StateSpace:
     """The ``rigid`` (A_RR), ``coupled`` (Eq. 4) or ``qsd`` (Eq. 9–10) model at ``condition``.
 
     The QSD model also outputs the quasi-static modal deflections
     η = −A_EE⁻¹ (A_ER x_R + G_E w_g). ``a_rr`` replaces the analytic rigid block (see
-    :func:`coupled_blocks`).
+    :func:`coupled_blocks`). ``controls``: inputs (w_g, elevator, throttle) instead of w_g
+    alone, and the outputs n_z and tip_twist after the states (module docstring).
     """
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+    if controls:
+        return _with_controls(model, condition, wing, aero, a_rr)
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
     if model == "rigid":
         a, g = rigid_matrices(rigid_derivatives(condition, aero))
@@ -272,3 +412,33 @@ def build_state_space(
         outputs=RIGID_STATES + e_names[:n], output_units=RIGID_STATE_UNITS + e_units[:n],
         notes=notes, **common,
     )
+
+
+def _with_controls(model, condition, wing, aero, a_rr) -> StateSpace:
+    """:func:`build_state_space` with the elevator and throttle inputs and the n_z and
+    tip-twist outputs."""
+    base = build_state_space(model, condition, wing, aero, a_rr)
+    b_rigid = control_columns(condition, aero)
+    n = base.n_states
+    if model == "qsd" or model == "rigid":
+        b_ctrl = b_rigid  # the controls do not load the wing: the QSD reduction keeps them
+    else:
+        b_ctrl = np.vstack([b_rigid, np.zeros((n - 4, 2))])
+    d_ctrl = np.zeros((base.d.shape[0], 2))
+    notes = dict(base.notes, aerodynamics=AERODYNAMIC_MODEL,
+                 density_kg_m3=condition.density_kg_m3, trim_cl=condition.cl_trim,
+                 rigid_block="JSBSim linearization" if a_rr is not None else "analytic")
+    ss = StateSpace(
+        model=base.model, speed_m_s=base.speed_m_s, a=base.a,
+        b=np.hstack([base.b, b_ctrl]), c=base.c, d=np.hstack([base.d, d_ctrl]),
+        states=base.states, state_units=base.state_units,
+        inputs=base.inputs + CONTROL_INPUTS, input_units=base.input_units + CONTROL_INPUT_UNITS,
+        outputs=base.outputs, output_units=base.output_units, notes=notes,
+    )
+    ia = ss.states.index("alpha")
+    tip = None
+    if model != "rigid" and wing is not None and wing.tip_twist_per_eta is not None:
+        theta_tip = np.asarray(wing.tip_twist_per_eta, dtype=float)
+        eta_rows = [ss.outputs.index(f"eta{i + 1}") for i in range(wing.n_modes)]
+        tip = (theta_tip @ ss.c[eta_rows], theta_tip @ ss.d[eta_rows])
+    return _with_outputs(ss, ss.a[ia], ss.b[ia], tip)

@@ -146,6 +146,7 @@ def get_variant(name: str) -> WingVariant:
 # ---------------------------------------------------------------------------------------
 # Variant files
 # ---------------------------------------------------------------------------------------
+PHYSICAL_PIN = "physical"  # pin_c_eta1_q1 = "physical": no pin, the strip model's value
 _VARIANT_KEYS = {
     "name", "base", "x_inertial_frac", "x_elastic_frac", "ribs", "structural_damping",
     "modes_file", "overrides", "pin_c_eta1_q1", "description",
@@ -205,16 +206,69 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
                 raise VariantError(f"{source}: overrides.{k} must be a finite number")
             checked[k] = float(v)
         values["overrides"] = checked
+    if "modes_file" in data:
+        moved = [k for k in ("x_inertial_frac", "x_elastic_frac", "ribs") if k in data]
+        if moved:
+            raise VariantError(
+                f"{source}: {moved[0]!r} has no effect with 'modes_file': the modes file "
+                "gives the structure, its [axes] table the axis positions; move it there "
+                "or remove it")
+        from bioflex_jsb.structures.modal_file import read_modal_file
+
+        modes = read_modal_file(values["modes_file"])
+        # the axes the wing has: the modes file's (their mean where it gives one per station)
+        values["x_inertial_frac"] = float(np.mean(modes.x_inertial_frac))
+        values["x_elastic_frac"] = float(np.mean(modes.x_elastic_frac))
+    else:
+        modes = None
     if "pin_c_eta1_q1" in data:
         pin = data["pin_c_eta1_q1"]
-        if isinstance(pin, bool) or not isinstance(pin, int | float) or not math.isfinite(pin):
-            raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number")
-        values["pinned_c_eta1_q1"] = float(pin)
+        if pin == PHYSICAL_PIN:
+            values["pinned_c_eta1_q1"] = None
+        elif isinstance(pin, bool) or not isinstance(pin, int | float) or not math.isfinite(pin):
+            raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
+                               f"{PHYSICAL_PIN!r} (the strip model's own value)")
+        else:
+            values["pinned_c_eta1_q1"] = float(pin)
     else:
-        values["pinned_c_eta1_q1"] = None
+        values["pinned_c_eta1_q1"] = _inherited_pin(base, values, source, modes)
     if "description" in data:
         values["description"] = str(data["description"])
     return replace(base, published_c_eta1_q1=None, **values)
+
+
+def _differs(a, b) -> bool:
+    return bool(np.any(np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) > 1e-9))
+
+
+def _inherited_pin(base: WingVariant, values: dict, source: str, modes) -> float | None:
+    """The base's C_η1^Q1 pin for a variant file that does not say ``pin_c_eta1_q1``.
+
+    Inherited when the variant keeps the base's axes and structure (e.g. the base's wing with
+    the user's own FE modes at the same axes, other damping, overrides): the pin is part of
+    the named wing. Refused, with what to add, when the variant moves an axis or the ribs, or
+    brings a modes file with other [axes]: the base's pin was set for the base's axes, and
+    whether it still holds is the user's decision.
+    """
+    if base.pinned_c_eta1_q1 is None:
+        return None
+    changes = []
+    if modes is not None:
+        for key, mine in (("x_inertial_frac", modes.x_inertial_frac),
+                          ("x_elastic_frac", modes.x_elastic_frac)):
+            if _differs(mine, getattr(base, key)):
+                changes.append(f"the modes file's [axes] {key} is not {getattr(base, key):g}")
+    else:
+        for key in ("x_inertial_frac", "x_elastic_frac", "ribs"):
+            if key in values and values[key] != getattr(base, key):
+                changes.append(f"{key} = {values[key]} (base: {getattr(base, key)})")
+    if changes:
+        raise VariantError(
+            f"{source}: {changes[0]}, so base {base.name!r}'s C_eta1^Q1 pin "
+            f"({base.pinned_c_eta1_q1:g}) may not apply; add pin_c_eta1_q1 = "
+            f"{base.pinned_c_eta1_q1:g} to keep it, another number, or pin_c_eta1_q1 = "
+            f"\"{PHYSICAL_PIN}\" for the strip model's own value (docs/wing_variants.md)")
+    return base.pinned_c_eta1_q1
 
 
 def load_variant_file(path: str | Path) -> WingVariant:
@@ -336,6 +390,8 @@ def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planfo
     masses = np.asarray(modes.generalised_masses_kg_m2, dtype=float)
     if mass_basis == "consistent":
         masses = 2.0 * masses
+    # Damping rule (docs/wing_variants.md): each mode gets the larger of its own ζ_i (the
+    # modes file's damping_ratio, 0 for the beam) and the variant's structural_damping.
     damping = np.asarray(modes.damping_ratios, dtype=float)
     if variant.structural_damping > 0.0:
         damping = np.maximum(damping, variant.structural_damping)
@@ -347,6 +403,7 @@ def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planfo
         coefficients=coeffs,
         wing_lift_slope_per_rad=float(aero.wing_lift_slope_per_rad),
         cm_ac=CM_AC_SECTION,
+        tip_twist_per_eta=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
     )
     return WingBuild(variant, modes, aero, model, mass_basis, float(physical.c_eta_q[0, 0]),
                      e_shift_m / planform.chord_m)

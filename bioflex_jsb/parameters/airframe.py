@@ -17,6 +17,15 @@ from dataclasses import dataclass
 
 from bioflex_jsb.parameters import prototype as P
 
+# DECISION: the airspeeds every command accepts [m/s], one range for all of them (gust,
+# compare, modes, export, trim, linearize, sitl, export-jsbsim, bench). Top: the native
+# export's modal tables and the flutter scan end at 40 m/s (above it nothing here is
+# tabulated or checked); the paper's aircraft flies 10-25 m/s (Table 1). Bottom: 5 m/s,
+# where the paper's root loci (Figs. 15-19) start; the linear models are defined there, but
+# the JSBSim airframe cannot trim below about 9 m/s (C_L beyond the lift peak), so the
+# commands that trim say so with a one-line reason.
+AIRSPEED_RANGE_M_S = (5.0, 40.0)
+
 
 @dataclass(frozen=True)
 class MassProperties:

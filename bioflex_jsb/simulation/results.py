@@ -9,11 +9,33 @@ Channels of a gust run (perturbations are from the trim at the start of the run)
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
 SETTLING_BAND = 0.05  # settled: |Δα| stays within 5 % of its peak (a common 5 % criterion)
+TURBULENCE_KINDS = ("dryden", "vonkarman")  # continuous gusts: no single peak to settle from
+
+# How a run left its valid range (the stop messages of simulation/limits.py), as a name.
+_DIVERGENCE_PATTERNS = (
+    (re.compile(r"mode (aeroelastic_\d+) diverged"), None),  # None: the matched mode name
+    (re.compile(r"angle of attack"), "angle_of_attack"),
+    (re.compile(r"non-finite"), "non_finite_state"),
+    (re.compile(r"ground"), "ground"),
+    (re.compile(r"interrupted"), "interrupted"),
+)
+
+
+def divergence_mode(stopped: str) -> str:
+    """Short name of why a run stopped: ``aeroelastic_<i>`` (a wing mode beyond its linear
+    range), ``angle_of_attack`` (left the aerodynamic tables), ``non_finite_state``,
+    ``ground``, ``interrupted``, else ``other``."""
+    for pattern, name in _DIVERGENCE_PATTERNS:
+        found = pattern.search(stopped)
+        if found:
+            return name or found.group(1)
+    return "other"
 
 
 @dataclass
@@ -30,6 +52,13 @@ class TimeHistory:
     def __getitem__(self, name: str) -> np.ndarray:
         return self.channels[name]
 
+    @property
+    def stop_time_s(self) -> float | None:
+        """Time of the last sample of a run that stopped early [s]; None if it finished."""
+        if self.stopped is None:
+            return None
+        return float(self.time_s[-1]) if len(self.time_s) else 0.0
+
     def truncated(self, n: int) -> TimeHistory:
         """The first ``n`` samples."""
         return TimeHistory(
@@ -42,41 +71,107 @@ class TimeHistory:
         )
 
 
+# The numeric fields of GustMetrics (GustMetrics.as_dict), e.g. a results table's columns.
+NUMERIC_METRICS = (
+    "peak_du_m_s", "peak_dalpha_rad", "peak_dq_rad_s", "peak_dtheta_rad", "peak_dn_z",
+    "overshoot", "settling_time_s", "rms_du_m_s", "rms_dalpha_rad", "rms_dq_rad_s",
+    "rms_dtheta_rad", "rms_dn_z", "divergence_time_s",
+)
+
+
 @dataclass(frozen=True)
 class GustMetrics:
-    """Gust-response summary of one run (perturbations from trim).
+    """Gust-response summary of one run (perturbations from trim, after the gust start).
 
-    peak_du_m_s, peak_dalpha_rad, peak_dq_rad_s, peak_dtheta_rad: largest |perturbation|;
-    peak_dn_z: largest |n_z − 1| [-]; overshoot: largest excursion of Δα past zero after
-    its first peak, as a fraction of that peak [-] (a short-period damping measure: 0 for a
-    dead-beat response); settling_time_s: from gust start until |Δα| stays within 5 % of its
-    peak [s] (None if it never does within the run).
+    Every run: peak_du_m_s, peak_dalpha_rad, peak_dq_rad_s, peak_dtheta_rad: largest
+    |perturbation| [m/s, rad, rad/s, rad]; peak_dn_z: largest |n_z − 1| [-].
+
+    A discrete gust (``kind`` "discrete": sharp-edged, 1-cosine): overshoot, the largest
+    excursion of Δα past zero after its first peak as a fraction of that peak [-] (a
+    short-period damping measure: 0 for a dead-beat response); settling_time_s, from the gust
+    start until |Δα| stays within 5 % of its peak [s], None when it has not settled by the
+    end of the run.
+
+    Turbulence (``kind`` "turbulence": Dryden, von Kármán): there is no single peak to
+    overshoot or settle from, so overshoot and settling_time_s are None and the RMS of each
+    perturbation is given instead (rms_du_m_s, rms_dalpha_rad, rms_dq_rad_s, rms_dtheta_rad
+    [m/s, rad, rad/s, rad], rms_dn_z [-]); the peaks are the largest values of this one
+    random record.
+
+    A run that diverged (left the valid range: ``diverged`` True) has every response metric
+    None: a peak of a diverging response measures the divergence, not the gust response.
+    ``divergence_time_s`` [s] and ``divergence_mode`` (:func:`divergence_mode`) say when and
+    how, ``divergence`` the full reason.
     """
 
-    peak_du_m_s: float
-    peak_dalpha_rad: float
-    peak_dq_rad_s: float
-    peak_dtheta_rad: float
-    peak_dn_z: float
-    overshoot: float
-    settling_time_s: float | None
+    kind: str
+    peak_du_m_s: float | None
+    peak_dalpha_rad: float | None
+    peak_dq_rad_s: float | None
+    peak_dtheta_rad: float | None
+    peak_dn_z: float | None
+    overshoot: float | None = None
+    settling_time_s: float | None = None
+    rms_du_m_s: float | None = None
+    rms_dalpha_rad: float | None = None
+    rms_dq_rad_s: float | None = None
+    rms_dtheta_rad: float | None = None
+    rms_dn_z: float | None = None
+    diverged: bool = False
+    divergence_time_s: float | None = None
+    divergence_mode: str | None = None
+    divergence: str | None = None
 
     def as_dict(self) -> dict[str, float | None]:
+        """The numeric metrics only (:data:`NUMERIC_METRICS`: numbers or None)."""
+        return {k: getattr(self, k) for k in NUMERIC_METRICS}
+
+    def as_json(self) -> dict[str, object]:
+        """Every field: the numeric metrics and ``kind``, ``diverged``, ``divergence_mode``,
+        ``divergence``."""
         return dict(self.__dict__)
 
 
-def gust_metrics(run: TimeHistory, gust_start_s: float) -> GustMetrics:
-    """Summarise ``run`` for a gust that starts at ``gust_start_s`` [s]."""
-    t = run.time_s
-    after = t >= gust_start_s
-    alpha = run["alpha"][after]
-    ta = t[after]
+def is_turbulence(gust_text: str) -> bool:
+    """Whether a gust specification (``dryden:1:50``, ``sharp:3``) is continuous turbulence."""
+    return str(gust_text).split(":", 1)[0].strip().lower() in TURBULENCE_KINDS
 
-    def peak(name: str) -> float:
-        return float(np.max(np.abs(run[name][after]))) if np.any(after) else 0.0
 
-    i_peak = int(np.argmax(np.abs(alpha))) if len(alpha) else 0
-    a_peak = float(alpha[i_peak]) if len(alpha) else 0.0
+def gust_metrics(run: TimeHistory, gust_start_s: float,
+                 turbulence: bool | None = None) -> GustMetrics:
+    """Summarise ``run`` for a gust that starts at ``gust_start_s`` [s].
+
+    ``turbulence``: whether the gust is continuous (RMS instead of overshoot and settling);
+    None reads it from the gust specification ``run.meta["gust"]``.
+    """
+    if turbulence is None:
+        turbulence = is_turbulence(str(run.meta.get("gust", "")))
+    kind = "turbulence" if turbulence else "discrete"
+    if run.stopped is not None:
+        return GustMetrics(kind, None, None, None, None, None, diverged=True,
+                           divergence_time_s=run.stop_time_s,
+                           divergence_mode=divergence_mode(run.stopped),
+                           divergence=" ".join(str(run.stopped).split()))
+    after = run.time_s >= gust_start_s
+    if not np.any(after):
+        return GustMetrics(kind, None, None, None, None, None)
+    ta = run.time_s[after]
+    du, alpha, dq, dtheta = (run[c][after] for c in ("u", "alpha", "q", "theta"))
+    dn_z = run["n_z"][after] - 1.0
+
+    def peak(x: np.ndarray) -> float:
+        return float(np.max(np.abs(x)))
+
+    def rms(x: np.ndarray) -> float:
+        return float(np.sqrt(np.mean(np.square(x))))
+
+    common = dict(peak_du_m_s=peak(du), peak_dalpha_rad=peak(alpha), peak_dq_rad_s=peak(dq),
+                  peak_dtheta_rad=peak(dtheta), peak_dn_z=peak(dn_z))
+    if turbulence:
+        return GustMetrics(kind, **common, rms_du_m_s=rms(du), rms_dalpha_rad=rms(alpha),
+                           rms_dq_rad_s=rms(dq), rms_dtheta_rad=rms(dtheta), rms_dn_z=rms(dn_z))
+    i_peak = int(np.argmax(np.abs(alpha)))
+    a_peak = float(alpha[i_peak])
     if a_peak != 0.0:
         past = -np.sign(a_peak) * alpha[i_peak:]
         overshoot = float(max(0.0, past.max()) / abs(a_peak))
@@ -85,15 +180,7 @@ def gust_metrics(run: TimeHistory, gust_start_s: float) -> GustMetrics:
         settling = None if last == len(alpha) - 1 else float(ta[last + 1] - gust_start_s)
     else:
         overshoot, settling = 0.0, 0.0
-    return GustMetrics(
-        peak_du_m_s=peak("u"),
-        peak_dalpha_rad=abs(a_peak),
-        peak_dq_rad_s=peak("q"),
-        peak_dtheta_rad=peak("theta"),
-        peak_dn_z=float(np.max(np.abs(run["n_z"][after] - 1.0))) if np.any(after) else 0.0,
-        overshoot=overshoot,
-        settling_time_s=settling,
-    )
+    return GustMetrics(kind, **common, overshoot=overshoot, settling_time_s=settling)
 
 
 def nrmse(reference: np.ndarray, other: np.ndarray) -> float:

@@ -1,7 +1,16 @@
-"""Export of state-space models: .npz, .mat (scipy.io), python-control ``StateSpace``."""
+"""Export of state-space models: .npz, .mat (scipy.io), python-control ``StateSpace``.
+
+A file holds A, B, C, D; the names and units of states, inputs and outputs; ``model``,
+``speed_m_s``; and ``metadata``, a JSON text of what the model was built from (wing, speed,
+mass basis, aerodynamic model, overrides, …). :func:`read_state_space` reads it back and
+:func:`to_python_control` accepts a :class:`StateSpace`, such a file's path, or what
+``numpy.load`` / ``scipy.io.loadmat`` returned for it.
+"""
 
 from __future__ import annotations
 
+import json
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -10,37 +19,120 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import StateSpace
 
 FORMATS = (".npz", ".mat")
+_NAME_KEYS = ("states", "state_units", "inputs", "input_units", "outputs", "output_units")
 
 
-def _arrays(ss: StateSpace) -> dict[str, object]:
+def _json_safe(value):
+    if isinstance(value, dict):
+        return {str(k): _json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return value
+
+
+def _arrays(ss: StateSpace, metadata: Mapping[str, object] | None) -> dict[str, object]:
+    meta = dict(ss.notes)
+    meta.update(metadata or {})
+    meta.setdefault("model", ss.model)
+    meta.setdefault("speed_m_s", ss.speed_m_s)
     return {
         "A": ss.a, "B": ss.b, "C": ss.c, "D": ss.d,
         "states": np.array(ss.states), "state_units": np.array(ss.state_units),
         "inputs": np.array(ss.inputs), "input_units": np.array(ss.input_units),
         "outputs": np.array(ss.outputs), "output_units": np.array(ss.output_units),
         "model": np.array(ss.model), "speed_m_s": np.array(ss.speed_m_s),
+        "metadata": np.array(json.dumps(_json_safe(meta), sort_keys=True)),
     }
 
 
-def write_state_space(ss: StateSpace, path: str | Path) -> Path:
-    """Write ``ss`` with its signal names and units; the suffix picks the format."""
+def write_state_space(ss: StateSpace, path: str | Path,
+                      metadata: Mapping[str, object] | None = None) -> Path:
+    """Write ``ss`` with its signal names and units and ``metadata`` (merged over
+    ``ss.notes``, stored as JSON text); the suffix picks the format."""
     p = Path(path)
     if p.suffix not in FORMATS:
         raise InputError(f"unknown model file type {p.suffix!r}; accepted: {', '.join(FORMATS)}")
     if p.suffix == ".npz":
-        np.savez(p, **_arrays(ss))
+        with open(p, "wb") as fh:  # np.savez on a name would append .npz to other suffixes
+            np.savez(fh, **_arrays(ss, metadata))
     else:
         from scipy.io import savemat
 
-        savemat(p, _arrays(ss))
+        savemat(p, _arrays(ss, metadata))
     return p
 
 
-def to_python_control(ss: StateSpace):
+def _names(value) -> tuple[str, ...]:
+    # .mat stores a string array as rows padded with blanks: strip them
+    return tuple(str(x).strip() for x in np.asarray(value).reshape(-1))
+
+
+def _scalar_text(value) -> str:
+    arr = np.asarray(value)
+    return str(arr.reshape(-1)[0]).strip() if arr.size else ""
+
+
+def state_space_from_arrays(data: Mapping[str, object], source: str = "model file") -> StateSpace:
+    """A :class:`StateSpace` from the arrays of a model file (``numpy.load`` of a .npz, or
+    ``scipy.io.loadmat`` of a .mat)."""
+    try:
+        a, b, c, d = (np.atleast_2d(np.asarray(data[k], dtype=float)) for k in "ABCD")
+        names = {k: _names(data[k]) for k in _NAME_KEYS}
+        model = _scalar_text(data["model"])
+        speed = float(np.asarray(data["speed_m_s"], dtype=float).reshape(-1)[0])
+    except KeyError as exc:
+        raise InputError(f"{source}: not a bioflex-jsb model file (no {exc.args[0]!r})") from None
+    notes: dict[str, object] = {}
+    if "metadata" in data:
+        try:
+            notes = json.loads(_scalar_text(data["metadata"]))
+        except ValueError:
+            raise InputError(f"{source}: its metadata is not valid JSON") from None
+    n, m, p = a.shape[0], b.shape[1], c.shape[0]
+    if (b.shape[0], c.shape[1], d.shape) != (n, n, (p, m)) or len(names["states"]) != n \
+            or len(names["inputs"]) != m or len(names["outputs"]) != p:
+        raise InputError(f"{source}: the matrices and the signal names do not agree in size")
+    return StateSpace(model=model, speed_m_s=speed, a=a, b=b, c=c, d=d, notes=notes, **names)
+
+
+def read_state_space(path: str | Path) -> StateSpace:
+    """Read a model file written by :func:`write_state_space` (``bioflex-jsb export``)."""
+    p = Path(path)
+    if p.suffix not in FORMATS:
+        raise InputError(f"unknown model file type {p.suffix!r}; accepted: {', '.join(FORMATS)}")
+    try:
+        if p.suffix == ".npz":
+            with np.load(p, allow_pickle=False) as data:
+                return state_space_from_arrays(dict(data), str(p))
+        from scipy.io import loadmat
+
+        return state_space_from_arrays(loadmat(p), str(p))
+    except OSError as exc:
+        raise InputError(f"cannot read {str(p)!r}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # not a zip/mat file
+        raise InputError(f"{str(p)!r} is not a model file: {exc}") from None
+
+
+def to_python_control(model):
     """A python-control ``StateSpace`` with named states, inputs and outputs.
 
-    Needs the optional dependency (``pip install "bioflex-jsb[control]"``).
+    ``model``: a :class:`StateSpace`, the path of a file ``bioflex-jsb export`` wrote (.npz
+    or .mat), or the mapping ``numpy.load``/``scipy.io.loadmat`` returned for one. Needs the
+    optional dependency (``pip install "bioflex-jsb[control]"``).
     """
+    if isinstance(model, str | Path):
+        ss = read_state_space(model)
+    elif isinstance(model, StateSpace):
+        ss = model
+    elif isinstance(model, Mapping) or hasattr(model, "files"):  # dict, NpzFile
+        ss = state_space_from_arrays({k: model[k] for k in model.keys()})
+    else:
+        raise InputError(f"to_python_control needs a StateSpace, a model file or its arrays, "
+                         f"got {type(model).__name__}")
     try:
         import control
     except ImportError:

@@ -1,8 +1,13 @@
-"""Plots (the only module that imports matplotlib): root loci and time histories."""
+"""Plots (the only module that imports matplotlib): root loci and time histories.
+
+Every figure is written with ``Software = "bioflex-jsb <version>"`` in its metadata
+(:data:`SOFTWARE_TAG`), so a later run can tell a plot of ours (which it may replace) from a
+user's file (which needs ``--force``): :func:`is_our_plot`.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -10,106 +15,329 @@ import matplotlib
 matplotlib.use("Agg")  # files only; no display is needed or assumed
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
 
+from bioflex_jsb import __version__  # noqa: E402
 from bioflex_jsb.flight_dynamics.eigen import Sweep  # noqa: E402
 from bioflex_jsb.simulation.results import TimeHistory  # noqa: E402
 
+SOFTWARE_TAG = f"bioflex-jsb {__version__}"
+DPI = 110
+
+# One style per wing model, chosen to stay apart where the lines overlap: rigid thin black
+# dash-dot, coupled a wide solid blue, QSD an orange dashed line drawn on top of it (the
+# blue shows between the dashes where the two agree).
 MODEL_STYLE = {
-    "rigid": dict(color="black", marker="o"),
-    "coupled": dict(color="tab:green", marker="s"),
-    "qsd": dict(color="tab:red", marker="^"),
+    "rigid": dict(color="black", ls="-.", lw=1.1, zorder=3),
+    "coupled": dict(color="tab:blue", ls="-", lw=2.2, zorder=2),
+    "qsd": dict(color="tab:orange", ls=(0, (5, 2.5)), lw=1.5, zorder=4),
+    "native": dict(color="tab:green", ls="-", lw=1.4, zorder=3),
 }
-MODE_COLOURS = {
-    "short_period": "tab:blue",
-    "phugoid": "tab:gray",
-    "aeroelastic_1": "tab:orange",
-    "aeroelastic_2": "tab:purple",
-    "aeroelastic_3": "tab:brown",
+LOCUS_COLOURS = {"rigid": "black", "coupled": "tab:blue", "qsd": "tab:red"}
+MODE_MARKERS = {
+    "short_period": ("o", "-"),
+    "phugoid": ("s", "-"),
+    "aeroelastic_1": ("^", "--"),
+    "aeroelastic_2": ("v", ":"),
+    "aeroelastic_3": ("D", "-."),
 }
+UNSTABLE_SHADE = dict(color="tab:red", alpha=0.06, lw=0)
 
 
-def _arrowed_branch(ax, lam: np.ndarray, colour: str, label: str | None, marker: str):
-    """One root's path with an arrow every few points, pointing to increasing speed."""
-    ax.plot(lam.real, lam.imag, "-", color=colour, lw=1.0, label=label, marker=marker, ms=2.5)
-    step = max(1, len(lam) // 6)
-    for k in range(step, len(lam), step):
-        ax.annotate(
-            "",
-            xy=(lam[k].real, lam[k].imag),
-            xytext=(lam[k - 1].real, lam[k - 1].imag),
-            arrowprops=dict(arrowstyle="->", color=colour, lw=1.2),
-        )
+def supported_formats() -> dict[str, str]:
+    """File suffixes (no dot) that :func:`time_histories` and :func:`root_locus` can write."""
+    return dict(FigureCanvasBase.get_supported_filetypes())
+
+
+def is_our_plot(path: str | Path) -> bool:
+    """Whether ``path`` is a PNG that bioflex-jsb wrote (its Software tag starts with
+    ``bioflex-jsb``); anything else, or an unreadable file, is not ours."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            if image.format != "PNG":
+                return False
+            return str(image.info.get("Software", "")).startswith("bioflex-jsb")
+    except OSError:  # not an image PIL can read (PIL.UnidentifiedImageError is an OSError)
+        return False
+
+
+def _save(fig, path: str | Path) -> Path:
+    out = Path(path)
+    suffix = out.suffix.lower().lstrip(".")
+    meta = {"Software": SOFTWARE_TAG} if suffix == "png" else {"Creator": SOFTWARE_TAG}
+    fig.savefig(out, dpi=DPI, metadata=meta if suffix in ("png", "pdf", "svg") else None)
+    plt.close(fig)
+    return out
+
+
+# ---------------------------------------------------------------------------------------
+# Root loci
+# ---------------------------------------------------------------------------------------
+def _branches(sweep: Sweep):
+    """(label, roots over the sweep) of each branch, upper half plane only: the samples of a
+    branch below the real axis are NaN (a conjugate branch keeps its real-axis part, where a
+    pair has split into two real roots)."""
+    out = []
+    for j, name in enumerate(sweep.labels):
+        lam = np.array(sweep.eigenvalues[:, j], dtype=complex)
+        below = lam.imag < -1e-9
+        if np.all(below):
+            continue
+        lam[below] = complex(np.nan, np.nan)
+        out.append((name, lam))
+    return out
+
+
+def _speed_labels(ax, lam, speeds, colour, every_m_s=5.0, inside=None):
+    """Write the airspeed [m/s] beside the root at each multiple of ``every_m_s``."""
+    for v in np.arange(np.ceil(speeds[0] / every_m_s) * every_m_s, speeds[-1] + 1e-9, every_m_s):
+        k = int(np.argmin(np.abs(speeds - v)))
+        if abs(speeds[k] - v) > 1e-6:
+            continue
+        z = lam[k]
+        if not np.isfinite(z) or (inside is not None and not inside(z)):
+            continue
+        ax.annotate(f"{v:g}", (z.real, z.imag), textcoords="offset points", xytext=(4, 4),
+                    fontsize=7, color=colour)
+
+
+def _box(points: np.ndarray, margin: float = 0.12, min_span: float = 0.2):
+    """Axis limits that hold ``points`` (complex) with a margin, the imaginary axis from 0."""
+    points = points[np.isfinite(points)]
+    re, im = points.real, points.imag
+    x0, x1 = float(re.min()), float(re.max())
+    y0, y1 = min(0.0, float(im.min())), float(im.max())
+    dx, dy = max(x1 - x0, min_span), max(y1 - y0, min_span)
+    return (x0 - margin * dx, x1 + margin * dx), (y0 - margin * dy, y1 + margin * dy)
 
 
 def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
     """Root loci of one or more models over their speed sweeps (Figs. 15, 16, 18, 19).
 
-    Left: every root of every model (aeroelastic branches included); right: the short period
-    and phugoid region. Arrows point towards increasing airspeed; the speed range is in the
-    legend. Units: rad/s on both axes.
+    Four panels, rad/s on every axis: (a) every root of every model; (b) the short period,
+    zoomed so that it holds every root of that branch, also where it turns real and
+    unstable; (c) the phugoid, zoomed; (d) the growth rate Re λ of each mode against the
+    airspeed [m/s], where a crossing of zero is a flutter or divergence speed. Colour = model
+    (rigid black, coupled blue, QSD red), marker and line style = mode; numbers beside the
+    roots are airspeeds [m/s], arrows point to increasing speed; the right half plane
+    (unstable) is shaded.
     """
-    fig, (ax_all, ax_sp) = plt.subplots(1, 2, figsize=(13, 5.5))
+    fig, axes = plt.subplots(2, 2, figsize=(14, 11))
+    ax_all, ax_sp, ax_ph, ax_re = axes.flat
+    sp_points, ph_points = [], []
+    v_lo = min(float(s.speeds_m_s[0]) for s in sweeps)
+    v_hi = max(float(s.speeds_m_s[-1]) for s in sweeps)
     for sweep in sweeps:
-        style = MODEL_STYLE.get(sweep.model, dict(color="k", marker="."))
-        v0, v1 = sweep.speeds_m_s[0], sweep.speeds_m_s[-1]
+        colour = LOCUS_COLOURS.get(sweep.model, "tab:gray")
+        speeds = np.asarray(sweep.speeds_m_s, dtype=float)
         seen: set[str] = set()
+        growth: dict[str, np.ndarray] = {}
         for j, name in enumerate(sweep.labels):
-            lam = sweep.eigenvalues[:, j]
-            if lam[len(lam) // 2].imag < -1e-9:
-                continue  # draw the upper half plane only
-            colour = MODE_COLOURS.get(name, style["color"])
-            if sweep.model == "rigid":
-                colour = "black"
-            label = f"{sweep.model}: {name}" if (name not in seen) else None
+            re = sweep.eigenvalues[:, j].real
+            growth[name] = np.maximum(growth.get(name, re), re)
+        for name, lam in _branches(sweep):
+            marker, ls = MODE_MARKERS.get(name, (".", "-"))
+            label = None if name in seen else f"{sweep.model}: {name}"
             seen.add(name)
-            _arrowed_branch(ax_all, lam, colour, label, style["marker"])
-            if name in ("short_period", "phugoid"):
-                _arrowed_branch(ax_sp, lam, colour, label, style["marker"])
-        ax_all.set_title(f"{title}: all roots, {v0:g}–{v1:g} m/s")
-    ax_sp.set_title("short period and phugoid (zoom)")
-    for ax in (ax_all, ax_sp):
-        ax.axvline(0.0, color="0.6", lw=0.8)
+            targets = [ax_all]
+            if name == "short_period":
+                targets.append(ax_sp)
+                sp_points.append(lam)
+            elif name == "phugoid":
+                targets.append(ax_ph)
+                ph_points.append(lam)
+            for ax in targets:
+                ax.plot(lam.real, lam.imag, ls=ls, color=colour, lw=1.0, marker=marker, ms=3,
+                        markevery=max(1, len(lam) // 25), label=label)
+                step = max(1, len(lam) // 5)
+                for k in range(step, len(lam), step):
+                    if not (np.isfinite(lam[k]) and np.isfinite(lam[k - 1])):
+                        continue
+                    ax.annotate("", xy=(lam[k].real, lam[k].imag),
+                                xytext=(lam[k - 1].real, lam[k - 1].imag),
+                                arrowprops=dict(arrowstyle="->", color=colour, lw=1.1))
+                unstable = np.nan_to_num(lam.real, nan=-1.0) > 0.0
+                if np.any(unstable):
+                    ax.plot(lam.real[unstable], lam.imag[unstable], ls="none", marker="x",
+                            color="tab:red", ms=5, mew=1.2)
+            if name.startswith("aeroelastic") or name == "short_period":
+                _speed_labels(ax_all, lam, speeds, colour, every_m_s=10.0)
+            if name == "short_period":
+                _speed_labels(ax_sp, lam, speeds, colour)
+            if name == "phugoid":
+                _speed_labels(ax_ph, lam, speeds, colour)
+        for name, re in growth.items():
+            marker, ls = MODE_MARKERS.get(name, (".", "-"))
+            ax_re.plot(speeds, re, ls=ls, color=colour, lw=1.2, marker=marker, ms=3,
+                       markevery=max(1, len(speeds) // 12), label=f"{sweep.model}: {name}")
+    ax_all.set_title(f"(a) {title}: all roots, {v_lo:g}–{v_hi:g} m/s "
+                     "(numbers: airspeed [m/s])", fontsize=10)
+    ax_sp.set_title("(b) short period (zoom; × = unstable root)", fontsize=10)
+    ax_ph.set_title("(c) phugoid (zoom)", fontsize=10)
+    ax_re.set_title("(d) growth rate of each mode: Re λ > 0 is unstable", fontsize=10)
+    for ax, points in ((ax_sp, sp_points), (ax_ph, ph_points)):
+        if points:
+            (x0, x1), (y0, y1) = _box(np.concatenate(points))
+            ax.set_xlim(x0, x1)
+            ax.set_ylim(y0, y1)
+    for ax in (ax_all, ax_sp, ax_ph):
+        x0, x1 = ax.get_xlim()
+        if x1 > 0.0:
+            ax.axvspan(0.0, x1, **UNSTABLE_SHADE)
+            ax.set_xlim(x0, x1)
+        ax.axvline(0.0, color="0.5", lw=0.8)
         ax.set_xlabel("Re λ [rad/s]")
         ax.set_ylabel("Im λ [rad/s]")
         ax.grid(True, alpha=0.3)
-    ax_all.legend(fontsize=7, loc="best")
-    ax_sp.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=7, loc="best")
+    ax_re.axhline(0.0, color="0.3", lw=0.9)
+    y0, y1 = ax_re.get_ylim()
+    if y1 > 0.0:
+        ax_re.axhspan(0.0, y1, **UNSTABLE_SHADE)
+        ax_re.set_ylim(y0, y1)
+    ax_re.set_xlabel("airspeed [m/s]")
+    ax_re.set_ylabel("Re λ [rad/s]")
+    ax_re.grid(True, alpha=0.3)
+    ax_re.legend(fontsize=7, loc="best", ncol=2)
     fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return _save(fig, path)
 
 
+# ---------------------------------------------------------------------------------------
+# Time histories
+# ---------------------------------------------------------------------------------------
 TIME_PANELS = (
     ("u", "Δu [m/s]", 1.0),
     ("alpha", "Δα [deg]", 180.0 / np.pi),
     ("q", "q [deg/s]", 180.0 / np.pi),
     ("theta", "Δθ [deg]", 180.0 / np.pi),
     ("n_z", "n_z [-]", 1.0),
-    ("eta1", "η₁ [deg]", 180.0 / np.pi),
+    ("w_g", "gust w_g [m/s] (up)", 1.0),
+    ("eta1", "η₁ [deg]: envelope and mean", 180.0 / np.pi),
+    ("eta1_zoom", "η₁ [deg], zoom", 180.0 / np.pi),
 )
+ENVELOPE_WINDOW_S = 0.1  # η₁ envelope: max/min over 0.1 s (three cycles of a 31 Hz mode)
+ZOOM_BEFORE_S, ZOOM_AFTER_S = 0.05, 0.35  # the η₁ zoom around the gust onset [s]
 
 
-def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str) -> Path:
-    """Gust time histories of several runs on shared axes (like Figs. 21 and 22)."""
-    fig, axes = plt.subplots(3, 2, figsize=(12, 9), sharex=True)
-    for ax, (name, label, scale) in zip(axes.flat, TIME_PANELS, strict=True):
+def _style(run: TimeHistory) -> dict:
+    style = dict(MODEL_STYLE.get(run.model, dict(color=None, ls="-", lw=1.2, zorder=2)))
+    for key, meta in (("color", "color"), ("ls", "linestyle"), ("lw", "linewidth")):
+        if meta in run.meta:
+            style[key] = run.meta[meta]
+    return style
+
+
+def _envelope(t: np.ndarray, x: np.ndarray, window_s: float):
+    """Running minimum, maximum and mean of ``x`` over windows of ``window_s`` [s]."""
+    if len(t) < 2:
+        return t, x, x, x
+    n = max(1, int(round(window_s / float(t[1] - t[0]))))
+    k = len(x) // n
+    if k < 2:
+        return t, x, x, x
+    blocks = x[: k * n].reshape(k, n)
+    tc = t[: k * n].reshape(k, n).mean(axis=1)
+    return tc, blocks.min(axis=1), blocks.max(axis=1), blocks.mean(axis=1)
+
+
+def _gust_onset(runs: Sequence[TimeHistory]) -> float:
+    for run in runs:
+        if "gust_start_s" in run.meta:
+            return float(run.meta["gust_start_s"])
+    for run in runs:
+        if "w_g" in run.channels and len(run.time_s):
+            nz = np.nonzero(np.abs(run["w_g"]) > 0.0)[0]
+            if len(nz):
+                return float(run.time_s[nz[0]])
+    return 0.0
+
+
+def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
+                   nrmse: Mapping[str, float] | None = None) -> Path:
+    """Gust time histories of several runs on shared axes (like Figs. 21 and 22).
+
+    Eight panels against time [s]: Δu, Δα, q, Δθ, n_z, the gust input w_g, η₁ as an envelope
+    (running min/max over 0.1 s, shaded, with the running mean: the 31 Hz oscillation would
+    otherwise fill a solid band) and η₁ itself around the gust onset. A run that stopped
+    early (diverged) ends in a red × on every panel and says when in the legend; the axes
+    are scaled to the runs that finished, so they stay readable. ``nrmse`` (channel →
+    NRMSE [-]) labels the LTI prediction's line in every panel (``compare``).
+    """
+    fig, axes = plt.subplots(4, 2, figsize=(12, 12))
+    t_gust = _gust_onset(runs)
+    elastic = [r for r in runs if r.model != "rigid" and "eta1" in r.channels]
+    t_zoom = t_gust  # the η₁ zoom: the gust onset, or where the wing diverged before it
+    if elastic and all(r.stopped is not None and r.stop_time_s < t_gust for r in elastic):
+        t_zoom = max(r.stop_time_s for r in elastic) - ZOOM_AFTER_S + ZOOM_BEFORE_S
+    t_end = max((float(r.time_s[-1]) for r in runs if len(r.time_s)), default=1.0)
+    for ax, (name, ylabel, scale) in zip(axes.flat, TIME_PANELS, strict=True):
+        channel = "eta1" if name == "eta1_zoom" else name
+        zoom = (t_zoom - ZOOM_BEFORE_S, t_zoom + ZOOM_AFTER_S) if name == "eta1_zoom" else None
+        drawn_gust = False
+        limits: list[float] = []
+        stops: list[tuple[float, float]] = []  # (t [s], value) where a diverged run ends
         for run in runs:
-            if name not in run.channels:
+            if channel not in run.channels or not len(run.time_s):
                 continue
-            style = MODEL_STYLE.get(run.model, {})
-            tag = run.meta.get("label", run.model)
-            ax.plot(run.time_s, run[name] * scale, label=str(tag), color=style.get("color"),
-                    lw=1.2, ls=str(run.meta.get("linestyle", "-")))
-        ax.set_ylabel(label)
+            if channel == "eta1" and run.model == "rigid":
+                continue  # the rigid wing does not deform: η₁ ≡ 0
+            if name == "w_g":
+                if drawn_gust:
+                    continue  # one gust input: every run flies the same samples
+                drawn_gust = True
+            style = _style(run)
+            t, y = run.time_s, run[channel] * scale
+            label = str(run.meta.get("label", run.model))
+            if nrmse is not None and run.meta.get("source") == "lti" and channel in nrmse:
+                label += f", NRMSE {nrmse[channel]:.3f}"
+            if run.stopped is not None:
+                label += f" (diverged at t = {run.stop_time_s:.2f} s)"
+            if name == "w_g":
+                style = dict(color="black", ls="-", lw=1.2, zorder=2)
+                gust_text = str(run.meta.get("gust", "") or "")
+                label = f"w_g, gust {gust_text}" if gust_text else "w_g"
+            if zoom is not None:
+                keep = (t >= zoom[0]) & (t <= zoom[1])
+                t, y = t[keep], y[keep]
+                if not len(t):
+                    continue
+            if name == "eta1" and len(t) > 2:
+                tc, lo, hi, mean = _envelope(t, y, ENVELOPE_WINDOW_S)
+                ax.fill_between(tc, lo, hi, color=style["color"], alpha=0.18, lw=0,
+                                zorder=style["zorder"] - 1)
+                ax.plot(tc, mean, label=label, **style)
+                if run.stopped is None:
+                    limits += [float(lo.min()), float(hi.max())]
+            else:
+                ax.plot(t, y, label=label, **style)
+                if run.stopped is None:
+                    limits += [float(y.min()), float(y.max())]
+            if run.stopped is not None and name != "w_g" and (
+                    zoom is None or run.time_s[-1] <= zoom[1]):
+                stops.append((float(t[-1]), float(y[-1])))
+        if limits and any(r.stopped is not None and channel in r.channels for r in runs):
+            lo, hi = min(limits), max(limits)
+            pad = 0.15 * max(hi - lo, 1e-9)
+            ax.set_ylim(lo - pad, hi + pad)  # diverged runs are clipped, their × at the edge
+            stops = [(t, float(np.clip(y, lo - pad, hi + pad))) for t, y in stops]
+        for t_stop, y_stop in stops:
+            ax.plot([t_stop], [y_stop], marker="X", color="tab:red", ms=9, ls="none",
+                    zorder=6, clip_on=False)
+        if zoom is not None:
+            ax.set_xlim(*zoom)
+        else:
+            ax.set_xlim(0.0, t_end)
+        if t_gust > 0.0 and (zoom is None or zoom[0] <= t_gust <= zoom[1]):
+            ax.axvline(t_gust, color="0.6", lw=0.7, ls=":")
+        ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
+        if nrmse is not None or name in ("u", "w_g"):
+            ax.legend(fontsize=7, loc="best")
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
-    axes.flat[0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return _save(fig, path)
