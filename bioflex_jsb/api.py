@@ -9,6 +9,7 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 >>> runs = api.fly_gust(wing, speed_m_s=15.0, gust="sharp:3", models=("rigid", "coupled"))
 >>> runs["coupled"]["q"]               # pitch rate [rad/s] at runs["coupled"].time_s [s]
 >>> lti = api.linear_model(wing, speed_m_s=15.0, model="coupled")
+>>> unsteady = api.fly_gust(wing, gust="sharp:0.3", aero="unsteady")  # Jones/Küssner strips
 >>> api.flutter(wing).flutter_speed_m_s  # [m/s]
 """
 
@@ -16,7 +17,9 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from bioflex_jsb.aeroelasticity.free_aircraft import AERO_MODELS, unsteady_state_space
 from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.eigen import FlutterResult, ModeSet, find_flutter, modes_at
 from bioflex_jsb.flight_dynamics.lti import MODELS, StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
@@ -48,23 +51,36 @@ def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BA
 
 
 def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
-             models: Iterable[str] = ("rigid", "coupled", "qsd"), duration_s: float = 5.0,
+             models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
-             recorders: dict[str, StepRecorder] | None = None) -> dict[str, TimeHistory]:
+             recorders: dict[str, StepRecorder] | None = None,
+             aero: str = "quasi-steady") -> dict[str, TimeHistory]:
     """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing``, one per model
-    (``rigid``, ``coupled``, ``qsd``): trim at ``speed_m_s`` [m/s] and ``altitude_m`` [m],
+    (``rigid``, ``coupled``, ``qsd``; default all three, or ``coupled`` alone with
+    ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and ``altitude_m`` [m],
     then fly ``duration_s`` [s] at the step ``dt_s`` [s] through ``gust`` (``sharp:A``,
     ``1cos:A:L``, ``dryden:SIGMA:SCALE[:SEED]``, ``vonkarman:…``; m/s, m) starting at
     ``gust_start_s`` [s]. ``recorders``: a step recorder (an MCAP log) per model.
+    ``aero``: the wing's strips, ``quasi-steady`` (the paper's) or ``unsteady`` (Jones lag
+    states, apparent mass, Küssner gust: :mod:`bioflex_jsb.simulation.unsteady_wing`; the
+    coupled model only, on the Python step).
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
     reason, the time and the mode) and holds every step up to then."""
+    if aero not in AERO_MODELS:
+        raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
+    if models is None:
+        models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
     setup = RunSetup(speed_m_s, parse_gust(gust), duration_s, gust_start_s, altitude_m, dt_s)
     airframe = Airframe()
     out = {}
     for model in models:
         recorder = (recorders or {}).get(model)
-        out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder)
+        if aero == "unsteady":
+            out[model] = run_gust(airframe, wing, model, setup, recorder=recorder,
+                                  aero=aero)
+        else:
+            out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder)
     return out
 
 
@@ -86,12 +102,23 @@ def metrics(run: TimeHistory, gust_start_s: float = 0.5) -> GustMetrics:
     return gust_metrics(run, gust_start_s)
 
 
-def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "coupled"
-                 ) -> StateSpace:
+def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "coupled",
+                 aero: str = "quasi-steady") -> StateSpace:
     """The paper's LTI model (Eq. 4) at ``speed_m_s`` [m/s]: ``rigid`` (A_RR), ``coupled``
-    or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units."""
+    or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units.
+
+    ``aero="unsteady"`` (``coupled`` only): Eq. (4) on unsteady strips with the Küssner gust
+    (:func:`bioflex_jsb.aeroelasticity.free_aircraft.unsteady_state_space`, ``gust=True``),
+    the model the co-simulation's unsteady wing integrates: states u, α, q, θ, η, η̇ and
+    per strip k lag1[k], lag2[k], kussner1[k], kussner2[k] [m/s]."""
+    if aero not in AERO_MODELS:
+        raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+    if aero == "unsteady":
+        if model != "coupled" or wing is None:
+            raise InputError("aero='unsteady' is the coupled model of an elastic wing")
+        return unsteady_state_space(wing, speed_m_s, gust=True)
     return build_state_space(model, level_flight_condition(speed_m_s),
                              None if wing is None else wing.model)
 

@@ -8,7 +8,9 @@
 * :mod:`~bioflex_jsb.aeroelasticity.state_space`: eigen-analysis of structure + lag states;
 * :mod:`~bioflex_jsb.aeroelasticity.flutter`: the result, mechanism and the Goland benchmark;
 * :mod:`~bioflex_jsb.aeroelasticity.free_aircraft`: the paper's free aircraft, Eq. (4) with
-  unsteady strips (named Jones lag states), its flutter and the six-wing table.
+  unsteady strips (named Jones lag states), its flutter and the six-wing table;
+* :mod:`~bioflex_jsb.aeroelasticity.strip_increments`: the unsteady strips' loads beyond the
+  quasi-steady ones as rows on the state (for the LTI model and the co-simulation's wing).
 """
 
 from bioflex_jsb.aeroelasticity.flutter import FlutterResult, goland_flutter

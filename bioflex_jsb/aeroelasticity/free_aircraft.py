@@ -39,13 +39,12 @@ the paper's). Strips are normal to y: the outer panel's sweep is not corrected f
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq, linear_sum_assignment
 
-from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER, SEARS_SPARKS_KUSSNER
+from bioflex_jsb.aeroelasticity.strip_increments import strip_increments
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
@@ -129,15 +128,17 @@ class DescriptorSystem:
 def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float | None = None,
                          density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
                          geometry: StripGeometry | None = None,
-                         gust: bool = False) -> StateSpace:
+                         gust: bool = False, a_rr: np.ndarray | None = None) -> StateSpace:
     """Eq. (4) of ``build`` (a WingBuild) at ``speed_m_s`` with unsteady strips
     (module docstring): states u, α, q, θ, η, η̇, then lag1[k], lag2[k] [m/s]; with
     ``gust`` also kussner1[k], kussner2[k] [m/s]: the wing's gust lift through Küssner's
     function (Sears & Sparks's two exponentials) instead of the paper's instantaneous one.
     ``geometry`` replaces :func:`strip_geometry` (tests: its ``e_m`` must be the one the
-    build's Table B1 coefficients were computed with)."""
+    build's Table B1 coefficients were computed with). ``a_rr`` replaces the analytic rigid
+    block (JSBSim's linearization at the same trim, as ``compare`` does; G_R follows it)."""
     d = unsteady_descriptor(build, speed_m_s, structural_damping=structural_damping,
-                            density_kg_m3=density_kg_m3, geometry=geometry, gust=gust)
+                            density_kg_m3=density_kg_m3, geometry=geometry, gust=gust,
+                            a_rr=a_rr)
     a = np.linalg.solve(d.e, d.a)
     b_in = np.linalg.solve(d.e, d.b)
     n_all = a.shape[0]
@@ -154,71 +155,21 @@ def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float |
 def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | None = None,
                         density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
                         geometry: StripGeometry | None = None,
-                        gust: bool = False) -> DescriptorSystem:
-    """The :class:`DescriptorSystem` of :func:`unsteady_state_space`."""
+                        gust: bool = False, a_rr: np.ndarray | None = None
+                        ) -> DescriptorSystem:
+    """The :class:`DescriptorSystem` of :func:`unsteady_state_space`: Eq. (4) plus the
+    strips' increments (:func:`~bioflex_jsb.aeroelasticity.strip_increments.strip_increments`)
+    through the rigid and modal equations."""
     model = with_damping(build, structural_damping)
     cond = level_flight_condition(float(speed_m_s), density_kg_m3)
-    base = build_state_space("coupled", cond, model)
+    base = build_state_space("coupled", cond, model, a_rr=a_rr)
     g = strip_geometry(build) if geometry is None else geometry
-    n, k_strips = model.n_modes, g.chord_m.size
-    n0 = 4 + 2 * n
-    n_all = n0 + (4 if gust else 2) * k_strips
-    v, rho = float(speed_m_s), float(density_kg_m3)
-    b = 0.5 * g.chord_m
+    n = model.n_modes
+    inc = strip_increments(g, n, speed_m_s, density_kg_m3, gust=gust)
+    n0, n_all = 4 + 2 * n, inc.n_states
+    v = float(speed_m_s)
     ia, iq = 1, 2
-    ie = slice(4, 4 + n)
     ied = slice(4 + n, 4 + 2 * n)
-    lag = [slice(n0 + j * k_strips, n0 + (j + 1) * k_strips) for j in range(4 if gust else 2)]
-    amp, beta = JONES_WAGNER.amplitudes, JONES_WAGNER.exponents
-
-    def rows() -> np.ndarray:
-        return np.zeros((k_strips, n_all))
-
-    # three-quarter-chord upwash [m/s] and the paper's angle × V [m/s]
-    w34 = rows()
-    w34[:, ia] = v
-    w34[:, iq] = -g.d_34_m
-    w34[:, ie] = v * g.theta.T
-    w34[:, ied] = (g.phi + g.e_34_m * g.theta).T
-    wqs = rows()
-    wqs[:, ia] = v
-    wqs[:, iq] = -g.d_m
-    wqs[:, ie] = v * g.theta.T
-    wqs[:, ied] = g.phi.T
-    half = 0.5 * rho * v * g.cl_alpha_c_m[:, None]
-    l_c = half * (1.0 - sum(amp)) * w34
-    for j in range(2):
-        l_c[:, lag[j]] += np.diag(half[:, 0])
-    dl_circ = l_c - half * wqs  # circulatory increment [N/m] on x
-    # apparent mass: heave acceleration (down), pitch rate and acceleration, on x and ẋ
-    hdd_x, hdd_xd = rows(), rows()
-    hdd_x[:, iq] = -v
-    hdd_xd[:, ia] = v
-    hdd_xd[:, iq] = -g.d_e_m
-    hdd_xd[:, ied] = g.phi.T
-    ad_x = rows()
-    ad_x[:, iq] = 1.0
-    ad_x[:, ied] = g.theta.T
-    add_xd = ad_x.copy()
-    ad_x_only = ad_x  # α̇_s in x; α̈_s = the same row on ẋ
-    pb2 = (math.pi * rho * b**2)[:, None]
-    ba = (b * g.a)[:, None]
-    l_nc_x = pb2 * (hdd_x + v * ad_x_only)
-    l_nc_xd = pb2 * (hdd_xd - ba * add_xd)
-    m_nc_x = pb2 * (ba * hdd_x - v * (b * (0.5 - g.a))[:, None] * ad_x_only)
-    m_nc_xd = pb2 * (ba * hdd_xd - (b**2 * (0.125 + g.a**2))[:, None] * add_xd)
-    w = g.weights_m
-
-    def loads(dl_c, l_nc, m_nc):
-        """Z [N], M about CG [N·m], Q_i [N·m] of the strip increments (rows on x or ẋ)."""
-        z = -(w @ (dl_c + l_nc))
-        m = (w * g.d_m) @ dl_c + w @ (m_nc + g.d_e_m[:, None] * l_nc)
-        q = ((g.e_m * g.theta - g.phi) * w) @ dl_c + (-(g.phi * w) @ l_nc
-                                                      + (g.theta * w) @ m_nc)
-        return z, m, q
-
-    zx, mx, qx = loads(dl_circ, l_nc_x, m_nc_x)
-    zxd, mxd, qxd = loads(np.zeros_like(dl_circ), l_nc_xd, m_nc_xd)
     mass, iyy = MASS_PROPERTIES.mass_kg, MASS_PROPERTIES.iyy_kg_m2
     rd = rigid_derivatives(cond, RIGID_AERODYNAMICS)
     mi = np.asarray(model.generalised_masses_kg_m2, dtype=float)
@@ -226,6 +177,8 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
 
     def rates(z, m, q) -> np.ndarray:
         """Rows of ẋ from loads: u̇, α̇, q̇ and η̈ (θ̇, η̇ kinematic rows untouched)."""
+        z, m = np.atleast_1d(z), np.atleast_1d(m)
+        q = q.reshape(n, -1)
         out = np.zeros((n_all, z.size))
         out[0] = 2.0 * k_ind * cond.cl_trim * z / mass
         out[ia] = z / (mass * v)
@@ -235,32 +188,16 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
 
     a_full = np.zeros((n_all, n_all))
     a_full[:n0, :n0] = base.a
-    a_full += rates(zx, mx, qx)
-    for j in range(2):
-        rate = beta[j] * v / b
-        a_full[lag[j], lag[j]] -= np.diag(rate)
-        a_full[lag[j]] += amp[j] * rate[:, None] * w34
-    e_mat = np.eye(n_all) - rates(zxd, mxd, qxd)
+    a_full += rates(inc.z_x, inc.m_x, inc.q_x)
+    a_full[inc.lag_slice] += inc.lag_a
+    e_mat = np.eye(n_all) - rates(inc.z_xd, inc.m_xd, inc.q_xd)
     b_in = np.zeros((n_all, 1))
     b_in[:n0] = base.b
-    names = base.states + tuple(f"lag{j + 1}[{k}]" for j in range(2) for k in range(k_strips))
+    b_in[inc.lag_slice, 0] += inc.lag_b
     if gust:
-        # wing's gust lift: ½ρV C_lα c Σ x_g (Küssner) instead of ½ρV C_lα c w_g (paper),
-        # on the paper's arms; Sears & Sparks: Σ A_j = 1, no direct term
-        kamp, kbeta = SEARS_SPARKS_KUSSNER.amplitudes, SEARS_SPARKS_KUSSNER.exponents
-        dl_g = rows()
-        for j in range(2):
-            dl_g[:, lag[2 + j]] += np.diag(half[:, 0])
-            rate = kbeta[j] * v / b
-            a_full[lag[2 + j], lag[2 + j]] -= np.diag(rate)
-            b_in[lag[2 + j], 0] += kamp[j] * rate
-        zero = np.zeros_like(dl_g)
-        a_full += rates(*loads(dl_g, zero, zero))
-        dl_w = -half  # (K, 1): minus the paper's instantaneous gust lift per m/s
-        b_in += rates(*loads(dl_w, np.zeros_like(dl_w), np.zeros_like(dl_w)))
-        names += tuple(f"kussner{j + 1}[{k}]" for j in range(2) for k in range(k_strips))
-    units = base.state_units + ("m/s",) * (len(names) - len(base.states))
-    return DescriptorSystem(e_mat, a_full, b_in, base, names, units)
+        b_in += rates(inc.z_w, inc.m_w, inc.q_w)
+    units = base.state_units + ("m/s",) * (n_all - n0)
+    return DescriptorSystem(e_mat, a_full, b_in, base, inc.states, units)
 
 
 def _quasi_steady_a(build, v, zeta, rho):

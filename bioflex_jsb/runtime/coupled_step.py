@@ -40,6 +40,7 @@ from bioflex_jsb.aerodynamics.airframe_polars import alpha_peak_rad
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation import step_kernel as K
@@ -54,6 +55,7 @@ from bioflex_jsb.simulation.modal_wing import (
     TrimReference,
     WingLoads,
 )
+from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
 
 STEP_MODELS = (*WING_MODELS, "native")
 AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
@@ -158,22 +160,35 @@ class CoupledStep:
         compiled: run the per-step numerics as the compiled kernel
             (:mod:`bioflex_jsb.simulation.step_kernel`); False: the readable Python step, the
             reference the kernel is tested against. The native model has no wing step.
+        aero: the wing's strips, ``quasi-steady`` (the paper's, default) or ``unsteady``
+            (:class:`~bioflex_jsb.simulation.unsteady_wing.UnsteadyModalWing`: Jones lag
+            states, apparent mass, Küssner gust; coupled model only; ``wing`` then a
+            :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`; always the Python
+            step). ``wing`` may be a WingBuild for either (its ``model`` is used).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
     """
 
-    def __init__(self, airframe: Airframe, wing: ElasticWingModel | None, model: str,
+    def __init__(self, airframe: Airframe, wing: ElasticWingModel | WingBuild | None, model: str,
                  speed_m_s: float, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady") -> None:
         if aero not in AERO_MODELS:
             raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
-        if aero != "quasi-steady":
-            raise InputError("aero='unsteady' is not in the co-simulation step yet")
         if model not in STEP_MODELS:
             raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
+        unsteady = aero == "unsteady"
+        if unsteady and model != "coupled":
+            raise InputError(f"aero='unsteady' is for the coupled wing, not {model!r} (the "
+                             "rigid, qsd and native wings are quasi-steady)")
+        if unsteady and not isinstance(wing, WingBuild):
+            raise InputError("aero='unsteady' needs the wing's build (its strips), not only "
+                             "its ElasticWingModel")
+        build = wing if isinstance(wing, WingBuild) else None
+        if build is not None:
+            wing = build.model
         native = model == "native"
         if wing is None and not native:
             raise InputError(f"the {model} model needs a wing")
@@ -204,18 +219,24 @@ class CoupledStep:
             self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
                                    for i in range(self.n_modes)]
             self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
+        elif unsteady:
+            self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s)
+            self.n_modes = wing.n_modes
+            self._write_reactions = airframe.external_reaction_writer()
         else:
             self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s)
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
         self.model = model
+        self.aero = aero
         self.units = channel_units(self.n_modes)
         self.names = tuple(self.units)
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad()
-        self.compiled = bool(compiled) and not native
+        # the unsteady wing runs the Python step (the kernel carries the quasi-steady wing)
+        self.compiled = bool(compiled) and not native and not unsteady
         if self.compiled:
             self._setup_kernel(nodes)
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
@@ -244,6 +265,8 @@ class CoupledStep:
         that becomes coupled starts undeformed."""
         if self.native or model not in WING_MODELS:
             raise InputError(f"cannot switch a {self.model} wing to {model!r}")
+        if self.aero == "unsteady" and model != self.model:
+            raise InputError(f"cannot switch the unsteady coupled wing to {model!r}")
         if model != self.wing.model:
             self.wing.model = model
             self.wing.eta = np.zeros(self.n_modes)
@@ -290,8 +313,12 @@ class CoupledStep:
         else:
             mw = self.wing
             eta, eta_dot = mw.eta, mw.eta_dot
-            mw.step(flow)  # η_k → η_{k+1} over [t_k, t_k+1] with the flow of t_k held
-            loads = mw.loads(flow)
+            if self.aero == "unsteady":  # the lag states need the gust apart from α
+                mw.step(flow, w_g_m_s)
+                loads = mw.loads(flow, w_g_m_s)
+            else:
+                mw.step(flow)  # η_k → η_{k+1} over [t_k, t_k+1] with the flow of t_k held
+                loads = mw.loads(flow)
             alpha = flow.alpha_rad
             ca, sa = math.cos(alpha), math.sin(alpha)
             self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
