@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import csv
 import os
+import re
+import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,13 +18,57 @@ from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.generators import native_wing as J
 
 REPO = Path(__file__).resolve().parents[1]
+DOCS = REPO / "docs" / "native.md"
+# A console run takes well under a second; this only stops a hung one.
+CONSOLE_TIMEOUT_S = 120
+
+
+def _exe(name: str) -> str:
+    """A console program of this environment: beside the interpreter, never from PATH."""
+    path = Path(sys.executable).with_name(name)
+    assert path.is_file(), f"{name} is not installed beside {sys.executable}"
+    return str(path)
+
+
+def _documented(prefix: str) -> list[str]:
+    """The commands of docs/native.md that start with ``prefix`` (indented code lines)."""
+    lines = [m.group(1) for m in re.finditer(r"^    (\S.*)$", DOCS.read_text(encoding="utf-8"),
+                                             re.MULTILINE)]
+    found = [line for line in lines if line.startswith(prefix)]
+    assert found, f"docs/native.md documents no command starting with {prefix!r}"
+    return found
+
+
+def _run(command: str, cwd: Path, **placeholders: str) -> subprocess.CompletedProcess:
+    """Run a documented command as written, its placeholders (whole words: DIR, REPO, ...)
+    replaced, its program taken from beside the interpreter."""
+    argv = shlex.split(command)
+    for name, value in placeholders.items():
+        argv = [re.sub(rf"\b{re.escape(name)}\b", lambda _m, v=value: v, a) for a in argv]
+    proc = subprocess.run([_exe(argv[0]), *argv[1:]], cwd=cwd, capture_output=True, text=True,
+                          timeout=CONSOLE_TIMEOUT_S)
+    assert proc.returncode == 0, (argv, proc.stdout[-2000:], proc.stderr[-2000:])
+    return proc
+
+
+def _read_csv(path: Path) -> dict[str, np.ndarray]:
+    """The console program's CSV: column caption → values."""
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    data = np.array(rows[1:], dtype=float)
+    return {h.strip(): data[:, i] for i, h in enumerate(rows[0])}
+
+
+CAPTIONS = ["Time", "vt [ft/s]", "u [ft/s]", "w [ft/s]", "q [rad/s]", "theta [rad]",
+            "alpha [rad]", "wind_down [ft/s]", "rpm [rev/min]", "eta1 [rad]", "eta2 [rad]",
+            "eta3 [rad]", "active [-]"]
 
 
 def test_repository_files_are_up_to_date():
     """systems/, aircraft/bioflex_<variant>/ and the Fig. 21 script are the exporter's output."""
     stale = [rel for rel, text in repository_files().items()
              if not (REPO / rel).is_file() or (REPO / rel).read_text(encoding="utf-8") != text]
-    assert not stale, f"regenerate with python -m bioflex_jsb.generators.native_wing: {stale}"
+    assert not stale, f"regenerate with python -m bioflex_jsb.drivers.native: {stale}"
 
 
 def _spec(variant, **kw):
@@ -150,38 +199,37 @@ def test_published_modal_state_is_the_state_at_the_current_time():
     assert af["aero/force/modal-lift"] == 0.0 and af["aero/moment/modal-pitch"] == 0.0
 
 
-def test_fig21_script_runs_in_the_console_program(tmp_path):
-    """``jsbsim --script=scripts/fig21_native.xml``: no JSBSim trim (the Python trim as the
-    initial condition, the airframe held while the propellers spin up), the modal wing
-    active, η1 and q as the co-simulation's of the same case."""
-    import csv
-    import shutil
-    import subprocess
-    import sys
+@pytest.fixture(scope="module")
+def fig21_console_csv(tmp_path_factory) -> dict[str, np.ndarray]:
+    """The documented Fig. 21 command of docs/native.md, run as written (REPO, OUTDIR: an
+    absolute directory), from another working directory."""
+    (command,) = _documented("jsbsim --root=REPO --script=scripts/fig21_native.xml")
+    out = tmp_path_factory.mktemp("fig21_out")
+    cwd = tmp_path_factory.mktemp("elsewhere")
+    proc = _run(command, cwd, REPO=str(REPO), OUTDIR=str(out))
+    assert "Overriding simulation step size" in proc.stdout  # --simulation-rate took
+    assert "bioflex: stopped" not in proc.stdout
+    return _read_csv(out / J.FIG21_OUTPUT)
 
+
+def test_fig21_script_runs_in_the_console_program(fig21_console_csv):
+    """No JSBSim trim (the Python trim as the initial condition, the airframe held while the
+    propellers spin up), the modal wing active, η1 and q as the co-simulation's of the same
+    case, the columns as docs/native.md lists them."""
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.parameters import prototype as P
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import nrmse
 
-    exe = shutil.which("jsbsim") or str(Path(sys.executable).with_name("jsbsim"))
+    col = fig21_console_csv
+    assert list(col) == CAPTIONS
+    docs = DOCS.read_text(encoding="utf-8")
+    assert all(f"| `{c}` |" in docs for c in CAPTIONS)  # every column explained
     dt = J.DEFAULT_DT_S
-    proc = subprocess.run(
-        [exe, f"--root={REPO}", f"--script={J.FIG21_SCRIPT}", f"--simulation-rate={1 / dt}",
-         f"--outputpath={tmp_path}"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=20)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    assert "Overriding simulation step size" in proc.stdout  # --simulation-rate took
-    with open(tmp_path / J.FIG21_OUTPUT, newline="") as fh:
-        rows = list(csv.reader(fh))
-    head = [h.strip().removeprefix("/fdm/jsbsim/") for h in rows[0]]
-    data = np.array(rows[1:], dtype=float)
-    col = {h: data[:, i] for i, h in enumerate(head)}
     t = col["Time"]
     assert t[-1] >= J.FIG21_SETTLE_S + J.FIG21_DURATION_S - 2 * dt
-    flying = t >= J.FIG21_SETTLE_S
-    assert np.all(col["bioflex/modal/active"][flying] == 1.0)
+    assert np.all(col["active [-]"][1:] == 1.0)
     setup = RunSetup(P.SECTION5_AIRSPEED_M_S, parse_gust(f"sharp:{P.SECTION5_GUST_AMPLITUDE_M_S}"),
                      duration_s=J.FIG21_DURATION_S, gust_start_s=J.FIG21_GUST_START_S, dt_s=dt)
     ref = run_gust(Airframe(), build_wing(VARIANTS[J.FIG21_VARIANT]).model, "coupled", setup)
@@ -189,11 +237,91 @@ def test_fig21_script_runs_in_the_console_program(tmp_path):
     # alignment (measured, not fitted per run): the row stamped settle + t − dt holds the
     # state the co-simulation samples at t (one row later NRMSE is ≈ 14 % on η1)
     at = J.FIG21_SETTLE_S + ref.time_s - dt
-    eta1 = np.interp(at, t, col["bioflex/modal/eta1"])
-    q = np.interp(at, t, col["velocities/q-rad_sec"])
+    eta1 = np.interp(at, t, col["eta1 [rad]"])
+    q = np.interp(at, t, col["q [rad/s]"])
     errors = {"eta1": nrmse(ref.channels["eta1"], eta1), "q": nrmse(ref.channels["q"], q)}
     assert max(errors.values()) < 0.01, errors
     assert np.max(np.abs(eta1)) > 0.01  # the wing flexed
+
+
+def test_documented_export_flies_in_the_console_program(tmp_path, fig21_console_csv):
+    """docs/native.md's two lines (export, then the console program), run as written from
+    one working directory with a relative DIR: the exported optimised wing at the default
+    15 m/s and gust is the Fig. 21 flight, row for row."""
+    (export,) = _documented("bioflex-jsb export-jsbsim --wing")
+    (fly,) = _documented("jsbsim --root=DIR ")
+    out = _run(export, tmp_path, DIR="flight").stdout
+    root = (tmp_path / "flight").resolve()
+    assert f"fly it: jsbsim --root={root} " in out  # the printed command: absolute root
+    proc = _run(fly, tmp_path, DIR="flight")
+    assert "bioflex: stopped" not in proc.stdout
+    col = _read_csv(root / "bioflex_optimised.csv")
+    assert list(col) == CAPTIONS
+    assert col["Time"].shape == fig21_console_csv["Time"].shape
+    for name in CAPTIONS:
+        np.testing.assert_array_equal(col[name], fig21_console_csv[name], err_msg=name)
+    # and the exported aircraft is the repository's
+    rel = "aircraft/bioflex_optimised/bioflex_optimised.xml"
+    assert (root / rel).read_text(encoding="utf-8") == (REPO / rel).read_text(encoding="utf-8")
+
+
+def test_the_command_of_the_help_flies_the_export(tmp_path, capsys):
+    """``export-jsbsim --help``'s command, DIR and <wing> filled in, flies an export."""
+    assert _cli(["export-jsbsim", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    (command,) = re.findall(r"`(jsbsim [^`]+)`", text)
+    assert "--simulation-rate=960" in command
+    assert _cli(["export-jsbsim", "--wing", "elastic-forward", "--out", str(tmp_path / "x")]) == 0
+    printed = capsys.readouterr().out
+    command = command.replace("<wing>", "elastic-forward")
+    assert f"fly it: {command.replace('DIR', str((tmp_path / 'x').resolve()))}\n" in printed
+    _run(command, tmp_path, DIR="x")
+    col = _read_csv(tmp_path / "x" / "bioflex_elastic-forward.csv")
+    assert np.all(col["active [-]"][1:] == 1.0) and np.max(np.abs(col["eta1 [rad]"])) > 1e-3
+
+
+def test_a_run_at_another_step_stops_at_once_with_a_message(tmp_path):
+    """Without --simulation-rate the wheel's console program runs at 1/120 s, where the wing
+    would be rigid: the script stops at its first step and says what to add."""
+    proc = _run(f"jsbsim --root=REPO --script={J.FIG21_SCRIPT} --outputpath=OUT", tmp_path,
+                REPO=str(REPO), OUT=str(tmp_path))
+    assert "bioflex: stopped, simulation/dt is not the exported step" in proc.stdout
+    assert "--simulation-rate=960" in proc.stdout
+    rows = (tmp_path / J.FIG21_OUTPUT).read_text().splitlines()
+    assert len(rows) <= 2  # the header, at most one row
+
+
+def _export(spec, root: Path, gust_up_m_s: float):
+    """What ``export-jsbsim`` writes, through the driver: (case, trim)."""
+    from bioflex_jsb.drivers.native import export_flight, write_export
+
+    case, state, files = export_flight(spec, gust_up_m_s)
+    write_export(files, root)
+    return case, state
+
+
+def test_relative_outputpath_is_taken_from_the_root(tmp_path):
+    """As docs/native.md says: JSBSim resolves a relative --outputpath against --root."""
+    case, _ = _export(_spec("original"), tmp_path / "root", 0.0)
+    (tmp_path / "root" / "runs").mkdir()
+    _run(f"{case.command('ROOT')} --outputpath=runs", tmp_path, ROOT=str(tmp_path / "root"))
+    assert (tmp_path / "root" / "runs" / case.output).is_file()
+    assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.parametrize("variant, speed", [("original", 9.5), ("original", 32.0)])
+def test_export_flies_level_at_the_ends_of_the_trim_range(tmp_path, variant, speed):
+    """No gust: released from the trim, the exported aircraft stays in level flight (the
+    propellers settled on the trim RPM during the hold)."""
+    case, state = _export(_spec(variant, speed_m_s=speed), tmp_path, 0.0)
+    assert "atmosphere/wind-down-fps\"" not in (tmp_path / case.script).read_text("utf-8")
+    _run(case.command("ROOT"), tmp_path, ROOT=str(tmp_path))
+    col = _read_csv(tmp_path / case.output)
+    fly = col["Time"] >= case.settle_s
+    assert col["rpm [rev/min]"][fly][0] == pytest.approx(state.propeller_rpm, rel=1e-8)
+    assert np.max(np.abs(col["q [rad/s]"][fly])) < 1e-4  # measured 7e-6 rad/s
+    assert np.ptp(col["theta [rad]"][fly]) < 1e-4  # measured 1e-5 rad over 5 s
+    assert np.all(col["active [-]"][fly] == 1.0)
 
 
 def test_native_airframe_is_loaded_once_at_the_exported_step():
@@ -225,6 +353,13 @@ def test_cli_writes_a_loadable_root(tmp_path, capsys, model, craft):
                  "--out", str(tmp_path), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
     assert info["aircraft"] == craft
+    assert info["script"] == f"scripts/{craft}.xml"
+    assert info["initial_condition"] == f"aircraft/{craft}/trim.xml"
+    assert info["command"] == (f"jsbsim --root={tmp_path.resolve()} --script=scripts/{craft}.xml"
+                               " --simulation-rate=960")
+    assert info["output_csv"] == str(tmp_path.resolve() / f"{craft}.csv")
+    assert [c["column"] for c in info["columns"]] == CAPTIONS
+    assert all((tmp_path / rel).is_file() for rel in (info["script"], info["initial_condition"]))
     if model == "coupled":
         assert 0.0 < info["eigenvalue_error_max"] <= J.EIGEN_REL_TOL
     af = Airframe(root=tmp_path, aircraft=craft)
@@ -242,11 +377,50 @@ def test_cli_writes_a_loadable_root(tmp_path, capsys, model, craft):
     (["--wing", "no-such-wing"], "unknown wing"),
     (["--dt", "0"], "time step"),
     (["--wing", "optimised", "--dt", "0.0025"], "too coarse"),
+    (["--speed", "4.9"], "speed 4.9 m/s is outside 5..40 m/s"),
+    (["--speed", "40.5"], "speed 40.5 m/s is outside 5..40 m/s"),
+    (["--speed", "nan"], "outside 5..40 m/s"),
+    (["--speed", "8"], "cannot trim at 8 m/s"),  # in the range, but below the stall speed
+    (["--gust", "1cos:3:10"], "sharp-edged gust (sharp:A) or none"),
+    (["--gust", "sharp:x"], "must be a number"),
 ])
-def test_cli_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, words):
-    assert _cli(["export-jsbsim", "--out", str(tmp_path), *argv]) == 2
+def test_cli_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, argv, words):
+    out = tmp_path / "root"
+    assert _cli(["export-jsbsim", "--out", str(out), *argv]) == 2
     err = capsys.readouterr().err
     assert words in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_cli_refuses_a_root_where_jsbsim_could_not_write_the_csv(tmp_path, capsys):
+    (tmp_path / "bioflex_original.csv").mkdir()
+    assert _cli(["export-jsbsim", "--wing", "original", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "is not a regular file" in err and err.count("\n") == 1
+
+
+def test_cli_replaces_its_own_files_but_not_a_users_without_force(tmp_path, capsys):
+    argv = ["export-jsbsim", "--wing", "original", "--out", str(tmp_path)]
+    assert _cli(argv) == 0
+    assert _cli(argv) == 0  # its own files: replaced
+    script = tmp_path / "scripts" / "bioflex_original.xml"
+    script.write_text("<runscript/>\n", encoding="utf-8")
+    capsys.readouterr()
+    assert _cli(argv) == 2
+    err = capsys.readouterr().err
+    assert "already exists" in err and "--force" in err and err.count("\n") == 1
+    assert script.read_text(encoding="utf-8") == "<runscript/>\n"
+    assert _cli([*argv, "--force"]) == 0
+    assert "GENERATED by bioflex_jsb" in script.read_text(encoding="utf-8")
+
+
+def test_cli_without_gust_writes_a_script_in_still_air(tmp_path, capsys):
+    assert _cli(["export-jsbsim", "--wing", "original", "--gust", "none", "--speed", "20",
+                 "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "scripts" / "bioflex_original.xml").read_text(encoding="utf-8")
+    assert "in still air" in text and 'name="atmosphere/wind-down-fps"' not in text
+    ic = (tmp_path / "aircraft" / "bioflex_original" / "trim.xml").read_text(encoding="utf-8")
+    assert "trim at 20 m/s" in ic
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root can write anywhere")
@@ -258,5 +432,13 @@ def test_cli_unwritable_directory_exits_2(tmp_path, capsys):
         assert _cli(["export-jsbsim", "--wing", "original", "--out", str(locked / "x")]) == 2
     finally:
         locked.chmod(0o700)
+    err = capsys.readouterr().err
+    assert "cannot write" in err and err.count("\n") == 1
+
+
+def test_cli_unusable_directory_exits_2(tmp_path, capsys):
+    """Also as root: a path through a regular file cannot be a directory."""
+    (tmp_path / "file").write_text("x", encoding="utf-8")
+    assert _cli(["export-jsbsim", "--wing", "original", "--out", str(tmp_path / "file" / "x")]) == 2
     err = capsys.readouterr().err
     assert "cannot write" in err and err.count("\n") == 1

@@ -1,72 +1,158 @@
-"""``bioflex-jsb export-jsbsim``: the modal wing as JSBSim systems and an aircraft that flies it."""
+"""``bioflex-jsb export-jsbsim``: the modal wing as JSBSim systems, an aircraft that flies it,
+its trim and a script for the ``jsbsim`` console program."""
 
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 
-from bioflex_jsb.cli.common import UsageError, add_wing_arguments, print_json, wing_from_args
+from bioflex_jsb.cli.case import (
+    DEFAULT_GUST,
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    add_force_argument,
+    airspeed,
+    speed_help,
+)
+from bioflex_jsb.cli.common import (
+    UsageError,
+    add_wing_arguments,
+    check_output,
+    print_json,
+    wing_from_args,
+)
+from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S
 
-HELP = """Write a JSBSim root under --out DIR: systems/bioflex_modal_<wing>.xml (the modal wing
-integrated by JSBSim: each mode's structure exact, the aerodynamic coupling as a leapfrog kick)
-and aircraft/bioflex_<wing>/ (the bioflex airframe including it, the modal loads in its
-aerodynamics, with its trim companion). Fly it with `jsbsim --root=DIR
---aircraft=bioflex_<wing>`. The system holds for one time step, --dt [s] (default 1/960 s; a
+HELP = f"""Write a JSBSim root under --out DIR: systems/bioflex_modal_<wing>.xml (the modal wing
+integrated by JSBSim: each mode's structure exact, the aerodynamic coupling as a leapfrog kick),
+aircraft/bioflex_<wing>/ (the bioflex airframe including it, the modal loads in its
+aerodynamics, with its trim companion), the level trim at --speed as the initial condition
+aircraft/bioflex_<wing>/trim.xml and the script scripts/bioflex_<wing>.xml (held at the trim
+while the propellers spin up, 5 s, then flown 5 s, through --gust 0.5 s after the release).
+Fly it with `jsbsim --root=DIR --script=scripts/bioflex_<wing>.xml --simulation-rate=960`
+(960 = 1/--dt; the command is printed with DIR's absolute path); it writes
+DIR/bioflex_<wing>.csv, columns and units in docs/native.md. --outputpath, if you add it, is
+taken relative to DIR by JSBSim, not to the working directory, and must exist: else JSBSim
+writes nothing and exits 0. The system holds for one time step, --dt [s] (default 1/960 s; a
 step at which the integration's eigenvalues are more than 1 % off the exact ones up to 40 m/s
 is refused, naming a halved step that is not); the trim lift coefficient and the reference
-flow of the exact part are those of level flight at --speed [m/s]. See docs/native.md."""
+flow of the exact part are those of level flight at --speed, {AIRSPEED_RANGE_M_S[0]:g} to
+{AIRSPEED_RANGE_M_S[1]:g} m/s (the airframe trims at about 9.4 to 32.7 m/s: outside, the export
+refuses with the trim's reason). For `--model qsd` the names end in _qsd. See docs/native.md."""
 
 
 def register(sub) -> None:
     from bioflex_jsb.generators.native_wing import EXPORT_MODELS
     from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
-    p = sub.add_parser("export-jsbsim", help="write the modal wing as JSBSim systems",
-                       description=HELP)
-    add_wing_arguments(p)
-    p.add_argument("--model", choices=EXPORT_MODELS, default="coupled")
+    p = sub.add_parser("export-jsbsim", help="write the modal wing as JSBSim systems, an "
+                       "aircraft, its trim and a console-program script", description=HELP)
+    add_wing_arguments(p, default=DEFAULT_WING)
+    p.add_argument("--model", choices=EXPORT_MODELS, default="coupled",
+                   help="coupled (modal states) or qsd (quasi-static deformation); "
+                        "default coupled")
     p.add_argument("--out", required=True, metavar="DIR", help="JSBSim root to write into")
     p.add_argument("--dt", type=float, default=DEFAULT_DT_S,
                    help=f"JSBSim step the system is exported for [s] (default {DEFAULT_DT_S:.6g})")
-    p.add_argument("--speed", type=float, default=15.0,
-                   help="trim airspeed of the trim lift coefficient and of the reference flow "
-                        "[m/s] (default 15)")
+    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S,
+                   help=speed_help(extra="; it sets the script's level trim (the airframe trims at "
+                                         "about 9.4-32.7 m/s), the trim lift coefficient and "
+                                         "the reference flow of the system"))
+    p.add_argument("--gust", default=DEFAULT_GUST, metavar="sharp:A|none",
+                   help="the script's vertical gust: sharp-edged, A [m/s] up, 0.5 s after the "
+                        f"release, or none (default {DEFAULT_GUST}, the paper's Fig. 21)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print what was written as JSON")
     p.set_defaults(run=run)
 
 
+def _gust_up_m_s(text: str) -> float:
+    """The script's sharp-edged gust [m/s] (0: none); other gust kinds are refused."""
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    gust = parse_gust(text)  # GustSpecError: one line
+    if gust.kind == "none":
+        return 0.0
+    if gust.kind != "sharp":
+        raise UsageError(f"--gust {text!r}: the exported script flies a sharp-edged gust "
+                         "(sharp:A) or none")
+    return float(gust.amplitude_m_s)
+
+
+def _ours(path: Path) -> bool:
+    """A file an export (or the repository's generators) wrote: replaced without --force."""
+    try:
+        with path.open("rb") as fh:
+            return b"GENERATED by bioflex_jsb" in fh.read(512)
+    except OSError:  # unreadable: not known to be ours, so not replaced without --force
+        return False
+
+
+def _check_csv_target(path: Path) -> None:
+    """JSBSim disables its output silently (exit 0) when it cannot open the CSV: refuse a
+    root where that is already so."""
+    if (path.exists() or path.is_symlink()) and not path.is_file():
+        raise UsageError(f"{str(path)!r} exists and is not a regular file: the script's CSV "
+                         "could not be written there; remove it or choose another --out")
+
+
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.drivers.native import export_flight, write_export
+    from bioflex_jsb.generators import native_aircraft as NA
     from bioflex_jsb.generators import native_wing as J
-    from bioflex_jsb.generators.native_aircraft import export
 
     build = wing_from_args(args)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} is not a directory")
+    gust_up = _gust_up_m_s(args.gust)
     try:
         spec = J.ExportSpec(build.model, build.variant.name, args.model, args.dt, args.speed)
     except J.ExportError as exc:
         raise UsageError(str(exc)) from None
+    case, state, files = export_flight(spec, gust_up)  # TrimError: one line, nothing written
+    for rel in files:
+        check_output(str(out / rel), args.force, "file", ours=_ours)
+    _check_csv_target(out / case.output)
     try:
-        written = export(spec, out)
+        written = write_export(files, out)
     except OSError as exc:
         raise UsageError(f"cannot write into {args.out!r}: {exc.strerror or exc}") from None
-    nums = J.modal_matrices(spec.wing, spec.cl_trim)
+    root = out.resolve()
+    command = case.command(shlex.quote(str(root)))
     info = {
-        "out": str(out),
-        "aircraft": J.aircraft_name(spec.variant, spec.model),
+        "out": str(root),
+        "aircraft": case.aircraft,
         "system": J.system_name(spec.variant, spec.model),
         "model": spec.model,
         "dt_s": spec.dt_s,
+        "speed_m_s": spec.speed_m_s,
+        "gust_up_m_s": gust_up,
+        "initial_condition": case.ic_path,
+        "script": case.script,
+        "command": command,
+        "output_csv": str(root / case.output),
+        "columns": [{"column": "Time", "property": "simulation/sim-time-sec",
+                     "meaning": "simulation time [s]"}]
+                   + [{"column": c.caption, "property": c.prop, "meaning": c.meaning}
+                      for c in NA.COLUMNS],
+        "trim": {"propeller_rpm": state.propeller_rpm,
+                 "throttle": state.controls["fcs/throttle-cmd-norm[0]"],
+                 "theta_rad": state.ic["theta"][1]},
         "files": [str(p) for p in written],
     }
     if spec.model == "coupled":
+        nums = J.modal_matrices(spec.wing, spec.cl_trim)
         err, at = J.leapfrog_eigen_error(nums, spec.leapfrog(nums))
         info["eigenvalue_error_max"] = err
         info["eigenvalue_error_at_speed_m_s"] = at
     if args.json:
         print_json(info)
     else:
-        print(f"{spec.model} modal wing {spec.variant!r} for a {spec.dt_s:.6g} s step: "
-              f"aircraft {info['aircraft']} under {out} ({len(written)} files)")
+        print(f"{spec.model} modal wing {spec.variant!r} for a {spec.dt_s:.6g} s step, trimmed "
+              f"at {spec.speed_m_s:g} m/s: aircraft {case.aircraft} under {out} "
+              f"({len(written)} files)")
+        print(f"fly it: {command}")
+        print(f"it writes {info['output_csv']} (columns and units: docs/native.md)")
     return 0

@@ -1,5 +1,5 @@
-"""The native modal-wing aircraft (the wing in JSBSim's XML): its Fig. 21 trim, its files, and
-the aircraft loaded once for the benchmark.
+"""The native modal-wing aircraft (the wing in JSBSim's XML): its trim for the console program
+(the Fig. 21 case's and an export's), its files, and the aircraft loaded once for the benchmark.
 
 A native run is :func:`bioflex_jsb.drivers.gust.run_gust` with the model ``native``: the same
 coupled step, with JSBSim flying the wing. Regenerate the repository's native files with
@@ -23,12 +23,16 @@ from bioflex_jsb.runtime.fdm import TRIM_CONTROLS, Airframe
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 
-def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
-    """Trim of the Fig. 21 case by :meth:`Airframe.trim` (the co-simulation's trim: same
-    integrators and step), read from the flying instance."""
+def trim_state(speed_m_s: float = P.SECTION5_AIRSPEED_M_S,
+               dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
+    """Level trim at ``speed_m_s`` [m/s], ISA sea level, by :meth:`Airframe.trim` (the
+    co-simulation's trim: same integrators and step ``dt_s`` [s]) of the rigid airframe, read
+    from the flying instance. The native aircraft's trim is the same: its trim companion is the
+    airframe's, and the modal loads are zero at the trim reference. Raises TrimError (one
+    line) where level flight cannot be trimmed."""
     af = Airframe()
     configure_airframe(af, dt_s)
-    af.trim(P.SECTION5_AIRSPEED_M_S)
+    trim = af.trim(speed_m_s)
     ic = {
         "ubody": ("FT/SEC", af["velocities/u-fps"]),
         "vbody": ("FT/SEC", af["velocities/v-fps"]),
@@ -45,7 +49,33 @@ def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
         "longitude": ("RAD", af["position/long-gc-rad"]),
     }
     names = TRIM_CONTROLS + tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(af.engine_count))
-    return NA.TrimState(ic, {name: af[name] for name in names})
+    return NA.TrimState(ic, {name: af[name] for name in names}, trim.speed_m_s,
+                        trim.propeller_rpm, af.last_rpm_settle_s)
+
+
+def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
+    """Trim of the Fig. 21 case (:func:`trim_state` at the paper's 15 m/s)."""
+    return trim_state(P.SECTION5_AIRSPEED_M_S, dt_s)
+
+
+def export_flight(spec: J.ExportSpec, gust_up_m_s: float = P.SECTION5_GUST_AMPLITUDE_M_S,
+                  ) -> tuple[NA.FlightCase, NA.TrimState, dict[str, str]]:
+    """``bioflex-jsb export-jsbsim``'s files: the trim at the export's speed, then the system,
+    the aircraft, the trim as an initial condition and a script
+    (:func:`~bioflex_jsb.generators.native_aircraft.export_case`). Returns the case, the trim
+    and the files (path from the JSBSim root → text; write them with
+    :func:`write_export`). Raises TrimError (one line), ExportError."""
+    state = trim_state(spec.speed_m_s, spec.dt_s)
+    case = NA.export_case(spec, state, gust_up_m_s)
+    files = NA.render_aircraft_files(spec)
+    files.update(NA.flight_files(state, case))
+    return case, state, files
+
+
+def write_export(files: dict[str, str], out_dir: Path) -> list[Path]:
+    """Write :func:`export_flight`'s files under the JSBSim root ``out_dir``; the paths.
+    Raises OSError."""
+    return airframe_xml.write_files(files, out_dir)
 
 
 def repository_files() -> dict[str, str]:
