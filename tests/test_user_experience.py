@@ -19,7 +19,6 @@ from bioflex_jsb.flight_dynamics import eigen
 from bioflex_jsb.flight_dynamics.lti import build_state_space, thrust_speed_derivative_n_s_m
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import (
-    VariantError,
     build_wing,
     get_variant,
     load_variant_file,
@@ -90,22 +89,32 @@ def test_metrics_unit_diverged_and_turbulence():
 
 
 # ---- item 2: own FE modes on the first try ----------------------------------------------
+def docs_example(tmp_path) -> str:
+    """The variant file of docs/wing_variants.md ("Your own FE modes, end to end"), verbatim."""
+    text = (ROOT / "docs" / "wing_variants.md").read_text(encoding="utf-8")
+    block = text.split("```toml\n# my_wing.toml\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "example_ribbed.toml").write_bytes(EXAMPLE_MODES.read_bytes())
+    return block
+
+
 def own_modes_variant(tmp_path, extra=""):
     f = tmp_path / "my_wing.toml"
-    f.write_text(f'name = "my-wing"\nbase = "original"\nmodes_file = "{EXAMPLE_MODES}"\n{extra}')
+    f.write_text(docs_example(tmp_path) + extra)
     return f
 
 
-def test_own_fe_modes_example_inherits_the_pin_and_flies(capsys, tmp_path):
-    """The docs/wing_variants.md example: the original wing with modes from a file."""
+def test_own_fe_modes_example_inherits_the_pin_and_flies(capsys, tmp_path, monkeypatch):
+    """The docs/wing_variants.md example, run as the docs say (in the file's folder)."""
     f = own_modes_variant(tmp_path)
     v = load_variant_file(f)
     assert v.pinned_c_eta1_q1 == get_variant("original").pinned_c_eta1_q1
     assert eigen.find_flutter(build_wing(v).model).flutter_speed_m_s is None
-    code, out, err = run_cli(capsys, "gust", "--wing", f, "--speed", 15, "--duration", 1.5,
-                             "--models", "coupled", "--no-log", "--json")
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, "modes", "--wing", "my_wing.toml", "--speed", "15")
+    assert code == 0 and "UNSTABLE" not in out, err
+    code, out, err = run_cli(capsys, "gust", "--wing", "my_wing.toml")
     assert code == 0, err
-    assert json.loads(out)["summary"]["coupled"]["diverged"] is False
+    assert "diverged" not in out and (tmp_path / "gust.png").is_file()
 
 
 @pytest.mark.parametrize("extra, needle", [

@@ -76,7 +76,8 @@ def check_plot_path(path: str | None, force: bool) -> None:
     formats = plot_formats()
     if suffix not in formats:
         shown = ", ".join(f".{s}" for s in ("png", "pdf", "svg") if s in formats)
-        raise UsageError(f"plot file {path!r}: cannot write {('.' + suffix) if suffix else 'a file without a suffix'}; "
+        what = f".{suffix}" if suffix else "a file without a suffix"
+        raise UsageError(f"plot file {path!r}: cannot write {what}; "
                          f"give a name ending in {shown} (or any of "
                          f"{', '.join('.' + s for s in sorted(formats))})")
     from bioflex_jsb.sinks.plotting import is_our_plot

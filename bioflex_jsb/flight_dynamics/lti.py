@@ -222,7 +222,8 @@ def elastic_state_names(n: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
 CONTROL_INPUTS = ("elevator", "throttle")
 CONTROL_INPUT_UNITS = ("rad", "-")
 AERODYNAMIC_MODEL = ("quasi-steady: Table B1/B2 derivatives (strip/vortex-lattice spanwise "
-                     "loading), the paper's Eq. (4); analytic rigid block (flight_dynamics/rigid.py)")
+                     "loading), the paper's Eq. (4); analytic rigid block "
+                     "(flight_dynamics/rigid.py)")
 
 
 def control_columns(condition: FlightCondition, aero: RigidAerodynamics = RIGID_AERODYNAMICS,
