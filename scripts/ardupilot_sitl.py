@@ -39,16 +39,21 @@ NETNS_ENV = "BIOFLEX_ARDUPILOT_NETNS"  # set inside the private namespace
 MAVLINK_URL = "tcp:127.0.0.1:5760"  # ArduPilot SITL SERIAL0, instance 0
 # The bioflex side: the co-simulation as ArduPilot's JSON physics (``bioflex-jsb ardupilot``,
 # bioflex_jsb/drivers/ardupilot.py): the optimised wing, coupled, a 2 m/s 1-cosine gust of
-# 30 m (2 s at 15 m/s) 60 s after the launch; its JSON summary goes to physics.json and its
-# frames to physics.npz in --out. Override with --physics-cmd.
+# 30 m (2 s at 15 m/s) 30 s after the launch (on the square's second leg); its JSON summary
+# goes to physics.json and its frames to physics.npz in --out. Override with --physics-cmd.
 DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb ardupilot "
-                       "--wing optimised --model coupled --gust 1cos:2:30 --gust-at 60 "
+                       "--wing optimised --model coupled --gust 1cos:2:30 --gust-at 30 "
                        "--summary physics.json --table physics.npz")
 # Mission (metres from home, NED; altitude above home [m]): a 300 m square flown clockwise.
 TAKEOFF_ALT_M = 40.0  # NAV_TAKEOFF altitude
 TAKEOFF_PITCH_DEG = 12.0  # NAV_TAKEOFF minimum pitch (ArduPlane docs suggest 10..15 deg)
 MISSION_ALT_M = 60.0
 SQUARE_M = ((300.0, 0.0), (300.0, 300.0), (0.0, 300.0), (0.0, 0.0))
+LAUNCH_SWITCH_PWM_US = 1900  # RC 5 "fire" (the physics fires at 1880..1920 us held 0.5 s)
+RTL_WATCH_S = 30.0  # the flight ends after this long [s] in RTL near home
+LAUNCH_SWITCH_S = 2.0  # how long the switch is held [s of wall time]
+PLANE_MODE_RTL = 11  # ArduPlane custom_mode of RTL
+NO_OVERRIDE = 65535  # RC_CHANNELS_OVERRIDE: leave this channel alone
 EARTH_RADIUS_M = 6378137.0  # WGS-84 equatorial radius: metres → degrees near home
 
 
@@ -201,6 +206,9 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
     asked_home_s = 0.0
     armed = False
     arm_sent_s = 0.0
+    launch_until = 0.0  # wall time [s] until which the launch switch is held
+    launch_sent_s = 0.0
+    launch_released = False
     current_seq = -1
     legs: dict[int, float] = {}  # mission item -> largest |cross-track error| on its leg [m]
     track = []  # (sim time [s], north [m], east [m], alt above home [m], mission item)
@@ -245,19 +253,40 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
             mav.mav.command_long_send(mav.target_system, mav.target_component,
                                       m.MAV_CMD_GET_HOME_POSITION, 0, 0, 0, 0, 0, 0, 0, 0)
         if state == "wait_ready" and home is not None:
+            # SITL boots in AUTO (FLTMODE1 with no RC input) with an empty mission; AUTO is
+            # only (re)started on entering it, so leave it first, then start at the take-off
+            mav.set_mode("FBWA")
             n_items = _mission(mav, *home)
+            mav.waypoint_set_current_send(1)
             mav.set_mode("AUTO")
             mav.arducopter_arm()
             arm_sent_s = time.monotonic()
             state = "auto"
         if state == "auto" and not armed and time.monotonic() - arm_sent_s > 5.0:
-            mav.set_mode("AUTO")  # pre-arm checks (EKF, GPS) may refuse at first: again
-            mav.arducopter_arm()
+            mav.arducopter_arm()  # pre-arm checks (EKF, GPS) may refuse at first: again
             arm_sent_s = time.monotonic()
-        if state == "auto" and summary["reached"] and summary["reached"][-1] >= n_items - 2:
-            # the last square corner reached: RTL follows; watch it arrive and loiter
+        if state == "auto" and armed and "launch_sent_at_s" not in summary:
+            summary["launch_sent_at_s"] = sim_s
+            launch_until = time.monotonic() + LAUNCH_SWITCH_S
+        if state == "auto" and armed and time.monotonic() < launch_until \
+                and time.monotonic() - launch_sent_s > 0.2:
+            # the launch switch: RC 5 high (SERVO5_FUNCTION 55 passes it to the physics)
+            launch_sent_s = time.monotonic()
+            mav.mav.rc_channels_override_send(
+                mav.target_system, mav.target_component,
+                *([NO_OVERRIDE] * 4), LAUNCH_SWITCH_PWM_US, *([NO_OVERRIDE] * 3))
+        elif launch_until and time.monotonic() >= launch_until and not launch_released:
+            launch_released = True
+            mav.mav.rc_channels_override_send(
+                mav.target_system, mav.target_component,
+                *([NO_OVERRIDE] * 4), 0, *([NO_OVERRIDE] * 3))  # 0: back to RC input
+        if state == "auto" and kind == "HEARTBEAT" and msg.get_srcSystem() == mav.target_system \
+                and msg.custom_mode == PLANE_MODE_RTL and "rtl_at_s" not in summary:
+            summary["rtl_at_s"] = sim_s
+        if state == "auto" and "rtl_at_s" in summary and sim_s - summary["rtl_at_s"] > RTL_WATCH_S:
+            # the mission's RTL flown: home and loitering there
             if mav.location().alt is not None and _near_home(mav, home):
-                summary["ended"] = "home reached"
+                summary["ended"] = "home reached in RTL"
                 break
     summary["sim_s"] = sim_s
     summary["mission_items"] = n_items

@@ -207,6 +207,22 @@ def test_valid_range_stop_goes_back_to_the_launcher(link):
     assert ph.airframe["position/h-agl-ft"] * U.M_PER_FT == pytest.approx(2.0, abs=1e-6)
 
 
+def test_launch_switch_on_servo_5_fires_the_launcher(link):
+    """In AUTO ArduPlane keeps the throttle at 0 until it detects the launch: the ground
+    station's launch switch (RC 5 passed through to servo 5) fires it instead."""
+    ph = link.physics
+    for _ in range(ph.launch_hold_steps + 5):
+        link.frame(DISARMED + (1800,))  # SITL's own RC 5 at boot: not the switch
+    assert ph.phase == ad.REST
+    for _ in range(ph.launch_hold_steps - 1):
+        link.frame(DISARMED + (1900,))
+    assert ph.phase == ad.REST
+    link.frame(DISARMED + (1500,))  # released before the hold: the count starts again
+    for _ in range(ph.launch_hold_steps):
+        link.frame(DISARMED + (1900,))
+    assert ph.phase == ad.LAUNCH
+
+
 def test_channel_map(link):
     ch = {c.prop: c for c in ad.CHANNEL_MAP}
     assert ch["fcs/aileron-cmd-norm"].value(2000) == 1.0
@@ -236,6 +252,9 @@ def test_gust_report(wing):
     assert rep["w_g_peak_m_s"] == pytest.approx(2.0, rel=1e-6)
     assert rep["start_flight_s"] == pytest.approx(0.1, abs=ph.dt_s)
     assert abs(rep["eta1_change_peak_rad"]) > 1e-4
+    assert abs(rep["eta1_change_peak_in_gust_rad"]) > 1e-4
+    assert rep["eta1_min_in_gust_rad"] <= rep["eta1_max_in_gust_rad"]
+    assert rep["n_z_min_in_gust"] < 1.0 < rep["n_z_max_in_gust"]  # the 1-cosine's load
     json.dumps(ph.summary(), allow_nan=False)
 
 

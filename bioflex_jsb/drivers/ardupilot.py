@@ -32,9 +32,11 @@ phases (:attr:`ArduPilotPhysics.phase`):
 * ``rest``: held on the launcher at the trim attitude (wings level, pitch θ_trim, heading
   north), position (0, 0, 0) from home, velocity 0, airspeed 0, specific force
   R(θ)ᵀ(0, 0, −g) (level: (0, 0, −g)); JSBSim waits trimmed at the exit speed, unstepped.
-* ``launch``: when ArduPlane's throttle output (servo 3) has been above
-  :data:`LAUNCH_THROTTLE_US` for :data:`LAUNCH_HOLD_S` (armed in AUTO, waiting for the
-  launch at ``TKOFF_THR_IDLE``), a constant push along the trim's velocity (horizontal,
+* ``launch``: when for :data:`LAUNCH_HOLD_S` ArduPlane's throttle output (servo 3) has
+  been above :data:`LAUNCH_THROTTLE_US` (armed in TAKEOFF mode, waiting for the launch at
+  ``TKOFF_THR_IDLE``) or servo 5 within :data:`LAUNCH_SWITCH_US` (the launch switch: RC
+  input 5 passed through, set by the ground station once ArduPlane is armed in AUTO),
+  a constant push along the trim's velocity (horizontal,
   north) to the trim (exit) speed ``speed_m_s`` at ``launch_accel_m_s2`` (default 40 m/s²
   over 0.375 s, a 2.8 m stroke), exact constant-acceleration kinematics: specific force
   R(θ)ᵀ(a, 0, −g), the push seen by ArduPlane's ``TKOFF_THR_MINACC``.
@@ -64,9 +66,10 @@ The state sent (:meth:`ArduPilotPhysics.state`), in flight:
 
 Gusts: any :class:`~bioflex_jsb.simulation.gusts.GustSpec`, starting ``gust_at_s`` [s] after
 the launch (flight time), sampled by the coupled step's step number. The first modal
-coordinate's peak during the gust and until :data:`GUST_DECAY_S` after it, and its largest
-change from the gust's start (:attr:`ArduPilotPhysics.gust_report`, [rad]) are measured on
-every step.
+coordinate's range and largest change from the gust's start while the gust blows
+(``*_in_gust``, with n_z's range), and its peak and largest change until
+:data:`GUST_DECAY_S` after it (which may include a manoeuvre of the autopilot's), are
+measured on every step (:attr:`ArduPilotPhysics.gust_report`, [rad]).
 
 Recording: :meth:`ArduPilotPhysics.on_frame` (the server's ``on_frame``) keeps every
 ``record_every``-th frame, and every resend and reset, in :attr:`records` (columns
@@ -132,9 +135,16 @@ CHANNEL_MAP: tuple[Channel, ...] = (
 )
 THROTTLE_CHANNEL = 2
 
-# The launch fires when servo 3 has been above this [µs] for LAUNCH_HOLD_S [s]: ArduPlane
-# armed in AUTO at NAV_TAKEOFF holds TKOFF_THR_IDLE (5 % = 1050 µs); disarmed it sends 1000.
+# The launch fires when, for LAUNCH_HOLD_S [s], servo 3 has been above LAUNCH_THROTTLE_US
+# (ArduPlane in TAKEOFF mode holds TKOFF_THR_IDLE, 5 % = 1050 µs, while it waits; disarmed
+# it sends 1000) or servo 5 within LAUNCH_SWITCH_US (SERVO5_FUNCTION 55 passes RC input 5
+# through: the launch switch a ground station sets with RC_CHANNELS_OVERRIDE. In AUTO this
+# ArduPlane keeps the throttle at 0 until the launch is detected, so TKOFF_THR_IDLE cannot
+# signal it there). The window is narrow because SITL's own RC 5 idles at 1800 µs, which
+# fired the launcher at boot when the switch was "above 1700 µs".
 LAUNCH_THROTTLE_US = 1020
+LAUNCH_SWITCH_CHANNEL = 4  # servo 5
+LAUNCH_SWITCH_US = (1880, 1920)
 LAUNCH_HOLD_S = 0.5
 DEFAULT_LAUNCH_ACCEL_M_S2 = 40.0  # a canister/bungee push, > TKOFF_THR_MINACC = 15 m/s²
 DEFAULT_LAUNCH_HEIGHT_M = 2.0  # launcher above the ground [m]
@@ -286,16 +296,18 @@ class ArduPilotPhysics:
             self.gust_spec, self.speed_m_s, self.gust_at_s, self.gust_at_s + 600.0,
             core.dt_s)
         self._gust_steps = (-1, -1)
+        self._gust_end_k = -1
         if self.gust_spec is not None:
             k0 = math.ceil(self.gust_at_s / core.dt_s - 1e-9)
             length_s = (self.gust_spec.length_m / self.speed_m_s
                         if self.gust_spec.kind == "1cos" else 600.0)
             self._gust_steps = (k0, k0 + int(round((length_s + GUST_DECAY_S) / core.dt_s)))
+            self._gust_end_k = k0 + int(round(length_s / core.dt_s))
         core.prepare(0.0)
 
     def _to_rest(self) -> None:
         self.phase = REST
-        self._throttle_hold_k = 0  # frames with the throttle above LAUNCH_THROTTLE_US
+        self._throttle_hold_k = 0  # frames with the launch signalled (throttle or switch)
         self._stroke_k = 0
 
     @property
@@ -305,7 +317,7 @@ class ArduPilotPhysics:
 
     @property
     def launch_hold_steps(self) -> int:
-        """Frames of throttle above LAUNCH_THROTTLE_US that fire the launcher."""
+        """Frames of the launch signal (throttle or switch) that fire the launcher."""
         return max(1, math.ceil(LAUNCH_HOLD_S / self.dt_s - 1e-9))
 
     @property
@@ -337,7 +349,10 @@ class ArduPilotPhysics:
         self.frame_k += 1
         if self.phase == REST:
             thr = pwm_us[THROTTLE_CHANNEL] if len(pwm_us) > THROTTLE_CHANNEL else 0
-            self._throttle_hold_k = self._throttle_hold_k + 1 if thr > LAUNCH_THROTTLE_US else 0
+            switch = pwm_us[LAUNCH_SWITCH_CHANNEL] if len(pwm_us) > LAUNCH_SWITCH_CHANNEL else 0
+            lo, hi = LAUNCH_SWITCH_US
+            ready = thr > LAUNCH_THROTTLE_US or lo <= switch <= hi
+            self._throttle_hold_k = self._throttle_hold_k + 1 if ready else 0
             if self._throttle_hold_k >= self.launch_hold_steps:
                 self.phase = LAUNCH
                 self.launches += 1
@@ -374,7 +389,9 @@ class ArduPilotPhysics:
             rep.update(start_time_s=self.t_s, start_flight_s=k * self.core.dt_s,
                        eta1_peak_rad=0.0, eta1_peak_time_s=math.nan,
                        eta1_at_start_rad=eta1, eta1_change_peak_rad=0.0,
-                       w_g_peak_m_s=0.0)
+                       w_g_peak_m_s=0.0, eta1_min_in_gust_rad=eta1, eta1_max_in_gust_rad=eta1,
+                       eta1_change_peak_in_gust_rad=0.0, n_z_min_in_gust=math.inf,
+                       n_z_max_in_gust=-math.inf)
         if not rep:
             return
         if abs(eta1) > abs(rep["eta1_peak_rad"]):
@@ -383,6 +400,14 @@ class ArduPilotPhysics:
         change = eta1 - rep["eta1_at_start_rad"]
         if abs(change) > abs(rep["eta1_change_peak_rad"]):
             rep["eta1_change_peak_rad"] = change
+        if k <= self._gust_end_k:  # while the gust blows (1-cosine: its length)
+            rep["eta1_min_in_gust_rad"] = min(rep["eta1_min_in_gust_rad"], eta1)
+            rep["eta1_max_in_gust_rad"] = max(rep["eta1_max_in_gust_rad"], eta1)
+            if abs(change) > abs(rep["eta1_change_peak_in_gust_rad"]):
+                rep["eta1_change_peak_in_gust_rad"] = change
+            n_z = self.core.get["nz"]()  # of the state the step reached
+            rep["n_z_min_in_gust"] = min(rep["n_z_min_in_gust"], n_z)
+            rep["n_z_max_in_gust"] = max(rep["n_z_max_in_gust"], n_z)
         if abs(self._last_w_g) > abs(rep["w_g_peak_m_s"]):
             rep["w_g_peak_m_s"] = self._last_w_g
 
