@@ -47,6 +47,9 @@ def gust_log(tmp_path_factory) -> Path:
 
 
 STEPS_1S = int(round(1.0 / DEFAULT_DT_S))
+# a log written before protobuf (JSON messages): gust --duration 0.3 --gust-start 0.1
+OLD_JSON_LOG = ROOT / "tests" / "fixtures" / "old_json_log.mcap"
+OLD_STEPS = int(round(0.3 / DEFAULT_DT_S))
 
 
 def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
@@ -142,8 +145,8 @@ def _node_checker(tmp_path_factory):
     where = tmp_path_factory.mktemp("mcapjs")
     (where / "package.json").write_text('{"name": "mcap-check", "private": true}\n')
     done = subprocess.run([npm, "install", "--no-audit", "--no-fund", "@mcap/core",
-                           "@foxglove/wasm-zstd"], cwd=where, capture_output=True, text=True,
-                          timeout=300)
+                           "@foxglove/wasm-zstd", "protobufjs"], cwd=where,
+                          capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     shutil.copy(JS_CHECK, where / JS_CHECK.name)
 
@@ -168,6 +171,24 @@ def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
     assert result["statistics"] == expected
     assert result["dataCrcOk"] is True and result["ordered"] is True
     assert result["schemas"]["/bioflex/coupled/location"] == "foxglove.LocationFix"
+    assert set(result["encodings"].values()) == {"protobuf"}
+    # protobufjs (Foxglove's decoder) reads every message as our own reader does
+    ours = read_all(gust_log)
+    for top, theirs in result["samples"].items():
+        mine = ours[top][1][1]
+        if "timestamp" in theirs:  # google.protobuf.Timestamp: seconds/nanos
+            ts = theirs.pop("timestamp")
+            assert mine.pop("timestamp") == {"sec": ts.get("seconds", 0),
+                                             "nsec": ts.get("nanos", 0)}
+        mine = {k: v for k, v in mine.items() if v not in (0, 0.0)}  # proto3 defaults
+        theirs = {k: v for k, v in theirs.items() if v not in (0, 0.0)}
+        assert theirs == mine, top  # the same doubles, bit for bit
+
+
+def test_old_json_log_reads_with_mcap_core(node_check):
+    result = node_check(OLD_JSON_LOG)
+    assert set(result["encodings"].values()) == {"json"}
+    assert result["counts"][sink.topic("coupled", "pose")] == OLD_STEPS
 
 
 def test_pymcap_cli_doctor(gust_log):
@@ -279,7 +300,7 @@ def test_bad_files_exit_2_with_one_line(command, gust_log, tmp_path, capsys):
         assert len(err.strip().splitlines()) == 1 and words in err, err
 
 
-def test_non_finite_numbers_are_written_as_null(tmp_path):
+def test_non_finite_numbers_are_written_as_they_are(tmp_path):
     row = {k: 0.01 for k in ("u", "alpha", "q", "theta", "w_g", "latitude_rad",
                              "longitude_rad", "phi_rad", "theta_rad", "psi_rad", "p_rad_s",
                              "r_rad_s", "elevator_rad", "throttle", "lift_n", "drag_n",
@@ -291,8 +312,8 @@ def test_non_finite_numbers_are_written_as_null(tmp_path):
                                  "u": 1e-300})
     log.close()
     msgs = read_all(tmp_path / "nan.mcap")
-    assert msgs["/bioflex/coupled/modal"][1][1]["eta_rad"] == [None]
-    assert msgs["/bioflex/coupled/modal_loads"][1][1]["lift_n"] is None
+    assert math.isnan(msgs["/bioflex/coupled/modal"][1][1]["eta_rad"][0])  # binary doubles
+    assert msgs["/bioflex/coupled/modal_loads"][1][1]["lift_n"] == math.inf
     assert msgs["/bioflex/coupled/rigid_body"][1][1]["du_m_s"] == 1e-300
     assert msgs["/bioflex/coupled/rigid_body"][0][1]["du_m_s"] == 0.01
 
@@ -326,13 +347,18 @@ def _env():
 DRIVER = """
 import sys
 from bioflex_jsb import cli
-from bioflex_jsb.sinks import mcap as sink
-original = sink.TableRecorder.step
-def step(self, k):
-    original(self, k)
-    sys.stdout.write(repr(float(self._time_s[k])) + "\\n")
-    sys.stdout.flush()
-sink.TableRecorder.step = step
+from bioflex_jsb.runtime.coupled_step import CoupledStep
+original = CoupledStep.stepper
+def stepper(self):
+    advance, k = original(self), [0]
+    def counted(w_g, table, j):
+        stop = advance(w_g, table, j)
+        sys.stdout.write(repr(k[0] * self.dt_s) + "\\n")
+        sys.stdout.flush()
+        k[0] += 1
+        return stop
+    return counted
+CoupledStep.stepper = stepper
 sys.exit(cli.main(sys.argv[1:]))
 """
 
@@ -406,69 +432,80 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
 
 
-def test_fixed_width_numbers_match_printf():
-    """The vectorised "% .8e" formatting equals Python's, and flags what does not fit."""
-    rng = np.random.default_rng(7)
-    x = np.concatenate([rng.standard_normal(20000) * 10.0 ** rng.integers(-120, 120, 20000),
-                        [0.0, -0.0, 1.0, -1.0, 10.0, 1e-5, 9.9999999949, 9.99999999e99,
-                         1e100, 1e-99, 1e-100, 5e-324, 1.7e308, np.nan, np.inf, -np.inf]])
-    chars, ok = sink.fixed_e(x)
-    for v, c, fits in zip(x.tolist(), chars, ok.tolist(), strict=True):
-        text = format(v, " .8e")
-        assert fits == (len(text) == 15 and math.isfinite(v)), v
-        if fits:
-            assert c.tobytes().decode() == text
-    n = np.array([0, 7, 10, 999_999_999, 1_234_567_890])
-    assert [c.tobytes().decode() for c in sink.fixed_d(n)] == [f"{i:10d}" for i in n]
+def test_varints_are_canonical_protobuf():
+    """The timestamp varints: every length 1 … 5 bytes, equal to the shortest encoding."""
+    from bioflex_jsb.sinks.mcap import formatting, protobuf
+
+    v = np.array([0, 1, 127, 128, 16383, 16384, 2**21 - 1, 2**21, 2**28 - 1, 2**28,
+                  999_999_999], dtype=np.int64)
+    lengths = formatting.varint_lengths(v)
+    assert lengths.tolist() == [len(protobuf.varint(int(x))) for x in v]
+    for x, n in zip(v.tolist(), lengths.tolist(), strict=True):
+        got = formatting.varint_bytes(np.array([x], dtype=np.int64), n)[0].tobytes()
+        assert got == protobuf.varint(x) and protobuf.read_varint(got, 0) == (x, n)
+
+
+def _chunks_of(recorder, time_s, table, dt_s=1 / 960):
+    """Hand ``table`` to ``recorder`` as run_gust does: blocks of the steps it asks for."""
+    block = recorder.start(tuple(NAMES_2), dt_s)
+    for k in range(0, len(table), block):
+        recorder.rows(time_s[k:k + block], table[k:k + block])
+    recorder.stop(len(table))
+    return block
+
+
+def _names(n_modes: int) -> tuple[str, ...]:
+    from bioflex_jsb.simulation.channels import channel_units as base_channels
+
+    return tuple(base_channels(n_modes))
+
+
+NAMES_2 = _names(2)
 
 
 def test_dict_samples_and_table_recorder_write_the_same_messages(tmp_path):
-    from bioflex_jsb.simulation.channels import channel_units as base_channels
-
-    names = tuple(base_channels(2))
+    names = NAMES_2
     rng = np.random.default_rng(3)
     table = rng.standard_normal((1000, len(names))) * 0.1
     table[:, names.index("altitude_m")] += 100.0
     time_s = np.arange(1000) / 960
     a, b = _bare_log(tmp_path / "a.mcap"), _bare_log(tmp_path / "b.mcap")
-    recorder = a.recorder("coupled")
-    recorder.start(names, time_s, table)
+    block = _chunks_of(a.recorder("coupled"), time_s, table)
+    assert block == 864  # CHUNK_SPAN_S of steps at 960 Hz
     for k in range(1000):
-        recorder.step(k)
         b.sample("coupled", time_s[k], dict(zip(names, table[k].tolist(), strict=True)))
-    recorder.stop(1000)
     a.close()
     b.close()
     ma, mb = read_all(tmp_path / "a.mcap"), read_all(tmp_path / "b.mcap")
     assert ma == mb and len(ma["/bioflex/coupled/rigid_body"]) == 1000
     first = ma["/bioflex/coupled/modal"][5][1]
-    assert first["eta_rad"][1] == pytest.approx(table[5, names.index("eta2")], rel=1e-8)
+    assert first["eta_rad"][1] == table[5, names.index("eta2")]  # the double itself
     # a chunk every CHUNK_SPAN_S of simulated time (864 steps at 960 Hz): 2 for 1000 steps
     assert sink.summarise(tmp_path / "a.mcap")["chunks"] == 2
 
 
-def test_recorder_writes_each_complete_row_once_whatever_stops_the_run(tmp_path):
-    """Rows reach the file as soon as their chunk is complete, each once: stop(n) after a
-    failure writes the rest, a second stop or a stop at the chunk boundary adds nothing."""
-    from bioflex_jsb.simulation.channels import channel_units as base_channels
-
-    names = tuple(base_channels(1))
+def test_recorder_writes_each_block_at_once_and_once(tmp_path):
+    """Rows reach the file as soon as their block is handed over, each once; stop adds
+    nothing; a block across a varint-length change of the timestamps reads back in order."""
+    names = NAMES_2
     n_rows = 1000
     table = np.zeros((n_rows, len(names)))
     table[:, 0] = np.arange(n_rows)  # u: the row number, to find every row in the file
-    time_s = np.arange(n_rows) / 960
+    time_s = 127.5 + np.arange(n_rows) / 960  # seconds 127 → 128: 1 → 2 byte varints
     log = _bare_log(tmp_path / "r.mcap")
     rec = log.recorder("coupled")
-    rec.start(names, time_s, table)
-    for k in range(900):
-        rec.step(k)
-    # the first chunk (864 rows) was written when its last row completed, before stop
-    assert log._writer._n_messages == 864 * 7
-    rec.stop(900)  # the loop failed after row 899
+    block = rec.start(names, 1 / 960)
+    rec.rows(time_s[:block], table[:block])
+    assert log._writer._n_messages == block * 7  # written when handed over, before stop
+    rec.rows(time_s[block:900], table[block:900])  # the loop failed after row 899
+    rec.stop(900)
     rec.stop(900)
     log.close()
-    rows = read_all(tmp_path / "r.mcap")["/bioflex/coupled/rigid_body"]
-    assert [m["du_m_s"] for _, m in rows] == list(range(900))
+    msgs = read_all(tmp_path / "r.mcap")
+    assert [m["du_m_s"] for _, m in msgs["/bioflex/coupled/rigid_body"]] == list(range(900))
+    pose = msgs["/bioflex/coupled/pose"]
+    assert [ns for ns, _ in pose] == [round(t * 1e9) for t in time_s[:900]]
+    assert all(m["timestamp"] == {"sec": ns // 10**9, "nsec": ns % 10**9} for ns, m in pose)
 
 
 # --------------------------------------------------------------- run descriptions and errors

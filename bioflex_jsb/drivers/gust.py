@@ -1,10 +1,12 @@
 """A nonlinear gust run: trim, then fly the one coupled step through a gust.
 
 :func:`run_gust` is a thin loop over :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`
-(whose docstring has the order of a step): the gust is sampled by step number, every row is
-stored in the run's table and handed to a recorder (an MCAP log), and the run stops when the
-step leaves its valid range. The Fig. 21 run is within 1 % NRMSE of the same run at a quarter
-of the step (``tests/test_cosim.py``).
+(whose docstring has the order of a step): the gust is sampled by step number, the rows are
+written block by block (a block = the log's chunk, 0.9 s of simulated time) and each full
+block is handed to a recorder (an MCAP log), and the run stops when the step leaves its valid
+range. Short runs keep every row; long ones keep one block plus a bounded envelope for their
+summary (``keep``), so memory stays flat however long the run. The Fig. 21 run is within
+1 % NRMSE of the same run at a quarter of the step (``tests/test_cosim.py``).
 """
 
 from __future__ import annotations
@@ -36,22 +38,66 @@ class RunSetup:
     dt_s: float = DEFAULT_DT_S
 
 
-class StepRecorder(Protocol):
-    """Something that keeps a run's steps as they complete (an MCAP log), reading them from
-    the run's own table rather than being handed each step's numbers.
+# A run keeps every step (keep="all") up to this duration by default [s] (≈ 0.24 MB per
+# simulated second of table, and as much again for the returned history); longer runs keep
+# an envelope (keep="envelope").
+KEEP_ALL_MAX_S = 120.0
+# The envelope: per this span of simulated time [s], the first and last step and the steps
+# where each summary channel reaches its minimum and maximum.
+ENVELOPE_S = 0.25
+SUMMARY_CHANNELS = ("u", "alpha", "q", "theta", "n_z")  # what gust_metrics reads
+WINDOW_S = 0.9  # rows per block without a recorder [s of simulated time]
+KEEP_CHOICES = ("auto", "all", "envelope")
 
-    ``start`` is called once before the first step with the channel names, the times [s] of
-    every step the run may take and the (steps × channels) table the run fills row by row
-    (units: :func:`bioflex_jsb.simulation.channels.channel_units`); ``step(k)`` after row k
-    is complete; ``stop(n)`` once at the end, however the run ends (finished, stopped,
-    interrupted, failed), with the number of complete rows.
+
+class StepRecorder(Protocol):
+    """Something that keeps a run's steps as they complete (an MCAP log), handed a block of
+    rows at a time.
+
+    ``start(names, dt_s)`` is called once before the first step with the channel names and
+    the step [s] and returns how many steps a block should hold (the log's chunk);
+    ``rows(time_s, rows)`` with each block's complete rows as soon as it is flown (times [s],
+    a (steps × channels) array in the names' order, units:
+    :func:`bioflex_jsb.simulation.channels.channel_units`; both may be reused once it
+    returns), and with the rows left when the run stops; ``stop(n)`` once at the end,
+    however the run ends (finished, stopped, interrupted, failed), with the number of
+    complete rows.
     """
 
-    def start(self, names: tuple[str, ...], time_s: np.ndarray, table: np.ndarray) -> None: ...
+    def start(self, names: tuple[str, ...], dt_s: float) -> int: ...
 
-    def step(self, k: int) -> None: ...
+    def rows(self, time_s: np.ndarray, rows: np.ndarray) -> None: ...
 
     def stop(self, n: int) -> None: ...
+
+
+class _Envelope:
+    """A bounded-rate history of a long run: per ENVELOPE_S of steps, the first and last
+    step and the steps where each of :data:`SUMMARY_CHANNELS` is smallest and largest, so
+    the peaks (and the overshoot) that ``gust_metrics`` reports are those of every step;
+    its settling time is resolved to ENVELOPE_S."""
+
+    def __init__(self, names: tuple[str, ...], dt_s: float) -> None:
+        self.cols = [names.index(c) for c in SUMMARY_CHANNELS if c in names]
+        self.every = max(1, int(round(ENVELOPE_S / dt_s)))
+        self._t: list[np.ndarray] = []
+        self._rows: list[np.ndarray] = []
+
+    def add(self, time_s: np.ndarray, rows: np.ndarray) -> None:
+        for a in range(0, len(rows), self.every):
+            seg = rows[a:a + self.every]
+            x = seg[:, self.cols]
+            nan = np.isnan(x)
+            hi = np.argmax(np.where(nan, -np.inf, x), axis=0)
+            lo = np.argmin(np.where(nan, np.inf, x), axis=0)
+            keep = np.unique(np.concatenate([[0, len(seg) - 1], hi, lo]))
+            self._t.append(time_s[a + keep])
+            self._rows.append(seg[keep])
+
+    def history(self, n_channels: int) -> tuple[np.ndarray, np.ndarray]:
+        if not self._rows:
+            return np.empty(0), np.empty((0, n_channels))
+        return np.concatenate(self._t), np.concatenate(self._rows)
 
 
 def run_gust(
@@ -63,60 +109,119 @@ def run_gust(
     trim: TrimResult | None = None,
     recorder: StepRecorder | None = None,
     compiled: bool = True,
+    keep: str = "auto",
     aero: str = "quasi-steady",
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
     aircraft with the wing in its XML, ``wing`` then None).
 
     ``on_sample(k, t_s, row)`` is called after every step (progress), ``row`` the step's
-    row of the table (channel order; read it, do not keep it); ``recorder`` (a log) reads
-    the steps from the run's table (:class:`StepRecorder`). A run that leaves the valid
-    range stops: the returned history holds every step up to then and its ``stopped``
-    field says why. ``trim``: the airframe was just trimmed to this (skip it).
-    ``compiled``: the compiled step kernel, or (False) the readable Python step it is
-    tested against.
+    row (channel order; read it, do not keep it); ``recorder`` (a log) is handed the rows a
+    block at a time (:class:`StepRecorder`). A run that leaves the valid range stops: the
+    returned history holds the steps up to then and its ``stopped`` field says why.
+    ``trim``: the airframe was just trimmed to this (skip it). ``compiled``: the compiled
+    step kernel, or (False) the readable Python step it is tested against.
+
+    ``keep``: what the returned history holds. ``"all"``: every step (memory grows with the
+    run, ≈ 0.5 MB per simulated second); ``"envelope"``: a bounded-rate envelope (per
+    ENVELOPE_S, the first and last step and each summary channel's extremes: exact peaks,
+    settling time to ENVELOPE_S; ``meta["history"]`` says which) while the run itself keeps
+    only one block of rows; ``"auto"`` (default): ``"all"`` up to KEEP_ALL_MAX_S of
+    duration, else ``"envelope"``.
     """
+    if keep not in KEEP_CHOICES:
+        raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m, setup.dt_s,
                        trim=trim, compiled=compiled, aero=aero)
     dt = step.dt_s
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))
     names = step.names
-    table = np.full((n_steps, len(names)), np.nan)  # row k: step k, columns in names' order
-    time_s = np.arange(n_steps) * dt
+    keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
     stopped = None
     interrupted = False
-    done = 0  # complete rows of the table
+    block = max(1, int(round(WINDOW_S / dt)))
     if recorder is not None:
-        recorder.start(names, time_s, table)
-        record = recorder.step
+        block = max(1, int(recorder.start(names, dt)))
+    block = min(block, max(n_steps, 1))
+    if keep_all:  # row k: step k, columns in names' order
+        table = np.full((n_steps, len(names)), np.nan)
+        envelope = None
+    else:  # one block of rows, refilled block after block
+        table = np.full((block, len(names)), np.nan)
+        envelope = _Envelope(names, dt)
+
+    def hand(k0: int, m: int, j0: int) -> None:
+        """Rows [k0, k0 + m) of the run, complete in the table from row j0: to the
+        recorder and the envelope."""
+        if m <= 0:
+            return
+        rows = table[j0:j0 + m]
+        time_s = (k0 + np.arange(m)) * dt
+        if recorder is not None:
+            recorder.rows(time_s, rows)
+        if envelope is not None:
+            envelope.add(time_s, rows)
+
     advance_into = step.stepper()  # the step, bound once (compiled or Python)
-    w_g = gust.samples(n_steps).tolist()  # the gust by step number [m/s, up]
+    w_g = gust.samples(n_steps)  # the gust by step number [m/s, up]
+    k = 0  # steps handed over
+    i = 0  # complete steps of the block in progress
+    j0 = 0  # its first row in the table
     try:
         with airframe.capturing():  # JSBSim's output captured once for the loop
-            for k in range(n_steps):
-                stop = advance_into(w_g[k], table, k)
-                done = k + 1
-                if recorder is not None:
-                    record(k)
-                if on_sample is not None:
-                    on_sample(k, k * dt, table[k])
+            while k < n_steps:
+                j0 = k if keep_all else 0
+                ws = w_g[k:k + block].tolist()
+                stop = None
+                i = 0
+                if on_sample is None:
+                    for w in ws:
+                        stop = advance_into(w, table, j0 + i)
+                        i += 1
+                        if stop:
+                            break
+                else:
+                    for w in ws:
+                        stop = advance_into(w, table, j0 + i)
+                        i += 1
+                        on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
+                        if stop:
+                            break
+                m, i = i, 0
+                k += m
+                hand(k - m, m, j0)
                 if stop:
                     stopped = stop
                     break
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
-        stopped = f"interrupted at t = {done * dt:.3f} s"
     finally:
         step.release()
-        if recorder is not None:
-            recorder.stop(done)  # also when the loop failed: keep every complete step
-    n = done
+        try:
+            if i:  # the block in progress when the loop failed or was interrupted
+                m, i = i, 0
+                k += m
+                hand(k - m, m, j0)
+        finally:
+            if recorder is not None:
+                recorder.stop(k)  # also when the loop failed: every complete step kept
+    n = k
+    if interrupted:
+        stopped = f"interrupted at t = {n * dt:.3f} s"
     trim = step.trim
+    if envelope is None:
+        time_s = np.arange(n) * dt
+        channels = {name: table[:n, c].copy() for c, name in enumerate(names)}
+        history = "all"
+    else:
+        time_s, rows = envelope.history(len(names))
+        channels = {name: rows[:, c].copy() for c, name in enumerate(names)}
+        history = "envelope"
     return TimeHistory(
         model=model,
-        time_s=time_s[:n],
-        channels={name: table[:n, i].copy() for i, name in enumerate(names)},
+        time_s=time_s,
+        channels=channels,
         units=dict(step.units),
         meta={
             "source": "jsbsim-native" if model == "native" else "jsbsim-cosim",
@@ -131,6 +236,9 @@ def run_gust(
             "alpha_peak_rad": step.alpha_peak_rad,
             "time_beyond_stall_s": step.stall_steps * dt,
             "interrupted": interrupted,
+            "history": history,
+            "steps": n,
+            "envelope_s": ENVELOPE_S if envelope is not None else None,
         },
         stopped=stopped,
     )

@@ -1,13 +1,37 @@
 // Independent check of a bioflex-jsb MCAP log with the @mcap/core indexed reader (Node).
-// Usage: node check_mcap.cjs FILE.mcap   (run where @mcap/core and @foxglove/wasm-zstd are
-// installed). Prints one JSON object: message counts per topic (read back through the chunk
-// indexes, every chunk's CRC checked), the statistics record's counts, and whether the
-// summary CRC (checked by Initialize) and the data-section CRC (checked here) hold.
+// Usage: node check_mcap.cjs FILE.mcap   (run where @mcap/core, @foxglove/wasm-zstd and
+// protobufjs are installed). Prints one JSON object: message counts per topic (read back
+// through the chunk indexes, every chunk's CRC checked), the statistics record's counts,
+// whether the summary CRC (checked by Initialize) and the data-section CRC (checked here)
+// hold, and one decoded message per topic: protobuf messages are decoded with protobufjs
+// from the file's own FileDescriptorSet schemas (as Foxglove does), JSON ones (older logs)
+// with JSON.parse.
 "use strict";
 const fs = require("fs");
 const { McapIndexedReader } = require("@mcap/core");
 const { crc32 } = require("@foxglove/crc");
 const zstd = require("@foxglove/wasm-zstd");
+const protobuf = require("protobufjs");
+const descriptor = require("protobufjs/ext/descriptor");
+
+const decoders = new Map(); // channel id -> function(bytes) -> object
+function decoderFor(reader, channel) {
+  let d = decoders.get(channel.id);
+  if (d) return d;
+  if (channel.messageEncoding === "json") {
+    d = (data) => JSON.parse(new TextDecoder().decode(data));
+  } else if (channel.messageEncoding === "protobuf") {
+    const schema = reader.schemasById.get(channel.schemaId);
+    if (!schema || schema.encoding !== "protobuf") throw new Error(`no protobuf schema: ${channel.topic}`);
+    const root = protobuf.Root.fromDescriptor(descriptor.FileDescriptorSet.decode(schema.data));
+    const type = root.lookupType(schema.name);
+    d = (data) => type.toObject(type.decode(data), { longs: Number, defaults: false });
+  } else {
+    throw new Error(`unexpected message encoding ${channel.messageEncoding} on ${channel.topic}`);
+  }
+  decoders.set(channel.id, d);
+  return d;
+}
 
 async function main(path) {
   await zstd.isLoaded;
@@ -28,10 +52,15 @@ async function main(path) {
   const counts = {};
   let last = -1n;
   let ordered = true;
+  const samples = {};
+  const encodings = {};
   for await (const msg of reader.readMessages({ validateCrcs: true })) {
-    const topic = reader.channelsById.get(msg.channelId).topic;
+    const channel = reader.channelsById.get(msg.channelId);
+    const topic = channel.topic;
     counts[topic] = (counts[topic] || 0) + 1;
-    JSON.parse(new TextDecoder().decode(msg.data)); // every message is JSON
+    const decoded = decoderFor(reader, channel)(msg.data); // every message decodes
+    encodings[topic] = channel.messageEncoding;
+    if (counts[topic] === 2) samples[topic] = decoded;
     if (msg.logTime < last) ordered = false;
     last = msg.logTime;
   }
@@ -54,7 +83,7 @@ async function main(path) {
     schemas[ch.topic] = reader.schemasById.get(ch.schemaId).name;
   }
   console.log(JSON.stringify({
-    counts, statistics, schemas, ordered, dataCrcOk,
+    counts, statistics, schemas, encodings, samples, ordered, dataCrcOk,
     chunks: reader.chunkIndexes.length, library: reader.header.library,
   }));
 }

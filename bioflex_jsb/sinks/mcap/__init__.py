@@ -1,6 +1,7 @@
 """MCAP logs of runs: writing (every step of a run), reading back, recovering a killed log.
 
-This is the only package that imports ``mcap``. Topics (JSON messages with JSON schemas;
+This is the only package that imports ``mcap``. Topics (protobuf messages whose schemas,
+``FileDescriptorSet`` records, are in the file; older logs: JSON, still read;
 ``<model>`` is ``rigid``, ``coupled`` or ``qsd``; units in every field name and in the schema
 descriptions; the full table is in ``docs/logging.md``):
 
@@ -30,18 +31,20 @@ overrides; package, JSBSim and mcap versions: :mod:`.metadata`) and ``bioflex.wo
 Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_WALL_S` of
 wall time, or 4096 steps) and written to the operating system at once, so a process killed
 hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed
-file from the complete chunks of such a log. A gust run is logged from the run's own table
-of steps (:meth:`RunLog.recorder`, nothing copied per step) and a chunk's steps are
-formatted at once, vectorised, in fixed-width numbers (:func:`fixed_e`), so record lengths and index
-offsets are known in advance (``docs/logging.md``, Overhead).
+file from the intact chunks of such a log (skipping damaged ones) and :func:`check_chunks`
+verifies every chunk's CRC. A gust run hands the log a chunk of rows at a time
+(:meth:`RunLog.recorder`, nothing per step) and a chunk's protobuf records are built at once
+with numpy (:mod:`.formatting`, ``docs/logging.md``, Encoding and Overhead).
 
 The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
 the 20 % overhead budget allows at seven messages per step); every record other than the
 messages in a chunk is serialised with the ``mcap`` package's record classes, and the files are
 checked by independent readers in the tests (``@mcap/core``, ``pymcap-cli doctor``).
 
-Modules: :mod:`.schemas` (topics, frames, JSON schemas), :mod:`.writer` (the MCAP file
-writer), :mod:`.formatting` (a chunk's steps as fixed-width records), :mod:`.log`
+Modules: :mod:`.schemas` (topics, frames, fields, protobuf schemas), :mod:`.protobuf` (the
+wire format, schemas and a decoder), :mod:`.foxglove_descriptors` (Foxglove's published
+schemas), :mod:`.writer` (the MCAP file writer), :mod:`.formatting` (a chunk's steps as
+protobuf records), :mod:`.log`
 (:class:`RunLog`, :class:`TableRecorder`), :mod:`.metadata` (the ``bioflex.run`` record),
 :mod:`.reader` (summaries, messages, time histories), :mod:`.recover`, :mod:`.compare`
 (two logs message by message), :mod:`.errors`. A sink takes a run description and the run's
@@ -51,7 +54,7 @@ data, never command-line arguments, and raises its own one-line errors
 
 from bioflex_jsb.sinks.mcap.compare import compare_logs
 from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError
-from bioflex_jsb.sinks.mcap.formatting import enu_quaternion, fixed_d, fixed_e
+from bioflex_jsb.sinks.mcap.formatting import enu_quaternion
 from bioflex_jsb.sinks.mcap.log import RunLog, TableRecorder
 from bioflex_jsb.sinks.mcap.metadata import description_from_metadata, run_metadata
 from bioflex_jsb.sinks.mcap.reader import (
@@ -62,10 +65,11 @@ from bioflex_jsb.sinks.mcap.reader import (
     read_metadata,
     summarise,
 )
-from bioflex_jsb.sinks.mcap.recover import recover
+from bioflex_jsb.sinks.mcap.recover import check_chunks, recover
 from bioflex_jsb.sinks.mcap.schemas import (
     FRAME_METADATA,
     GROUPS,
+    PROTO_SCHEMAS,
     RUN_METADATA,
     SCHEMAS,
     WORLD_FRAME,
@@ -82,9 +86,10 @@ from bioflex_jsb.sinks.mcap.writer import (
 
 __all__ = [
     "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "FRAME_METADATA", "GROUPS", "MAGIC",
-    "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError", "McapFileWriter",
-    "RunLog", "TableRecorder", "body_frame", "check_file", "compare_logs",
-    "description_from_metadata", "enu_quaternion", "fixed_d", "fixed_e", "histories",
+    "PROTO_SCHEMAS", "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError",
+    "McapFileWriter",
+    "RunLog", "TableRecorder", "body_frame", "check_chunks", "check_file", "compare_logs",
+    "description_from_metadata", "enu_quaternion", "histories",
     "messages_by_topic", "open_reader", "read_metadata", "recover", "run_metadata",
     "summarise", "topic",
 ]

@@ -1,15 +1,15 @@
 """The run log: an open MCAP file that runs write every step into.
 
-A gust run is logged from the run's own table of steps (:meth:`RunLog.recorder`, nothing
-copied per step); a loop without a table (SITL) gives its steps as dicts
-(:meth:`RunLog.sample`). Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or
+A gust run hands its steps to the log a chunk at a time (:meth:`RunLog.recorder`: one call
+per chunk of rows, nothing per step); a loop without a table (SITL) gives its steps as dicts
+(:meth:`RunLog.sample`). Messages are protobuf, built a chunk at a time (:mod:`.formatting`).
+Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or
 :data:`CHUNK_WALL_S` of wall time, or 4096 steps) and handed to the operating system at once,
 so a process killed hard loses at most the chunk in progress.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from collections.abc import Mapping
@@ -21,17 +21,16 @@ import numpy as np
 
 from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogWriteError
-from bioflex_jsb.sinks.mcap.formatting import _ModelChannels
+from bioflex_jsb.sinks.mcap.formatting import _ModelChannels, lti_records
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
 from bioflex_jsb.sinks.mcap.schemas import (
     FRAME_METADATA,
+    PROTO_SCHEMAS,
     RUN_METADATA,
-    SCHEMAS,
     WORLD_FRAME,
     topic,
 )
 from bioflex_jsb.sinks.mcap.writer import (
-    CHUNK_MAX_BYTES,
     CHUNK_SPAN_S,
     CHUNK_WALL_S,
     McapFileWriter,
@@ -85,13 +84,14 @@ class RunLog:
         writer = McapFileWriter(stream, library=f"bioflex-jsb {__version__}")
         log = cls(path, stream, writer)
         writer.add_metadata(RUN_METADATA, meta)
+        writer.flush()  # header and run metadata on disk before the first step
         return log
 
     # -- channels -----------------------------------------------------------------------
     def _channel_id(self, model: str, group: str) -> int:
         if group not in self._schema_ids:
-            schema = SCHEMAS[group]
-            self._schema_ids[group] = self._writer.add_schema(schema["title"], schema)
+            name, data = PROTO_SCHEMAS[group]
+            self._schema_ids[group] = self._writer.add_schema(name, "protobuf", data)
         return self._writer.add_channel(topic(model, group), self._schema_ids[group],
                                         {"model": model})
 
@@ -117,9 +117,9 @@ class RunLog:
 
     # -- writing --------------------------------------------------------------------------
     def recorder(self, model: str) -> TableRecorder:
-        """A recorder of the run of ``model`` for ``cosim.run_gust(..., recorder=)``: it logs
-        every step (seven messages, one per run topic) from the run's own table, a chunk at
-        a time, so a step costs the run one call and a comparison."""
+        """A recorder of the run of ``model`` for ``run_gust(..., recorder=)``: it logs every
+        step (seven messages, one per run topic), handed a chunk of rows at a time, so a
+        step costs the run nothing beyond its share of one call per chunk."""
         return TableRecorder(self, model)
 
     def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
@@ -171,26 +171,21 @@ class RunLog:
         cid = self._channel_id(model, "lti_prediction")
         etas = sorted((k for k in history.channels if k.startswith("eta") and k[3:].isdigit()),
                       key=lambda k: int(k[3:]))
-        zeros = [0.0] * len(history.time_s)
-
-        def col(name):
-            return history.channels[name] if name in history.channels else zeros
-
-        cols = [col(c) for c in ("u", "alpha", "q", "theta", "n_z")]
-        eta_cols = [history.channels[k] for k in etas]
+        t = np.asarray(history.time_s, dtype=float)
+        zeros = np.zeros(len(t))
+        cols = [np.asarray(history.channels.get(c, zeros), dtype=float)
+                for c in ("u", "alpha", "q", "theta", "n_z", *etas)]
+        values = np.column_stack(cols) if cols else np.empty((len(t), 0))
+        records = lti_records(cid, len(etas))
+        ns = np.rint(t * 1e9).astype(np.int64)
         w = self._writer
-        for k, t in enumerate(history.time_s):
-            t_s = float(t)
-            payload = {}
-            for name, c in zip(("du_m_s", "dalpha_rad", "q_rad_s", "dtheta_rad", "n_z"), cols,
-                               strict=True):
-                payload[name] = _finite_or_none(float(c[k]))
-            payload["eta_rad"] = [_finite_or_none(float(c[k])) for c in eta_cols]
-            ns = int(round(t_s * 1e9))
-            w.append(cid, ns, k, json.dumps(payload).encode())
-            if w.chunk_bytes() >= CHUNK_MAX_BYTES:
+        self.flush()
+        with _signals_deferred():
+            for k0 in range(0, len(t), _MAX_PENDING_STEPS):
+                k1 = min(len(t), k0 + _MAX_PENDING_STEPS)
+                block, index = records.build(ns[k0:k1], values[k0:k1], k0)
+                w.append_block(block, index)
                 w.close_chunk()
-        w.close_chunk()
 
     def flush(self) -> None:
         """Write the kept steps as a chunk and hand it to the operating system."""
@@ -206,73 +201,62 @@ class RunLog:
                 self.flush()
                 self._writer.finish()
             finally:
+                self._writer.shutdown()
                 self._stream.close()
                 self.closed = True
 
 
-_MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~1.2 kB per step)
-_WALL_CHECK_MASK = 63  # a recorder looks at the wall clock every 64 steps
+_MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~0.6 kB per step)
+
+
+def chunk_steps(dt_s: float) -> int:
+    """Steps per chunk of a run at the step ``dt_s`` [s]: the first step at least
+    CHUNK_SPAN_S after a chunk's first step begins the next chunk (at most
+    _MAX_PENDING_STEPS)."""
+    return max(1, min(_MAX_PENDING_STEPS, math.ceil((CHUNK_SPAN_S - 0.5e-9) / dt_s)))
 
 
 class TableRecorder:
-    """Logs a run's steps from the table the run fills (``cosim.StepRecorder``).
+    """Logs a run's steps as the run hands them over, a chunk of rows at a time
+    (``drivers.gust.StepRecorder``).
 
-    The steps of a chunk are rows [k0, k_end) of the table, k_end the first step at least
-    CHUNK_SPAN_S after step k0 (as the chunks of :meth:`RunLog.sample`), at most
-    _MAX_PENDING_STEPS rows; the chunk is written as soon as its last row is complete, or
-    when CHUNK_WALL_S of wall time have passed since it began (checked every 64 steps).
-    Writing a chunk holds SIGINT/SIGTERM, so an interrupt never logs a row twice or not at
-    all; :meth:`stop` writes the rows left.
+    ``start`` says how many steps a chunk holds (:func:`chunk_steps`: CHUNK_SPAN_S of
+    simulated time); the run calls ``rows`` with each chunk's complete rows as soon as the
+    chunk is flown (and with the rows left when it stops), and each call writes one chunk
+    and hands it to the operating system. Writing holds SIGINT/SIGTERM, so an interrupt
+    never logs a row twice or not at all.
     """
 
     def __init__(self, log: RunLog, model: str) -> None:
         self._log = log
         self._model = model
         self._ch: _ModelChannels | None = None
-        self._time_s = self._table = None
-        self._k0 = 0
-        self._last_k = -1
-        self._due_wall = math.inf
+        self.steps = 0  # rows logged
 
-    def start(self, names, time_s: np.ndarray, table: np.ndarray) -> None:
+    def start(self, names, dt_s: float) -> int:
+        """Before the first step: the channel names and the step [s]; returns the number of
+        steps per chunk."""
         log = self._log
         log.flush()  # steps kept for another model go first
         self._ch = log._model(self._model, names)
-        self._time_s, self._table = time_s, table
-        self._begin(0)
+        log._writer.flush()  # schemas and channels on disk before the first step
+        return chunk_steps(dt_s)
 
-    def _begin(self, k0: int) -> None:
-        t = self._time_s
-        self._k0 = k0
-        if k0 >= len(t):
-            self._last_k = len(t)
+    def rows(self, time_s: np.ndarray, rows: np.ndarray) -> None:
+        """Log the complete rows ``rows`` (steps × channels, in the names' order) at the
+        times ``time_s`` [s] as one chunk (the arrays may be reused once this returns)."""
+        log, ch = self._log, self._ch
+        if ch is None or not len(rows):
             return
-        k_end = int(np.searchsorted(t, t[k0] + CHUNK_SPAN_S - 0.5e-9, side="left"))
-        self._last_k = min(max(k_end, k0 + 1), k0 + _MAX_PENDING_STEPS, len(t)) - 1
-        self._due_wall = time.monotonic() + CHUNK_WALL_S
-
-    def step(self, k: int) -> None:
-        if k >= self._last_k or (not k & _WALL_CHECK_MASK
-                                 and time.monotonic() >= self._due_wall):
-            self._write(k + 1)
-
-    def stop(self, n: int) -> None:
-        if self._ch is not None and n > self._k0:
-            self._write(n)
-
-    def _write(self, n: int) -> None:
-        """Write rows [k0, n) as a chunk and begin the next at n."""
-        log, ch, k0 = self._log, self._ch, self._k0
         with _signals_deferred():
-            rows = self._table[k0:n]
             if log._origin is None:
                 log._set_origin(*rows[0, [ch.i_lat, ch.i_lon, ch.i_alt]].tolist())
-            block, index = ch.format(self._time_s[k0:n], rows, ch.seq, log._origin)
-            ch.seq += n - k0
+            block, index = ch.format(time_s, rows, ch.seq, log._origin)
+            ch.seq += len(rows)
             log._writer.append_block(block, index)
             log._writer.close_chunk()
-            self._begin(n)
+            self.steps += len(rows)
 
-
-def _finite_or_none(v: float):
-    return v if math.isfinite(v) else None
+    def stop(self, n: int) -> None:
+        """The run is over (``n`` complete rows): nothing is pending, every chunk was
+        written by :meth:`rows`."""

@@ -12,6 +12,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
+from bioflex_jsb.sinks.mcap.protobuf import decoder
 from bioflex_jsb.sinks.mcap.schemas import RUN_METADATA
 from bioflex_jsb.sinks.mcap.writer import MAGIC
 
@@ -69,14 +70,35 @@ def read_metadata(reader) -> dict[str, dict[str, str]]:
         raise LogError(f"unreadable metadata ({exc})") from None
 
 
-def iter_json(reader, topics: list[str] | None = None) -> Iterator[tuple[str, int, dict]]:
-    """(topic, log time [ns], decoded JSON) of every message, in log-time order."""
+def message_decoder(schema, channel):
+    """A function from a message's bytes to a dict: JSON (logs written before protobuf) or
+    protobuf with the file's own schema (:func:`.protobuf.decoder`); LogError for another
+    encoding."""
+    encoding = channel.message_encoding
+    if encoding == "json":
+        return json.loads
+    if encoding == "protobuf" and schema is not None and schema.encoding == "protobuf":
+        return decoder(schema.data, schema.name)
+    raise LogError(f"channel {channel.topic!r}: message encoding {encoding!r} is not one "
+                   "that bioflex-jsb writes (protobuf, or json in older logs)")
+
+
+def iter_messages(reader, topics: list[str] | None = None
+                  ) -> Iterator[tuple[str, int, dict]]:
+    """(topic, log time [ns], decoded message) of every message, in log-time order."""
+    decoders: dict[int, object] = {}
     try:
-        for _schema, channel, message in reader.iter_messages(topics=topics,
-                                                              log_time_order=True):
-            yield channel.topic, message.log_time, json.loads(message.data)
+        for schema, channel, message in reader.iter_messages(topics=topics,
+                                                             log_time_order=True):
+            decode = decoders.get(channel.id)
+            if decode is None:
+                decode = decoders[channel.id] = message_decoder(schema, channel)
+            yield channel.topic, message.log_time, decode(message.data)
     except bad_data_errors() as exc:
         raise LogError(f"unreadable message data ({exc})") from None
+
+
+iter_json = iter_messages  # the name from when every log was JSON
 
 
 def summarise(path: str | Path) -> dict:
@@ -118,7 +140,7 @@ def histories(path: str | Path) -> tuple[list, dict[str, str]]:
                   if ch.topic.rsplit("/", 1)[-1] in ("rigid_body", "modal", "gust",
                                                       "lti_prediction")]
         cols: dict[tuple[str, str], dict[str, list]] = {}
-        for top, ns, msg in iter_json(reader, wanted):
+        for top, ns, msg in iter_messages(reader, wanted):
             _, _, model, group = top.split("/", 3)
             key = (model, "lti" if group == "lti_prediction" else "run")
             d = cols.setdefault(key, {})
@@ -155,7 +177,7 @@ def messages_by_topic(path: str | Path) -> dict[str, list[tuple[int, dict]]]:
     """Every message of a finished log, per topic, in log-time order."""
     out: dict[str, list[tuple[int, dict]]] = {}
     with open_reader(path) as (reader, _summary):
-        for top, ns, msg in iter_json(reader):
+        for top, ns, msg in iter_messages(reader):
             out.setdefault(top, []).append((ns, msg))
     return out
 

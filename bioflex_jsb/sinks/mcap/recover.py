@@ -1,76 +1,290 @@
-"""Recovery of a log whose writer was killed: its complete chunks into a finished file."""
+"""Recovery of a log whose writer was killed or whose file was damaged, and a check of every
+chunk's CRC.
+
+Both read the file sequentially, record by record (``opcode``, ``length``, body), without
+its summary: a chunk whose CRC, compression or records do not check is *skipped* and the
+scan goes on with the next record (or, where the damage hit a record's length, with the next
+place that holds a whole, valid chunk), so every intact chunk after a damaged one is kept.
+The recovered file is written by our own :class:`~.writer.McapFileWriter`: finished and
+indexed like any log (the tests run ``pymcap-cli doctor`` on it).
+"""
 
 from __future__ import annotations
 
+import mmap
+import struct
+import zlib
+from collections.abc import Iterator
 from pathlib import Path
-
-from mcap.records import Metadata
 
 from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError, bad_data_errors
-from bioflex_jsb.sinks.mcap.reader import check_file
+from bioflex_jsb.sinks.mcap.writer import MAGIC, McapFileWriter
+
+_OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
+_OP_METADATA, _OP_DATA_END = 0x0C, 0x0F
+_KNOWN_OPS = set(range(0x01, 0x10))
+_COMPRESSIONS = (b"", b"zstd", b"lz4")
+_MAX_RESYNC_TRIES = 100_000  # candidate chunk starts tried after a damaged record length
+
+
+def _open_data(p: Path):
+    size = p.stat().st_size
+    if size == 0:
+        raise LogError(f"{str(p)!r} is empty: its writer was killed before writing the MCAP "
+                       "header; there is nothing to recover")
+    with open(p, "rb") as f:  # the map outlives the file object; freed with its last view
+        data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+    if data[:len(MAGIC)] != MAGIC:
+        raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
+    return data
+
+
+def _chunk_records(body) -> tuple[int, list[tuple[int, bytes]]]:
+    """(uncompressed CRC, the records) of a Chunk body, decompressed and CRC-checked;
+    ValueError (or a zstd/lz4 error) if anything does not check."""
+    if len(body) < 36:
+        raise ValueError("chunk record too short")
+    _start, _end, size, crc, name_len = struct.unpack_from("<QQQII", body, 0)
+    at = 32
+    name = bytes(body[at:at + name_len])
+    if name not in _COMPRESSIONS:
+        raise ValueError(f"unknown chunk compression {name[:16]!r}")
+    at += name_len
+    (n_bytes,) = struct.unpack_from("<Q", body, at)
+    at += 8
+    if at + n_bytes != len(body):
+        raise ValueError("chunk records length does not match the record length")
+    raw = body[at:at + n_bytes]
+    if name == b"zstd":
+        import zstandard
+
+        data = zstandard.ZstdDecompressor().decompress(raw, max_output_size=size)
+    elif name == b"lz4":
+        import lz4.frame
+
+        data = lz4.frame.decompress(raw)
+    else:
+        data = bytes(raw)
+    if len(data) != size:
+        raise ValueError(f"chunk decompresses to {len(data)} bytes, not {size}")
+    if crc and zlib.crc32(data) != crc:
+        raise ValueError("chunk CRC mismatch")
+    records, pos = [], 0
+    while pos < size:
+        if pos + 9 > size:
+            raise ValueError("chunk ends inside a record")
+        op, length = data[pos], struct.unpack_from("<Q", data, pos + 1)[0]
+        if pos + 9 + length > size:
+            raise ValueError("chunk record overruns the chunk")
+        records.append((op, data[pos + 9:pos + 9 + length]))
+        pos += 9 + length
+    return crc, records
+
+
+def _next_chunk(data, start: int) -> int | None:
+    """The offset of the next whole, valid Chunk record at or after ``start`` (a scan after
+    a damaged record length), or None."""
+    size, pos, tries = len(data), start, 0
+    while tries < _MAX_RESYNC_TRIES:
+        pos = data.find(b"\x06", pos)
+        if pos < 0 or pos + 9 > size:
+            return None
+        tries += 1
+        length = struct.unpack_from("<Q", data, pos + 1)[0]
+        if pos + 9 + length <= size:
+            try:
+                _chunk_records(memoryview(data)[pos + 9:pos + 9 + length])
+                return pos
+            except bad_data_errors():
+                pass
+        pos += 1
+    return None
+
+
+def scan(data) -> Iterator[tuple[int, int, object]]:
+    """(offset, opcode, body or the error) of every record of the data section, in file
+    order: a chunk's body is (crc, inner records) when it checks, else the error; the
+    scan stops at Data End, a Footer or the end of the file (an incomplete record at the
+    end is yielded as (offset, 0, the error))."""
+    view = memoryview(data)
+    size, pos = len(data), len(MAGIC)
+    while pos < size:
+        if pos + 9 > size:
+            yield pos, 0, EOFError(f"incomplete record at byte {pos} (the file ends)")
+            return
+        op, length = data[pos], struct.unpack_from("<Q", data, pos + 1)[0]
+        end = pos + 9 + length
+        if op not in _KNOWN_OPS or end > size:
+            nxt = _next_chunk(data, pos + 1)
+            if nxt is None:
+                yield pos, 0, EOFError(
+                    f"incomplete or damaged record at byte {pos} (nothing valid after it)")
+                return
+            yield pos, _OP_CHUNK, ValueError(f"damaged record header ({nxt - pos} bytes "
+                                             "skipped)")
+            pos = nxt
+            continue
+        body = view[pos + 9:end]
+        if op == _OP_CHUNK:
+            try:
+                yield pos, op, _chunk_records(body)
+            except bad_data_errors() as exc:
+                yield pos, op, exc
+        elif op in (_OP_DATA_END, _OP_FOOTER):
+            yield pos, op, body
+            return
+        else:
+            yield pos, op, body
+        pos = end
+
+
+def _string(b, at: int) -> tuple[str, int]:
+    (n,) = struct.unpack_from("<I", b, at)
+    return bytes(b[at + 4:at + 4 + n]).decode(), at + 4 + n
+
+
+def _bytes(b, at: int, width: str = "<I") -> tuple[bytes, int]:
+    (n,) = struct.unpack_from(width, b, at)
+    w = struct.calcsize(width)
+    return bytes(b[at + w:at + w + n]), at + w + n
+
+
+def _string_map(b, at: int) -> tuple[dict[str, str], int]:
+    (n,) = struct.unpack_from("<I", b, at)
+    at += 4
+    end, out = at + n, {}
+    while at < end:
+        k, at = _string(b, at)
+        v, at = _string(b, at)
+        out[k] = v
+    return out, at
+
+
+class _Copier:
+    """Writes the records of the source into a new log, renumbering schemas and channels."""
+
+    def __init__(self, writer: McapFileWriter) -> None:
+        self.w = writer
+        self.schemas: dict[int, int] = {0: 0}
+        self.channels: dict[int, int] = {}
+        self.messages = 0
+        self.last_ns: int | None = None
+
+    def record(self, op: int, b) -> None:
+        if op == _OP_SCHEMA:
+            (sid,) = struct.unpack_from("<H", b, 0)
+            name, at = _string(b, 2)
+            encoding, at = _string(b, at)
+            data, _ = _bytes(b, at)
+            if sid not in self.schemas:
+                self.schemas[sid] = self.w.add_schema(name, encoding, data)
+        elif op == _OP_CHANNEL:
+            cid, sid = struct.unpack_from("<HH", b, 0)
+            topic, at = _string(b, 4)
+            encoding, at = _string(b, at)
+            meta, _ = _string_map(b, at)
+            if cid not in self.channels:
+                self.channels[cid] = self.w.add_channel(topic, self.schemas.get(sid, 0), meta,
+                                                        encoding)
+        elif op == _OP_METADATA:
+            name, at = _string(b, 0)
+            meta, _ = _string_map(b, at)
+            self.w.add_metadata(name, meta)
+        elif op == _OP_MESSAGE:
+            cid, seq, log_ns, _pub = struct.unpack_from("<HIQQ", b, 0)
+            if cid not in self.channels:
+                raise ValueError(f"message on channel {cid} before its channel record")
+            self.w.append(self.channels[cid], log_ns, seq, bytes(b[22:]))
+            self.messages += 1
+            self.last_ns = log_ns if self.last_ns is None else max(self.last_ns, log_ns)
 
 
 def recover(path: str | Path, out: str | Path) -> dict:
-    """Copy every complete record of a (killed) log into a finished, indexed file ``out``.
-
-    Reads ``path`` sequentially with the ``mcap`` package's non-indexed stream reader
-    (checking each chunk's CRC) and stops at the first incomplete or damaged record.
-    Returns counts and the last log time kept [s].
-    """
-    from mcap.records import Channel as _Channel
-    from mcap.records import Chunk as _Chunk
-    from mcap.records import Message
-    from mcap.records import Schema as _Schema
-    from mcap.stream_reader import StreamReader, breakup_chunk
-    from mcap.writer import CompressionType, Writer
-
-    p = check_file(path)
+    """Copy every intact record of a (killed or damaged) log into a finished, indexed file
+    ``out``: every chunk whose CRC checks, also those after a damaged one (each skipped
+    chunk is listed in ``skipped``: its byte offset and why). Returns counts, the last log
+    time kept [s] and where and why the read stopped."""
+    p = Path(path)
+    if not p.exists():
+        raise LogError(f"{str(p)!r}: no such file")
+    if not p.is_file():
+        raise LogError(f"{str(p)!r} is not a file")
     dst = Path(out)
-    if dst.resolve() == p.resolve():
+    if dst.exists() and dst.resolve() == p.resolve():
         raise LogError("--recover must name a new file, not the log itself")
-    schemas: dict[int, int] = {}
-    channels: dict[int, int] = {}
-    n_messages, last_ns, stop = 0, None, "end of file"
+    data = _open_data(p)
     try:
         fout = open(dst, "wb")  # noqa: SIM115 - closed below
     except OSError as exc:
         raise LogWriteError(f"cannot write {str(dst)!r}: {exc.strerror}") from None
-    with open(p, "rb") as fin, fout:
-        writer = Writer(fout, chunk_size=1024 * 1024, compression=CompressionType.ZSTD)
-        writer.start(profile="", library=f"bioflex-jsb {__version__} (recovered)")
-
-        def handle(record) -> None:
-            nonlocal n_messages, last_ns
-            if isinstance(record, _Schema):
-                if record.id not in schemas:
-                    schemas[record.id] = writer.register_schema(record.name, record.encoding,
-                                                                record.data)
-            elif isinstance(record, _Channel):
-                if record.id not in channels:
-                    channels[record.id] = writer.register_channel(
-                        record.topic, record.message_encoding,
-                        schemas.get(record.schema_id, 0), dict(record.metadata))
-            elif isinstance(record, Message):
-                writer.add_message(channels[record.channel_id], record.log_time, record.data,
-                                   record.publish_time, record.sequence)
-                n_messages += 1
-                last_ns = record.log_time if last_ns is None else max(last_ns, record.log_time)
-            elif isinstance(record, Metadata):
-                writer.add_metadata(record.name, dict(record.metadata))
-
-        records = StreamReader(fin, emit_chunks=True, validate_crcs=True).records
-        try:
-            for record in records:
-                if isinstance(record, _Chunk):
-                    inner = breakup_chunk(record, validate_crc=True)  # whole chunk or nothing
-                    for r in inner:
-                        handle(r)
-                else:
-                    handle(record)
-        except bad_data_errors() as exc:  # truncated or damaged tail: keep the rest
-            stop = f"{type(exc).__name__} {exc}".strip()
+    with fout:
+        writer = McapFileWriter(fout, library=f"bioflex-jsb {__version__} (recovered)",
+                                background=False)
+        copier = _Copier(writer)
+        skipped: list[str] = []
+        stop, chunks = "end of file", 0
+        for offset, op, body in scan(data):
+            if isinstance(body, BaseException):
+                if op == _OP_CHUNK:
+                    skipped.append(f"chunk at byte {offset} ({body})")
+                    continue
+                stop = str(body)
+                break
+            if op in (_OP_DATA_END, _OP_FOOTER):
+                stop = "the end of the data section (the file was finished)"
+                break
+            if op == _OP_CHUNK:
+                _crc, records = body
+                try:
+                    for inner_op, inner in records:
+                        copier.record(inner_op, inner)
+                except (ValueError, struct.error, UnicodeDecodeError) as exc:
+                    skipped.append(f"chunk at byte {offset} ({exc})")
+                    writer.close_chunk()
+                    continue
+                writer.close_chunk()  # one chunk out per chunk in
+                chunks += 1
+            elif op != _OP_HEADER:
+                try:
+                    copier.record(op, body)
+                except (ValueError, struct.error, UnicodeDecodeError) as exc:
+                    skipped.append(f"record at byte {offset} ({exc})")
         writer.finish()
-    return {"file": str(p), "out": str(dst), "messages": n_messages,
-            "channels": len(channels),
-            "last_time_s": None if last_ns is None else last_ns * 1e-9, "stopped_at": stop}
+    last = copier.last_ns
+    return {"file": str(p), "out": str(dst), "messages": copier.messages,
+            "channels": len(copier.channels), "chunks": chunks,
+            "last_time_s": None if last is None else last * 1e-9, "stopped_at": stop,
+            "skipped": skipped}
+
+
+def check_chunks(path: str | Path) -> dict:
+    """Every chunk of a log decompressed and its CRC checked (and the data section's CRC
+    where the file is finished): ``chunks``, ``bad`` (byte offset and why, per chunk that
+    fails), ``data_crc`` (``ok``, ``bad``, ``absent`` or ``unfinished``)."""
+    p = Path(path)
+    if not p.exists():
+        raise LogError(f"{str(p)!r}: no such file")
+    if not p.is_file():
+        raise LogError(f"{str(p)!r} is not a file")
+    data = _open_data(p)
+    chunks, bad, data_crc, stop = 0, [], "unfinished", None
+    for offset, op, body in scan(data):
+        if isinstance(body, BaseException):
+            if op == _OP_CHUNK:
+                chunks += 1
+                bad.append(f"chunk at byte {offset}: {body}")
+                continue
+            stop = str(body)
+            break
+        if op == _OP_CHUNK:
+            chunks += 1
+        elif op == _OP_DATA_END:
+            (stored,) = struct.unpack_from("<I", body, 0)
+            if stored == 0:
+                data_crc = "absent"
+            else:
+                data_crc = "ok" if zlib.crc32(data[:offset]) == stored else "bad"
+            break
+    return {"file": str(p), "chunks": chunks, "bad": bad, "data_crc": data_crc,
+            "stopped_at": stop}

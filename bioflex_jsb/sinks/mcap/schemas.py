@@ -170,3 +170,35 @@ SCHEMAS: dict[str, dict] = {
 }
 for _s in SCHEMAS.values():
     _s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+
+
+# -- the protobuf schemas the logs are written with (docs/logging.md, Encoding) -------------
+def _proto_fields(group: str) -> tuple[tuple[str, int, bool], ...]:
+    """(field, number, repeated) of a bioflex message: the JSON schema's fields in order,
+    numbered from 1 (every field a double)."""
+    props = SCHEMAS[group]["properties"]
+    return tuple((name, i + 1, props[name].get("type") == "array")
+                 for i, name in enumerate(props))
+
+
+def _proto_schemas() -> dict[str, tuple[str, bytes]]:
+    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor, file_descriptor_set
+
+    out = {}
+    for group, schema in SCHEMAS.items():
+        name = schema["title"]
+        if group == "pose":
+            files = [fox.FILES[f] for f in fox.FRAME_TRANSFORM_FILES]
+        elif group == "location":
+            files = [fox.FILES[f] for f in fox.LOCATION_FIX_FILES]
+        else:
+            package, message = name.split(".")
+            files = [file_descriptor(package, message, _proto_fields(group))]
+        out[group] = (name, file_descriptor_set(files))
+    return out
+
+
+PROTO_FIELDS = {g: _proto_fields(g) for g in SCHEMAS if g not in ("pose", "location")}
+# group → (schema name, serialised FileDescriptorSet): schema encoding "protobuf"
+PROTO_SCHEMAS: dict[str, tuple[str, bytes]] = _proto_schemas()

@@ -1,5 +1,10 @@
 """The MCAP file writer: chunked, indexed, many small messages per step.
 
+The header (and whatever the caller writes before the first chunk: metadata, schemas,
+channels) is handed to the operating system when the writer is created and by
+:meth:`McapFileWriter.flush`, so a process killed before its first step leaves a file that
+:func:`~bioflex_jsb.sinks.mcap.recover.recover` turns into a finished, empty log.
+
 Every record other than the messages in a chunk is serialised with the ``mcap`` package's
 record classes; the messages themselves are written here (the package's ``Writer`` costs
 ~6.5 µs per message, more than the logging overhead budget allows).
@@ -7,10 +12,10 @@ record classes; the messages themselves are written here (the package's ``Writer
 
 from __future__ import annotations
 
-import json
 import signal
 import struct
 import zlib
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
 import numpy as np
@@ -34,6 +39,7 @@ CHUNK_SPAN_S = 0.9
 CHUNK_WALL_S = 0.9  # wall time per chunk [s] (runs slower than real time, SITL sessions)
 CHUNK_MAX_BYTES = 4 * 1024 * 1024  # uncompressed chunk size limit [bytes]
 COMPRESSION = "zstd"
+ZSTD_LEVEL = -3  # zstd's fast level: see McapFileWriter
 _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 0x03, 0x04, 0x05, 0x06
 _OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
 _MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
@@ -78,17 +84,17 @@ class McapFileWriter:
     footer with its CRC.
     """
 
-    def __init__(self, stream, library: str) -> None:
+    def __init__(self, stream, library: str, background: bool = False) -> None:
         import zstandard
 
         self._stream = stream
-        # zstd's level 1 with a small hash table and window and long minimum matches: the
-        # chunks repeat one step's layout every ~1.4 kB, so recent long matches are all it
-        # needs; measured on a gust-run chunk: 0.75 ms and 9.2:1 against level 1's 1.04 ms
-        # and 7.9:1 and the default level 3's 1.6 ms and 7.0:1
+        # zstd at level -3 with a small hash table and window: protobuf doubles are mostly
+        # incompressible mantissa bytes, so every level from -3 to 3 gives ≈ 2:1 on a
+        # gust-run chunk; measured (alone, per step of 702 bytes): level -3 0.5 µs, level 1
+        # 0.9 µs, both 2.06:1 / 2.1:1 (docs/logging.md, Overhead)
         self._compress = zstandard.ZstdCompressor(
             compression_params=zstandard.ZstdCompressionParameters.from_level(
-                1, window_log=17, hash_log=11, min_match=7)).compress
+                ZSTD_LEVEL, window_log=17, hash_log=11, min_match=7)).compress
         self._crc = 0
         self._offset = 0
         self._schemas: list[Schema] = []
@@ -105,22 +111,49 @@ class McapFileWriter:
         self._index: dict[int, list[tuple[int, int]]] = {}
         self._blocks: dict[int, list[np.ndarray]] = {}
         self.finished = False
+        self._pending = None  # the Future of the chunk being written in the background
+        # background=True: one writer thread compresses and writes a closed chunk (zstd and
+        # the file write release the GIL) while the run flies the next, at most one pending;
+        # off by default: a SIGKILL can then also lose the chunk in flight (≈ 1 ms of wall
+        # time), a write error surfaces a chunk later, and on this shared 2-vCPU machine the
+        # gain could not be measured above the noise (docs/logging.md, Overhead)
+        self._pool = (ThreadPoolExecutor(max_workers=1, thread_name_prefix="mcap-chunk")
+                      if background else None)
         self._write(MAGIC + _record_bytes(Header(profile="", library=library)))
+        self._stream.flush()
 
     def _write(self, data: bytes) -> None:
+        self._wait()
+        self._write_now(data)
+
+    def _write_now(self, data: bytes) -> None:
         self._stream.write(data)
         self._crc = zlib.crc32(data, self._crc)
         self._offset += len(data)
 
-    def add_schema(self, name: str, data: dict) -> int:
-        schema = Schema(id=len(self._schemas) + 1, name=name, encoding="jsonschema",
-                        data=json.dumps(data, ensure_ascii=False).encode())
+    def flush(self) -> None:
+        """Hand everything written so far to the operating system."""
+        self._wait()
+        self._stream.flush()
+
+    def _wait(self) -> None:
+        """Wait for the chunk being written in the background (its error, if any, is raised
+        here: a full disk surfaces at the next chunk or at finish)."""
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            pending.result()
+
+    def add_schema(self, name: str, encoding: str, data: bytes) -> int:
+        """A Schema record (``encoding``: ``protobuf``, ``jsonschema``, …); its id."""
+        schema = Schema(id=len(self._schemas) + 1, name=name, encoding=encoding, data=data)
         self._schemas.append(schema)
         self._write(_record_bytes(schema))
         return schema.id
 
-    def add_channel(self, topic_name: str, schema_id: int, metadata: dict[str, str]) -> int:
-        channel = Channel(id=len(self._channels) + 1, topic=topic_name, message_encoding="json",
+    def add_channel(self, topic_name: str, schema_id: int, metadata: dict[str, str],
+                    message_encoding: str = "protobuf") -> int:
+        channel = Channel(id=len(self._channels) + 1, topic=topic_name,
+                          message_encoding=message_encoding,
                           schema_id=schema_id, metadata=metadata)
         self._channels.append(channel)
         self._index[channel.id] = []
@@ -131,6 +164,7 @@ class McapFileWriter:
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         record = _record_bytes(Metadata(name=name, metadata=data))
+        self._wait()  # self._offset includes the chunk being written
         self._metadata_indexes.append(MetadataIndex(offset=self._offset, length=len(record),
                                                     name=name))
         self._write(record)
@@ -202,7 +236,12 @@ class McapFileWriter:
         self._end_ns = max(self._end_ns, end)
         # the message indexes do not depend on where the chunk lands: serialised here
         index_records = [(cid, _message_index(cid, entries)) for cid, entries in indexes.items()]
-        self._write_chunk(data, index_records, start, end)
+        self._wait()
+        if self._pool is None:
+            self._write_chunk(data, index_records, start, end)
+        else:  # compressed and written while the run goes on; the next chunk waits for it
+            self._pending = self._pool.submit(self._write_chunk, data, index_records, start,
+                                              end)
 
     def _write_chunk(self, data, index_records: list[tuple[int, bytes]], start: int,
                      end: int) -> None:
@@ -226,7 +265,7 @@ class McapFileWriter:
             chunk_length=chunk_length, message_index_offsets=offsets,
             message_index_length=at - chunk_start - chunk_length, compression=COMPRESSION,
             compressed_size=len(compressed), uncompressed_size=n))
-        self._write(b"".join([header, compressed, *(r for _, r in index_records)]))
+        self._write_now(b"".join([header, compressed, *(r for _, r in index_records)]))
         self._stream.flush()
 
     def finish(self) -> None:
@@ -235,6 +274,7 @@ class McapFileWriter:
             return
         with _signals_deferred():
             self._close_chunk()
+            self._wait()  # the data section's CRC and length include the last chunk
             self._write(_record_bytes(DataEnd(data_section_crc=self._crc)))
             summary_start = self._offset
             summary = bytearray()
@@ -268,3 +308,10 @@ class McapFileWriter:
             self._write(bytes(summary) + footer_prefix + struct.pack("<I", crc) + MAGIC)
             self._stream.flush()
             self.finished = True
+        self.shutdown()
+
+    def shutdown(self) -> None:
+        """Stop the writer thread (after finish, or when the file is abandoned)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
