@@ -1,0 +1,240 @@
+"""The geometry-consistent aircraft (parameters/airframe_consistent.py): its derivatives from
+the stated geometry, the CG calibration, and the paper's tables with either parameter set.
+
+* :func:`consistent_derivatives`: wing + tail vortex lattice at a CG, downwash lag, Munk's
+  fuselage moment → a :class:`~bioflex_jsb.parameters.airframe.RigidAerodynamics`;
+* :func:`calibrate_cg_fraction`: the CG whose rigid short period at 15 m/s has Table 3's
+  natural frequency (the one calibration);
+* :class:`AircraftSet` and :data:`AIRCRAFT_SETS` (``default``, ``consistent``): a rigid
+  parameter set with the planform carrying its CG;
+* :func:`modes_with`, :func:`flutter_with`: :mod:`bioflex_jsb.flight_dynamics.eigen`'s
+  labelling, tracking and flutter search with a set's ``aero`` (eigen itself always uses
+  the default set; with an ``aero`` argument there, these two can go).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq, linear_sum_assignment
+
+from bioflex_jsb.aerodynamics.wing_tail import (
+    WingTailDerivatives,
+    munk_moment_slope_per_rad,
+    prolate_spheroid_apparent_mass_factor,
+    wing_tail_derivatives,
+)
+from bioflex_jsb.flight_dynamics import eigen
+from bioflex_jsb.flight_dynamics.elastic_trim import StaticWingLoads, linear_rigid_trim
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
+from bioflex_jsb.flight_dynamics.rigid import (
+    level_flight_condition,
+    rigid_derivatives,
+    rigid_matrices,
+)
+from bioflex_jsb.parameters import airframe as default_set
+from bioflex_jsb.parameters import airframe_consistent as consistent_set
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import RigidAerodynamics
+from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
+
+CBAR_M = P.MEAN_AERODYNAMIC_CHORD_M
+TABLE3_RIGID_15 = complex(*P.TABLE3_SHORT_PERIOD[(15.0, "rigid")])
+
+
+@dataclass(frozen=True)
+class ConsistentDerivatives:
+    """What the stated geometry gives at one CG: the lattice's derivatives, the fuselage's
+    Munk moment slope [1/rad], and the resulting rigid aerodynamics (C_m0 set so that the
+    linear rigid trim at 15 m/s needs the default set's elevator)."""
+
+    cg_fraction: float
+    lattice: WingTailDerivatives
+    fuselage_cm_alpha_per_rad: float
+    aero: RigidAerodynamics
+
+    @property
+    def static_margin(self) -> float:
+        return -self.aero.cm_alpha_per_rad / self.aero.cl_alpha_per_rad
+
+
+def cm0_for_elevator(aero: RigidAerodynamics, elevator_rad: float,
+                     speed_m_s: float = P.CRUISE_SPEED_M_S) -> float:
+    """C_m0 [-] that makes the linear rigid trim of ``aero`` at ``speed_m_s`` need
+    ``elevator_rad`` (the tail incidence that does it)."""
+    cond = level_flight_condition(speed_m_s, aero=aero)
+    # α from the lift balance with that elevator, then C_m0 from the moment balance
+    qs = cond.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+    alpha = ((P.MASS_KG * P.STANDARD_GRAVITY_M_S2 / qs - aero.cl0
+              - aero.cl_delta_e_per_rad * elevator_rad) / aero.cl_alpha_per_rad)
+    return -(aero.cm_alpha_per_rad * alpha + aero.cm_delta_e_per_rad * elevator_rad)
+
+
+def consistent_derivatives(
+    cg_fraction: float = consistent_set.CG_FRACTION_OF_CHORD,
+    *,
+    tail=consistent_set.TAIL,
+    fuselage=consistent_set.FUSELAGE,
+    planform: Planform = DEFAULT_PLANFORM,
+    base: RigidAerodynamics = default_set.RIGID_AERODYNAMICS,
+) -> ConsistentDerivatives:
+    """Derivatives of wing + ``tail`` + ``fuselage`` about the CG at ``cg_fraction`` of c̄
+    aft of the root leading edge; every other coefficient is ``base``'s."""
+    x_cg = cg_fraction * CBAR_M
+    lat = wing_tail_derivatives(
+        planform, tail, tail_height_m=tail.height_m, x_cg_m=x_cg, cbar_m=CBAR_M,
+        tail_efficiency=tail.efficiency, elevator_chord_fraction=tail.elevator_chord_fraction,
+    )
+    k = prolate_spheroid_apparent_mass_factor(fuselage.fineness_ratio)
+    d_cm_f = munk_moment_slope_per_rad(fuselage.volume_m3, k, P.REFERENCE_AREA_M2, CBAR_M)
+    aero = replace(
+        base,
+        cl_alpha_per_rad=lat.cl_alpha,
+        cm_alpha_per_rad=lat.cm_alpha + d_cm_f,
+        cm_q_per_rad=lat.cm_q,
+        cm_alphadot_per_rad=lat.cm_alphadot,
+        cl_delta_e_per_rad=lat.cl_delta_e,
+        cm_delta_e_per_rad=lat.cm_delta_e,
+    )
+    base_trim = linear_rigid_trim(level_flight_condition(P.CRUISE_SPEED_M_S, aero=base),
+                                  base)(StaticWingLoads())
+    aero = replace(aero, cm0=cm0_for_elevator(aero, base_trim.elevator_rad))
+    return ConsistentDerivatives(cg_fraction, lat, d_cm_f, aero)
+
+
+def rigid_short_period(aero: RigidAerodynamics, speed_m_s: float,
+                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> complex:
+    """The rigid short-period root (upper half plane) of A_RR with ``aero`` [rad/s]."""
+    cond = level_flight_condition(speed_m_s, density_kg_m3, aero)
+    lam = np.linalg.eigvals(rigid_matrices(rigid_derivatives(cond, aero))[0])
+    root = lam[np.argmax(np.abs(lam))]
+    return complex(root.real, abs(root.imag))
+
+
+def calibrate_cg_fraction(target_frequency_rad_s: float = abs(TABLE3_RIGID_15),
+                          speed_m_s: float = 15.0,
+                          bracket: tuple[float, float] = (0.32, 0.46)) -> float:
+    """The CG [fraction of c̄] whose rigid short period at ``speed_m_s`` has the natural
+    frequency ``target_frequency_rad_s`` (default Table 3's 10.60 rad/s); brentq to 1e-6."""
+    def miss(f: float) -> float:
+        return abs(rigid_short_period(consistent_derivatives(f).aero, speed_m_s)) \
+            - target_frequency_rad_s
+
+    return float(brentq(miss, *bracket, xtol=1e-6))
+
+
+@dataclass(frozen=True)
+class AircraftSet:
+    """A rigid parameter set: its aerodynamics and the planform carrying its CG."""
+
+    name: str
+    aero: RigidAerodynamics
+    planform: Planform
+    source: str
+
+
+AIRCRAFT_SETS = {
+    "default": AircraftSet("default", default_set.RIGID_AERODYNAMICS, DEFAULT_PLANFORM,
+                           "parameters/airframe.py (calibrated to Table 3)"),
+    "consistent": AircraftSet("consistent", consistent_set.RIGID_AERODYNAMICS,
+                              consistent_set.PLANFORM, consistent_set.SOURCE),
+}
+
+
+# --------------------------------------------------------------------------------------
+# eigen's labelling and tracking, with a parameter set's aero
+# --------------------------------------------------------------------------------------
+def _eig(model, v, wing, aero, rho):
+    ss = build_state_space(model, level_flight_condition(float(v), rho, aero), wing, aero)
+    return np.linalg.eig(ss.a)
+
+
+def _reference(model, wing, cond, aero):
+    """As eigen._reference, with ``aero``."""
+    lam = np.linalg.eigvals(build_state_space("rigid", cond, aero=aero).a)
+    order = np.argsort(-np.abs(lam))
+    labels = [eigen.RIGID_LABELS[0]] * 2 + [eigen.RIGID_LABELS[1]] * 2
+    ref = [(labels[k], lam[i]) for k, i in enumerate(order)]
+    if model == "coupled":
+        blk = coupled_blocks(wing, cond, aero)
+        n = wing.n_modes
+        s = np.block([[np.zeros((n, n)), np.eye(n)], [blk.a_ee, blk.a_eedot]])
+        lam_e = np.linalg.eigvals(s)
+        for k, i in enumerate(np.argsort(np.abs(lam_e), kind="stable")):
+            ref.append((f"aeroelastic_{k // 2 + 1}", lam_e[i]))
+    return ref if model == "coupled" else ref[:4]
+
+
+def _track(model, speeds, wing, aero, rho):
+    lams, vecs, labels = [], [], []
+    for k, v in enumerate(speeds):
+        lam, vec = _eig(model, v, wing, aero, rho)
+        if k == 0:
+            ref = _reference(model, wing, level_flight_condition(float(v), rho, aero), aero)
+            ref_lam = np.array([r[1] for r in ref])
+            cost = np.abs(ref_lam[:, None] - lam[None, :]) / (1.0 + np.abs(ref_lam[:, None]))
+            rows, cols = linear_sum_assignment(cost)
+            perm = cols[np.argsort(rows)]
+            labels = [r[0] for r in ref]
+        else:
+            perm = eigen._match(lams[-1], vecs[-1], lam, vec)
+        lams.append(lam[perm])
+        vecs.append(vec[:, perm])
+    return np.array(lams), vecs, tuple(labels)
+
+
+def modes_with(model: str, speeds_m_s: Sequence[float], wing: ElasticWingModel | None,
+               aero: RigidAerodynamics,
+               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> list[eigen.ModeSet]:
+    """:func:`eigen.modes_at` with ``aero`` (labels tracked from 2 m/s, 0.25 m/s grid)."""
+    targets = sorted(set(float(v) for v in speeds_m_s))
+    grid = eigen.sweep_grid(targets)
+    lams, _, labels = _track(model, grid, wing, aero, density_kg_m3)
+    index = {float(v): k for k, v in enumerate(grid)}
+    return [eigen._collapse(float(v), model, labels, lams[index[float(v)]]) for v in speeds_m_s]
+
+
+def flutter_with(wing: ElasticWingModel, aero: RigidAerodynamics,
+                 range_m_s: tuple[float, float] = (5.0, 40.0), step_m_s: float = 0.1,
+                 tol_m_s: float = 0.01,
+                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> eigen.FlutterResult:
+    """:func:`eigen.find_flutter` with ``aero`` (phugoid left out, as there)."""
+    lo, hi = range_m_s
+    grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
+    grid = grid[grid <= hi + 1e-12]
+    lams, vecs, labels = _track("coupled", grid, wing, aero, density_kg_m3)
+    considered = np.array([lab not in eigen.EXCLUDED_FROM_FLUTTER for lab in labels])
+    growth = lams[:, considered].real.max(axis=1)
+    unstable = np.nonzero((growth > 1e-9) & (grid >= lo - 1e-12))[0]
+    if len(unstable) == 0:
+        return eigen.FlutterResult(wing.name, None, None, None, None, (lo, hi))
+    k = int(unstable[0])
+
+    def continued(v):
+        lam, vec = _eig("coupled", v, wing, aero, density_kg_m3)
+        return lam[eigen._match(lams[k - 1], vecs[k - 1], lam, vec)]
+
+    if k == 0 or grid[k - 1] < lo - 1e-12:
+        v_cross, at = float(grid[k]), lams[k]
+    else:
+        a, b = float(grid[k - 1]), float(grid[k])
+        while b - a > tol_m_s:
+            mid = 0.5 * (a + b)
+            if continued(mid)[considered].real.max() > 1e-9:
+                b = mid
+            else:
+                a = mid
+        v_cross, at = b, continued(b)
+    j = int(np.argmax(np.where(considered, at.real, -np.inf)))
+    kind = "flutter" if abs(at[j].imag) > eigen.IMAG_TOL_RAD_S else "divergence"
+    return eigen.FlutterResult(wing.name, round(v_cross, 2), labels[j], float(abs(at[j].imag)),
+                               kind, (lo, hi))
+
+
+def relative_error(model: complex, paper: complex) -> tuple[float, float]:
+    """((re_m − re_p)/|re_p|, (im_m − im_p)/|im_p|) [-]."""
+    return ((model.real - paper.real) / abs(paper.real),
+            (model.imag - paper.imag) / abs(paper.imag) if paper.imag else math.nan)
