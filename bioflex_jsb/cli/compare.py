@@ -23,11 +23,13 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.gust import (
     Interrupted,
+    add_aero_arguments,
     add_run_arguments,
     check_run_arguments,
     fly,
     open_log,
     run_description,
+    wing_for_run,
 )
 
 HELP = f"""Fly --gust through the nonlinear JSBSim co-simulation and through the linear model
@@ -57,6 +59,7 @@ def register(sub) -> None:
     add_run_arguments(p, DEFAULT_GUST)
     p.add_argument("--model", choices=("coupled", "qsd", "rigid"), default="coupled",
                    help="wing model of both runs (default coupled)")
+    add_aero_arguments(p)
     add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png",
                    help="overlay of both time histories, NRMSE in the legends (.png, .pdf, "
@@ -75,7 +78,10 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.simulation.lti_response import simulate
     from bioflex_jsb.simulation.results import nrmse
 
-    build = wing_from_args(args)
+    build = wing_for_run(wing_from_args(args), args)
+    if args.aero == "unsteady" and args.model != "coupled":
+        raise UsageError("--aero unsteady compares the coupled model (rigid has no wing "
+                         "loads; the quasi-static model has no unsteady form)")
     check_run_arguments(args)
     check_plot_path(args.plot, args.force)
     args.out = log_path(args, "compare", args.wing)
@@ -94,16 +100,22 @@ def run(args: argparse.Namespace) -> int:
             lin = Airframe().linearize(args.speed)
         except FdmError as exc:
             raise UsageError(str(exc)) from None
-        ss = build_state_space(args.model, level_flight_condition(args.speed), build.model,
-                               a_rr=lin.a)
+        if args.aero == "unsteady":  # Eq. (4) on unsteady strips, Küssner's gust
+            from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space
+
+            ss = unsteady_state_space(build, args.speed, gust=True, a_rr=lin.a)
+        else:
+            ss = build_state_space(args.model, level_flight_condition(args.speed),
+                                   build.model, a_rr=lin.a)
         linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
         if log is not None:
             log.prediction(args.model, linear)
     finally:
         if log is not None:
             log.close()
-    linear.meta.update(label=f"LTI {args.model} (Eq. 4)", linestyle="--", color="tab:orange",
-                       linewidth=1.6)
+    strips = ", unsteady strips" if args.aero == "unsteady" else ""
+    linear.meta.update(label=f"LTI {args.model} (Eq. 4{strips})", linestyle="--",
+                       color="tab:orange", linewidth=1.6)
     nonlinear.meta.update(label=f"JSBSim {args.model}", color="tab:blue", linestyle="-",
                           linewidth=2.2)
     channels = [c for c in CHANNELS if c in linear.channels and c in nonlinear.channels]

@@ -75,8 +75,10 @@ def register(sub) -> None:
     p = sub.add_parser("gust", help="nonlinear gust runs (rigid, coupled, QSD)", description=HELP)
     add_wing_arguments(p, default=DEFAULT_WING)
     add_run_arguments(p)
-    p.add_argument("--models", type=models_list, default=("rigid", "coupled", "qsd"),
-                   help="comma-separated subset of rigid,coupled,qsd (default: all three)")
+    p.add_argument("--models", type=models_list, default=None,
+                   help="comma-separated subset of rigid,coupled,qsd (default: all three; "
+                   "with --aero unsteady: rigid,coupled)")
+    add_aero_arguments(p)
     add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="time histories to FILE.png (.png, .pdf, .svg; default gust.png when "
@@ -85,6 +87,51 @@ def register(sub) -> None:
     add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
+
+
+def add_aero_arguments(p: argparse.ArgumentParser) -> None:
+    """--aero and --structural-damping, shared by gust and compare."""
+    p.add_argument("--aero", choices=("quasi-steady", "unsteady"), default="quasi-steady",
+                   help="the wing's strip aerodynamics: quasi-steady (the paper's Eq. 3, "
+                   "default) or unsteady (Theodorsen/Wagner strips with named lag states and "
+                   "Küssner gust penetration; the coupled model only; docs/aeroelasticity.md)")
+    p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
+                   help="structural damping ratio ζ of every wing mode, 0 <= Z < 1 (default: "
+                   "the wing's own, docs/wing_variants.md)")
+
+
+def damping_ratio(text: str) -> float:
+    """argparse type: a damping ratio 0 <= ζ < 1 [-]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"damping ratio must be a number, got {text!r}"
+                                         ) from None
+    if not 0.0 <= value < 1.0:
+        raise argparse.ArgumentTypeError(f"damping ratio must satisfy 0 <= Z < 1, got {text}")
+    return value
+
+
+def resolve_models(args) -> tuple[str, ...]:
+    """The models to fly: --models, or the default of the chosen aerodynamics; QSD has no
+    unsteady form (a quasi-static deflection carries no lag states)."""
+    unsteady = args.aero == "unsteady"
+    models = args.models or (("rigid", "coupled") if unsteady else ("rigid", "coupled", "qsd"))
+    if unsteady and "qsd" in models:
+        raise UsageError("--aero unsteady flies the coupled wing (rigid has no wing loads); "
+                         "the quasi-static model has no unsteady form: drop qsd from --models")
+    return models
+
+
+def wing_for_run(build, args):
+    """The wing build a run flies: with ``--structural-damping`` every mode's ζ set."""
+    if args.structural_damping is None:
+        return build
+    import dataclasses
+
+    from bioflex_jsb.aeroelasticity.free_aircraft import with_damping
+
+    return dataclasses.replace(build, model=with_damping(build, args.structural_damping))
 
 
 class Interrupted(Exception):
@@ -140,10 +187,15 @@ def run_description(args, kind: str, models):
     run from its checked arguments: what the log records and ``rerun`` flies again."""
     from bioflex_jsb.simulation.run import RunDescription
 
+    extra = {}
+    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
+        extra["aero"] = args.aero
+    if getattr(args, "structural_damping", None) is not None:
+        extra["structural_damping"] = args.structural_damping
     return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
                           gust=args.gust.text(), models=tuple(models),
                           duration_s=args.duration, gust_start_s=args.gust_start,
-                          dt_s=args.dt, mass_basis=args.mass_basis)
+                          dt_s=args.dt, mass_basis=args.mass_basis, extra=extra)
 
 
 def open_log(path: str, description, build):
@@ -177,9 +229,11 @@ def fly(args, build, models, log=None):
                 def on_sample(k, t, values, bar=bar, steps=steps):
                     if k % 50 == 49 or k == steps - 1:
                         bar.update(k + 1 - bar.n)
+            unsteady = getattr(args, "aero", "quasi-steady") == "unsteady" and model == "coupled"
             try:
-                run = run_gust(airframe, build.model, model, setup, on_sample,
-                               recorder=recorder)
+                run = run_gust(airframe, build if unsteady else build.model, model, setup,
+                               on_sample, recorder=recorder,
+                               aero="unsteady" if unsteady else "quasi-steady")
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -197,7 +251,8 @@ def fly(args, build, models, log=None):
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.simulation.results import gust_metrics
 
-    build = wing_from_args(args)
+    build = wing_for_run(wing_from_args(args), args)
+    args.models = resolve_models(args)
     check_run_arguments(args)
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     check_plot_path(plot, args.force)

@@ -23,6 +23,7 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.gust import damping_ratio, wing_for_run
 from bioflex_jsb.flight_dynamics import eigen
 
 PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
@@ -54,6 +55,13 @@ def register(sub) -> None:
         "--models", type=models_list, default=("rigid", "coupled", "qsd"),
         help="comma-separated subset of rigid,coupled,qsd (default: all three)",
     )
+    p.add_argument("--aero", choices=("quasi-steady", "unsteady"), default="quasi-steady",
+                   help="the wing's strip aerodynamics for the coupled model: quasi-steady "
+                   "(the paper's, default) or unsteady (Theodorsen strips with named lag "
+                   "states; the lag roots are not listed; docs/aeroelasticity.md)")
+    p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
+                   help="structural damping ratio ζ of every wing mode, 0 <= Z < 1 (default: "
+                   "the wing's own)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--plot", metavar="FILE.png",
@@ -68,9 +76,12 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     speeds = args.speed or [DEFAULT_SPEED_M_S]
     check_plot_path(args.plot, args.force)
-    build = wing_from_args(args)
+    build = wing_for_run(wing_from_args(args), args)
     results = []
     for model in args.models:
+        if model == "coupled" and args.aero == "unsteady":
+            results.extend(_unsteady_mode_sets(build, speeds))
+            continue
         sets = eigen.modes_at(model, speeds, None if model == "rigid" else build.model)
         results.extend(sets)
     payload = {
@@ -90,14 +101,14 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"wing {build.variant.name}  (mass basis {build.mass_basis}"
           + (f", overrides {payload['overrides']}" if payload["overrides"] else "") + ")")
-    print(f"{'V [m/s]':>8} {'model':<8} {'mode':<14} {'re [rad/s]':>11} {'im [rad/s]':>11} "
+    print(f"{'V [m/s]':>8} {'model':<16} {'mode':<14} {'re [rad/s]':>11} {'im [rad/s]':>11} "
           f"{'damping':>8} {'ω_n [rad/s]':>12}  stability")
     for s in results:
         for m in s.modes:
             note = "UNSTABLE" if m.unstable else "stable"
             if m.branch != m.mode:
                 note += f" (real root of the {m.branch} branch)"
-            print(f"{s.speed_m_s:8.2f} {s.model:<8} {m.mode:<14} {m.re:11.3f} {m.im:11.3f} "
+            print(f"{s.speed_m_s:8.2f} {s.model:<16} {m.mode:<14} {m.re:11.3f} {m.im:11.3f} "
                   f"{m.damping:8.3f} {m.frequency_rad_s:12.3f}  {note}")
     n_bad = len(payload["unstable"])
     if n_bad:
@@ -106,6 +117,29 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"root loci written to {args.plot}")
     return 0
+
+
+def _unsteady_mode_sets(build, speeds) -> list:
+    """The coupled model on unsteady strips at ``speeds``: its labelled roots (short period,
+    phugoid, aeroelastic_i; the strips' lag roots left out) as :class:`eigen.ModeSet`s."""
+    from bioflex_jsb.aeroelasticity.free_aircraft import track_free
+
+    grid = eigen.sweep_grid(speeds)
+    track = track_free(build, grid, aero="unsteady")  # ζ already in the build
+    index = {float(v): k for k, v in enumerate(track.speeds_m_s)}
+    names = [lab for lab in dict.fromkeys(track.labels) if lab != "lag"]
+    out = []
+    for v in speeds:
+        k = index[float(v)]
+        modes = []
+        for name in names:
+            lam = track.mode(k, name)
+            unstable_real = lam.real > eigen.UNSTABLE_RE_RAD_S and abs(lam.imag) < 1e-6
+            modes.append(eigen.Mode("divergence" if unstable_real else name, lam.real,
+                                    abs(lam.imag), branch=name))
+        modes = tuple(modes)
+        out.append(eigen.ModeSet(float(v), "coupled-unsteady", modes))
+    return out
 
 
 def _plot(args, build, speeds) -> None:
