@@ -61,3 +61,16 @@ def test_structural_damping_moves_the_aeroelastic_roots(capsys):
                     if m["mode"] == "aeroelastic_1")
 
     assert ae1(high)["re"] < ae1(low)["re"] - 1.0
+
+
+def test_trim_with_a_wing_reports_its_elastic_trim_and_refuses_beyond_divergence(capsys):
+    status, data = run_json(["trim", "--wing", "inertial-backward", "--speed", "15", "--json"],
+                            capsys)
+    assert status == 0
+    e = data["elastic"]
+    # the backward-axis wing twists leading edge up at 15 m/s (docs/decisions.md: +2.3 deg)
+    assert 1.0 < e["tip_twist_deg"] < 4.0 and e["converged"]
+    assert e["divergence_speed_m_s"] == pytest.approx(18.73, abs=0.05)
+    assert main(["trim", "--wing", "inertial-backward", "--speed", "20"]) == 2
+    err = capsys.readouterr().err
+    assert "divergence speed 18.73 m/s" in err and err.count("\n") == 1

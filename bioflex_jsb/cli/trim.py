@@ -17,7 +17,12 @@ maximum shaft power. With --json, angles are in rad (keys ending in _rad), resid
 accelerations in m/s^2 and rad/s^2. Valid range: --speed {SPEED_RANGE_TEXT}, default
 {DEFAULT_SPEED_M_S:g} (the paper's cruise); a speed in it that the aircraft cannot fly (below
 the stall speed, beyond the motor's thrust at about 32 m/s) ends with a one-line reason and
-exit status 2."""
+exit status 2. With --wing W: also the elastic trim of that wing (the static aeroelastic
+equilibrium under the trim loads, with the aerodynamic stiffness at the trim's dynamic
+pressure, iterated with the rigid trim to a fixed point): the modal deflections eta_i [rad],
+the tip twist [deg, leading edge up], alpha and elevator rigid -> elastic, the wing's loads
+and its static divergence speed; at or beyond that speed it ends with one line naming it
+(docs/decisions.md, "Elastic trim")."""
 
 
 def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
@@ -52,8 +57,15 @@ def load_airframe(args: argparse.Namespace):
 
 
 def register(sub) -> None:
+    from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS, MASS_BASES, VARIANTS
+
     p = sub.add_parser("trim", help="level-flight trim of the JSBSim airframe", description=HELP)
     add_flight_condition_arguments(p)
+    p.add_argument("--wing", default=None, metavar="NAME|FILE.toml",
+                   help=f"also the elastic trim of this wing: {', '.join(VARIANTS)}, or a "
+                   "variant file (default: the rigid trim only)")
+    p.add_argument("--mass-basis", choices=MASS_BASES, default=DEFAULT_MASS_BASIS,
+                   help=f"generalised-mass basis of --wing (default {DEFAULT_MASS_BASIS})")
     p.add_argument("--json", action="store_true", help="print JSON (SI, rad) instead of a table")
     p.set_defaults(run=run)
 
@@ -79,8 +91,12 @@ def trim_payload(result) -> dict:
 def run(args: argparse.Namespace) -> int:
     airframe = load_airframe(args)
     result = airframe.trim(args.speed, args.altitude)
+    elastic = _elastic_trim(args, airframe) if args.wing else None
     if args.json:
-        print_json(trim_payload(result))
+        payload = trim_payload(result)
+        if elastic is not None:
+            payload["elastic"] = elastic.as_dict()
+        print_json(payload)
         return 0
     deg = math.degrees
     rows = [
@@ -97,4 +113,36 @@ def run(args: argparse.Namespace) -> int:
     print(f"Trim (JSBSim, wings level, level flight), converged: {result.converged}")
     for name, value, unit in rows:
         print(f"  {name:<10} {value:>10}  {unit}")
+    if elastic is not None:
+        _print_elastic(elastic.as_dict())
     return 0
+
+
+def _elastic_trim(args, airframe):
+    """The elastic trim of --wing at --speed, at the density JSBSim's trim flew in."""
+    from bioflex_jsb import units as U
+    from bioflex_jsb.cli.common import wing_from_args
+    from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
+
+    rho = airframe["atmosphere/rho-slugs_ft3"] * U.KG_M3_PER_SLUG_FT3
+    return elastic_trim(wing_from_args(args), args.speed, density_kg_m3=rho)
+
+
+def _print_elastic(e: dict) -> None:
+    deg = math.degrees
+    print(f"Elastic trim of the {e['wing']} wing at {e['speed_m_s']:g} m/s "
+          f"(Q = {e['dynamic_pressure_pa']:.1f} Pa; converged: {e['converged']} in "
+          f"{e['iterations']} iterations)")
+    for i, eta in enumerate(e["eta_rad"]):
+        print(f"  eta{i + 1:<7} {eta:10.5f}  rad (modal deflection)")
+    print(f"  {'tip twist':<10} {e['tip_twist_deg']:10.2f}  deg (+ leading edge up)")
+    print(f"  {'alpha':<10} {deg(e['alpha_rigid_rad']):10.2f} -> {deg(e['alpha_rad']):.2f}  "
+          "deg (rigid -> elastic)")
+    print(f"  {'elevator':<10} {deg(e['elevator_rigid_rad']):10.2f} -> "
+          f"{deg(e['elevator_rad']):.2f}  deg (rigid -> elastic)")
+    loads = e["wing_loads"]
+    print(f"  {'wing lift':<10} {loads['lift_n']:10.3f}  N;  pitching moment "
+          f"{loads['pitch_moment_n_m']:.4f} N*m")
+    div = e["divergence_speed_m_s"]
+    print(f"  {'divergence':<10} {'none' if div is None else f'{div:.2f} m/s':>10}  "
+          "(static, body held)")

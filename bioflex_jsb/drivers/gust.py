@@ -164,7 +164,6 @@ def run_gust(
             envelope.add(time_s, rows)
 
     advance_into = step.stepper()  # the step, bound once (compiled or Python)
-    w_g = gust.samples(n_steps)  # the gust by step number [m/s, up]
     k = 0  # steps handed over
     i = 0  # complete steps of the block in progress
     j0 = 0  # its first row in the table
@@ -172,7 +171,8 @@ def run_gust(
         with airframe.capturing():  # JSBSim's output captured once for the loop
             while k < n_steps:
                 j0 = k if keep_all else 0
-                ws = w_g[k:k + block].tolist()
+                # the gust by step number [m/s, up], one block at a time
+                ws = gust.samples(min(block, n_steps - k), k).tolist()
                 stop = None
                 i = 0
                 if on_sample is None:

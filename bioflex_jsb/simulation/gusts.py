@@ -184,9 +184,10 @@ class GustField:
             spectrum[0] = 0.0
             self._series = np.fft.irfft(spectrum, n=n_fft)[:n]
 
-    def samples(self, n_steps: int) -> np.ndarray:
-        """w_g [m/s, up] at steps 0 … n_steps − 1 (:meth:`at_step` of each), as an array."""
-        k = np.arange(n_steps)
+    def samples(self, n_steps: int, first_step: int = 0) -> np.ndarray:
+        """w_g [m/s, up] at steps first_step … first_step + n_steps − 1 (:meth:`at_step` of
+        each), as an array: a run samples its gust block by block, in bounded memory."""
+        k = np.arange(first_step, first_step + n_steps)
         if self._series is not None:
             j = k - self._first_step
             out = self._series[np.clip(j, 0, len(self._series) - 1)]
@@ -194,7 +195,7 @@ class GustField:
         tau = k * self._dt - self.start_s
         kind = self.spec.kind
         if kind == "none":
-            return np.zeros(n_steps)
+            return np.zeros(len(k))
         if kind == "sharp":
             return np.where(tau < 0.0, 0.0, self.spec.amplitude_m_s)
         x = tau * self.speed_m_s
