@@ -174,7 +174,8 @@ def check_run_arguments(args) -> None:
     """The run arguments that argparse cannot check alone (before any file is written)."""
     if args.dt > 0.02:
         raise UsageError(f"--dt {args.dt:g} s is too coarse; accepted: up to 0.02 s")
-    check_run_length(args.duration, args.dt)
+    check_run_length(args.duration, args.dt,
+                     turbulence=args.gust.kind in ("dryden", "vonkarman"))
     if args.gust_start >= args.duration:
         raise UsageError(
             f"--gust-start {args.gust_start:g} s must be before the end of the run "

@@ -55,7 +55,6 @@ from bioflex_jsb.simulation.modal_wing import (
     TrimReference,
     WingLoads,
 )
-from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
 
 STEP_MODELS = (*WING_MODELS, "native")
 AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
@@ -220,6 +219,10 @@ class CoupledStep:
                                    for i in range(self.n_modes)]
             self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
         elif unsteady:
+            # imported here: the unsteady strips pull in scipy's integrators and optimisers,
+            # ~15 MB a quasi-steady run does not need
+            from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
+
             self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s)
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
