@@ -74,3 +74,14 @@ def test_trim_with_a_wing_reports_its_elastic_trim_and_refuses_beyond_divergence
     assert main(["trim", "--wing", "inertial-backward", "--speed", "20"]) == 2
     err = capsys.readouterr().err
     assert "divergence speed 18.73 m/s" in err and err.count("\n") == 1
+
+
+def test_rerun_flies_an_unsteady_damped_run_as_it_was():
+    from bioflex_jsb.cli.rerun import argv_for
+    from bioflex_jsb.simulation.run import RunDescription
+
+    d = RunDescription("gust", "optimised", 15.0, models=("rigid", "coupled"),
+                       extra={"aero": "unsteady", "structural_damping": 0.02})
+    argv = argv_for(d)
+    assert argv[argv.index("--aero") + 1] == "unsteady"
+    assert float(argv[argv.index("--structural-damping") + 1]) == 0.02

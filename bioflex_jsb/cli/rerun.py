@@ -60,6 +60,10 @@ def argv_for(description) -> list[str]:
               "--speed", repr(float(d.speed_m_s)), "--gust", d.gust,
               "--duration", repr(float(d.duration_s)),
               "--gust-start", repr(float(d.gust_start_s)), "--dt", repr(float(d.dt_s))]
+    if d.extra.get("aero", "quasi-steady") != "quasi-steady":
+        common += ["--aero", str(d.extra["aero"])]
+    if d.extra.get("structural_damping") is not None:
+        common += ["--structural-damping", repr(float(d.extra["structural_damping"]))]
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")
