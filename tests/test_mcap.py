@@ -395,7 +395,9 @@ def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
     # every step, none skipped, the same count on every topic, through @mcap/core too
     assert [ns for ns, _ in rigid] == [round(k * DEFAULT_DT_S * 1e9) for k in range(n)]
     if flown:
-        assert rigid[-1][0] * 1e-9 == pytest.approx(flown[-1], abs=1e-9)
+        # the signal lands between two statements of the instrumented loop: the last step
+        # printed and the last step logged can be one step apart (either way), no more
+        assert abs(rigid[-1][0] * 1e-9 - flown[-1]) <= DEFAULT_DT_S + 1e-9
     counts = node_check(path)["counts"]
     assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
     assert "interrupted" in err and "holds every step" in err
