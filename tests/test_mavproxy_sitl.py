@@ -71,7 +71,7 @@ def test_mavproxy_detects_the_vehicle_and_receives_its_parameters(signed, tmp_pa
     params.set("GUST_LEN_M", 42.5)  # values MAVProxy can only know from the vehicle
     params.set("AP_HDG_RAD", 0.75)
     key = hashlib.sha256(PASSPHRASE.encode("ascii")).digest() if signed else None
-    link = MavlinkLink("udpin:127.0.0.1:0", params, sim.manual, signing_key=key)
+    link = MavlinkLink("udpin:127.0.0.1:0", params, sim.vehicle, signing_key=key)
     extra = ["--mav20", f"--cmd=signing key {PASSPHRASE}"] if signed else []
     n = len(SitlParameters.names)
 

@@ -48,7 +48,7 @@ class Session:
 
     def __init__(self, sim: SitlSim, kind: str = "udpin", link: MavlinkLink | None = None):
         self.sim = sim
-        self.link = link or MavlinkLink(f"{kind}:127.0.0.1:0", SitlParameters(sim), sim.manual)
+        self.link = link or MavlinkLink(f"{kind}:127.0.0.1:0", SitlParameters(sim), sim.vehicle)
         self.port = self.link.local_address[1]
         self._stop = threading.Event()
         self.stats = None
@@ -169,7 +169,8 @@ def test_live_session_handshakes_telemetry_parameters(build):
         hb = wait_for(c, "HEARTBEAT", poke=lambda: c.mav.heartbeat_send(6, 8, 0, 0, 0),
                       cond=lambda m: m.get_srcSystem() == 1)
         assert (hb.get_srcSystem(), hb.get_srcComponent()) == (1, 1)
-        assert hb.type == M.MAV_TYPE_FIXED_WING and hb.autopilot == M.MAV_AUTOPILOT_GENERIC
+        assert hb.type == M.MAV_TYPE_FIXED_WING and hb.autopilot == M.MAV_AUTOPILOT_ARDUPILOTMEGA
+        assert hb.custom_mode == 7 and hb.base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED  # CRUISE
         assert hb.system_status == M.MAV_STATE_ACTIVE
         assert hb.get_msgbuf()[0] == 0xFD  # MAVLink 2 framing
 
@@ -177,7 +178,8 @@ def test_live_session_handshakes_telemetry_parameters(build):
         assert abs(att.pitch - sim.trim.theta_rad) < 0.05 and abs(att.roll) < 0.05
         assert abs(att.time_boot_ms / 1e3 - sim.t_s) < 0.5  # simulated time
         pos = wait_for(c, "GLOBAL_POSITION_INT")
-        assert abs(pos.lat / 1e7 - 45.0) < 0.01 and abs(pos.vx / 100.0 - 15.0) < 0.5
+        assert abs(pos.lat / 1e7 + 35.363261) < 0.01 and abs(pos.vx / 100.0 - 15.0) < 0.5
+        assert abs(pos.relative_alt / 1e3 - 100.0) < 3.0  # 100 m above the CMAC field
         gps = wait_for(c, "GPS_RAW_INT")
         assert gps.fix_type == M.GPS_FIX_TYPE_3D_FIX
         hud = wait_for(c, "VFR_HUD")
@@ -221,11 +223,11 @@ def test_live_session_handshakes_telemetry_parameters(build):
         pv = wait_for(c, "PARAM_VALUE", cond=lambda m: m.param_id == "GUST_AMP_MS")
         assert pv.param_value == pytest.approx(2.0)
 
-        # mission: an empty one, of the type asked for
-        for mission_type in (M.MAV_MISSION_TYPE_MISSION, M.MAV_MISSION_TYPE_FENCE):
+        # mission: only home (ArduPilot's item 0); no fence
+        for mission_type, n in ((M.MAV_MISSION_TYPE_MISSION, 1), (M.MAV_MISSION_TYPE_FENCE, 0)):
             c.mav.mission_request_list_send(1, 1, mission_type)
             mc = wait_for(c, "MISSION_COUNT", cond=lambda m, t=mission_type: m.mission_type == t)
-            assert mc.count == 0 and mc.target_system == 255
+            assert mc.count == n and mc.target_system == 255
 
         # commands: unknown → UNSUPPORTED; AUTOPILOT_VERSION on request
         c.mav.command_long_send(1, 1, M.MAV_CMD_DO_SET_SERVO, 0, 1, 1500, 0, 0, 0, 0, 0)
@@ -233,7 +235,7 @@ def test_live_session_handshakes_telemetry_parameters(build):
         assert ack.result == M.MAV_RESULT_UNSUPPORTED
         c.mav.command_int_send(1, 1, 0, M.MAV_CMD_DO_REPOSITION, 0, 0, 0, 0, 0, 0, 0, 0, 0)
         ack = wait_for(c, "COMMAND_ACK", cond=lambda m: m.command == M.MAV_CMD_DO_REPOSITION)
-        assert ack.result == M.MAV_RESULT_UNSUPPORTED
+        assert ack.result == M.MAV_RESULT_DENIED  # no position given
         c.mav.command_long_send(1, 1, M.MAV_CMD_REQUEST_MESSAGE, 0,
                                 M.MAVLINK_MSG_ID_AUTOPILOT_VERSION, 0, 0, 0, 0, 0, 0)
         ack = wait_for(c, "COMMAND_ACK", cond=lambda m: m.command == M.MAV_CMD_REQUEST_MESSAGE)
@@ -309,7 +311,7 @@ print(n)
 
 def test_flood_of_random_bytes_does_not_stop_the_loop_or_the_link(build):
     sim = make_sim(build)
-    link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.manual)
+    link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.vehicle)
     port = link.local_address[1]
     duration = 3.0
     flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(port), str(duration + 0.5)],
@@ -329,7 +331,7 @@ def test_flood_of_random_bytes_does_not_stop_the_loop_or_the_link(build):
     # pace is a benchmark figure (`bioflex-jsb bench`: sitl_p50_ms, sitl_p99_ms): on a shared
     # 2-core machine, with the flood busy-looping on one core, wall times and percentiles
     # measure the machine's load, not the loop.
-    assert len(stats.errors_s) == sim.k and wall > 0.0
+    assert stats.steps == sim.k and wall > 0.0
     # and the link still talks to a real ground station afterwards
     with Session(sim, link=link):
         c = client(port)

@@ -114,7 +114,7 @@ class Gcs:
 
 def test_signed_vehicle_answers_the_key_and_ignores_the_rest():
     sim = make_sim(build_wing(VARIANTS["optimised"]))
-    link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.manual, signing_key=KEY)
+    link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.vehicle, signing_key=KEY)
     with Session(sim, link=link) as session:
         good = Gcs(session.port, KEY)
         good.mav.signing.sign_outgoing = False

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from bioflex_jsb.cli.common import (
-    EXIT_DIVERGED,
     UsageError,
     add_log_arguments,
     add_wing_arguments,
@@ -55,6 +55,15 @@ def register(sub) -> None:
                    help="simulated time [s] (default: until Ctrl-C)")
     p.add_argument("--speedup", type=positive_float("speed-up", "x"), default=1.0,
                    help="simulated seconds per wall-clock second (default 1, 0.1..50)")
+    p.add_argument("--home", metavar="LAT,LON,ALT", default=None,
+                   help="home on the ground: latitude, longitude [deg], ground altitude "
+                   "[m AMSL] (default -35.363261,149.165230,584: the CMAC field ArduPilot's "
+                   "SITL uses)")
+    p.add_argument("--start-height", type=positive_float("start height", "m"), default=100.0,
+                   help="start (and reset) height above home [m] (default 100)")
+    p.add_argument("--log-max-mb", type=positive_float("log size", "MB"), default=256.0,
+                   help="start a new log file (NAME-001.mcap, ...) when one reaches this size "
+                   "[MB] (default 256); each file is a finished MCAP")
     p.add_argument("--signing-key", metavar="FILE",
                    help="MAVLink 2 signing key file: 64 hex digits (32 bytes); sign what is "
                    "sent, accept only signed messages")
@@ -65,11 +74,13 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.sitl import (
+        DEFAULT_HOME,
         SPEEDUP_RANGE,
         SitlParameters,
         SitlSim,
         run_paced,
     )
+    from bioflex_jsb.errors import InputError
     from bioflex_jsb.links.mavlink import (
         LinkError,
         MavlinkLink,
@@ -86,15 +97,15 @@ def run(args: argparse.Namespace) -> int:
         key = None if args.signing_key is None else read_signing_key(args.signing_key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
+    home = _parse_home(args.home, DEFAULT_HOME)
     build = wing_from_args(args)
     try:
         sim = SitlSim(build.model, build.modes, model=args.model, speed_m_s=args.speed,
-                      speedup=args.speedup)
-    except (FdmError, ValueError) as exc:
+                      home=home, start_height_m=args.start_height, speedup=args.speedup)
+    except (FdmError, InputError, ValueError) as exc:
         raise UsageError(str(exc)) from None
     try:
-        link = MavlinkLink(endpoint, SitlParameters(sim), on_manual=sim.manual,
-                           signing_key=key)
+        link = MavlinkLink(endpoint, SitlParameters(sim), sim.vehicle, signing_key=key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
     log = None
@@ -116,23 +127,17 @@ def run(args: argparse.Namespace) -> int:
             extra={"until_stopped": args.duration is None, "speedup": args.speedup,
                    "mavlink": endpoint.text(), "signed": key is not None})
         try:
-            log = open_log(args.out, description, build)
+            log = SplitLog(args.out, description, build, args.log_max_mb, open_log)
         except UsageError:
             link.close()
             raise
+        sim.on_reset = log.reset
         names = sim.names
-
-        pending = [0]
 
         def on_sample(t, model, values):
             log.sample(model, t, dict(zip(names, values, strict=True)))
-            pending[0] += 1
 
-        def idle(slack_s):  # write the chunk while there is time (≈ 0.5 ms + 20 µs/step)
-            if (pending[0] >= LOG_FLUSH_STEPS and slack_s >= LOG_FLUSH_SLACK_S
-                    or pending[0] >= LOG_FLUSH_MAX_STEPS):
-                log.flush()
-                pending[0] = 0
+        idle = log.idle
 
     host, port = link.local_address
     if not args.json:
@@ -150,6 +155,9 @@ def run(args: argparse.Namespace) -> int:
         if log is not None:
             log.close()
     summary = {
+        "resets": sim.resets,
+        "last_reset": sim.last_reset,
+        "log_files": log.paths if log is not None else [],
         "simulated_s": sim.t_s,
         "steps": sim.k,
         "pacing": stats.summary() if stats else None,
@@ -157,7 +165,6 @@ def run(args: argparse.Namespace) -> int:
                  "rejected_signature": link.stats.rejected_signature,
                  "sent": link.stats.sent, "datagrams": link.stats.datagrams,
                  "signing": link.signing},
-        "stopped": sim.stopped,
         "out": args.out,
     }
     if args.json:
@@ -169,13 +176,79 @@ def run(args: argparse.Namespace) -> int:
             line += (f"; pacing error p50 {pacing['p50_ms']:.3f} ms, p99 {pacing['p99_ms']:.3f}"
                      f" ms, {pacing['resyncs']} resyncs")
         print(line)
+        if sim.resets:
+            print(f"{sim.resets} resets (last: {sim.last_reset})")
         if args.out:
-            print(f"log written to {args.out}")
+            print(f"log written to {', '.join(log.paths)}")
     if interrupted:
         print("bioflex-jsb sitl: interrupted" + (f"; the log {args.out} holds every step flown"
                                                 if args.out else ""), file=sys.stderr)
         return 130
-    if sim.stopped:
-        print(f"bioflex-jsb sitl: diverged: {sim.stopped}", file=sys.stderr)
-        return EXIT_DIVERGED
     return 0
+
+
+def _parse_home(text: str | None, default: tuple[float, float, float]):
+    if text is None:
+        return default
+    parts = text.split(",")
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        raise UsageError(f"--home {text!r}: expected LAT,LON,ALT (three numbers)") from None
+    if len(values) != 3:
+        raise UsageError(f"--home {text!r}: expected LAT,LON,ALT (three numbers)")
+    return values
+
+
+class SplitLog:
+    """The session's MCAP log in files of at most ``max_mb`` [MB] (NAME.mcap, NAME-001.mcap,
+    ...), each closed (finished) before the next opens; a reset also starts a new file, whose
+    run description records the reason (``extra.after_reset``). Chunks are written when the
+    loop has slack (``idle``)."""
+
+    def __init__(self, path: str, description, build, max_mb: float, open_log) -> None:
+        import dataclasses
+        from pathlib import Path
+
+        self._base = Path(path)
+        self._description, self._build, self._open = description, build, open_log
+        self._replace = dataclasses.replace
+        self.max_bytes = int(max_mb * 1e6)
+        self.paths: list[str] = []
+        self._pending = 0
+        self._log = self._next(None)
+
+    def _next(self, reason: str | None):
+        n = len(self.paths)
+        path = self._base if n == 0 else self._base.with_name(
+            f"{self._base.stem}-{n:03d}{self._base.suffix}")
+        d = self._description
+        if n:
+            extra = dict(d.extra, segment=n, **({"after_reset": reason} if reason else {}))
+            d = self._replace(d, extra=extra)
+        log = self._open(str(path), d, self._build)
+        self.paths.append(str(path))
+        return log
+
+    def sample(self, model, t, row) -> None:
+        self._log.sample(model, t, row)
+        self._pending += 1
+
+    def idle(self, slack_s: float) -> None:
+        if (self._pending >= LOG_FLUSH_STEPS and slack_s >= LOG_FLUSH_SLACK_S
+                or self._pending >= LOG_FLUSH_MAX_STEPS):
+            self._log.flush()
+            self._pending = 0
+            if os.path.getsize(self.paths[-1]) >= self.max_bytes:
+                self._roll(None)
+
+    def _roll(self, reason: str | None) -> None:
+        self._log.close()
+        self._log = self._next(reason)
+        self._pending = 0
+
+    def reset(self, reason: str) -> None:
+        self._roll(reason)
+
+    def close(self) -> None:
+        self._log.close()

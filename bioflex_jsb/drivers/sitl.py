@@ -1,33 +1,46 @@
 """The SITL loop: the one coupled step paced to the wall clock.
 
 The one coupled step (:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`), on the
-``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml``, see
-:mod:`bioflex_jsb.generators.autopilot`) keeps it flying level on its own, for as long as
-asked (or until stopped).
+``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml`` and
+``systems/bioflex_autothrottle.xml``, see :mod:`bioflex_jsb.generators.autopilot`) flies the
+modes of :mod:`bioflex_jsb.drivers.sitl_vehicle`, for as long as asked (or until stopped).
+
+Where it flies: home is a point on the ground (latitude, longitude, ground altitude AMSL;
+default :data:`DEFAULT_HOME`, the Canberra model aircraft field ArduPilot's SITL also
+uses); the aircraft starts in trim ``start_height_m`` (default 100 m) above home, heading
+north, in CRUISE. JSBSim's terrain is the flat ground at home's altitude: an aircraft that
+reaches it (or leaves the valid range in any other way: divergence, stall) is reported and
+**reset** to trim at the start point (``SitlSim.resets``, STATUSTEXT), and the session goes
+on; the simulated clock keeps running.
 
 Pacing: step k is due at wall time W_0 + (t_k − t_0)/speedup. The loop sleeps until a step is
 due and runs late steps at once (catch-up); the *pacing error* of a step is its start minus
-its due time [s] (:class:`PacingStats`; ``sitl_p99_ms`` in ``bioflex-jsb bench``). A loop
-more than :data:`RESYNC_S` behind (a stall: debugger, swapped-out process) starts a new
-schedule from now instead of racing to catch up; the number of such resyncs is reported.
-Changing the time scale (parameter ``SIM_SPEEDUP``) starts a new schedule too.
+its due time [s] (:class:`PacingStats`, a fixed histogram: constant memory for any session
+length; ``sitl_p99_ms`` in ``bioflex-jsb bench``). A loop more than :data:`RESYNC_S` behind
+(a stall: debugger, swapped-out process, a reset's trim) starts a new schedule from now
+instead of racing to catch up; the number of such resyncs is reported. Changing the time
+scale (parameter ``SIM_SPEEDUP``) starts a new schedule too.
 
 The MAVLink link (:mod:`bioflex_jsb.links.mavlink`) is serviced every
-:data:`LINK_PERIOD_S` of simulated time (≥ 50 Hz of wall time up to a speed-up of 4); its
-reads are bounded per call, so a flood costs at most a fixed time per call.
+:data:`LINK_PERIOD_S` of simulated time; its reads are bounded per call, so a flood costs at
+most a fixed time per call.
 
 Parameters a ground station sees (:class:`SitlParameters`, all REAL32 in MAVLink):
 
 =============== =========================================================================
-AP_ENABLE       1: autopilot engaged (altitude and heading hold); 0: controls at trim
-AP_LOITER       1: loiter circle at a fixed bank instead of heading hold
-AP_ALT_M        altitude held [m above sea level]
-AP_HDG_RAD      heading held [rad, from north, clockwise]
-GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up]
-GUST_LEN_M      length of that gust [m]
+AP_ENABLE       1: autopilot engaged; 0: MANUAL (controls at trim without sticks)
+AP_LOITER       1: CIRCLE (fixed 20° bank); 0: back to CRUISE
+AP_ALT_M        altitude held [m AMSL], home's ground + 20 m .. + 1500 m
+AP_HDG_RAD      heading held in CRUISE [rad, from north, clockwise]; sets CRUISE
+WP_RADIUS_M     default waypoint acceptance radius [m], 5..500
+LOIT_RAD_M      loiter radius [m], 20..1000
+RTL_ALT_M       return altitude [m above home], 20..1000
+AIRSPEED_MS     airspeed held by the autothrottle [m/s], 12..22 (MAV_CMD_DO_CHANGE_SPEED)
+GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up], ±5
+GUST_LEN_M      length of that gust [m], 1..500
 GUST_TRIG       write 1: the gust starts now; reads 1 while it blows, then 0
 WING_COUPLED    1: the elastic wing's modal loads act (coupled); 0: rigid wing
-SIM_SPEEDUP     simulated seconds per wall-clock second
+SIM_SPEEDUP     simulated seconds per wall-clock second, 0.1..50
 =============== =========================================================================
 """
 
@@ -36,12 +49,18 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.drivers.sitl_vehicle import (
+    AIRSPEED_RANGE_M_S,
+    GUIDANCE_PERIOD_S,
+    SitlVehicle,
+)
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators.autopilot import SITL_AIRCRAFT
+from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink import VehicleState
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
@@ -51,44 +70,81 @@ from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 LINK_PERIOD_S = 1.0 / 200.0  # simulated time between link services [s]
 RESYNC_S = 0.25  # a loop this far behind its schedule starts a new one [s]
 SLEEP_MARGIN_S = 50e-6  # steps due within this are started at once (sleep overshoot)
-MANUAL_TIMEOUT_S = 1.0  # manual input older than this [wall s] gives control back
 SPEEDUP_RANGE = (0.1, 50.0)
+# Canberra Model Aircraft Club field (ArduPilot SITL's default home): lat, lon [deg], ground
+# altitude [m AMSL]
+DEFAULT_HOME = (-35.363261, 149.165230, 584.0)
+DEFAULT_START_HEIGHT_M = 100.0
+START_HEIGHT_RANGE_M = (20.0, 3000.0)
+ALT_HOLD_RANGE_ABOVE_HOME_M = (20.0, 1500.0)
+MAX_RESETS_PER_MINUTE = 30  # a run that keeps diverging: each reset still costs a trim
 
 
-@dataclass
 class PacingStats:
-    """Step start minus due time [s] of every paced step, and the resyncs."""
+    """|step start − due time| of every paced step in a fixed log-spaced histogram (1 µs to
+    100 s, 20 bins per decade: percentiles to ±6 %; memory independent of the session's
+    length), the exact largest value, and the resyncs."""
 
-    errors_s: list[float] = field(default_factory=list)
-    resyncs: int = 0
+    LO_S, DECADES, PER_DECADE = 1e-6, 8, 20
+
+    def __init__(self) -> None:
+        self.counts = np.zeros(self.DECADES * self.PER_DECADE + 2, dtype=np.int64)
+        self.max_s = 0.0
+        self.steps = 0
+        self.resyncs = 0
+        self._log_lo = math.log10(self.LO_S)
+
+    def add(self, error_s: float) -> None:
+        e = abs(error_s)
+        self.steps += 1
+        if e > self.max_s:
+            self.max_s = e
+        if e < self.LO_S:
+            self.counts[0] += 1
+            return
+        i = 1 + int((math.log10(e) - self._log_lo) * self.PER_DECADE)
+        self.counts[min(i, len(self.counts) - 1)] += 1
 
     def percentile_ms(self, q: float) -> float:
-        if not self.errors_s:
+        """The q-th percentile [ms] (the geometric middle of its bin; q = 100: the max)."""
+        if not self.steps:
             return math.nan
-        return float(np.percentile(np.abs(np.asarray(self.errors_s)), q) * 1e3)
+        if q >= 100.0:
+            return self.max_s * 1e3
+        rank = q / 100.0 * self.steps
+        i = int(np.searchsorted(np.cumsum(self.counts), max(rank, 1e-9)))
+        if i == 0:
+            return 0.0
+        lo = self.LO_S * 10.0 ** ((i - 1) / self.PER_DECADE)
+        mid = lo * 10.0 ** (0.5 / self.PER_DECADE)
+        return min(mid, self.max_s) * 1e3
 
     def summary(self) -> dict[str, float]:
         return {"p50_ms": self.percentile_ms(50), "p99_ms": self.percentile_ms(99),
-                "max_ms": self.percentile_ms(100), "steps": len(self.errors_s),
+                "max_ms": self.percentile_ms(100), "steps": self.steps,
                 "resyncs": self.resyncs}
 
 
 class SitlParameters:
     """The parameter set of the module docstring; ``set`` applies to the running sim."""
 
-    names = ("AP_ENABLE", "AP_LOITER", "AP_ALT_M", "AP_HDG_RAD", "GUST_AMP_MS", "GUST_LEN_M",
-             "GUST_TRIG", "WING_COUPLED", "SIM_SPEEDUP")
+    names = ("AP_ENABLE", "AP_LOITER", "AP_ALT_M", "AP_HDG_RAD", "WP_RADIUS_M", "LOIT_RAD_M",
+             "RTL_ALT_M", "AIRSPEED_MS", "GUST_AMP_MS", "GUST_LEN_M", "GUST_TRIG",
+             "WING_COUPLED", "SIM_SPEEDUP")
 
     def __init__(self, sim: SitlSim) -> None:
         self._sim = sim
 
     def get(self, name: str) -> float:
         s = self._sim
+        v, st = s.vehicle, s.vehicle.settings
         return float({
-            "AP_ENABLE": s.airframe["ap/engage"],
-            "AP_LOITER": s.airframe["ap/loiter"],
-            "AP_ALT_M": s.airframe["ap/altitude-hold-m"],
-            "AP_HDG_RAD": s.airframe["ap/heading-hold-rad"],
+            "AP_ENABLE": 0.0 if v.mode == MODES.MANUAL else 1.0,
+            "AP_LOITER": 1.0 if v.mode == MODES.CIRCLE else 0.0,
+            "AP_ALT_M": v.alt_target_m,
+            "AP_HDG_RAD": v.heading_target_rad,
+            "WP_RADIUS_M": st.wp_radius_m, "LOIT_RAD_M": st.loiter_radius_m,
+            "RTL_ALT_M": st.rtl_altitude_m, "AIRSPEED_MS": v.speed_target_m_s,
             "GUST_AMP_MS": s.gust_amplitude_m_s,
             "GUST_LEN_M": s.gust_length_m,
             "GUST_TRIG": 1.0 if s.gust_active else 0.0,
@@ -96,31 +152,54 @@ class SitlParameters:
             "SIM_SPEEDUP": s.speedup,
         }[name])
 
+    @staticmethod
+    def _range(name: str, value: float, lo: float, hi: float, unit: str = "") -> None:
+        if not lo <= value <= hi:
+            raise ValueError(f"{name} must be in {lo:g}..{hi:g}{unit}")
+
     def set(self, name: str, value: float) -> float:
         s = self._sim
+        v, st = s.vehicle, s.vehicle.settings
+        if name not in self.names:
+            raise KeyError(name)
         if not math.isfinite(value):
             raise ValueError(f"{name}: not a finite number")
         if name in ("AP_ENABLE", "AP_LOITER", "WING_COUPLED", "GUST_TRIG"):
             if value not in (0.0, 1.0):
                 raise ValueError(f"{name} must be 0 or 1")
         if name == "AP_ENABLE":
-            s.airframe["ap/engage"] = value
+            if value == 0.0:
+                v.set_mode(MODES.MANUAL)
+            elif v.mode == MODES.MANUAL:
+                v.set_mode(MODES.CRUISE)
         elif name == "AP_LOITER":
-            s.airframe["ap/loiter"] = value
+            if value == 1.0:
+                v.set_mode(MODES.CIRCLE)
+            elif v.mode == MODES.CIRCLE:
+                v.set_mode(MODES.CRUISE)
         elif name == "AP_ALT_M":
-            lo, hi = s.altitude_hold_range_m
-            if not lo <= value <= hi:
-                raise ValueError(f"AP_ALT_M must be in {lo:g}..{hi:g} m")
-            s.airframe["ap/altitude-hold-m"] = value
+            reason = v.change_altitude(value)
+            if reason:
+                raise ValueError(f"AP_ALT_M: {reason}")
         elif name == "AP_HDG_RAD":
-            s.airframe["ap/heading-hold-rad"] = math.remainder(value, 2.0 * math.pi)
+            v.set_heading(value)
+        elif name == "WP_RADIUS_M":
+            self._range(name, value, 5.0, 500.0, " m")
+            st.wp_radius_m = value
+        elif name == "LOIT_RAD_M":
+            self._range(name, value, 20.0, 1000.0, " m")
+            st.loiter_radius_m = value
+        elif name == "RTL_ALT_M":
+            self._range(name, value, 20.0, 1000.0, " m")
+            st.rtl_altitude_m = value
+        elif name == "AIRSPEED_MS":
+            self._range(name, value, *AIRSPEED_RANGE_M_S, " m/s")
+            v.change_speed(value)
         elif name == "GUST_AMP_MS":
-            if abs(value) > 5.0:
-                raise ValueError("GUST_AMP_MS must be within ±5 m/s")
+            self._range(name, value, -5.0, 5.0, " m/s")
             s.gust_amplitude_m_s = value
         elif name == "GUST_LEN_M":
-            if not 1.0 <= value <= 500.0:
-                raise ValueError("GUST_LEN_M must be in 1..500 m")
+            self._range(name, value, 1.0, 500.0, " m")
             s.gust_length_m = value
         elif name == "GUST_TRIG":
             if value == 1.0:
@@ -128,70 +207,133 @@ class SitlParameters:
         elif name == "WING_COUPLED":
             s.set_wing_model("coupled" if value == 1.0 else "rigid")
         elif name == "SIM_SPEEDUP":
-            lo, hi = SPEEDUP_RANGE
-            if not lo <= value <= hi:
-                raise ValueError(f"SIM_SPEEDUP must be in {lo:g}..{hi:g}")
+            self._range(name, value, *SPEEDUP_RANGE)
             s.speedup = value
             s.resync = True
-        else:
-            raise KeyError(name)
         return self.get(name)
+
+
+def check_home(lat_deg: float, lon_deg: float, ground_m: float, start_height_m: float) -> None:
+    """InputError (one line) for a home or start height outside the accepted ranges."""
+    if not (math.isfinite(lat_deg) and -85.0 <= lat_deg <= 85.0):
+        raise InputError(f"home latitude {lat_deg:g} deg is outside -85..85")
+    if not (math.isfinite(lon_deg) and -180.0 <= lon_deg <= 180.0):
+        raise InputError(f"home longitude {lon_deg:g} deg is outside -180..180")
+    if not (math.isfinite(ground_m) and -400.0 <= ground_m <= 5000.0):
+        raise InputError(f"home ground altitude {ground_m:g} m is outside -400..5000 m AMSL")
+    lo, hi = START_HEIGHT_RANGE_M
+    if not (math.isfinite(start_height_m) and lo <= start_height_m <= hi):
+        raise InputError(f"start height {start_height_m:g} m is outside {lo:g}..{hi:g} m "
+                         "above home")
 
 
 class SitlSim:
     """The co-simulation state between steps: the one coupled step (airframe trimmed,
-    autopilot engaged, modal wing) and the gust in progress."""
+    autopilot engaged, modal wing), the vehicle (modes, mission) and the gust in progress.
+
+    ``home``: (latitude [deg], longitude [deg], ground altitude [m AMSL]);
+    ``start_height_m``: the start (and reset) point's height above home [m].
+    ``on_reset(reason)``: called after each reset (the CLI starts a new log file)."""
 
     def __init__(self, wing_model, modes, model: str = "coupled", speed_m_s: float = 15.0,
-                 altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S, speedup: float = 1.0,
-                 airframe: Airframe | None = None) -> None:
+                 home: tuple[float, float, float] = DEFAULT_HOME,
+                 start_height_m: float = DEFAULT_START_HEIGHT_M, dt_s: float = DEFAULT_DT_S,
+                 speedup: float = 1.0, airframe: Airframe | None = None) -> None:
+        check_home(*home, start_height_m)
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
-        a = self.airframe
-
-        def disengage(af: Airframe) -> None:
-            af["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
-
-        self.core = CoupledStep(a, wing_model, model, speed_m_s, altitude_m, dt_s,
-                                before_trim=disengage)
-        core = self.core
-        self.trim = core.trim
+        self._wing_model, self._model0 = wing_model, model
+        self.home_deg = tuple(float(x) for x in home)
+        self.start_height_m = float(start_height_m)
+        self.start_altitude_m = self.home_deg[2] + self.start_height_m
         self.speed_m_s = speed_m_s
-        self.dt_s = core.dt_s
         self.speedup = float(speedup)
         self.resync = False
-        self._get = core.get
-        self.wing = core.wing
-        self.n_modes = core.n_modes
+        self.resets = 0
+        self.last_reset: str | None = None
+        self.on_reset: Callable[[str], None] | None = None
+        self._k_base = 0  # steps flown by the cores before the present one
+        self._reset_walls: list[float] = []
+        self._dt0 = dt_s
+        self._new_core(model)
+        self.dt_s = self.core.dt_s
+        self.n_modes = self.core.n_modes
         twist = np.asarray(modes.twist_rad, dtype=float)
         tip = int(np.argmax(np.abs(np.asarray(modes.stations_m, dtype=float))))
         self._tip_twist_per_mode = np.abs(twist[:, tip]) / np.max(np.abs(twist), axis=1)
-        self.h0_m = self._get["h"]() * U.M_PER_FT
-        self.altitude_hold_range_m = (self.h0_m - 250.0, self.h0_m + 1000.0)
-        a["ap/theta-trim-rad"] = self.trim.theta_rad
-        a["ap/altitude-hold-m"] = self.h0_m
-        a["ap/heading-hold-rad"] = self._get["psi"]()
-        a["ap/engage"] = 1.0
+        self.h0_m = self.start_altitude_m
+        ground = self.home_deg[2]
+        self.altitude_hold_range_m = (ground + ALT_HOLD_RANGE_ABOVE_HOME_M[0],
+                                      ground + ALT_HOLD_RANGE_ABOVE_HOME_M[1])
+        self.power_properties = tuple(f"propulsion/engine[{i}]/power-hp"
+                                      for i in range(self.airframe.engine_count))
         self.gust_amplitude_m_s = 1.0
         self.gust_length_m = 30.0
         self._gust: GustField | None = None
         self._gust_start_k = 0
         self._gust_end_s = 0.0
-        self.units = core.units
-        self.names = list(core.names)
-        self._manual_wall_s: float | None = None
+        self.units = self.core.units
+        self.names = list(self.core.names)
         self.stopped: str | None = None
-        core.prepare(0.0)
-        self._state = core.sense(0.0)
+        home_rad = (math.radians(self.home_deg[0]), math.radians(self.home_deg[1]),
+                    self.home_deg[2])
+        self.vehicle = SitlVehicle(self, home_rad)
+        self._guide_every = max(1, int(round(GUIDANCE_PERIOD_S / self.dt_s)))
+
+    def _new_core(self, model: str) -> None:
+        """Trim at the start altitude (JSBSim's trim flies at 45° N, 0° E), then move the
+        trimmed aircraft over home, its terrain at home's ground altitude."""
+        a = self.airframe
+
+        def disengage(af: Airframe) -> None:
+            af["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
+            af["ap/autothrottle"] = 0.0
+            af["ap/armed"] = 1.0
+
+        self.core = CoupledStep(a, self._wing_model, model, self.speed_m_s,
+                                self.start_altitude_m, self._dt0, before_trim=disengage)
+        self.trim = self.core.trim
+        self._relocate()
+        self._get = self.core.get
+        self.wing = self.core.wing
+        a["ap/theta-trim-rad"] = self.trim.theta_rad
+        a["ap/altitude-hold-m"] = self.start_altitude_m
+        a["ap/heading-hold-rad"] = math.remainder(self._get["psi"](), 2 * math.pi)
+        a["ap/airspeed-hold-mps"] = self.speed_m_s
+        a["ap/engage"] = 1.0
+        a["ap/autothrottle"] = 1.0
+        self.core.prepare(0.0)
+        self._state = self.core.sense(0.0)
+
+    def _relocate(self) -> None:
+        """Re-initialise JSBSim at its present (trimmed) state, over home. JSBSim's RunIC
+        keeps the propeller RPM (its reset property would stop the propellers); the
+        Airframe has no public call for it, so the flying instance's is used here."""
+        a = self.airframe
+        lat, lon, ground = self.home_deg
+        state = {
+            "ic/h-sl-ft": a["position/h-sl-ft"], "ic/phi-rad": a["attitude/phi-rad"],
+            "ic/theta-rad": a["attitude/theta-rad"], "ic/psi-true-rad": a["attitude/psi-rad"],
+            "ic/u-fps": a["velocities/u-fps"], "ic/v-fps": a["velocities/v-fps"],
+            "ic/w-fps": a["velocities/w-fps"], "ic/p-rad_sec": a["velocities/p-rad_sec"],
+            "ic/q-rad_sec": a["velocities/q-rad_sec"], "ic/r-rad_sec": a["velocities/r-rad_sec"],
+        }
+        a["ic/lat-geod-rad"] = math.radians(lat)
+        a["ic/long-gc-rad"] = math.radians(lon)
+        a["ic/terrain-elevation-ft"] = ground * U.FT_PER_M
+        for name, value in state.items():
+            a[name] = value
+        with a.capturing():
+            a._fdm.run_ic()  # noqa: SLF001 - see the docstring
 
     @property
     def k(self) -> int:
-        """Steps flown."""
-        return self.core.k
+        """Steps flown (over every reset)."""
+        return self._k_base + self.core.k
 
     @property
     def t_s(self) -> float:
-        """Simulated time now [s]."""
-        return self.core.k * self.dt_s
+        """Simulated time now [s] (over every reset)."""
+        return self.k * self.dt_s
 
     # -- commands from the link -------------------------------------------------------------
     @property
@@ -210,35 +352,55 @@ class SitlSim:
         self._gust = GustField(spec, self.speed_m_s, 0.0, 60.0, self.dt_s)
         self._gust_start_k = self.k
         self._gust_end_s = self.t_s + self.gust_length_m / self.speed_m_s
+        self.vehicle.status(5, f"Gust {self.gust_amplitude_m_s:g} m/s over "
+                               f"{self.gust_length_m:g} m")
 
     def set_wing_model(self, model: str) -> None:
         self.core.set_model(model)
 
-    def manual(self, pitch: float | None, roll: float | None) -> None:
-        """Stick increments on the trim (−1..1; pitch + = nose down), or None: release."""
-        a = self.airframe
-        if pitch is None or roll is None:
-            a["ap/manual"] = 0.0
-            self._manual_wall_s = None
-            return
-        a["ap/manual-elevator-norm"] = pitch
-        a["ap/manual-aileron-norm"] = roll
-        a["ap/manual"] = 1.0
-        self._manual_wall_s = time.monotonic()
+    def manual(self, pitch: float | None, roll: float | None) -> bool:
+        """Stick increments (−1..1; pitch + = nose down), or None: released."""
+        return self.vehicle.manual(pitch, roll)
 
     # -- the step -----------------------------------------------------------------------
     def step(self) -> tuple:
         """One co-simulation step (the one coupled step); returns the logged row's values
-        (in ``self.names`` order) and sets ``self.stopped`` when the run left its valid
-        range."""
+        (in ``self.names`` order). A run that leaves its valid range is reset (module
+        docstring); ``self.stopped`` then says why until the next step."""
         core = self.core
-        values = core.advance(self._w_g(core.k))
+        values = core.advance(self._w_g(self.k))
         self._state = None  # the snapshot of t_k+1 is read when asked for (vehicle_state)
-        self.stopped = core.stopped
-        if self._manual_wall_s is not None and \
-                time.monotonic() - self._manual_wall_s > MANUAL_TIMEOUT_S:
-            self.manual(None, None)
+        if core.stopped:
+            self.reset(core.stopped)
+            return values
+        self.stopped = None
+        if core.k % self._guide_every == 0:
+            self.vehicle.update(self.t_s)
         return values
+
+    def reset(self, reason: str) -> None:
+        """Report ``reason``, put the aircraft back in trim at the start point over home."""
+        self.stopped = reason
+        self.resets += 1
+        self.last_reset = reason
+        now = time.monotonic()
+        self._reset_walls = [w for w in self._reset_walls if now - w < 60.0] + [now]
+        ground = "ground" in reason or "terrain" in reason or "altitude" in reason
+        self.vehicle.status(2 if ground else 3, ("Crashed: " if ground else "Diverged: ")
+                            + reason)
+        model = self.core.model
+        self._k_base += self.core.k
+        self._gust = None
+        self._new_core(model)
+        self.vehicle.after_reset()
+        self.vehicle.status(4, "Reset to trim over home")
+        self.resync = True  # the trim took wall time: a new schedule
+        if self.on_reset is not None:
+            self.on_reset(reason)
+
+    @property
+    def resetting_too_often(self) -> bool:
+        return len(self._reset_walls) >= MAX_RESETS_PER_MINUTE
 
     def _w_g(self, k: int) -> float:
         """The gust [m/s, up] at step ``k``."""
@@ -247,23 +409,32 @@ class SitlSim:
 
     def vehicle_state(self) -> VehicleState:
         """The vehicle now (t_k, k steps flown), with the flow of this step's gust."""
-        get, a = self._get, self.airframe
+        get, v = self._get, self.vehicle
         if self._state is None:
-            self._state = self.core.sense(self._w_g(self.core.k))
+            self._state = self.core.sense(self._w_g(self.k))
         h = get["h"]() * U.M_PER_FT
         eta = self.core.eta
         named = {f"eta{i + 1}": float(eta[i]) for i in range(min(3, self.n_modes))}
         named["tip_twist"] = float(np.asarray(self._tip_twist_per_mode) @ eta)
+        b = v.battery
+        home = v.home
         return VehicleState(
             time_s=self.t_s, roll_rad=self._state.phi_rad, pitch_rad=self._state.theta_rad,
-            yaw_rad=get["psi"](),
+            yaw_rad=math.remainder(get["psi"](), 2.0 * math.pi),
             p_rad_s=get["p"](), q_rad_s=get["q"](), r_rad_s=get["r"](),
             latitude_rad=get["lat"](), longitude_rad=get["lon"](), altitude_m=h,
-            relative_altitude_m=h - self.h0_m,
+            relative_altitude_m=h - home[2],
             v_north_m_s=get["vn"]() * U.M_PER_FT, v_east_m_s=get["ve"]() * U.M_PER_FT,
             v_down_m_s=get["vd"]() * U.M_PER_FT, airspeed_m_s=self._state.flow.airspeed_m_s,
             throttle=get["throttle"](), named=named,
-            autopilot=a["ap/engage"] == 1.0, manual=a["ap/manual"] == 1.0,
+            autopilot=v.mode != MODES.MANUAL, manual=v.mode in MODES.STICK_MODES,
+            custom_mode=v.mode, armed=v.armed,
+            home_latitude_rad=home[0], home_longitude_rad=home[1], home_altitude_m=home[2],
+            mission_seq=v.mission_seq, mission_total=len(v.mission),
+            battery_voltage_v=b.voltage_v, battery_current_a=b.current_a,
+            battery_consumed_mah=b.consumed_mah, battery_energy_j=b.energy_j,
+            battery_remaining_pct=b.remaining_pct,
+            battery_time_remaining_s=b.time_remaining_s(),
         )
 
 
@@ -278,13 +449,14 @@ def run_paced(
     idle: Callable[[float], None] | None = None,
 ) -> PacingStats:
     """Fly ``sim`` paced to the wall clock for ``duration_s`` simulated seconds (None: until
-    ``should_stop()`` or a stop of the run; Ctrl-C raises KeyboardInterrupt). ``link``: a
+    ``should_stop()``; Ctrl-C raises KeyboardInterrupt; a run that leaves its valid range is
+    reset by ``sim.step`` and flies on). ``link``: a
     :class:`~bioflex_jsb.links.mavlink.MavlinkLink`, serviced every LINK_PERIOD_S;
     ``on_sample(t_s, model, values)`` after every step (logging); ``idle(slack_s)`` when the
     next step is not due for ``slack_s`` [s] (a place for work that may wait, such as writing
     a log chunk, without delaying a step)."""
     stats = PacingStats()
-    errors = stats.errors_s
+    add = stats.add
     dt = sim.dt_s
     n_end = None if duration_s is None else sim.k + int(round(duration_s / dt))
     link_every = max(1, int(round(LINK_PERIOD_S / dt)))
@@ -309,13 +481,12 @@ def run_paced(
                 stats.resyncs += 1
                 wall0, k0 = now, sim.k
                 late = 0.0
-            errors.append(late)
+            add(late)
             t = sim.t_s
+            model = sim.wing.model
             values = sim.step()
             if on_sample is not None:
-                on_sample(t, sim.wing.model, values)
-            if sim.stopped:
-                break
+                on_sample(t, model, values)
             if link is not None and sim.k % link_every == 0:
                 link.service(sim.vehicle_state())
             if should_stop is not None and sim.k % link_every == 0 and should_stop():
@@ -335,7 +506,7 @@ def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "o
 
     build = build_wing(VARIANTS[wing])
     sim = SitlSim(build.model, build.modes, speed_m_s=speed_m_s, speedup=speedup)
-    link = MavlinkLink(mavlink, SitlParameters(sim), sim.manual)
+    link = MavlinkLink(mavlink, SitlParameters(sim), sim.vehicle)
     try:
         stats = run_paced(sim, duration_s, link)
     finally:

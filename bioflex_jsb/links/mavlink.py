@@ -1,7 +1,7 @@
 """MAVLink 2 link of the SITL aircraft: telemetry out, ground-station handshakes in.
 
-This is the only module that imports :mod:`pymavlink` (its generated MAVLink 2 ``common``
-codec; the sockets are ours). The vehicle is system 1, component 1 (the autopilot).
+The ``links.mavlink*`` modules are the only ones that import :mod:`pymavlink` (its MAVLink 2
+``common`` codec; the sockets are ours). The vehicle is system 1, component 1 (the autopilot).
 
 Endpoints (``parse_endpoint``):
 
@@ -35,6 +35,16 @@ step are read at the end of that step (as in ``cosim.run_gust``), so those match
 step one time step (1/960 s) earlier. With ``--speedup N`` this clock runs N times faster
 than the wall clock.
 
+Sequence numbers: one counter for everything the vehicle sends, +1 (mod 256) per packet,
+as the MAVLink 2 spec asks (every peer sees the same numbers, so a peer's loss count is
+right). Peers (``udpin``) that stay silent for :data:`PEER_TIMEOUT_S` are dropped, which
+frees their slot; with signing on, only a peer whose message passed the signature check gets
+a slot (an unsigned RADIO_STATUS is accepted but adds no peer).
+
+MANUAL_CONTROL (and RC_CHANNELS_OVERRIDE) is obeyed from one ground station only: the first
+(system, component) that sends it, until that one is silent for :data:`CONTROLLER_TIMEOUT_S`;
+the vehicle obeys it only in its stick modes (MANUAL, STABILIZE, FBWA).
+
 Signing (``signing_key``, :func:`read_signing_key`): MAVLink 2 message signing with one
 32-byte secret. Everything sent is signed (link id 0, timestamps from the wall clock in
 10 µs since 2015-01-01 UTC, as the MAVLink signing spec asks); a received message is
@@ -42,7 +52,7 @@ accepted only with a valid signature whose timestamp is newer than the last one 
 stream (link id, system, component) and not more than 60 s older than the link's own
 time (replay protection, shared by all peers of the link). Unsigned or wrongly signed
 messages are dropped (counted in ``LinkStats.rejected_signature``) except RADIO_STATUS,
-which radios send unsigned. A peer whose messages are all rejected is never added
+which radios send unsigned. A peer with no validly signed message is never added
 (``udpin``), so it gets no telemetry either.
 """
 
@@ -51,26 +61,33 @@ from __future__ import annotations
 import errno
 import hashlib
 import hmac
-import math
 import socket
 import struct
 import time
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from pymavlink.dialects.v20 import common as mavlink
 
+from bioflex_jsb.links.mavlink_commands import CommandHandler
+from bioflex_jsb.links.mavlink_mission import MissionProtocol
 from bioflex_jsb.links.mavlink_setup import (  # noqa: F401  (the link's set-up and state)
     SIGNING_EPOCH_UNIX_S,
     SIGNING_KEY_BYTES,
     Endpoint,
     LinkError,
     Parameters,
+    Vehicle,
     VehicleState,
     parse_endpoint,
     read_signing_key,
     signing_time_10us,
+)
+from bioflex_jsb.links.mavlink_telemetry import (  # noqa: F401
+    CAPABILITIES,
+    DEFAULT_RATES_HZ,
+    STREAMS,
+    encode,
 )
 
 # What pymavlink's parser raises on bytes that are not MAVLink (hostile or corrupt input):
@@ -81,33 +98,15 @@ _CODEC_ERRORS = (mavlink.MAVError, struct.error, ValueError, IndexError, KeyErro
 SYSTEM_ID = 1
 COMPONENT_ID = 1
 MAX_PEERS = 4
+PEER_TIMEOUT_S = 5.0  # a udpin peer silent this long [wall s] is dropped
+CONTROLLER_TIMEOUT_S = 3.0  # the stick-controlling station's claim lapses after [wall s]
 MAX_DATAGRAMS = 16  # datagrams read per service call
 MAX_PARSE_BYTES = 4096  # bytes handed to the parser per service call
 MAX_TCP_BACKLOG = 256 * 1024  # unsent bytes to one TCP client before it is dropped
 PARAMS_PER_SERVICE = 8  # PARAM_VALUE messages of a list request sent per service call
+STATUSTEXTS_PER_SERVICE = 4
 
 M = mavlink
-# Default rates [Hz] of the streamed messages.
-DEFAULT_RATES_HZ = {
-    M.MAVLINK_MSG_ID_HEARTBEAT: 1.0,
-    M.MAVLINK_MSG_ID_SYS_STATUS: 1.0,
-    M.MAVLINK_MSG_ID_ATTITUDE: 50.0,
-    M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT: 10.0,
-    M.MAVLINK_MSG_ID_GPS_RAW_INT: 5.0,
-    M.MAVLINK_MSG_ID_VFR_HUD: 10.0,
-    M.MAVLINK_MSG_ID_NAMED_VALUE_FLOAT: 10.0,
-}
-# REQUEST_DATA_STREAM (deprecated, still sent by MAVProxy and QGC for ArduPilot): stream ids
-# → the messages they rate.
-_STREAMS = {
-    M.MAV_DATA_STREAM_RAW_SENSORS: (M.MAVLINK_MSG_ID_GPS_RAW_INT,),
-    M.MAV_DATA_STREAM_EXTENDED_STATUS: (M.MAVLINK_MSG_ID_SYS_STATUS,),
-    M.MAV_DATA_STREAM_POSITION: (M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,),
-    M.MAV_DATA_STREAM_EXTRA1: (M.MAVLINK_MSG_ID_ATTITUDE,),
-    M.MAV_DATA_STREAM_EXTRA2: (M.MAVLINK_MSG_ID_VFR_HUD,),
-    M.MAV_DATA_STREAM_EXTRA3: (M.MAVLINK_MSG_ID_NAMED_VALUE_FLOAT,),
-}
-_STREAMS[M.MAV_DATA_STREAM_ALL] = tuple(m for ids in _STREAMS.values() for m in ids)
 MAX_RATE_HZ = 200.0
 SIGNING_STREAM_AGE_10US = 60 * 100_000  # a new stream may be this much older (60 s)
 UNSIGNED_ALLOWED = frozenset({M.MAVLINK_MSG_ID_RADIO_STATUS})  # radios cannot sign
@@ -117,8 +116,6 @@ FTP_OP_RESET_SESSIONS = 2
 FTP_OP_ACK = 128
 FTP_OP_NAK = 129
 FTP_ERR_UNKNOWN_COMMAND = 7
-CAPABILITIES = (M.MAV_PROTOCOL_CAPABILITY_MAVLINK2 | M.MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
-                | M.MAV_PROTOCOL_CAPABILITY_MISSION_INT | M.MAV_PROTOCOL_CAPABILITY_COMMAND_INT)
 
 
 class _Parser(mavlink.MAVLink):
@@ -154,7 +151,8 @@ class LinkStats:
     rejected_signature: int = 0  # unsigned, wrongly signed or replayed (signing on)
     sent: int = 0
     send_dropped: int = 0
-    by_type: dict[str, int] = field(default_factory=dict)
+    peers_expired: int = 0
+    by_type: dict[str, int] = field(default_factory=dict)  # bounded: MAVLink's message names
 
 
 class _Peer:
@@ -166,17 +164,20 @@ class _Peer:
         self.parser = parser
         self.backlog = bytearray()
         self.last_seen = time.monotonic()
+        self.fixed = False  # udpout's one destination: never expires
 
 
 class MavlinkLink:
-    """The vehicle's MAVLink link (module docstring). Call :meth:`service` from the loop."""
+    """The vehicle's MAVLink link (module docstring). Call :meth:`service` from the loop.
+
+    ``vehicle``: what commands, modes, sticks and missions act on (:class:`Vehicle`; None: a
+    link that only streams and serves parameters)."""
 
     def __init__(self, endpoint: Endpoint | str, params: Parameters,
-                 on_manual: Callable[[float | None, float | None], None] | None = None,
-                 signing_key: bytes | None = None) -> None:
+                 vehicle: Vehicle | None = None, signing_key: bytes | None = None) -> None:
         self.endpoint = parse_endpoint(endpoint) if isinstance(endpoint, str) else endpoint
         self.params = params
-        self.on_manual = on_manual  # (pitch, roll) in -1..1; (None, None): released
+        self.vehicle = vehicle
         self.stats = LinkStats()
         self._mav = mavlink.MAVLink(None, srcSystem=SYSTEM_ID, srcComponent=COMPONENT_ID)
         self._rx_signing: mavlink.MAVLinkSigning | None = None
@@ -197,6 +198,12 @@ class MavlinkLink:
         self._peers: list[_Peer] = []
         self._listener: socket.socket | None = None
         self._udp: socket.socket | None = None
+        self._controller: tuple[int, int] | None = None
+        self._controller_seen = 0.0
+        self._last_mission_seq: int | None = None
+        self.mission = (MissionProtocol(self._mav, self._send, vehicle)
+                        if vehicle is not None else None)
+        self.commands = CommandHandler(self, vehicle)
         self._open()
 
     # -- sockets ------------------------------------------------------------------------
@@ -222,7 +229,9 @@ class MavlinkLink:
                 finally:
                     probe.close()
                 s.bind((local, 0))
-                self._peers.append(_Peer((ep.host, ep.port), self._new_parser()))
+                peer = _Peer((ep.host, ep.port), self._new_parser())
+                peer.fixed = True
+                self._peers.append(peer)
             s.setblocking(False)
             self._udp = s
         except OSError as exc:
@@ -260,10 +269,12 @@ class MavlinkLink:
         self._peers.clear()
 
     def _send(self, msg) -> None:
+        mav = self._mav
         if self._rx_signing is not None:  # signing timestamps follow the wall clock
-            sig = self._mav.signing
+            sig = mav.signing
             sig.timestamp = max(sig.timestamp, signing_time_10us())
-        data = msg.pack(self._mav)
+        data = msg.pack(mav)
+        mav.seq = (mav.seq + 1) % 256  # one sequence for all the vehicle sends
         self.stats.sent += 1
         if self._udp is not None:
             for p in self._peers:
@@ -295,12 +306,21 @@ class MavlinkLink:
         if p.sock is not None:
             p.sock.close()
 
+    def _expire_peers(self, now: float) -> None:
+        if self.endpoint.kind != "udpin":
+            return
+        for p in list(self._peers):
+            if not p.fixed and now - p.last_seen > PEER_TIMEOUT_S:
+                self._drop(p)
+                self.stats.peers_expired += 1
+
     # -- the loop's entry ---------------------------------------------------------------
     def service(self, state: VehicleState, now_s: float | None = None) -> None:
         """Read (bounded), answer, and send what is due at wall time ``now_s`` [s,
         monotonic]. Never blocks."""
         now = time.monotonic() if now_s is None else now_s
         self._receive(state)
+        self._expire_peers(now)
         for mid, interval in self.intervals_s.items():
             if interval <= 0.0:
                 continue
@@ -311,6 +331,30 @@ class MavlinkLink:
                 self._next_due[mid] = due if due > now else now + interval  # no burst
         for _ in range(min(PARAMS_PER_SERVICE, len(self._param_queue))):
             self._send_param(self._param_queue.popleft())
+        v = self.vehicle
+        if v is None:
+            return
+        self.mission.service(now)
+        for _ in range(min(STATUSTEXTS_PER_SERVICE, len(v.events))):
+            severity, text = v.events.popleft()
+            self.statustext(severity, text)
+        while v.reached:
+            self._send(self._mav.mission_item_reached_encode(v.reached.popleft()))
+        if state.mission_seq != self._last_mission_seq:
+            self._last_mission_seq = state.mission_seq
+            self._send_message(M.MAVLINK_MSG_ID_MISSION_CURRENT, state)
+
+    def statustext(self, severity: int, text: str) -> None:
+        """STATUSTEXT: up to 50 characters in one message, longer texts in chunks (id,
+        chunk_seq)."""
+        raw = text.encode("utf-8", "replace")
+        if len(raw) <= 50:
+            self._send(self._mav.statustext_encode(severity, raw))
+            return
+        self._text_id = (getattr(self, "_text_id", 0) % 65535) + 1
+        for k in range(0, min(len(raw), 50 * 8), 50):
+            self._send(self._mav.statustext_encode(severity, raw[k:k + 50], self._text_id,
+                                                   k // 50))
 
     def _receive(self, state: VehicleState) -> None:
         budget = MAX_PARSE_BYTES
@@ -373,6 +417,8 @@ class MavlinkLink:
             self._peers.append(_Peer(addr, self._new_parser(), conn))
 
     def _handle_bytes(self, peer: _Peer, data: bytes, state: VehicleState) -> int:
+        """Parse and handle; the number of messages that qualify their sender as a peer
+        (valid MAVLink; with signing on, validly signed)."""
         try:
             msgs = peer.parser.parse_buffer(data) or []
         except _CODEC_ERRORS:  # a codec error on hostile input: drop the bytes
@@ -380,6 +426,7 @@ class MavlinkLink:
             self.stats.bad += 1
             return 0
         good = 0
+        signing = self._rx_signing is not None
         for msg in msgs:
             name = msg.get_type()
             # unknown message ids carry no checkable CRC (no CRC_EXTRA): noise, not MAVLink
@@ -388,15 +435,22 @@ class MavlinkLink:
                 if name == "BAD_DATA" and "signature" in str(getattr(msg, "reason", "")):
                     self.stats.rejected_signature += 1
                 continue
-            good += 1
             self.stats.received += 1
             self.stats.by_type[name] = self.stats.by_type.get(name, 0) + 1
+            if signing and not getattr(msg, "_signed", False):
+                self._handle_unsigned(msg)
+                continue
+            good += 1
             peer.last_seen = time.monotonic()
             try:
                 self._handle(msg, state)
             except (ValueError, TypeError, OverflowError, KeyError, struct.error):
                 self.stats.bad += 1
         return good
+
+    def _handle_unsigned(self, msg) -> None:
+        """An unsigned message let through with signing on (RADIO_STATUS): nothing to do
+        (no peer slot, no answer)."""
 
     # -- protocol -----------------------------------------------------------------------
     def _for_us(self, msg) -> bool:
@@ -408,7 +462,7 @@ class MavlinkLink:
         t = msg.get_type()
         if t in ("COMMAND_LONG", "COMMAND_INT"):
             if self._for_us(msg):
-                self._command(msg, state)
+                self.commands.handle(msg, state)
         elif t == "PARAM_REQUEST_LIST":
             if self._for_us(msg):
                 self._param_queue.clear()
@@ -420,27 +474,42 @@ class MavlinkLink:
                 if msg.param_index >= 0:
                     if msg.param_index < len(names):
                         self._send_param(msg.param_index)
+                    else:
+                        self._param_error(msg, b"", msg.param_index,
+                                          M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
                 elif name in names:
                     self._send_param(names.index(name))
+                else:
+                    self._param_error(msg, name.encode()[:16], -1,
+                                      M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
         elif t == "PARAM_SET":
             if self._for_us(msg):
                 name = _param_name(msg.param_id)
                 if name in self.params.names:
                     try:
                         self.params.set(name, float(msg.param_value))
-                    except ValueError:
-                        pass  # the PARAM_VALUE below reports the value still in force
+                    except ValueError as exc:  # the PARAM_VALUE reports the value in force
+                        self._param_error(msg, name.encode()[:16], -1,
+                                          M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)
+                        self.statustext(M.MAV_SEVERITY_WARNING, str(exc))
                     self._send_param(self.params.names.index(name))
-        elif t == "MISSION_REQUEST_LIST":
-            if self._for_us(msg):
-                self._send(self._mav.mission_count_encode(
-                    msg.get_srcSystem(), msg.get_srcComponent(), 0, msg.mission_type))
-        elif t in ("MISSION_COUNT", "MISSION_CLEAR_ALL"):
-            if self._for_us(msg):
-                result = (M.MAV_MISSION_ACCEPTED if t == "MISSION_CLEAR_ALL" or msg.count == 0
-                          else M.MAV_MISSION_UNSUPPORTED)
+                else:
+                    self._param_error(msg, name.encode()[:16], -1,
+                                      M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
+        elif t.startswith("MISSION_"):
+            if self.mission is not None and self._for_us(msg):
+                self.mission.handle(msg, t)
+            elif self._for_us(msg) and t in ("MISSION_REQUEST_LIST", "MISSION_COUNT",
+                                             "MISSION_CLEAR_ALL"):
                 self._send(self._mav.mission_ack_encode(
-                    msg.get_srcSystem(), msg.get_srcComponent(), result, msg.mission_type))
+                    msg.get_srcSystem(), msg.get_srcComponent(), M.MAV_MISSION_UNSUPPORTED,
+                    getattr(msg, "mission_type", 0)))
+        elif t == "SET_MODE":
+            if msg.target_system == SYSTEM_ID and self.vehicle is not None:
+                if msg.base_mode & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
+                    reason = self.vehicle.set_mode(int(msg.custom_mode))
+                    if reason:
+                        self.statustext(M.MAV_SEVERITY_WARNING, reason)
         elif t == "TIMESYNC":
             if msg.tc1 == 0:  # a request: answer with the vehicle's (simulated) clock [ns]
                 self._send(self._mav.timesync_encode(max(1, int(state.time_s * 1e9)),
@@ -455,20 +524,37 @@ class MavlinkLink:
         elif t == "REQUEST_DATA_STREAM":
             if self._for_us(msg):
                 hz = float(msg.req_message_rate) if msg.start_stop else 0.0
-                for mid in _STREAMS.get(msg.req_stream_id, ()):
-                    self._set_rate(mid, hz)
+                for mid in STREAMS.get(msg.req_stream_id, ()):
+                    self.set_rate(mid, hz)
         elif t == "MANUAL_CONTROL":
-            if msg.target in (0, SYSTEM_ID) and self.on_manual is not None:
+            if msg.target in (0, SYSTEM_ID) and self._may_steer(msg):
                 # x: pitch (forward stick = nose down), y: roll; -1000..1000
-                self.on_manual(_clip_unit(msg.x / 1000.0), _clip_unit(msg.y / 1000.0))
+                self.vehicle.manual(_clip_unit(msg.x / 1000.0), _clip_unit(msg.y / 1000.0))
         elif t == "RC_CHANNELS_OVERRIDE":
-            if self._for_us(msg) and self.on_manual is not None:
+            if self._for_us(msg) and self._may_steer(msg):
                 roll, pitch = msg.chan1_raw, msg.chan2_raw
                 if roll in (0, 65535) or pitch in (0, 65535):
-                    self.on_manual(None, None)  # released: back to the autopilot
+                    self.vehicle.manual(None, None)  # released: back to the autopilot
+                    self._controller = None
                 else:
-                    self.on_manual(_clip_unit((pitch - 1500) / 500.0),
-                                   _clip_unit((roll - 1500) / 500.0))
+                    self.vehicle.manual(_clip_unit((pitch - 1500) / 500.0),
+                                        _clip_unit((roll - 1500) / 500.0))
+
+    def _may_steer(self, msg) -> bool:
+        """Sticks from the controlling station only (module docstring)."""
+        if self.vehicle is None:
+            return False
+        src, now = (msg.get_srcSystem(), msg.get_srcComponent()), time.monotonic()
+        if self._controller is None or now - self._controller_seen > CONTROLLER_TIMEOUT_S:
+            self._controller = src
+        if src != self._controller:
+            return False
+        self._controller_seen = now
+        return True
+
+    def _param_error(self, msg, name: bytes, index: int, error: int) -> None:
+        self._send(self._mav.param_error_encode(msg.get_srcSystem(), msg.get_srcComponent(),
+                                                name, index, error))
 
     def _ftp_reply(self, msg) -> None:
         """The vehicle has no MAVLink FTP server: every request gets a NAK (UnknownCommand),
@@ -489,42 +575,12 @@ class MavlinkLink:
         self._send(self._mav.file_transfer_protocol_encode(
             msg.target_network, msg.get_srcSystem(), msg.get_srcComponent(), body))
 
-    def _set_rate(self, mid: int, hz: float) -> None:
+    def set_rate(self, mid: int, hz: float) -> None:
         if mid == M.MAVLINK_MSG_ID_HEARTBEAT:
             return  # the heartbeat stays at 1 Hz
         hz = min(max(hz, 0.0), MAX_RATE_HZ)
         self.intervals_s[mid] = 1.0 / hz if hz > 0.0 else 0.0
         self._next_due.pop(mid, None)
-
-    def _ack(self, msg, result: int) -> None:
-        self._send(self._mav.command_ack_encode(msg.command, result, 0, 0, msg.get_srcSystem(),
-                                                msg.get_srcComponent()))
-
-    def _command(self, msg, state: VehicleState) -> None:
-        cmd = msg.command
-        if cmd == M.MAV_CMD_SET_MESSAGE_INTERVAL:
-            mid, interval_us = int(msg.param1), msg.param2
-            if mid not in DEFAULT_RATES_HZ or mid == M.MAVLINK_MSG_ID_HEARTBEAT:
-                self._ack(msg, M.MAV_RESULT_UNSUPPORTED)
-                return
-            if interval_us < 0:
-                hz = 0.0
-            elif interval_us == 0:
-                hz = DEFAULT_RATES_HZ[mid]
-            else:
-                hz = 1e6 / interval_us
-            self._set_rate(mid, hz)
-            self._ack(msg, M.MAV_RESULT_ACCEPTED)
-        elif cmd in (M.MAV_CMD_REQUEST_MESSAGE, M.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES):
-            mid = (M.MAVLINK_MSG_ID_AUTOPILOT_VERSION
-                   if cmd == M.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES else int(msg.param1))
-            if mid == M.MAVLINK_MSG_ID_AUTOPILOT_VERSION or mid in DEFAULT_RATES_HZ:
-                self._ack(msg, M.MAV_RESULT_ACCEPTED)
-                self._send_message(mid, state)
-            else:
-                self._ack(msg, M.MAV_RESULT_UNSUPPORTED)
-        else:
-            self._ack(msg, M.MAV_RESULT_UNSUPPORTED)
 
     # -- outgoing messages ----------------------------------------------------------------
     def _send_param(self, index: int) -> None:
@@ -534,54 +590,22 @@ class MavlinkLink:
                                                 M.MAV_PARAM_TYPE_REAL32, len(names), index))
 
     def _send_message(self, mid: int, s: VehicleState) -> None:
-        mav = self._mav
-        boot_ms = int(s.time_s * 1000.0 + 1e-6) & 0xFFFFFFFF  # ⌊1000 t⌋ (+1 ns: k·dt rounding)
-        if mid == M.MAVLINK_MSG_ID_HEARTBEAT:
-            mode = M.MAV_MODE_FLAG_SAFETY_ARMED | M.MAV_MODE_FLAG_STABILIZE_ENABLED
-            mode |= M.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED if s.manual else 0
-            mode |= M.MAV_MODE_FLAG_AUTO_ENABLED if s.autopilot and not s.manual else 0
-            self._send(mav.heartbeat_encode(M.MAV_TYPE_FIXED_WING, M.MAV_AUTOPILOT_GENERIC,
-                                            mode, 0, M.MAV_STATE_ACTIVE))
-        elif mid == M.MAVLINK_MSG_ID_SYS_STATUS:
-            sensors = (M.MAV_SYS_STATUS_SENSOR_3D_GYRO | M.MAV_SYS_STATUS_SENSOR_3D_ACCEL
-                       | M.MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE
-                       | M.MAV_SYS_STATUS_SENSOR_DIFFERENTIAL_PRESSURE
-                       | M.MAV_SYS_STATUS_SENSOR_GPS | M.MAV_SYS_STATUS_SENSOR_ANGULAR_RATE_CONTROL
-                       | M.MAV_SYS_STATUS_SENSOR_ATTITUDE_STABILIZATION)
-            # health also says "no geofence breach" (there is no fence: MAVProxy reads a
-            # missing health bit as a breach)
-            self._send(mav.sys_status_encode(sensors, sensors,
-                                             sensors | M.MAV_SYS_STATUS_GEOFENCE, 0, 16800,
-                                             -1, -1, 0, 0, 0, 0, 0, 0))
-        elif mid == M.MAVLINK_MSG_ID_ATTITUDE:
-            self._send(mav.attitude_encode(boot_ms, s.roll_rad, s.pitch_rad, s.yaw_rad,
-                                           s.p_rad_s, s.q_rad_s, s.r_rad_s))
-        elif mid == M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT:
-            self._send(mav.global_position_int_encode(
-                boot_ms, _deg_e7(s.latitude_rad), _deg_e7(s.longitude_rad),
-                _i32(s.altitude_m * 1000.0), _i32(s.relative_altitude_m * 1000.0),
-                _i16(s.v_north_m_s * 100.0), _i16(s.v_east_m_s * 100.0),
-                _i16(s.v_down_m_s * 100.0), _heading_cdeg(s.yaw_rad)))
-        elif mid == M.MAVLINK_MSG_ID_GPS_RAW_INT:
-            vg = math.hypot(s.v_north_m_s, s.v_east_m_s)
-            cog = math.atan2(s.v_east_m_s, s.v_north_m_s)
-            self._send(mav.gps_raw_int_encode(
-                int(s.time_s * 1e6 + 1e-3), M.GPS_FIX_TYPE_3D_FIX, _deg_e7(s.latitude_rad),
-                _deg_e7(s.longitude_rad), _i32(s.altitude_m * 1000.0), 80, 120,
-                min(int(vg * 100.0), 65534), _heading_cdeg(cog), 12))
-        elif mid == M.MAVLINK_MSG_ID_VFR_HUD:
-            vg = math.hypot(s.v_north_m_s, s.v_east_m_s)
-            heading = int(round(math.degrees(s.yaw_rad))) % 360
-            self._send(mav.vfr_hud_encode(s.airspeed_m_s, vg, heading,
-                                          int(round(100.0 * s.throttle)), s.altitude_m,
-                                          -s.v_down_m_s))
-        elif mid == M.MAVLINK_MSG_ID_NAMED_VALUE_FLOAT:
-            for name, value in s.named.items():
-                self._send(mav.named_value_float_encode(boot_ms, name.encode()[:10],
-                                                        float(value)))
-        elif mid == M.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
-            self._send(mav.autopilot_version_encode(
-                CAPABILITIES, 0, 0, 0, 0, [0] * 8, [0] * 8, [0] * 8, 0, 0, 0))
+        for msg in encode(self._mav, mid, s):
+            self._send(msg)
+
+    def send_message(self, mid: int, s: VehicleState) -> bool:
+        """Send message ``mid`` now (MAV_CMD_REQUEST_MESSAGE); False if it has no encoder."""
+        msgs = encode(self._mav, mid, s)
+        for msg in msgs:
+            self._send(msg)
+        return bool(msgs)
+
+    def send(self, msg) -> None:
+        self._send(msg)
+
+    @property
+    def mav(self):
+        return self._mav
 
 
 def _param_name(raw) -> str:
@@ -594,23 +618,7 @@ def _clip_unit(x: float) -> float:
     return max(-1.0, min(1.0, float(x)))
 
 
-def _i32(x: float) -> int:
-    return max(-(2**31), min(2**31 - 1, int(round(x)))) if math.isfinite(x) else 0
-
-
-def _i16(x: float) -> int:
-    return max(-32768, min(32767, int(round(x)))) if math.isfinite(x) else 0
-
-
-def _deg_e7(rad: float) -> int:
-    return _i32(math.degrees(rad) * 1e7)
-
-
-def _heading_cdeg(rad: float) -> int:
-    return int(round(math.degrees(rad) * 100.0)) % 36000 if math.isfinite(rad) else 65535
-
-
 # MAVLink constants the simulation side needs without importing pymavlink itself.
 MSG_IDS = {name: getattr(M, f"MAVLINK_MSG_ID_{name}") for name in (
     "HEARTBEAT", "SYS_STATUS", "ATTITUDE", "GLOBAL_POSITION_INT", "GPS_RAW_INT", "VFR_HUD",
-    "NAMED_VALUE_FLOAT", "AUTOPILOT_VERSION")}
+    "NAMED_VALUE_FLOAT", "AUTOPILOT_VERSION", "HOME_POSITION", "BATTERY_STATUS")}

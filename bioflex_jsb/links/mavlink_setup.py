@@ -122,6 +122,19 @@ class VehicleState:
     named: dict[str, float] = field(default_factory=dict)
     autopilot: bool = True
     manual: bool = False
+    custom_mode: int = 7
+    armed: bool = True
+    home_latitude_rad: float = 0.0
+    home_longitude_rad: float = 0.0
+    home_altitude_m: float = 0.0
+    mission_seq: int = 0
+    mission_total: int = 0
+    battery_voltage_v: float = 12.6
+    battery_current_a: float = 0.0
+    battery_consumed_mah: float = 0.0
+    battery_energy_j: float = 0.0
+    battery_remaining_pct: int = 100
+    battery_time_remaining_s: float = 0.0
 
 
 class Parameters(Protocol):
@@ -134,3 +147,25 @@ class Parameters(Protocol):
     def set(self, name: str, value: float) -> float:
         """Apply; return the value now in force. ValueError: rejected (value unchanged)."""
         ...
+
+
+class Vehicle(Protocol):
+    """What the link asks of the vehicle (:class:`bioflex_jsb.drivers.sitl_vehicle.SitlVehicle`).
+    Every command returns None when done, or a one-line reason it was refused; values are SI
+    (rad, m AMSL, m/s)."""
+
+    events: object  # deque of (MAV_SEVERITY, text) for STATUSTEXT, taken by the link
+    reached: object  # deque of mission item numbers reached, for MISSION_ITEM_REACHED
+
+    def set_mode(self, number: int) -> str | None: ...
+    def arm(self, armed: bool, force: bool) -> str | None: ...
+    def manual(self, pitch: float | None, roll: float | None) -> bool: ...
+    def change_speed(self, speed_m_s: float) -> str | None: ...
+    def change_altitude(self, alt_amsl_m: float) -> str | None: ...
+    def reposition(self, lat_rad: float, lon_rad: float,
+                   alt_amsl_m: float | None) -> str | None: ...
+    def loiter_at(self, lat_rad: float | None, lon_rad: float | None,
+                  radius_m: float) -> str | None: ...
+    def set_home(self, lat_rad: float, lon_rad: float, alt_amsl_m: float) -> str | None: ...
+    def mission_start(self, first: int, last: int) -> str | None: ...
+    def status(self, severity: int, text: str) -> None: ...

@@ -1,0 +1,437 @@
+"""What the SITL aircraft does as a vehicle: modes, arming, home, missions, guidance, the
+battery, and the events a pilot should see (docs/sitl.md).
+
+The vehicle acts on the JSBSim autopilot (``systems/bioflex_autopilot.xml``,
+``systems/bioflex_autothrottle.xml``; :mod:`bioflex_jsb.generators.autopilot`) through its
+``ap/*`` properties, every :data:`GUIDANCE_PERIOD_S` of simulated time:
+
+========== ===============================================================================
+MANUAL     autopilot off; MANUAL_CONTROL x, y move elevator and ailerons about the trim
+STABILIZE  (and FBWA) the sticks command bank (±30°) and pitch (θ_trim ∓ 15°); centred:
+           wings level at the trim pitch; airspeed held
+CRUISE     heading and altitude hold (AP_HDG_RAD, AP_ALT_M); airspeed held. The start mode
+CIRCLE     a fixed 20° bank (AP_LOITER 1), altitude held
+LOITER     L1 circle of LOIT_RAD_M about where it was entered (or the NAV_LOITER_UNLIM point)
+AUTO       the mission (mavlink_mission), from its current item
+RTL        L1 track to home at RTL_ALT_M above home, then LOITER about home
+GUIDED     L1 track to the DO_REPOSITION point, then a loiter there
+========== ===============================================================================
+
+Lateral guidance: L1 (:mod:`bioflex_jsb.simulation.guidance`), bank commanded through
+``ap/roll-mode`` 1. Waypoints are reached within their acceptance radius (item param2, else
+WP_RADIUS_M) — not by passing abeam: an aircraft that misses one turns back for it.
+The altitude of a waypoint is commanded from the start of its leg (no slope).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+
+from bioflex_jsb import units as U
+from bioflex_jsb.links import mavlink_modes as MODES
+from bioflex_jsb.links.mavlink_mission import (
+    AMSL_FRAMES,
+    DO_CHANGE_SPEED,
+    NAV_LOITER_TIME,
+    NAV_LOITER_TURNS,
+    NAV_LOITER_UNLIM,
+    NAV_RETURN_TO_LAUNCH,
+    NAV_TAKEOFF,
+    NAV_WAYPOINT,
+    MissionItem,
+    check_item,
+)
+from bioflex_jsb.simulation import guidance as G
+from bioflex_jsb.simulation.battery import Battery
+
+GUIDANCE_PERIOD_S = 0.02  # simulated time between guidance updates [s]
+MANUAL_TIMEOUT_S = 1.0  # sticks older than this [wall s]: control lost → RTL
+STICK_BANK_RAD = math.radians(30.0)
+STICK_PITCH_RAD = math.radians(15.0)
+FORCE_DISARM = 21196  # MAV_CMD_COMPONENT_ARM_DISARM param2: disarm in flight
+AIRSPEED_RANGE_M_S = (12.0, 22.0)
+SEVERITY = {"error": 3, "warning": 4, "notice": 5, "info": 6}
+
+
+class VehicleSettings:
+    """Navigation parameters (served as parameters by SitlParameters; SI)."""
+
+    def __init__(self) -> None:
+        self.wp_radius_m = 30.0
+        self.loiter_radius_m = 50.0
+        self.rtl_altitude_m = 100.0  # above home
+        self.l1_period_s = 17.0
+        self.l1_damping = 0.75
+
+
+class SitlVehicle:
+    """The vehicle behaviour of a :class:`~bioflex_jsb.drivers.sitl.SitlSim`."""
+
+    def __init__(self, sim, home: tuple[float, float, float], start_mode: int = MODES.CRUISE):
+        self.sim = sim
+        self.settings = VehicleSettings()
+        self.home = home  # latitude, longitude [rad], ground altitude [m AMSL]
+        self.armed = True  # it starts in the air, motor running
+        self.battery = Battery()
+        self.events: deque[tuple[int, str]] = deque(maxlen=64)
+        self.reached: deque[int] = deque(maxlen=16)
+        self.mission: list[MissionItem] = []
+        self.mission_seq = 0
+        self.speed_target_m_s = sim.speed_m_s
+        self.alt_target_m = sim.start_altitude_m
+        self.heading_target_rad = 0.0
+        self.mode = start_mode
+        self._sticks = (0.0, 0.0)
+        self._stick_wall: float | None = None
+        self._nav: tuple = ("heading",)
+        self._item_state: dict = {}
+        self._last_t = 0.0
+        self._guided_target: tuple[float, float] | None = None
+        self._battery_warned = False
+        self.set_mode(start_mode, quiet=True)
+
+    # -- events ---------------------------------------------------------------------------
+    def status(self, severity: int, text: str) -> None:
+        """Queue a STATUSTEXT (MAV_SEVERITY ``severity``; ≤ 50 characters are sent whole)."""
+        self.events.append((int(severity), str(text)))
+
+    # -- where it is --------------------------------------------------------------------
+    def position_ne(self) -> tuple[float, float]:
+        g = self.sim.core.get
+        return G.ne_from_latlon(g["lat"](), g["lon"](), self.home[0], self.home[1])
+
+    def velocity_ne(self) -> tuple[float, float]:
+        g = self.sim.core.get
+        return g["vn"]() * U.M_PER_FT, g["ve"]() * U.M_PER_FT
+
+    def altitude_m(self) -> float:
+        return self.sim.core.get["h"]() * U.M_PER_FT
+
+    def _ne(self, lat_rad: float, lon_rad: float) -> tuple[float, float]:
+        return G.ne_from_latlon(lat_rad, lon_rad, self.home[0], self.home[1])
+
+    def _item_alt_m(self, item: MissionItem) -> float:
+        """The item's altitude [m AMSL] (relative and terrain frames: above home)."""
+        return item.z if item.frame in AMSL_FRAMES else self.home[2] + item.z
+
+    # -- modes ----------------------------------------------------------------------------
+    def set_mode(self, number: int, quiet: bool = False) -> str | None:
+        """Enter mode ``number`` (ArduPlane's); None, or why not."""
+        number = int(number)
+        if number not in MODES.MODE_NAMES:
+            return f"mode {number} is not flown by this vehicle"
+        if number == MODES.AUTO and len(self.mission) < 2:
+            return "no mission to fly"
+        pos = self.position_ne()
+        a = self.sim.airframe
+        self.mode = number
+        if number in (MODES.CRUISE, MODES.CIRCLE):
+            self.heading_target_rad = self.sim.core.get["psi"]()
+            self.alt_target_m = self.altitude_m()
+            a["ap/heading-hold-rad"] = math.remainder(self.heading_target_rad, 2 * math.pi)
+            self._nav = ("heading",)
+        elif number == MODES.LOITER:
+            self.alt_target_m = self.altitude_m()
+            self._nav = ("circle", pos, self.settings.loiter_radius_m, True)
+        elif number == MODES.RTL:
+            self.alt_target_m = self.home[2] + self.settings.rtl_altitude_m
+            self._nav = ("goto", pos, (0.0, 0.0), "home")
+        elif number == MODES.GUIDED:
+            target = self._guided_target or pos
+            self._nav = ("goto", pos, target, "guided")
+        elif number == MODES.AUTO:
+            if self.mission_seq < 1 or self.mission_seq >= len(self.mission):
+                self.mission_seq = 1
+            self._start_item(pos)
+        else:  # stick modes
+            self._nav = ("stick",)
+        if not quiet:
+            self.status(6, f"Mode {MODES.mode_name(number)}")
+        self._apply_mode_flags()
+        return None
+
+    def _apply_mode_flags(self) -> None:
+        a, m = self.sim.airframe, self.mode
+        a["ap/engage"] = 0.0 if m == MODES.MANUAL else 1.0
+        a["ap/manual"] = 1.0 if m == MODES.MANUAL else 0.0
+        if m == MODES.MANUAL:
+            a["ap/manual-elevator-norm"], a["ap/manual-aileron-norm"] = self._sticks
+        a["ap/loiter"] = 1.0 if m == MODES.CIRCLE else 0.0
+        a["ap/autothrottle"] = 0.0 if m == MODES.MANUAL else 1.0
+        a["ap/airspeed-hold-mps"] = self.speed_target_m_s
+        a["ap/armed"] = 1.0 if self.armed else 0.0
+        stick = m in (MODES.STABILIZE, MODES.FLY_BY_WIRE_A)
+        a["ap/pitch-mode"] = 1.0 if stick else 0.0
+        a["ap/roll-mode"] = 1.0 if (stick or self._nav[0] in ("circle", "goto", "track")) \
+            else 0.0
+        a["ap/altitude-hold-m"] = self.alt_target_m
+
+    def arm(self, armed: bool, force: bool) -> str | None:
+        if armed == self.armed:
+            return None
+        if not armed and not force:
+            return "disarm in flight refused (force with param2 = 21196)"
+        self.armed = armed
+        self.sim.airframe["ap/armed"] = 1.0 if armed else 0.0
+        self.status(4 if not armed else 6, "Disarmed: motor stopped" if not armed else "Armed")
+        return None
+
+    def manual(self, pitch: float | None, roll: float | None) -> bool:
+        """Sticks (−1..1; pitch + = nose down, roll + = right), or None: released. Obeyed
+        only in MANUAL, STABILIZE and FBWA."""
+        if pitch is None or roll is None:
+            self._sticks, self._stick_wall = (0.0, 0.0), None
+            if self.mode == MODES.MANUAL:
+                self._apply_mode_flags()
+            return True
+        if self.mode not in MODES.STICK_MODES:
+            return False
+        self._sticks = (max(-1.0, min(1.0, pitch)), max(-1.0, min(1.0, roll)))
+        self._stick_wall = time.monotonic()
+        if self.mode == MODES.MANUAL:
+            a = self.sim.airframe
+            a["ap/manual-elevator-norm"], a["ap/manual-aileron-norm"] = self._sticks
+        return True
+
+    # -- commands -------------------------------------------------------------------------
+    def change_speed(self, speed_m_s: float) -> str | None:
+        lo, hi = AIRSPEED_RANGE_M_S
+        if not lo <= speed_m_s <= hi:
+            return f"airspeed must be in {lo:g}..{hi:g} m/s"
+        self.speed_target_m_s = float(speed_m_s)
+        self.sim.airframe["ap/airspeed-hold-mps"] = self.speed_target_m_s
+        self.status(6, f"Airspeed target {speed_m_s:.1f} m/s")
+        return None
+
+    def change_altitude(self, alt_amsl_m: float) -> str | None:
+        lo, hi = self.sim.altitude_hold_range_m
+        if not lo <= alt_amsl_m <= hi:
+            return f"altitude must be in {lo:.0f}..{hi:.0f} m AMSL"
+        self.alt_target_m = float(alt_amsl_m)
+        self.sim.airframe["ap/altitude-hold-m"] = self.alt_target_m
+        return None
+
+    def set_heading(self, heading_rad: float) -> None:
+        """CRUISE at ``heading_rad`` (parameter AP_HDG_RAD)."""
+        if self.mode != MODES.CRUISE:
+            self.set_mode(MODES.CRUISE)
+        self.heading_target_rad = math.remainder(heading_rad, 2 * math.pi)
+        self.sim.airframe["ap/heading-hold-rad"] = self.heading_target_rad
+
+    def reposition(self, lat_rad: float, lon_rad: float, alt_amsl_m: float | None) -> str | None:
+        if alt_amsl_m is not None:
+            reason = self.change_altitude(alt_amsl_m)
+            if reason:
+                return reason
+        self._guided_target = self._ne(lat_rad, lon_rad)
+        return self.set_mode(MODES.GUIDED)
+
+    def loiter_at(self, lat_rad: float | None, lon_rad: float | None,
+                  radius_m: float) -> str | None:
+        reason = self.set_mode(MODES.LOITER)
+        if reason is None:
+            centre = self.position_ne() if lat_rad is None else self._ne(lat_rad, lon_rad)
+            r = abs(radius_m) if radius_m else self.settings.loiter_radius_m
+            self._nav = ("circle", centre, max(r, 20.0), radius_m >= 0.0)
+            self._apply_mode_flags()
+        return reason
+
+    def set_home(self, lat_rad: float, lon_rad: float, alt_amsl_m: float) -> str | None:
+        if not (-0.5 * math.pi <= lat_rad <= 0.5 * math.pi and math.isfinite(alt_amsl_m)):
+            return "home position out of range"
+        self.home = (lat_rad, lon_rad, alt_amsl_m)
+        self.status(6, "Home position set")
+        return None
+
+    def mission_start(self, first: int, last: int) -> str | None:
+        if len(self.mission) < 2:
+            return "no mission to fly"
+        if first >= 1:
+            if first >= len(self.mission):
+                return f"mission has no item {first}"
+            self.mission_seq = first
+        else:
+            self.mission_seq = 1
+        return self.set_mode(MODES.AUTO)
+
+    # -- the mission store (mavlink_mission.MissionProtocol's vehicle) -------------------
+    def mission_items(self) -> list[MissionItem]:
+        lat, lon, alt = self.home
+        home = MissionItem(0, 0, NAV_WAYPOINT, 0, 1, x=int(round(math.degrees(lat) * 1e7)),
+                           y=int(round(math.degrees(lon) * 1e7)), z=alt)
+        return [home] + self.mission[1:]
+
+    def set_mission(self, items: list[MissionItem]) -> str | None:
+        for it in items[1:]:
+            bad = check_item(it)
+            if bad is not None:
+                return bad[1]
+        self.mission = list(items)
+        self.mission_seq = 1 if len(items) > 1 else 0
+        if self.mode == MODES.AUTO:
+            if len(items) < 2:
+                self.set_mode(MODES.LOITER)
+            else:
+                self._start_item(self.position_ne())
+        return None
+
+    def set_mission_current(self, seq: int) -> str | None:
+        if not 1 <= seq < len(self.mission):
+            return f"mission has no item {seq}"
+        self.mission_seq = seq
+        if self.mode == MODES.AUTO:
+            self._start_item(self.position_ne())
+        return None
+
+    # -- guidance -------------------------------------------------------------------------
+    def _start_item(self, pos) -> None:
+        """Begin mission item ``mission_seq`` from the position ``pos``: apply DO items,
+        set the navigation target of the next NAV item."""
+        while self.mission_seq < len(self.mission):
+            it = self.mission[self.mission_seq]
+            if it.command == DO_CHANGE_SPEED:
+                if it.param2 > 0:
+                    if self.change_speed(it.param2) is not None:
+                        self.status(4, f"Item {it.seq}: speed {it.param2:g} m/s refused")
+                self.mission_seq += 1
+                continue
+            break
+        if self.mission_seq >= len(self.mission):
+            self._mission_complete(pos)
+            return
+        it = self.mission[self.mission_seq]
+        self._item_state = {"t0": None, "angle": None, "turned": 0.0}
+        if it.command == NAV_RETURN_TO_LAUNCH:
+            self.alt_target_m = self.home[2] + self.settings.rtl_altitude_m
+            self._nav = ("goto", pos, (0.0, 0.0), "mission-rtl")
+        elif it.command == NAV_TAKEOFF:
+            self.alt_target_m = self._item_alt_m(it)
+            self._nav = ("heading",)
+            self.heading_target_rad = self.sim.core.get["psi"]()
+            self.sim.airframe["ap/heading-hold-rad"] = math.remainder(self.heading_target_rad,
+                                                                      2 * math.pi)
+        else:
+            self.alt_target_m = self._item_alt_m(it)
+            self._nav = ("goto", pos, self._ne(it.lat_rad, it.lon_rad), "mission")
+        self._apply_mode_flags()
+
+    def _mission_complete(self, pos) -> None:
+        self.status(6, "Mission complete: loitering")
+        last = next((it for it in reversed(self.mission[1:]) if it.has_position), None)
+        centre = self._ne(last.lat_rad, last.lon_rad) if last is not None else pos
+        self._nav = ("circle", centre, self.settings.loiter_radius_m, True)
+        self.mission_seq = len(self.mission) - 1
+        self._apply_mode_flags()
+
+    def _advance_item(self) -> None:
+        it = self.mission[self.mission_seq]
+        self.reached.append(it.seq)
+        self.status(6, f"Reached waypoint #{it.seq}")
+        self.mission_seq += 1
+        self._start_item(self.position_ne())
+
+    def update(self, t_s: float) -> None:
+        """One guidance update (every GUIDANCE_PERIOD_S of simulated time)."""
+        dt = t_s - self._last_t
+        self._last_t = t_s
+        self._battery(dt)
+        if self._stick_wall is not None and self.mode in MODES.STICK_MODES and \
+                time.monotonic() - self._stick_wall > MANUAL_TIMEOUT_S:
+            self._stick_wall = None
+            self._sticks = (0.0, 0.0)
+            self.status(4, "Manual control lost: RTL")
+            self.set_mode(MODES.RTL)
+        a = self.sim.airframe
+        if self.mode in (MODES.STABILIZE, MODES.FLY_BY_WIRE_A):
+            pitch, roll = self._sticks
+            a["ap/bank-cmd-rad"] = roll * STICK_BANK_RAD
+            a["ap/pitch-cmd-rad"] = self.sim.trim.theta_rad - pitch * STICK_PITCH_RAD
+            return
+        nav = self._nav
+        if nav[0] not in ("goto", "circle"):
+            return
+        pos, vel = self.position_ne(), self.velocity_ne()
+        s = self.settings
+        l1 = G.l1_distance_m(math.hypot(*vel), s.l1_period_s, s.l1_damping)
+        if nav[0] == "goto":
+            _, start, target, why = nav
+            if self.mode == MODES.AUTO and why == "mission":
+                it = self.mission[self.mission_seq]
+                radius = it.param2 if it.param2 > 0 else s.wp_radius_m
+                if it.command in (NAV_LOITER_UNLIM, NAV_LOITER_TURNS, NAV_LOITER_TIME):
+                    radius = max(radius, abs(it.param3) if it.param3 else s.loiter_radius_m)
+            else:
+                radius = s.wp_radius_m
+            if G.distance_m(pos, target) <= radius:
+                self._arrived(why, target, pos)
+                nav = self._nav
+                if nav[0] != "goto":
+                    return self.update_circle(pos, vel, l1) if nav[0] == "circle" else None
+                _, start, target, why = nav
+            cmd = G.l1_track(pos, vel, start, target, l1)
+        else:
+            return self.update_circle(pos, vel, l1)
+        a["ap/bank-cmd-rad"] = G.bank_for(cmd.accel_m_s2, STICK_BANK_RAD)
+
+    def update_circle(self, pos, vel, l1) -> None:
+        _, centre, radius, cw = self._nav
+        cmd = G.l1_circle(pos, vel, centre, radius, cw, l1)
+        self.sim.airframe["ap/bank-cmd-rad"] = G.bank_for(cmd.accel_m_s2, STICK_BANK_RAD)
+        if self.mode == MODES.AUTO and self.mission_seq < len(self.mission):
+            self._loiter_progress(pos, centre, radius)
+
+    def _arrived(self, why: str, target, pos) -> None:
+        s = self.settings
+        if why == "home":
+            self.status(6, "Home reached: loitering")
+            self._nav = ("circle", (0.0, 0.0), s.loiter_radius_m, True)
+        elif why == "guided":
+            self._nav = ("circle", target, s.loiter_radius_m, True)
+        elif why == "mission-rtl":
+            self._advance_item() if self.mission_seq + 1 < len(self.mission) else None
+            self._nav = ("circle", (0.0, 0.0), s.loiter_radius_m, True)
+            self.status(6, "Home reached: loitering")
+        else:
+            it = self.mission[self.mission_seq]
+            if it.command == NAV_WAYPOINT:
+                self._advance_item()
+            else:  # a loiter item: circle its point
+                r = abs(it.param3) if it.param3 else s.loiter_radius_m
+                self._nav = ("circle", target, max(r, 20.0), it.param3 >= 0.0)
+        self._apply_mode_flags()
+
+    def _loiter_progress(self, pos, centre, radius) -> None:
+        it = self.mission[self.mission_seq]
+        st = self._item_state
+        if it.command == NAV_LOITER_TIME:
+            if st["t0"] is None:
+                st["t0"] = self._last_t
+            elif self._last_t - st["t0"] >= it.param1:
+                self._advance_item()
+        elif it.command == NAV_LOITER_TURNS:
+            ang = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
+            if st["angle"] is not None:
+                st["turned"] += abs(math.remainder(ang - st["angle"], 2 * math.pi))
+            st["angle"] = ang
+            if st["turned"] >= 2 * math.pi * max(it.param1, 0.0):
+                self._advance_item()
+
+    def _battery(self, dt_s: float) -> None:
+        if dt_s <= 0.0:
+            return
+        a = self.sim.airframe
+        shaft_w = sum(a[p] for p in self.sim.power_properties) * U.WATT_PER_HP
+        self.battery.draw(shaft_w, dt_s)
+        if self.battery.soc < 0.2 and not self._battery_warned:
+            self._battery_warned = True
+            self.status(4, f"Battery low: {self.battery.remaining_pct} %")
+
+    def after_reset(self) -> None:
+        """The aircraft was put back at home in trim: loiter there."""
+        self._sticks, self._stick_wall = (0.0, 0.0), None
+        self.armed = True
+        self.set_mode(MODES.LOITER, quiet=True)
+        self._nav = ("circle", (0.0, 0.0), self.settings.loiter_radius_m, True)
+        self._apply_mode_flags()
