@@ -6,15 +6,21 @@ reply, no step), reset on a backward frame count, the IMU at rest, on the launch
 flight against the simulation's own state and kinematics (specific force + gravity =
 d(velocity)/dt in NED through ArduPilot's rotation matrix; d(position)/dt = velocity), the
 channel map, a valid-range stop putting the aircraft back on the launcher, the gust's η₁
-report and the command line. The server and the stand-in take turns in one thread.
+report, the session's MCAP log (the autopilot topic carries what the stand-in sent, in
+order; the run topics the state sent back; independent readers accept the file) and the
+command line. The server and the stand-in take turns in one thread.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import shutil
 import socket
+import subprocess
+import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,6 +30,8 @@ from bioflex_jsb.drivers import ardupilot as ad
 from bioflex_jsb.links import ardupilot_json as aj
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
+from bioflex_jsb.simulation.run import RunDescription
+from bioflex_jsb.sinks import mcap as sink
 from tests.ardupilot_standin import ArduPilotStandin, dcm_of
 
 G = ad.G0_M_S2
@@ -267,15 +275,205 @@ def test_bad_inputs_are_one_line_errors(wing):
 
     assert main(["ardupilot", "--gust", "1cos:2"]) == 2
     assert main(["ardupilot", "--table", "x.csv"]) == 2
+    assert main(["ardupilot", "--port", "0", "--out", "x.mcap", "--no-log"]) == 2
 
 
-def test_command_line_runs_and_writes_its_table(tmp_path):
+def _pymcap_cli() -> str:
+    """pymcap-cli of this interpreter's environment (the test extra), not whatever PATH has."""
+    exe = Path(sys.executable).with_name("pymcap-cli")
+    if exe.exists():
+        return str(exe)
+    found = shutil.which("pymcap-cli")
+    if found is None:
+        pytest.fail("pymcap-cli is missing: install the test extra (pip install '.[test]')")
+    return found
+
+
+def _doctor(path: Path) -> None:
+    out = subprocess.run([_pymcap_cli(), "doctor", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "passed" in out.stdout and "error" not in out.stdout.lower(), out.stdout
+
+
+def _servos(n: int, base: tuple[int, ...]) -> tuple[int, ...]:
+    """``base`` on servos 1–4 (or 5), then values that change every frame on the servos the
+    physics does not read (6–16): each frame's PWM is recognisable in the log."""
+    tail = tuple(1000 + (7 * n + 13 * j) % 1000 for j in range(16 - len(base)))
+    return base + tail
+
+
+@pytest.fixture(scope="module")
+def session_log(wing, tmp_path_factory):
+    """A stand-in session logged to MCAP: rest, a resend, launch, flight with a resend,
+    ArduPilot restarting, rest again. Returns (path, what was sent, the replies, physics)."""
+    path = tmp_path_factory.mktemp("aplog") / "session.mcap"
+    ph = _physics(wing, record_every=1)
+    desc = RunDescription(kind="ardupilot", wing="optimised", speed_m_s=15.0, gust="none",
+                          models=("coupled",), dt_s=ph.dt_s,
+                          extra={"autopilot": "ardupilot"})
+    log = sink.RunLog.open(path, desc)
+    ph.log_to(log)
+    lk = Link(ph)
+    sent, replies = [], []  # (frame_count, pwm, action); (session time, phase, parsed)
+    n = 0
+
+    def frame(base):
+        nonlocal n
+        pwm = _servos(n, base)
+        n += 1
+        count = lk.ap.frame_counter
+        p = lk.frame(pwm)
+        action = aj.RESET if sent and count < sent[-1][0] else aj.STEP
+        sent.append((count, pwm, action))
+        replies.append((ph.session_t_s, ph.phase, p))
+
+    def resend():
+        lk.ap.resend()
+        assert lk.server.serve_once(5.0)
+        assert lk.ap.accept(lk.ap.read_datagram()) is not None
+        sent.append((sent[-1][0], sent[-1][1], aj.RESEND))
+
+    try:
+        for _ in range(30):
+            frame(DISARMED)
+        resend()
+        for _ in range(ph.launch_hold_steps + ph.stroke_steps + 150):
+            frame(ARMED_IDLE)
+        assert ph.phase == ad.FLIGHT
+        resend()
+        for _ in range(50):
+            frame(ARMED_IDLE)
+        lk.ap.restart()  # frame_count back to 0: a reset
+        for _ in range(20):
+            frame(DISARMED)
+        assert lk.server.stats.resets == 1 and lk.server.stats.resends == 2
+    finally:
+        lk.close()
+        log.close()
+    return path, sent, replies, ph
+
+
+def test_log_autopilot_topic_is_what_the_standin_sent(session_log):
+    path, sent, replies, ph = session_log
+    msgs = sink.messages_by_topic(path)
+    ap = msgs[sink.topic("coupled", "autopilot")]
+    assert len(ap) == len(sent)
+    assert [m["frame_count"] for _, m in ap] == [c for c, _, _ in sent]  # in order
+    assert [tuple(m["pwm_us"]) for _, m in ap] == [pwm for _, pwm, _ in sent]
+    assert [sink.AUTOPILOT_ACTIONS[m.get("action", 0)] for _, m in ap] == [
+        "ACTION_" + a.upper() for _, _, a in sent]
+    assert sink.AUTOPILOT_ACTIONS == tuple("ACTION_" + a.upper() for a in ad.ACTIONS)
+    assert sink.AUTOPILOT_PHASES == tuple("PHASE_" + p.upper() for p in ad.PHASES)
+    assert all(m["frame_rate_hz"] == 1200 for _, m in ap)
+    times = [ns for ns, _ in ap]
+    assert times == sorted(times)  # the session's time goes on across the restart
+    # steps and resets: at the start of their step; resends: at the state they repeat; the
+    # timestamp is the reply's (back to dt after ArduPilot's restart)
+    steps = [(ns, m) for ns, m in ap if m.get("action", 0) != 1]
+    assert len(steps) == len(replies)
+    for (ns, m), (t_after, phase, p) in zip(steps, replies, strict=True):
+        assert ns == round((t_after - ph.dt_s) * 1e9)
+        assert m["timestamp_s"] == p.values["timestamp"]
+        assert sink.AUTOPILOT_PHASES[m.get("phase", 0)] == "PHASE_" + phase.upper()
+    resends = [(ns, m) for ns, m in ap if m.get("action", 0) == 1]
+    assert [m["frame_count"] for _, m in resends] == [c for c, _, a in sent if a == aj.RESEND]
+    for ns, m in resends:  # the time and timestamp of the frame they repeat
+        before = [m2 for ns2, m2 in ap if m2["frame_count"] == m["frame_count"]
+                  and m2.get("action", 0) == 0]
+        assert m["timestamp_s"] == before[0]["timestamp_s"]
+        assert ns == round(m["timestamp_s"] * 1e9)  # the first session: session = physics
+    reset = [m for _, m in ap if m.get("action", 0) == 2]
+    assert len(reset) == 1 and reset[0]["frame_count"] == 0
+    assert reset[0]["timestamp_s"] == pytest.approx(ph.dt_s, rel=1e-12)
+    # the mapped commands: the channel map of what was sent
+    for (_, m), (_, pwm, _) in zip(ap, sent, strict=True):
+        assert (m.get("aileron_cmd_norm", 0.0), m.get("elevator_cmd_norm", 0.0),
+                m.get("throttle_cmd_norm", 0.0), m.get("rudder_cmd_norm", 0.0)) == \
+            ph.commands(pwm)
+    assert ph.commands(ARMED_IDLE) == (0.0, 0.0, pytest.approx(0.05), 0.0)
+
+
+def test_log_run_topics_are_the_state_sent(session_log):
+    path, sent, replies, ph = session_log
+    msgs = sink.messages_by_topic(path)
+    rigid = msgs[sink.topic("coupled", "rigid_body")]
+    flight_steps = 200  # 150 + 50 frames after the stroke, the resend not a step
+    for group in ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose",
+                  "location"):
+        assert len(msgs[sink.topic("coupled", group)]) == flight_steps, group
+    # the snapshot logged at t is the state the reply at t sent (float32 in ArduPilot)
+    sent_at = {round(t * 1e9): p for t, phase, p in replies}
+    for ns, m in rigid:
+        p = sent_at[ns].values
+        yaw = math.remainder(m["yaw_rad"], 2 * math.pi)  # ArduPilot's is in (−π, π]
+        assert (m["roll_rad"], m["pitch_rad"], yaw) == pytest.approx(p["attitude"], abs=1e-6)
+        assert (m["v_north_m_s"], m["v_east_m_s"], m["v_down_m_s"]) == pytest.approx(
+            p["velocity"], abs=1e-5)
+        assert m["airspeed_m_s"] == pytest.approx(p["airspeed"], rel=1e-6)
+    # and every channel is the coupled step's row (the --table holds the same rows)
+    table = ph.table()
+    names = ph.record_names
+    col = {k: i for i, k in enumerate(names)}
+    rows = [r for r in table if r[col["action"]] != ad.ACTIONS.index(aj.RESEND)
+            and math.isfinite(r[col["u"]])]
+    assert len(rows) == flight_steps
+    modal = msgs[sink.topic("coupled", "modal")]
+    for (ns, m), (_, mm), r in zip(rigid, modal, rows, strict=True):
+        assert ns == round((r[col["time_s"]] - ph.dt_s) * 1e9)
+        assert m["du_m_s"] == r[col["u"]] and m["q_rad_s"] == r[col["q"]]
+        assert m["altitude_m"] == r[col["altitude_m"]]
+        assert mm["eta_rad"][0] == r[col["eta1"]] and mm["eta_dot_rad_s"][0] == r[
+            col["eta1_dot"]]
+    assert any(m["eta_rad"][0] != 0.0 for _, m in modal)  # the wing does move
+
+
+def test_log_is_read_by_independent_readers_and_the_log_commands(session_log, tmp_path,
+                                                                capsys):
+    from bioflex_jsb.cli import main
+
+    path, sent, _, _ = session_log
+    _doctor(path)
+    assert main(["info", str(path), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    counts = {c["topic"]: c["messages"] for c in info["channels"]}
+    assert counts[sink.topic("coupled", "autopilot")] == len(sent)
+    schemas = {c["topic"]: c["schema"] for c in info["channels"]}
+    assert schemas[sink.topic("coupled", "autopilot")] == "bioflex.Autopilot"
+    assert info["metadata"]["bioflex.run"]["command"] == "ardupilot"
+    png = tmp_path / "session.png"
+    assert main(["plot", str(path), "--out", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    capsys.readouterr()
+    assert main(["rerun", str(path), "--out", str(tmp_path / "again.mcap")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "'ardupilot'" in err and len(err.splitlines()) == 1
+
+
+def test_log_is_read_by_mcap_core_and_protobufjs(session_log, tmp_path_factory):
+    from tests.test_mcap import _node_checker
+
+    path, sent, _, _ = session_log
+    result = _node_checker(tmp_path_factory)(path)  # skips without node/npm
+    top = sink.topic("coupled", "autopilot")
+    assert result["counts"][top] == result["statistics"][top] == len(sent)
+    assert result["dataCrcOk"] is True and result["ordered"] is True
+    assert result["schemas"][top] == "bioflex.Autopilot"
+    theirs = result["samples"][top]  # the second message, decoded by protobufjs
+    mine = sink.messages_by_topic(path)[top][1][1]
+    mine = {k: v for k, v in mine.items() if v not in (0, 0.0)}  # proto3 defaults
+    theirs = {k: v for k, v in theirs.items() if v not in (0, 0.0)}
+    assert theirs == mine
+
+
+def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
     from bioflex_jsb.cli import build_parser
 
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     table, summary = tmp_path / "run.npz", tmp_path / "run.json"
+    monkeypatch.setenv("BIOFLEX_LOG_DIR", str(tmp_path / "logs"))  # the default log place
     args = build_parser().parse_args([
         "ardupilot", "--port", str(port), "--duration", "0.1", "--table", str(table),
         "--summary", str(summary), "--record-every", "4"])
@@ -302,3 +500,15 @@ def test_command_line_runs_and_writes_its_table(tmp_path):
         names = list(z["names"])
         assert names[:3] == ["time_s", "frame_count", "action"]
         assert z["table"].shape == (s["frames"]["steps"] // 4, len(names))
+    # the MCAP log, written as for any run: logs/ardupilot-<wing>-<UTC>.mcap
+    (log,) = (tmp_path / "logs").glob("ardupilot-optimised-*.mcap")
+    assert s["out"] == str(log)
+    msgs = sink.messages_by_topic(log)
+    ap = msgs[sink.topic("coupled", "autopilot")]
+    assert len(ap) == s["frames"]["steps"] + s["frames"]["resends"]
+    assert ap[-1][1]["frame_count"] == s["frames"]["last_frame_count"]
+    assert sink.topic("coupled", "rigid_body") not in msgs  # at rest: no coupled step
+    meta = sink.summarise(log)["metadata"]["bioflex.run"]
+    d = sink.description_from_metadata(meta)
+    assert d.kind == "ardupilot" and d.extra["autopilot"] == "ardupilot"
+    assert d.extra["udp_port"] == port and d.dt_s == pytest.approx(ad.DEFAULT_DT_S)

@@ -9,8 +9,10 @@ import time
 
 from bioflex_jsb.cli.common import (
     UsageError,
+    add_log_arguments,
     add_wing_arguments,
     finite_float,
+    log_path,
     positive_float,
     print_json,
     wing_from_args,
@@ -25,9 +27,12 @@ leaves the valid range is put back on the launcher, not ended. Servo map, frames
 parameter file: docs/ardupilot.md, bioflex_jsb/drivers/ardupilot.py,
 bioflex_jsb/data/ardupilot/bioflex_plane.parm. --gust starts --gust-at seconds after the
 launch. Runs until Ctrl-C/SIGTERM or --duration simulated seconds, then prints a JSON
-summary (frames, resends, resets, stops, the gust's eta1 peak). --table FILE.npz keeps every
---record-every-th frame (servos, ArduPilot's frame count, the step's channels); the MCAP log
-is not written by this command yet. Never expose ArduPlane's TCP ports: run both inside a
+summary (frames, resends, resets, stops, the gust's eta1 peak). Every frame is logged to
+the MCAP log as for any run (--out, --no-log; docs/logging.md): ArduPilot's frame count,
+rate and servo PWM, the mapped controls, the lock-step action and the launcher phase on
+/bioflex/<model>/autopilot, and every coupled step in flight on the run topics.
+--table FILE.npz also keeps every --record-every-th frame (servos 1-4, ArduPilot's frame
+count, the step's channels) as a numpy table. Never expose ArduPlane's TCP ports: run both inside a
 loopback-only network namespace (scripts/ardupilot_sitl.py fly)."""
 
 NATIVE = "native"
@@ -64,10 +69,12 @@ def register(sub) -> None:
                    help="record every N-th frame in --table (default 8: 120 Hz)")
     p.add_argument("--summary", metavar="FILE.json", default=None,
                    help="also write the summary to this file")
+    add_log_arguments(p)
     p.set_defaults(run=run)
 
 
 def _build(args: argparse.Namespace):
+    """The physics, and the wing's variant and coefficient overrides for the log (dicts)."""
     from bioflex_jsb.drivers.ardupilot import ArduPilotPhysics, Launcher
     from bioflex_jsb.runtime.fdm import Airframe, FdmError
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
@@ -94,29 +101,71 @@ def _build(args: argparse.Namespace):
             raise UsageError(f"--model native needs a named wing ({', '.join(VARIANTS)}), "
                              f"got {args.wing!r}")
         aircraft, wing = J.aircraft_name(args.wing), None
+        variant, overrides = VARIANTS[args.wing].as_dict(), {}
     else:
-        aircraft, wing = None, wing_from_args(args).model
+        build = wing_from_args(args)
+        aircraft, wing = None, build.model
+        variant = build.variant.as_dict()
+        overrides = dict(build.model.coefficients.overrides)
     try:
         airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
-        return ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
-                                altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
-                                launcher=launcher, record_every=args.record_every)
+        physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
+                                   altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
+                                   launcher=launcher, record_every=args.record_every)
     except (FdmError, ValueError) as exc:
+        raise UsageError(str(exc)) from None
+    return physics, variant, overrides
+
+
+def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict, port: int):
+    """The session's MCAP log (None with --no-log); a one-line UsageError if it cannot be
+    written."""
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks.mcap import LogWriteError, RunLog
+
+    args.out = log_path(args, "ardupilot", args.wing)
+    if not args.out:
+        return None
+    # a session follows ArduPlane: the description says how it began (rerun refuses it)
+    description = RunDescription(
+        kind="ardupilot", wing=args.wing, speed_m_s=args.speed, gust=args.gust,
+        models=(args.model,), gust_start_s=args.gust_at, altitude_m=args.altitude,
+        dt_s=physics.dt_s, mass_basis=args.mass_basis,
+        **({} if args.duration is None else {"duration_s": args.duration}),
+        extra={"autopilot": "ardupilot", "until_stopped": args.duration is None,
+               "gust_start": "s after the launch", "udp_port": port,
+               "instance": args.instance, "launch_accel_m_s2": physics.launch_accel_m_s2,
+               "launch_height_m": physics.launcher.height_m,
+               "record_every": args.record_every})
+    try:
+        return RunLog.open(args.out, description, wing_variant=variant, overrides=overrides)
+    except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 
 
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.links.ardupilot_json import LockstepServer
 
-    physics = _build(args)
+    physics, variant, overrides = _build(args)
     try:
         server = LockstepServer(physics, port=args.port, instance=args.instance,
                                 on_frame=physics.on_frame)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     host, port = server.address
+    log = None
+    opened = False
+    try:
+        log = _open_log(args, physics, variant, overrides, port)
+        opened = True
+    finally:
+        if not opened:  # a log that cannot be created: the port is given back
+            server.close()
+    if log is not None:
+        physics.log_to(log)
     print(f"bioflex-jsb ardupilot: physics on UDP {host}:{port} ({args.model} wing "
-          f"{args.wing}, step {physics.dt_s:.6g} s); waiting for ArduPilot; Ctrl-C stops",
+          f"{args.wing}, step {physics.dt_s:.6g} s); "
+          f"{'log ' + args.out if args.out else 'no log'}; waiting for ArduPilot; Ctrl-C stops",
           file=sys.stderr, flush=True)
     wall0 = time.monotonic()
     first_frame_wall = None
@@ -129,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
         interrupted = True
     finally:
         server.close()
+        if log is not None:
+            log.close()
     wall_s = time.monotonic() - (first_frame_wall or wall0)
     st = server.stats
     summary = physics.summary()
@@ -138,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
                 "last_frame_count": server.last_frame_count},
         wall_s=wall_s,
         real_time_factor=physics.t_s / wall_s if wall_s > 0 and physics.t_s > 0 else None,
-        table=args.table, interrupted=interrupted)
+        table=args.table, out=args.out, interrupted=interrupted)
     if args.table is not None:
         _write_table(args.table, physics)
     print_json(summary)

@@ -74,8 +74,23 @@ measured on every step (:attr:`ArduPilotPhysics.gust_report`, [rad]).
 Recording: :meth:`ArduPilotPhysics.on_frame` (the server's ``on_frame``) keeps every
 ``record_every``-th frame, and every resend and reset, in :attr:`records` (columns
 :attr:`record_names`: time, ArduPilot's frame count, the server's action, the phase, servos
-1–4 [µs], then the coupled step's row in flight, NaN before). The MCAP log of other runs is
-not written here yet.
+1–4 [µs], then the coupled step's row in flight, NaN before).
+
+The MCAP log (:meth:`ArduPilotPhysics.log_to`, a :class:`~bioflex_jsb.sinks.mcap.RunLog`;
+``docs/logging.md``), every frame the server answers:
+
+* ``/bioflex/<model>/autopilot``: one message per frame (steps, resends and resets, in the
+  order they arrived): ArduPilot's frame count and rate [Hz], all 16 (or 32) PWM values
+  [µs], the four commands the channel map gives for them (applied in flight only), the
+  server's action, the phase after the frame and the reply's timestamp [s];
+* the run topics (``rigid_body`` … ``location``) of every coupled step in flight: the step's
+  row, the snapshot at the step's start, as every run logs it (none at rest and on the
+  launcher: there is no coupled step there).
+
+Log time is the *session* time: the physics time, continued across ArduPilot restarts
+(which send the reply's timestamp back to 0), so the file's time never goes back. A step's
+messages are at the time of its start (the state the frame's PWM acts on, which is the state
+the previous reply sent); a resend's at the time of the state it repeats.
 """
 
 from __future__ import annotations
@@ -234,6 +249,10 @@ class ArduPilotPhysics:
         self.launches = 0
         self.restarts = 0  # ArduPilot restarts (reset())
         self.records: list[tuple[float, ...]] = []
+        self._log = None  # RunLog (log_to)
+        self._autopilot_log = None
+        self._step_row: tuple[float, ...] | None = None  # the last frame's flight row
+        self._t_offset_s = 0.0  # session time at ArduPilot's last restart [s]
         self._frames_seen = 0
         self.core: CoupledStep = None  # type: ignore[assignment]
         self._new_core(dt_s)
@@ -316,6 +335,12 @@ class ArduPilotPhysics:
         return self.frame_k * self.dt_s
 
     @property
+    def session_t_s(self) -> float:
+        """Session time [s]: the physics time, continued across ArduPilot restarts (the
+        log's time axis)."""
+        return self._t_offset_s + self.frame_k * self.dt_s
+
+    @property
     def launch_hold_steps(self) -> int:
         """Frames of the launch signal (throttle or switch) that fire the launcher."""
         return max(1, math.ceil(LAUNCH_HOLD_S / self.dt_s - 1e-9))
@@ -341,12 +366,14 @@ class ArduPilotPhysics:
         self.restarts += 1
         self._new_core(self.dt_s)
         self._to_rest()
+        self._t_offset_s += self.frame_k * self.dt_s
         self.frame_k = 0
 
     def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
         """One frame of ``dt_s`` with these servo outputs [µs, servo 1 first]."""
         self.pwm_us = pwm_us
         self.frame_k += 1
+        self._step_row = None
         if self.phase == REST:
             thr = pwm_us[THROTTLE_CHANNEL] if len(pwm_us) > THROTTLE_CHANNEL else 0
             switch = pwm_us[LAUNCH_SWITCH_CHANNEL] if len(pwm_us) > LAUNCH_SWITCH_CHANNEL else 0
@@ -369,7 +396,7 @@ class ArduPilotPhysics:
             write(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0))
         k = core.k
         w_g = self.gust.at_step(k) if self.gust is not None else 0.0
-        self._last_row = core.advance(w_g)
+        self._last_row = self._step_row = core.advance(w_g)
         self._last_w_g = w_g
         k0, k1 = self._gust_steps
         if k0 <= k <= k1:
@@ -451,8 +478,34 @@ class ArduPilotPhysics:
             airspeed_m_s=self._vt() * f)
 
     # -- recording --------------------------------------------------------------------------
+    def log_to(self, log) -> None:
+        """Log every frame answered from now on into ``log`` (a
+        :class:`~bioflex_jsb.sinks.mcap.RunLog`; module docstring); the caller closes it."""
+        self._log = log
+        self._autopilot_log = log.autopilot(self.model)
+
+    def commands(self, pwm_us: tuple[int, ...]) -> tuple[float, ...]:
+        """The four normalised commands (aileron, elevator, throttle, rudder) the channel map
+        gives for ``pwm_us`` [µs] (:data:`CHANNEL_MAP`)."""
+        return tuple(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0)
+                     for ch in CHANNEL_MAP)
+
+    def _log_frame(self, rec: FrameRecord) -> None:
+        # the state the frame arrived at: before the step (step, reset), the one repeated
+        k = self.frame_k if rec.action == RESEND else self.frame_k - 1
+        t = self._t_offset_s + k * self.dt_s
+        row, self._step_row = self._step_row, None
+        if row is not None and rec.action != RESEND:
+            self._log.sample(self.model, t, dict(zip(self.core.names, row, strict=True)))
+        self._autopilot_log.frame(
+            t, rec.frame_count, rec.frame_rate_hz, rec.pwm_us, self.commands(rec.pwm_us),
+            ACTIONS.index(rec.action), PHASES.index(self.phase), rec.timestamp_s)
+
     def on_frame(self, rec: FrameRecord) -> None:
-        """The server's callback: keep every ``record_every``-th frame, resends and resets."""
+        """The server's callback: log the frame (:meth:`log_to`); keep every
+        ``record_every``-th frame, resends and resets in :attr:`records`."""
+        if self._log is not None:
+            self._log_frame(rec)
         self._frames_seen += 1
         n = self.record_every
         if n == 0 or (rec.action not in (RESEND, RESET) and self._frames_seen % n):

@@ -17,8 +17,9 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 # What a run can be: a gust run of one or more models, one sweep case (a gust run), a
-# comparison of the co-simulation with the LTI model, a SITL session.
-RUN_KINDS = ("gust", "sweep", "compare", "sitl", "bench")
+# comparison of the co-simulation with the LTI model, a SITL session, a benchmark, an
+# ArduPlane SITL session (bioflex-jsb ardupilot: ArduPilot flies it, so it is not repeatable).
+RUN_KINDS = ("gust", "sweep", "compare", "sitl", "bench", "ardupilot")
 REPEATABLE_KINDS = ("gust", "sweep", "compare")
 
 

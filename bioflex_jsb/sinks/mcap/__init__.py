@@ -15,7 +15,10 @@ descriptions; the full table is in ``docs/logging.md``):
 * ``/bioflex/<model>/pose`` (``foxglove.FrameTransform``): ``world`` → ``<model>_body``;
 * ``/bioflex/<model>/location`` (``foxglove.LocationFix``): latitude, longitude [deg], altitude;
 * ``/bioflex/<model>/lti_prediction`` (``bioflex.LtiPrediction``): the linear model's response
-  to the same gust, where one ran alongside (:meth:`RunLog.prediction`).
+  to the same gust, where one ran alongside (:meth:`RunLog.prediction`);
+* ``/bioflex/<model>/autopilot`` (``bioflex.Autopilot``): an ArduPilot SITL session's servo
+  frames: ArduPilot's frame count and rate [Hz], the PWM values [µs], the mapped controls,
+  the lock-step action and the launcher phase (:meth:`RunLog.autopilot`).
 
 Frames: ``world`` is a local East-North-Up frame [m] whose origin is the aircraft's position
 at the first sample of the file (flat-Earth tangent plane on the WGS-84 ellipsoid);
@@ -44,8 +47,8 @@ checked by independent readers in the tests (``@mcap/core``, ``pymcap-cli doctor
 Modules: :mod:`.schemas` (topics, frames, fields, protobuf schemas), :mod:`.protobuf` (the
 wire format, schemas and a decoder), :mod:`.foxglove_descriptors` (Foxglove's published
 schemas), :mod:`.writer` (the MCAP file writer), :mod:`.formatting` (a chunk's steps as
-protobuf records), :mod:`.log`
-(:class:`RunLog`, :class:`TableRecorder`), :mod:`.metadata` (the ``bioflex.run`` record),
+protobuf records), :mod:`.log` (:class:`RunLog`, :class:`TableRecorder`,
+:class:`AutopilotRecorder`), :mod:`.metadata` (the ``bioflex.run`` record),
 :mod:`.reader` (summaries, messages, time histories), :mod:`.recover`, :mod:`.compare`
 (two logs message by message), :mod:`.errors`. A sink takes a run description and the run's
 data, never command-line arguments, and raises its own one-line errors
@@ -55,7 +58,7 @@ data, never command-line arguments, and raises its own one-line errors
 from bioflex_jsb.sinks.mcap.compare import compare_logs
 from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError
 from bioflex_jsb.sinks.mcap.formatting import enu_quaternion
-from bioflex_jsb.sinks.mcap.log import RunLog, TableRecorder
+from bioflex_jsb.sinks.mcap.log import AutopilotRecorder, RunLog, TableRecorder
 from bioflex_jsb.sinks.mcap.metadata import description_from_metadata, run_metadata
 from bioflex_jsb.sinks.mcap.reader import (
     check_file,
@@ -67,6 +70,8 @@ from bioflex_jsb.sinks.mcap.reader import (
 )
 from bioflex_jsb.sinks.mcap.recover import check_chunks, recover
 from bioflex_jsb.sinks.mcap.schemas import (
+    AUTOPILOT_ACTIONS,
+    AUTOPILOT_PHASES,
     FRAME_METADATA,
     GROUPS,
     PROTO_SCHEMAS,
@@ -85,6 +90,7 @@ from bioflex_jsb.sinks.mcap.writer import (
 )
 
 __all__ = [
+    "AUTOPILOT_ACTIONS", "AUTOPILOT_PHASES", "AutopilotRecorder",
     "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "FRAME_METADATA", "GROUPS", "MAGIC",
     "PROTO_SCHEMAS", "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError",
     "McapFileWriter",

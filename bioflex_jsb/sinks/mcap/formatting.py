@@ -22,7 +22,6 @@ from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, length_delimited, string_f
 from bioflex_jsb.sinks.mcap.schemas import (
     _RIGID_FIELDS,
     _RIGID_OPTIONAL,
-    GROUPS,
     PROTO_FIELDS,
     WORLD_FRAME,
     body_frame,
@@ -205,7 +204,7 @@ class _ModelChannels:
         self.names = tuple(names)
         col = {name: i for i, name in enumerate(self.names)}
         n = sum(1 for k in self.names if k.startswith("eta") and not k.endswith("_dot"))
-        self.ids = {g: log._channel_id(model, g) for g in GROUPS if g != "lti_prediction"}
+        self.ids = {g: log._channel_id(model, g) for g in STEP_GROUPS}
         self.seq = 0
         optional = [f for f, _ in _RIGID_OPTIONAL if f in col]
         rigid_keys = [k for _, k, _ in _RIGID_FIELDS] + optional
@@ -262,6 +261,97 @@ def lti_records(channel_id: int, n_eta: int) -> Records:
     return Records([channel_id],
                    lambda ls, ln: [_doubles(scalars) + _packed(number["eta_rad"], n_eta)],
                    timestamped=False)
+
+
+class AutopilotRecords:
+    """The records of ``bioflex.Autopilot`` on one channel, built a chunk at a time: every
+    field is fixed-width (``fixed32`` integers, doubles, one-byte enum varints, always
+    written, zeros included), so the messages of one PWM count share one layout, a numpy
+    structured type over the record bytes (a record header, then the fields in number
+    order)."""
+
+    def __init__(self, channel_id: int) -> None:
+        self.channel_id = channel_id
+        self._dtypes: dict[int, tuple[np.dtype, dict[str, int]]] = {}
+        number = {name: num for name, num, _ in PROTO_FIELDS["autopilot"]}
+        self._number = number
+
+    def _layout(self, n_pwm: int) -> tuple[np.dtype, dict[str, int]]:
+        got = self._dtypes.get(n_pwm)
+        if got is not None:
+            return got
+        from bioflex_jsb.sinks.mcap.protobuf import I32, VARINT
+
+        num = self._number
+        names, formats, offsets, consts = [], [], [], {}
+        at = 0
+
+        def put(name: str, fmt: str, size: int, const: int | None = None) -> None:
+            nonlocal at
+            names.append(name)
+            formats.append(fmt)
+            offsets.append(at)
+            if const is not None:
+                consts[name] = const
+            at += size
+
+        def const_bytes(label: str, data: bytes) -> None:
+            for i, b in enumerate(data):
+                put(f"{label}{i}", "u1", 1, b)
+
+        put("op", "u1", 1, _OP_MESSAGE)
+        put("length", "<u8", 8)
+        put("channel", "<u2", 2, self.channel_id)
+        put("sequence", "<u4", 4)
+        put("log_ns", "<u8", 8)
+        put("publish_ns", "<u8", 8)
+        start = at
+        for field in ("frame_count", "frame_rate_hz"):
+            const_bytes(f"t_{field}", tag(num[field], I32))
+            put(field, "<u4", 4)
+        const_bytes("t_pwm", tag(num["pwm_us"], LEN) + varint(4 * n_pwm))
+        put("pwm_us", f"({n_pwm},)<u4", 4 * n_pwm)
+        for field in ("aileron_cmd_norm", "elevator_cmd_norm", "throttle_cmd_norm",
+                      "rudder_cmd_norm"):
+            const_bytes(f"t_{field}", tag(num[field], I64))
+            put(field, "<f8", 8)
+        for field in ("action", "phase"):
+            const_bytes(f"t_{field}", tag(num[field], VARINT))
+            put(field, "u1", 1)
+        const_bytes("t_timestamp_s", tag(num["timestamp_s"], I64))
+        put("timestamp_s", "<f8", 8)
+        consts["length"] = 22 + at - start  # channel, sequence, times and the message
+        dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets,
+                          "itemsize": at})
+        self._dtypes[n_pwm] = (dtype, consts)
+        return dtype, consts
+
+    def build(self, ns: np.ndarray, seq0: int, frame_count, frame_rate_hz, pwm_us,
+              commands, action, phase, timestamp_s) -> tuple[bytes, dict[int, np.ndarray]]:
+        """The records of n frames at log times ``ns`` [ns] (sequence numbers from ``seq0``):
+        ``pwm_us`` an (n, channels) array, ``commands`` (n, 4) (aileron, elevator, throttle,
+        rudder), ``action`` and ``phase`` enum codes (< 128); and their index entries."""
+        n = len(ns)
+        pwm_us = np.asarray(pwm_us)
+        dtype, consts = self._layout(pwm_us.shape[1])
+        rec = np.zeros(n, dtype=dtype)
+        for name, value in consts.items():
+            rec[name] = value
+        rec["sequence"] = (seq0 + np.arange(n)) & 0xFFFFFFFF
+        rec["log_ns"] = ns
+        rec["publish_ns"] = ns
+        rec["frame_count"] = frame_count
+        rec["frame_rate_hz"] = frame_rate_hz
+        rec["pwm_us"] = pwm_us
+        commands = np.asarray(commands, dtype=float)
+        for j, field in enumerate(("aileron_cmd_norm", "elevator_cmd_norm",
+                                   "throttle_cmd_norm", "rudder_cmd_norm")):
+            rec[field] = commands[:, j]
+        rec["action"] = action
+        rec["phase"] = phase
+        rec["timestamp_s"] = timestamp_s
+        offsets = np.arange(n, dtype=np.int64) * dtype.itemsize
+        return rec.tobytes(), {self.channel_id: np.column_stack([ns, offsets])}
 
 
 def enu_quaternion(roll_rad, pitch_rad, yaw_rad) -> tuple:

@@ -2,7 +2,8 @@
 
 A gust run hands its steps to the log a chunk at a time (:meth:`RunLog.recorder`: one call
 per chunk of rows, nothing per step); a loop without a table (SITL) gives its steps as dicts
-(:meth:`RunLog.sample`). Messages are protobuf, built a chunk at a time (:mod:`.formatting`).
+(:meth:`RunLog.sample`); an ArduPilot session adds its servo frames (:meth:`RunLog.autopilot`).
+Messages are protobuf, built a chunk at a time (:mod:`.formatting`).
 Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or
 :data:`CHUNK_WALL_S` of wall time, or 4096 steps) and handed to the operating system at once,
 so a process killed hard loses at most the chunk in progress.
@@ -21,7 +22,7 @@ import numpy as np
 
 from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogWriteError
-from bioflex_jsb.sinks.mcap.formatting import _ModelChannels, lti_records
+from bioflex_jsb.sinks.mcap.formatting import AutopilotRecords, _ModelChannels, lti_records
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
 from bioflex_jsb.sinks.mcap.schemas import (
     FRAME_METADATA,
@@ -58,6 +59,7 @@ class RunLog:
         self._ts: list[float] = []
         self._rows: list[tuple] = []
         self._pending: _ModelChannels | None = None
+        self._streams: list[AutopilotRecorder] = []  # their frames go into the same chunks
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -130,6 +132,10 @@ class RunLog:
         ch = self._models.get(model)
         if ch is None:
             ch = self._model(model, tuple(row))
+        if (self._pending is None and not self._rows and self._first_t <= t_s < self._due_t
+                and time.monotonic() < self._due_wall
+                and any(s._frames for s in self._streams)):
+            self._pending = ch  # the chunk of an autopilot's frames in progress: join it
         if (self._pending is not ch or not self._first_t <= t_s < self._due_t
                 or time.monotonic() >= self._due_wall or len(self._rows) >= _MAX_PENDING_STEPS):
             self._next_chunk(ch, t_s)
@@ -138,7 +144,7 @@ class RunLog:
 
     def _next_chunk(self, ch: _ModelChannels, t_s: float) -> None:
         """Close the chunk in progress (if any) and start one for ``ch`` at ``t_s``."""
-        if self._rows:
+        if self._rows or any(s._frames for s in self._streams):
             self.flush()
         self._pending = ch
         self._first_t = t_s
@@ -164,6 +170,17 @@ class RunLog:
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
+
+    def autopilot(self, model: str) -> AutopilotRecorder:
+        """The recorder of an autopilot's servo frames on ``/bioflex/<model>/autopilot``
+        (``bioflex.Autopilot``: one message per frame, :meth:`AutopilotRecorder.frame`), in
+        the same chunks as the run's steps (:meth:`sample`)."""
+        for stream in self._streams:
+            if stream.model == model:
+                return stream
+        stream = AutopilotRecorder(self, model)
+        self._streams.append(stream)
+        return stream
 
     def prediction(self, model: str, history) -> None:
         """Log the LTI prediction ``history`` (a ``TimeHistory`` of the linear model of
@@ -191,6 +208,8 @@ class RunLog:
         """Write the kept steps as a chunk and hand it to the operating system."""
         with _signals_deferred():
             self._format_pending()
+            for stream in self._streams:
+                stream._format()
             self._writer.close_chunk()
         self._pending = None
 
@@ -260,3 +279,55 @@ class TableRecorder:
     def stop(self, n: int) -> None:
         """The run is over (``n`` complete rows): nothing is pending, every chunk was
         written by :meth:`rows`."""
+
+
+class AutopilotRecorder:
+    """Logs an autopilot's servo frames (ArduPilot's JSON SITL) on
+    ``/bioflex/<model>/autopilot``, one message per frame answered, formatted a chunk at a
+    time with the run's steps (:meth:`RunLog.autopilot`)."""
+
+    def __init__(self, log: RunLog, model: str) -> None:
+        self._log = log
+        self.model = model
+        self._records = AutopilotRecords(log._channel_id(model, "autopilot"))
+        self._frames: list[tuple] = []  # the frames of the chunk in progress
+        self.seq = 0
+        self.frames = 0  # frames logged
+
+    def frame(self, t_s: float, frame_count: int, frame_rate_hz: int, pwm_us, commands,
+              action: int, phase: int, timestamp_s: float) -> None:
+        """One frame at the log time ``t_s`` [s]: ArduPilot's ``frame_count`` and
+        ``frame_rate_hz`` [Hz], its ``pwm_us`` [µs] (16 or 32), the four mapped ``commands``
+        (aileron, elevator, throttle, rudder [-]), the server's ``action`` and the ``phase``
+        (enum codes: :data:`~.schemas.AUTOPILOT_ACTIONS`, :data:`~.schemas.AUTOPILOT_PHASES`)
+        and the reply's physics time ``timestamp_s`` [s]. The chunk closes as
+        :meth:`RunLog.sample`'s do."""
+        log = self._log
+        if (not log._first_t <= t_s < log._due_t or time.monotonic() >= log._due_wall
+                or len(self._frames) >= _MAX_PENDING_STEPS):
+            log._next_chunk(log._pending, t_s)
+        self._frames.append((t_s, frame_count, frame_rate_hz, tuple(pwm_us), tuple(commands),
+                             action, phase, timestamp_s))
+        self.frames += 1
+
+    def _format(self) -> None:
+        """Serialise the kept frames into the chunk in progress (the caller holds signals)."""
+        frames = self._frames
+        n = len(frames)
+        if not n:
+            return
+        start = 0
+        for k in range(1, n + 1):  # runs of frames with the same number of PWM values
+            if k < n and len(frames[k][3]) == len(frames[start][3]):
+                continue
+            run = frames[start:k]
+            ns = np.rint(np.array([f[0] for f in run], dtype=float) * 1e9).astype(np.int64)
+            block, index = self._records.build(
+                ns, self.seq, [f[1] for f in run], [f[2] for f in run],
+                np.array([f[3] for f in run], dtype=np.int64).reshape(len(run), -1),
+                np.array([f[4] for f in run], dtype=float).reshape(len(run), 4),
+                [f[5] for f in run], [f[6] for f in run], [f[7] for f in run])
+            self.seq += len(run)
+            self._log._writer.append_block(block, index)
+            start = k
+        del frames[:n]

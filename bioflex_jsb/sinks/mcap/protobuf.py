@@ -80,6 +80,30 @@ def file_descriptor(package: str, message: str, fields: Sequence[tuple[str, int,
             + length_delimited(4, body) + string_field(12, "proto3"))
 
 
+def _enum_descriptor(name: str, values: Sequence[str]) -> bytes:
+    """An ``EnumDescriptorProto``: ``values`` numbered from 0 (proto3: the first is 0)."""
+    body = string_field(1, name)
+    for number, value in enumerate(values):
+        body += length_delimited(2, string_field(1, value) + int_field(2, number))
+    return body
+
+
+def typed_file_descriptor(package: str, message: str,
+                          fields: Sequence[tuple[str, int, bool, int, str | None]],
+                          enums: Sequence[tuple[str, Sequence[str]]] = ()) -> bytes:
+    """A proto3 ``FileDescriptorProto`` of one message whose ``fields`` are (name, number,
+    repeated, FieldDescriptorProto type, enum name or None) and whose nested ``enums`` are
+    (name, value names); an enum field's type name is ``<package>.<message>.<enum>``."""
+    body = string_field(1, message)
+    for name, number, repeated, type_, enum in fields:
+        type_name = f"{package}.{message}.{enum}" if enum else None
+        body += length_delimited(2, _field_descriptor(name, number, type_, repeated, type_name))
+    for name, values in enums:
+        body += length_delimited(4, _enum_descriptor(name, values))
+    return (string_field(1, f"{package}/{message}.proto") + string_field(2, package)
+            + length_delimited(4, body) + string_field(12, "proto3"))
+
+
 def file_descriptor_set(files: Sequence[bytes]) -> bytes:
     """A ``FileDescriptorSet`` of serialised ``FileDescriptorProto`` records (dependencies
     first)."""

@@ -1,7 +1,9 @@
 """Topics, frames and JSON schemas of the MCAP logs (``docs/logging.md`` has the table).
 
-``<model>`` is ``rigid``, ``coupled`` or ``qsd``; units are in every field name and in the
-schema descriptions.
+``<model>`` is ``rigid``, ``coupled`` or ``qsd`` (``native`` in ArduPilot sessions); units are
+in every field name and in the schema descriptions. Every field of a run topic is a double;
+the ``autopilot`` topic (ArduPilot sessions) also has integers (protobuf ``fixed32``: a fixed
+width, so its records are built a chunk at a time like the others) and enums.
 """
 
 from __future__ import annotations
@@ -10,7 +12,12 @@ RUN_METADATA = "bioflex.run"
 FRAME_METADATA = "bioflex.world_frame"
 WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
-          "lti_prediction")
+          "lti_prediction", "autopilot")
+# The autopilot topic's enums: (JSON schema / protobuf enum name, value names from 0); the
+# values are the drivers' codes (bioflex_jsb.drivers.ardupilot ACTIONS and PHASES)
+AUTOPILOT_ACTIONS = ("ACTION_STEP", "ACTION_RESEND", "ACTION_RESET")
+AUTOPILOT_PHASES = ("PHASE_REST", "PHASE_LAUNCH", "PHASE_FLIGHT")
+AUTOPILOT_ENUMS = (("Action", AUTOPILOT_ACTIONS), ("Phase", AUTOPILOT_PHASES))
 
 
 def topic(model: str, group: str) -> str:
@@ -167,6 +174,44 @@ SCHEMAS: dict[str, dict] = {
                         "description": "modal coordinates, element i is mode i+1 [rad]"},
         },
     },
+    "autopilot": {
+        "title": "bioflex.Autopilot",
+        "description": "ArduPilot's side of an ArduPlane SITL session (bioflex-jsb ardupilot): "
+        "one message per servo frame answered, resends and resets included, in the order "
+        "they arrived. Log time: the session's physics time when the frame arrived (the start "
+        "of the step it drives; it goes on across ArduPilot restarts); timestamp_s: the "
+        "physics time of the reply (what ArduPilot's clock follows).",
+        "type": "object",
+        "properties": {
+            "frame_count": {"type": "integer", "minimum": 0, "maximum": 4294967295,
+                            "description": "ArduPilot's frame counter (uint32) [count]"},
+            "frame_rate_hz": {"type": "integer", "minimum": 0, "maximum": 65535,
+                              "description": "ArduPilot's frame rate request, SIM_RATE_HZ "
+                              "[Hz]"},
+            "pwm_us": {"type": "array", "items": {"type": "integer"},
+                       "description": "servo outputs, element i is servo i+1, 16 or 32 of "
+                       "them (SERVO_32_ENABLE); 0: a channel ArduPilot does not drive [µs]"},
+            "aileron_cmd_norm": _num("fcs/aileron-cmd-norm mapped from servo 1, + rolls "
+                                     "right, -1 to 1 [-]"),
+            "elevator_cmd_norm": _num("fcs/elevator-cmd-norm mapped from servo 2, + trailing "
+                                      "edge down (nose down), -1 to 1 [-]"),
+            "throttle_cmd_norm": _num("fcs/throttle-cmd-norm of every engine mapped from "
+                                      "servo 3, 0 to 1 [-]"),
+            "rudder_cmd_norm": _num("fcs/rudder-cmd-norm mapped from servo 4, + trailing "
+                                    "edge left (nose left), -1 to 1 [-]; the four commands "
+                                    "are applied to JSBSim in flight only"),
+            "action": {"type": "string", "title": "Action", "enum": list(AUTOPILOT_ACTIONS),
+                       "description": "what the lock-step server did: a physics step, the "
+                       "same reply again without a step (a repeated frame_count), or a "
+                       "physics reset then a step (frame_count went back: ArduPilot "
+                       "restarted)"},
+            "phase": {"type": "string", "title": "Phase", "enum": list(AUTOPILOT_PHASES),
+                      "description": "the aircraft after the frame: at rest on the launcher, "
+                      "on the launcher's stroke, or flying (the coupled step)"},
+            "timestamp_s": _num("physics time of the state in the reply [s] (0 at ArduPilot's "
+                                "start and restarts)"),
+        },
+    },
 }
 for _s in SCHEMAS.values():
     _s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
@@ -181,9 +226,33 @@ def _proto_fields(group: str) -> tuple[tuple[str, int, bool], ...]:
                  for i, name in enumerate(props))
 
 
+def _typed_fields(group: str) -> tuple[tuple[str, int, bool, int, str | None], ...]:
+    """(field, number, repeated, protobuf type, enum) of a message with integer or enum
+    fields: a JSON ``integer`` (or an array of them) is ``fixed32``, a ``string`` with an
+    ``enum`` the protobuf enum named by its ``title``, anything else a double."""
+    from bioflex_jsb.sinks.mcap.protobuf import TYPE_DOUBLE, TYPE_ENUM, TYPE_FIXED32
+
+    props = SCHEMAS[group]["properties"]
+    out = []
+    for name, number, repeated in _proto_fields(group):
+        p = props[name]
+        kind = p["items"]["type"] if repeated else p.get("type")
+        if kind == "integer":
+            out.append((name, number, repeated, TYPE_FIXED32, None))
+        elif kind == "string" and "enum" in p:
+            out.append((name, number, repeated, TYPE_ENUM, p["title"]))
+        else:
+            out.append((name, number, repeated, TYPE_DOUBLE, None))
+    return tuple(out)
+
+
 def _proto_schemas() -> dict[str, tuple[str, bytes]]:
     from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
-    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor, file_descriptor_set
+    from bioflex_jsb.sinks.mcap.protobuf import (
+        file_descriptor,
+        file_descriptor_set,
+        typed_file_descriptor,
+    )
 
     out = {}
     for group, schema in SCHEMAS.items():
@@ -192,6 +261,10 @@ def _proto_schemas() -> dict[str, tuple[str, bytes]]:
             files = [fox.FILES[f] for f in fox.FRAME_TRANSFORM_FILES]
         elif group == "location":
             files = [fox.FILES[f] for f in fox.LOCATION_FIX_FILES]
+        elif group == "autopilot":
+            package, message = name.split(".")
+            files = [typed_file_descriptor(package, message, _typed_fields(group),
+                                           AUTOPILOT_ENUMS)]
         else:
             package, message = name.split(".")
             files = [file_descriptor(package, message, _proto_fields(group))]
