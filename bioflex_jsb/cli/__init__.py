@@ -3,7 +3,10 @@
 Every sub-command lives in its own module of this package and exposes
 ``register(subparsers)``; the module's ``run(args) -> int`` does the work. Errors a user can
 fix are raised as :class:`~bioflex_jsb.cli.common.UsageError` and end as one line on stderr
-with exit status 2; a simulation that diverges exits with status 3.
+with exit status 2; a simulation that diverges exits with status 3; the machine failing
+(:class:`~bioflex_jsb.cli.common.EnvironmentFault`, an OSError such as ENOSPC) exits 4;
+SIGINT and SIGTERM, at any moment of the command, exit 130. The full rule is in
+:mod:`bioflex_jsb.cli.common` and docs/reliability.md.
 """
 
 from __future__ import annotations
@@ -12,7 +15,20 @@ import importlib
 import signal
 import sys
 
-from bioflex_jsb.cli.common import EXIT_USAGE, OneLineParser, UsageError
+from bioflex_jsb.cli.common import (
+    EXIT_DIVERGED,
+    EXIT_ENVIRONMENT,
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    EnvironmentFault,
+    OneLineParser,
+    UsageError,
+    environment_error,
+    install_signal_handlers,
+    os_error_line,
+    stop_requested,
+    uninstall_signal_handlers,
+)
 from bioflex_jsb.errors import InputError
 
 # Sub-command modules, in the order ``--help`` lists them.
@@ -54,6 +70,25 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line ``argv`` (default: this process's arguments); the exit status.
+
+    With ``argv=None`` the caller is the program itself (the ``bioflex-jsb`` script,
+    ``python -m bioflex_jsb``): the stop-signal handlers stay in place after the return,
+    so a signal while the interpreter exits still ends with status 130 and one line. An
+    in-process caller (tests, ``rerun``) passes ``argv`` and gets its handlers back."""
+    installed = install_signal_handlers("")
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # before a command was chosen (parsing the line, importing)
+        print("bioflex-jsb: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        uninstall_signal_handlers(installed, own_process=argv is None)
+
+
+def _main(argv: list[str] | None) -> int:
+    from bioflex_jsb.cli import common
+
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -62,22 +97,41 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return EXIT_USAGE
-    previous = signal.getsignal(signal.SIGTERM)
-    signal.signal(signal.SIGTERM, _terminate)  # SIGTERM stops a run like Ctrl-C: logs close
+    if common.SIGNALS.depth == 1:
+        common.SIGNALS.command = args.command
+    name = f"bioflex-jsb {args.command}"
     try:
-        return int(args.run(args) or 0)
+        status = int(args.run(args) or 0)
     except (UsageError, InputError) as exc:  # what the user can fix: one line, exit 2
-        print(f"bioflex-jsb {args.command}: error: {' '.join(str(exc).split())}",
-              file=sys.stderr)
+        print(f"{name}: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return EXIT_USAGE
+    except EnvironmentFault as exc:
+        print(f"{name}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return EXIT_ENVIRONMENT
     except KeyboardInterrupt:
-        print(f"bioflex-jsb {args.command}: interrupted", file=sys.stderr)
-        return 130
+        print(f"{name}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader of our output went away (`| head`): stop quietly
         _silence_stdout()
         return 128 + signal.SIGPIPE
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    except OSError as exc:
+        if not (environment_error(exc) or _is_log_write_error(exc)):
+            raise  # a bug: its traceback
+        print(f"{name}: error: {os_error_line(exc)} (what was written before is kept; "
+              "docs/reliability.md)", file=sys.stderr)
+        return EXIT_ENVIRONMENT
+    if stop_requested() and status in (0, EXIT_DIVERGED):
+        # the signal arrived while the command was closing its files (deferred): it finished
+        print(f"{name}: interrupted while closing its files; they were closed first",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return status
+
+
+def _is_log_write_error(exc: OSError) -> bool:
+    """A log that could not be written (the MCAP sink's own OSError, one line)."""
+    mcap_errors = sys.modules.get("bioflex_jsb.sinks.mcap.errors")
+    return mcap_errors is not None and isinstance(exc, mcap_errors.LogWriteError)
 
 
 def _silence_stdout() -> None:
@@ -89,10 +143,6 @@ def _silence_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
     except (OSError, ValueError, AttributeError):  # stdout without a file descriptor
         pass
-
-
-def _terminate(signum, frame):
-    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,19 +1,151 @@
-"""Shared CLI helpers: one-line errors, validated argument types, JSON output."""
+"""Shared CLI helpers: one-line errors, exit statuses, signals, validated argument types,
+JSON output, log names.
+
+Exit statuses (every command; docs/reliability.md):
+
+* 0: done.
+* 2 (:data:`EXIT_USAGE`): what was asked cannot be done as given (bad input, an unusable
+  path, an existing output without ``--force``): one line, nothing ran.
+* 3 (:data:`EXIT_DIVERGED`): a simulation left the model's valid range (a result).
+* 4 (:data:`EXIT_ENVIRONMENT`): the machine stopped the work (no space, a read-only or
+  failing disk, a lost cluster, an output another process holds): one line; what was
+  finished is kept, and the same command (``sweep --resume``) completes it once the cause
+  is fixed.
+* 130 (:data:`EXIT_INTERRUPTED`): stopped by SIGINT (Ctrl-C) *or* SIGTERM, at any moment,
+  including while the command closes its files or after it has finished (a signal that
+  arrives then is deferred until the files are closed, and the status is still 130), so a
+  supervisor sees one status for "stopped on request". A signal never turns 2 or 4 into
+  130. A third signal while files are being closed ends the process at once (130, one line).
+* 141: the reader of our output went away (``| head``), quietly.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import json
 import math
+import os
+import signal
 import sys
+import threading
 from typing import Any, NoReturn
 
 EXIT_USAGE = 2
 EXIT_DIVERGED = 3
+EXIT_ENVIRONMENT = 4
+EXIT_INTERRUPTED = 130
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class UsageError(Exception):
     """A problem with what the user asked for; reported as one line, exit status 2."""
+
+
+class EnvironmentFault(Exception):
+    """The machine stopped the work (disk full, a lost cluster, an output held by another
+    process); reported as one line, exit status 4."""
+
+
+# The errno values that mean "the storage or the system failed", not "this path is wrong":
+# an OSError with one of them ends any command with one line and exit status 4.
+ENVIRONMENT_ERRNOS = frozenset(
+    getattr(errno, name) for name in
+    ("ENOSPC", "EDQUOT", "EFBIG", "EROFS", "EIO", "ENOMEM", "EMFILE", "ENFILE", "ENOLCK")
+    if hasattr(errno, name)
+)
+
+
+def environment_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is an OSError of the machine (disk full, read-only, I/O error)."""
+    return isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRNOS
+
+
+def os_error_line(exc: OSError) -> str:
+    """One line for an OSError: the reason and the file, without the chain."""
+    where = f": {exc.filename!r}" if getattr(exc, "filename", None) else ""
+    return f"{exc.strerror or ' '.join(str(exc).split()) or type(exc).__name__}{where}"
+
+
+# ---------------------------------------------------------------------------------------
+# Signals: the first SIGINT/SIGTERM stops the work (KeyboardInterrupt); later ones, and any
+# that arrive inside ``closing()`` or after the command returned, are deferred.
+# ---------------------------------------------------------------------------------------
+class _SignalState:
+    def __init__(self) -> None:
+        self.depth = 0  # nested main() calls (rerun runs a command inside its own)
+        self.received = 0  # stop signals since the outermost main() started
+        self.shield = 0  # closing() blocks entered
+        self.previous: dict[int, Any] = {}
+        self.command = ""
+
+
+SIGNALS = _SignalState()
+
+
+def _emergency_exit(reason: str) -> NoReturn:
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(f"bioflex-jsb {SIGNALS.command}: {reason}\n")
+        sys.stderr.flush()
+    os._exit(EXIT_INTERRUPTED)
+
+
+def _on_stop_signal(signum, frame) -> None:
+    SIGNALS.received += 1
+    if SIGNALS.shield or SIGNALS.received > 1:
+        if SIGNALS.received >= 3:
+            _emergency_exit("stopped at once (third signal while closing files); a log "
+                            "may need `bioflex-jsb info --recover`")
+        return  # deferred: the files are being closed; the exit status will be 130
+    raise KeyboardInterrupt
+
+
+def _on_late_signal(signum, frame) -> None:
+    """After the command returned (the interpreter is exiting): flush, status 130."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            stream.flush()
+    _emergency_exit("interrupted while exiting (the work was complete and its files "
+                    "closed)")
+
+
+def install_signal_handlers(command: str) -> bool:
+    """Called by ``main``: SIGINT and SIGTERM raise KeyboardInterrupt once (both exit 130).
+    Returns False for a nested call (handlers already in place) or off the main thread."""
+    SIGNALS.depth += 1
+    if SIGNALS.depth > 1 or threading.current_thread() is not threading.main_thread():
+        return False
+    SIGNALS.received, SIGNALS.shield, SIGNALS.command = 0, 0, command
+    SIGNALS.previous = {s: signal.signal(s, _on_stop_signal) for s in STOP_SIGNALS}
+    return True
+
+
+def uninstall_signal_handlers(installed: bool, own_process: bool) -> None:
+    """Called by ``main`` on its way out: an in-process caller (tests, rerun) gets its
+    handlers back; the program itself (``own_process``) keeps deferring to the end."""
+    SIGNALS.depth -= 1
+    if not installed:
+        return
+    for s, h in SIGNALS.previous.items():
+        signal.signal(s, _on_late_signal if own_process else h)
+    SIGNALS.previous = {}
+
+
+def stop_requested() -> bool:
+    """Whether SIGINT/SIGTERM arrived since the command started (deferred or not)."""
+    return SIGNALS.received > 0
+
+
+@contextlib.contextmanager
+def closing():
+    """A block that a stop signal must not cut (closing a log, compacting a table): a signal
+    inside it is deferred, the block completes, and the command then exits 130."""
+    SIGNALS.shield += 1
+    try:
+        yield
+    finally:
+        SIGNALS.shield -= 1
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -125,18 +257,29 @@ LOG_DIR_ENV_VAR = "BIOFLEX_LOG_DIR"  # where runs write their logs by default (e
 
 
 def add_log_arguments(parser: argparse.ArgumentParser) -> None:
-    """--out and --no-log: every run writes an MCAP log unless told not to."""
+    """--out, --force and --no-log: every run writes an MCAP log unless told not to."""
     parser.add_argument(
         "--out", metavar="RUN.mcap",
         help="MCAP log of every step (default: logs/<command>-<wing>-<UTC time>.mcap, the "
-        f"directory from ${LOG_DIR_ENV_VAR} when set; docs/logging.md)")
+        f"directory from ${LOG_DIR_ENV_VAR} when set, never an existing file; an existing "
+        "--out is refused unless --force; docs/logging.md)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an existing --out file")
     parser.add_argument("--no-log", action="store_true", help="write no MCAP log")
 
 
+MAX_LOG_NAME_TRIES = 10_000
+
+
 def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
-    """The log file a run writes: --out, else a new file in the log directory (created);
-    None with --no-log. A directory that cannot be created is a UsageError."""
-    import os
+    """The log file a run writes; None with --no-log.
+
+    ``--out``: refused if it exists unless ``--force`` (:func:`check_output`). Otherwise a
+    new file ``<command>-<wing>-<UTC time>[-N].mcap`` in the log directory, *created here*
+    with ``O_CREAT | O_EXCL`` (empty, for the log writer to fill): of runs started at the
+    same second, in any number of processes, each gets its own file (the first free N), and
+    no run ever opens a file another created. A directory that cannot be created or written
+    is a UsageError."""
     import time
     from pathlib import Path
 
@@ -145,6 +288,7 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
             raise UsageError("--out and --no-log contradict each other; give one")
         return None
     if args.out:
+        check_output(args.out, getattr(args, "force", False), "--out")
         return args.out
     folder = Path(os.environ.get(LOG_DIR_ENV_VAR) or "logs")
     try:
@@ -153,11 +297,21 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
         raise UsageError(f"cannot create the log directory {str(folder)!r}: {exc.strerror}; "
                          "give --out FILE.mcap or --no-log") from None
     stem = f"{command}-{Path(wing).stem}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
-    path, n = folder / f"{stem}.mcap", 1
-    while path.exists():
-        n += 1
-        path = folder / f"{stem}-{n}.mcap"
-    return str(path)
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+    for n in range(1, MAX_LOG_NAME_TRIES + 1):
+        path = folder / (f"{stem}.mcap" if n == 1 else f"{stem}-{n}.mcap")
+        try:
+            fd = os.open(path, flags, 0o644)
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            kind = EnvironmentFault if environment_error(exc) else UsageError
+            raise kind(f"cannot create a log in {str(folder)!r}: {exc.strerror}; give "
+                       "--out FILE.mcap or --no-log") from None
+        os.close(fd)
+        return str(path)
+    raise UsageError(f"{str(folder)!r} already holds {MAX_LOG_NAME_TRIES} logs named "
+                     f"{stem}*.mcap; give --out FILE.mcap")
 
 
 def check_output(path: str, force: bool, what: str, ours=None) -> None:

@@ -7,14 +7,24 @@ import re
 import sys
 from pathlib import Path
 
-from bioflex_jsb.cli.common import UsageError, print_json
+from bioflex_jsb.cli.common import (
+    EXIT_ENVIRONMENT,
+    EnvironmentFault,
+    UsageError,
+    closing,
+    print_json,
+)
 
 HELP = """Run every case of a campaign file (wings or axis positions x speeds [m/s] x gusts x
 turbulence seeds x models; docs/sweeps.md) and write one row per case with every input and
 the asked metrics (gust-run peaks in SI: m/s, rad, rad/s, load factor; flutter speed [m/s];
 LTI eigenvalues [rad/s]). Rows are written as cases finish, to --out (.parquet: a directory
 of part files compacted at the end; .csv: appended). A case that fails or diverges is
-recorded with its error; a worker process that dies has its case retried once. By default
+recorded with its error; a worker process that dies has its case retried once. A case the
+machine could not run or record (no space for its log, an unwritable --logs directory, a
+lost Dask scheduler or workers, the results table itself unwritable) is not recorded: the
+sweep stops with exit status 4 and one line, and --resume runs it and the rest once the
+cause is fixed (docs/reliability.md). One sweep at a time may write an --out. By default
 the cases run on local processes, one per core; --scheduler sends them to a Dask cluster."""
 
 _SCHEDULER = re.compile(r"^(tcp|tls|ucx|inproc)://[^\s/]+(:\d+)?/?$")
@@ -54,6 +64,9 @@ def register(sub) -> None:
                    help="run the cases on this Dask scheduler ('local': a Dask LocalCluster)")
     p.add_argument("--resume", action="store_true",
                    help="complete an existing --out: run only the cases it does not hold")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="with --resume: also run again the cases recorded as failed (their "
+                   "new rows replace the old)")
     p.add_argument("--logs", metavar="DIR", default=None,
                    help="write each case's gust run to DIR/CASE_ID.mcap (on the worker's "
                    "filesystem)")
@@ -71,10 +84,25 @@ def _progress(total: int, initial: int, label: str):
                 dynamic_ncols=True)
 
 
+def _check_log_dir(logs: str | None) -> None:
+    """Refuse a --logs directory that cannot be created or written, before any case runs
+    (one that stops being writable later stops the sweep: exit 4)."""
+    if not logs:
+        return
+    import tempfile
+
+    folder = Path(logs)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise UsageError(f"--logs {logs!r}: cannot write there: {exc.strerror}") from None
+
+
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.sweep.campaign import CampaignError, load_campaign
-    from bioflex_jsb.sweep.driver import missing_cases, run_sweep
-    from bioflex_jsb.sweep.store import StoreError, open_store
+    from bioflex_jsb.sweep.store import SUFFIXES, OutputBusy, OutputLock
 
     try:
         campaign = load_campaign(args.campaign)
@@ -83,16 +111,49 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler and args.scheduler != "local" and args.workers is not None:
         raise UsageError("--workers applies to local processes and --scheduler local; a "
                          "cluster's workers are started with it (dask worker)")
+    if args.retry_failed and not args.resume:
+        raise UsageError("--retry-failed applies to --resume (an existing --out)")
     out = Path(args.out) if args.out else Path(f"{campaign.name}.parquet")
-    cases = campaign.cases()
+    if out.suffix.lower() not in SUFFIXES:
+        raise UsageError(f"--out {str(out)!r}: unknown suffix {out.suffix!r}; accepted: "
+                         ".parquet, .csv")
+    _check_log_dir(args.logs)
+    try:
+        lock = OutputLock(out)
+    except OutputBusy as exc:
+        raise EnvironmentFault(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"--out {str(out)!r}: cannot lock: {exc.strerror}") from None
+    try:
+        return _run_locked(args, campaign, out)
+    finally:
+        with closing():
+            lock.release()
+
+
+def _run_locked(args, campaign, out: Path) -> int:
+    """The sweep once ``out`` is locked: open the table, run the missing cases, close."""
+    from bioflex_jsb.sweep.driver import MissingCases, run_sweep
+    from bioflex_jsb.sweep.store import StoreError, open_store
+
     try:
         store = open_store(out, campaign.columns(), resume=args.resume)
     except StoreError as exc:
         raise UsageError(str(exc)) from None
-    todo = missing_cases(cases, store.done_ids)
+    except OSError as exc:  # e.g. setting a damaged part aside on a full disk
+        raise EnvironmentFault(f"--out {str(out)!r}: cannot open: {exc.strerror}") from None
+    if store.damaged:
+        print(f"bioflex-jsb sweep: {len(store.damaged)} damaged part(s) of {out} set aside "
+              f"as {', '.join(store.damaged[:3])}{' …' if len(store.damaged) > 3 else ''}; "
+              "their cases run again", file=sys.stderr)
+    done = store.done_ids - store.failed_ids if args.retry_failed else store.done_ids
+    todo = MissingCases(campaign.iter_cases(), done)
+    total = campaign.n_cases
 
     executor = _executor(args)
-    bar = _progress(len(cases), len(cases) - len(todo), campaign.name)
+    bar = _progress(total, 0, campaign.name)
+    if bar is not None:
+        todo.on_skip = lambda: bar.update(1)
 
     def on_row(summary, row):
         if bar is not None:
@@ -102,19 +163,25 @@ def run(args: argparse.Namespace) -> int:
                                 refresh=False)
 
     try:
-        if todo:
+        if todo.any():  # a complete table starts no workers
             with executor:
-                summary = run_sweep(todo, store, executor, total=len(cases), on_row=on_row)
+                summary = run_sweep(todo, store, executor, total=total, on_row=on_row)
         else:
-            summary = run_sweep([], store, executor, total=len(cases))
-    except (*_executor_errors(), StoreError) as exc:
+            summary = run_sweep(todo, store, executor, total=total)
+    except _executor_errors() as exc:  # the cluster cannot be reached: nothing ran
         raise UsageError(str(exc)) from None
-    except OSError as exc:  # the results output failed mid-sweep (disk full, removed, ...)
-        raise UsageError(f"--out {str(out)!r}: cannot write: {exc.strerror or exc}") from None
     finally:
         if bar is not None:
             bar.close()
-        store.close()
+    compacted = None
+    with closing():  # a signal now is deferred: the table is finished first
+        try:
+            store.close()
+        except OSError as exc:  # compaction failed (disk full): every part is still there
+            compacted = (f"--out {str(out)!r}: cannot compact the parts ({exc.strerror}); "
+                         "every row is kept in them: rerun with --resume to compact")
+    if summary.stopped is None and compacted is not None:
+        summary.stopped = compacted
     result = {"campaign": campaign.name, "out": str(out),
               "executor": executor.name, **summary.as_dict()}
     if args.json:
@@ -126,6 +193,10 @@ def run(args: argparse.Namespace) -> int:
               f"{c['failed']} failed) in {summary.wall_time_s:.1f} s on {executor.name} "
               "workers")
         print(f"results written to {out}")
+    if summary.stopped is not None:
+        print(f"bioflex-jsb sweep: stopped: {summary.stopped}; {summary.remaining} cases "
+              f"left, not recorded: fix the cause and rerun with --resume", file=sys.stderr)
+        return EXIT_ENVIRONMENT
     if summary.interrupted:
         print(f"bioflex-jsb sweep: interrupted with {summary.remaining} cases left; "
               f"{out} keeps the finished ones: rerun with --resume", file=sys.stderr)

@@ -71,6 +71,11 @@ _TOP_KEYS = {"format", "format_version", "source", "notes", "units", "stations",
 _MODE_KEYS = {"frequency", "damping_ratio", "generalised_mass", "bending", "twist"}
 
 
+# Largest modal-data file read [bytes]: a finite-element export of a few hundred stations
+# and modes is a few MB; a bigger file is refused rather than read into memory.
+MAX_MODAL_BYTES = 64 * 1024 * 1024
+
+
 class ModalFileError(InputError):
     """A modal-data file that cannot be used; one-line message naming key and line."""
 
@@ -274,16 +279,18 @@ def parse_modal_text(text: str, *, name: str = "<modal text>", normalise: bool =
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModalFileError(f"{name}: TOML syntax error: {exc}".replace("\n", " ")) from None
+    except RecursionError:  # nesting deeper than the interpreter's recursion limit
+        raise ModalFileError(f"{name}: nests arrays or tables too deep to parse") from None
     return _Reader(text, name).parse(data, normalise)
 
 
 def read_modal_file(path: str | Path, *, normalise: bool = True) -> ModalData:
     """Read a modal-data file into SI :class:`ModalData` (normalised unless told not to)."""
+    from bioflex_jsb.tomlfile import read_input_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModalFileError(f"{p}: cannot read: {exc}".replace("\n", " ")) from None
+    # a regular file of at most MAX_MODAL_BYTES, UTF-8 (a FIFO or a device: refused at once)
+    text = read_input_text(p, "modal-data file", ModalFileError, MAX_MODAL_BYTES)
     return parse_modal_text(text, name=str(p), normalise=normalise)
 
 

@@ -72,6 +72,20 @@ class CampaignError(InputError):
     """A campaign file that cannot be used; the one-line message names the key."""
 
 
+class RecordingError(Exception):
+    """A case that could not be run or recorded because of the machine, not the case: no
+    space left for its log, a log directory that cannot be written, a lost cluster. It is
+    not a result: the sweep stops (exit status 4) and the case stays missing, so that
+    ``--resume`` runs it once the cause is fixed. Raised in workers, so it pickles: the
+    only argument is the one-line message."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(" ".join(str(message).split()))
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 # ---------------------------------------------------------------------------------------
 # Result columns
 # ---------------------------------------------------------------------------------------
@@ -202,15 +216,43 @@ class Case:
 
 
 def _wing_identity(wing: WingVariant) -> dict[str, Any]:
-    """The wing's definition for hashing; a modes file enters by its content, not its path."""
+    """The wing's definition for hashing; a modes file enters by its content, not its path
+    (read once per process and file: a regular file within the modal-file size limit)."""
     d = wing.as_dict()
     d.pop("description", None)
     if wing.modes_file:
-        try:
-            d["modes_file"] = hashlib.sha256(Path(wing.modes_file).read_bytes()).hexdigest()
-        except OSError:
-            pass  # the build will fail and record the case as failed
+        digest = _modes_digest(wing.modes_file)
+        if digest is not None:
+            d["modes_file"] = digest
+        # else: the build will fail and record the case as failed
     return d
+
+
+_MODES_DIGESTS: dict[str, str | None] = {}
+
+
+def _modes_digest(path: str) -> str | None:
+    if path not in _MODES_DIGESTS:
+        from bioflex_jsb.structures.modal_file import MAX_MODAL_BYTES, ModalFileError
+        from bioflex_jsb.tomlfile import read_input_bytes
+
+        try:
+            data = read_input_bytes(path, "modal-data file", ModalFileError, MAX_MODAL_BYTES)
+            _MODES_DIGESTS[path] = hashlib.sha256(data).hexdigest()
+        except ModalFileError:
+            _MODES_DIGESTS[path] = None
+    return _MODES_DIGESTS[path]
+
+
+def _id_text(wing_json: str, speed_m_s: float, gust: str, model: str, settings_json: str,
+             metrics_json: str) -> str:
+    """The hashed text: exactly ``json.dumps(payload, sort_keys=True, default=str)`` of
+    :func:`case_id`'s payload, assembled from its parts (the wing's and the settings' parts
+    are serialised once per campaign, not once per case)."""
+    return (f'{{"gust": {json.dumps(gust)}, "metrics": {metrics_json}, '
+            f'"model": {json.dumps(model)}, "settings": {settings_json}, '
+            f'"speed_m_s": {json.dumps(speed_m_s)}, "v": {CASE_ID_VERSION}, '
+            f'"wing": {wing_json}}}')
 
 
 def case_id(case: Case) -> str:
@@ -250,16 +292,28 @@ class Campaign:
     source: str = ""
 
     def cases(self) -> list[Case]:
-        """The Cartesian product wings × speeds × gusts × models, with ids."""
-        out: list[Case] = []
+        """The Cartesian product wings × speeds × gusts × models, with ids (a list; a sweep
+        uses :meth:`iter_cases`)."""
+        return list(self.iter_cases())
+
+    def iter_cases(self):
+        """The cases one at a time, in campaign order: a million-case campaign starts its
+        first case at once and never holds every case in memory (≈ 2 µs a case)."""
+        dumps = json.dumps
+        settings_json = dumps(dataclasses.asdict(self.settings), sort_keys=True, default=str)
+        metrics_json = dumps(sorted(self.metrics))
+        index = 0
         for wing in self.wings:
+            wing_json = dumps(_wing_identity(wing), sort_keys=True, default=str)
             for speed in self.speeds_m_s:
                 for gust in self.gusts:
                     for model in self.models:
-                        c = Case(len(out), wing, speed, gust, model, self.settings,
-                                 self.metrics)
-                        out.append(dataclasses.replace(c, case_id=case_id(c)))
-        return out
+                        text = _id_text(wing_json, speed, gust, model, settings_json,
+                                        metrics_json)
+                        cid = hashlib.sha256(text.encode()).hexdigest()[:16]
+                        yield Case(index, wing, speed, gust, model, self.settings,
+                                   self.metrics, cid)
+                        index += 1
 
     @property
     def n_cases(self) -> int:
@@ -350,12 +404,16 @@ def _values(v: Any, key: str, integer: bool = False) -> list:
 
 
 def _unique(values: list, key: str) -> list:
-    seen = []
+    seen: set = set()
     for x in values:
-        if x in seen:
+        try:
+            dup = x in seen
+            seen.add(x)
+        except TypeError:  # an unhashable value (a table): refused by the caller's checks
+            dup = False
+        if dup:
             raise CampaignError(f"{key}: {x!r} appears twice")
-        seen.append(x)
-    return seen
+    return list(values)
 
 
 def parse_campaign(
@@ -476,10 +534,11 @@ def _wings(axes: dict, base_dir: Path | None) -> list[WingVariant]:
     if not wings:
         raise CampaignError("axes.wings: missing; give axes.wings or axes.x_inertial_frac and "
                             "axes.x_elastic_frac")
-    names = [w.name for w in wings]
-    for n in names:
-        if names.count(n) > 1:
-            raise CampaignError(f"axes.wings: wing {n!r} appears twice")
+    names: set[str] = set()
+    for w in wings:
+        if w.name in names:
+            raise CampaignError(f"axes.wings: wing {w.name!r} appears twice")
+        names.add(w.name)
     return wings
 
 

@@ -13,18 +13,31 @@ started by hand uses its own settings: start its scheduler with
 ``DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES=1`` and
 ``DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION=1.0`` and its workers with ``--nthreads 1``
 for the same behaviour (Dask's defaults: 3 and 1.1).
+
+Cases are submitted lazily, a bounded window ahead of the workers (a million-case campaign
+does not become a million futures). What stops a run instead of being recorded
+(:class:`~bioflex_jsb.sweep.campaign.RecordingError`; the cases stay missing for
+``--resume``, docs/reliability.md): a case's own RecordingError (its log could not be
+written), the scheduler lost (the client cancels every future: ``scheduler-connection-lost``),
+and no worker at all for :attr:`DaskExecutor.no_workers_s` seconds (every worker gone and
+none coming back: the scheduler would wait forever). The LocalCluster's worker processes
+die with the driver: Dask's own nanny watches its parent through a pipe.
 """
 
 from __future__ import annotations
 
+import logging
+import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import CancelledError
 from typing import Any
 
-from bioflex_jsb.sweep.campaign import Case, failed_row
+from bioflex_jsb.sweep.campaign import Case, RecordingError, failed_row
 from bioflex_jsb.sweep.evaluate import run_case
 
 CONNECT_TIMEOUT_S = 10.0
+POLL_S = 1.0  # how often a waiting driver looks at the cluster's workers
 WORKER_IMPORTS = ("bioflex_jsb.sweep.evaluate", "bioflex_jsb.drivers.gust")
 
 
@@ -36,6 +49,8 @@ class DaskExecutor:
     """Run cases on a Dask cluster; ``fn(case, log_dir) -> row``."""
 
     name = "dask"
+    no_workers_s = 60.0  # a cluster with no worker this long stops the sweep
+    window_per_worker = 4  # cases submitted ahead, per worker (at least 16 in all)
 
     def __init__(self, scheduler: str | None = None, workers: int = 2,
                  log_dir: str | None = None,
@@ -46,9 +61,16 @@ class DaskExecutor:
         self.fn = fn
         self.cluster = None
         self.client = None
+        self._client_log_level: int | None = None
 
     def __enter__(self) -> DaskExecutor:
         from distributed import Client, LocalCluster
+
+        # the client logs a lost scheduler as tracebacks on stderr; the sweep reports it
+        # in one line (RecordingError), so its logger is quieted while we hold it
+        client_log = logging.getLogger("distributed.client")
+        self._client_log_level = client_log.level
+        client_log.setLevel(logging.CRITICAL)
 
         if self.scheduler:
             try:
@@ -98,36 +120,95 @@ class DaskExecutor:
         if self.cluster is not None:
             self.cluster.close()
             self.cluster = None
+        if self._client_log_level is not None:
+            logging.getLogger("distributed.client").setLevel(self._client_log_level)
+            self._client_log_level = None
 
     @property
     def n_workers(self) -> int:
         return len(self.client.scheduler_info().get("workers", {})) if self.client else 0
 
-    def run(self, cases: list[Case]) -> Iterator[tuple[Case, dict[str, Any]]]:
-        """Yield ``(case, row)`` as cases finish (in finishing order)."""
-        from distributed import as_completed
+    def run(self, cases: Iterable[Case]) -> Iterator[tuple[Case, dict[str, Any]]]:
+        """Yield ``(case, row)`` as cases finish (in finishing order); ``cases`` is read
+        lazily. :class:`RecordingError` when the cluster cannot run them (see above)."""
+        from distributed import wait
         from distributed.scheduler import KilledWorker
 
         token = uuid.uuid4().hex[:8]
-        futures = {}
-        for c in cases:
-            fut = self.client.submit(self.fn, c, self.log_dir, pure=False,
-                                     key=f"bioflex-case-{c.case_id}-{token}")
-            futures[fut.key] = (fut, c)
-        remaining = dict(futures)
+        pending = iter(cases)
+        exhausted = False
+        in_flight: dict[str, tuple[Any, Case]] = {}
+        workers_seen = time.monotonic()
+        n_workers, counted = self._workers_now(), time.monotonic()
         try:
-            for fut in as_completed([f for f, _ in futures.values()]):
-                _, c = remaining.pop(fut.key)
+            while not exhausted or in_flight:
+                if time.monotonic() - counted > POLL_S:
+                    n_workers, counted = self._workers_now(), time.monotonic()
+                window = max(16, self.window_per_worker * max(1, n_workers or 0))
+                while not exhausted and len(in_flight) < window:
+                    c = next(pending, None)
+                    if c is None:
+                        exhausted = True
+                        break
+                    fut = self.client.submit(self.fn, c, self.log_dir, pure=False,
+                                             key=f"bioflex-case-{c.case_id}-{token}")
+                    in_flight[fut.key] = (fut, c)
+                if not in_flight:
+                    continue
                 try:
-                    row = fut.result()
-                except KilledWorker as exc:
-                    row = failed_row(c, f"worker died running this case, also on retry "
-                                        f"(Dask KilledWorker: {exc})")
-                # any other exception from a worker is a bug in the evaluation (the physics
-                # stopping a case is a row, not an exception): it propagates with its
-                # traceback
-                fut.release()
-                yield c, row
+                    done, _ = wait([f for f, _ in in_flight.values()], timeout=POLL_S,
+                                   return_when="FIRST_COMPLETED")
+                except TimeoutError:
+                    done = set()
+                except CancelledError:  # FuturesCancelledError: the scheduler is gone
+                    raise RecordingError(
+                        f"lost the Dask scheduler {self._address()} ({len(in_flight)} cases "
+                        "cancelled: scheduler-connection-lost)") from None
+                if not done:
+                    self._check_cluster()
+                    n_workers, counted = self._workers_now(), time.monotonic()
+                    if n_workers:
+                        workers_seen = time.monotonic()
+                    elif time.monotonic() - workers_seen > self.no_workers_s:
+                        raise RecordingError(
+                            f"the Dask cluster has had no worker for {self.no_workers_s:g} s "
+                            f"({len(in_flight)} cases waiting)")
+                    continue
+                workers_seen = time.monotonic()
+                for fut in done:
+                    _, c = in_flight.pop(fut.key)
+                    try:
+                        row = fut.result()
+                    except KilledWorker as exc:
+                        row = failed_row(c, f"worker died running this case, also on retry "
+                                            f"(Dask KilledWorker: {exc})")
+                    except RecordingError as exc:
+                        raise RecordingError(str(exc)) from None
+                    except CancelledError:  # the client cancelled it: the scheduler is gone
+                        raise RecordingError(
+                            f"lost the Dask scheduler {self._address()} (case {c.case_id} "
+                            "cancelled: scheduler-connection-lost)") from None
+                    # any other exception from a worker is a bug in the evaluation (the
+                    # physics stopping a case is a row, not an exception): it propagates
+                    # with its traceback
+                    fut.release()
+                    yield c, row
         finally:
-            if remaining:
-                self.client.cancel([f for f, _ in remaining.values()])
+            if in_flight and self.client is not None and self.client.status == "running":
+                self.client.cancel([f for f, _ in in_flight.values()])
+
+    def _workers_now(self) -> int | None:
+        """Workers the scheduler knows now; None if it cannot be asked."""
+        try:
+            return self.n_workers
+        except (OSError, TimeoutError):  # the scheduler is unreachable: see _check_cluster
+            return None
+
+    def _address(self) -> str:
+        return self.scheduler or "(LocalCluster)"
+
+    def _check_cluster(self) -> None:
+        """RecordingError if the client has lost its scheduler for good."""
+        if self.client is None or self.client.status in ("closed", "closing", "failed"):
+            raise RecordingError(f"lost the Dask scheduler {self._address()} (client "
+                                 f"{getattr(self.client, 'status', 'closed')})")

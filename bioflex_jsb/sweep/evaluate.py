@@ -12,7 +12,10 @@ differently, would then not give identical tables.
 
 A case never raises for a problem of its own: a failing build or run is a row with status
 ``failed`` and the error; a run that leaves the model's valid range is a row with status
-``diverged``, the reason and the metrics up to that point.
+``diverged``, the reason and the metrics up to that point. A problem of the machine is not
+the case's: an ``OSError`` (no space for the case's log, a log directory that cannot be
+written, a file that vanished) raises :class:`~bioflex_jsb.sweep.campaign.RecordingError`,
+which stops the sweep and leaves the case for ``--resume`` (docs/reliability.md).
 """
 
 from __future__ import annotations
@@ -24,7 +27,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from bioflex_jsb.sweep.campaign import EIGEN_MODES, Case, failed_row, result_columns
+from bioflex_jsb.sweep.campaign import (
+    EIGEN_MODES,
+    Case,
+    RecordingError,
+    failed_row,
+    result_columns,
+)
 
 _FLUTTER_CACHE: dict[tuple, Any] = {}
 
@@ -50,23 +59,32 @@ def _num(x: Any) -> float | None:
 def case_errors() -> tuple[type[Exception], ...]:
     """What a case can fail with that is a result, not a bug: a validated-input problem
     (InputError: the airframe cannot trim, e.g. below the stall speed; a wing, gust or run
-    description that is not valid), a singular matrix at an extreme design point, a log
-    that cannot be written (OSError)."""
+    description that is not valid), a singular matrix at an extreme design point. A log
+    that cannot be written (OSError) is not a result: see :func:`run_case`."""
     import numpy as np
 
     from bioflex_jsb.errors import InputError
 
-    return (InputError, np.linalg.LinAlgError, OSError)
+    return (InputError, np.linalg.LinAlgError)
+
+
+def _os_reason(exc: OSError) -> str:
+    where = f" {exc.filename!r}" if getattr(exc, "filename", None) else ""
+    return f"{exc.strerror or exc}{where}"
 
 
 def run_case(case: Case, log_dir: str | None = None) -> dict[str, Any]:
-    """Run ``case``; the returned row has every column of the campaign's results table."""
+    """Run ``case``; the returned row has every column of the campaign's results table.
+    :class:`RecordingError` if the machine stopped it (an OSError: disk full, permissions)."""
     started = time.time()
     t0 = time.perf_counter()
     try:
         row = _evaluate(case, log_dir)
     except case_errors() as exc:  # recorded as the case's error; anything else is a bug
         row = failed_row(case, f"{type(exc).__name__}: {exc}")
+    except OSError as exc:  # the machine, not the case: the sweep stops, --resume runs it
+        raise RecordingError(f"case {case.case_id} on {worker_name()}: "
+                             f"{_os_reason(exc)}") from None
     row["worker"] = worker_name()
     row["started_unix_s"] = started
     row["wall_time_s"] = time.perf_counter() - t0

@@ -1,19 +1,32 @@
 """Results tables on disk, written a row at a time as cases finish (adapter: file I/O).
 
-* ``.csv``: one file, a header then one row per case, appended and flushed per case. A row
-  cut off by a kill is dropped when the file is reopened with ``resume``.
+* ``.csv``: one file, a header then one row per case. A row is written whole or not at all:
+  it goes to the file in one ``write`` on an append descriptor, then ``fsync``; a write that
+  fails part-way (disk full) is cut back to the previous end of the file before the error
+  is raised. A row cut off by a kill (power loss) is dropped when the file is reopened with
+  ``resume``.
 * ``.parquet``: a Parquet *dataset*, a directory of part files (``part-*.parquet``), one per
-  finished case while the sweep runs (written to a hidden name, then renamed, so a reader
-  never sees half a file); at the end of the sweep the parts are compacted into one.
-  ``pyarrow.parquet.read_table(DIR)`` / ``pandas.read_parquet(DIR)`` read the directory.
+  finished case while the sweep runs: each is written to a hidden temporary name, flushed
+  and ``fsync``-ed, then renamed (and the directory ``fsync``-ed), so a reader never sees
+  half a file; at the end of the sweep the parts are compacted into one (written the same
+  way before the parts go). ``pyarrow.parquet.read_table(DIR)`` / ``pandas.read_parquet(DIR)``
+  read the directory. On ``resume`` every part is opened: a damaged one (a disk that
+  lost it, an editor) is renamed ``.damaged-<name>`` (hidden, so dataset readers skip it)
+  and its cases run again.
 
 Rows are keyed by ``case_id``; if a case appears twice (a crash between writing the
-compacted file and removing the parts), :func:`read_results` keeps the last one.
+compacted file and removing the parts, or a failed case run again with
+``--retry-failed``), :func:`read_results` keeps the last one.
+
+:class:`OutputLock`: one sweep at a time writes an output (an ``flock`` on a hidden file
+beside it, released by the kernel if the sweep dies).
 """
 
 from __future__ import annotations
 
 import csv
+import errno
+import io
 import os
 import tempfile
 import time
@@ -28,8 +41,79 @@ class StoreError(ValueError):
     """The results output cannot be used; one line."""
 
 
+class OutputBusy(RuntimeError):
+    """Another sweep holds the output's lock (one line)."""
+
+
+def _fsync_dir(folder: Path) -> None:
+    """Make a rename or a new file in ``folder`` durable (best effort where unsupported)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError as exc:  # e.g. EINVAL on file systems without directory fsync
+        if exc.errno not in (errno.EINVAL, errno.EBADF, errno.ENOTSUP):
+            raise
+    finally:
+        os.close(fd)
+
+
+class OutputLock:
+    """An exclusive, non-blocking ``flock`` on ``.<name>.lock`` beside ``path``: a second
+    sweep on the same output is refused with :class:`OutputBusy` naming the holder's pid.
+    The kernel releases the lock when its process dies, so a killed sweep never leaves a
+    stale lock; :meth:`release` removes the file (checked by inode against a holder that
+    raced the removal)."""
+
+    def __init__(self, path: Path) -> None:
+        import fcntl
+
+        self.path = path.parent / f".{path.name}.lock"
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        while True:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 64).decode("ascii", "replace").strip() or "?"
+                os.close(fd)
+                raise OutputBusy(f"--out {str(path)!r} is being written by another sweep "
+                                 f"(pid {holder}, lock {str(self.path)!r}); wait for it "
+                                 "or choose another --out") from None
+            try:
+                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)  # the holder removed the file as we locked it: take the new one
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self._fd: int | None = fd
+
+    def release(self) -> None:
+        if self._fd is None:
+            return
+        try:
+            os.unlink(self.path)
+        except FileNotFoundError:
+            pass
+        os.close(self._fd)  # unlink first, then unlock: no one locks a file that then goes
+        self._fd = None
+
+    def __enter__(self) -> OutputLock:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
 def open_store(path: str | Path, columns: dict[str, str], resume: bool):
-    """The store for ``path`` by its suffix; ``resume`` keeps (and reports) existing rows."""
+    """The store for ``path`` by its suffix; ``resume`` keeps (and reports) existing rows:
+    ``done_ids`` (every case with a row) and ``failed_ids`` (those whose last row is
+    ``failed``, run again with ``--retry-failed``)."""
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix == ".csv":
@@ -82,28 +166,54 @@ class CsvStore:
         self.path = path
         self.columns = columns
         self.done_ids: set[str] = set()
+        self.failed_ids: set[str] = set()
+        self.damaged: list[str] = []
         if path.exists():
             if not resume:
                 raise _exists_error(path)
+            if not path.is_file():
+                raise StoreError(f"--out {str(path)!r} is not a regular file")
             self._recover()
         _check_writable(path)
-        self._fh = None  # opened with the first row: a sweep that never starts leaves no file
-        self._writer = None
+        self._fd: int | None = None  # opened with the first row: a sweep that never starts
+        self._header = list(columns)  # leaves no file
 
     def _open(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        new = not self.path.exists() or self.path.stat().st_size == 0
-        self._fh = open(self.path, "a", newline="", encoding="utf-8")  # noqa: SIM115
-        self._writer = csv.DictWriter(self._fh, fieldnames=list(self.columns))
-        if new:
-            self._writer.writeheader()
+        self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_CLOEXEC,
+                           0o644)
+        if os.fstat(self._fd).st_size == 0:
+            self._write_whole(self._line(self._header))
+            _fsync_dir(self.path.parent)
+
+    @staticmethod
+    def _line(values: list[str]) -> bytes:
+        buf = io.StringIO()
+        csv.writer(buf).writerow(values)
+        return buf.getvalue().encode("utf-8")
+
+    def _write_whole(self, data: bytes) -> None:
+        """Append ``data`` in full, durably, or leave the file as it was and raise."""
+        end = os.fstat(self._fd).st_size
+        view = memoryview(data)
+        try:
+            while view:
+                n = os.write(self._fd, view)
+                view = view[n:]
+            os.fsync(self._fd)
+        except OSError:
+            try:
+                os.ftruncate(self._fd, end)  # frees what the partial write took
+            except OSError:
+                pass  # the cut-off row is dropped on --resume
+            raise
 
     def _recover(self) -> None:
         data = self.path.read_bytes()
         if data and not data.endswith(b"\n"):  # a row cut off by a kill
             with open(self.path, "r+b") as fh:
                 fh.truncate(data.rfind(b"\n") + 1)
-        with open(self.path, newline="", encoding="utf-8") as fh:
+        with open(self.path, newline="", encoding="utf-8", errors="replace") as fh:
             reader = csv.reader(fh)
             header = next(reader, None)
             if header is None:
@@ -112,17 +222,25 @@ class CsvStore:
                 raise StoreError(f"--out {str(self.path)!r} has other columns than this "
                                  "campaign (other metrics?); choose another --out")
             k = header.index("case_id")
-            self.done_ids = {r[k] for r in reader if len(r) == len(header)}
+            st = header.index("status")
+            for r in reader:
+                if len(r) != len(header):
+                    continue
+                self.done_ids.add(r[k])
+                if r[st] == "failed":
+                    self.failed_ids.add(r[k])
+                else:
+                    self.failed_ids.discard(r[k])
 
     def append(self, row: dict[str, Any]) -> None:
-        if self._fh is None:
+        if self._fd is None:
             self._open()
-        self._writer.writerow({k: _text(row.get(k)) for k in self.columns})
-        self._fh.flush()
+        self._write_whole(self._line([_text(row.get(k)) for k in self.columns]))
 
     def close(self) -> None:
-        if self._fh is not None and not self._fh.closed:
-            self._fh.close()
+        if self._fd is not None:
+            fd, self._fd = self._fd, None
+            os.close(fd)
 
 
 def _schema(columns: dict[str, str]):
@@ -141,6 +259,8 @@ class ParquetStore:
         self.columns = columns
         self.schema = _schema(columns)
         self.done_ids: set[str] = set()
+        self.failed_ids: set[str] = set()
+        self.damaged: list[str] = []  # parts set aside on resume (their cases run again)
         self._written = 0
         if path.exists():
             if not path.is_dir():
@@ -151,20 +271,43 @@ class ParquetStore:
                     raise _exists_error(path)
                 for tmp in path.glob(".*.tmp"):  # a part cut off by a kill
                     tmp.unlink()
-                parts = self._parts()
-                if parts:
-                    schema = pq.read_schema(parts[0])
-                    if schema.names != self.schema.names:
-                        raise StoreError(f"--out {str(path)!r} has other columns than this "
-                                         "campaign (other metrics?); choose another --out")
-                    table = pq.read_table(path, columns=["case_id"], schema=self.schema)
-                    self.done_ids = set(table.column("case_id").to_pylist())
+                self._recover()
         _check_writable(path)
+
+    def _recover(self) -> None:
+        """Read the status of every case in every part; set damaged parts aside."""
+        import pyarrow as pa
+
+        for part in self._parts():
+            try:
+                schema = self._pq.read_schema(part)
+                if schema.names != self.schema.names:
+                    raise StoreError(f"--out {str(self.path)!r} has other columns than this "
+                                     "campaign (other metrics?); choose another --out")
+                table = self._pq.read_table(part, columns=["case_id", "status"])
+            except (pa.ArrowException, OSError, ValueError) as exc:
+                if isinstance(exc, StoreError):
+                    raise
+                aside = part.with_name(f".damaged-{part.name}")
+                os.replace(part, aside)
+                self.damaged.append(aside.name)
+                continue
+            for cid, status in zip(table.column("case_id").to_pylist(),
+                                   table.column("status").to_pylist(), strict=True):
+                self.done_ids.add(cid)
+                if status == "failed":
+                    self.failed_ids.add(cid)
+                else:
+                    self.failed_ids.discard(cid)
+        if self.damaged:
+            _fsync_dir(self.path)
 
     def _parts(self) -> list[Path]:
         return sorted(self.path.glob("part-*.parquet"))
 
     def _write(self, rows: list[dict[str, Any]], stem: str) -> Path:
+        """Write ``rows`` as the part ``stem``: temporary name, flush, fsync, rename, fsync
+        of the directory. A failure (disk full) removes the temporary file and raises."""
         import pyarrow as pa
 
         table = pa.Table.from_pylist(
@@ -173,8 +316,18 @@ class ParquetStore:
         self.path.mkdir(parents=True, exist_ok=True)
         final = self.path / f"{stem}.parquet"
         tmp = self.path / f".{stem}.parquet.tmp"
-        self._pq.write_table(table, tmp)
-        os.replace(tmp, final)
+        renamed = False
+        try:
+            with open(tmp, "wb") as fh:
+                self._pq.write_table(table, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, final)
+            renamed = True
+        finally:
+            if not renamed:  # whatever stopped it (disk full, Ctrl-C): no temporary stays
+                tmp.unlink(missing_ok=True)
+        _fsync_dir(self.path)
         return final
 
     def append(self, row: dict[str, Any]) -> None:
@@ -182,7 +335,8 @@ class ParquetStore:
         self._written += 1
 
     def close(self) -> None:
-        """Compact the part files into one (new file first, then the old ones go)."""
+        """Compact the part files into one (new file first, then the old ones go). A
+        failure here (disk full) loses nothing: the parts stay, ``--resume`` compacts."""
         parts = self._parts() if self.path.is_dir() else []
         if len(parts) <= 1:
             return
@@ -191,6 +345,7 @@ class ParquetStore:
         for p in parts:
             if p != keep:
                 p.unlink()
+        _fsync_dir(self.path)
 
 
 def read_results(path: str | Path, columns: dict[str, str] | None = None) -> list[dict]:
