@@ -100,3 +100,74 @@ def test_mavproxy_detects_the_vehicle_and_receives_its_parameters(signed, tmp_pa
     if signed:  # everything the vehicle accepted carried MAVProxy's signature
         assert "Setup signing key" in text
         assert link.stats.received > 0 and link.signing
+
+
+WAYPOINTS = """QGC WPL 110
+0\t1\t0\t16\t0\t0\t0\t0\t-35.363261\t149.165230\t584.000000\t1
+1\t0\t3\t16\t0\t30\t0\t0\t-35.360563\t149.165230\t100.000000\t1
+2\t0\t3\t16\t0\t30\t0\t0\t-35.360563\t149.168537\t100.000000\t1
+3\t0\t3\t16\t0\t30\t0\t0\t-35.363261\t149.168537\t100.000000\t1
+"""
+
+
+def test_mavproxy_names_and_sets_modes_uploads_a_mission_and_sees_no_loss(tmp_path):
+    """MAVProxy driven through its console (stdin): mode names from the HEARTBEAT, mode
+    changes, a mission upload and download, and its own link report: < 1 % loss."""
+    port_probe = __import__("socket").socket(2, 2)
+    port_probe.bind(("127.0.0.1", 0))
+    port = port_probe.getsockname()[1]
+    port_probe.close()
+    vehicle = subprocess.Popen(
+        [sys.executable, "-m", "bioflex_jsb", "sitl", "--mavlink", f"udpin:127.0.0.1:{port}",
+         "--speedup", "2", "--no-log", "--duration", "400"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    (tmp_path / "wp.txt").write_text(WAYPOINTS)
+    env = {**os.environ, "HOME": str(tmp_path)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "MAVProxy.mavproxy", f"--master=udpout:127.0.0.1:{port}",
+         f"--state-basedir={tmp_path}", "--aircraft=bioflex", "--dialect=common"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env=env, cwd=tmp_path)
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(x.rstrip() for x in proc.stdout),
+                              daemon=True)
+    reader.start()
+
+    def wait(pattern: str, timeout: float = TIMEOUT_S) -> re.Match:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            for x in list(lines):
+                if (m := re.search(pattern, x)) is not None:
+                    return m
+            time.sleep(0.1)
+        raise AssertionError(f"MAVProxy never printed {pattern!r}:\n" + "\n".join(lines))
+
+    def cmd(text: str) -> None:
+        proc.stdin.write(text + "\n")
+        proc.stdin.flush()
+
+    try:
+        wait(r"Detected vehicle 1:1")
+        wait(r"Mode CRUISE")
+        cmd("mode LOITER")
+        wait(r"AP: Mode LOITER")
+        cmd("wp load wp.txt")
+        wait(r"MISSION_ACK: TYPE_MISSION: ACCEPTED")
+        cmd("wp list")
+        wait(r"Saved 4 waypoints")
+        cmd("mode AUTO")
+        wait(r"AP: Mode AUTO")
+        wait(r"AP: Reached waypoint #1", 60.0)
+        lines.clear()
+        cmd("link")
+        m = wait(r"link 1 OK \((\d+) packets.*?(\d+) lost, ([\d.]+)% loss")
+    finally:
+        for p in (proc, vehicle):
+            p.terminate()
+            try:
+                p.wait(5.0)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+    packets, lost, loss_pct = int(m.group(1)), int(m.group(2)), float(m.group(3))
+    assert packets > 1000 and loss_pct < 1.0, (packets, lost, loss_pct)
