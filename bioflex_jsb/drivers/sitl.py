@@ -285,8 +285,9 @@ class SitlSim:
         a = self.airframe
 
         def disengage(af: Airframe) -> None:
-            af["ap/engage"] = 0.0  # the trim and the RPM settling see no autopilot
-            af["ap/autothrottle"] = 0.0
+            for name in ("ap/engage", "ap/autothrottle", "ap/manual", "ap/loiter",
+                         "ap/roll-mode", "ap/pitch-mode"):
+                af[name] = 0.0  # the trim and the RPM settling see no autopilot
             af["ap/armed"] = 1.0
 
         self.core = CoupledStep(a, self._wing_model, model, self.speed_m_s,
