@@ -54,7 +54,7 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
              models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
-             aero: str = "quasi-steady") -> dict[str, TimeHistory]:
+             aero: str = "quasi-steady", trim: str = "rigid") -> dict[str, TimeHistory]:
     """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing``, one per model
     (``rigid``, ``coupled``, ``qsd``; default all three, or ``coupled`` alone with
     ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and ``altitude_m`` [m],
@@ -63,7 +63,9 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     ``gust_start_s`` [s]. ``recorders``: a step recorder (an MCAP log) per model.
     ``aero``: the wing's strips, ``quasi-steady`` (the paper's) or ``unsteady`` (Jones lag
     states, apparent mass, Küssner gust: :mod:`bioflex_jsb.simulation.unsteady_wing`; the
-    coupled model only, on the Python step).
+    coupled model only, on the Python step). ``trim``: ``rigid`` (the paper's reading) or
+    ``elastic`` (start from the static aeroelastic equilibrium: the wing's static deflection
+    and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
     reason, the time and the mode) and holds every step up to then."""
@@ -76,9 +78,10 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     out = {}
     for model in models:
         recorder = (recorders or {}).get(model)
-        if aero == "unsteady":
+        elastic = trim == "elastic" and model != "rigid"
+        if aero == "unsteady" or elastic:
             out[model] = run_gust(airframe, wing, model, setup, recorder=recorder,
-                                  aero=aero)
+                                  aero=aero, trim_mode="elastic" if elastic else "rigid")
         else:
             out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder)
     return out
@@ -103,14 +106,31 @@ def metrics(run: TimeHistory, gust_start_s: float = 0.5) -> GustMetrics:
 
 
 def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "coupled",
-                 aero: str = "quasi-steady") -> StateSpace:
+                 aero: str = "quasi-steady", trim: str = "rigid") -> StateSpace:
     """The paper's LTI model (Eq. 4) at ``speed_m_s`` [m/s]: ``rigid`` (A_RR), ``coupled``
     or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units.
 
     ``aero="unsteady"`` (``coupled`` only): Eq. (4) on unsteady strips with the Küssner gust
     (:func:`bioflex_jsb.aeroelasticity.free_aircraft.unsteady_state_space`, ``gust=True``),
     the model the co-simulation's unsteady wing integrates: states u, α, q, θ, η, η̇ and
-    per strip k lag1[k], lag2[k], kussner1[k], kussner2[k] [m/s]."""
+    per strip k lag1[k], lag2[k], kussner1[k], kussner2[k] [m/s].
+
+    ``trim="elastic"`` (``coupled``, ``qsd``): linearised about the elastic trim
+    (:func:`bioflex_jsb.flight_dynamics.elastic_trim.linearise_about_elastic_trim`: the
+    modes' force per unit airspeed from the deflected wing); ``notes["eta_static_rad"]``
+    holds the static deflection η₀ the states are measured from."""
+    if trim not in ("rigid", "elastic"):
+        raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
+    if trim == "elastic":
+        if aero != "quasi-steady" or wing is None:
+            raise InputError("trim='elastic' linearises the quasi-steady coupled or qsd model "
+                             "of an elastic wing")
+        from bioflex_jsb.flight_dynamics.elastic_trim import (
+            elastic_trim,
+            linearise_about_elastic_trim,
+        )
+
+        return linearise_about_elastic_trim(model, elastic_trim(wing, speed_m_s), wing.model)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if model not in MODELS:

@@ -79,6 +79,10 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.simulation.results import nrmse
 
     build = wing_for_run(wing_from_args(args), args)
+    if args.trim == "elastic" and (args.aero == "unsteady" or args.model == "rigid"):
+        raise UsageError("--trim elastic compares the quasi-steady coupled or qsd model "
+                         "(the rigid model has no wing; the unsteady one is linearised about "
+                         "the rigid trim)")
     if args.aero == "unsteady" and args.model != "coupled":
         raise UsageError("--aero unsteady compares the coupled model (rigid has no wing "
                          "loads; the quasi-static model has no unsteady form)")
@@ -104,6 +108,14 @@ def run(args: argparse.Namespace) -> int:
             from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space
 
             ss = unsteady_state_space(build, args.speed, gust=True, a_rr=lin.a)
+        elif args.trim == "elastic":  # about the static aeroelastic equilibrium
+            from bioflex_jsb.flight_dynamics.elastic_trim import (
+                elastic_trim,
+                linearise_about_elastic_trim,
+            )
+
+            ss = linearise_about_elastic_trim(args.model, elastic_trim(build, args.speed),
+                                              build.model, a_rr=lin.a)
         else:
             ss = build_state_space(args.model, level_flight_condition(args.speed),
                                    build.model, a_rr=lin.a)

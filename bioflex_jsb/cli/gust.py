@@ -98,6 +98,11 @@ def add_aero_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
                    help="structural damping ratio ζ of every wing mode, 0 <= Z < 1 (default: "
                    "the wing's own, docs/wing_variants.md)")
+    p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
+                   help="the trim the elastic-wing runs start from: rigid (the paper's "
+                   "reading, default) or elastic (the static aeroelastic equilibrium: the "
+                   "wing's static deflection and its loads carried by JSBSim's trim; "
+                   "`bioflex-jsb trim --wing W` shows it; docs/decisions.md)")
 
 
 def damping_ratio(text: str) -> float:
@@ -193,6 +198,8 @@ def run_description(args, kind: str, models):
         extra["aero"] = args.aero
     if getattr(args, "structural_damping", None) is not None:
         extra["structural_damping"] = args.structural_damping
+    if getattr(args, "trim", "rigid") != "rigid":
+        extra["trim"] = args.trim
     return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
                           gust=args.gust.text(), models=tuple(models),
                           duration_s=args.duration, gust_start_s=args.gust_start,
@@ -231,10 +238,12 @@ def fly(args, build, models, log=None):
                     if k % 50 == 49 or k == steps - 1:
                         bar.update(k + 1 - bar.n)
             unsteady = getattr(args, "aero", "quasi-steady") == "unsteady" and model == "coupled"
+            elastic = getattr(args, "trim", "rigid") == "elastic" and model != "rigid"
             try:
-                run = run_gust(airframe, build if unsteady else build.model, model, setup,
-                               on_sample, recorder=recorder,
-                               aero="unsteady" if unsteady else "quasi-steady")
+                run = run_gust(airframe, build if unsteady or elastic else build.model, model,
+                               setup, on_sample, recorder=recorder,
+                               aero="unsteady" if unsteady else "quasi-steady",
+                               trim_mode="elastic" if elastic else "rigid")
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,

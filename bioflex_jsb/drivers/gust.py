@@ -111,6 +111,7 @@ def run_gust(
     compiled: bool = True,
     keep: str = "auto",
     aero: str = "quasi-steady",
+    trim_mode: str = "rigid",
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
     aircraft with the wing in its XML, ``wing`` then None).
@@ -132,7 +133,8 @@ def run_gust(
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m, setup.dt_s,
-                       trim=trim, compiled=compiled, aero=aero)
+                       trim=trim, compiled=compiled, aero=aero,
+                       trim_mode=trim_mode)
     dt = step.dt_s
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))
@@ -237,6 +239,9 @@ def run_gust(
             "time_beyond_stall_s": step.stall_steps * dt,
             "interrupted": interrupted,
             "history": history,
+            "trim_mode": trim_mode,
+            "static_eta_rad": (None if step.elastic_trim is None
+                               else [float(e) for e in step.elastic_trim.eta_rad]),
             "steps": n,
             "envelope_s": ENVELOPE_S if envelope is not None else None,
         },

@@ -394,9 +394,11 @@ def linearise_about_elastic_trim(
     trim: ElasticTrim,
     wing,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    a_rr: np.ndarray | None = None,
 ) -> StateSpace:
     """The ``coupled`` or ``qsd`` model of Eq. (4) linearised about ``trim`` (module
     docstring): H_iu = 2 ω_i² η₀_i / u₀ replaces the paper's; everything else is Eq. (4).
+    ``a_rr``: JSBSim's rigid block instead of the analytic one (as ``compare`` uses).
 
     The states stay perturbations (Δη for ``coupled``); ``notes["eta_static_rad"]`` holds η₀,
     so absolute deflections are η₀ + Δη. ``rigid`` has no wing and is refused.
@@ -405,7 +407,7 @@ def linearise_about_elastic_trim(
         raise InputError(f"linearising about the elastic trim needs a wing model "
                          f"(coupled or qsd), not {model!r}")
     condition = level_flight_condition(trim.speed_m_s, trim.density_kg_m3, aero)
-    base = build_state_space(model, condition, wing, aero)
+    base = build_state_space(model, condition, wing, aero, a_rr=a_rr)
     blk = coupled_blocks(wing, condition, aero)
     n = wing.n_modes
     d_h_u = trim.h_u_elastic_per_m - blk.a_er[:, 0]  # change of the u column of A_ER

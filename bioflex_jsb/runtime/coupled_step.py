@@ -57,6 +57,8 @@ from bioflex_jsb.simulation.modal_wing import (
 )
 
 STEP_MODELS = (*WING_MODELS, "native")
+TRIM_MODES = ("rigid", "elastic")  # the trim a run starts from (``trim_mode``)
+ELASTIC_TRIM_TOL_RAD = 1e-6  # the elastic trim's fixed point on α with JSBSim's trim [rad]
 AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
 # The JSBSim properties of a snapshot (JSBSim units, as the names say).
 PROPERTIES: Mapping[str, str] = MappingProxyType({
@@ -156,6 +158,11 @@ class CoupledStep:
         trim: the airframe was just trimmed to this (skip the trim).
         before_trim: called with the configured airframe before the trim (e.g. to disengage
             an autopilot).
+        trim_mode: ``rigid`` (the paper's reading: JSBSim's trim of the airframe, the wing
+            at its static deformation with no loads of its own) or ``elastic`` (the static
+            aeroelastic equilibrium: the wing's static deflection η₀ and its loads carried
+            by JSBSim's trim; Δη is measured from η₀; needs the WingBuild;
+            ``docs/decisions.md``, "Elastic trim").
         compiled: run the per-step numerics as the compiled kernel
             (:mod:`bioflex_jsb.simulation.step_kernel`); False: the readable Python step, the
             reference the kernel is tested against. The native model has no wing step.
@@ -173,7 +180,14 @@ class CoupledStep:
                  speed_m_s: float, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
-                 compiled: bool = True, aero: str = "quasi-steady") -> None:
+                 compiled: bool = True, aero: str = "quasi-steady",
+                 trim_mode: str = "rigid") -> None:
+        if trim_mode not in TRIM_MODES:
+            raise InputError(f"unknown trim {trim_mode!r}; accepted: {', '.join(TRIM_MODES)}")
+        if trim_mode == "elastic" and (not isinstance(wing, WingBuild)
+                                       or model not in ("coupled", "qsd") or trim is not None):
+            raise InputError("the elastic trim needs the wing's build (its modes) and the "
+                             f"coupled or qsd wing, trimmed here (got {model!r})")
         if aero not in AERO_MODELS:
             raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
         if model not in STEP_MODELS:
@@ -196,9 +210,13 @@ class CoupledStep:
         configure_airframe(airframe, dt_s, modal_hooks=not native)
         if before_trim is not None:
             before_trim(airframe)
-        if trim is None:
+        self.elastic_trim = None
+        if trim_mode == "elastic":
+            trim, self.elastic_trim = _trim_elastic(airframe, build, speed_m_s, altitude_m)
+        elif trim is None:
             trim = airframe.trim(speed_m_s, altitude_m)
         self.trim = trim
+        self.trim_mode = trim_mode
         self.speed_m_s = float(speed_m_s)
         self.dt_s = airframe.dt_s
         nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()}
@@ -227,7 +245,9 @@ class CoupledStep:
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
         else:
-            self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s)
+            static = None if self.elastic_trim is None else self.elastic_trim.eta_rad
+            self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s,
+                                  static_eta=static)
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
         self.model = model
@@ -392,6 +412,7 @@ class CoupledStep:
         v["load_eta"][:] = np.ravel(mm.load_eta)
         v["load_etadot"][:] = np.ravel(mm.load_etadot)
         v["refresh_rel"][0] = mw.refresh_rel
+        v["static_load"][:] = mw._static_load
         v["model"][0] = K.MODEL_CODES[mw.model]
         self._reactions, self._out_flow = v["reactions"], v["out_flow"]
         slots = K.KERNEL_SLOTS + self._eta_names + self._etadot_names
@@ -477,6 +498,33 @@ class CoupledStep:
         """Leave no modal loads behind in the airframe for its next user."""
         if not self.native:
             self.airframe.set_external_reactions()
+
+
+def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitude_m: float):
+    """JSBSim's trim of the rigid states carrying the static wing loads of the elastic trim
+    (:func:`bioflex_jsb.flight_dynamics.elastic_trim.elastic_trim` with JSBSim as its rigid
+    trim): (the final JSBSim trim, the elastic trim). The loads, lift and drag against the
+    air, go into the external reactions in body axes with the trim's α; the airframe is left
+    trimmed with them. Beyond the wing's static divergence speed: InputError, one line."""
+    from bioflex_jsb.flight_dynamics.elastic_trim import RigidTrimPoint, elastic_trim
+
+    state = {"trim": airframe.trim(speed_m_s, altitude_m)}  # rigid: the start, and ρ
+
+    def jsbsim_trim(loads) -> RigidTrimPoint:
+        alpha = state["trim"].alpha_rad
+        ca, sa = math.cos(alpha), math.sin(alpha)
+        airframe.set_external_reactions(loads.lift_n * ca + loads.drag_n * sa,
+                                        loads.drag_n * ca - loads.lift_n * sa,
+                                        loads.pitch_moment_n_m)
+        state["trim"] = airframe.trim(speed_m_s, altitude_m)
+        return RigidTrimPoint(state["trim"].alpha_rad, state["trim"].elevator_rad)
+
+    rho = airframe["atmosphere/rho-slugs_ft3"] * U.KG_M3_PER_SLUG_FT3
+    # JSBSim's trim resolves α to its own tolerances: 1e-6 rad is well within them
+    elastic = elastic_trim(build, speed_m_s, density_kg_m3=rho, rigid_trim=jsbsim_trim,
+                           tol_rad=ELASTIC_TRIM_TOL_RAD)
+    jsbsim_trim(elastic.loads)  # leave the airframe trimmed with the final loads
+    return state["trim"], elastic
 
 
 def _native_mode_count(airframe: Airframe) -> int:

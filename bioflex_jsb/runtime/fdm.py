@@ -586,13 +586,20 @@ class Airframe:
 
         lift_n: force along body −z (up) [N]; drag_n: along body −x (aft) [N];
         pitch_moment_n_m: about body +y, nose up [N·m]; roll_moment_n_m: about body +x,
-        right wing down [N·m]. They act from the next time step on.
+        right wing down [N·m]. They act from the next time step on, in the flying instance
+        and in the trim companion (so that a trim carries them: the elastic trim).
         """
         prop = airframe_xml.external_property
-        self[prop("modal-lift")] = float(lift_n) * U.LBF_PER_N
-        self[prop("modal-drag")] = float(drag_n) * U.LBF_PER_N
-        self[prop("modal-pitch")] = float(pitch_moment_n_m) * U.LBF_FT_PER_N_M
-        self[prop("modal-roll")] = float(roll_moment_n_m) * U.LBF_FT_PER_N_M
+        values = {"modal-lift": float(lift_n) * U.LBF_PER_N,
+                  "modal-drag": float(drag_n) * U.LBF_PER_N,
+                  "modal-pitch": float(pitch_moment_n_m) * U.LBF_FT_PER_N_M,
+                  "modal-roll": float(roll_moment_n_m) * U.LBF_FT_PER_N_M}
+        for fdm in self._instances():
+            manager = fdm.get_property_manager()
+            for name, value in values.items():
+                if not manager.hasNode(prop(name)):
+                    raise KeyError(f"JSBSim has no property {prop(name)!r}")
+                fdm[prop(name)] = value
 
     def external_reaction_writer(self) -> Callable[[float, float, float], None]:
         """A fast writer of the modal external reactions for a per-step loop:

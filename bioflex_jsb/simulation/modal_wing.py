@@ -41,7 +41,7 @@ t_{k+1}: no coupling lag. ``qsd`` takes Δη as the quasi-static solution of the
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -120,7 +120,13 @@ class ModalWing:
         dt_s: float = 1.0 / 120.0,
         aero: RigidAerodynamics = RIGID_AERODYNAMICS,
         refresh_rel: float = 0.05,
+        static_eta: np.ndarray | None = None,
     ) -> None:
+        """``static_eta``: the static deflection η₀ [rad] of an elastic trim
+        (:mod:`bioflex_jsb.flight_dynamics.elastic_trim`), from which Δη is measured: its
+        loads join the incremental ones and the ΔQ forcing becomes ω²η₀/Q₀ (the whole
+        aerodynamic generalised force at trim per unit Q); None: the rigid trim (η₀ = 0,
+        the paper's reading)."""
         if model not in WING_MODELS:
             raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(WING_MODELS)}")
         if not (np.isfinite(dt_s) and dt_s > 0.0):
@@ -134,6 +140,12 @@ class ModalWing:
         self.n_modes = n
         # the one builder of the modal matrices (shared with the native export)
         mm = modal_matrices(wing, trim.cl_trim, aero)
+        self.static_eta = np.zeros(wing.n_modes) if static_eta is None else np.asarray(
+            static_eta, dtype=float)
+        if static_eta is not None:
+            mm = replace(mm, b_0=mm.omega**2 * self.static_eta / trim.dynamic_pressure_pa)
+        # loads of the static deflection per unit Q S [C_L, C_D, C_m·c̄]: zero for a rigid trim
+        self._static_load = mm.load_eta @ self.static_eta
         self.matrices = mm
         self._load_eta, self._load_etadot = mm.load_eta, mm.load_etadot
         # Per-unit-Q parts of the lower (η̈) rows, so a step needs no matrix assembly:
@@ -269,7 +281,7 @@ class ModalWing:
         qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
         rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
         self._load_x[:, self.n_modes :] = self._load_etadot * rate  # rates scale with c̄/2V
-        lift, drag, moment = (self._load_x @ self._x).tolist()
+        lift, drag, moment = (self._load_x @ self._x + self._static_load).tolist()
         return WingLoads(qs * lift, qs * drag, qs * moment)
 
     def tip_twist_rad(self, tip_twist_per_mode: np.ndarray) -> float:

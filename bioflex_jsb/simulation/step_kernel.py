@@ -54,7 +54,8 @@ def layout(n_modes: int) -> dict[str, tuple[int, int]]:
     sizes = (("stack", 3 * n2 * n2), ("input_cols", n2 * 3), ("key", 2), ("trim", 4),
              ("k_aero", n * n), ("omega2", n), ("forcing", n * 3), ("load_eta", 3 * n),
              ("load_etadot", 3 * n), ("consts", N_CONSTS), ("refresh_rel", 1), ("model", 1),
-             ("reactions", 3), ("out_flow", 4), ("stall_steps", 1), ("scratch", n2))
+             ("reactions", 3), ("out_flow", 4), ("stall_steps", 1), ("scratch", n2),
+             ("static_load", 3))
     out, offset = {}, 0
     for name, size in sizes:
         out[name] = (offset, size)
@@ -94,6 +95,7 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     o_rr = o_c + N_CONSTS
     o_out = o_rr + 2
     o_scratch = o_out + 8
+    o_sl = o_scratch + n2  # the static deflection's loads per unit Q S (elastic trim; or 0)
     consts = params[o_c:o_c + N_CONSTS]
     refresh_rel = params[o_rr]
     model = int(params[o_rr + 1])
@@ -153,7 +155,7 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             x[n + i] = 0.0
     if model != 0:
         rate = cbar / (2.0 * vt)
-        l0 = l1 = l2 = 0.0
+        l0, l1, l2 = params[o_sl], params[o_sl + 1], params[o_sl + 2]
         for i in range(n):
             e, ed = x[i], rate * x[n + i]
             l0 += params[o_le + i] * e + params[o_ld + i] * ed
