@@ -17,6 +17,7 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    closing,
     log_path,
     print_json,
     wing_from_args,
@@ -124,7 +125,8 @@ def run(args: argparse.Namespace) -> int:
             log.prediction(args.model, linear)
     finally:
         if log is not None:
-            log.close()
+            with closing():  # a stop signal now waits until the log is finished
+                log.close()
     strips = ", unsteady strips" if args.aero == "unsteady" else ""
     linear.meta.update(label=f"LTI {args.model} (Eq. 4{strips})", linestyle="--",
                        color="tab:orange", linewidth=1.6)

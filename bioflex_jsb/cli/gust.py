@@ -23,6 +23,7 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    closing,
     log_path,
     models_list,
     positive_float,
@@ -280,7 +281,8 @@ def run(args: argparse.Namespace) -> int:
         return 130
     finally:
         if log is not None:
-            log.close()
+            with closing():  # a stop signal now waits until the log is finished
+                log.close()
     summary = {}
     for r in runs:
         summary[r.model] = gust_metrics(r, args.gust_start).as_json()
