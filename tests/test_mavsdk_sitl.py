@@ -204,8 +204,9 @@ def test_mavsdk_flies_with_the_sitl_vehicle_and_matches_the_log(tmp_path):
         time.sleep(0.1)
         after_trigger_s = rec.last_attitude_s()
 
-        # the mission: empty
-        assert MissionRaw(vehicle).download_mission() == []
+        # the mission: only home (ArduPilot's item 0)
+        items = MissionRaw(vehicle).download_mission()
+        assert len(items) == 1 and items[0].seq == 0
 
         stdout, stderr = proc.communicate(timeout=DURATION_S / SPEEDUP + 60.0)
         wall_s = time.monotonic() - wall0
@@ -219,12 +220,12 @@ def test_mavsdk_flies_with_the_sitl_vehicle_and_matches_the_log(tmp_path):
 
     summary = json.loads(stdout)
     assert summary["simulated_s"] == pytest.approx(DURATION_S, abs=0.01)
-    assert summary["stopped"] is None
+    assert summary["resets"] == 0
     log = LogSeries(out)
     assert log.t_s[-1] == pytest.approx(DURATION_S, abs=0.01)
 
     # the parameters set over MAVSDK changed the run
-    assert abs(log.deg["yaw"][0]) < 0.5
+    assert abs(math.remainder(log.deg["yaw"][0], 360.0)) < 0.5  # the log: JSBSim's [0, 360)
     assert abs(math.remainder(log.deg["yaw"][-1] - math.degrees(HEADING_RAD), 360.0)) < 2.0
     blowing = np.flatnonzero(log.w_g_m_s != 0.0)
     assert len(blowing) > 0, "GUST_TRIG set over MAVSDK started no gust"
@@ -262,3 +263,68 @@ def test_mavsdk_flies_with_the_sitl_vehicle_and_matches_the_log(tmp_path):
         print(f"  times shifted {SHIFT_S * 1e3:.0f} ms: {name}: {off} of {len(shifted[name])} "
               "off the log")
         assert off >= share * len(shifted[name]), (name, off)
+
+
+def test_mavsdk_arms_flies_a_raw_mission_and_returns_to_launch():
+    """MAVSDK's Action, MissionRaw and Telemetry against the vehicle: flight-mode names,
+    arm (already armed in flight), mission upload, download, progress and RTL."""
+    from mavsdk.plugins.action import Action
+    from mavsdk.plugins.mission_raw import MissionItem
+    from mavsdk.plugins.telemetry import FlightMode
+
+    port = free_udp_port()
+    mavsdk = Mavsdk(Configuration.create_with_component_type(ComponentType.GROUND_STATION))
+    proc = None
+    try:
+        assert mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}").name == "SUCCESS"
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "bioflex_jsb", "sitl", "--duration", "600", "--speedup",
+             "4", "--mavlink", f"udpout:127.0.0.1:{port}", "--no-log"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        vehicle = mavsdk.first_autopilot(20.0)
+        assert vehicle is not None
+        telemetry, action, mission = Telemetry(vehicle), Action(vehicle), MissionRaw(vehicle)
+        end = time.monotonic() + 10.0
+        while time.monotonic() < end and not telemetry.armed():
+            time.sleep(0.1)
+        assert telemetry.armed()
+        assert telemetry.flight_mode() == FlightMode.UNKNOWN  # CRUISE has no MAVSDK name
+        action.arm()
+        home = telemetry.home()
+        lat0, lon0 = home.latitude_deg, home.longitude_deg
+        assert (lat0, lon0) == pytest.approx((-35.363261, 149.165230), abs=1e-6)
+
+        def item(seq, north_m, east_m, alt_m, frame=6):
+            lat = lat0 + math.degrees(north_m / 6_371_000.0)
+            lon = lon0 + math.degrees(east_m / (6_371_000.0 * math.cos(math.radians(lat0))))
+            return MissionItem(seq=seq, frame=frame, command=16, current=int(seq == 1),
+                               autocontinue=1, param1=0.0, param2=30.0, param3=0.0,
+                               param4=0.0, x=int(round(lat * 1e7)), y=int(round(lon * 1e7)),
+                               z=alt_m, mission_type=0)
+
+        plan = [item(0, 0, 0, 584.0, frame=0), item(1, 250, 0, 100), item(2, 250, 250, 100)]
+        mission.upload_mission(plan)
+        back = mission.download_mission()
+        assert [(i.seq, i.x, i.y) for i in back[1:]] == [(i.seq, i.x, i.y) for i in plan[1:]]
+        progress = []
+        mission.subscribe_mission_progress(
+            lambda p, _u: progress.append((p.current, p.total)), None)
+        mission.start_mission()
+        end = time.monotonic() + 120.0
+        while time.monotonic() < end and not any(c >= 2 for c, _ in progress):
+            time.sleep(0.2)
+        assert telemetry.flight_mode() == FlightMode.MISSION
+        assert any(c >= 2 for c, _ in progress), progress
+        action.return_to_launch()
+        end = time.monotonic() + 10.0
+        while time.monotonic() < end and telemetry.flight_mode() != FlightMode.RETURN_TO_LAUNCH:
+            time.sleep(0.1)
+        assert telemetry.flight_mode() == FlightMode.RETURN_TO_LAUNCH
+        action.hold()
+        time.sleep(1.5)
+        assert telemetry.flight_mode() == FlightMode.HOLD  # ArduPlane LOITER
+    finally:
+        if proc is not None and proc.poll() is None:
+            proc.terminate()
+            proc.wait(20.0)
+        mavsdk.destroy()
