@@ -24,10 +24,12 @@ LOG_FLUSH_MAX_STEPS = 96  # faster than real time there is less slack: smaller c
 
 HELP = """Fly the JSBSim airframe with the elastic wing paced to the wall clock (--speedup N:
 N simulated seconds per second) and stream it as a MAVLink 2 vehicle (system 1, component 1,
-fixed wing) to a ground station: QGroundControl, MAVProxy, MAVSDK. A simple autopilot
-(JSBSim systems: altitude/pitch hold on the elevator, heading/roll hold on the ailerons)
-keeps it in level flight; parameters AP_*, GUST_*, WING_COUPLED and SIM_SPEEDUP change the
-run from the ground station (docs in bioflex_jsb/drivers/sitl.py). --mavlink:
+fixed wing, ArduPlane modes) to a ground station: QGroundControl, MAVProxy, MAVSDK. It
+starts 100 m above home (--home, default the CMAC field near Canberra) in CRUISE; ground
+stations set modes (MANUAL, STABILIZE, CRUISE, LOITER, AUTO, RTL, GUIDED), fly missions and
+change parameters (AP_*, WP_RADIUS_M, LOIT_RAD_M, RTL_ALT_M, AIRSPEED_MS, GUST_*,
+WING_COUPLED, SIM_SPEEDUP); docs/sitl.md. A crash or divergence is reported and the aircraft
+is reset to trim over home; the session goes on. --mavlink:
 udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:14550),
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
 simulated seconds, or until Ctrl-C. Prints the pacing error (step start minus its wall-clock
