@@ -307,8 +307,8 @@ class SitlSim:
 
     def _relocate(self) -> None:
         """Re-initialise JSBSim at its present (trimmed) state, over home. JSBSim's RunIC
-        keeps the propeller RPM (its reset property would stop the propellers); the
-        Airframe has no public call for it, so the flying instance's is used here."""
+        keeps the propeller RPM (its reset property would stop the propellers):
+        :meth:`Airframe.restart_from_initial_conditions`."""
         a = self.airframe
         lat, lon, ground = self.home_deg
         state = {
@@ -323,8 +323,7 @@ class SitlSim:
         a["ic/terrain-elevation-ft"] = ground * U.FT_PER_M
         for name, value in state.items():
             a[name] = value
-        with a.capturing():
-            a._fdm.run_ic()  # noqa: SLF001 - see the docstring
+        a.restart_from_initial_conditions()
 
     @property
     def k(self) -> int:

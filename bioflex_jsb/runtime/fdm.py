@@ -1,8 +1,8 @@
 """JSBSim adapter for the rigid airframe: load, initial conditions, trim, linearization.
 
-The runtime package is the only one of bioflex-jsb that imports :mod:`jsbsim`. Everything that crosses
-its boundary is SI (m, s, kg, N, rad); JSBSim's slug-ft-s/degree values are converted here,
-once, with the constants of :mod:`bioflex_jsb.units`.
+The runtime package is the only one of bioflex-jsb that imports :mod:`jsbsim`. Everything
+crossing its boundary is SI (m, s, kg, N, rad); JSBSim's slug-ft-s/degree values are
+converted here, once, with the constants of :mod:`bioflex_jsb.units`.
 
 The JSBSim root (the directory holding ``aircraft/`` and ``systems/``) is found by
 :mod:`bioflex_jsb.runtime.roots`. JSBSim's console output (very verbose) is captured, not
@@ -64,7 +64,6 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
@@ -76,6 +75,7 @@ from bioflex_jsb.aerodynamics.propeller import propeller_tables
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
+from bioflex_jsb.runtime.jsbsim_log import LogRecord, _captured, _CapturingLogger
 from bioflex_jsb.runtime.linearization import reduce_to_rigid
 from bioflex_jsb.runtime.results import (  # noqa: F401  (the runtime's errors and results)
     RIGID_STATE_UNITS,
@@ -144,58 +144,6 @@ _WIND_PROPERTIES = (
 
 def _one_line(text: str) -> str:
     return " ".join(str(text).split())
-
-
-# ======================================================================================
-# JSBSim console output
-# ======================================================================================
-
-
-@dataclass(frozen=True)
-class LogRecord:
-    """One message of JSBSim's logger: ``level`` is a :class:`jsbsim.LogLevel` value."""
-
-    level: int
-    text: str
-
-
-class _CapturingLogger(jsbsim.FGLogger):
-    """Keeps JSBSim's messages instead of printing them."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.records: list[LogRecord] = []
-        self._level = int(jsbsim.LogLevel.INFO)
-        self._parts: list[str] = []
-
-    def set_level(self, level) -> None:
-        self._level = int(level)
-        self._parts = []
-
-    def file_location(self, filename: str, line: int) -> None:
-        self._parts.append(f"{filename}:{line}: ")
-
-    def message(self, message: str) -> None:
-        self._parts.append(message)
-
-    def format(self, log_format) -> None:  # colours and emphasis are dropped
-        return None
-
-    def flush(self) -> None:
-        text = "".join(self._parts)
-        self._parts = []
-        if text.strip():
-            self.records.append(LogRecord(self._level, text))
-
-
-@contextlib.contextmanager
-def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
-    previous = jsbsim.get_logger()
-    jsbsim.set_logger(logger)
-    try:
-        yield logger
-    finally:
-        jsbsim.set_logger(previous)
 
 
 # ======================================================================================
@@ -627,6 +575,14 @@ class Airframe:
         prop = airframe_xml.external_property
         return tuple(self.property_node(prop(name)).set_double_value
                      for name in ("modal-lift", "modal-drag", "modal-pitch"))
+
+    def restart_from_initial_conditions(self) -> None:
+        """JSBSim's ``RunIC`` on the flying instance: restart from the ``ic/*`` values set
+        (position, attitude, velocities), keeping the propellers' RPM and every control (a
+        SITL reset moves the trimmed aircraft to a new place this way; setting the state
+        properties instead would stop the propellers)."""
+        with _captured(self._log):
+            self._fdm.run_ic()
 
     def run(self, steps: int = 1) -> None:
         """Advance JSBSim by ``steps`` time steps of its integration step."""

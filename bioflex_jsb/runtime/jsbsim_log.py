@@ -1,0 +1,57 @@
+"""JSBSim's console output, captured instead of printed (it is very verbose): the records
+the runtime keeps for its one-line diagnoses (:attr:`Airframe.warnings`, trim failures)."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import jsbsim
+
+
+@dataclass(frozen=True)
+class LogRecord:
+    """One message of JSBSim's logger: ``level`` is a :class:`jsbsim.LogLevel` value."""
+
+    level: int
+    text: str
+
+
+class _CapturingLogger(jsbsim.FGLogger):
+    """Keeps JSBSim's messages instead of printing them."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.records: list[LogRecord] = []
+        self._level = int(jsbsim.LogLevel.INFO)
+        self._parts: list[str] = []
+
+    def set_level(self, level) -> None:
+        self._level = int(level)
+        self._parts = []
+
+    def file_location(self, filename: str, line: int) -> None:
+        self._parts.append(f"{filename}:{line}: ")
+
+    def message(self, message: str) -> None:
+        self._parts.append(message)
+
+    def format(self, log_format) -> None:  # colours and emphasis are dropped
+        return None
+
+    def flush(self) -> None:
+        text = "".join(self._parts)
+        self._parts = []
+        if text.strip():
+            self.records.append(LogRecord(self._level, text))
+
+
+@contextlib.contextmanager
+def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
+    previous = jsbsim.get_logger()
+    jsbsim.set_logger(logger)
+    try:
+        yield logger
+    finally:
+        jsbsim.set_logger(previous)
