@@ -83,10 +83,15 @@ def run(args: argparse.Namespace) -> int:
                "kernel_compile_s": compile_s, "dt_s": bench.DEFAULT_DT_S, "steps": args.steps,
                "repeat": args.repeat}
     if args.sitl_seconds > 0.0:
+        import tempfile
+        from pathlib import Path
+
         from bioflex_jsb.drivers.sitl import measure_pacing
 
-        payload["sitl"] = measure_pacing(duration_s=args.sitl_seconds,
-                                         speedup=args.sitl_speedup)
+        with tempfile.TemporaryDirectory() as tmp:  # the session logged, as sitl does
+            payload["sitl"] = measure_pacing(duration_s=args.sitl_seconds,
+                                             speedup=args.sitl_speedup,
+                                             log_path=str(Path(tmp) / "sitl.mcap"))
     if args.json:
         print_json(payload)
     else:
@@ -134,5 +139,5 @@ def _print(p: dict) -> None:
           f"{c['cached']:.2f} s")
     if "sitl" in p:
         s = p["sitl"]
-        print(f"SITL pacing ({s['speedup']:g}x): p50 {s['p50_ms']:.3f} ms, p99 "
-              f"{s['p99_ms']:.3f} ms, resyncs {s['resyncs']}")
+        print(f"SITL pacing ({s['speedup']:g}x, logged, {s['steps']} steps): p50 "
+              f"{s['p50_ms']:.3f} ms, p99 {s['p99_ms']:.3f} ms, resyncs {s['resyncs']}")

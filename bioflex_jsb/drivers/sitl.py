@@ -495,20 +495,44 @@ def run_paced(
 
 
 def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "optimised",
-                   speed_m_s: float = 15.0, mavlink: str = "udpin:127.0.0.1:0") -> dict:
+                   speed_m_s: float = 15.0, mavlink: str = "udpin:127.0.0.1:0",
+                   log_path: str | None = None) -> dict:
     """Pacing error of a real-time SITL run (for ``bioflex-jsb bench``: ``sitl_p50_ms``,
     ``sitl_p99_ms``): ``duration_s`` simulated seconds of the coupled wing at ``speedup``,
     with the MAVLink link serviced as in a session (default: listening on a loopback port,
-    telemetry at its default rates, 50 Hz ATTITUDE). Returns :meth:`PacingStats.summary`
-    ([ms] and counts) with ``dt_s`` and ``speedup``."""
+    telemetry at its default rates, 50 Hz ATTITUDE) and, with ``log_path``, every step
+    logged to that MCAP file as ``bioflex-jsb sitl`` logs it (chunks written when the loop
+    has slack). Returns :meth:`PacingStats.summary` ([ms] and counts) with ``dt_s``,
+    ``speedup`` and ``logged``."""
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
     from bioflex_jsb.links.mavlink import MavlinkLink
 
     build = build_wing(VARIANTS[wing])
     sim = SitlSim(build.model, build.modes, speed_m_s=speed_m_s, speedup=speedup)
     link = MavlinkLink(mavlink, SitlParameters(sim), sim.vehicle)
+    log = on_sample = idle = None
+    if log_path is not None:
+        from bioflex_jsb.simulation.run import RunDescription
+        from bioflex_jsb.sinks.mcap import RunLog
+
+        log = RunLog.open(log_path, RunDescription("sitl", wing, speed_m_s, gust="none",
+                                                   models=("coupled",), duration_s=duration_s,
+                                                   extra={"speedup": speedup}))
+        names, pending = sim.names, [0]
+
+        def on_sample(t, model, values):
+            log.sample(model, t, dict(zip(names, values, strict=True)))
+            pending[0] += 1
+
+        def idle(slack_s: float) -> None:  # as the CLI's session log
+            if pending[0] >= 24 and slack_s >= 0.7e-3 or pending[0] >= 96:
+                log.flush()
+                pending[0] = 0
     try:
-        stats = run_paced(sim, duration_s, link)
+        stats = run_paced(sim, duration_s, link, on_sample, idle=idle)
     finally:
         link.close()
-    return {**stats.summary(), "dt_s": sim.dt_s, "speedup": speedup}
+        if log is not None:
+            log.close()
+    return {**stats.summary(), "dt_s": sim.dt_s, "speedup": speedup,
+            "logged": log_path is not None}
