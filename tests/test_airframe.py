@@ -207,8 +207,12 @@ def test_propeller_tables_are_plausible_and_size_the_motor():
     assert 0.08 < ct[0] < 0.14 and 0.03 < cp[0] < 0.07
     eta = j * ct / np.where(cp > 0, cp, np.nan)
     assert 0.6 < np.nanmax(eta) < 0.85  # peak propulsive efficiency
-    j0 = jsbsim_fdm._zero_thrust_advance_ratio()
+    k = int(np.argmax(ct <= 0.0))
+    j0 = float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
     assert 0.6 < j0 < 1.0 and j[-1] > j0  # the table runs past zero thrust
+    # and the runtime reads the same zero-thrust point from the file JSBSim flies
+    path = jsbsim_fdm.aircraft_file(REPO, jsbsim_fdm.DEFAULT_AIRCRAFT)
+    assert jsbsim_fdm._zero_thrust_advance_ratio(path) == pytest.approx(j0, rel=1e-9)
 
 
 def test_hand_derived_short_period_matches_jsbsim_linearization():

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from bioflex_jsb.parameters.airframe import PROPULSION, Propulsion
 
@@ -28,6 +27,8 @@ def propeller_coefficients(
     axial induced velocity v makes the blade-element thrust equal the momentum thrust
     4πrρ(V+v)vF. Evaluated at n = 1 rev/s, ρ = 1 (the coefficients are scale-free).
     """
+    from scipy.optimize import brentq  # when the tables are computed (build time)
+
     radius = prop.prop_diameter_m / 2.0
     n_rev_s, rho = 1.0, 1.0
     speed = advance_ratio * n_rev_s * prop.prop_diameter_m

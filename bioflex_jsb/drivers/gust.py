@@ -45,6 +45,10 @@ KEEP_ALL_MAX_S = 120.0
 # The envelope: per this span of simulated time [s], the first and last step and the steps
 # where each summary channel reaches its minimum and maximum.
 ENVELOPE_S = 0.25
+# At most this many envelope windows are kept: beyond, neighbours are merged in pairs (the
+# span doubles), so the envelope of a run of any length stays under ~6 MB; its peaks stay
+# those of every step.
+ENVELOPE_MAX_WINDOWS = 2048
 SUMMARY_CHANNELS = ("u", "alpha", "q", "theta", "n_z")  # what gust_metrics reads
 WINDOW_S = 0.9  # rows per block without a recorder [s of simulated time]
 KEEP_CHOICES = ("auto", "all", "envelope")
@@ -72,27 +76,49 @@ class StepRecorder(Protocol):
 
 
 class _Envelope:
-    """A bounded-rate history of a long run: per ENVELOPE_S of steps, the first and last
-    step and the steps where each of :data:`SUMMARY_CHANNELS` is smallest and largest, so
-    the peaks (and the overshoot) that ``gust_metrics`` reports are those of every step;
-    its settling time is resolved to ENVELOPE_S."""
+    """A bounded history of a long run: per window of steps (ENVELOPE_S, doubled each time
+    more than ENVELOPE_MAX_WINDOWS are kept), the first and last step and the steps where
+    each of :data:`SUMMARY_CHANNELS` is smallest and largest, so the peaks (and the
+    overshoot) that ``gust_metrics`` reports are those of every step; its settling time is
+    resolved to the window (``span_s``)."""
 
     def __init__(self, names: tuple[str, ...], dt_s: float) -> None:
         self.cols = [names.index(c) for c in SUMMARY_CHANNELS if c in names]
         self.every = max(1, int(round(ENVELOPE_S / dt_s)))
+        self.span_s = self.every * dt_s
         self._t: list[np.ndarray] = []
         self._rows: list[np.ndarray] = []
 
+    def _keep(self, t: np.ndarray, seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = seg[:, self.cols]
+        nan = np.isnan(x)
+        hi = np.argmax(np.where(nan, -np.inf, x), axis=0)
+        lo = np.argmin(np.where(nan, np.inf, x), axis=0)
+        keep = np.unique(np.concatenate([[0, len(seg) - 1], hi, lo]))
+        return t[keep], seg[keep]
+
     def add(self, time_s: np.ndarray, rows: np.ndarray) -> None:
         for a in range(0, len(rows), self.every):
-            seg = rows[a:a + self.every]
-            x = seg[:, self.cols]
-            nan = np.isnan(x)
-            hi = np.argmax(np.where(nan, -np.inf, x), axis=0)
-            lo = np.argmin(np.where(nan, np.inf, x), axis=0)
-            keep = np.unique(np.concatenate([[0, len(seg) - 1], hi, lo]))
-            self._t.append(time_s[a + keep])
-            self._rows.append(seg[keep])
+            t, seg = self._keep(time_s[a:a + self.every], rows[a:a + self.every])
+            self._t.append(t)
+            self._rows.append(seg.copy())
+        if len(self._rows) > ENVELOPE_MAX_WINDOWS:
+            self._coarsen()
+
+    def _coarsen(self) -> None:
+        """Merge neighbouring windows in pairs: the span doubles, the extremes stay."""
+        ts, rs = [], []
+        for i in range(0, len(self._rows) - 1, 2):
+            t, seg = self._keep(np.concatenate(self._t[i:i + 2]),
+                                np.concatenate(self._rows[i:i + 2]))
+            ts.append(t)
+            rs.append(seg)
+        if len(self._rows) % 2:
+            ts.append(self._t[-1])
+            rs.append(self._rows[-1])
+        self._t, self._rows = ts, rs
+        self.every *= 2
+        self.span_s *= 2.0
 
     def history(self, n_channels: int) -> tuple[np.ndarray, np.ndarray]:
         if not self._rows:
@@ -243,7 +269,7 @@ def run_gust(
             "static_eta_rad": (None if step.elastic_trim is None
                                else [float(e) for e in step.elastic_trim.eta_rad]),
             "steps": n,
-            "envelope_s": ENVELOPE_S if envelope is not None else None,
+            "envelope_s": envelope.span_s if envelope is not None else None,
         },
         stopped=stopped,
     )

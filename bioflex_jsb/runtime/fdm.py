@@ -71,7 +71,6 @@ import jsbsim
 import numpy as np
 
 from bioflex_jsb import units as U
-from bioflex_jsb.aerodynamics.propeller import propeller_tables
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
@@ -188,10 +187,28 @@ def _alpha_limits_rad(path: Path) -> tuple[float, float]:
         raise AircraftLoadError(f"malformed <alphalimits> in {str(path)!r}") from None
 
 
-@lru_cache(maxsize=1)
-def _zero_thrust_advance_ratio() -> float:
-    """J at which the propeller's C_T(J) crosses zero [-] (windmilling)."""
-    j, ct, _ = propeller_tables(PROPULSION)
+@lru_cache(maxsize=8)
+def _zero_thrust_advance_ratio(aircraft_path: Path) -> float:
+    """J at which the propeller's C_T(J) crosses zero [-] (windmilling), from the C_THRUST
+    table of the aircraft's first thruster file (``Engines/<file>.xml`` beside it): the
+    table JSBSim flies, read rather than recomputed (the blade-element model that wrote it,
+    :mod:`bioflex_jsb.aerodynamics.propeller`, needs scipy's optimisers, ~30 MB of memory a
+    run does not otherwise need)."""
+    aircraft = ET.parse(aircraft_path).getroot()
+    thruster = aircraft.find(".//propulsion/engine/thruster")
+    if thruster is None or not thruster.get("file"):
+        raise AircraftLoadError(f"{str(aircraft_path)!r} has no propeller (thruster file)")
+    prop_path = aircraft_path.parent / "Engines" / f"{thruster.get('file')}.xml"
+    try:
+        table = ET.parse(prop_path).getroot().find(".//table[@name='C_THRUST']/tableData")
+    except (OSError, ET.ParseError) as exc:
+        raise AircraftLoadError(f"cannot read the propeller {str(prop_path)!r}: {exc}") from None
+    if table is None or not (table.text or "").strip():
+        raise AircraftLoadError(f"{str(prop_path)!r} has no C_THRUST table")
+    rows = np.array([float(x) for x in table.text.split()]).reshape(-1, 2)
+    j, ct = rows[:, 0], rows[:, 1]
+    if not np.any(ct <= 0.0) or ct[0] <= 0.0:
+        raise AircraftLoadError(f"the C_THRUST table of {str(prop_path)!r} does not cross zero")
     k = int(np.argmax(ct <= 0.0))
     return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
 
@@ -249,8 +266,10 @@ class Airframe:
         companion = aircraft + airframe_xml.TRIM_SUFFIX
         companion_path = aircraft_file(self.root, companion)
         self.trim_load_messages: tuple[LogRecord, ...] = ()
+        self._trim_aircraft_path = self.aircraft_path
         if companion_path.is_file():
             self.trim_aircraft = companion
+            self._trim_aircraft_path = companion_path
             self._trim_fdm = _load_fdm(self.root, companion, companion_path, self._log)
             self._trim_fdm.set_dt(self._dt_nominal_s)
             self.trim_load_messages = tuple(self._log.records)
@@ -353,7 +372,8 @@ class Airframe:
         """
         n = PROPULSION.rotor_count
         omega_rad_s = (
-            2.0 * math.pi * speed_m_s / (_zero_thrust_advance_ratio() * PROPULSION.prop_diameter_m)
+            2.0 * math.pi * speed_m_s
+            / (_zero_thrust_advance_ratio(self._trim_aircraft_path) * PROPULSION.prop_diameter_m)
         )
         inertia_slug_ft2 = PROPULSION.trim_rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
         power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M

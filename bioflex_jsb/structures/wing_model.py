@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq, least_squares
 
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing_structure import (
@@ -151,6 +150,8 @@ def _calibrate_arm_hand(structure: WingStructure, targets: tuple[float, float, f
 
     # Start: root GJ of the linear-taper fit order of magnitude, kink at 0.3, h = 1.
     p0 = np.log([3.0, 0.3, 1.0])
+    from scipy.optimize import least_squares  # calibration only: imported when run
+
     sol = least_squares(residual, p0, x_scale=1.0, xtol=1e-13, ftol=1e-13, gtol=1e-13,
                         bounds=(np.log([1e-2, 1e-3, 0.05]), np.log([1e3, 1.0, 2.0])))
     # 1e-8 relative: a converged square system solves to round-off; a miss is far larger.
@@ -205,6 +206,8 @@ def calibrate_stiffness(
     def ratio_error(ratio: float) -> float:
         ft, _ = _split_modes(replace(stiff, torsional_stiffness_tip_ratio=ratio), 2, n_elements)
         return ft[1] / ft[0] - f2 / f1
+
+    from scipy.optimize import brentq  # calibration only: imported when run
 
     ratio = brentq(ratio_error, 1e-4, 1.0, xtol=1e-10, rtol=1e-10)
     ft, _ = _split_modes(replace(stiff, torsional_stiffness_tip_ratio=ratio), 2, n_elements)
