@@ -338,3 +338,24 @@ def test_no_progress_bar_without_a_terminal(tmp_path):
                            "--models", "rigid", "--no-log", "--plot", ""], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "step/s" not in done.stderr
+
+
+def test_plot_of_a_log_never_replaces_a_users_file(tmp_path, capsys):
+    """`plot run.mcap` writes run.png beside the log: a file of the user's there is refused
+    (exit 2, one line) unless --force; a figure bioflex-jsb drew may be redrawn."""
+    from bioflex_jsb.cli import main
+
+    log = tmp_path / "r.mcap"
+    assert main(["gust", "--duration", "1", "--models", "rigid", "--out", str(log), "--json",
+                 "--plot", ""]) == 0
+    capsys.readouterr()
+    png = tmp_path / "r.png"
+    png.write_text("the user's notes")
+    assert main(["plot", str(log)]) == 2
+    err = capsys.readouterr().err
+    assert "--force" in err and err.count("\n") == 1
+    assert png.read_text() == "the user's notes"
+    assert main(["plot", str(log), "--out", str(tmp_path / "r.txt")]) == 2
+    capsys.readouterr()
+    assert main(["plot", str(log), "--force"]) == 0
+    assert main(["plot", str(log)]) == 0  # now ours: redrawn without --force

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from bioflex_jsb.cli.case import add_force_argument, check_plot_path
 from bioflex_jsb.cli.common import UsageError, print_json
 
 HELP = """Draw the time histories logged in FILE.mcap (every wing model's run, and the LTI
@@ -16,7 +17,9 @@ def register(sub) -> None:
     p = sub.add_parser("plot", help="time histories of an MCAP log", description=HELP)
     p.add_argument("file", metavar="FILE.mcap", help="the log")
     p.add_argument("--out", metavar="FILE.png", default=None,
-                   help="the figure (default: FILE.png beside the log)")
+                   help="the figure (.png, .pdf, .svg; default: FILE.png beside the log; an "
+                   "existing file is replaced only if bioflex-jsb drew it, else give --force)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -26,13 +29,14 @@ def run(args: argparse.Namespace) -> int:
 
     from bioflex_jsb.sinks.mcap import LogError, histories
 
+    out = args.out or str(Path(args.file).with_suffix(".png"))
+    check_plot_path(out, args.force)  # before reading the log: nothing is overwritten
     try:
         runs, meta = histories(args.file)
     except LogError as exc:
         raise UsageError(str(exc)) from None
     if not runs or all(len(r.time_s) == 0 for r in runs):
         raise UsageError(f"{args.file!r} holds no bioflex run topics to plot")
-    out = args.out or str(Path(args.file).with_suffix(".png"))
     title = (f"{meta.get('wing', '?')} wing, {meta.get('speed_m_s', '?')} m/s, "
              f"gust {meta.get('gust', '?')}" if meta else Path(args.file).name)
     from bioflex_jsb.sinks import plotting
