@@ -50,6 +50,8 @@ def test_bad_home_is_one_line(build):  # noqa: F811
 def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
     sim = make_sim(build, start_height_m=20.0)
     v = sim.vehicle
+    heard = []  # the on_status hook (the session log's events): every STATUSTEXT, timed
+    v.on_status = lambda t_s, severity, text: heard.append((t_s, severity, text))
     assert v.set_mode(MODES.MANUAL) is None
     sim.manual(0.8, 0.0)  # stick forward: nose down into the ground
     with sim.airframe.capturing():
@@ -61,6 +63,8 @@ def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
     texts = [t for _, t in v.events]
     assert any(t.startswith(("Crashed", "Diverged")) for t in texts), texts
     assert "Reset to trim over home" in texts
+    assert [(s, t) for _, s, t in heard] == list(v.events)
+    assert heard[-1][0] == heard[-2][0] == sim.t_s > 0.0  # the crash and the reset: now
     s = sim.vehicle_state()
     assert v.mode == MODES.LOITER
     assert s.relative_altitude_m == pytest.approx(20.0, abs=0.5)

@@ -254,6 +254,11 @@ def fly(args, build, models, log=None):
                 raise Interrupted(runs)
             if run.stopped:
                 stops.append(f"{model} run stopped: {run.stopped}")
+                if log is not None:  # the stop is an event in the log, at the last step
+                    from bioflex_jsb.simulation.results import divergence_mode
+
+                    log.event(run.stop_time_s, "ERROR", f"{model} run stopped "
+                              f"({divergence_mode(run.stopped)}): {run.stopped}", name=model)
     except FdmError as exc:  # the airframe cannot load or trim at --speed
         raise UsageError(str(exc)) from None
     return runs, stops

@@ -7,16 +7,18 @@ import json
 
 from bioflex_jsb.cli.common import UsageError, print_json
 
-HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels (topic,
-schema, message count), the number of messages and chunks, the time span [s of simulation
-time] and the metadata records (the run's command and arguments, wing, gust, time step,
-versions). Read through the mcap package's indexed reader. A log whose writer was killed
-(SIGKILL, power loss) has no summary; --recover FIXED.mcap copies every complete chunk of it
-into a new, finished file (at most the last chunk, 0.9 s of simulated time, is lost); a
-damaged chunk is skipped, every intact chunk after it kept, and the skipped ones are named.
---check decompresses every chunk and verifies its CRC (and the data section's): exit status
-1 and the damaged chunks if any fails. Logs in protobuf (this version) and JSON (older
-versions) are read alike."""
+HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels
+(topic, schema, message count), the number of messages and chunks, the time span [s of
+simulation time], the metadata records (the run's command and arguments, wing, gust, time
+step, versions) and the events on /bioflex/events (time [s], level, text: a run that
+diverged, a SITL session's STATUSTEXT: crashes, resets, mode changes). Read through the
+mcap package's indexed reader. A log whose writer was killed (SIGKILL, power loss) has no
+summary; --recover FIXED.mcap copies every complete chunk of it into a new, finished file
+(at most the last chunk, 0.9 s of simulated time, is lost); a damaged chunk is skipped,
+every intact chunk after it kept, and the skipped ones are named. --check decompresses
+every chunk and verifies its CRC (and the data section's): exit status 1 and the damaged
+chunks if any fails. Logs in protobuf (this version) and JSON (older versions) are read
+alike."""
 
 
 def register(sub) -> None:
@@ -88,3 +90,8 @@ def print_summary(s: dict) -> None:
                 except ValueError:
                     pass
             print(f"  {key}: {value}")
+    events = s.get("events") or []
+    if events:
+        print(f"events ({len(events)}):")
+    for e in events:
+        print(f"  t = {e['time_s']:.3f} s  {e['level']:<7}  {e['text']}")

@@ -21,6 +21,11 @@ from bioflex_jsb.cli.common import (
 LOG_FLUSH_STEPS = 24
 LOG_FLUSH_SLACK_S = 0.7e-3
 LOG_FLUSH_MAX_STEPS = 96  # faster than real time there is less slack: smaller chunks (≈ 1.6 ms)
+# MAV_SEVERITY (0 EMERGENCY … 7 DEBUG) → the foxglove.Log level of the event in the log
+# (crashes, CRITICAL, and divergences, ERROR, are both ERROR: the session goes on)
+EVENT_LEVEL = {0: "FATAL", 1: "FATAL", 2: "ERROR", 3: "ERROR", 4: "WARNING", 5: "INFO",
+               6: "INFO", 7: "DEBUG"}
+EVENT_NAME = "vehicle"  # the events' reporter (foxglove.Log name)
 
 HELP = """Fly the JSBSim airframe with the elastic wing paced to the wall clock (--speedup N:
 N simulated seconds per second) and stream it as a MAVLink 2 vehicle (system 1, component 1,
@@ -133,12 +138,7 @@ def run(args: argparse.Namespace) -> int:
         except UsageError:
             link.close()
             raise
-        sim.on_reset = log.reset
-        names = sim.names
-
-        def on_sample(t, model, values):
-            log.sample(model, t, dict(zip(names, values, strict=True)))
-
+        on_sample = log.attach(sim)
         idle = log.idle
 
     host, port = link.local_address
@@ -206,7 +206,14 @@ class SplitLog:
     """The session's MCAP log in files of at most ``max_mb`` [MB] (NAME.mcap, NAME-001.mcap,
     ...), each closed (finished) before the next opens; a reset also starts a new file, whose
     run description records the reason (``extra.after_reset``). Chunks are written when the
-    loop has slack (``idle``)."""
+    loop has slack (``idle``).
+
+    Every STATUSTEXT of the vehicle (``status``, its ``on_status`` hook) is an event
+    (``RunLog.event``, level :data:`EVENT_LEVEL`) at its simulated time, written after the
+    sample of the step it happened in (so a crash follows the last step flown); a reset
+    (``reset``, called within that step after the vehicle's "Reset to trim" STATUSTEXT)
+    starts the new file after that sample and the step's events: the reset's event is the
+    last record of the file that ends and the first of the new one."""
 
     def __init__(self, path: str, description, build, max_mb: float, open_log) -> None:
         import dataclasses
@@ -218,6 +225,8 @@ class SplitLog:
         self.max_bytes = int(max_mb * 1e6)
         self.paths: list[str] = []
         self._pending = 0
+        self._events: list[tuple[float, int, str]] = []  # (t_s, MAV_SEVERITY, text)
+        self._reset: tuple[str, tuple[float, int, str] | None] | None = None
         self._log = self._next(None)
 
     def _next(self, reason: str | None):
@@ -232,9 +241,41 @@ class SplitLog:
         self.paths.append(str(path))
         return log
 
+    def attach(self, sim):
+        """Log the session of ``sim``: its resets and its vehicle's STATUSTEXT; returns the
+        ``on_sample`` of :func:`~bioflex_jsb.drivers.sitl.run_paced` (``idle``: :meth:`idle`)."""
+        sim.on_reset = self.reset
+        sim.vehicle.on_status = self.status
+        names = sim.names
+
+        def on_sample(t, model, values):
+            self.sample(model, t, dict(zip(names, values, strict=True)))
+
+        return on_sample
+
     def sample(self, model, t, row) -> None:
         self._log.sample(model, t, row)
         self._pending += 1
+        if self._events or self._reset is not None:
+            self._write_events()
+
+    def status(self, t_s: float, severity: int, text: str) -> None:
+        """A STATUSTEXT at ``t_s`` [s]: logged after the sample of the step in progress."""
+        self._events.append((t_s, severity, text))
+
+    def _event(self, event: tuple[float, int, str]) -> None:
+        t_s, severity, text = event
+        self._log.event(t_s, EVENT_LEVEL.get(severity, "UNKNOWN"), text, name=EVENT_NAME)
+
+    def _write_events(self) -> None:
+        events, self._events = self._events, []
+        for e in events:
+            self._event(e)
+        if self._reset is not None:
+            (reason, last), self._reset = self._reset, None
+            self._roll(reason)
+            if last is not None:
+                self._event(last)
 
     def idle(self, slack_s: float) -> None:
         if (self._pending >= LOG_FLUSH_STEPS and slack_s >= LOG_FLUSH_SLACK_S
@@ -250,7 +291,10 @@ class SplitLog:
         self._pending = 0
 
     def reset(self, reason: str) -> None:
-        self._roll(reason)
+        """The aircraft was reset (``reason``): a new file once the step's sample is in."""
+        self._reset = (reason, self._events[-1] if self._events else None)
 
     def close(self) -> None:
+        if self._events or self._reset is not None:
+            self._write_events()
         self._log.close()

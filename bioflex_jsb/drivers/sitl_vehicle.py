@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
+from collections.abc import Callable
 
 from bioflex_jsb import units as U
 from bioflex_jsb.links import mavlink_modes as MODES
@@ -76,6 +77,8 @@ class SitlVehicle:
         self.armed = True  # it starts in the air, motor running
         self.battery = Battery()
         self.events: deque[tuple[int, str]] = deque(maxlen=64)
+        # on_status(t_s, severity, text): every STATUSTEXT as it is queued (the session log)
+        self.on_status: Callable[[float, int, str], None] | None = None
         self.reached: deque[int] = deque(maxlen=16)
         self.mission: list[MissionItem] = []
         self.mission_seq = 0
@@ -94,8 +97,11 @@ class SitlVehicle:
 
     # -- events ---------------------------------------------------------------------------
     def status(self, severity: int, text: str) -> None:
-        """Queue a STATUSTEXT (MAV_SEVERITY ``severity``; ≤ 50 characters are sent whole)."""
+        """Queue a STATUSTEXT (MAV_SEVERITY ``severity``; ≤ 50 characters are sent whole)
+        and hand it to ``on_status`` with the simulated time [s]."""
         self.events.append((int(severity), str(text)))
+        if self.on_status is not None:
+            self.on_status(self.sim.t_s, int(severity), str(text))
 
     # -- where it is --------------------------------------------------------------------
     def position_ne(self) -> tuple[float, float]:

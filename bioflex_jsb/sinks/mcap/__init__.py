@@ -18,7 +18,9 @@ descriptions; the full table is in ``docs/logging.md``):
   to the same gust, where one ran alongside (:meth:`RunLog.prediction`);
 * ``/bioflex/<model>/autopilot`` (``bioflex.Autopilot``): an ArduPilot SITL session's servo
   frames: ArduPilot's frame count and rate [Hz], the PWM values [µs], the mapped controls,
-  the lock-step action and the launcher phase (:meth:`RunLog.autopilot`).
+  the lock-step action and the launcher phase (:meth:`RunLog.autopilot`);
+* ``/bioflex/events`` (``foxglove.Log``, one per file): what happened (a run that stopped, a
+  SITL vehicle's STATUSTEXT): time, level, text, reporter (:meth:`RunLog.event`).
 
 Frames: ``world`` is a local East-North-Up frame [m] whose origin is the aircraft's position
 at the first sample of the file (flat-Earth tangent plane on the WGS-84 ellipsoid);
@@ -72,6 +74,8 @@ from bioflex_jsb.sinks.mcap.recover import check_chunks, recover
 from bioflex_jsb.sinks.mcap.schemas import (
     AUTOPILOT_ACTIONS,
     AUTOPILOT_PHASES,
+    EVENT_LEVELS,
+    EVENTS_TOPIC,
     FRAME_METADATA,
     GROUPS,
     PROTO_SCHEMAS,
@@ -91,7 +95,8 @@ from bioflex_jsb.sinks.mcap.writer import (
 
 __all__ = [
     "AUTOPILOT_ACTIONS", "AUTOPILOT_PHASES", "AutopilotRecorder",
-    "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "FRAME_METADATA", "GROUPS", "MAGIC",
+    "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "EVENTS_TOPIC", "EVENT_LEVELS",
+    "FRAME_METADATA", "GROUPS", "MAGIC",
     "PROTO_SCHEMAS", "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError",
     "McapFileWriter",
     "RunLog", "TableRecorder", "body_frame", "check_chunks", "check_file", "compare_logs",

@@ -18,7 +18,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, length_delimited, string_field, tag, varint
+from bioflex_jsb.sinks.mcap.protobuf import (
+    I64,
+    LEN,
+    VARINT,
+    length_delimited,
+    string_field,
+    tag,
+    varint,
+)
 from bioflex_jsb.sinks.mcap.schemas import (
     _RIGID_FIELDS,
     _RIGID_OPTIONAL,
@@ -352,6 +360,16 @@ class AutopilotRecords:
         rec["timestamp_s"] = timestamp_s
         offsets = np.arange(n, dtype=np.int64) * dtype.itemsize
         return rec.tobytes(), {self.channel_id: np.column_stack([ns, offsets])}
+
+
+def log_message(log_ns: int, level: int, text: str, name: str) -> bytes:
+    """A ``foxglove.Log`` message (the events topic): its timestamp (the log time
+    ``log_ns`` [ns], seconds and nanoseconds always written, as on the other Foxglove
+    topics), ``level`` (``foxglove.Log.Level``), the ``text`` and the reporter's ``name``."""
+    sec, nsec = divmod(int(log_ns), 1_000_000_000)
+    stamp = b"\x08" + varint(sec) + b"\x10" + varint(nsec)
+    return (length_delimited(1, stamp) + tag(2, VARINT) + varint(int(level))
+            + string_field(3, text) + string_field(4, name))
 
 
 def enu_quaternion(roll_rad, pitch_rad, yaw_rad) -> tuple:

@@ -1,8 +1,9 @@
 """Foxglove's published protobuf schemas, embedded: the serialised ``FileDescriptorProto``
-of each file that ``foxglove.FrameTransform`` and ``foxglove.LocationFix`` need, byte for
-byte as the ``foxglove-schemas-protobuf`` package (0.4.0) ships them
-(``<module>_pb2.DESCRIPTOR.serialized_pb``; ``tests/test_log_faults.py`` compares them where
-that package is installed). Base64, dependencies first."""
+of each file that ``foxglove.FrameTransform``, ``foxglove.LocationFix`` and ``foxglove.Log``
+need, byte for byte as the ``foxglove-schemas-protobuf`` package (0.4.0) ships them
+(``<module>_pb2.DESCRIPTOR.serialized_pb``; ``tests/test_log_faults.py`` compares
+:data:`FILES`, ``tests/test_events.py`` :data:`LOG_FILE`, where that package is installed).
+Base64, dependencies first."""
 
 from __future__ import annotations
 
@@ -62,3 +63,19 @@ FRAME_TRANSFORM_FILES = ("foxglove/Quaternion.proto", "foxglove/Vector3.proto",
 LOCATION_FIX_FILES = ("foxglove/Vector3.proto", "google/protobuf/timestamp.proto",
                       "foxglove/Color.proto", "foxglove/KeyValuePair.proto",
                       "foxglove/LocationFix.proto")
+# foxglove.Log (the events topic), apart from FILES (the files of the run topics); its one
+# import, google/protobuf/timestamp.proto, is in FILES
+LOG_FILE: bytes = base64.b64decode(
+    "ChJmb3hnbG92ZS9Mb2cucHJvdG8SCGZveGdsb3ZlGh9nb29nbGUvcHJvdG9idWYvdGltZXN0YW1w"
+    "LnByb3RvIuEBCgNMb2cSLQoJdGltZXN0YW1wGAEgASgLMhouZ29vZ2xlLnByb3RvYnVmLlRpbWVz"
+    "dGFtcBIiCgVsZXZlbBgCIAEoDjITLmZveGdsb3ZlLkxvZy5MZXZlbBIPCgdtZXNzYWdlGAMgASgJ"
+    "EgwKBG5hbWUYBCABKAkSDAoEZmlsZRgFIAEoCRIMCgRsaW5lGAYgASgHIkwKBUxldmVsEgsKB1VO"
+    "S05PV04QABIJCgVERUJVRxABEggKBElORk8QAhILCgdXQVJOSU5HEAMSCQoFRVJST1IQBBIJCgVG"
+    "QVRBTBAFYgZwcm90bzM="
+)
+LOG_FILES = ("google/protobuf/timestamp.proto", "foxglove/Log.proto")
+
+
+def files(names) -> list[bytes]:
+    """The serialised files ``names`` (of FILES and foxglove/Log.proto), in that order."""
+    return [LOG_FILE if n == "foxglove/Log.proto" else FILES[n] for n in names]

@@ -2,7 +2,9 @@
 
 A gust run hands its steps to the log a chunk at a time (:meth:`RunLog.recorder`: one call
 per chunk of rows, nothing per step); a loop without a table (SITL) gives its steps as dicts
-(:meth:`RunLog.sample`); an ArduPilot session adds its servo frames (:meth:`RunLog.autopilot`).
+(:meth:`RunLog.sample`); an ArduPilot session adds its servo frames (:meth:`RunLog.autopilot`);
+events (a run that stopped, a SITL vehicle's STATUSTEXT) are ``foxglove.Log`` messages on
+``/bioflex/events`` (:meth:`RunLog.event`), in the chunk in progress in time order.
 Messages are protobuf, built a chunk at a time (:mod:`.formatting`).
 Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or
 :data:`CHUNK_WALL_S` of wall time, or 4096 steps) and handed to the operating system at once,
@@ -22,9 +24,17 @@ import numpy as np
 
 from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogWriteError
-from bioflex_jsb.sinks.mcap.formatting import AutopilotRecords, _ModelChannels, lti_records
+from bioflex_jsb.sinks.mcap.formatting import (
+    AutopilotRecords,
+    _ModelChannels,
+    log_message,
+    lti_records,
+)
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
 from bioflex_jsb.sinks.mcap.schemas import (
+    EVENT_LEVELS,
+    EVENTS_PROTO_SCHEMA,
+    EVENTS_TOPIC,
     FRAME_METADATA,
     PROTO_SCHEMAS,
     RUN_METADATA,
@@ -60,6 +70,8 @@ class RunLog:
         self._rows: list[tuple] = []
         self._pending: _ModelChannels | None = None
         self._streams: list[AutopilotRecorder] = []  # their frames go into the same chunks
+        self._events_id: int | None = None  # the events channel, made at the first event
+        self.events = 0  # events logged
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -170,6 +182,37 @@ class RunLog:
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
+
+    def event(self, t_s: float, level: int | str, text: str, name: str = "bioflex-jsb") -> None:
+        """An event at the log time ``t_s`` [s]: a ``foxglove.Log`` message on
+        ``/bioflex/events`` (``level``: a ``foxglove.Log.Level`` name of
+        :data:`~.schemas.EVENT_LEVELS`, DEBUG … FATAL, or its number; ``text``: what
+        happened; ``name``: who reports it). It goes into the chunk in progress after the
+        steps and frames kept so far (serialised now, the chunk stays open), so an event no
+        earlier than the last step logged keeps the chunk, and the file, in log-time order.
+        ValueError (one line) for an unknown level."""
+        if isinstance(level, str):
+            if level.upper() not in EVENT_LEVELS:
+                raise ValueError(f"event level {level!r} is not one of "
+                                 f"{', '.join(EVENT_LEVELS[1:])}")
+            number = EVENT_LEVELS.index(level.upper())
+        else:
+            number = int(level)
+            if not 0 <= number < len(EVENT_LEVELS):
+                raise ValueError(f"event level {level!r} is not one of 0..{len(EVENT_LEVELS) - 1}")
+        w = self._writer
+        if self._events_id is None:
+            schema_name, data = EVENTS_PROTO_SCHEMA
+            sid = self._writer.add_schema(schema_name, "protobuf", data)
+            self._events_id = w.add_channel(EVENTS_TOPIC, sid, {})
+        with _signals_deferred():
+            self._format_pending()  # the steps before the event go first
+            for stream in self._streams:
+                stream._format()
+            log_ns = int(round(t_s * 1e9))
+            w.append(self._events_id, log_ns, self.events,
+                     log_message(log_ns, number, str(text), str(name)))
+            self.events += 1
 
     def autopilot(self, model: str) -> AutopilotRecorder:
         """The recorder of an autopilot's servo frames on ``/bioflex/<model>/autopilot``

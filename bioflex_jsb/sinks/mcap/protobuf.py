@@ -3,12 +3,12 @@ their schemas (``FileDescriptorSet`` records), and a decoder driven by a file's 
 
 The logs' messages are protobuf (``message_encoding: protobuf``, schema encoding
 ``protobuf``: a serialised ``google.protobuf.FileDescriptorSet`` holding the message's file
-and every file it imports), which Foxglove decodes natively. ``foxglove.FrameTransform`` and
-``foxglove.LocationFix`` are Foxglove's published schemas, embedded byte for byte
-(:mod:`.foxglove_descriptors`); the ``bioflex.*`` schemas are built here from their field
-lists. Messages are written by :mod:`.formatting` with numpy, a chunk at a time; this module
-only knows the wire format: varints, tags, length-delimited fields (``protobuf.dev``,
-"Encoding").
+and every file it imports), which Foxglove decodes natively. ``foxglove.FrameTransform``,
+``foxglove.LocationFix`` and ``foxglove.Log`` are Foxglove's published schemas, embedded
+byte for byte (:mod:`.foxglove_descriptors`); the ``bioflex.*`` schemas are built here from
+their field lists. Messages are written by :mod:`.formatting` with numpy, a chunk at a
+time; this module only knows the wire format: varints, tags, length-delimited fields
+(``protobuf.dev``, "Encoding").
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
 from bioflex_jsb.sinks.mcap.protobuf import decoder
-from bioflex_jsb.sinks.mcap.schemas import RUN_METADATA
+from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC, RUN_METADATA
 from bioflex_jsb.sinks.mcap.writer import MAGIC
 
 
@@ -101,8 +101,24 @@ def iter_messages(reader, topics: list[str] | None = None
 iter_json = iter_messages  # the name from when every log was JSON
 
 
+def read_events(reader, summary) -> list[dict]:
+    """The events of a log (``/bioflex/events``, ``foxglove.Log``) in log-time order: time
+    [s], level name, text and reporter's name (only the chunks that hold events are read)."""
+    if not any(ch.topic == EVENTS_TOPIC for ch in summary.channels.values()):
+        return []
+    out = []
+    for _, ns, msg in iter_messages(reader, [EVENTS_TOPIC]):
+        level = msg.get("level", 0)
+        out.append({"time_s": ns * 1e-9,
+                    "level": EVENT_LEVELS[level] if 0 <= level < len(EVENT_LEVELS)
+                    else str(level),
+                    "text": msg.get("message", ""), "name": msg.get("name", "")})
+    return out
+
+
 def summarise(path: str | Path) -> dict:
-    """Channels (topic, schema, count), duration, chunks and metadata of a finished log."""
+    """Channels (topic, schema, count), duration, chunks, metadata and events
+    (:func:`read_events`) of a finished log."""
     with open_reader(path) as (reader, summary):
         stats = summary.statistics
         counts = dict(stats.channel_message_counts) if stats else {}
@@ -124,6 +140,7 @@ def summarise(path: str | Path) -> dict:
             "end_s": end * 1e-9,
             "duration_s": (end - start) * 1e-9,
             "metadata": meta,
+            "events": read_events(reader, summary),
         }
 
 

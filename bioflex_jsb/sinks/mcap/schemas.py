@@ -18,6 +18,11 @@ GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "loc
 AUTOPILOT_ACTIONS = ("ACTION_STEP", "ACTION_RESEND", "ACTION_RESET")
 AUTOPILOT_PHASES = ("PHASE_REST", "PHASE_LAUNCH", "PHASE_FLIGHT")
 AUTOPILOT_ENUMS = (("Action", AUTOPILOT_ACTIONS), ("Phase", AUTOPILOT_PHASES))
+# The events of a run (one topic for the file, not per model): foxglove.Log messages, whose
+# level is foxglove.Log.Level (these names, numbered from 0)
+EVENTS_TOPIC = "/bioflex/events"
+EVENT_SCHEMA = "foxglove.Log"
+EVENT_LEVELS = ("UNKNOWN", "DEBUG", "INFO", "WARNING", "ERROR", "FATAL")
 
 
 def topic(model: str, group: str) -> str:
@@ -275,3 +280,14 @@ def _proto_schemas() -> dict[str, tuple[str, bytes]]:
 PROTO_FIELDS = {g: _proto_fields(g) for g in SCHEMAS if g not in ("pose", "location")}
 # group → (schema name, serialised FileDescriptorSet): schema encoding "protobuf"
 PROTO_SCHEMAS: dict[str, tuple[str, bytes]] = _proto_schemas()
+
+
+def _event_schema() -> tuple[str, bytes]:
+    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor_set
+
+    return EVENT_SCHEMA, file_descriptor_set(fox.files(fox.LOG_FILES))
+
+
+# the events topic's schema: (name, serialised FileDescriptorSet), schema encoding "protobuf"
+EVENTS_PROTO_SCHEMA: tuple[str, bytes] = _event_schema()
