@@ -53,6 +53,11 @@ def register(sub) -> None:
     add_wing_arguments(p, default="optimised")
     p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
                    help="trim airspeed [m/s] (default 15)")
+    p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
+                   help="the trim the session starts from (and resets to): rigid (the paper's "
+                   "reading, default) or elastic (the static aeroelastic equilibrium: the "
+                   "wing's static deflection and its loads carried by the trim; `bioflex-jsb "
+                   "trim --wing W` shows it)")
     p.add_argument("--model", choices=("coupled", "rigid"), default="coupled",
                    help="elastic wing coupled (default) or rigid; parameter WING_COUPLED")
     p.add_argument("--mavlink", default="udpout:127.0.0.1:14550", metavar="ENDPOINT",
@@ -107,8 +112,9 @@ def run(args: argparse.Namespace) -> int:
     home = _parse_home(args.home, DEFAULT_HOME)
     build = wing_from_args(args)
     try:
-        sim = SitlSim(build.model, build.modes, model=args.model, speed_m_s=args.speed,
-                      home=home, start_height_m=args.start_height, speedup=args.speedup)
+        sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
+                      home=home, start_height_m=args.start_height, speedup=args.speedup,
+                      trim_mode=args.trim)
     except (FdmError, InputError, ValueError) as exc:
         raise UsageError(str(exc)) from None
     try:
@@ -132,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
             models=(args.model,), mass_basis=args.mass_basis,
             **({} if args.duration is None else {"duration_s": args.duration}),
             extra={"until_stopped": args.duration is None, "speedup": args.speedup,
-                   "mavlink": endpoint.text(), "signed": key is not None})
+                   "mavlink": endpoint.text(), "signed": key is not None,
+                   "trim": args.trim})
         try:
             log = SplitLog(args.out, description, build, args.log_max_mb, open_log)
         except UsageError:

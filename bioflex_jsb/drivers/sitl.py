@@ -238,8 +238,13 @@ class SitlSim:
     def __init__(self, wing_model, modes, model: str = "coupled", speed_m_s: float = 15.0,
                  home: tuple[float, float, float] = DEFAULT_HOME,
                  start_height_m: float = DEFAULT_START_HEIGHT_M, dt_s: float = DEFAULT_DT_S,
-                 speedup: float = 1.0, airframe: Airframe | None = None) -> None:
+                 speedup: float = 1.0, airframe: Airframe | None = None,
+                 trim_mode: str = "rigid") -> None:
+        """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
+        ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
+        :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``)."""
         check_home(*home, start_height_m)
+        self.trim_mode = trim_mode
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
         self._wing_model, self._model0 = wing_model, model
         self.home_deg = tuple(float(x) for x in home)
@@ -290,8 +295,13 @@ class SitlSim:
                 af[name] = 0.0  # the trim and the RPM settling see no autopilot
             af["ap/armed"] = 1.0
 
-        self.core = CoupledStep(a, self._wing_model, model, self.speed_m_s,
-                                self.start_altitude_m, self._dt0, before_trim=disengage)
+        elastic = self.trim_mode == "elastic" and model != "rigid"
+        wing = self._wing_model
+        if not elastic and hasattr(wing, "model"):  # a WingBuild: the model is enough
+            wing = wing.model
+        self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
+                                self._dt0, before_trim=disengage,
+                                trim_mode="elastic" if elastic else "rigid")
         self.trim = self.core.trim
         self._relocate()
         self._get = self.core.get
