@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
                       trim_mode=args.trim)
-    except (FdmError, InputError, ValueError) as exc:
+    except (FdmError, InputError) as exc:  # the airframe cannot trim, a home out of range
         raise UsageError(str(exc)) from None
     try:
         link = MavlinkLink(endpoint, SitlParameters(sim), sim.vehicle, signing_key=key)

@@ -112,7 +112,7 @@ def _build(args: argparse.Namespace):
         physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
                                    altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
                                    launcher=launcher, record_every=args.record_every)
-    except (FdmError, ValueError) as exc:
+    except FdmError as exc:  # the airframe cannot load or trim (InputErrors reach the CLI)
         raise UsageError(str(exc)) from None
     return physics, variant, overrides
 

@@ -102,6 +102,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.links.ardupilot_json import RESEND, RESET, FrameRecord, JsonState
 from bioflex_jsb.runtime.coupled_step import CoupledStep
@@ -204,9 +205,9 @@ class Launcher:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.accel_m_s2) and 5.0 <= self.accel_m_s2 <= 200.0):
-            raise ValueError(f"launch acceleration must be 5..200 m/s^2, got {self.accel_m_s2!r}")
+            raise InputError(f"launch acceleration must be 5..200 m/s^2, got {self.accel_m_s2!r}")
         if not (math.isfinite(self.height_m) and 0.5 <= self.height_m <= 100.0):
-            raise ValueError(f"launcher height must be 0.5..100 m, got {self.height_m!r}")
+            raise InputError(f"launcher height must be 0.5..100 m, got {self.height_m!r}")
 
 
 class ArduPilotPhysics:
@@ -231,10 +232,10 @@ class ArduPilotPhysics:
                  gust_at_s: float = 60.0, launcher: Launcher | None = None,
                  record_every: int = 8) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
-            raise ValueError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
+            raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
         if isinstance(record_every, bool) or not isinstance(record_every, int) \
                 or record_every < 0:
-            raise ValueError(f"record_every must be an integer >= 0, got {record_every!r}")
+            raise InputError(f"record_every must be an integer >= 0, got {record_every!r}")
         self.airframe = airframe
         self.wing_model = wing
         self.model = model
