@@ -324,7 +324,11 @@ def test_flood_of_random_bytes_does_not_stop_the_loop_or_the_link(build):
     finally:
         sent = int(flood.communicate(timeout=10)[0] or 0)
     assert sent > 1000, "the flood did not run"
-    assert link.stats.datagrams > 100 and link.stats.received == 0
+    # Random bytes can hold a valid frame by chance: a MAVLink frame is checked by a 16-bit
+    # CRC (with the message's CRC_EXTRA), so about one candidate start byte in 65 536 passes
+    # (CI once saw 1 VISION_POSITION_ESTIMATE in 7.8 MB); none may be more than chance.
+    assert link.stats.datagrams > 100
+    assert link.stats.received <= 5, link.stats
     assert sim.t_s == pytest.approx(duration, abs=sim.dt_s)
     # Function, not timing: the flood neither stops the loop nor makes it fall behind for
     # good (it flies the whole duration, every step has a pacing record). How fast it keeps
