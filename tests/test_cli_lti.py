@@ -7,22 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from bioflex_jsb.cli import main
 from bioflex_jsb.parameters import prototype as P
-
-
-def run_cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def assert_one_line_error(code, err, needle):
-    assert code == 2
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1, err
-    assert "Traceback" not in err
-    assert needle in lines[0], lines[0]
+from tests.cli_helpers import assert_one_line_error, run_cli
 
 
 def test_modes_json_matches_table3_within_10_percent(capsys):

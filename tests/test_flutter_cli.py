@@ -9,20 +9,7 @@ import pytest
 
 from bioflex_jsb.cli import main
 from bioflex_jsb.parameters import goland as G
-
-
-def run_cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def assert_one_line_error(code, err, needle):
-    assert code == 2
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    assert len(lines) == 1, err
-    assert "Traceback" not in err
-    assert needle in lines[0], lines[0]
+from tests.cli_helpers import assert_one_line_error, run_cli
 
 
 @pytest.fixture(scope="module")

@@ -16,11 +16,9 @@ from bioflex_jsb.cli.common import (
     wing_from_args,
 )
 
-# The log is written in small chunks when the loop has time for them: a chunk of the default
-# 0.5 s (480 steps) takes ≈ 10 ms to format and compress, and would make the steps after it late.
-LOG_FLUSH_STEPS = 24
-LOG_FLUSH_SLACK_S = 0.7e-3
-LOG_FLUSH_MAX_STEPS = 96  # faster than real time there is less slack: smaller chunks (≈ 1.6 ms)
+# The log is written in small chunks when the loop has time for them (a chunk of 0.5 s, 480
+# steps, takes ≈ 10 ms to format and compress and would make the steps after it late):
+# drivers.sitl.log_flush_due says when.
 # MAV_SEVERITY (0 EMERGENCY … 7 DEBUG) → the foxglove.Log level of the event in the log
 # (crashes, CRITICAL, and divergences, ERROR, are both ERROR: the session goes on)
 EVENT_LEVEL = {0: "FATAL", 1: "FATAL", 2: "ERROR", 3: "ERROR", 4: "WARNING", 5: "INFO",
@@ -285,8 +283,9 @@ class SplitLog:
                 self._event(last)
 
     def idle(self, slack_s: float) -> None:
-        if (self._pending >= LOG_FLUSH_STEPS and slack_s >= LOG_FLUSH_SLACK_S
-                or self._pending >= LOG_FLUSH_MAX_STEPS):
+        from bioflex_jsb.drivers.sitl import log_flush_due
+
+        if log_flush_due(self._pending, slack_s):
             self._log.flush()
             self._pending = 0
             if os.path.getsize(self.paths[-1]) >= self.max_bytes:

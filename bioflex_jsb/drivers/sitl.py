@@ -504,6 +504,21 @@ def run_paced(
     return stats
 
 
+# When a session's log writes its kept steps as a chunk (``bioflex-jsb sitl`` and the
+# pacing benchmark): once at least LOG_FLUSH_STEPS are kept and the loop has
+# LOG_FLUSH_SLACK_S [s] of slack before the next step, and at LOG_FLUSH_MAX_STEPS whatever
+# the slack (faster than real time there is less slack: smaller chunks, ≈ 1.6 ms each).
+LOG_FLUSH_STEPS = 24
+LOG_FLUSH_SLACK_S = 0.7e-3
+LOG_FLUSH_MAX_STEPS = 96
+
+
+def log_flush_due(pending_steps: int, slack_s: float) -> bool:
+    """Whether a session log with ``pending_steps`` kept should write them now."""
+    return (pending_steps >= LOG_FLUSH_STEPS and slack_s >= LOG_FLUSH_SLACK_S
+            or pending_steps >= LOG_FLUSH_MAX_STEPS)
+
+
 def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "optimised",
                    speed_m_s: float = 15.0, mavlink: str = "udpin:127.0.0.1:0",
                    log_path: str | None = None) -> dict:
@@ -535,7 +550,7 @@ def measure_pacing(duration_s: float = 2.0, speedup: float = 1.0, wing: str = "o
             pending[0] += 1
 
         def idle(slack_s: float) -> None:  # as the CLI's session log
-            if pending[0] >= 24 and slack_s >= 0.7e-3 or pending[0] >= 96:
+            if log_flush_due(pending[0], slack_s):
                 log.flush()
                 pending[0] = 0
     try:
