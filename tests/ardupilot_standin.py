@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import re
+import select
 import socket
 import struct
 from dataclasses import dataclass, field
@@ -204,8 +205,17 @@ class ArduPilotStandin:
         self.sock.settimeout(timeout_s)
         self.restart()
 
-    def restart(self) -> None:
-        """A new SITL process: counters, clock and buffer from zero (the socket is kept)."""
+    def restart(self, new_process: bool = False) -> None:
+        """SITL started again: counters, clock and buffer from zero. ``new_process``: as a
+        new ArduPilot process after the old one was killed, a new socket, so the servo
+        packets come from a new ephemeral port (SITL's JSON socket is never bound:
+        ``JSON::set_interface_ports`` only sets the target); otherwise the socket is kept."""
+        if new_process:
+            timeout = self.sock.gettimeout()
+            self.sock.close()
+            self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            self.sock.bind(("127.0.0.1", 0))
+            self.sock.settimeout(timeout)
         self.frame_counter = 0
         self.last_timestamp_s = 0.0
         self.time_now_us = 0.0
@@ -217,6 +227,15 @@ class ArduPilotStandin:
 
     def close(self) -> None:
         self.sock.close()
+
+    @property
+    def source(self) -> tuple[str, int]:
+        """(address, port) the servo packets come from."""
+        return self.sock.getsockname()
+
+    def pending(self) -> bool:
+        """Whether a datagram waits to be read (without waiting)."""
+        return bool(select.select([self.sock], [], [], 0.0)[0])
 
     def packet(self, pwm_us: list[int] | tuple[int, ...], frame_count: int | None = None) -> bytes:
         """The servo datagram for ``pwm_us`` (padded with 0 to the channel count)."""

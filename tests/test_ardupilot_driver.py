@@ -53,9 +53,10 @@ def _physics(wing, **kw):
 class Link:
     """A server and a stand-in taking turns: one frame out, one reply in."""
 
-    def __init__(self, physics):
+    def __init__(self, physics, **server_kw):
         self.physics = physics
-        self.server = aj.LockstepServer(physics, port=0, on_frame=physics.on_frame)
+        self.server = aj.LockstepServer(physics, port=0, on_frame=physics.on_frame,
+                                        on_event=physics.event, **server_kw)
         self.ap = ArduPilotStandin(self.server.address)
 
     def frame(self, pwm):
@@ -466,21 +467,25 @@ def test_log_is_read_by_mcap_core_and_protobufjs(session_log, tmp_path_factory):
     assert theirs == mine
 
 
-def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
-    from bioflex_jsb.cli import build_parser
-
+def _free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
         s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    table, summary = tmp_path / "run.npz", tmp_path / "run.json"
-    monkeypatch.setenv("BIOFLEX_LOG_DIR", str(tmp_path / "logs"))  # the default log place
-    args = build_parser().parse_args([
-        "ardupilot", "--port", str(port), "--duration", "0.1", "--table", str(table),
-        "--summary", str(summary), "--record-every", "4"])
+        return s.getsockname()[1]
+
+
+def _cli_session(argv: list[str], port: int, second_sender: bool = False) -> tuple[int, int]:
+    """Run ``bioflex-jsb ardupilot ARGV`` in a thread and fly the stand-in against it until
+    it ends (``--duration``); with ``second_sender`` another stand-in sends a frame 0 after
+    each of the first one's frames. Returns (exit status, the stand-in's port)."""
+    from bioflex_jsb.cli import build_parser
+
+    args = build_parser().parse_args(["ardupilot", "--port", str(port), *argv])
     result = {}
     th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
     th.start()
     ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
+    other = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
+    ap_port = ap.source[1]
     try:
         for _ in range(400):
             if not th.is_alive():
@@ -490,10 +495,22 @@ def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
                 ap.receive()
             except TimeoutError:
                 continue
+            if second_sender and ap.frame_counter > 1:  # once bound
+                other.send_servos(DISARMED)
     finally:
         ap.close()
+        other.close()
     th.join(10.0)
-    assert result.get("rc") == 0
+    return result.get("rc"), ap_port
+
+
+def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
+    port = _free_port()
+    table, summary = tmp_path / "run.npz", tmp_path / "run.json"
+    monkeypatch.setenv("BIOFLEX_LOG_DIR", str(tmp_path / "logs"))  # the default log place
+    rc, _ = _cli_session(["--duration", "0.1", "--table", str(table), "--summary",
+                          str(summary), "--record-every", "4"], port)
+    assert rc == 0
     s = json.loads(summary.read_text())
     assert s["frames"]["steps"] >= 96 and s["phase"] == "rest" and s["stops"] == []
     with np.load(table) as z:
@@ -512,3 +529,216 @@ def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
     d = sink.description_from_metadata(meta)
     assert d.kind == "ardupilot" and d.extra["autopilot"] == "ardupilot"
     assert d.extra["udp_port"] == port and d.dt_s == pytest.approx(ad.DEFAULT_DT_S)
+
+
+# ---------------------------------------------------------------------------------------
+# Sessions as a user flies them (faults of a flight with a real ArduPlane: re-launches
+# mid-mission, the gust after every launch, the real-time factor after restarts, stops not
+# in the log, an unflyable wing accepted)
+# ---------------------------------------------------------------------------------------
+
+CRUISE = (1500, 1000, 1500, 1500)  # mid-mission: throttle well up; elevator full nose down
+
+
+class FakeClock:
+    """The server's wall clock, advanced by the test [s] (no dependence on machine load)."""
+
+    def __init__(self) -> None:
+        self.t = 50.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+def _launch(link, pwm=ARMED_IDLE):
+    ph = link.physics
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps):
+        link.frame(pwm)
+    assert ph.phase == ad.FLIGHT
+
+
+def _fly_to_a_stop(link, limit=3000):
+    ph = link.physics
+    n = len(ph.stops)
+    for _ in range(limit):
+        link.frame(CRUISE)
+        if len(ph.stops) > n:
+            return
+    pytest.fail("no valid-range stop")
+
+
+def test_a_stop_resets_once_and_no_relaunch_until_arduPilot_restarts(link):
+    ph = link.physics
+    _launch(link)
+    _fly_to_a_stop(link)
+    assert ph.phase == ad.REST and ph.grounded and ph.launches == 1
+    # ArduPlane is still mid-mission: throttle up for 4 s (8 launch holds): no re-launch
+    for _ in range(8 * ph.launch_hold_steps):
+        p = link.frame(CRUISE)
+    assert ph.launches == 1 and ph.phase == ad.REST and len(ph.stops) == 1
+    assert p.values["velocity"] == (0, 0, 0)
+    stop_events = [e for e in ph.events if e[1] == "ERROR"]
+    assert len(stop_events) == 1 and "valid-range stop" in stop_events[0][2]
+    assert stop_events[0][0] == pytest.approx(ph.stops[0]["session_s"])
+    # ArduPilot restarts: the launcher is armed again
+    link.ap.restart()
+    link.frame(DISARMED)
+    assert ph.restarts == 1 and not ph.grounded
+    _launch(link)
+    link.frame(ARMED_IDLE)  # one step of the second flight
+    s = ph.summary()
+    assert (s["launches"], s["relaunches"], s["stop_count"], s["restarts"]) == (2, 1, 1, 1)
+    assert s["flown_s"] > s["stops"][0]["flight_s"] > 0.0
+
+
+def _steps(ph, n, pwm=ARMED_IDLE):
+    w = []
+    for _ in range(n):
+        ph.step(pwm + (0,) * 12, 1200)
+        w.append(ph._last_w_g if ph.phase == ad.FLIGHT else 0.0)
+    return np.array(w)
+
+
+@pytest.mark.parametrize("repeat", [False, True])
+def test_gust_blows_once_per_session_unless_repeated(wing, repeat):
+    ph = _physics(wing, gust=parse_gust("1cos:2:15"), gust_at_s=0.1, gust_repeat=repeat)
+    n_launch = ph.launch_hold_steps + ph.stroke_steps
+    n_gust = int(1.3 / ph.dt_s)  # past the 1 s gust that starts 0.1 s into the flight
+    first = _steps(ph, n_launch + n_gust)
+    assert np.max(np.abs(first)) == pytest.approx(2.0, rel=1e-6)
+    report = dict(ph.gust_report)
+    ph.reset()  # ArduPilot restarts, launches again
+    second = _steps(ph, n_launch + n_gust)
+    assert ph.launches == 2 and ph.phase == ad.FLIGHT
+    if repeat:
+        assert np.max(np.abs(second)) == pytest.approx(2.0, rel=1e-6)
+    else:
+        assert np.all(second == 0.0) and ph.gust is None
+        assert ph.gust_report == report  # the session's one gust
+    assert ph.summary()["gust_applied"] and ph.summary()["gust_repeat"] == repeat
+
+
+def test_real_time_factor_at_a_known_pace_across_a_kill_and_restart(wing):
+    """300 frames 2 ms apart, ArduPilot killed, 10 s of silence, a new ArduPilot on a new
+    port, 300 frames 2 ms apart: physics time 600/960 s over 598 x 2 ms connected."""
+    from bioflex_jsb.cli.sitl_ardupilot import session_summary
+
+    clock = FakeClock()
+    lk = Link(_physics(wing), clock=clock)
+    try:
+        clock.t += 20.0  # ArduPlane booting: not connected
+        for _ in range(300):
+            clock.t += 2e-3
+            lk.frame(DISARMED)
+        lk.ap.restart(new_process=True)
+        clock.t += 10.0
+        lk.ap.send_servos(DISARMED)  # ArduPilot's frame 0, re-sent until answered
+        assert lk.server.serve_once(5.0) and lk.ap.receive() is not None
+        for _ in range(299):
+            clock.t += 2e-3
+            lk.frame(DISARMED)
+        ph = lk.physics
+        s = session_summary(ph, lk.server, wall_s=clock.t - 50.0)
+    finally:
+        lk.close()
+    assert s["frames"]["resets"] == 1 and s["source_check"]["restarts_new_port"] == 1
+    assert s["session_s"] == pytest.approx(600 * ph.dt_s)
+    assert s["connected_wall_s"] == pytest.approx(598 * 2e-3)
+    assert s["real_time_factor"] == pytest.approx((600 / 960) / (598 * 2e-3), rel=1e-9)
+    assert s["real_time_factor"] == pytest.approx(0.5226, abs=1e-4)
+    # the old figure: time since the last restart over the wall time from the first frame
+    old = ph.t_s / (clock.t - 70.0)
+    assert old < 0.5 * s["real_time_factor"]
+
+
+def test_session_events_are_in_the_log(wing, tmp_path):
+    path = tmp_path / "events.mcap"
+    ph = _physics(wing)
+    desc = RunDescription(kind="ardupilot", wing="optimised", speed_m_s=15.0, gust="none",
+                          models=("coupled",), dt_s=ph.dt_s, extra={"autopilot": "ardupilot"})
+    log = sink.RunLog.open(path, desc)
+    ph.log_to(log)
+    lk = Link(ph)
+    stray = ArduPilotStandin(lk.server.address)
+    try:
+        for _ in range(20):
+            lk.frame(DISARMED)
+        stray.send_servos(DISARMED)  # frame 0 from another port
+        assert lk.server.serve_once(5.0)
+        ph.flush_events()
+        _launch(lk)
+        _fly_to_a_stop(lk)
+        lk.frame(DISARMED)
+    finally:
+        stray.close()
+        lk.close()
+        log.close()
+    _doctor(path)
+    events = [m for _, m in sink.messages_by_topic(path)[sink.EVENTS_TOPIC]]
+    texts = [m["message"] for m in events]
+    assert any("bound to ArduPilot" in t for t in texts)
+    assert any("ignored a servo packet" in t for t in texts)
+    assert any("launch 1" in t for t in texts)
+    (stop,) = [m for m in events if "valid-range stop" in m["message"]]
+    assert stop["level"] in ("ERROR", 4)
+    assert ph.summary()["stop_count"] == 1 and lk.server.stats.resets == 0
+
+
+def test_unsteady_wing_flies_on_the_python_step():
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    build = build_wing(VARIANTS["inertial-backward"])
+    ph = ad.ArduPilotPhysics(Airframe(), build, "coupled", aero="unsteady", compiled=False)
+    assert ph.step_kind == "python" and ph.core.aero == "unsteady"
+    _steps(ph, ph.launch_hold_steps + ph.stroke_steps + 480)
+    s = ph.summary()
+    assert s["phase"] == ad.FLIGHT and s["stop_count"] == 0
+    assert (s["aero"], s["step"]) == ("unsteady", "python")
+    assert np.any(ph.core.eta != 0.0)
+
+
+def test_unflyable_wing_is_refused_before_the_flight(capsys):
+    """--wing inertial-backward: quasi-steady flutter at 14.9 m/s, below the 15 m/s trim
+    (531 stops in 15 min when it was flown); the unsteady strips are stable to 18.9 m/s."""
+    from bioflex_jsb.cli import main
+    from bioflex_jsb.cli.sitl_ardupilot import preflight
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    assert main(["ardupilot", "--wing", "inertial-backward", "--port", "0", "--no-log"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    for word in ("15 m/s", "aeroelastic_1", "14.9 m/s", "--aero unsteady", "18.9 m/s",
+                 "--allow-unstable"):
+        assert word in err, err
+    build = build_wing(VARIANTS["inertial-backward"])
+    assert preflight(build, "coupled", "unsteady", 15.0)["stable"]
+    assert not preflight(build, "coupled", "quasi-steady", 15.0)["stable"]
+    ok = preflight(build_wing(VARIANTS["optimised"]), "coupled", "quasi-steady", 15.0)
+    assert ok["stable"] and ok["max_growth_1_s"] < -1.0 and ok["unstable"] == []
+
+
+def test_help_says_servo_5_fires_the_launcher_in_auto():
+    from bioflex_jsb.cli.sitl_ardupilot import HELP
+
+    text = " ".join(HELP.split())
+    assert "in AUTO" not in text.split("launch switch fires it")[1][:20]
+    assert "keeps the throttle at 0 until the launch, so there the launch switch fires it: " \
+        "servo 5" in text
+    assert "armed in AUTO at a NAV_TAKEOFF (throttle" not in text
+
+
+def test_command_line_ignores_a_second_sender_and_prints_json(tmp_path, capsys):
+    out = tmp_path / "s.mcap"
+    rc, ap_port = _cli_session(["--duration", "0.1", "--json", "--out", str(out)],
+                               _free_port(), second_sender=True)
+    assert rc == 0
+    captured = capsys.readouterr()
+    s = json.loads(captured.out)
+    assert s["frames"]["resets"] == 0 and s["source_check"]["foreign_packets"] >= 1
+    assert s["source_check"]["peer"] == f"127.0.0.1:{ap_port}"
+    assert s["step"] == "compiled kernel" and s["aero"] == "quasi-steady"
+    assert s["real_time_factor"] > 0 and "connected" in s["real_time_factor_definition"]
+    assert "ignored a servo packet" in captured.err
+    events = [m["message"] for _, m in sink.messages_by_topic(out)[sink.EVENTS_TOPIC]]
+    end = json.loads(events[-1].removeprefix("session end: "))
+    assert end["session_s"] == s["session_s"] >= 0.1

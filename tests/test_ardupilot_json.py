@@ -412,3 +412,142 @@ def test_level_at_rest_reads_minus_g_on_body_z():
     assert parsed.values["accel_body"] == pytest.approx((0.0, 0.0, -G_M_S2), abs=1e-6)
     dcm = np.array(dcm_of(parsed))
     np.testing.assert_allclose(dcm, np.eye(3), atol=1e-7)
+
+
+# ---------------------------------------------------------------------------------------
+# The source check: one peer per session (faults found by fault injection: one stray
+# 40-byte frame-0 packet reset a flight; a second sender caused 102 resets)
+# ---------------------------------------------------------------------------------------
+
+class FakeClock:
+    """A wall clock the test advances [s]: no test here depends on the machine's pace."""
+
+    def __init__(self) -> None:
+        self.t = 1000.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+@pytest.fixture
+def bound():
+    """A server on a fake clock, its events, and ArduPilot's stand-in bound as the peer."""
+    physics = LevelTurn()
+    clock = FakeClock()
+    events: list[tuple[str, str]] = []
+    records: list[aj.FrameRecord] = []
+    server = aj.LockstepServer(physics, port=0, on_frame=records.append,
+                               on_event=lambda lvl, text: events.append((lvl, text)),
+                               clock=clock)
+    ap = ArduPilotStandin(server.address)
+    others: list[ArduPilotStandin] = []
+    yield physics, server, ap, clock, events, others
+    for o in (ap, *others):
+        o.close()
+    server.close()
+
+
+def _paced_frame(server, ap, clock, pwm, pace_s):
+    clock.t += pace_s
+    return _frame(server, ap, pwm)
+
+
+def test_stray_frame_zero_from_another_port_never_resets_the_flight(bound):
+    physics, server, ap, clock, events, others = bound
+    for k in range(50):
+        assert _paced_frame(server, ap, clock, _pwm(k), 1e-3) is not None
+    stray = ArduPilotStandin(server.address)
+    others.append(stray)
+    stray.send_servos([1500] * 16)  # 40 bytes, magic 18458, frame_count 0
+    assert len(stray.last_packet) == 40
+    assert server.serve_once(5.0)
+    assert physics.resets == 0 and server.stats.resets == 0 and physics.k == 50
+    assert server.stats.foreign == 1 and server.stats.first_foreign == stray.source
+    assert not stray.pending()  # never answered
+    assert [lvl for lvl, _ in events] == ["INFO", "WARNING"]
+    assert f"{stray.source[1]}" in events[-1][1] and "ignored" in events[-1][1]
+    # the flight goes on where it was
+    parsed = _paced_frame(server, ap, clock, _pwm(50), 1e-3)
+    assert parsed.values["timestamp"] == 51 * DT_S and server.peer == ap.source
+
+
+def test_second_sender_interleaving_frames_causes_no_reset_and_no_step(bound):
+    physics, server, ap, clock, events, others = bound
+    second = ArduPilotStandin(server.address)
+    others.append(second)
+    _paced_frame(server, ap, clock, _pwm(0), 1e-3)
+    for k in range(1, 121):
+        second.send_servos(_pwm(1000 + k))  # its own counter, 0 every time (never answered)
+        second.frame_counter = k % 7  # and any counts at all, going back and forth
+        assert server.serve_once(5.0)
+        assert _paced_frame(server, ap, clock, _pwm(k), 1e-3) is not None
+    assert server.stats.resets == 0 and physics.resets == 0
+    assert len(physics.steps) == 121 and server.stats.foreign == 120
+    assert all(p == tuple(_pwm(k)) for k, (p, _) in enumerate(physics.steps))
+    assert not second.pending()
+    # reported: the first one, then at 10 and 100 (not 120 lines)
+    warnings = [t for lvl, t in events if lvl == "WARNING"]
+    assert len(warnings) == 3 and "10 servo packets" in warnings[1] \
+        and "100 servo packets" in warnings[2]
+    assert server.peer == ap.source
+
+
+def test_restart_from_the_same_port_resets_and_a_stale_count_is_ignored(bound):
+    physics, server, ap, clock, events, _ = bound
+    for k in range(20):
+        _paced_frame(server, ap, clock, _pwm(k), 1e-3)
+    # a smaller frame_count other than 0: not a restart (ArduPilot restarts at frame 0)
+    ap.sock.sendto(ap.packet(_pwm(0), frame_count=7), server.address)
+    assert server.serve_once(5.0)
+    assert server.stats.stale == 1 and physics.resets == 0 and not ap.pending()
+    ap.restart()  # the same socket: frame 0 again from the peer's port
+    parsed = _paced_frame(server, ap, clock, _pwm(0), 1e-3)
+    assert physics.resets == 1 and server.stats.resets == 1 and server.stats.rebinds == 0
+    assert parsed.values["timestamp"] == DT_S
+    assert "restarted" in events[-1][1]
+
+
+def test_killed_arduPilot_restarted_on_a_new_port_rebinds_after_the_silence(bound):
+    physics, server, ap, clock, events, _ = bound
+    for k in range(30):
+        _paced_frame(server, ap, clock, _pwm(k), 1e-3)
+    old = ap.source
+    ap.restart(new_process=True)  # SIGKILL, then a new ArduPlane: new ephemeral port
+    assert ap.source != old
+    clock.t += 1.0  # its frame 0 within the silence: could be a second sender
+    ap.send_servos(_pwm(0))
+    assert server.serve_once(5.0)
+    assert not ap.pending() and physics.resets == 0 and server.stats.foreign == 1
+    clock.t += aj.PEER_SILENCE_S  # ArduPilot re-sends frame 0 every second
+    ap.resend()
+    assert server.serve_once(5.0)
+    parsed = ap.receive()
+    assert parsed is not None and parsed.values["timestamp"] == DT_S
+    assert physics.resets == 1 and server.stats.rebinds == 1 and server.peer == ap.source
+    assert "new port" in events[-1][1]
+    # the old port, back from the dead, is now the foreign one
+    stale = ArduPilotStandin(server.address)
+    try:
+        stale.send_servos(_pwm(0))
+        assert server.serve_once(5.0)
+        assert physics.resets == 1 and server.stats.foreign == 2
+    finally:
+        stale.close()
+
+
+def test_connected_wall_time_excludes_waiting_and_the_dead_peer(bound):
+    """The real-time factor's denominator at a known pace: 200 frames 2 ms apart (a pace
+    of 1/960 s of physics per 2 ms: 0.52 x real time), a kill, 10 s of silence, a new
+    ArduPilot, 100 more frames at the same pace."""
+    physics, server, ap, clock, _, _ = bound
+    clock.t += 25.0  # waiting for ArduPilot to boot: not connected time
+    pace_s = 2e-3
+    for k in range(200):
+        _paced_frame(server, ap, clock, _pwm(k), pace_s)
+    assert server.stats.connected_wall_s == pytest.approx(199 * pace_s, rel=1e-9)
+    ap.restart(new_process=True)
+    clock.t += 10.0
+    for k in range(100):
+        assert _paced_frame(server, ap, clock, _pwm(k), pace_s) is not None
+    assert server.stats.rebinds == 1
+    assert server.stats.connected_wall_s == pytest.approx(298 * pace_s, rel=1e-9)

@@ -20,22 +20,44 @@ from bioflex_jsb.cli.common import (
 
 HELP = """Be ArduPilot's physics: answer ArduPlane SITL started with --model JSON:127.0.0.1
 (UDP 9002 + 10 x --instance) lock-step, one co-simulation step per ArduPilot frame, with the
-JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native). The aircraft
-starts at rest on a launcher; ArduPlane armed in AUTO at a NAV_TAKEOFF (throttle above
-1020 us for 0.5 s) fires it (--launch-accel m/s^2 up to the trim speed --speed); a run that
-leaves the valid range is put back on the launcher, not ended. Servo map, frames and the
-parameter file: docs/ardupilot.md, bioflex_jsb/drivers/ardupilot.py,
-bioflex_jsb/data/ardupilot/bioflex_plane.parm. --gust starts --gust-at seconds after the
-launch. Runs until Ctrl-C/SIGTERM or --duration simulated seconds, then prints a JSON
-summary (frames, resends, resets, stops, the gust's eta1 peak). Every frame is logged to
-the MCAP log as for any run (--out, --no-log; docs/logging.md): ArduPilot's frame count,
-rate and servo PWM, the mapped controls, the lock-step action and the launcher phase on
-/bioflex/<model>/autopilot, and every coupled step in flight on the run topics.
---table FILE.npz also keeps every --record-every-th frame (servos 1-4, ArduPilot's frame
-count, the step's channels) as a numpy table. Never expose ArduPlane's TCP ports: run both inside a
-loopback-only network namespace (scripts/ardupilot_sitl.py fly)."""
+JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native; --aero
+unsteady for the coupled wing's unsteady strips, which run on the Python step). The session
+binds to the first ArduPilot that sends (address and port); servo packets from any other
+source are counted and reported, never answered; a restart of that ArduPilot (frame 0
+again, or frame 0 from its address on a new port after 3 s of silence) resets the physics.
+The aircraft starts at rest on a launcher. Armed in AUTO at a NAV_TAKEOFF, ArduPlane keeps
+the throttle at 0 until the launch, so there the launch switch fires it: servo 5
+(SERVO5_FUNCTION 55, RC 5 passed through) at 1880..1920 us for 0.5 s; in TAKEOFF mode the
+idle throttle on servo 3 above 1020 us for 0.5 s fires it too (--launch-accel m/s^2 up to
+the trim speed --speed). A run that leaves the valid range is put back on the launcher once,
+reported, and stays there until ArduPilot restarts (no re-launch mid-mission). --gust starts
+--gust-at seconds after the launch, once per session (--gust-repeat: after every launch).
+Before the flight the chosen model's stability at the trim speed is checked (eigenvalues of
+the linear model; the phugoid left out): an unstable wing is refused (exit 2) unless
+--allow-unstable. Servo map, frames and the parameter file: docs/ardupilot.md,
+bioflex_jsb/drivers/ardupilot.py, bioflex_jsb/data/ardupilot/bioflex_plane.parm. Runs until
+Ctrl-C/SIGTERM or --duration simulated seconds, then prints a summary (--json: JSON; frames,
+resends, restarts, ignored packets, stops, re-launches, the real-time factor, the gust's
+eta1 peak). Every frame is logged to the MCAP log as for any run (--out, --no-log;
+docs/logging.md): ArduPilot's frame count, rate and servo PWM, the mapped controls, the
+lock-step action and the launcher phase on /bioflex/<model>/autopilot, every coupled step in
+flight on the run topics, and the session's events (binding, ignored packets, restarts,
+launches, stops, the summary at the end) on /bioflex/events. --table FILE.npz also keeps
+every --record-every-th frame (servos 1-4, ArduPilot's frame count, the step's channels) as
+a numpy table. Never expose ArduPlane's TCP ports: run both inside a loopback-only network
+namespace (scripts/ardupilot_sitl.py fly)."""
 
 NATIVE = "native"
+AERO_CHOICES = ("quasi-steady", "unsteady")
+# DEFINITION: a root is unstable when Re(lambda) exceeds this [1/s] (the flutter search's
+# threshold, bioflex_jsb.flight_dynamics.eigen.find_flutter / free_aircraft.GROWTH_TOL_1_S).
+GROWTH_TOL_1_S = 1e-9
+PREFLIGHT_GRID_STEP_M_S = 0.5  # mode tracking from 2 m/s to the trim speed (labels only)
+RTF_DEFINITION = (
+    "session_s / connected_wall_s: the physics time advanced (every frame stepped, across "
+    "ArduPilot restarts) over the wall time while an ArduPilot peer was connected (gaps "
+    "between its frames shorter than 3 s; waiting for a peer and a killed ArduPilot's "
+    "silence are left out)")
 
 
 def register(sub) -> None:
@@ -57,6 +79,14 @@ def register(sub) -> None:
                    "vonkarman:..., none (default none)")
     p.add_argument("--gust-at", type=finite_float("gust start", "s"), default=60.0,
                    help="gust start [s after the launch] (default 60)")
+    p.add_argument("--gust-repeat", action="store_true",
+                   help="blow the gust after every launch (default: once per session)")
+    p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
+                   help="the coupled wing's strips: quasi-steady (the paper's; compiled "
+                   "kernel) or unsteady (Jones lag states, apparent mass, Kuessner gust; the "
+                   "Python step); default quasi-steady")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="fly a model that is unstable at the trim speed (refused otherwise)")
     p.add_argument("--instance", type=int, default=0,
                    help="ArduPilot SITL instance (-I): UDP port 9002 + 10 x N (default 0)")
     p.add_argument("--port", type=int, default=None,
@@ -69,12 +99,69 @@ def register(sub) -> None:
                    help="record every N-th frame in --table (default 8: 120 Hz)")
     p.add_argument("--summary", metavar="FILE.json", default=None,
                    help="also write the summary to this file")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_log_arguments(p)
     p.set_defaults(run=run)
 
 
+def preflight(build, model: str, aero: str, speed_m_s: float) -> dict:
+    """The chosen model's stability at the trim speed ``speed_m_s`` [m/s], phugoid left out
+    (the autopilot flies it; the flutter search leaves it out too).
+
+    Quasi-steady: the labelled eigenvalues of the linear model (``api.modes``; ``native``
+    is the coupled wing JSBSim carries, ``rigid`` the short period alone). Unsteady (coupled
+    only): Eq. 4 with the Jones lag states (``aeroelasticity.free_aircraft.track_free``).
+    Returns ``stable``, the unstable roots (mode, Re [1/s], Im [rad/s]) and the largest
+    growth rate [1/s] of the roots considered."""
+    import numpy as np
+
+    from bioflex_jsb import api
+
+    if aero == "unsteady":
+        from bioflex_jsb.aeroelasticity.free_aircraft import EXCLUDED, track_free
+
+        grid = np.append(np.arange(2.0, speed_m_s, PREFLIGHT_GRID_STEP_M_S), speed_m_s)
+        tr = track_free(build, grid, aero="unsteady")
+        roots = [(lab, float(lam.real), float(lam.imag))
+                 for lab, lam in zip(tr.labels, tr.eigenvalues[-1], strict=True)
+                 if lab not in EXCLUDED]
+    else:
+        lti = "coupled" if model == NATIVE else model
+        roots = [(m.mode, float(m.re), float(m.im)) for m in api.modes(build, speed_m_s, lti).modes
+                 if m.mode != "phugoid"]
+    unstable = sorted((r for r in roots if r[1] > GROWTH_TOL_1_S), key=lambda r: -r[1])
+    return {"model": model, "aero": aero, "speed_m_s": speed_m_s, "stable": not unstable,
+            "max_growth_1_s": max(r[1] for r in roots),
+            "unstable": [{"mode": m, "re_1_s": re, "im_rad_s": im} for m, re, im in unstable]}
+
+
+def _refusal(args: argparse.Namespace, build, check: dict) -> str:
+    """The one line that refuses an unstable model, with the speeds that say why."""
+    from bioflex_jsb import api
+    from bioflex_jsb.aeroelasticity.free_aircraft import free_flutter
+
+    worst = check["unstable"][0]
+    text = (f"--wing {args.wing} cannot be flown at {args.speed:g} m/s with the {args.aero} "
+            f"{args.model} wing: its {worst['mode']} root is unstable there "
+            f"(Re = {worst['re_1_s']:+.3g} 1/s)")
+    if args.model in ("coupled", NATIVE):
+        first = api.flutter(build).flutter_speed_m_s if args.aero == "quasi-steady" \
+            else free_flutter(build, aero="unsteady").speed_m_s
+        if first is not None:
+            text += f"; its {args.aero} flutter speed is {first:.1f} m/s"
+        if args.aero == "quasi-steady":
+            other = free_flutter(build, aero="unsteady").speed_m_s
+            if other is None or other > args.speed:
+                how = "--aero unsteady" if args.model == "coupled" else \
+                    "--model coupled --aero unsteady"
+                stable_to = "up to 40 m/s" if other is None else f"to {other:.1f} m/s"
+                text += f"; try {how} (stable {stable_to})"
+    return text + "; --allow-unstable flies it anyway"
+
+
 def _build(args: argparse.Namespace):
-    """The physics, and the wing's variant and coefficient overrides for the log (dicts)."""
+    """The physics, the wing's variant and coefficient overrides for the log (dicts), and
+    the pre-flight check (:func:`preflight`)."""
     from bioflex_jsb.drivers.ardupilot import ArduPilotPhysics, Launcher
     from bioflex_jsb.runtime.fdm import Airframe, FdmError
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
@@ -89,32 +176,45 @@ def _build(args: argparse.Namespace):
         raise UsageError(f"--record-every must be >= 0, got {args.record_every}")
     if args.table is not None and not args.table.endswith(".npz"):
         raise UsageError(f"--table must name a .npz file, got {args.table!r}")
+    if args.aero == "unsteady" and args.model != "coupled":
+        raise UsageError(f"--aero unsteady is for --model coupled, not {args.model} (the "
+                         "rigid, qsd and native wings are quasi-steady)")
     try:
         launcher = Launcher(args.launch_accel, args.launch_height)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     if args.model == NATIVE:
-        from bioflex_jsb.flight_dynamics.wing_model import VARIANTS
+        from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
         from bioflex_jsb.generators import native_wing as J
 
         if args.wing not in VARIANTS:
             raise UsageError(f"--model native needs a named wing ({', '.join(VARIANTS)}), "
                              f"got {args.wing!r}")
         aircraft, wing = J.aircraft_name(args.wing), None
+        build = build_wing(VARIANTS[args.wing], mass_basis=args.mass_basis)
         variant, overrides = VARIANTS[args.wing].as_dict(), {}
     else:
         build = wing_from_args(args)
-        aircraft, wing = None, build.model
+        aircraft, wing = None, build
         variant = build.variant.as_dict()
         overrides = dict(build.model.coefficients.overrides)
+    check = preflight(build, args.model, args.aero, args.speed)
+    check["allowed_unstable"] = bool(args.allow_unstable)
+    if not check["stable"] and not args.allow_unstable:
+        raise UsageError(_refusal(args, build, check))
+    # the unsteady strips are not in the compiled kernel: their Python step, asked for
+    # explicitly (the summary's "step" says which one flies)
+    compiled = args.aero == "quasi-steady"
     try:
         airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
         physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
                                    altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
-                                   launcher=launcher, record_every=args.record_every)
+                                   launcher=launcher, record_every=args.record_every,
+                                   gust_repeat=args.gust_repeat, aero=args.aero,
+                                   compiled=compiled)
     except FdmError as exc:  # the airframe cannot load or trim (InputErrors reach the CLI)
         raise UsageError(str(exc)) from None
-    return physics, variant, overrides
+    return physics, variant, overrides, check
 
 
 def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict, port: int):
@@ -136,20 +236,67 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "gust_start": "s after the launch", "udp_port": port,
                "instance": args.instance, "launch_accel_m_s2": physics.launch_accel_m_s2,
                "launch_height_m": physics.launcher.height_m,
-               "record_every": args.record_every})
+               "record_every": args.record_every, "aero": args.aero,
+               "step": physics.step_kind, "gust_repeat": args.gust_repeat,
+               "duration": ("until stopped: the flown duration is in the session-end event "
+                            "(session_s)") if args.duration is None else "--duration"})
     try:
         return RunLog.open(args.out, description, wing_variant=variant, overrides=overrides)
     except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 
 
+def session_summary(physics, server, wall_s: float) -> dict:
+    """The session's summary (JSON-ready): the physics' (:meth:`ArduPilotPhysics.summary`),
+    the server's counters and source check, and one real-time factor
+    (:data:`RTF_DEFINITION`); ``wall_s`` [s] is the whole session's wall time, waiting
+    included (for information)."""
+    st = server.stats
+    summary = physics.summary()
+    connected = st.connected_wall_s
+    summary.update(
+        frames={"steps": st.steps, "resends": st.resends, "resets": st.resets,
+                "skipped": st.frames_skipped, "rejected": st.rejected,
+                "last_frame_count": server.last_frame_count},
+        source_check={
+            "peer": None if server.peer is None else f"{server.peer[0]}:{server.peer[1]}",
+            "foreign_packets": st.foreign, "stale_packets": st.stale,
+            "first_foreign": None if st.first_foreign is None
+            else f"{st.first_foreign[0]}:{st.first_foreign[1]}",
+            "restarts_new_port": st.rebinds},
+        wall_s=wall_s, connected_wall_s=connected,
+        real_time_factor=physics.session_t_s / connected if connected > 0 else None,
+        real_time_factor_definition=RTF_DEFINITION)
+    return summary
+
+
+def _text_report(s: dict) -> str:
+    rtf = s["real_time_factor"]
+    sc = s["source_check"]
+    lines = [f"flew {s['session_s']:.2f} s of physics ({s['flown_s']:.2f} s in flight), "
+             f"{s['frames']['steps']} frames, {s['restarts']} ArduPilot restarts, "
+             f"{s['launches']} launches ({s['relaunches']} re-launches), {s['stop_count']} "
+             f"valid-range stops; {s['step']} step, {s['aero']} wing",
+             "real-time factor " + ("n/a" if rtf is None else f"{rtf:.3f}")
+             + " (physics time over wall time while ArduPilot was connected)"]
+    if sc["foreign_packets"] or sc["stale_packets"]:
+        lines.append(f"ignored {sc['foreign_packets']} packets from other sources than "
+                     f"{sc['peer']} and {sc['stale_packets']} stale ones")
+    for stop in s["stops"]:
+        lines.append(f"stop after {stop['flight_s']:.2f} s of flight: {stop['reason']}")
+    if s["out"]:
+        lines.append(f"log written to {s['out']}")
+    return "\n".join(lines)
+
+
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.links.ardupilot_json import LockstepServer
 
-    physics, variant, overrides = _build(args)
+    wall0 = time.monotonic()
+    physics, variant, overrides, check = _build(args)
     try:
         server = LockstepServer(physics, port=args.port, instance=args.instance,
-                                on_frame=physics.on_frame)
+                                on_frame=physics.on_frame, on_event=physics.event)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     host, port = server.address
@@ -163,36 +310,38 @@ def run(args: argparse.Namespace) -> int:
             server.close()
     if log is not None:
         physics.log_to(log)
+    physics.on_event = lambda t, level, text: print(
+        f"bioflex-jsb ardupilot: {level.lower()}: {text}", file=sys.stderr, flush=True)
+    if not check["stable"]:
+        physics.event("WARNING", f"flying a model unstable at the trim speed "
+                      f"(--allow-unstable): largest growth {check['max_growth_1_s']:+.3g} 1/s")
     print(f"bioflex-jsb ardupilot: physics on UDP {host}:{port} ({args.model} wing "
-          f"{args.wing}, step {physics.dt_s:.6g} s); "
+          f"{args.wing}, {args.aero}, {physics.step_kind} step {physics.dt_s:.6g} s); "
           f"{'log ' + args.out if args.out else 'no log'}; waiting for ArduPilot; Ctrl-C stops",
           file=sys.stderr, flush=True)
-    wall0 = time.monotonic()
-    first_frame_wall = None
     interrupted = False
     try:
-        while args.duration is None or physics.t_s < args.duration:
-            if server.serve_once(0.5) and first_frame_wall is None and server.stats.steps:
-                first_frame_wall = time.monotonic()
+        while args.duration is None or physics.session_t_s < args.duration:
+            server.serve_once(0.5)
+            physics.flush_events()  # the server's events between frames
     except KeyboardInterrupt:
         interrupted = True
     finally:
         server.close()
+        summary = session_summary(physics, server, time.monotonic() - wall0)
+        summary.update(preflight=check, table=args.table, out=args.out,
+                       interrupted=interrupted)
         if log is not None:
+            physics.flush_events()
+            log.event(physics.session_t_s, "INFO", "session end: " + json.dumps(
+                summary, allow_nan=False, separators=(",", ":")))
             log.close()
-    wall_s = time.monotonic() - (first_frame_wall or wall0)
-    st = server.stats
-    summary = physics.summary()
-    summary.update(
-        frames={"steps": st.steps, "resends": st.resends, "resets": st.resets,
-                "skipped": st.frames_skipped, "rejected": st.rejected,
-                "last_frame_count": server.last_frame_count},
-        wall_s=wall_s,
-        real_time_factor=physics.t_s / wall_s if wall_s > 0 and physics.t_s > 0 else None,
-        table=args.table, out=args.out, interrupted=interrupted)
     if args.table is not None:
         _write_table(args.table, physics)
-    print_json(summary)
+    if args.json:
+        print_json(summary)
+    else:
+        print(_text_report(summary))
     if args.summary is not None:
         try:
             with open(args.summary, "w") as fh:

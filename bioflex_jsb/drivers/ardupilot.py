@@ -43,12 +43,16 @@ phases (:attr:`ArduPilotPhysics.phase`):
 * ``flight``: the coupled step, from the trim state at the end of the stroke (the same
   velocity, position and attitude: the hand-over is continuous).
 
-The ground is put ``launch_height_m`` below the launcher; a run that leaves the valid range
+The ground is put ``launch_height_m`` below the launcher. A run that leaves the valid range
 (the ground, deep stall, a diverged mode: :mod:`bioflex_jsb.simulation.limits`) does not end
-the server: the aircraft is put back on the launcher at rest (re-trimmed, wing undeformed),
-the reason is kept in :attr:`ArduPilotPhysics.stops`, and the time goes on (ArduPilot's
-clock must not go back). ArduPilot restarting (its frame count going back) calls
-:meth:`ArduPilotPhysics.reset`: the same, with the time back to 0.
+the server: the aircraft is put back on the launcher at rest once (re-trimmed, wing
+undeformed), the stop is kept in :attr:`ArduPilotPhysics.stops` and reported as an ERROR
+event, and the time goes on (ArduPilot's clock must not go back). It then stays on the
+launcher (``grounded``) until ArduPilot restarts: ArduPlane, still mid-mission, holds its
+throttle up and would otherwise fire the launcher again half a second later, every time
+(a 20 m/s gust gave 38 stops and 39 re-launches in 5 min that way). ArduPilot restarting
+(:meth:`ArduPilotPhysics.reset`) puts it on the launcher with the time back to 0 and the
+launcher armed again: a re-launch needs ArduPilot's restart.
 
 The state sent (:meth:`ArduPilotPhysics.state`), in flight:
 
@@ -65,11 +69,18 @@ The state sent (:meth:`ArduPilotPhysics.state`), in flight:
   the state reached with the wind of the step).
 
 Gusts: any :class:`~bioflex_jsb.simulation.gusts.GustSpec`, starting ``gust_at_s`` [s] after
-the launch (flight time), sampled by the coupled step's step number. The first modal
-coordinate's range and largest change from the gust's start while the gust blows
+the launch (flight time), sampled by the coupled step's step number; once per session (the
+first flight that reaches ``gust_at_s``), or after every launch with ``gust_repeat``. The
+first modal coordinate's range and largest change from the gust's start while the gust blows
 (``*_in_gust``, with n_z's range), and its peak and largest change until
 :data:`GUST_DECAY_S` after it (which may include a manoeuvre of the autopilot's), are
 measured on every step (:attr:`ArduPilotPhysics.gust_report`, [rad]).
+
+Events (:meth:`ArduPilotPhysics.event`): launches, valid-range stops and what the server
+reports (its source check, ArduPilot's restarts) are kept in :attr:`ArduPilotPhysics.events`
+(session time [s], foxglove.Log level, text), logged on ``/bioflex/events`` and handed to
+``on_event`` (the command prints them on stderr). An event raised inside a frame is written
+after the frame's messages, at the time of the state the frame's reply sends.
 
 Recording: :meth:`ArduPilotPhysics.on_frame` (the server's ``on_frame``) keeps every
 ``record_every``-th frame, and every resend and reset, in :attr:`records` (columns
@@ -104,6 +115,7 @@ import numpy as np
 from bioflex_jsb import units as U
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.links.ardupilot_json import RESEND, RESET, FrameRecord, JsonState
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
@@ -221,16 +233,22 @@ class ArduPilotPhysics:
         speed_m_s: trim and launcher exit speed [m/s].
         altitude_m: launch altitude [m above sea level, ISA].
         dt_s: the co-simulation step [s] (ArduPilot adopts 1/dt as its physics rate).
-        gust: the gust (None: still air); gust_at_s: its start [s after the launch].
+        gust: the gust (None: still air); gust_at_s: its start [s after the launch];
+        gust_repeat: after every launch (default: once per session).
         launcher: :class:`Launcher`.
         record_every: keep every n-th frame in :attr:`records` (0: none).
+        aero: the wing's strips, ``quasi-steady`` or ``unsteady`` (coupled model, ``wing`` a
+            WingBuild); compiled: the coupled step's compiled kernel (False: its Python step);
+            both go to :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep` as they are,
+            and :meth:`summary` says which step runs (:attr:`step_kind`).
     """
 
-    def __init__(self, airframe: Airframe, wing: ElasticWingModel | None, model: str,
-                 speed_m_s: float = 15.0, altitude_m: float = 0.0,
+    def __init__(self, airframe: Airframe, wing: ElasticWingModel | WingBuild | None,
+                 model: str, speed_m_s: float = 15.0, altitude_m: float = 0.0,
                  dt_s: float = DEFAULT_DT_S, gust: GustSpec | None = None,
                  gust_at_s: float = 60.0, launcher: Launcher | None = None,
-                 record_every: int = 8) -> None:
+                 record_every: int = 8, gust_repeat: bool = False,
+                 aero: str = "quasi-steady", compiled: bool = True) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
             raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
         if isinstance(record_every, bool) or not isinstance(record_every, int) \
@@ -245,16 +263,25 @@ class ArduPilotPhysics:
         self.gust_spec = gust if gust is not None and gust.kind != "none" else None
         self.gust_at_s = float(gust_at_s)
         self.record_every = record_every
+        self.gust_repeat = bool(gust_repeat)
+        self.aero = aero
+        self.compiled = bool(compiled)
+        self._gust_applied = False  # the gust has begun in a flight of this session
         self._controls: list[Callable[[float], None]] = []
         self.stops: list[dict] = []  # valid-range stops: reason, time [s]
         self.launches = 0
         self.restarts = 0  # ArduPilot restarts (reset())
+        self.grounded = False  # stopped: on the launcher until ArduPilot restarts
+        self.events: list[tuple[float, str, str]] = []  # (session time [s], level, text)
+        self._pending_events: list[tuple[float, str, str]] = []
+        self.on_event: Callable[[float, str, str], None] | None = None
         self.records: list[tuple[float, ...]] = []
         self._log = None  # RunLog (log_to)
         self._autopilot_log = None
         self._step_row: tuple[float, ...] | None = None  # the last frame's flight row
         self._t_offset_s = 0.0  # session time at ArduPilot's last restart [s]
         self._frames_seen = 0
+        self._flown_before_s = 0.0  # flight time of the flights before this one [s]
         self.core: CoupledStep = None  # type: ignore[assignment]
         self._new_core(dt_s)
         self.dt_s = self.core.dt_s
@@ -272,9 +299,10 @@ class ArduPilotPhysics:
         """A fresh coupled step: trimmed at the exit speed, the wing undeformed, the ground
         ``launcher.height_m`` below; the control writers and the readers of the reply."""
         if self.core is not None:
+            self._flown_before_s += self.core.k * self.core.dt_s
             self.core.release()
         core = CoupledStep(self.airframe, self.wing_model, self.model, self.speed_m_s,
-                           self.altitude_m, dt_s)
+                           self.altitude_m, dt_s, compiled=self.compiled, aero=self.aero)
         self.core = core
         a = self.airframe
         node = a.property_node
@@ -312,18 +340,39 @@ class ArduPilotPhysics:
             else:
                 writers.append(node(ch.prop).set_double_value)
         self._controls = writers
-        self.gust = None if self.gust_spec is None else GustField(
+        blows = self.gust_spec is not None and (self.gust_repeat or not self._gust_applied)
+        self.gust = None if not blows else GustField(
             self.gust_spec, self.speed_m_s, self.gust_at_s, self.gust_at_s + 600.0,
             core.dt_s)
         self._gust_steps = (-1, -1)
         self._gust_end_k = -1
-        if self.gust_spec is not None:
+        if blows:
             k0 = math.ceil(self.gust_at_s / core.dt_s - 1e-9)
             length_s = (self.gust_spec.length_m / self.speed_m_s
                         if self.gust_spec.kind == "1cos" else 600.0)
             self._gust_steps = (k0, k0 + int(round((length_s + GUST_DECAY_S) / core.dt_s)))
             self._gust_end_k = k0 + int(round(length_s / core.dt_s))
         core.prepare(0.0)
+
+    @property
+    def step_kind(self) -> str:
+        """Which coupled step flies: ``compiled kernel`` or ``python`` (None for rest)."""
+        return "compiled kernel" if self.core.compiled else "python"
+
+    def event(self, level: str, text: str) -> None:
+        """Report ``text`` (level INFO, WARNING or ERROR) at the session time now; written
+        to the log and ``on_event`` by :meth:`flush_events` (after the frame in progress)."""
+        self._pending_events.append((self.session_t_s, level, text))
+
+    def flush_events(self) -> None:
+        """Log and hand on the events raised since the last call."""
+        pending, self._pending_events = self._pending_events, []
+        for t, level, text in pending:
+            self.events.append((t, level, text))
+            if self._log is not None:
+                self._log.event(t, level, text)
+            if self.on_event is not None:
+                self.on_event(t, level, text)
 
     def _to_rest(self) -> None:
         self.phase = REST
@@ -363,8 +412,9 @@ class ArduPilotPhysics:
 
     # -- JsonPhysics ------------------------------------------------------------------------
     def reset(self) -> None:
-        """ArduPilot restarted: back on the launcher at rest, time 0."""
+        """ArduPilot restarted: back on the launcher at rest, time 0, the launcher armed."""
         self.restarts += 1
+        self.grounded = False
         self._new_core(self.dt_s)
         self._to_rest()
         self._t_offset_s += self.frame_k * self.dt_s
@@ -380,12 +430,15 @@ class ArduPilotPhysics:
             switch = pwm_us[LAUNCH_SWITCH_CHANNEL] if len(pwm_us) > LAUNCH_SWITCH_CHANNEL else 0
             lo, hi = LAUNCH_SWITCH_US
             ready = thr > LAUNCH_THROTTLE_US or lo <= switch <= hi
-            self._throttle_hold_k = self._throttle_hold_k + 1 if ready else 0
+            self._throttle_hold_k = self._throttle_hold_k + 1 if ready and not self.grounded \
+                else 0
             if self._throttle_hold_k >= self.launch_hold_steps:
                 self.phase = LAUNCH
                 self.launches += 1
                 self._stroke_k = 0
                 self._launch_t_s = self.t_s
+                self.event("INFO", f"launch {self.launches} at {self.t_s:.3f} s of ArduPilot's "
+                           f"time ({self.step_kind} step, {self.aero} wing)")
             return
         if self.phase == LAUNCH:
             self._stroke_k += 1
@@ -401,13 +454,19 @@ class ArduPilotPhysics:
         self._last_w_g = w_g
         k0, k1 = self._gust_steps
         if k0 <= k <= k1:
+            self._gust_applied = True
             self._track_gust(k, k0)
         if core.stopped:
+            flight_s = core.k * core.dt_s
             self.stops.append({"reason": core.stopped, "time_s": self.t_s,
-                               "flight_s": core.k * core.dt_s})
+                               "session_s": self.session_t_s, "flight_s": flight_s})
             self._new_core(self.dt_s)
             self._to_rest()
+            self.grounded = True
             self._last_row = self._nan_row
+            self.event("ERROR", f"valid-range stop after {flight_s:.2f} s of flight: "
+                       f"{core.stopped}; the aircraft is back on the launcher at rest and "
+                       "stays there until ArduPilot restarts")
 
     def _track_gust(self, k: int, k0: int) -> None:
         rep = self.gust_report
@@ -508,6 +567,8 @@ class ArduPilotPhysics:
         if self._log is not None:
             self._log_frame(rec)
         self._frames_seen += 1
+        if self._pending_events:
+            self.flush_events()
         n = self.record_every
         if n == 0 or (rec.action not in (RESEND, RESET) and self._frames_seen % n):
             return
@@ -524,13 +585,18 @@ class ArduPilotPhysics:
     def summary(self) -> dict:
         """Counts, stops and the gust's η₁ peak (SI; JSON-ready)."""
         return {
-            "model": self.model, "speed_m_s": self.speed_m_s, "altitude_m": self.altitude_m,
-            "dt_s": self.dt_s, "time_s": self.t_s, "phase": self.phase,
+            "model": self.model, "aero": self.aero, "step": self.step_kind,
+            "speed_m_s": self.speed_m_s, "altitude_m": self.altitude_m,
+            "dt_s": self.dt_s, "time_s": self.t_s, "session_s": self.session_t_s,
+            "phase": self.phase, "grounded": self.grounded,
             "flight_s": self.core.k * self.dt_s if self.phase == FLIGHT else 0.0,
-            "launches": self.launches, "restarts": self.restarts, "stops": list(self.stops),
+            "flown_s": self._flown_before_s + self.core.k * self.dt_s,
+            "launches": self.launches, "relaunches": max(0, self.launches - 1),
+            "restarts": self.restarts, "stop_count": len(self.stops), "stops": list(self.stops),
             "launch_accel_m_s2": self.launch_accel_m_s2, "stroke_m": self.stroke_m,
             "gust": None if self.gust_spec is None else self.gust_spec.text(),
-            "gust_at_s": self.gust_at_s,
+            "gust_at_s": self.gust_at_s, "gust_repeat": self.gust_repeat,
+            "gust_applied": self._gust_applied,
             "gust_report": {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                             for k, v in self.gust_report.items()},
         }

@@ -49,8 +49,25 @@ only on a reply it could parse); without a reply for 1 s it sends frame n again.
   reply with the new state (a jump of more than one is counted in ``frames_skipped``);
 * the same frame_count again: the same reply again, no step (ArduPilot's timestamp then
   does not change, so its clock does not advance either);
-* a smaller frame_count: ArduPilot SITL restarted, so the physics is reset, then stepped
-  once as for a new frame.
+* frame_count 0 after a larger one: ArduPilot SITL restarted, so the physics is reset, then
+  stepped once as for a new frame; a smaller frame_count other than 0 is a stale datagram
+  (counted in ``stale``, not answered): a restarted ArduPilot always begins at frame 0 and
+  re-sends it every second until it is answered.
+
+Source check (the peer): the session binds to the source (address, port) of the first
+servo packet. Servo packets from any other source are counted (``foreign``), reported to
+``on_event`` (the first one, then at 10, 100, 1000 ... of them), never answered and never
+stepped, so a stray packet or a second sender cannot reset or advance the flight. The one
+exception is ArduPilot restarted as a new process: SITL's socket is not bound, so the new
+process sends from the same address with a new ephemeral port. A packet from the peer's
+address with frame_count 0, after the peer has been silent for at least
+:data:`PEER_SILENCE_S` of wall time, re-binds the session to the new port and resets the
+physics (a live ArduPilot is never silent that long: it re-sends its frame every second).
+
+Wall time while connected (``ServerStats.connected_wall_s``, the denominator of the
+session's real-time factor): the sum of the wall-time gaps between consecutive frames of the
+peer that are shorter than :data:`PEER_SILENCE_S`; waiting for the first peer, and the
+silence of a killed ArduPilot until its restart, are not in it.
 
 ArduPilot adopts 1/Δtimestamp as its frame rate for 0 < Δt < 0.1 s, so the physics may
 step by its own time step; ``frame_rate_hz`` is passed to it for information. frame_count
@@ -65,6 +82,7 @@ import math
 import select
 import socket
 import struct
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -82,6 +100,10 @@ DEFAULT_HOST = "127.0.0.1"
 MAX_REPLY_BYTES = 32000
 RECV_BYTES = 512  # larger datagrams are truncated and then rejected by their length
 QUATERNION_NORM_TOLERANCE = 1e-3  # ArduPilot's rotation_matrix assumes a unit quaternion
+# DEFINITION: the peer is taken for gone (killed, stopped) after this much wall time without a
+# frame [s]: three of ArduPilot's 1 s re-send intervals (JSON::recv_fdm re-sends the frame
+# after 1 s without a reply), so a live ArduPilot, however slow its host, never reaches it.
+PEER_SILENCE_S = 3.0
 
 
 class ServoPacketError(ValueError):
@@ -272,30 +294,46 @@ class ServerStats:
 
     steps: int = 0  # physics steps (new frames, including those after a reset)
     resends: int = 0  # repeated frame_count answered again without a step
-    resets: int = 0  # frame_count went backwards: physics reset
+    resets: int = 0  # the peer restarted (frame 0 again, or re-bound): physics reset
     frames_skipped: int = 0  # frame numbers jumped over (never stepped)
     rejected: int = 0  # datagrams that were not servo packets (not answered)
     last_error: str = ""  # the last rejection's reason
     received: int = 0  # datagrams read
     by_reason: dict[str, int] = field(default_factory=dict)
+    foreign: int = 0  # servo packets from another source than the peer (ignored)
+    first_foreign: tuple[str, int] | None = None  # the source of the first of them
+    stale: int = 0  # the peer's packets with a smaller frame_count other than 0 (ignored)
+    rebinds: int = 0  # of them, restarts as a new process (same address, new port)
+    connected_wall_s: float = 0.0  # wall time while a peer was connected [s] (module doc)
 
 
 class LockstepServer:
     """ArduPilot's JSON physics peer over one UDP socket: one step and one reply per frame.
 
     Binds ``host:port`` (default 127.0.0.1 and :func:`instance_port` of ``instance``; port 0
-    picks a free port, see :attr:`address`) and replies to each packet's source. The physics
-    is not reset at start: the first frame, whatever its count, is stepped from the state it
-    is in. Exceptions of the physics (a range check of the co-simulation, say) propagate to
-    the caller of :meth:`serve_once` / :meth:`serve`; bad datagrams never do.
+    picks a free port, see :attr:`address`) and replies to the peer (module docstring: the
+    source check). The physics is not reset at start: the first frame, whatever its count,
+    is stepped from the state it is in. Exceptions of the physics (a range check of the
+    co-simulation, say) propagate to the caller of :meth:`serve_once` / :meth:`serve`; bad
+    datagrams never do.
+
+    ``on_event(level, text)``: what the session should report (foxglove.Log level names:
+    INFO, WARNING): the first foreign packet and their count, a restart of the peer.
+    ``clock``: the wall clock [s] (monotonic; a test passes its own).
     """
 
     def __init__(self, physics: JsonPhysics, *, host: str = DEFAULT_HOST,
                  port: int | None = None, instance: int = 0,
-                 on_frame: Callable[[FrameRecord], None] | None = None) -> None:
+                 on_frame: Callable[[FrameRecord], None] | None = None,
+                 on_event: Callable[[str, str], None] | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.physics = physics
         self.on_frame = on_frame
+        self.on_event = on_event
+        self._clock = clock
         self.stats = ServerStats()
+        self.peer: tuple[str, int] | None = None  # the bound ArduPilot (address, port)
+        self._peer_wall_s: float | None = None  # wall time of the peer's last frame [s]
         self.last_frame_count: int | None = None
         self._last_reply: bytes | None = None
         self._last_time_s = math.nan
@@ -329,24 +367,78 @@ class LockstepServer:
         self.stats.by_reason[reason] = self.stats.by_reason.get(reason, 0) + 1
         self.stats.last_error = detail
 
-    def handle(self, data: bytes, source: tuple[str, int] = ("", 0)) -> bytes | None:
-        """Apply the lock-step rules to one datagram; the reply to send, or None if rejected."""
+    def _event(self, level: str, text: str) -> None:
+        if self.on_event is not None:
+            self.on_event(level, text)
+
+    def _foreign(self, source: tuple[str, int]) -> None:
+        st = self.stats
+        st.foreign += 1
+        if st.first_foreign is None:
+            st.first_foreign = source
+            self._event("WARNING", f"ignored a servo packet from {source[0]}:{source[1]}: the "
+                        f"session is bound to ArduPilot at {self.peer[0]}:{self.peer[1]}; "
+                        "packets from other sources are counted, never answered")
+        elif math.log10(st.foreign).is_integer():
+            self._event("WARNING", f"{st.foreign} servo packets from other sources than "
+                        f"{self.peer[0]}:{self.peer[1]} ignored so far")
+
+    def _restart(self, text: str) -> None:
+        self.stats.resets += 1
+        self._event("WARNING", text)
+        self.physics.reset()
+
+    def handle(self, data: bytes, source: tuple[str, int] = ("", 0),
+               now_s: float | None = None) -> bytes | None:
+        """Apply the source check and the lock-step rules to one datagram (arrived at wall
+        time ``now_s`` [s], default the clock); the reply to send, or None (rejected,
+        foreign or stale: not answered)."""
         try:
             packet = parse_servo_packet(data)
         except ServoPacketError as exc:
             self._reject(exc.reason, str(exc))
             return None
+        now = self._clock() if now_s is None else now_s
+        source = (str(source[0]), int(source[1]))
         last = self.last_frame_count
-        if last is not None and packet.frame_count == last and self._last_reply is not None:
+        restart = ""
+        if self.peer is None:
+            self.peer = source
+            self._event("INFO", f"bound to ArduPilot at {source[0]}:{source[1]} (frame "
+                        f"{packet.frame_count}); other sources are ignored")
+        elif source != self.peer:
+            silent = self._peer_wall_s is None or now - self._peer_wall_s >= PEER_SILENCE_S
+            if source[0] == self.peer[0] and packet.frame_count == 0 and silent:
+                restart = (f"ArduPilot restarted: frame 0 from {source[0]}:{source[1]} after "
+                           f"{now - (self._peer_wall_s or now):.1f} s of silence of "
+                           f"{self.peer[0]}:{self.peer[1]}; bound to the new port, physics "
+                           "reset")
+                self.stats.rebinds += 1
+                self.peer = source
+                self._peer_wall_s = None
+                last = None
+            else:
+                self._foreign(source)
+                return None
+        elif last is not None and packet.frame_count < last:
+            if packet.frame_count != 0:
+                self.stats.stale += 1
+                return None
+            restart = (f"ArduPilot restarted: frame 0 after frame {last} from "
+                       f"{source[0]}:{source[1]}; physics reset")
+        if self._peer_wall_s is not None and now - self._peer_wall_s < PEER_SILENCE_S:
+            self.stats.connected_wall_s += now - self._peer_wall_s
+        self._peer_wall_s = now
+        if not restart and last is not None and packet.frame_count == last \
+                and self._last_reply is not None:
             action = RESEND
             self.stats.resends += 1
             reply = self._last_reply
         else:
             action = STEP
-            if last is not None and packet.frame_count < last:
+            if restart:
                 action = RESET
-                self.stats.resets += 1
-                self.physics.reset()
+                self._restart(restart)
             elif last is not None and packet.frame_count > last + 1:
                 self.stats.frames_skipped += packet.frame_count - last - 1
             self.physics.step(packet.pwm_us, packet.frame_rate_hz)
@@ -360,7 +452,7 @@ class LockstepServer:
             self.on_frame(FrameRecord(
                 frame_count=packet.frame_count, frame_rate_hz=packet.frame_rate_hz,
                 pwm_us=packet.pwm_us, action=action, timestamp_s=self._last_time_s,
-                source=(str(source[0]), int(source[1]))))
+                source=source))
         return reply
 
     def serve_once(self, timeout_s: float | None = None) -> bool:
@@ -378,7 +470,7 @@ class LockstepServer:
         except BlockingIOError:
             return False
         self.stats.received += 1
-        reply = self.handle(data, source)
+        reply = self.handle(data, source, self._clock())
         if reply is not None:
             try:
                 self._sock.sendto(reply, source)
