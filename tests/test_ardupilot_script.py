@@ -1,0 +1,81 @@
+"""scripts/ardupilot_sitl.py without ArduPilot: its report of a flight and its exit status.
+
+Faults of the documented flight: ``fly`` exited 0 when the mission was not completed; its
+cross-track error mixed the 30 m jump at each waypoint switch with the error on the line
+(docs quote 0.57 m from 8 s into each leg); two real-time factors were printed unnamed.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "ardupilot_sitl.py"
+
+
+@pytest.fixture(scope="module")
+def script():
+    spec = importlib.util.spec_from_file_location("ardupilot_sitl_script", SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _leg(seq: int, rate_hz: float = 10.0, length_s: float = 20.0):
+    """A leg as NAV_CONTROLLER_OUTPUT reports it: 30 m off the new line at the switch,
+    converging over 6 s, then 0.5 m peak-to-peak weave around it."""
+    out = []
+    for i in range(int(length_s * rate_hz)):
+        t = i / rate_hz
+        x = 30.0 * max(0.0, 1.0 - t / 6.0) + 0.25 * math.sin(2.0 * t)
+        out.append((t, seq, x))
+    return out
+
+
+def test_cross_track_is_reported_settled_and_with_the_turns(script):
+    samples = [s for seq in (2, 3, 4, 5) for s in _leg(seq)]
+    rep = script.cross_track_report(samples)
+    settled, turns = rep["xtrack_from_8s_into_leg_m"], rep["xtrack_including_turns_m"]
+    assert settled["max"] == pytest.approx(0.25, abs=1e-3)  # the weave only
+    assert settled["p95"] <= settled["max"] < 0.3
+    assert turns["max"] == pytest.approx(30.0, abs=1e-9)  # the switch's jump
+    assert settled["samples"] == 4 * 120 and turns["samples"] == 4 * 200
+    assert set(rep["xtrack_by_item_m"]) == {"2", "3", "4", "5"}
+    assert rep["xtrack_by_item_m"]["3"]["including_turn_max"] == pytest.approx(30.0)
+    assert script.LEG_SETTLE_S == 8.0
+    assert script.cross_track_report([])["xtrack_from_8s_into_leg_m"] is None
+
+
+def test_incomplete_mission_exits_1(script, monkeypatch, capsys, tmp_path):
+    done = {"reached": [1, 2, 3, 4, 5, 6], "ended": "home reached in RTL"}
+    assert script.incomplete(done) == []
+    missed = {"reached": [1, 2, 3], "ended": "a process exited"}
+    why = script.incomplete(missed)
+    assert why == ["waypoint item 4 not reached", "waypoint item 5 not reached",
+                   "ended: a process exited"]
+    assert script.incomplete({"reached": [2, 3, 4, 5]}) == ["ended: timeout"]
+    summary = {**missed, "incomplete": why}
+    monkeypatch.setattr(script, "fly", lambda *a: summary)
+    assert script.main(["fly", str(tmp_path)]) == script.EXIT_INCOMPLETE == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "mission not completed" in err
+    monkeypatch.setattr(script, "fly", lambda *a: {**done, "incomplete": []})
+    assert script.main(["fly", str(tmp_path)]) == 0
+
+
+def test_missing_binary_is_exit_2(script, monkeypatch, capsys, tmp_path):
+    monkeypatch.setenv(script.NETNS_ENV, "1")  # as inside the namespace: no unshare here
+    assert script.main(["fly", str(tmp_path), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "not built" in err
+
+
+def test_real_time_factors_are_named(script):
+    physics = {"real_time_factor": 0.97, "real_time_factor_definition": "session_s / ..."}
+    rtf = script.real_time_factors({"physics": physics, "sim_s": 64.3, "wall_s": 100.0})
+    assert rtf["physics"] == 0.97 and rtf["physics_definition"].startswith("session_s")
+    assert rtf["arduplane_boot_to_end"] == pytest.approx(0.643)
+    assert "boot" in rtf["arduplane_boot_to_end_definition"]
