@@ -551,3 +551,26 @@ def test_connected_wall_time_excludes_waiting_and_the_dead_peer(bound):
         assert _paced_frame(server, ap, clock, _pwm(k), pace_s) is not None
     assert server.stats.rebinds == 1
     assert server.stats.connected_wall_s == pytest.approx(298 * pace_s, rel=1e-9)
+
+
+def test_a_slow_step_of_ours_counts_as_connected_time():
+    """A 4 s stall inside our step (a kernel compiling, a loaded machine) is the session
+    being slow, not the peer being gone: it counts, and the peer is still the peer."""
+    clock = FakeClock()
+
+    class Stalling(LevelTurn):
+        def step(self, pwm_us, frame_rate_hz):
+            super().step(pwm_us, frame_rate_hz)
+            if self.k == 10:
+                clock.t += 4.0
+
+    physics = Stalling()
+    with aj.LockstepServer(physics, port=0, clock=clock) as server:
+        ap = ArduPilotStandin(server.address)
+        try:
+            for k in range(20):
+                assert _paced_frame(server, ap, clock, _pwm(k), 1e-3) is not None
+        finally:
+            ap.close()
+    assert server.stats.connected_wall_s == pytest.approx(19e-3 + 4.0, rel=1e-9)
+    assert server.stats.rebinds == 0 and physics.resets == 0

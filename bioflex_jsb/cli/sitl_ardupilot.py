@@ -11,6 +11,7 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    closing,
     finite_float,
     log_path,
     positive_float,
@@ -327,15 +328,16 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         interrupted = True
     finally:
-        server.close()
-        summary = session_summary(physics, server, time.monotonic() - wall0)
-        summary.update(preflight=check, table=args.table, out=args.out,
-                       interrupted=interrupted)
-        if log is not None:
-            physics.flush_events()
-            log.event(physics.session_t_s, "INFO", "session end: " + json.dumps(
-                summary, allow_nan=False, separators=(",", ":")))
-            log.close()
+        with closing():  # a stop signal now waits until the log is finished
+            server.close()
+            summary = session_summary(physics, server, time.monotonic() - wall0)
+            summary.update(preflight=check, table=args.table, out=args.out,
+                           interrupted=interrupted)
+            if log is not None:
+                physics.flush_events()
+                log.event(physics.session_t_s, "INFO", "session end: " + json.dumps(
+                    summary, allow_nan=False, separators=(",", ":")))
+                log.close()
     if args.table is not None:
         _write_table(args.table, physics)
     if args.json:
@@ -348,7 +350,11 @@ def run(args: argparse.Namespace) -> int:
                 json.dump(summary, fh, indent=1, allow_nan=False)
         except OSError as exc:
             raise UsageError(f"cannot write --summary {args.summary!r}: {exc.strerror}") from None
-    return 130 if interrupted else 0
+    if interrupted:
+        print("bioflex-jsb ardupilot: interrupted" + (f"; the log {args.out} holds every frame"
+                                                     if args.out else ""), file=sys.stderr)
+        return 130
+    return 0
 
 
 def _write_table(path: str, physics) -> None:

@@ -65,9 +65,12 @@ address with frame_count 0, after the peer has been silent for at least
 physics (a live ArduPilot is never silent that long: it re-sends its frame every second).
 
 Wall time while connected (``ServerStats.connected_wall_s``, the denominator of the
-session's real-time factor): the sum of the wall-time gaps between consecutive frames of the
-peer that are shorter than :data:`PEER_SILENCE_S`; waiting for the first peer, and the
-silence of a killed ArduPilot until its restart, are not in it.
+session's real-time factor): the sum of the wall-time intervals between consecutive frames
+of the peer, each counted when the peer's silence in it (from our reply to its next frame)
+is shorter than :data:`PEER_SILENCE_S`; our own processing always counts (a slow step is
+the session being slow), while waiting for the first peer, and the silence of a killed
+ArduPilot until its restart, are not in it. The silence of the re-binding rule is measured
+the same way: from our last reply to the peer.
 
 ArduPilot adopts 1/Δtimestamp as its frame rate for 0 < Δt < 0.1 s, so the physics may
 step by its own time step; ``frame_rate_hz`` is passed to it for information. frame_count
@@ -334,6 +337,7 @@ class LockstepServer:
         self.stats = ServerStats()
         self.peer: tuple[str, int] | None = None  # the bound ArduPilot (address, port)
         self._peer_wall_s: float | None = None  # wall time of the peer's last frame [s]
+        self._peer_reply_s = -math.inf  # wall time the last frame was answered [s]
         self.last_frame_count: int | None = None
         self._last_reply: bytes | None = None
         self._last_time_s = math.nan
@@ -407,10 +411,10 @@ class LockstepServer:
             self._event("INFO", f"bound to ArduPilot at {source[0]}:{source[1]} (frame "
                         f"{packet.frame_count}); other sources are ignored")
         elif source != self.peer:
-            silent = self._peer_wall_s is None or now - self._peer_wall_s >= PEER_SILENCE_S
+            silent = now - self._peer_reply_s >= PEER_SILENCE_S
             if source[0] == self.peer[0] and packet.frame_count == 0 and silent:
                 restart = (f"ArduPilot restarted: frame 0 from {source[0]}:{source[1]} after "
-                           f"{now - (self._peer_wall_s or now):.1f} s of silence of "
+                           f"{now - self._peer_reply_s:.1f} s of silence of "
                            f"{self.peer[0]}:{self.peer[1]}; bound to the new port, physics "
                            "reset")
                 self.stats.rebinds += 1
@@ -426,7 +430,7 @@ class LockstepServer:
                 return None
             restart = (f"ArduPilot restarted: frame 0 after frame {last} from "
                        f"{source[0]}:{source[1]}; physics reset")
-        if self._peer_wall_s is not None and now - self._peer_wall_s < PEER_SILENCE_S:
+        if self._peer_wall_s is not None and now - self._peer_reply_s < PEER_SILENCE_S:
             self.stats.connected_wall_s += now - self._peer_wall_s
         self._peer_wall_s = now
         if not restart and last is not None and packet.frame_count == last \
@@ -453,6 +457,7 @@ class LockstepServer:
                 frame_count=packet.frame_count, frame_rate_hz=packet.frame_rate_hz,
                 pwm_us=packet.pwm_us, action=action, timestamp_s=self._last_time_s,
                 source=source))
+        self._peer_reply_s = self._clock()  # the peer waits from here: its silence
         return reply
 
     def serve_once(self, timeout_s: float | None = None) -> bool:
