@@ -174,14 +174,17 @@ def coupled_blocks(
     condition: FlightCondition,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     a_rr: np.ndarray | None = None,
+    elastic: ElasticDerivatives | None = None,
 ) -> CoupledBlocks:
     """Assemble the blocks of Eq. (4).
 
     ``a_rr`` replaces the analytic A_RR (e.g. by JSBSim's linearization of the airframe at
     the same trim); G_R is then its α column over u_0, which is what Appendix B's G_R is.
+    ``elastic`` replaces the Table B2 derivatives of the modes (:func:`elastic_derivatives`
+    at ``condition``), e.g. one of them changed for a sensitivity study.
     """
     rd = rigid_derivatives(condition, aero)
-    ed = elastic_derivatives(wing, condition, aero)
+    ed = elastic if elastic is not None else elastic_derivatives(wing, condition, aero)
     a_rr_analytic, g_r = rigid_matrices(rd)
     if a_rr is None:
         a_rr = a_rr_analytic
@@ -355,17 +358,21 @@ def build_state_space(
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     a_rr: np.ndarray | None = None,
     controls: bool = False,
+    elastic: ElasticDerivatives | None = None,
 ) -> StateSpace:
     """The ``rigid`` (A_RR), ``coupled`` (Eq. 4) or ``qsd`` (Eq. 9–10) model at ``condition``.
 
     The QSD model also outputs the quasi-static modal deflections
-    η = −A_EE⁻¹ (A_ER x_R + G_E w_g). ``a_rr`` replaces the analytic rigid block (see
-    :func:`coupled_blocks`). ``controls``: inputs (w_g, elevator, throttle) instead of w_g
-    alone, and the outputs n_z and tip_twist after the states (module docstring).
+    η = −A_EE⁻¹ (A_ER x_R + G_E w_g). ``a_rr`` replaces the analytic rigid block and
+    ``elastic`` the Table B2 derivatives of the modes (see :func:`coupled_blocks`).
+    ``controls``: inputs (w_g, elevator, throttle) instead of w_g alone, and the outputs n_z
+    and tip_twist after the states (module docstring).
     """
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     if controls:
+        if elastic is not None:
+            raise ValueError("elastic= is for the sensitivity models, without controls")
         return _with_controls(model, condition, wing, aero, a_rr)
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
     if model == "rigid":
@@ -380,7 +387,7 @@ def build_state_space(
         )
     if wing is None:
         raise InputError(f"the {model} model needs an elastic wing")
-    blk = coupled_blocks(wing, condition, aero, a_rr)
+    blk = coupled_blocks(wing, condition, aero, a_rr, elastic)
     n = wing.n_modes
     e_names, e_units = elastic_state_names(n)
     notes = {"wing": wing.name, "overrides": dict(wing.coefficients.overrides)}

@@ -15,6 +15,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 SETTLING_BAND = 0.05  # settled: |Δα| stays within 5 % of its peak (a common 5 % criterion)
+# The short-period settling (GustMetrics.short_period_settling_time_s) separates the slow
+# motion by a least-squares fit of Δα = a Δu + b Δθ + c over the last SLOW_FIT_FRACTION of
+# the record after the gust; it needs at least SLOW_FIT_MIN_RECORD_S of record after the
+# gust, so that the fit window (≥ 1 s) spans more than one short-period cycle (0.7-0.9 s at
+# 15 m/s: Table 3) and cannot absorb a short period that is still ringing.
+SLOW_FIT_FRACTION = 0.5
+SLOW_FIT_MIN_RECORD_S = 2.0
 TURBULENCE_KINDS = ("dryden", "vonkarman")  # continuous gusts: no single peak to settle from
 
 # How a run left its valid range (the stop messages of simulation/limits.py), as a name.
@@ -75,7 +82,7 @@ class TimeHistory:
 NUMERIC_METRICS = (
     "peak_du_m_s", "peak_dalpha_rad", "peak_dq_rad_s", "peak_dtheta_rad", "peak_dn_z",
     "overshoot", "settling_time_s", "rms_du_m_s", "rms_dalpha_rad", "rms_dq_rad_s",
-    "rms_dtheta_rad", "rms_dn_z", "divergence_time_s",
+    "rms_dtheta_rad", "rms_dn_z", "divergence_time_s", "short_period_settling_time_s",
 )
 
 
@@ -90,7 +97,24 @@ class GustMetrics:
     excursion of Δα past zero after its first peak as a fraction of that peak [-] (a
     short-period damping measure: 0 for a dead-beat response); settling_time_s, from the gust
     start until |Δα| stays within 5 % of its peak [s], None when it has not settled by the
-    end of the run.
+    end of the run. Δα is measured from the trim α, and that is the right reference: α is
+    the angle to the relative wind, and a uniform vertical gust that persists leaves the
+    same trim relative to the air (the aircraft climbs with the air mass), so Δα returns to
+    0. This settling time is that of the whole motion, the phugoid included: where the
+    phugoid carries |Δα| above 5 % of the peak (the elastic wing's phugoid, whose α follows
+    the speed through the wing's twist), it measures the phugoid's decay, not the short
+    period's.
+
+    short_period_settling_time_s [s]: the same 5 % band on the short-period part of Δα, the
+    "stabilisation time" of the paper's Fig. 21 (whose transfer functions are those of the
+    short-period response; the paper leaves the phugoid out): Δα minus its slow part, where
+    the slow part is a Δu + b Δθ + c fitted by least squares over the last half of the
+    record after the gust. Once the fast modes (short period, wing modes) have decayed, the
+    state of a linear model lies in the phugoid's two-dimensional invariant subspace, on
+    which Δα is a fixed linear combination of Δu and Δθ, so the fit leaves exactly the
+    fast part. None when the run has not settled so by its end, or when it has less than
+    SLOW_FIT_MIN_RECORD_S [s] of record after the gust (the fit window would not span a
+    short-period cycle).
 
     Turbulence (``kind`` "turbulence": Dryden, von Kármán): there is no single peak to
     overshoot or settle from, so overshoot and settling_time_s are None and the RMS of each
@@ -117,6 +141,7 @@ class GustMetrics:
     rms_dq_rad_s: float | None = None
     rms_dtheta_rad: float | None = None
     rms_dn_z: float | None = None
+    short_period_settling_time_s: float | None = None
     diverged: bool = False
     divergence_time_s: float | None = None
     divergence_mode: str | None = None
@@ -175,12 +200,37 @@ def gust_metrics(run: TimeHistory, gust_start_s: float,
     if a_peak != 0.0:
         past = -np.sign(a_peak) * alpha[i_peak:]
         overshoot = float(max(0.0, past.max()) / abs(a_peak))
-        outside = np.nonzero(np.abs(alpha) > SETTLING_BAND * abs(a_peak))[0]
-        last = outside[-1]
-        settling = None if last == len(alpha) - 1 else float(ta[last + 1] - gust_start_s)
+        band = SETTLING_BAND * abs(a_peak)
+        settling = _settling_time(ta, alpha, band, gust_start_s)
+        fast = _short_period_part(ta, alpha, du, dtheta, gust_start_s)
+        sp_settling = None if fast is None else _settling_time(ta, fast, band, gust_start_s)
     else:
-        overshoot, settling = 0.0, 0.0
-    return GustMetrics(kind, **common, overshoot=overshoot, settling_time_s=settling)
+        overshoot, settling, sp_settling = 0.0, 0.0, 0.0
+    return GustMetrics(kind, **common, overshoot=overshoot, settling_time_s=settling,
+                       short_period_settling_time_s=sp_settling)
+
+
+def _settling_time(t: np.ndarray, x: np.ndarray, band: float, start_s: float) -> float | None:
+    """Time from ``start_s`` until |x| stays within ``band`` [s]; None if the last sample
+    is outside it."""
+    outside = np.nonzero(np.abs(x) > band)[0]
+    if len(outside) == 0:
+        return 0.0
+    last = outside[-1]
+    return None if last == len(x) - 1 else float(t[last + 1] - start_s)
+
+
+def _short_period_part(t: np.ndarray, alpha: np.ndarray, du: np.ndarray, dtheta: np.ndarray,
+                       start_s: float) -> np.ndarray | None:
+    """Δα minus its slow (phugoid) part a Δu + b Δθ + c, fitted over the last
+    SLOW_FIT_FRACTION of the record after ``start_s`` (GustMetrics); None if the record
+    after ``start_s`` is shorter than SLOW_FIT_MIN_RECORD_S."""
+    if len(t) < 2 or t[-1] - start_s < SLOW_FIT_MIN_RECORD_S:
+        return None
+    fit = t >= t[-1] - SLOW_FIT_FRACTION * (t[-1] - start_s)
+    basis = np.column_stack([du, dtheta, np.ones_like(du)])
+    coef = np.linalg.lstsq(basis[fit], alpha[fit], rcond=None)[0]
+    return alpha - basis @ coef
 
 
 def nrmse(reference: np.ndarray, other: np.ndarray) -> float:
