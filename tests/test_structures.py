@@ -165,22 +165,40 @@ def test_section_mass_and_inertia_of_a_uniform_plate():
 
 
 # --------------------------------------------------------------------------------------
-# Calibration against Table 2
+# Calibration against Table 2 (what was fitted: test_calibration_*) and what it predicts
 # --------------------------------------------------------------------------------------
-@pytest.mark.parametrize("ribs", [True, False])
-def test_table2_frequencies_within_two_percent(ribs):
-    rows = table2_comparison(ribs)
-    paper = P.MODE_FREQUENCIES_RIBS_HZ if ribs else P.MODE_FREQUENCIES_NO_RIBS_HZ
-    for row, f in zip(rows, paper, strict=True):
+# The stored stiffnesses are rounded to 4 significant digits (≤ 5e-4 relative), which moves
+# the fitted frequencies by less than 0.03 %; measured worst residual 0.008 % (ribbed mode 1).
+CALIBRATION_FREQUENCY_TOL = 1e-3
+
+
+def test_calibration_table2_ribbed_frequencies():
+    """Fitted: the ribbed wing's arm/hand GJ (root, kink ratio) and hand inertia ratio h,
+    three numbers, were solved so that its first three torsion modes are Table 2's "with
+    ribs" 30.9, 71.9, 107.2 Hz (structures.wing_model.calibrate_default_wings). Model 30.898,
+    71.895, 107.194 Hz: the fit holds; it validates nothing."""
+    rows = table2_comparison(True)
+    for row, f in zip(rows, P.MODE_FREQUENCIES_RIBS_HZ, strict=True):
         assert row.paper_frequency_hz == f
-        # 2 %: the brief's acceptance band. With ribs all three are calibrated (arm/hand
-        # wing); the no-rib third mode is a prediction.
-        assert abs(row.frequency_error) < 0.02, row
+        assert abs(row.frequency_error) < CALIBRATION_FREQUENCY_TOL, row
 
 
-def test_ribbed_third_mode_within_two_percent():
-    # Was a strict xfail (+6.4 % with the linear taper); the arm/hand wing closes it.
-    assert abs(table2_comparison(True)[2].frequency_error) < 0.02  # brief's 2 % band
+def test_calibration_table2_unribbed_first_two_frequencies():
+    """Fitted: the unribbed wing's linear GJ taper (root, tip ratio) on Table 2's "without
+    ribs" modes 1-2, 20.8 and 49.6 Hz. Model 20.798, 49.596 Hz."""
+    rows = table2_comparison(False)
+    for row, f in zip(rows[:2], P.MODE_FREQUENCIES_NO_RIBS_HZ[:2], strict=True):
+        assert row.paper_frequency_hz == f
+        assert abs(row.frequency_error) < CALIBRATION_FREQUENCY_TOL, row
+
+
+def test_unribbed_third_frequency_is_predicted():
+    """Predicted (not fitted): the unribbed third torsion mode, Table 2 79.6 Hz, model
+    79.63 Hz (+0.03 %). Tolerance 0.12 %: twice the paper's printing resolution (79.6 Hz is
+    ±0.05 Hz, ±0.06 %)."""
+    row = table2_comparison(False)[2]
+    assert row.paper_frequency_hz == P.MODE_FREQUENCIES_NO_RIBS_HZ[2]
+    assert abs(row.frequency_error) < 1.2e-3, row
 
 
 def test_arm_hand_sections():
@@ -251,16 +269,46 @@ def test_first_bending_mode_above_the_three_table2_modes(structure):
     assert bend[0] > np.max(f[sol.torsion_energy_fraction > 0.5][:3])
 
 
-def test_ribbed_generalised_masses_are_twist_normalised_and_small():
+# Model/paper ratio of the ribbed generalised masses (not fitted: they follow from the mass
+# estimates of wing_structure and the calibrated stiffness), measured 2026-12-01.
+RIBBED_MASS_RATIOS = (0.2472, 0.1815, 1.394)
+UNRIBBED_MASS_RATIOS = (2.841, 26.85, 4.682)
+
+
+def test_ribbed_generalised_masses_are_twist_normalised_and_torsion_sized():
+    """Twist-normalised torsion modes have generalised masses of 1e-6..1e-4 kg·m² (Table 2:
+    6.57e-5, 5.70e-5, 8.37e-6); a bending mode normalised on twist is orders of magnitude
+    larger (the old bending mode 3 gave 1.1e-2, 1300x Table 2)."""
+    for r in table2_comparison(True):
+        assert 1e-6 < r.model_generalised_mass_kg_m2 < 1e-4, r
+
+
+def test_disagreement_ribbed_generalised_masses():
+    """Predicted, not reproduced: Table 2 "with ribs" 6.57e-5, 5.70e-5, 8.37e-6 kg·m²; model
+    1.62e-5, 1.03e-5, 1.17e-5 (0.25x, 0.18x, 1.39x). History (git log -L of this test): the
+    linear-taper wing gave 0.74x / 0.42x for modes 1-2, inside the old 3x band; commit
+    048dd75 (the arm/hand wing, three parameters fitted to the three ribbed frequencies,
+    with a lighter hand: h = 0.47) moved them to 0.25x / 0.18x, and the band was widened to
+    6x instead of recording the disagreement. The frequencies are fitted; the
+    masses are what the fitted structure gives, and they do not match. Pin ±2 % of the
+    ratio: re-running the calibration (4-digit rounding) moves them by < 0.1 %."""
     rows = table2_comparison(True)
-    # Table 2 third mass (8.37e-6 kg*m^2) is of torsion size; the old bending mode 3 gave
-    # 1.1e-2 (1300x). Factor 6: the masses are not calibrated (mass estimates only); the
-    # arm/hand wing puts modes 1-2 at 0.25x / 0.18x Table 2 (the linear taper: 0.74x /
-    # 0.42x, docs/structures.md), so a band of 3 no longer holds; 6 still rejects a bending
-    # mode by two orders of magnitude.
-    for r in rows:
-        assert r.paper_generalised_mass_kg_m2 / 6 < r.model_generalised_mass_kg_m2
-        assert r.model_generalised_mass_kg_m2 < 6 * r.paper_generalised_mass_kg_m2
+    for r, measured in zip(rows, RIBBED_MASS_RATIOS, strict=True):
+        ratio = r.model_generalised_mass_kg_m2 / r.paper_generalised_mass_kg_m2
+        assert ratio == pytest.approx(measured, rel=0.02), r
+        assert abs(ratio - 1.0) > 0.3  # outside ±30 % of Table 2: a disagreement
+
+
+def test_disagreement_unribbed_generalised_masses():
+    """Predicted, not reproduced: Table 2 "without ribs" 1.50e-5, 9.29e-7, 4.48e-6 kg·m²;
+    model 4.26e-5, 2.49e-5, 2.10e-5 (2.8x, 27x, 4.7x). Table 2's second mass is below the
+    other two by more than an order of magnitude, which a twist-normalised torsion mode of a
+    smooth wing does not give. Pin ±2 % as above."""
+    rows = table2_comparison(False)
+    for r, measured in zip(rows, UNRIBBED_MASS_RATIOS, strict=True):
+        ratio = r.model_generalised_mass_kg_m2 / r.paper_generalised_mass_kg_m2
+        assert ratio == pytest.approx(measured, rel=0.02), r
+        assert abs(ratio - 1.0) > 0.3
 
 
 def test_stored_calibration_is_what_the_calibration_finds():
