@@ -2,9 +2,10 @@
 
 Run:  python scripts/paper_tables.py [--mass-basis paper|consistent]
 
-Every published number is printed beside the model's with the relative difference; rows
-beyond the acceptance tolerance (5 % rigid, 10 % coupled/QSD) are flagged "OFF". Nothing is
-tuned per row: see docs/decisions.md for what was calibrated, to what.
+Every published number is printed beside the model's with the relative difference, and
+marked by what it is (docs/validation.md, "Validation and calibration"): "fitted" (the model
+was calibrated to it: a calibration check, not a validation), or a prediction that "agrees"
+(within AGREEMENT_TOL) or "DISAGREES". Nothing is tuned per row.
 """
 
 from __future__ import annotations
@@ -18,13 +19,15 @@ from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING
 from bioflex_jsb.structures.wing_model import wing_modes
 
-TOLERANCE = {"rigid": 0.05, "coupled": 0.10, "qsd": 0.10}
+# A prediction agrees within 5 %: twice the 2.5 % scatter between the paper's own coupled and
+# QSD rows, which it calls "similar" (tests/test_paper_validation.py uses the same figure).
+AGREEMENT_TOL = 0.05
 
 
 def table2() -> None:
     print("Table 2: structural modes (beam model vs paper; masses normalised on twist)")
-    print(f"{'':10}{'mode':>5} {'f paper [Hz]':>13} {'f model':>9} {'m_i paper':>11} "
-          f"{'m_i model':>11}")
+    print(f"{'':10}{'mode':>5} {'f paper [Hz]':>13} {'f model':>9} {'f is':>10} "
+          f"{'m_i paper':>11} {'m_i model':>11} {'m_i is':>18}")
     for label, structure, f_p, m_p in (
         ("ribs", RIBBED_WING, P.MODE_FREQUENCIES_RIBS_HZ, P.GENERALISED_MASSES_RIBS_KG_M2),
         ("no ribs", UNRIBBED_WING, P.MODE_FREQUENCIES_NO_RIBS_HZ,
@@ -33,9 +36,17 @@ def table2() -> None:
         modes = wing_modes(structure, 3)
         for i in range(3):
             f_m = modes.frequencies_rad_s[i] / (2 * math.pi)
-            print(f"{label:10}{i + 1:5d} {f_p[i]:13.1f} {f_m:9.2f} {m_p[i]:11.3g} "
-                  f"{modes.generalised_masses_kg_m2[i]:11.3g}")
+            fitted = label == "ribs" or i < 2  # calibrate_default_wings: ribbed 3, unribbed 2
+            f_kind = "fitted" if fitted else verdict(f_m / f_p[i] - 1.0)
+            m_m = modes.generalised_masses_kg_m2[i]
+            print(f"{label:10}{i + 1:5d} {f_p[i]:13.1f} {f_m:9.2f} {f_kind:>10} "
+                  f"{m_p[i]:11.3g} {m_m:11.3g} {verdict(m_m / m_p[i] - 1.0):>9} "
+                  f"({m_m / m_p[i]:.2f}x)")
     print()
+
+
+def verdict(relative_error: float) -> str:
+    return "agrees" if abs(relative_error) <= AGREEMENT_TOL else "DISAGREES"
 
 
 def eigen_tables(mass_basis: str) -> None:
@@ -44,10 +55,11 @@ def eigen_tables(mass_basis: str) -> None:
         print(f"{rows[0].table}: short period, wing {wing} (mass basis {mass_basis})")
         print(f"{'V':>4} {'model':<8} {'paper':>16} {'model':>18} {'Δre':>7} {'Δim':>7}")
         for r in rows:
-            off = max(abs(r.re_error), abs(r.im_error)) > TOLERANCE[r.model]
+            kind = ("fitted" if r.model == "rigid"  # C_mα, C_mq, C_mα̇: parameters/airframe.py
+                    else verdict(max(abs(r.re_error), abs(r.im_error))))
             print(f"{r.speed_m_s:4.0f} {r.model:<8} {r.paper_re:7.1f} ±{r.paper_im:5.1f}i "
                   f"{r.model_re:8.2f} ±{r.model_im:6.2f}i {100 * r.re_error:6.1f}% "
-                  f"{100 * r.im_error:6.1f}% {'OFF' if off else ''}")
+                  f"{100 * r.im_error:6.1f}% {kind}")
         print()
 
 
@@ -78,11 +90,13 @@ def flutter(mass_basis: str) -> None:
     print("Flutter / divergence, 5-30 m/s (paper: backward axes reach body-freedom flutter above")
     print("20 m/s; original, optimised and forward: none up to 25 m/s)")
     for r in validation.flutter_rows(mass_basis=mass_basis):
+        backward = r.wing.endswith("backward")
         if r.flutter_speed_m_s is None:
-            print(f"{r.wing:<18} none")
+            print(f"{r.wing:<18} none {'DISAGREES' if backward else 'agrees'}")
         else:
-            print(f"{r.wing:<18} {r.kind} at {r.flutter_speed_m_s:.1f} m/s, {r.mode}, "
-                  f"{r.frequency_rad_s:.1f} rad/s")
+            agrees = backward and r.flutter_speed_m_s > 20.0
+            print(f"{r.wing:<18} {r.kind} at {r.flutter_speed_m_s:.2f} m/s, {r.mode}, "
+                  f"{r.frequency_rad_s:.1f} rad/s  {'agrees' if agrees else 'DISAGREES'}")
     print()
 
 

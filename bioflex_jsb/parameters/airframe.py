@@ -93,6 +93,9 @@ class RigidAerodynamics:
 # Checked in JSBSim: the full linearization of the generated airframe (drag, thrust, trim α,
 # RPM quasi-static) reproduces both Table 3 rigid rows within 1 %
 # (tests/test_trim_linearize.py), so these three values needed no re-calibration.
+# Because they were fitted to them, Table 3's (and Table 6's identical) rigid rows are
+# calibration checks, not validation (tests/test_paper_validation.py::
+# test_calibration_rigid_short_period; docs/validation.md lists what was fitted to what).
 # C_Lα = 5.3 /rad: lifting-line slope of the AR 9.3 wing (≈ 5.0) plus the small tail (≈ 0.3).
 RIGID_AERODYNAMICS = RigidAerodynamics(
     # ESTIMATE: cambered thin membrane aerofoil, zero-lift angle −C_L0/C_Lα ≈ −4.3° (thin-
