@@ -61,10 +61,26 @@ def plot(rows, path: Path, title: str) -> None:
         ("short_period_damping", "short-period damping ζ [-]", "viridis"),
         ("peak_dn_z", "peak |Δn_z| of the gust run [-]", "magma_r"),
     ]
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8), constrained_layout=True)
+    from matplotlib.patches import Patch
+
+    def hatched(r, key) -> bool:
+        """A cell whose value is not a measure of the wing: its LTI model is unstable at the
+        campaign's speed (ζ of an unstable or real short-period root is meaningless) or, on
+        the load-factor map, the gust run diverged."""
+        fs = r.get("flutter_speed_m_s")
+        if key == "peak_dn_z":
+            return r["status"] != "ok"
+        return fs is not None and fs <= r["speed_m_s"]
+
+    fig, axes = plt.subplots(1, 3, figsize=(16, 5.4), constrained_layout=True)
     for ax, (key, label, cmap) in zip(axes, panels, strict=True):
         xe, xi, z = grid(rows, key)
-        z = np.ma.masked_invalid(np.asarray(z))
+        z = np.asarray(z, dtype=float)
+        if key != "c_eta1_q1":  # hatched cells carry no colour: their value means nothing
+            for r in rows:
+                if hatched(r, key):
+                    z[xi.index(r["x_inertial_frac"]), xe.index(r["x_elastic_frac"])] = np.nan
+        z = np.ma.masked_invalid(z)
         if key == "c_eta1_q1":
             lim = float(np.nanmax(np.abs(z))) if z.count() else 1.0
             mesh = ax.pcolormesh(xe, xi, z, cmap=cmap, vmin=-lim, vmax=lim, shading="nearest")
@@ -76,9 +92,7 @@ def plot(rows, path: Path, title: str) -> None:
             dy = (xi[1] - xi[0]) / 2 if len(xi) > 1 else 0.05
             for r in rows:
                 fs = r.get("flutter_speed_m_s")
-                lti_unstable = fs is not None and fs <= r["speed_m_s"]
-                if (key == "peak_dn_z" and r["status"] == "ok") or (
-                        key != "peak_dn_z" and not lti_unstable):
+                if not hatched(r, key):
                     continue
                 x, y = r["x_elastic_frac"], r["x_inertial_frac"]
                 ax.add_patch(plt.Rectangle((x - dx, y - dy), 2 * dx, 2 * dy, fill=False,
@@ -92,6 +106,16 @@ def plot(rows, path: Path, title: str) -> None:
         ax.set_xlabel("elastic axis x_E [fraction of chord]")
         ax.set_ylabel("inertial axis x_I [fraction of chord]")
         ax.set_title(label.split(" [")[0])
+        if key != "c_eta1_q1":
+            what = ("gust run diverged (status or LTI flutter speed written)"
+                    if key == "peak_dn_z" else
+                    "LTI model unstable at this speed (its flutter speed written)")
+            ax.legend(handles=[Patch(facecolor="white", edgecolor="0.4", hatch="xx",
+                                     label=what),
+                               plt.Line2D([], [], ls="none", marker="o", mfc="none", mec="k",
+                                          label="paper's wings (Table 8)")],
+                      loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8,
+                      frameon=False, ncol=1)
     fig.suptitle(title)
     fig.savefig(path, dpi=120)
     plt.close(fig)

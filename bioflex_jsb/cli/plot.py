@@ -37,8 +37,7 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     if not runs or all(len(r.time_s) == 0 for r in runs):
         raise UsageError(f"{args.file!r} holds no bioflex run topics to plot")
-    title = (f"{meta.get('wing', '?')} wing, {meta.get('speed_m_s', '?')} m/s, "
-             f"gust {meta.get('gust', '?')}" if meta else Path(args.file).name)
+    title = _title(meta, runs, Path(args.file).name)
     from bioflex_jsb.sinks import plotting
 
     try:
@@ -52,3 +51,27 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"time histories of {len(runs)} run(s) written to {out}")
     return 0
+
+
+def _title(meta: dict, runs, file_name: str) -> str:
+    """The figure's title from the run description; the gust as flown: a SITL or ArduPilot
+    session is described with gust ``none`` and may be given one in flight, so its title
+    says when the logged gust ``w_g`` [m/s] first acted and how strong it was."""
+    if not meta:
+        return file_name
+    import numpy as np
+
+    head = f"{meta.get('wing', '?')} wing, {meta.get('speed_m_s', '?')} m/s"
+    gust = str(meta.get("gust", "?"))
+    if meta.get("command") in ("sitl", "ardupilot"):
+        head = f"{meta.get('wing', '?')} wing, {meta['command']} session"
+        flown = [r for r in runs if "w_g" in r.channels and len(r.time_s)
+                 and np.any(r["w_g"] != 0.0)]
+        if flown:
+            r = flown[0]
+            first = int(np.flatnonzero(r["w_g"] != 0.0)[0])
+            peak = float(np.max(np.abs(r["w_g"])))
+            return (f"{head}, gust from t = {float(r.time_s[first]):.1f} s "
+                    f"(|w_g| up to {peak:.2f} m/s)")
+        return f"{head}, still air"
+    return f"{head}, gust {gust}"

@@ -34,6 +34,14 @@ MODEL_STYLE = {
     "native": dict(color="tab:green", ls="-", lw=1.4, zorder=3),
 }
 LOCUS_COLOURS = {"rigid": "black", "coupled": "tab:blue", "qsd": "tab:red"}
+# Where the coupled and QSD roots agree (every rigid-body root of a stiff wing) one model's
+# line would hide the other's: the coupled roots are drawn wide and pale underneath, the QSD
+# roots thin with open markers on top, so both show.
+LOCUS_LINE = {
+    "rigid": dict(lw=1.0, zorder=3),
+    "coupled": dict(lw=3.4, alpha=0.55, zorder=2),
+    "qsd": dict(lw=1.0, zorder=4, markerfacecolor="none"),
+}
 MODE_MARKERS = {
     "short_period": ("o", "-"),
     "phugoid": ("s", "-"),
@@ -120,7 +128,8 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
     zoomed so that it holds every root of that branch, also where it turns real and
     unstable; (c) the phugoid, zoomed; (d) the growth rate Re λ of each mode against the
     airspeed [m/s], where a crossing of zero is a flutter or divergence speed. Colour = model
-    (rigid black, coupled blue, QSD red), marker and line style = mode; numbers beside the
+    (rigid black, coupled wide pale blue underneath, QSD thin red with open markers on top,
+    so that both show where they agree), marker and line style = mode; numbers beside the
     roots are airspeeds [m/s], arrows point to increasing speed; the right half plane
     (unstable) is shaded.
     """
@@ -148,9 +157,11 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
             elif name == "phugoid":
                 targets.append(ax_ph)
                 ph_points.append(lam)
+            line = LOCUS_LINE.get(sweep.model, dict(lw=1.0, zorder=3))
             for ax in targets:
-                ax.plot(lam.real, lam.imag, ls=ls, color=colour, lw=1.0, marker=marker, ms=3,
-                        markevery=max(1, len(lam) // 25), label=label)
+                ax.plot(lam.real, lam.imag, ls=ls, color=colour, marker=marker,
+                        ms=5 if sweep.model == "qsd" else 3,
+                        markevery=max(1, len(lam) // 25), label=label, **line)
                 step = max(1, len(lam) // 5)
                 for k in range(step, len(lam), step):
                     if not (np.isfinite(lam[k]) and np.isfinite(lam[k - 1])):
@@ -170,8 +181,11 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
                 _speed_labels(ax_ph, lam, speeds, colour)
         for name, re in growth.items():
             marker, ls = MODE_MARKERS.get(name, (".", "-"))
-            ax_re.plot(speeds, re, ls=ls, color=colour, lw=1.2, marker=marker, ms=3,
-                       markevery=max(1, len(speeds) // 12), label=f"{sweep.model}: {name}")
+            line = LOCUS_LINE.get(sweep.model, dict(lw=1.0, zorder=3))
+            ax_re.plot(speeds, re, ls=ls, color=colour, marker=marker,
+                       ms=5 if sweep.model == "qsd" else 3,
+                       markevery=max(1, len(speeds) // 12), label=f"{sweep.model}: {name}",
+                       **line)
     ax_all.set_title(f"(a) {title}: all roots, {v_lo:g}–{v_hi:g} m/s "
                      "(numbers: airspeed [m/s])", fontsize=10)
     ax_sp.set_title("(b) short period (zoom; × = unstable root)", fontsize=10)
@@ -215,9 +229,16 @@ TIME_PANELS = (
     ("theta", "Δθ [deg]", 180.0 / np.pi),
     ("n_z", "n_z [-]", 1.0),
     ("w_g", "gust w_g [m/s] (up)", 1.0),
-    ("eta1", "η₁ [deg]: envelope and mean", 180.0 / np.pi),
-    ("eta1_zoom", "η₁ [deg], zoom", 180.0 / np.pi),
+    ("eta1", "η₁ [deg]: 0.1 s envelope, mean", 180.0 / np.pi),
+    ("eta1_zoom", "η₁ [deg] at the gust onset", 180.0 / np.pi),
 )
+# η₁ is the first wing mode's coordinate; each mode is scaled so that its largest section
+# twist is 1 rad/rad (docs/conventions.md), so η₁ reads as the twist of that section (the tip).
+ETA1_NOTE = ("η₁: first wing mode (twist-dominated), scaled to equal its largest section "
+             "twist (at the tip; leading edge up positive). Shaded: running min/max over 0.1 s")
+# Runs that share a model's style (e.g. two wings flown with the same model) get these
+# colours instead, in order, so that every line in a figure can be told apart.
+EXTRA_COLOURS = ("tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 ENVELOPE_WINDOW_S = 0.1  # η₁ envelope: max/min over 0.1 s (three cycles of a 31 Hz mode)
 ZOOM_BEFORE_S, ZOOM_AFTER_S = 0.05, 0.35  # the η₁ zoom around the gust onset [s]
 
@@ -266,8 +287,9 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
     are scaled to the runs that finished, so they stay readable. ``nrmse`` (channel →
     NRMSE [-]) labels the LTI prediction's line in every panel (``compare``).
     """
-    fig, axes = plt.subplots(4, 2, figsize=(12, 12))
+    fig, axes = plt.subplots(4, 2, figsize=(12, 12.6), sharex=False)
     t_gust = _gust_onset(runs)
+    styles = _distinct_styles(runs)
     elastic = [r for r in runs if r.model != "rigid" and "eta1" in r.channels]
     t_zoom = t_gust  # the η₁ zoom: the gust onset, or where the wing diverged before it
     if elastic and all(r.stopped is not None and r.stop_time_s < t_gust for r in elastic):
@@ -288,7 +310,7 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                 if drawn_gust:
                     continue  # one gust input: every run flies the same samples
                 drawn_gust = True
-            style = _style(run)
+            style = dict(styles[id(run)])
             t, y = run.time_s, run[channel] * scale
             label = str(run.meta.get("label", run.model))
             if nrmse is not None and run.meta.get("source") == "lti" and channel in nrmse:
@@ -334,10 +356,40 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
             ax.axvline(t_gust, color="0.6", lw=0.7, ls=":")
         ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
-        if nrmse is not None or name in ("u", "w_g"):
-            ax.legend(fontsize=7, loc="best")
+        if nrmse is not None or name == "w_g":
+            ax.legend(fontsize=7, loc="best")  # NRMSE differs by panel: a legend in each
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig.suptitle(title, y=0.995)
+    if nrmse is None:  # one legend for the figure: the same lines in every panel
+        handles: dict[str, object] = {}
+        for ax in axes.flat:
+            for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+                if not label.startswith("w_g"):
+                    handles.setdefault(label, handle)
+        if handles:
+            fig.legend(list(handles.values()), list(handles), loc="upper center",
+                       ncol=min(len(handles), 4), fontsize=9, frameon=False,
+                       bbox_to_anchor=(0.5, 0.975))
+    if any("eta1" in r.channels and r.model != "rigid" for r in runs):
+        fig.text(0.5, 0.004, ETA1_NOTE, ha="center", va="bottom", fontsize=8, color="0.25",
+                 wrap=True)
+    fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955))
     return _save(fig, path)
+
+
+def _distinct_styles(runs: Sequence[TimeHistory]) -> dict[int, dict]:
+    """Each run's line style; a run whose colour and dash repeat an earlier run's gets the
+    next of :data:`EXTRA_COLOURS` (and a solid line), so no two runs look alike."""
+    out: dict[int, dict] = {}
+    seen: set[tuple[str, str]] = set()
+    extra = iter(EXTRA_COLOURS)
+    for run in runs:
+        style = _style(run)
+        key = (str(style.get("color")), str(style.get("ls")))
+        if key in seen:
+            style = dict(style, color=next(extra, "0.4"), ls="-", lw=1.6)
+            key = (str(style["color"]), "-")
+        seen.add(key)
+        out[id(run)] = style
+    return out
