@@ -20,6 +20,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -742,3 +743,56 @@ def test_command_line_ignores_a_second_sender_and_prints_json(tmp_path, capsys):
     events = [m["message"] for _, m in sink.messages_by_topic(out)[sink.EVENTS_TOPIC]]
     end = json.loads(events[-1].removeprefix("session end: "))
     assert end["session_s"] == s["session_s"] >= 0.1
+    d = sink.description_from_metadata(sink.summarise(out)["metadata"]["bioflex.run"])
+    assert d.duration_s == 0.1 and d.extra["duration"] == "--duration"
+    assert d.extra["aero"] == "quasi-steady" and d.extra["step"] == "compiled kernel"
+
+
+def test_command_line_session_across_a_killed_and_restarted_arduPilot(tmp_path):
+    """The command with the real clock: 300 frames, ArduPilot killed (its port gone), 3.5 s
+    of silence (> PEER_SILENCE_S), a new ArduPilot process on a new port; the session
+    re-binds once, resets once, and the silence is not in the real-time factor."""
+    from bioflex_jsb.cli import build_parser
+
+    port = _free_port()
+    summary = tmp_path / "s.json"
+    args = build_parser().parse_args(["ardupilot", "--port", str(port), "--duration", "0.6",
+                                      "--no-log", "--summary", str(summary)])
+    result = {}
+    th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
+    th.start()
+    ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
+    try:
+        for _ in range(400):  # the command starts (imports, trim) while we send
+            ap.send_servos(DISARMED)
+            try:
+                ap.receive()
+            except TimeoutError:
+                continue
+            if ap.frame_counter == 300:
+                break
+        first_port = ap.source[1]
+        ap.restart(new_process=True)
+        time.sleep(aj.PEER_SILENCE_S + 0.5)
+        for _ in range(400):
+            if not th.is_alive():
+                break
+            ap.send_servos(DISARMED)
+            try:
+                ap.receive()
+            except TimeoutError:
+                continue
+        second_port = ap.source[1]
+    finally:
+        ap.close()
+    th.join(10.0)
+    assert result.get("rc") == 0
+    s = json.loads(summary.read_text())
+    assert first_port != second_port
+    assert s["frames"]["resets"] == 1 and s["restarts"] == 1
+    assert s["source_check"]["restarts_new_port"] == 1
+    assert s["source_check"]["peer"] == f"127.0.0.1:{second_port}"
+    assert s["session_s"] == pytest.approx(0.6, abs=2 * ad.DEFAULT_DT_S)
+    # the 3.5 s of silence is in wall_s, not in the real-time factor's denominator
+    assert s["connected_wall_s"] < s["wall_s"] - aj.PEER_SILENCE_S
+    assert s["real_time_factor"] == pytest.approx(s["session_s"] / s["connected_wall_s"])
