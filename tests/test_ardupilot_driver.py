@@ -474,10 +474,13 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def _cli_session(argv: list[str], port: int, second_sender: bool = False) -> tuple[int, int]:
+def _cli_session(argv: list[str], port: int, second_sender: bool = False,
+                 restart_at: int | None = None) -> tuple[int, list[int]]:
     """Run ``bioflex-jsb ardupilot ARGV`` in a thread and fly the stand-in against it until
     it ends (``--duration``); with ``second_sender`` another stand-in sends a frame 0 after
-    each of the first one's frames. Returns (exit status, the stand-in's port)."""
+    each of the first one's frames; with ``restart_at`` the stand-in is killed at that frame
+    count and restarted as a new process (new port) after PEER_SILENCE_S + 0.5 s of
+    silence. Returns (exit status, the stand-in's ports in the order used)."""
     from bioflex_jsb.cli import build_parser
 
     args = build_parser().parse_args(["ardupilot", "--port", str(port), *argv])
@@ -486,9 +489,9 @@ def _cli_session(argv: list[str], port: int, second_sender: bool = False) -> tup
     th.start()
     ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
     other = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
-    ap_port = ap.source[1]
+    ports = [ap.source[1]]
     try:
-        for _ in range(400):
+        for _ in range(800):
             if not th.is_alive():
                 break
             ap.send_servos(DISARMED)
@@ -498,11 +501,15 @@ def _cli_session(argv: list[str], port: int, second_sender: bool = False) -> tup
                 continue
             if second_sender and ap.frame_counter > 1:  # once bound
                 other.send_servos(DISARMED)
+            if restart_at is not None and ap.frame_counter == restart_at and len(ports) == 1:
+                ap.restart(new_process=True)
+                ports.append(ap.source[1])
+                time.sleep(aj.PEER_SILENCE_S + 0.5)
     finally:
         ap.close()
         other.close()
     th.join(10.0)
-    return result.get("rc"), ap_port
+    return result.get("rc"), ports
 
 
 def test_command_line_runs_and_writes_its_table(tmp_path, monkeypatch):
@@ -730,8 +737,8 @@ def test_help_says_servo_5_fires_the_launcher_in_auto():
 
 def test_command_line_ignores_a_second_sender_and_prints_json(tmp_path, capsys):
     out = tmp_path / "s.mcap"
-    rc, ap_port = _cli_session(["--duration", "0.1", "--json", "--out", str(out)],
-                               _free_port(), second_sender=True)
+    rc, (ap_port,) = _cli_session(["--duration", "0.1", "--json", "--out", str(out)],
+                                  _free_port(), second_sender=True)
     assert rc == 0
     captured = capsys.readouterr()
     s = json.loads(captured.out)
@@ -752,41 +759,11 @@ def test_command_line_session_across_a_killed_and_restarted_arduPilot(tmp_path):
     """The command with the real clock: 300 frames, ArduPilot killed (its port gone), 3.5 s
     of silence (> PEER_SILENCE_S), a new ArduPilot process on a new port; the session
     re-binds once, resets once, and the silence is not in the real-time factor."""
-    from bioflex_jsb.cli import build_parser
-
-    port = _free_port()
     summary = tmp_path / "s.json"
-    args = build_parser().parse_args(["ardupilot", "--port", str(port), "--duration", "0.6",
-                                      "--no-log", "--summary", str(summary)])
-    result = {}
-    th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
-    th.start()
-    ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
-    try:
-        for _ in range(400):  # the command starts (imports, trim) while we send
-            ap.send_servos(DISARMED)
-            try:
-                ap.receive()
-            except TimeoutError:
-                continue
-            if ap.frame_counter == 300:
-                break
-        first_port = ap.source[1]
-        ap.restart(new_process=True)
-        time.sleep(aj.PEER_SILENCE_S + 0.5)
-        for _ in range(400):
-            if not th.is_alive():
-                break
-            ap.send_servos(DISARMED)
-            try:
-                ap.receive()
-            except TimeoutError:
-                continue
-        second_port = ap.source[1]
-    finally:
-        ap.close()
-    th.join(10.0)
-    assert result.get("rc") == 0
+    rc, (first_port, second_port) = _cli_session(
+        ["--duration", "0.6", "--no-log", "--summary", str(summary)], _free_port(),
+        restart_at=300)
+    assert rc == 0
     s = json.loads(summary.read_text())
     assert first_port != second_port
     assert s["frames"]["resets"] == 1 and s["restarts"] == 1
