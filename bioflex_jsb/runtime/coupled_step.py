@@ -168,9 +168,10 @@ class CoupledStep:
             reference the kernel is tested against. The native model has no wing step.
         aero: the wing's strips, ``quasi-steady`` (the paper's, default) or ``unsteady``
             (:class:`~bioflex_jsb.simulation.unsteady_wing.UnsteadyModalWing`: Jones lag
-            states, apparent mass, Küssner gust; coupled model only; ``wing`` then a
-            :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`; always the Python
-            step). ``wing`` may be a WingBuild for either (its ``model`` is used).
+            states, apparent mass, Küssner gust; the coupled model from the rigid trim only;
+            ``wing`` then a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`; its
+            compiled step: :mod:`bioflex_jsb.simulation.unsteady_kernel`). ``wing`` may be a
+            WingBuild for either (its ``model`` is used).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -199,6 +200,9 @@ class CoupledStep:
         if unsteady and not isinstance(wing, WingBuild):
             raise InputError("aero='unsteady' needs the wing's build (its strips), not only "
                              "its ElasticWingModel")
+        if unsteady and trim_mode == "elastic":
+            raise InputError("aero='unsteady' flies from the rigid trim (its lag states are "
+                             "linearised about it); accepted with it: trim_mode='rigid'")
         build = wing if isinstance(wing, WingBuild) else None
         if build is not None:
             wing = build.model
@@ -258,8 +262,7 @@ class CoupledStep:
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad()
-        # the unsteady wing runs the Python step (the kernel carries the quasi-steady wing)
-        self.compiled = bool(compiled) and not native and not unsteady
+        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         if self.compiled:
             self._setup_kernel(nodes)
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
@@ -391,41 +394,56 @@ class CoupledStep:
     def _setup_kernel(self, nodes) -> None:
         """Bind what the kernel needs once: the property readers in its order, the writers
         of the reactions, the wing's arrays packed into one parameter array, and the table
-        column of each of its slots (by channel name)."""
+        column of each of its slots (by channel name). The unsteady wing has a kernel of
+        its own (:mod:`bioflex_jsb.simulation.unsteady_kernel`) with the same arguments."""
         mw, mm = self.wing, self.wing.matrices
         self._getters = tuple(nodes[k].get_double_value for k in K.READ_KEYS)
         self._set_reactions = self.airframe.external_reaction_setters()
-        lay = K.layout(self.n_modes)
-        self._params = np.zeros(sum(size for _, size in lay.values()))
-        self._views = {name: self._params[o:o + size] for name, (o, size) in lay.items()}
+        if self.aero == "unsteady":
+            from bioflex_jsb.simulation import unsteady_kernel as UK
+
+            self._kernel = UK.unsteady_kernel
+            self._params, v = UK.new_params(self.n_modes, mw.state.size)
+            v["dt"][0] = mw.dt_s
+            v["k_induced2"][0] = mw._k2
+        else:
+            self._kernel = K.step_kernel
+            lay = K.layout(self.n_modes)
+            self._params = np.zeros(sum(size for _, size in lay.values()))
+            v = {name: self._params[o:o + size] for name, (o, size) in lay.items()}
+            v["k_aero"][:] = np.ravel(mm.k_aero)
+            v["omega2"][:] = np.asarray(mm.omega, dtype=float) ** 2
+            v["forcing"][:] = np.ravel(mm.forcing_columns())
+            v["static_load"][:] = mw._static_load
+            v["model"][0] = K.MODEL_CODES[mw.model]
+            mw.prepare_arrays()
+        self._views = v
         lo, hi = ALPHA_TABLE_RANGE_RAD
-        v = self._views
         v["consts"][:] = (U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, P.REFERENCE_AREA_M2,
                           P.MEAN_AERODYNAMIC_CHORD_M, U.LBF_PER_N, U.LBF_FT_PER_N_M,
                           ETA_LIMIT_RAD, lo, hi, self.alpha_peak_rad)
         v["trim"][:] = (self.trim.alpha_rad, self.trim.theta_rad,
                         self.reference.dynamic_pressure_pa, self.speed_m_s)
         v["key"][:] = np.nan  # no reference yet: the first step computes it
-        v["k_aero"][:] = np.ravel(mm.k_aero)
-        v["omega2"][:] = np.asarray(mm.omega, dtype=float) ** 2
-        v["forcing"][:] = np.ravel(mm.forcing_columns())
         v["load_eta"][:] = np.ravel(mm.load_eta)
         v["load_etadot"][:] = np.ravel(mm.load_etadot)
         v["refresh_rel"][0] = mw.refresh_rel
-        v["static_load"][:] = mw._static_load
-        v["model"][0] = K.MODEL_CODES[mw.model]
         self._reactions, self._out_flow = v["reactions"], v["out_flow"]
         slots = K.KERNEL_SLOTS + self._eta_names + self._etadot_names
         self._cols = np.array([self.names.index(s) for s in slots], dtype=np.int64)
         self._scratch = np.zeros((1, len(self.names)))
         self._fast = None
-        mw.prepare_arrays()
         if mw._key is not None:
             self._load_reference()
 
     def _load_reference(self) -> None:
         """Copy the wing's reference step (after a refresh) into the parameter array."""
         mw, v = self.wing, self._views
+        if self.aero == "unsteady":
+            from bioflex_jsb.simulation.unsteady_kernel import load_reference
+
+            load_reference(v, mw._phi, mw._psi_b, mw._load_poly, mw._key)
+            return
         v["stack"][:] = np.ravel(mw._stack)
         v["input_cols"][:] = np.ravel(mw._input_cols)
         v["key"][:] = mw._key
@@ -458,7 +476,7 @@ class CoupledStep:
         # from Python into the kernel (a list into the array costs 0.5 µs more per step)
         (g_u, g_v, g_w, g_q, g_p, g_r, g_theta, g_phi, g_psi, g_rho, g_nz, g_h, g_agl, g_lat,
          g_lon, g_vn, g_ve, g_vd, g_elevator, g_throttle) = self._getters
-        kernel, needs_refresh, ok = K.step_kernel, K.NEEDS_REFRESH, K.OK
+        kernel, needs_refresh, ok = self._kernel, K.NEEDS_REFRESH, K.OK
         set_wind, jsbsim_step, agl = self._set_wind, self.airframe.step_function(), self._agl_m
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow

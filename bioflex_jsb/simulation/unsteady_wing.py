@@ -36,7 +36,9 @@ every matrix is a quadratic in V (stiffness ∝ Q, damping ∝ ρV, lag rates �
 
 Φ_r = e^{A(V_r) Δt}, Ψ_r = ∫_0^Δt e^{A(V_r) τ} dτ, ∂Φ/∂V the Fréchet derivative of the
 exponential along dA/dV: exact at the reference for any step, first order in the change
-since. Loads of the state after the step in the step's flow, η̈ from the held inputs.
+since. Loads of the state after the step in the step's flow, η̈ from the held inputs. This
+is the readable reference; the co-simulation runs the same arithmetic compiled
+(:mod:`bioflex_jsb.simulation.unsteady_kernel`, held to it by tests/test_unsteady_kernel.py).
 """
 
 from __future__ import annotations
@@ -51,7 +53,12 @@ from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
-from bioflex_jsb.simulation.modal_wing import FlowState, TrimReference, WingLoads
+from bioflex_jsb.simulation.modal_wing import (
+    FlowState,
+    TrimReference,
+    WingLoads,
+    _one_blas_thread,
+)
 
 INPUTS = ("Q*dalpha", "Q*q/V", "dQ", "alpha_i", "q", "alpha_i_dot", "q_dot", "w_g")
 INPUT_UNITS = ("Pa*rad", "Pa*rad/m", "Pa", "rad", "rad/s", "rad/s^2", "rad/s^2", "m/s")
@@ -150,7 +157,13 @@ class UnsteadyModalWing:
 
     # -- reference step -------------------------------------------------------------------
     def _reference(self, q_pa: float, v_m_s: float) -> None:
-        """Exact step at (Q_r, V_r) and the quadratics in V at ρ_r (module docstring)."""
+        """Exact step at (Q_r, V_r) and the quadratics in V at ρ_r (module docstring), BLAS
+        on one thread (as ModalWing's: on a loaded 2-core machine OpenBLAS's threads made a
+        refresh of these 166-state matrices take 335-1550 ms instead of 54-113 ms)."""
+        with _one_blas_thread():
+            self._compute_reference(q_pa, v_m_s)
+
+    def _compute_reference(self, q_pa: float, v_m_s: float) -> None:
         rho = 2.0 * q_pa / (v_m_s * v_m_s)
         nodes = [c * v_m_s for c in _NODES]
         mats = [self.continuous(v, rho) for v in nodes]
