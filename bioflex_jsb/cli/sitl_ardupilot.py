@@ -93,7 +93,8 @@ def register(sub) -> None:
     p.add_argument("--port", type=int, default=None,
                    help="UDP port to listen on instead (0: any free port)")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=None,
-                   help="stop after this much physics time [s] (default: until Ctrl-C)")
+                   help="stop after this much session physics time [s], ArduPilot restarts "
+                   "included (default: until Ctrl-C)")
     p.add_argument("--table", metavar="FILE.npz", default=None,
                    help="write the recorded frames to this .npz (names, units, table)")
     p.add_argument("--record-every", type=int, default=8,
