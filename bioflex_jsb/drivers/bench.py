@@ -1,22 +1,44 @@
-"""Benchmarks of the coupled step: figures measured in one run, as ratios of interleaved pairs.
+"""Benchmarks of the coupled step: per-step costs that cannot come out negative.
 
-Machines are shared and noisy (load averages of 4-10 on 2 cores were seen), so every ratio
-is the median of pairs timed back to back (the load changes less within a pair than across
-a run), with its min and max; and per-step costs are separated from fixed per-run costs by
-timing each run at two lengths (per step = ΔT/ΔN, fixed = T − N·per step).
+Machines are shared and noisy (load averages of 4-10 on 2 cores were seen): the difference of
+two run lengths, the earlier estimator, gave per-step costs below zero (ratio min −0.32 next to
+a median of 2.3) when one of the two runs was slowed. Here:
+
+* every configuration is timed at several run lengths N_j (``steps`` × 1, 2, 4), the lengths
+  and the configurations interleaved, ``repeat`` times, on two clocks: the process's CPU time
+  (``time.process_time``: what the code costs; a run preempted by another engineer's job is
+  not charged for the wait) and the wall clock;
+* :func:`estimate_per_step`: noise on a shared machine only ever adds time, so the fit is
+  made to the least time of each length over the repeats, T_min(N) = F + b N by least
+  squares (F the fixed cost per run: trim excluded, the step's set-up, the first reference
+  step, the log's opening and closing); each repeat's per-step cost is then its longest run
+  less that fixed cost, (T_i(N_max) − F)/N_max, F clipped to [0, T_min(N_1)] (a small
+  negative F, long runs slowed more than short ones, is taken as 0: the per-step cost is
+  then an upper bound): positive whenever the repeat took longer than the fixed cost, which
+  the checks below make sure of;
+* an estimate is *not trusted*, and no figure is given for it (its reason instead), when
+  the slope is not positive, the fit's residual is more than :data:`MAX_RESIDUAL` of the
+  times, the fixed cost comes out below zero by more than that share of the mean time, or
+  the slope and the least per-repeat cost differ by more than :data:`MAX_DISAGREEMENT`;
+* ratios are taken repeat by repeat (configurations timed back to back: the load changes
+  less within a repeat than across the run) and given as median, min and max.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from bioflex_jsb.drivers.gust import RunSetup, run_gust
 from bioflex_jsb.drivers.native import native_airframe
@@ -28,6 +50,16 @@ from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks.mcap import RunLog
 
+LENGTH_FACTORS = (1, 2, 4)  # run lengths, × ``steps``
+# An estimate is trusted when the least times lie on a line within 10 % (rms) of their
+# mean (a run of a few thousand steps under load 4-5 on 2 cores: 1-6 % measured) and the
+# slope agrees with the least per-repeat cost within 25 %.
+MAX_RESIDUAL = 0.10
+MAX_DISAGREEMENT = 0.25
+# The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step.
+BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2}
+CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
+
 
 @dataclass(frozen=True)
 class Spread:
@@ -38,27 +70,114 @@ class Spread:
     max: float
 
     @classmethod
-    def of(cls, values: list[float]) -> Spread:
+    def of(cls, values: Sequence[float]) -> Spread:
         return cls(statistics.median(values), min(values), max(values))
 
     def as_dict(self) -> dict[str, float]:
         return {"median": self.median, "min": self.min, "max": self.max}
 
 
+@dataclass(frozen=True)
+class PerStep:
+    """A per-step cost from timings at several run lengths (:func:`estimate_per_step`).
+
+    per_repeat_s: each repeat's per-step cost [s] (None when not trusted); slope_s: the
+    least-squares slope of the least times [s/step]; fixed_s: the fixed cost per run [s];
+    residual: rms residual of that fit / the mean least time [-]; reason: why the
+    estimate is not trusted (None when it is)."""
+
+    per_repeat_s: tuple[float, ...] | None
+    slope_s: float
+    fixed_s: float
+    residual: float
+    reason: str | None
+
+    @property
+    def trusted(self) -> bool:
+        return self.reason is None
+
+    def as_dict(self, scale: float = 1e6) -> dict[str, object]:
+        """Per-step spread × ``scale`` (µs by default) and the fit (fixed cost [ms])."""
+        spread = (Spread.of(self.per_repeat_s).as_dict() if self.per_repeat_s is not None
+                  else {"median": None, "min": None, "max": None})
+        return {**{k: _scaled(v, scale) for k, v in spread.items()}, "trusted": self.trusted,
+                "reason": self.reason, "slope": _scaled(self.slope_s, scale),
+                "fixed_ms": _scaled(self.fixed_s, 1e3), "residual": _finite(self.residual)}
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def _scaled(x: float | None, scale: float) -> float | None:
+    return None if x is None else _finite(x * scale)
+
+
+def estimate_per_step(lengths: Sequence[int], times_s) -> PerStep:
+    """The per-step cost of timings ``times_s`` [s] (repeats × lengths) of runs of
+    ``lengths`` steps (module docstring). Never negative: an estimate that the timings do
+    not support comes back with a reason and no figure."""
+    n = np.asarray(lengths, dtype=float)
+    t = np.asarray(times_s, dtype=float)
+    if t.ndim != 2 or t.shape[1] != n.size or n.size < 2 or t.shape[0] < 1:
+        raise ValueError(f"times of shape {t.shape} for {n.size} run lengths")
+    if np.unique(n).size != n.size or np.any(n <= 0):
+        raise ValueError(f"run lengths must be distinct and positive, got {lengths}")
+    if not np.all(np.isfinite(t)) or np.any(t < 0.0):
+        raise ValueError("timings must be finite and >= 0 s")
+    order = np.argsort(n)
+    n, t = n[order], t[:, order]
+    t_min = t.min(axis=0)  # noise only adds time: the least of the repeats
+    slope, fixed = np.polyfit(n, t_min, 1)
+    mean = float(np.mean(t_min))
+    resid = t_min - (fixed + slope * n)
+    residual = float(np.sqrt(np.mean(resid**2)) / mean) if mean > 0.0 else math.inf
+    reason = None
+    if not slope > 0.0:
+        reason = f"the time does not grow with the steps (slope {slope * 1e6:.3g} µs/step)"
+    elif residual > MAX_RESIDUAL:
+        reason = (f"the timings are not linear in the steps (residual {residual:.0%} > "
+                  f"{MAX_RESIDUAL:.0%}): too noisy, use more --steps or --repeat")
+    elif fixed < -MAX_RESIDUAL * mean:  # a fixed cost cannot be negative: not a line
+        reason = (f"the fixed cost per run comes out negative ({fixed * 1e3:.3g} ms, "
+                  f"beyond {MAX_RESIDUAL:.0%} of the mean time)")
+    if reason is not None:
+        return PerStep(None, float(slope), float(fixed), residual, reason)
+    f = min(max(float(fixed), 0.0), float(t_min[0]))
+    per = (t[:, -1] - f) / n[-1]
+    if not np.all(per > 0.0):
+        return PerStep(None, float(slope), f, residual,
+                       "a long run took no longer than the fixed cost")
+    disagreement = abs(float(per.min()) - slope) / slope
+    if disagreement > MAX_DISAGREEMENT:
+        return PerStep(None, float(slope), f, residual,
+                       f"the slope and the least per-repeat cost differ by "
+                       f"{disagreement:.0%} > {MAX_DISAGREEMENT:.0%}")
+    return PerStep(tuple(float(p) for p in per), float(slope), f, residual, None)
+
+
+def ratio(num: PerStep, den: PerStep) -> dict[str, object]:
+    """num / den repeat by repeat: median, min, max, or None and the reason when either
+    estimate is not trusted."""
+    if num.per_repeat_s is None or den.per_repeat_s is None:
+        why = num.reason if num.reason is not None else den.reason
+        return {"median": None, "min": None, "max": None, "trusted": False, "reason": why}
+    values = [a / b for a, b in zip(num.per_repeat_s, den.per_repeat_s, strict=True)]
+    return {**Spread.of(values).as_dict(), "trusted": True, "reason": None}
+
+
 class BenchmarkStopped(RuntimeError):
     """A benchmark run left the valid range (the benchmark case must fly)."""
 
 
-def _per_step(timed: Callable[[int], float], n_short: int, n_long: int) -> tuple[float, float]:
-    """(per-step [s], fixed per-run [s]) of ``timed(n) -> seconds`` from two run lengths."""
-    t_short, t_long = timed(n_short), timed(n_long)
-    per_step = (t_long - t_short) / (n_long - n_short)
-    return per_step, t_short - n_short * per_step
+def _clocks() -> tuple[float, float]:
+    return time.process_time(), time.perf_counter()
 
 
 class StepBench:
-    """Bare JSBSim, the co-simulation (compiled and Python steps), logged, and the native XML
-    wing, on one airframe at the co-simulation's step."""
+    """Bare JSBSim, the co-simulation (compiled and Python steps, quasi-steady and unsteady
+    strips), logged, and the native XML wing, on one airframe at the co-simulation's step.
+    Every timed method returns (CPU seconds, wall seconds) of a run of ``n`` steps."""
 
     def __init__(self, build: WingBuild, speed_m_s: float = 15.0, steps: int = 1200) -> None:
         self.build = build
@@ -74,28 +193,29 @@ class StepBench:
     def close(self) -> None:
         self._tmp.cleanup()
 
-    def bare(self, n: int) -> float:
-        """Seconds for ``n`` steps of JSBSim alone (trimmed first, outside the timing)."""
+    def bare(self, n: int) -> tuple[float, float]:
+        """``n`` steps of JSBSim alone (trimmed first, outside the timing)."""
         self.airframe.trim(self.speed_m_s)
         return self._timed_run(self.airframe, n)
 
-    def native_run(self, n: int) -> float:
+    def native_run(self, n: int) -> tuple[float, float]:
         self.native.trim(self.speed_m_s)
         return self._timed_run(self.native, n)
 
     @staticmethod
-    def _timed_run(af: Airframe, n: int) -> float:
+    def _timed_run(af: Airframe, n: int) -> tuple[float, float]:
         step = af.step_function()
         with af.capturing():
-            t0 = time.perf_counter()
+            c0, w0 = _clocks()
             for _ in range(n):
                 step()
-            return time.perf_counter() - t0
+            c1, w1 = _clocks()
+        return c1 - c0, w1 - w0
 
     def cosim(self, n: int, gust: str = "sharp:0.3", logged: bool = False,
-              compiled: bool = True) -> float:
-        """Seconds for a co-simulated run of ``n`` steps (the coupled wing) through ``gust``,
-        starting at half the run; with an MCAP log when ``logged``."""
+              compiled: bool = True, aero: str = "quasi-steady") -> tuple[float, float]:
+        """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
+        at half the shortest run; with an MCAP log when ``logged``; ``aero`` the strips."""
         dt = DEFAULT_DT_S
         setup = RunSetup(self.speed_m_s, parse_gust(gust), duration_s=n * dt,
                          gust_start_s=0.5 * self.steps * dt, dt_s=dt)
@@ -106,67 +226,80 @@ class StepBench:
             desc = RunDescription("bench", self.build.variant.name, self.speed_m_s, gust=gust,
                                   models=("coupled",), duration_s=n * dt)
             log = RunLog.open(Path(self._tmp.name) / f"bench{self._logs}.mcap", desc)
+        wing = self.build if aero == "unsteady" else self.build.model
         try:
-            t0 = time.perf_counter()
-            run = run_gust(self.airframe, self.build.model, "coupled", setup, trim=trim,
+            c0, w0 = _clocks()
+            run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=log.recorder("coupled") if log else None,
-                           compiled=compiled)
-            elapsed = time.perf_counter() - t0
+                           compiled=compiled, aero=aero)
+            c1, w1 = _clocks()
         finally:
             if log is not None:
                 log.close()
         if run.stopped:
             raise BenchmarkStopped(f"benchmark run stopped: {run.stopped}")
-        return elapsed
+        return c1 - c0, w1 - w0
+
+    def configurations(self, gusts: Sequence[str]) -> dict[str, Callable[[int], tuple]]:
+        """name → timed run of n steps, in the order they are interleaved."""
+        configs: dict[str, Callable[[int], tuple]] = {
+            "bare": self.bare,
+            "cosim": lambda n: self.cosim(n),
+            "logged": lambda n: self.cosim(n, logged=True),
+            "unsteady": lambda n: self.cosim(n, aero="unsteady"),
+            "native": self.native_run,
+            "python": lambda n: self.cosim(n, compiled=False),
+        }
+        for g in gusts:
+            if g != "sharp:0.3":  # that one is "cosim"
+                configs[f"gust:{g}"] = lambda n, g=g: self.cosim(n, gust=g)
+        return configs
 
     def measure(self, repeat: int = 5, gusts: tuple[str, ...] = ("sharp:0.3", "sharp:3",
                                                                     "dryden:1.5:100:7"),
                 progress=None) -> dict[str, object]:
-        """Every figure of ``bioflex-jsb bench`` (module docstring; times in µs per step)."""
-        n1, n2 = self.steps, 2 * self.steps
-        pairs: dict[str, list[float]] = {k: [] for k in (
-            "ratio", "logged_ratio", "log_ratio", "native_ratio", "python_ratio")}
-        us: dict[str, list[float]] = {k: [] for k in (
-            "bare", "cosim", "logged", "native", "python")}
-        fixed: dict[str, list[float]] = {k: [] for k in ("cosim", "logged")}
-        by_gust: dict[str, list[float]] = {g: [] for g in gusts}
-        # warm-up, not timed: the first run pays one-time costs (lazy imports, the first
-        # reference step, the log writer's first chunk) that would land in one run length
-        self.cosim(n1)
-        self.cosim(n1, logged=True)
-        self.cosim(n1, compiled=False)
-        self.native_run(n1)
-        for _ in range(repeat):
-            b, _f = _per_step(self.bare, n1, n2)
-            c, fc = _per_step(lambda n: self.cosim(n), n1, n2)
-            lg, fl = _per_step(lambda n: self.cosim(n, logged=True), n1, n2)
-            b2, _f = _per_step(self.bare, n1, n2)
-            nat, _f = _per_step(self.native_run, n1, n2)
-            py, _f = _per_step(lambda n: self.cosim(n, compiled=False), n1, n2)
-            bb = 0.5 * (b + b2)  # the bare step on both sides of the co-simulated ones
-            pairs["ratio"].append(c / bb)
-            pairs["logged_ratio"].append(lg / bb)
-            pairs["log_ratio"].append(lg / c)
-            pairs["native_ratio"].append(nat / b2)
-            pairs["python_ratio"].append(py / bb)
-            for key, value in (("bare", bb), ("cosim", c), ("logged", lg), ("native", nat),
-                               ("python", py)):
-                us[key].append(value * 1e6)
-            fixed["cosim"].append(fc * 1e3)
-            fixed["logged"].append(fl * 1e3)
-            for g in gusts:
-                gc, _f = _per_step(lambda n, g=g: self.cosim(n, gust=g), n1, n2)
-                by_gust[g].append(gc * 1e6)
+        """Every figure of ``bioflex-jsb bench`` (module docstring; per-step costs in µs)."""
+        lengths = [f * self.steps for f in LENGTH_FACTORS]
+        configs = self.configurations(gusts)
+        # [clock][config] → repeats × lengths [s]
+        times = {c: {k: np.zeros((repeat, len(lengths))) for k in configs} for c in CLOCKS}
+        # warm-up, not timed: the first run pays one-time costs (lazy imports, the kernels'
+        # load, the first reference step, the log writer's first chunk)
+        for run in configs.values():
+            run(self.steps)
+        for i in range(repeat):
+            for j, n in enumerate(lengths):
+                for name, run in configs.items():
+                    times["cpu"][name][i, j], times["wall"][name][i, j] = run(n)
             if progress is not None:
                 progress.update(1)
         if progress is not None:
             progress.close()
+        est = {c: {k: estimate_per_step(lengths, v) for k, v in times[c].items()}
+               for c in CLOCKS}
+        cpu = est["cpu"]
+        pairs = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
+                 "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
+                 "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare")}
+        figures: dict[str, object] = {}
+        for key, (num, den) in pairs.items():
+            figures[key] = ratio(cpu[num], cpu[den])
+            if key in BARS:
+                figures[key]["bar"] = BARS[key]
+                med = figures[key]["median"]
+                figures[key]["meets_bar"] = None if med is None else bool(med <= BARS[key])
+        plain = [k for k in configs if not k.startswith("gust:")]
         return {
-            **{k: Spread.of(v).as_dict() for k, v in pairs.items()},
-            "us_per_step": {k: Spread.of(v).as_dict() for k, v in us.items()},
-            "fixed_ms_per_run": {k: Spread.of(v).as_dict() for k, v in fixed.items()},
-            "cosim_us_per_step_by_gust": {g: Spread.of(v).as_dict()
-                                          for g, v in by_gust.items()},
+            **figures,
+            "clock": "process CPU time (time.process_time); wall-clock figures in 'wall'",
+            "us_per_step": {k: cpu[k].as_dict() for k in plain},
+            "wall": {"us_per_step": {k: est["wall"][k].as_dict() for k in plain},
+                     **{key: ratio(est["wall"][a], est["wall"][b])
+                        for key, (a, b) in pairs.items()}},
+            "cosim_us_per_step_by_gust": {
+                g: cpu["cosim" if g == "sharp:0.3" else f"gust:{g}"].as_dict() for g in gusts},
+            "run_lengths": lengths,
+            "load_average": list(os.getloadavg()),
         }
 
 
@@ -176,27 +309,53 @@ def refresh_cost_ms(build: WingBuild, n: int = 50) -> dict[str, float]:
     from bioflex_jsb.simulation.modal_wing import ModalWing, TrimReference
 
     mw = ModalWing(build.model, TrimReference(0.05, 137.8, 0.5), dt_s=DEFAULT_DT_S)
-    mw._reference(137.8, 15.0)  # the first call loads what it needs: not a refresh
+    return _refresh_times(mw, n)
+
+
+def unsteady_refresh_cost_ms(build: WingBuild, n: int = 5) -> dict[str, float]:
+    """The same for the unsteady wing (166 states for the prototype: tens of ms)."""
+    from bioflex_jsb.simulation.modal_wing import TrimReference
+    from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
+
+    uw = UnsteadyModalWing.from_build(build, TrimReference(0.05, 137.8, 0.5), DEFAULT_DT_S)
+    return _refresh_times(uw, n)
+
+
+def _refresh_times(wing, n: int) -> dict[str, float]:
+    wing._reference(137.8, 15.0)  # the first call loads what it needs: not a refresh
     times = []
     for i in range(n):
         t0 = time.perf_counter()
-        mw._reference(137.8 * (1.0 + 0.01 * (i + 1)), 15.0)
+        wing._reference(137.8 * (1.0 + 0.01 * (i + 1)), 15.0)
         times.append((time.perf_counter() - t0) * 1e3)
     return {"median": statistics.median(times), "max": max(times)}
 
 
-def compile_cost_s() -> dict[str, float]:
-    """Seconds to import and compile the step kernel with an empty numba cache (``cold``: a
-    fresh machine pays this once) and to import it again with that cache filled
-    (``cached``: every later run), each measured in a child process."""
-    code = ("import time; t0 = time.perf_counter(); "
-            "from bioflex_jsb.simulation import step_kernel as K; K.compile_now(); "
-            "print(time.perf_counter() - t0)")
+_COMPILE = """import json, time
+t0 = time.perf_counter()
+from bioflex_jsb.simulation import step_kernel
+step_kernel.compile_now()
+t1 = time.perf_counter()
+from bioflex_jsb.simulation import unsteady_kernel
+unsteady_kernel.compile_now()
+t2 = time.perf_counter()
+print(json.dumps({"step_kernel": t1 - t0, "unsteady_kernel": t2 - t1}))
+"""
+
+
+def compile_cost_s() -> dict[str, object]:
+    """Seconds to import and compile the step kernels (quasi-steady, then unsteady) with an
+    empty numba cache (``cold``: a fresh machine pays this once) and to import them again
+    with that cache filled (``cached``: every later run), each in a child process; with the
+    load average at the time."""
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-        out = {}
+        out: dict[str, object] = {}
         for name in ("cold", "cached"):
-            run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                                 text=True, check=True, timeout=600)
-            out[name] = float(run.stdout.strip().splitlines()[-1])
+            run = subprocess.run([sys.executable, "-c", _COMPILE], env=env,
+                                 capture_output=True, text=True, check=True, timeout=600)
+            parts = json.loads(run.stdout.strip().splitlines()[-1])
+            out[name] = sum(parts.values())
+            out[f"{name}_by_kernel"] = parts
+        out["load_average"] = list(os.getloadavg())
     return out
