@@ -11,16 +11,30 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 >>> lti = api.linear_model(wing, speed_m_s=15.0, model="coupled")
 >>> unsteady = api.fly_gust(wing, gust="sharp:0.3", aero="unsteady")  # Jones/Küssner strips
 >>> api.flutter(wing).flutter_speed_m_s  # [m/s]
+>>> api.flutter("goland", clamped=True).as_dict()  # a clamped wing from its definition
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
-from bioflex_jsb.aeroelasticity.free_aircraft import AERO_MODELS, unsteady_state_space
+import numpy as np
+
+from bioflex_jsb.aeroelasticity.free_aircraft import (
+    AERO_MODELS,
+    free_flutter,
+    unsteady_mode_sets,
+    unsteady_state_space,
+    with_damping,
+)
+from bioflex_jsb.definition import Definition
+from bioflex_jsb.definition import load_definition as _load_definition
+from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
 from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.eigen import FlutterResult, ModeSet, find_flutter, modes_at
+from bioflex_jsb.flight_dynamics.flutter_engine import METHODS
 from bioflex_jsb.flight_dynamics.lti import MODELS, StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import (
@@ -36,7 +50,8 @@ from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metric
 
 __all__ = [
     "DEFAULT_DT_S", "FlutterResult", "GustMetrics", "StateSpace", "TimeHistory", "WingBuild",
-    "flutter", "fly_fig21", "fly_gust", "linear_model", "load_wing", "metrics", "modes",
+    "flutter", "fly_fig21", "fly_gust", "linear_model", "load_definition", "load_wing",
+    "metrics", "modes",
     "to_python_control",
 ]
 
@@ -151,13 +166,139 @@ def to_python_control(ss: StateSpace):
     return convert(ss)
 
 
-def modes(wing: WingBuild, speed_m_s: float = 15.0, model: str = "coupled") -> ModeSet:
-    """Labelled eigenvalues (short period, phugoid, aeroelastic_i) of ``model`` at
-    ``speed_m_s`` [m/s]."""
-    return modes_at(model, [speed_m_s], wing.model)[0]
+def load_definition(name_or_file: str = "goland") -> Definition:
+    """An aircraft definition (docs/aircraft.md): a shipped name (``goland``) or a TOML
+    file; today a clamped wing (a definition without an airframe). Checked when read."""
+    return _load_definition(name_or_file)
 
 
-def flutter(wing: WingBuild, range_m_s: tuple[float, float] = (5.0, 40.0)) -> FlutterResult:
-    """The lowest airspeed [m/s] in ``range_m_s`` at which a mode of the coupled model goes
-    unstable, its frequency [rad/s] and kind (flutter or divergence)."""
-    return find_flutter(wing.model, range_m_s)
+def _clamped(definition, lift_slope: str | None):
+    from bioflex_jsb.definition.clamped import clamped_model
+
+    d = load_definition(definition) if isinstance(definition, str) else definition
+    return d, clamped_model(d, lift_slope)
+
+
+def _check_choice(what: str, value, accepted) -> None:
+    if value not in accepted:
+        raise InputError(f"unknown {what} {value!r}; accepted: {', '.join(accepted)}")
+
+
+def _check_density(rho: float) -> float:
+    lo, hi = DENSITY_RANGE_KG_M3
+    if not lo <= float(rho) <= hi:
+        raise InputError(f"density {rho!r} kg/m^3 is outside {lo:g}..{hi:g} kg/m^3 (about 33 "
+                         "km altitude to denser than any surface air)")
+    return float(rho)
+
+
+def modes(wing, speed_m_s: float = 15.0, model: str = "coupled", *,
+          aero: str = "quasi-steady", clamped: bool = False, method: str = "state-space",
+          structural_damping: float | None = None) -> ModeSet:
+    """Labelled eigenvalues at ``speed_m_s`` [m/s].
+
+    Free aircraft (``wing`` a :class:`WingBuild`): ``model`` rigid, coupled or qsd of the
+    paper (short period, phugoid, aeroelastic_i), ``aero="unsteady"`` the coupled model on
+    unsteady strips (lag roots left out). Clamped (``clamped=True``, ``wing`` a definition
+    or its name/file): the wing's branches tracked from the bottom of its derived range by
+    ``method`` (``pk`` or ``state-space``) on ``aero`` strips (lag roots left out)."""
+    _check_choice("aerodynamics", aero, AERO_MODELS)
+    if clamped:
+        return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
+    if aero == "unsteady":
+        if model != "coupled":
+            raise InputError("aero='unsteady' is the coupled model of an elastic wing")
+        return unsteady_mode_sets(wing, [speed_m_s], structural_damping)[0]
+    w = wing.model if structural_damping is None else with_damping(wing, structural_damping)
+    return modes_at(model, [speed_m_s], None if model == "rigid" else w)[0]
+
+
+def _clamped_modes(definition, speed_m_s, aero, method, structural_damping) -> ModeSet:
+    from bioflex_jsb.aeroelasticity.pk import PkFamily
+    from bioflex_jsb.aeroelasticity.state_space import state_space_family
+    from bioflex_jsb.definition.clamped import derived_speed_range_m_s, scan_step_m_s
+    from bioflex_jsb.flight_dynamics import flutter_engine as engine
+    from bioflex_jsb.flight_dynamics.eigen import Mode
+
+    _check_choice("method", method, METHODS)
+    d, m = _clamped(definition, None)
+    zeta = d.structure.damping_ratio if structural_damping is None else structural_damping
+    rho = d.air.density_kg_m3
+    kw = dict(density_kg_m3=rho, aero=aero, structural_damping=zeta, name=d.name)
+    fam = PkFamily(m, **kw) if method == "pk" else state_space_family(m, **kw)
+    lo = min(derived_speed_range_m_s(m, rho)[0], float(speed_m_s))
+    step = scan_step_m_s((lo, max(float(speed_m_s), lo + 1.0)))
+    grid = np.union1d(np.arange(lo, float(speed_m_s), step), [float(speed_m_s)])
+    last = engine.scan(fam, grid).points[-1]
+    out = []
+    for name in dict.fromkeys(lab for lab, c in zip(fam.labels, fam.considered, strict=True)
+                              if c):
+        roots = [r for r, lab in zip(last.roots, fam.labels, strict=True) if lab == name]
+        r = max(roots, key=lambda z: z.imag)
+        out.append(Mode(name, float(r.real), float(abs(r.imag))))
+    return ModeSet(float(speed_m_s), f"clamped-{method}-{aero}", tuple(out))
+
+
+def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
+            aero: str | None = None, method: str | None = None, clamped: bool = False,
+            structural_damping: float | None = None, density_kg_m3: float | None = None,
+            lift_slope: str | None = None) -> FlutterResult:
+    """The first instability [m/s] in ``range_m_s``: flutter, body-freedom flutter or
+    static divergence, its frequency [rad/s], k, modes, mechanism, and whether it is
+    already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``).
+
+    Free aircraft (``wing`` a :class:`WingBuild`): Eq. (4) on ``aero`` strips (default
+    ``quasi-steady``, the paper's; ``unsteady``: Jones lag states), ``method``
+    ``state-space``; range default 5-40 m/s; ``structural_damping`` ζ [-] replaces the
+    wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML
+    file): ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and ρ
+    default to the definition's; the range to the one derived from the wing
+    (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`)."""
+    if range_m_s is not None:
+        lo, hi = (float(x) for x in range_m_s)
+        if not 0.0 < lo < hi:
+            raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
+    if density_kg_m3 is not None:
+        _check_density(density_kg_m3)
+    if clamped:
+        return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
+                                density_kg_m3, lift_slope)
+    aero = aero or "quasi-steady"
+    _check_choice("aerodynamics", aero, AERO_MODELS)
+    if method not in (None, "state-space"):
+        raise InputError("the free aircraft's flutter is by state-space eigen-analysis; "
+                         "method='pk' is for clamped wings")
+    if lift_slope is not None:
+        raise InputError("lift_slope is for clamped wings; the free aircraft takes the "
+                         "vortex lattice's span loading (Table B1)")
+    rng = (5.0, 40.0) if range_m_s is None else range_m_s
+    air = {} if density_kg_m3 is None else {"density_kg_m3": float(density_kg_m3)}
+    if aero == "unsteady":
+        return free_flutter(wing, aero="unsteady", structural_damping=structural_damping,
+                            range_m_s=rng, **air)
+    model = wing.model if structural_damping is None else with_damping(wing,
+                                                                       structural_damping)
+    return find_flutter(model, rng, **air)
+
+
+def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope):
+    from bioflex_jsb.aeroelasticity import pk, state_space
+    from bioflex_jsb.definition.clamped import derived_speed_range_m_s, scan_step_m_s
+
+    d, m = _clamped(definition, lift_slope)
+    aero = aero or d.aero.model
+    method = method or d.analysis.method
+    _check_choice("aerodynamics", aero, AERO_MODELS)
+    _check_choice("method", method, METHODS)
+    rho = d.air.density_kg_m3 if rho is None else rho
+    zeta = d.structure.damping_ratio if zeta is None else float(zeta)
+    rng = range_m_s or d.analysis.speed_range_m_s or derived_speed_range_m_s(m, rho)
+    solve = pk.pk_flutter if method == "pk" else state_space.state_space_flutter
+    step = pk.DEFAULT_SPEED_STEP_M_S if d.analysis.speed_range_m_s or range_m_s else \
+        scan_step_m_s(rng)
+    res = solve(m, density_kg_m3=rho, aero=aero, structural_damping=zeta,
+                speed_range_m_s=tuple(rng), speed_step_m_s=min(step, scan_step_m_s(rng)),
+                name=d.name)
+    return replace(res, settings=dict(res.settings, definition=d.path or d.name,
+                                      range_derived=range_m_s is None
+                                      and d.analysis.speed_range_m_s is None))

@@ -125,11 +125,12 @@ def six_wings() -> list[dict]:
             row[f"{s}_flutter_quasi_steady_m_s"] = qs.flutter_speed_m_s
             row[f"{s}_flutter_quasi_steady_mode"] = qs.mode
             for zeta in (0.0, 0.02):
-                v_f, root = unsteady_flutter_with(b, aset.aero, aset.planform,
-                                                  structural_damping=zeta)
-                row[f"{s}_flutter_unsteady_zeta{zeta:g}_m_s"] = v_f
+                res = unsteady_flutter_with(b, aset.aero, aset.planform,
+                                            structural_damping=zeta)
+                row[f"{s}_flutter_unsteady_zeta{zeta:g}_m_s"] = (
+                    None if res.speed_m_s is None else round(res.speed_m_s, 2))
                 row[f"{s}_flutter_unsteady_zeta{zeta:g}_rad_s"] = (
-                    None if root is None else round(abs(root.imag), 2))
+                    None if res.frequency_rad_s is None else round(res.frequency_rad_s, 2))
         rows.append(row)
     return rows
 

@@ -147,3 +147,45 @@ def test_vlm_span_loading_raises_flutter_speed(pk_unsteady):
                    speed_step_m_s=4.0)
     assert 1.2 < r.speed_m_s / pk_unsteady.speed_m_s < 1.4
     assert r.mechanism == "coalescence"
+
+
+def _hale_model():
+    # Patil, Hodges & Cesnik (2001) HALE wing (docs/aircraft.md): EA = CG at mid-chord
+    from bioflex_jsb.aeroelasticity.clamped_wing import clamped_wing_model
+    from bioflex_jsb.structures.beam import uniform_sections
+
+    return clamped_wing_model(uniform_sections(
+        16.0, bending_stiffness_n_m2=2e4, torsional_stiffness_n_m2=1e4,
+        mass_per_length_kg_m=0.75, torsional_inertia_kg_m=0.1, chord_m=1.0,
+        x_elastic_frac=0.5, x_inertial_frac=0.5))
+
+
+@pytest.mark.parametrize("method", ["pk", "state-space"])
+def test_unstable_at_every_speed_is_reported_by_both_methods(method):
+    # Quasi-steady strips on the HALE wing (elastic axis at mid-chord): the torsion root is
+    # unstable from the lowest speed on. Before the one engine p-k said "static divergence"
+    # at 37.16 m/s and state space "no instability"; both must say: unstable at the lower
+    # end, in torsion, oscillatory.
+    from bioflex_jsb.aeroelasticity.flutter import clamped_flutter
+
+    r = clamped_flutter(_hale_model(), method=method, aero="quasi-steady",
+                        density_kg_m3=0.0889, speed_range_m_s=(3.0, 56.0))
+    assert r.present_at_lower_end and r.speed_m_s == 3.0
+    assert r.mode == "mode 3 (torsion)" and r.kind == "flutter" and r.frequency_rad_s > 25.0
+
+
+@pytest.mark.parametrize("method", ["pk", "state-space"])
+def test_crossing_below_the_range_is_present_at_lower_end(method):
+    # Goland flutters at 136.96 m/s (p-k); a range from 140 m/s returned no flutter.
+    r = goland_flutter(method=method, speed_range_m_s=(140.0, 260.0))
+    assert r.present_at_lower_end and r.speed_m_s == 140.0 and r.mode == "mode 2 (torsion)"
+
+
+def test_divergence_in_range_is_the_first_instability():
+    # a divergence of the clamped system inside the range, with no dynamic crossing before
+    # it, is reported as the instability (never "no instability" beside it): the Goland wing
+    # with its flutter damped out by ζ = 0.3 (measured: no dynamic crossing below 252.3 m/s)
+    r = goland_flutter(structural_damping=0.3, speed_range_m_s=(200.0, 300.0))
+    assert r.mechanism == "static divergence" and r.kind == "divergence"
+    assert r.speed_m_s == pytest.approx(r.divergence_speed_m_s) == pytest.approx(252.30,
+                                                                                abs=0.01)

@@ -4,9 +4,12 @@
   (2-D lift slope or the vortex lattice's span loading); the Goland wing's sections;
 * :mod:`~bioflex_jsb.aeroelasticity.strip_aero`: generalised aerodynamic forces, Theodorsen
   (frequency domain) and Jones/Küssner finite-state (time domain);
-* :mod:`~bioflex_jsb.aeroelasticity.pk`: p-k flutter solution with branch tracking;
-* :mod:`~bioflex_jsb.aeroelasticity.state_space`: eigen-analysis of structure + lag states;
-* :mod:`~bioflex_jsb.aeroelasticity.flutter`: the result, mechanism and the Goland benchmark;
+* :mod:`~bioflex_jsb.aeroelasticity.pk`: the p-k branches (a root family of the one engine,
+  :mod:`bioflex_jsb.flight_dynamics.flutter_engine`: tracking, search, result, mechanism);
+* :mod:`~bioflex_jsb.aeroelasticity.state_space`: structure + lag states, the engine's
+  eigen family;
+* :mod:`~bioflex_jsb.aeroelasticity.flutter`: either method on a clamped wing, the Goland
+  benchmark;
 * :mod:`~bioflex_jsb.aeroelasticity.free_aircraft`: the paper's free aircraft, Eq. (4) with
   unsteady strips (named Jones lag states), its flutter and the six-wing table;
 * :mod:`~bioflex_jsb.aeroelasticity.strip_increments`: the unsteady strips' loads beyond the

@@ -202,3 +202,8 @@ def clamped_wing_model(
 def reduced_frequency(frequency_rad_s: float, speed_m_s: float, semichord_m: float) -> float:
     """k = ωb/V [-]; ∞ at zero speed."""
     return math.inf if speed_m_s == 0.0 else abs(frequency_rad_s) * semichord_m / speed_m_s
+
+
+def structural_damping_matrix(model: ClampedWingModel, zeta: float) -> np.ndarray:
+    """Modal viscous damping diag(2 ζ ω_i) [1/s] (ζ [-] the same for every mode)."""
+    return np.diag(2.0 * float(zeta) * model.natural_frequencies_rad_s)

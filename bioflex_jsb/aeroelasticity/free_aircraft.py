@@ -42,9 +42,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq, linear_sum_assignment
 
 from bioflex_jsb.aeroelasticity.strip_increments import strip_increments
+from bioflex_jsb.flight_dynamics import eigen
+from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
@@ -52,15 +53,8 @@ from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
-AERO_MODELS = ("quasi-steady", "unsteady")
-# DEFINITION (free aircraft; bioflex_jsb.cli.flutter uses it for both models): coalescence
-# when another branch's frequency is within this fraction of the unstable one's at the
-# crossing. The clamped rule (separation against the wind-off one) does not carry over: the
-# short period starts near 0 rad/s and the first aeroelastic mode softens by 40 % before it
-# flutters, halving their separation without any approach (elastic-backward, quasi-steady,
-# 15.4 m/s: 82.8 vs 15.1 rad/s).
-COALESCENCE_RELATIVE_GAP = 0.25
-EXCLUDED = ("phugoid",)
+AERO_MODELS = engine.AERO_MODELS
+EXCLUDED = eigen.EXCLUDED_FROM_FLUTTER
 
 
 @dataclass(frozen=True)
@@ -211,33 +205,32 @@ def _system(build, v, aero, zeta, rho) -> np.ndarray:
     return _quasi_steady_a(build, v, zeta, rho)
 
 
-def _mac(v1, v2):
-    num = np.abs(v1.conj().T @ v2) ** 2
-    den = np.outer(np.sum(np.abs(v1) ** 2, 0), np.sum(np.abs(v2) ** 2, 0))
-    return num / den
-
-
-MECHANISMS = ("coalescence", "single-mode", "body-freedom", "static divergence")
-
-
 def wing_divergence_speed_m_s(build, *, density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
                               range_m_s: tuple[float, float] = (2.0, 60.0)) -> float | None:
-    """Speed [m/s] at which the wing's static stiffness in the aircraft, A_EE = −ω² + H_η
-    of Eq. (4), first becomes singular (its divergence with the body held); None in range.
-    The same for both aerodynamic models (the unsteady increments vanish in a steady state)."""
-    from bioflex_jsb.flight_dynamics.lti import coupled_blocks
+    """:func:`bioflex_jsb.flight_dynamics.eigen.wing_divergence_speed_m_s` of ``build``'s
+    model: the wing's divergence with the body held [m/s] (None in range)."""
+    return eigen.wing_divergence_speed_m_s(build.model, density_kg_m3, range_m_s)
 
-    def det(v):
-        return float(np.linalg.det(coupled_blocks(build.model,
-                                                  level_flight_condition(v, density_kg_m3)).a_ee))
 
-    grid = np.arange(range_m_s[0], range_m_s[1] + 0.25, 0.5)
-    signs = np.sign([det(v) for v in grid])
-    flips = np.flatnonzero(signs[1:] != signs[:-1])
-    if flips.size == 0:
-        return None
-    k = int(flips[0])
-    return float(brentq(det, grid[k], grid[k + 1], xtol=1e-4))
+def free_family(build, *, aero: str = "unsteady", structural_damping: float | None = None,
+                density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                start_m_s: float = eigen.SCAN_START_M_S) -> engine.EigenFamily:
+    """The free aircraft (Eq. 4, ``aero`` strips) as the engine's family. Labels: the
+    quasi-steady Eq. (4)'s at ``start_m_s`` (:func:`eigen.track`), given to the nearest
+    roots of this system there; the strips' lag roots are ``lag``."""
+    if aero not in AERO_MODELS:
+        raise ValueError(f"aero must be one of {AERO_MODELS}, not {aero!r}")
+    model = with_damping(build, structural_damping)
+    ref = eigen.track("coupled", [float(start_m_s)], model, density_kg_m3)
+    fam = engine.EigenFamily(
+        lambda v: _system(build, v, aero, structural_damping, density_kg_m3),
+        ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=EXCLUDED,
+        rigid_labels=eigen.RIGID_LABELS,
+        natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
+        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, method="state-space",
+        aero=aero, name=build.variant.name)
+    fam.divergence_speed_m_s = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3)
+    return fam
 
 
 @dataclass(frozen=True, eq=False)
@@ -260,143 +253,57 @@ class FreeTrack:
 
 def track_free(build, speeds_m_s, *, aero: str = "unsteady",
                structural_damping: float | None = None,
-               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
-               stop_when_unstable_from: float | None = None) -> FreeTrack:
-    """Eigenvalues over increasing ``speeds_m_s``, labels carried by eigenvector
-    correlation (MAC) + eigenvalue continuity (as :mod:`bioflex_jsb.flight_dynamics.eigen`);
-    with ``stop_when_unstable_from`` the scan ends at the first speed ≥ it with an
-    unstable non-phugoid root."""
-    from bioflex_jsb.flight_dynamics import eigen
-
-    if aero not in AERO_MODELS:
-        raise ValueError(f"aero must be one of {AERO_MODELS}, not {aero!r}")
+               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> FreeTrack:
+    """Eigenvalues over increasing ``speeds_m_s``, labels carried by the engine's tracker
+    (eigenvector correlation + eigenvalue continuity)."""
     speeds = np.asarray(speeds_m_s, dtype=float)
-    ref = eigen.track("coupled", speeds[:1], with_damping(build, structural_damping),
-                      density_kg_m3)
-    labels: list[str] = []
-    out, done = [], []
-    prev_lam = prev_vec = None
-    for v in speeds:
-        lam, vec = np.linalg.eig(_system(build, v, aero, structural_damping, density_kg_m3))
-        if prev_lam is None:
-            r = ref.eigenvalues[0]
-            cost = np.abs(r[:, None] - lam[None, :]) / (1.0 + np.abs(r[:, None]))
-            rows_, cols = linear_sum_assignment(cost)
-            chosen = list(cols[np.argsort(rows_)])
-            rest = [i for i in range(lam.size) if i not in chosen]
-            order = np.array(chosen + rest)
-            labels = list(ref.labels) + ["lag"] * len(rest)
-        else:
-            order = _match(prev_lam, prev_vec, lam, vec)
-        prev_lam, prev_vec = lam[order], vec[:, order]
-        out.append(prev_lam)
-        done.append(v)
-        if stop_when_unstable_from is not None and v >= stop_when_unstable_from - 1e-12:
-            considered = np.array([lab not in EXCLUDED for lab in labels])
-            if prev_lam[considered].real.max() > GROWTH_TOL_1_S:
-                break
-    return FreeTrack(np.array(done), np.array(out), tuple(labels), prev_vec)
+    fam = free_family(build, aero=aero, structural_damping=structural_damping,
+                      density_kg_m3=density_kg_m3, start_m_s=float(speeds[0]))
+    tr = engine.scan(fam, speeds)
+    return FreeTrack(tr.speeds_m_s, tr.roots, tr.labels, tr.points[-1].vectors)
 
 
-def _match(prev_lam, prev_vec, lam, vec) -> np.ndarray:
-    cost = (1.0 - _mac(prev_vec, vec)) + np.abs(prev_lam[:, None] - lam[None, :]) / (
-        1.0 + np.abs(prev_lam)[:, None])
-    rows_, cols = linear_sum_assignment(cost)
-    return cols[np.argsort(rows_)]
+def unsteady_mode_sets(build, speeds_m_s, structural_damping: float | None = None,
+                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> list:
+    """The coupled model on unsteady strips at ``speeds_m_s`` [m/s]: its labelled roots
+    (short period, phugoid, aeroelastic_i; the strips' lag roots left out) as
+    :class:`eigen.ModeSet`s (labels tracked from 2 m/s on a 0.25 m/s grid)."""
+    grid = eigen.sweep_grid(list(speeds_m_s))
+    tr = track_free(build, grid, aero="unsteady", structural_damping=structural_damping,
+                    density_kg_m3=density_kg_m3)
+    index = {float(v): k for k, v in enumerate(tr.speeds_m_s)}
+    names = [lab for lab in dict.fromkeys(tr.labels) if lab != "lag"]
+    out = []
+    for v in speeds_m_s:
+        k = index[float(v)]
+        modes = []
+        for name in names:
+            lam = tr.mode(k, name)
+            unstable_real = lam.real > eigen.UNSTABLE_RE_RAD_S and abs(lam.imag) < 1e-6
+            modes.append(eigen.Mode("divergence" if unstable_real else name, lam.real,
+                                    abs(lam.imag), branch=name))
+        out.append(eigen.ModeSet(float(v), "coupled-unsteady", tuple(modes)))
+    return out
 
 
-GROWTH_TOL_1_S = 1e-9  # a root is unstable when Re λ exceeds this [1/s]
-
-
-@dataclass(frozen=True)
-class FreeFlutter:
-    """First instability of the free aircraft (phugoid left out, as in the paper).
-
-    mechanism: ``static divergence`` (real root), ``body-freedom`` (a rigid-body branch, the
-    short period, goes unstable: the rigid aircraft's does not, so the wing drives it),
-    ``coalescence`` (an elastic branch within :data:`COALESCENCE_RELATIVE_GAP` of another
-    branch's frequency; partner named) or ``single-mode``.
-    """
-
-    wing: str
-    aero: str
-    structural_damping: float | None
-    speed_m_s: float | None
-    frequency_rad_s: float | None
-    mode: str | None
-    mechanism: str | None
-    partner_mode: str | None
-    range_m_s: tuple[float, float]
-    wing_divergence_speed_m_s: float | None = None
-
-    def as_dict(self) -> dict:
-        from dataclasses import asdict
-
-        d = asdict(self)
-        d["range_m_s"] = list(self.range_m_s)
-        return d
+# Bisection tolerance of the free aircraft's search [m/s].
+FREE_TOL_M_S = 1e-4
 
 
 def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | None = None,
-                 range_m_s: tuple[float, float] = (5.0, 40.0), step_m_s: float = 0.1,
-                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> FreeFlutter:
-    """Scan from 2 m/s in ``step_m_s`` (:func:`track_free`), bisect the first crossing of
-    a non-phugoid root into the right half plane to 1e-3 m/s."""
-    from bioflex_jsb.flight_dynamics.eigen import RIGID_LABELS
-
+                 range_m_s: tuple[float, float] = (5.0, 40.0),
+                 step_m_s: float = eigen.SCAN_STEP_M_S,
+                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> engine.FlutterResult:
+    """First instability of the free aircraft (phugoid left out, as in the paper): the
+    engine's scan from 2 m/s in ``step_m_s``, bisection to :data:`FREE_TOL_M_S`;
+    mechanism by the engine's rule (body-freedom when the short period goes unstable)."""
     lo, hi = range_m_s
-    grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
-    grid = grid[grid <= hi + 1e-12]
-    zeta = structural_damping
-    tr = track_free(build, grid, aero=aero, structural_damping=zeta,
-                    density_kg_m3=density_kg_m3, stop_when_unstable_from=lo)
-    v_div = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3)
-    labels = tr.labels
-    considered = np.array([lab not in EXCLUDED for lab in labels])
-    last = tr.eigenvalues[-1]
-    base = dict(wing=build.variant.name, aero=aero, structural_damping=zeta,
-                range_m_s=(lo, hi), wing_divergence_speed_m_s=v_div)
-    if last[considered].real.max() <= GROWTH_TOL_1_S or tr.speeds_m_s[-1] < lo - 1e-12:
-        return FreeFlutter(speed_m_s=None, frequency_rad_s=None, mode=None, mechanism=None,
-                           partner_mode=None, **base)
-    if len(tr.speeds_m_s) < 2 or tr.speeds_m_s[-2] < lo - 1e-12:
-        v_f, lam_f = float(tr.speeds_m_s[-1]), last
-    else:
-        p_lam = tr.eigenvalues[-2]
-        lam0, vec0 = np.linalg.eig(_system(build, tr.speeds_m_s[-2], aero, zeta,
-                                           density_kg_m3))
-        same = np.abs(p_lam[:, None] - lam0[None, :])
-        rows_, cols = linear_sum_assignment(same)
-        p_vec = vec0[:, cols[np.argsort(rows_)]]  # the labelled roots' vectors
-
-        def continued(vv):
-            lam, vec = np.linalg.eig(_system(build, vv, aero, zeta, density_kg_m3))
-            return lam[_match(p_lam, p_vec, lam, vec)]
-
-        v_f = float(brentq(lambda vv: continued(vv)[considered].real.max() - GROWTH_TOL_1_S,
-                           float(tr.speeds_m_s[-2]), float(tr.speeds_m_s[-1]), xtol=1e-3))
-        lam_f = continued(v_f)
-    j = int(np.argmax(np.where(considered, lam_f.real, -np.inf)))
-    omega = abs(lam_f[j].imag)
-    mech, partner = _mechanism(labels, lam_f, j, omega, RIGID_LABELS)
-    return FreeFlutter(speed_m_s=v_f, frequency_rad_s=float(omega), mode=labels[j],
-                       mechanism=mech, partner_mode=partner, **base)
-
-
-def _mechanism(labels, lam, j, omega, rigid_labels):
-    if omega < 1e-6:
-        return "static divergence", None
-    if labels[j] in rigid_labels:
-        return "body-freedom", None
-    gaps = {}
-    for i, lab in enumerate(labels):
-        if lab in EXCLUDED or lab == labels[j] or lab == "lag" or lam[i].imag <= 0.0:
-            continue
-        gaps[lab] = abs(lam[i].imag - omega) / omega
-    partner = min(gaps, key=gaps.get) if gaps else None
-    if partner is not None and gaps[partner] < COALESCENCE_RELATIVE_GAP:
-        return "coalescence", partner
-    return "single-mode", None
+    fam = free_family(build, aero=aero, structural_damping=structural_damping,
+                      density_kg_m3=density_kg_m3, start_m_s=min(eigen.SCAN_START_M_S, lo))
+    return engine.first_instability(
+        fam, engine.default_grid((lo, hi), step_m_s, eigen.SCAN_START_M_S), (lo, hi),
+        tol_m_s=FREE_TOL_M_S, structural_damping=structural_damping,
+        density_kg_m3=density_kg_m3)
 
 
 # --------------------------------------------------------------------------------------

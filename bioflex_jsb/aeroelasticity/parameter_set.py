@@ -71,51 +71,25 @@ def unsteady_flutter_with(build, aero: RigidAerodynamics, planform: Planform, *,
                           range_m_s: tuple[float, float] = (5.0, 40.0),
                           step_m_s: float = 0.25, tol_m_s: float = 0.01,
                           density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3):
-    """First speed [m/s] in ``range_m_s`` at which a root of the exchanged unsteady system
-    other than the phugoid crosses into the right half plane, with its root [rad/s];
-    (None, None) if none. The phugoid is the slowest complex pair of the rigid block at the
-    range's start, followed by continuity of its eigenvalue (MAC-free: it stays below
-    2 rad/s and far from every other root here)."""
-    def roots(v):
-        return np.linalg.eigvals(unsteady_state_space_with(
-            build, v, aero, planform, structural_damping=structural_damping,
-            density_kg_m3=density_kg_m3).a)
-
-    def phugoid_near(lam, guess):
-        return int(np.argmin(np.abs(lam - guess)))
+    """The first instability of the exchanged unsteady system in ``range_m_s`` (the
+    engine's search: labels from the set's quasi-steady Eq. 4 at 2 m/s, phugoid and lag
+    roots left out, scan in ``step_m_s``, bisection to ``tol_m_s``)."""
+    from bioflex_jsb.flight_dynamics import eigen
+    from bioflex_jsb.flight_dynamics import flutter_engine as engine
 
     lo, hi = range_m_s
-    grid = np.arange(lo, hi + 0.5 * step_m_s, step_m_s)
-    rigid = np.linalg.eigvals(build_state_space(
-        "rigid", level_flight_condition(lo, density_kg_m3, aero), aero=aero).a)
-    guess = rigid[np.argmin(np.abs(rigid))]
-    guess = complex(guess.real, abs(guess.imag))
-
-    def growth(v):
-        nonlocal guess
-        lam = roots(v)
-        j = phugoid_near(lam, guess)
-        guess = complex(lam[j].real, abs(lam[j].imag))
-        rest = np.delete(lam, [j] + [k for k in range(lam.size)
-                                     if k != j and abs(lam[k] - np.conj(lam[j])) < 1e-9])
-        k = int(np.argmax(rest.real))
-        return float(rest[k].real), complex(rest[k])
-
-    previous = None
-    for v in grid:
-        g, root = growth(float(v))
-        if g > 1e-9:
-            if previous is None:
-                return float(v), root
-            a_, b_ = previous, float(v)
-            saved = guess
-            while b_ - a_ > tol_m_s:
-                mid = 0.5 * (a_ + b_)
-                if growth(mid)[0] > 1e-9:
-                    b_ = mid
-                else:
-                    a_ = mid
-            guess = saved
-            return round(b_, 2), growth(b_)[1]
-        previous = float(v)
-    return None, None
+    start = min(eigen.SCAN_START_M_S, lo)
+    model = fa.with_damping(build, structural_damping)
+    ref = eigen.track("coupled", [start], model, density_kg_m3, aero)
+    fam = engine.EigenFamily(
+        lambda v: unsteady_state_space_with(build, v, aero, planform,
+                                            structural_damping=structural_damping,
+                                            density_kg_m3=density_kg_m3).a,
+        ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=fa.EXCLUDED,
+        rigid_labels=eigen.RIGID_LABELS,
+        natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
+        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, aero="unsteady",
+        name=build.variant.name)
+    return engine.first_instability(
+        fam, engine.default_grid((lo, hi), step_m_s, start), (lo, hi), tol_m_s=tol_m_s,
+        structural_damping=structural_damping, density_kg_m3=density_kg_m3)

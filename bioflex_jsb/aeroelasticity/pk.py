@@ -12,11 +12,12 @@ is right at the flutter boundary (Re p = 0), where the p-k and the exact k-metho
 iteration", J. Aircraft 8(11), 885-889). The frozen-C eigenproblem is solved by its
 first-order companion form; each branch iterates ω until it repeats.
 
-Tracking: branches start at the wind-off roots p = iω_i(1 + iζ) at the lowest speed and are
-followed in small steps from their linear extrapolation over the two previous speeds; the
-roots are shared out among the branches by joint nearest assignment (Hungarian algorithm),
-so that two branches cannot settle on one root near a coalescence. The first sign change of a
-branch's Re p is refined by Brent's method on that branch.
+Tracking and the flutter search are the one engine's
+(:mod:`bioflex_jsb.flight_dynamics.flutter_engine`): :class:`PkFamily` gives it the branches,
+started at the wind-off roots p = iω_i√(1 − ζ²) − ζω_i at the lowest speed and followed
+from their linear extrapolation over the two previous speeds; at each pass of a branch's
+frequency iteration the roots are shared out among all branches by the engine's joint
+assignment, so that two branches cannot settle on one root near a coalescence.
 """
 
 from __future__ import annotations
@@ -24,19 +25,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq, linear_sum_assignment
 
-from bioflex_jsb.aeroelasticity.clamped_wing import ClampedWingModel
-from bioflex_jsb.aeroelasticity.flutter import (
-    FlutterResult,
-    classify_mechanism,
-    divergence_speed_m_s,
+from bioflex_jsb.aeroelasticity.clamped_wing import (
+    ClampedWingModel,
+    structural_damping_matrix,
 )
 from bioflex_jsb.aeroelasticity.strip_aero import (
     check_aero,
     circulation_functions,
+    divergence_speed_m_s,
     modal_strip_matrices,
 )
+from bioflex_jsb.flight_dynamics import flutter_engine as engine
 
 # DEFINITIONS of the iteration: the frequency iteration stops when ω changes by less than
 # this fraction of the lowest natural frequency, or after the maximum number of passes.
@@ -45,6 +45,8 @@ _MAX_ITER = 100
 # Speed step of the tracking sweep [m/s]. ESTIMATE: 2 m/s keeps every Goland branch's root
 # change per step far below the gap between branches (no swaps; checked in the tests).
 DEFAULT_SPEED_STEP_M_S = 2.0
+# Bisection tolerance of the clamped searches [m/s]: far below any figure reported (0.01).
+CLAMPED_TOL_M_S = 1e-7
 
 
 def _roots(model, mats, damping, omega_ref, aero):
@@ -75,18 +77,54 @@ def _branch_root(model, mats, damping, aero, guesses: np.ndarray, branch: int) -
     for _ in range(_MAX_ITER):
         roots = _roots(model, mats, damping, abs(p.imag), aero)
         upper = roots[roots.imag >= -1e-9 * np.abs(roots).max()]
-        cost = np.abs(guesses[:, None] - upper[None, :])
-        rows, cols = linear_sum_assignment(cost)
-        new = complex(upper[cols[list(rows).index(branch)]])
+        new = complex(upper[engine.assign(guesses, upper)[branch]])
         if abs(abs(new.imag) - abs(p.imag)) <= tol:
             return new
         p = new
     return p
 
 
-def structural_damping_matrix(model: ClampedWingModel, zeta: float) -> np.ndarray:
-    """Modal viscous damping diag(2 ζ ω_i) [1/s] (ζ [-] the same for every mode)."""
-    return np.diag(2.0 * float(zeta) * model.natural_frequencies_rad_s)
+class PkFamily(engine.RootFamily):
+    """The clamped wing's p-k branches (one per structural mode) for the engine."""
+
+    extrapolate = True
+    method = "pk"
+
+    def __init__(self, model: ClampedWingModel, *, density_kg_m3: float,
+                 aero: str = "unsteady", structural_damping: float = 0.0,
+                 name: str = "") -> None:
+        self.model = model
+        self.density_kg_m3 = float(density_kg_m3)
+        self.aero = check_aero(aero)
+        self.zeta = float(structural_damping)
+        self.damping = structural_damping_matrix(model, self.zeta)
+        self.labels = model.mode_labels()
+        self.considered = np.ones(model.n_modes, dtype=bool)
+        self.natural_frequencies_rad_s = tuple(float(w) for w in
+                                               model.natural_frequencies_rad_s)
+        self.reference_semichord_m = float(np.mean(model.semichord_m))
+        self.divergence_speed_m_s = _finite_or_none(divergence_speed_m_s(
+            model, self.density_kg_m3))
+        self.divergence_is_instability = True
+        self.name = name
+
+    def _at(self, v: float, guesses: np.ndarray) -> engine.Point:
+        mats = modal_strip_matrices(self.model, speed_m_s=v, density_kg_m3=self.density_kg_m3)
+        roots = np.array([_branch_root(self.model, mats, self.damping, self.aero, guesses, b)
+                          for b in range(self.model.n_modes)])
+        return engine.Point(float(v), roots)
+
+    def first(self, speed_m_s: float) -> engine.Point:
+        w0 = self.model.natural_frequencies_rad_s
+        z = self.zeta
+        return self._at(speed_m_s, 1j * w0 * math.sqrt(max(1.0 - z * z, 0.0)) - z * w0)
+
+    def follow(self, speed_m_s, previous, predicted) -> engine.Point:
+        return self._at(speed_m_s, predicted)
+
+
+def _finite_or_none(v: float) -> float | None:
+    return v if math.isfinite(v) else None
 
 
 def pk_sweep(
@@ -98,26 +136,9 @@ def pk_sweep(
     structural_damping: float = 0.0,
 ) -> np.ndarray:
     """Tracked branch roots p [1/s], shape (len(speeds), n_modes), over increasing speeds."""
-    check_aero(aero)
-    speeds = np.asarray(speeds_m_s, dtype=float)
-    if np.any(np.diff(speeds) <= 0.0) or speeds[0] <= 0.0:
-        raise ValueError("speeds_m_s must be positive and increasing")
-    damping = structural_damping_matrix(model, structural_damping)
-    w0 = model.natural_frequencies_rad_s
-    zeta = float(structural_damping)
-    prev = [1j * w0 * math.sqrt(max(1.0 - zeta * zeta, 0.0)) - zeta * w0]
-    out = np.empty((speeds.size, model.n_modes), dtype=complex)
-    for i, v in enumerate(speeds):
-        mats = modal_strip_matrices(model, speed_m_s=v, density_kg_m3=density_kg_m3)
-        if len(prev) >= 2 and i >= 2:
-            h0, h1 = speeds[i - 1] - speeds[i - 2], v - speeds[i - 1]
-            guess = prev[-1] + (prev[-1] - prev[-2]) * (h1 / h0)
-        else:
-            guess = prev[-1]
-        out[i] = [_branch_root(model, mats, damping, aero, guess, b)
-                  for b in range(model.n_modes)]
-        prev.append(out[i].copy())
-    return out
+    fam = PkFamily(model, density_kg_m3=density_kg_m3, aero=aero,
+                   structural_damping=structural_damping)
+    return engine.scan(fam, speeds_m_s).roots
 
 
 def pk_flutter(
@@ -128,41 +149,21 @@ def pk_flutter(
     structural_damping: float = 0.0,
     speed_range_m_s: tuple[float, float] = (20.0, 260.0),
     speed_step_m_s: float = DEFAULT_SPEED_STEP_M_S,
-) -> FlutterResult:
-    """First flutter or divergence of ``model`` in ``speed_range_m_s`` by the p-k method."""
-    lo, hi = (float(x) for x in speed_range_m_s)
-    speeds = np.arange(lo, hi + 0.5 * speed_step_m_s, speed_step_m_s)
-    roots = pk_sweep(model, speeds, density_kg_m3=density_kg_m3, aero=aero,
-                     structural_damping=structural_damping)
-    labels = model.mode_labels()
-    w0 = model.natural_frequencies_rad_s
-    v_div = divergence_speed_m_s(model, density_kg_m3)
-    base = dict(natural_frequencies_rad_s=tuple(float(x) for x in w0), mode_labels=labels,
-                divergence_speed_m_s=v_div, method="pk", aero=aero,
-                lift_slope=model.lift_slope, structural_damping=float(structural_damping),
-                speeds_m_s=speeds, branch_roots=roots)
-    unstable = roots.real > 0.0
-    hits = np.argwhere(unstable[1:] & ~unstable[:-1])
-    if hits.size == 0:
-        return FlutterResult(None, None, None, None, None, None, **base)
-    j = int(hits[:, 0].min())
-    branch = int(hits[hits[:, 0] == j][:, 1][0])
-    damping = structural_damping_matrix(model, structural_damping)
+    name: str = "",
+) -> engine.FlutterResult:
+    """First flutter or divergence of ``model`` in ``speed_range_m_s`` by the p-k method
+    (the engine's search, bisected to :data:`CLAMPED_TOL_M_S`)."""
+    fam = PkFamily(model, density_kg_m3=density_kg_m3, aero=aero,
+                   structural_damping=structural_damping, name=name)
+    return clamped_search(fam, model, speed_range_m_s, speed_step_m_s)
 
-    def root_at(v: float) -> np.ndarray:
-        mats = modal_strip_matrices(model, speed_m_s=v, density_kg_m3=density_kg_m3)
-        frac = (v - speeds[j]) / (speeds[j + 1] - speeds[j])
-        guess = roots[j] + frac * (roots[j + 1] - roots[j])
-        return np.array([_branch_root(model, mats, damping, aero, guess, b)
-                         for b in range(model.n_modes)])
 
-    v_f = brentq(lambda v: root_at(v)[branch].real, speeds[j], speeds[j + 1], xtol=1e-6)
-    r = root_at(v_f)
-    omega = abs(r[branch].imag)
-    mech, partner = classify_mechanism(np.abs(r.imag), w0, branch, omega)
-    b_ref = float(np.mean(model.semichord_m))
-    return FlutterResult(
-        speed_m_s=float(v_f), frequency_rad_s=float(omega),
-        reduced_frequency=float(omega * b_ref / v_f), mode=labels[branch],
-        partner_mode=None if partner is None else labels[partner], mechanism=mech, **base,
-    )
+def clamped_search(fam: engine.RootFamily, model: ClampedWingModel,
+                   speed_range_m_s: tuple[float, float],
+                   speed_step_m_s: float) -> engine.FlutterResult:
+    """The engine's search over a clamped wing's family (p-k or state space) on a grid of
+    ``speed_step_m_s`` [m/s], bisected to :data:`CLAMPED_TOL_M_S`."""
+    return engine.first_instability(
+        fam, engine.default_grid(speed_range_m_s, speed_step_m_s), speed_range_m_s,
+        tol_m_s=CLAMPED_TOL_M_S, structural_damping=float(fam.zeta),
+        density_kg_m3=fam.density_kg_m3, settings={"lift_slope": model.lift_slope})

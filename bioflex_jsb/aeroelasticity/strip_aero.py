@@ -220,3 +220,20 @@ def finite_state_model(
         i = j
     return ModalAeroStateSpace(a, b_q, b_qd, b_g, c, d_q, d_qd, d_g, m_a, tuple(names),
                                tuple(units))
+
+
+def divergence_speed_m_s(model: ClampedWingModel, density_kg_m3: float) -> float:
+    """Static divergence speed [m/s] of the strip model (steady aerodynamics, C = 1).
+
+    Steady generalised forces D W η are ∝ V² (D ∝ V, W ∝ V): divergence where
+    K − V² G loses positive definiteness, G = D W at 1 m/s. ``math.inf`` if never.
+    """
+    import math
+
+    from scipy.linalg import eig
+
+    mats = modal_strip_matrices(model, speed_m_s=1.0, density_kg_m3=density_kg_m3)
+    g = mats.force @ mats.upwash_displacement
+    lam = eig(g, model.stiffness, right=False)  # G x = μ K x → V² = 1/μ
+    mu = lam[(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) & (lam.real > 0.0)].real
+    return math.inf if mu.size == 0 else float(1.0 / math.sqrt(mu.max()))

@@ -1,13 +1,12 @@
 """``bioflex-jsb flutter``: the lowest airspeed at which a wing goes unstable.
 
-Two analyses, chosen by --wing and --clamped (docs/aeroelasticity.md):
+Two analyses, chosen by --wing and --clamped (docs/aeroelasticity.md, docs/aircraft.md),
+both :func:`bioflex_jsb.api.flutter` (this module only formats its result):
 
 * a paper wing (``original``, ``optimised``, ... or a variant file), free aircraft: the
-  coupled model of Eq. (4) on the paper's quasi-steady strips (Table B1), eigen-analysis with
-  mode tracking (:func:`bioflex_jsb.flight_dynamics.eigen.find_flutter`);
-* ``--wing goland --clamped``: the Goland benchmark cantilever without a rigid body
-  (:mod:`bioflex_jsb.aeroelasticity`), unsteady (Theodorsen) or quasi-steady strips with the
-  2-D (2π) or vortex-lattice lift slope, by p-k or by state-space eigen-analysis.
+  coupled model of Eq. (4) on quasi-steady or unsteady strips;
+* ``--clamped FILE`` (or ``--clamped goland``, or ``--wing goland --clamped``): a clamped
+  wing from its definition file, by p-k or by state-space eigen-analysis.
 
 Combinations that are not available are refused with one line (exit 2) naming what is.
 """
@@ -18,9 +17,8 @@ import argparse
 import math
 from dataclasses import replace
 
-import numpy as np
-
 from bioflex_jsb.cli.common import UsageError, add_wing_arguments, print_json, wing_from_args
+from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3, SHIPPED
 
 BENCHMARK_WINGS = ("goland",)
 AERO_CHOICES = ("unsteady", "quasi-steady")
@@ -28,9 +26,10 @@ METHOD_CHOICES = ("pk", "state-space")
 LIFT_SLOPE_CHOICES = ("strip", "vlm")
 INERTIA_CHOICES = ("elastic-axis", "centre-of-mass")
 MAX_SPEED_M_S = 400.0  # upper end of --range [m/s]
-MAX_DENSITY_KG_M3 = 2.0  # upper end of --density [kg/m³]
+MIN_DENSITY_KG_M3, MAX_DENSITY_KG_M3 = DENSITY_RANGE_KG_M3  # --density [kg/m³], the
+# definition format's range (definition/loader.py: about 33 km altitude to denser than any
+# surface air)
 PAPER_DEFAULT_RANGE_M_S = (5.0, 40.0)
-GOLAND_DEFAULT_RANGE_M_S = (20.0, 260.0)
 
 HELP = """Flutter (oscillatory) or static divergence: the first root that crosses into the
 right half plane in --range. Reports the speed [m/s], the frequency of the crossing root
@@ -45,12 +44,17 @@ from 2 m/s with mode tracking and bisected (printed to 0.1 m/s); the phugoid is 
 as in the paper; with unsteady strips also the wing's divergence speed with the body held.
 Not available for them: --clamped, --method pk, --lift-slope, --inertia-about.
 
---wing goland --clamped: the Goland cantilever (semi-span 6.096 m, chord 1.8288 m; data and
-published results with citations in bioflex_jsb/parameters/goland.py), published strip
-theory result 137.2 m/s, 70.7 rad/s (Goland 1945, as tabulated by Patil, Hodges & Cesnik
-2001). Defaults: --aero unsteady, --method pk, --lift-slope strip, --structural-damping 0,
---inertia-about elastic-axis, --density 1.225 kg/m^3 (the issue's literal reading of the
-data is --inertia-about centre-of-mass --density 1.02)."""
+--clamped FILE.toml: any clamped wing from its definition file (docs/aircraft.md: span
+stations, beam sections, aerodynamics, air; units and ranges checked when read). --clamped
+goland (or --wing goland --clamped): the shipped Goland cantilever (semi-span 6.096 m,
+chord 1.8288 m; bioflex_jsb/data/aircraft/goland.toml), published strip theory result
+137.2 m/s, 70.7 rad/s (Goland 1945, as tabulated by Patil, Hodges & Cesnik 2001). Defaults
+from the definition (Goland: --aero unsteady, --method pk, --lift-slope strip,
+--structural-damping 0, --inertia-about elastic-axis, --density 1.225 kg/m^3; the issue's
+literal reading of the data is --inertia-about centre-of-mass --density 1.02); default
+--range derived from the wing: 5 % to 150 % of its static divergence speed (docs/aircraft.md).
+An instability already present at the range's lower end is reported as "unstable at and
+below LOW m/s", never as no instability."""
 
 
 def speed_range(text: str) -> tuple[float, float]:
@@ -84,81 +88,85 @@ def density(text: str) -> float:
         rho = float(text)
     except ValueError:
         rho = math.nan
-    if not (0.0 < rho <= MAX_DENSITY_KG_M3):
+    if not (MIN_DENSITY_KG_M3 <= rho <= MAX_DENSITY_KG_M3):
         raise argparse.ArgumentTypeError(
-            f"density must satisfy 0 < RHO <= {MAX_DENSITY_KG_M3:g} kg/m^3, got {text!r}")
+            f"density must satisfy {MIN_DENSITY_KG_M3:g} <= RHO <= {MAX_DENSITY_KG_M3:g} "
+            f"kg/m^3 (about 33 km altitude to denser than any surface air), got {text!r}")
     return rho
 
 
 def register(sub) -> None:
-    p = sub.add_parser("flutter", help="flutter / divergence speed (free aircraft or clamped "
-                       "benchmark wing)", description=HELP)
+    p = sub.add_parser("flutter", help="flutter / divergence speed (free aircraft or a clamped "
+                       "wing from its definition)", description=HELP)
     add_wing_arguments(p)
     wing_action = p._option_string_actions["--wing"]
-    wing_action.help = (f"{wing_action.help}; or the benchmark wing {', '.join(BENCHMARK_WINGS)} "
+    wing_action.help = (f"{wing_action.help}; or the benchmark wing {', '.join(SHIPPED)} "
                         "(with --clamped)")
-    p.add_argument("--clamped", action="store_true",
-                   help="clamped cantilever without the rigid body (--wing goland only)")
+    p.add_argument("--clamped", nargs="?", const="", default=None, metavar="FILE",
+                   help="a clamped wing without the rigid body: a definition file (.toml, "
+                   f"docs/aircraft.md) or a shipped name ({', '.join(SHIPPED)}); bare "
+                   "--clamped takes the name from --wing")
     p.add_argument("--aero", choices=AERO_CHOICES, default=None,
                    help="strip aerodynamics: unsteady (Theodorsen C(k); Jones lag states in "
-                   "state-space) or quasi-steady (C = 1); default unsteady for --clamped, "
-                   "quasi-steady (the paper's) for paper wings")
+                   "state-space) or quasi-steady (C = 1); default the definition's for "
+                   "--clamped, quasi-steady (the paper's) for paper wings")
     p.add_argument("--method", choices=METHOD_CHOICES, default=None,
                    help="pk (frequency domain, --clamped only) or state-space "
-                   "(eigen-analysis with mode tracking); default pk for --clamped, "
-                   "state-space for paper wings")
+                   "(eigen-analysis with mode tracking); default the definition's for "
+                   "--clamped, state-space for paper wings")
     p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
                    help="viscous modal damping ratio zeta [-], 0 <= Z < 1, on every mode "
-                   "(2 zeta omega_i); default 0 for --clamped, the variant's (0.02) for paper "
-                   "wings")
+                   "(2 zeta omega_i); default the definition's for --clamped, the variant's "
+                   "(0.02) for paper wings")
     p.add_argument("--lift-slope", choices=LIFT_SLOPE_CHOICES, default=None,
-                   help="strip lift slope, --clamped only: strip (2 pi on every strip, "
-                   "default) or vlm (the vortex lattice's spanwise C_la(y))")
+                   help="strip lift slope, --clamped only: strip (the definition's 2-D slope "
+                   "on every strip) or vlm (the vortex lattice's spanwise C_la(y))")
     p.add_argument("--inertia-about", choices=INERTIA_CHOICES, default=None,
-                   help="axis of the Goland wing's published 8.64 kg m (--wing goland only): "
-                   "elastic-axis (default) or centre-of-mass (the issue's wording)")
+                   help="axis of the definition's pitch inertia (--clamped only): "
+                   "elastic-axis or centre-of-mass (Goland's 8.64 kg m: the issue's wording)")
     p.add_argument("--density", type=density, default=None, metavar="RHO",
-                   help=f"air density [kg/m^3], 0 < RHO <= {MAX_DENSITY_KG_M3:g}; default "
-                   "1.225 (sea level)")
+                   help=f"air density [kg/m^3], {MIN_DENSITY_KG_M3:g} <= RHO <= "
+                   f"{MAX_DENSITY_KG_M3:g}; default the definition's for --clamped, 1.225 "
+                   "(sea level) for paper wings")
     p.add_argument("--range", type=speed_range, default=None, metavar="LOW:HIGH",
                    help=f"airspeed range to search [m/s], 0 < LOW < HIGH <= "
                    f"{MAX_SPEED_M_S:g}; default {PAPER_DEFAULT_RANGE_M_S[0]:g}:"
-                   f"{PAPER_DEFAULT_RANGE_M_S[1]:g} for paper wings, "
-                   f"{GOLAND_DEFAULT_RANGE_M_S[0]:g}:{GOLAND_DEFAULT_RANGE_M_S[1]:g} for "
-                   "--clamped")
+                   f"{PAPER_DEFAULT_RANGE_M_S[1]:g} for paper wings, derived from the wing "
+                   "for --clamped")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
 
-def check_combination(args: argparse.Namespace) -> None:
-    """Refuse (UsageError, one line) what is not available for the chosen wing."""
-    benchmark = args.wing in BENCHMARK_WINGS
-    if benchmark:
-        if not args.clamped:
+def clamped_target(args: argparse.Namespace) -> str | None:
+    """The definition (name or file) to analyse clamped, or None for the free aircraft;
+    refuses (UsageError, one line) what is not available for the chosen wing."""
+    if args.clamped is None:
+        if args.wing in SHIPPED:
             raise UsageError(f"--wing {args.wing} is a benchmark cantilever with no aircraft "
                              f"around it: give --clamped (accepted: --wing {args.wing} "
                              "--clamped)")
-        return
-    if args.clamped:
-        raise UsageError(f"--clamped is available for the benchmark wing "
-                         f"{', '.join(BENCHMARK_WINGS)} only; paper wings are analysed as the "
-                         "free aircraft (drop --clamped)")
-    if args.method == "pk":
-        raise UsageError("--method pk is available with --wing goland --clamped only; paper "
-                         "wings accept --method state-space")
-    for flag, value in (("--lift-slope", args.lift_slope),
-                        ("--inertia-about", args.inertia_about)):
-        if value is not None:
-            raise UsageError(f"{flag} is available with --wing goland --clamped only; paper "
-                             "wings take the vortex lattice's span loading (Table B1)")
+        if args.method == "pk":
+            raise UsageError("--method pk is available for clamped wings only; paper "
+                             "wings accept --method state-space")
+        for flag, value in (("--lift-slope", args.lift_slope),
+                            ("--inertia-about", args.inertia_about)):
+            if value is not None:
+                raise UsageError(f"{flag} is available for clamped wings (--clamped) only; "
+                                 "paper wings take the vortex lattice's span loading "
+                                 "(Table B1)")
+        return None
+    target = args.clamped or args.wing
+    if target not in SHIPPED and not target.endswith(".toml"):
+        raise UsageError(f"--clamped takes a clamped-wing definition: a shipped name "
+                         f"({', '.join(SHIPPED)}) or a .toml file (docs/aircraft.md), got "
+                         f"{target!r}; paper wings are analysed as the free aircraft (drop "
+                         "--clamped)")
+    return target
 
 
 def run(args: argparse.Namespace) -> int:
-    check_combination(args)
-    if args.wing in BENCHMARK_WINGS:
-        payload = goland_payload(args)
-    else:
-        payload = paper_payload(args)
+    target = clamped_target(args)
+    payload = paper_payload(args) if target is None else clamped_payload(args, target)
     if args.json:
         print_json(payload)
         return 0
@@ -170,165 +178,82 @@ def _round(x: float | None, digits: int) -> float | None:
     return None if x is None else round(float(x), digits)
 
 
-def goland_payload(args: argparse.Namespace) -> dict:
-    """The clamped Goland wing's flutter point beside the published one."""
-    from bioflex_jsb.aeroelasticity import goland_flutter
+def _formatted(res, digits: int) -> dict:
+    """The api result's dictionary with the speeds and frequencies rounded for printing."""
+    d = res.as_dict()
+    d["flutter_speed_m_s"] = _round(res.speed_m_s, digits)
+    d["speed_m_s"] = d["flutter_speed_m_s"]
+    d["frequency_rad_s"] = _round(res.frequency_rad_s, 2)
+    d["reduced_frequency"] = _round(res.reduced_frequency, 4)
+    d["divergence_speed_m_s"] = _round(res.divergence_speed_m_s, 2)
+    d["natural_frequencies_rad_s"] = [round(w, 2) for w in res.natural_frequencies_rad_s]
+    d["range_m_s"] = [round(x, 2) for x in res.range_m_s]
+    return d
+
+
+def clamped_payload(args: argparse.Namespace, target: str) -> dict:
+    """A clamped wing's first instability (:func:`bioflex_jsb.api.flutter`), beside the
+    published one for the Goland wing."""
+    from bioflex_jsb import api
+
+    definition = api.load_definition(target)
+    if args.inertia_about is not None:
+        definition = replace(definition, structure=replace(
+            definition.structure, inertia_axis=args.inertia_about))
+    res = api.flutter(definition, args.range, aero=args.aero, method=args.method,
+                      clamped=True, structural_damping=args.structural_damping,
+                      density_kg_m3=args.density, lift_slope=args.lift_slope)
+    d = _formatted(res, 2)
+    lift_slope = res.settings["lift_slope"]
+    d.update(wing=definition.name, clamped=True, lift_slope=lift_slope,
+             inertia_about=definition.structure.inertia_axis)
+    if definition.name == "goland":
+        d["published"] = goland_published(res, lift_slope)
+    return d
+
+
+def goland_published(res, lift_slope: str) -> dict:
+    """The published Goland flutter point and the model's difference from it (when the
+    model is the published one's: unsteady strips, 2π, no structural damping)."""
     from bioflex_jsb.parameters import goland as G
 
-    aero = args.aero or "unsteady"
-    method = args.method or "pk"
-    lift_slope = args.lift_slope or "strip"
-    zeta = 0.0 if args.structural_damping is None else args.structural_damping
-    axis = args.inertia_about or G.DEFAULT_INERTIA_AXIS
-    rho = G.FLUTTER_DENSITY_KG_M3 if args.density is None else args.density
-    lo, hi = args.range or GOLAND_DEFAULT_RANGE_M_S
-    res = goland_flutter(aero=aero, lift_slope=lift_slope, method=method,
-                         structural_damping=zeta, speed_range_m_s=(lo, hi),
-                         inertia_about=axis, density_kg_m3=rho)
-    d = res.as_dict()
-    kind = None
-    if res.mechanism is not None:
-        kind = "divergence" if res.mechanism == "static divergence" else "flutter"
-    comparable = aero == "unsteady" and lift_slope == "strip" and zeta == 0.0
+    comparable = (res.aero == "unsteady" and lift_slope == "strip"
+                  and res.structural_damping == 0.0 and not res.present_at_lower_end)
     pub_v, pub_w = G.PUBLISHED_FLUTTER_SPEED_M_S, G.PUBLISHED_FLUTTER_FREQUENCY_RAD_S
 
     def rel(x, ref):
-        return None if x is None else round(float(x) / ref - 1.0, 4)
+        return None if x is None or not comparable else round(float(x) / ref - 1.0, 4)
 
     return {
-        "wing": "goland",
-        "clamped": True,
-        "aero": aero,
-        "method": method,
-        "lift_slope": lift_slope,
-        "structural_damping": zeta,
-        "inertia_about": axis,
-        "density_kg_m3": rho,
-        "range_m_s": [lo, hi],
-        "flutter_speed_m_s": _round(res.speed_m_s, 2),
-        "frequency_rad_s": _round(res.frequency_rad_s, 2),
-        "reduced_frequency": _round(res.reduced_frequency, 4),
-        "semichord_m": G.CHORD_M / 2.0,
-        "mode": res.mode,
-        "partner_mode": res.partner_mode,
-        "mechanism": res.mechanism,
-        "kind": kind,
-        "divergence_speed_m_s": _round(d["divergence_speed_m_s"], 2),
-        "natural_frequencies_rad_s": [round(w, 2) for w in res.natural_frequencies_rad_s],
-        "mode_labels": list(res.mode_labels),
-        "published": {
-            "flutter_speed_m_s": pub_v,
-            "frequency_rad_s": pub_w,
-            "natural_frequencies_rad_s": list(G.PUBLISHED_NATURAL_FREQUENCIES_RAD_S),
-            "source": G.PUBLISHED_SOURCE,
-            "applies_to": "--aero unsteady --lift-slope strip --structural-damping 0",
-            "comparable": comparable,
-            "speed_rel_diff": rel(res.speed_m_s, pub_v) if comparable else None,
-            "frequency_rel_diff": rel(res.frequency_rad_s, pub_w) if comparable else None,
-        },
+        "flutter_speed_m_s": pub_v,
+        "frequency_rad_s": pub_w,
+        "natural_frequencies_rad_s": list(G.PUBLISHED_NATURAL_FREQUENCIES_RAD_S),
+        "source": G.PUBLISHED_SOURCE,
+        "applies_to": "--aero unsteady --lift-slope strip --structural-damping 0",
+        "comparable": comparable,
+        "speed_rel_diff": rel(res.speed_m_s, pub_v),
+        "frequency_rel_diff": rel(res.frequency_rad_s, pub_w),
     }
 
 
 def paper_payload(args: argparse.Namespace) -> dict:
-    """The free aircraft's first instability (Eq. 4, quasi-steady strips)."""
-    from bioflex_jsb.flight_dynamics import eigen
-    from bioflex_jsb.parameters import prototype as P
+    """The free aircraft's first instability (:func:`bioflex_jsb.api.flutter`)."""
+    from bioflex_jsb import api
+    from bioflex_jsb.aeroelasticity.free_aircraft import with_damping
 
     build = wing_from_args(args)
-    model = build.model
-    if args.structural_damping is not None:
-        model = replace(model, damping_ratios=np.full(model.n_modes, args.structural_damping))
-    rho = P.SEA_LEVEL_DENSITY_KG_M3 if args.density is None else args.density
-    lo, hi = args.range or PAPER_DEFAULT_RANGE_M_S
-    if args.aero == "unsteady":
-        return paper_unsteady_payload(args, build, model, rho, (lo, hi))
-    res = eigen.find_flutter(model, (lo, hi), density_kg_m3=rho)
-    payload = res.as_dict()
-    mech, partner = None, None
-    k_red = None
-    b = P.MEAN_AERODYNAMIC_CHORD_M / 2.0
-    if res.flutter_speed_m_s is not None:
-        mech, partner = paper_mechanism(model, res, rho)
-        k_red = round(res.frequency_rad_s * b / res.flutter_speed_m_s, 4)
-        payload["flutter_speed_m_s"] = round(res.flutter_speed_m_s, 1)
-    payload.update(
-        clamped=False,
-        aero="quasi-steady",
-        method="state-space",
+    model = build.model if args.structural_damping is None else with_damping(
+        build, args.structural_damping)
+    res = api.flutter(build, args.range or PAPER_DEFAULT_RANGE_M_S,
+                      aero=args.aero or "quasi-steady", method=args.method,
+                      structural_damping=args.structural_damping, density_kg_m3=args.density)
+    d = _formatted(res, 1)
+    d.update(
+        wing=build.variant.name, clamped=False,
         structural_damping=[float(z) for z in model.damping_ratios],
-        density_kg_m3=rho,
-        reduced_frequency=k_red,
-        semichord_m=b,
-        mechanism=mech,
-        partner_mode=partner,
-        natural_frequencies_rad_s=[round(float(w), 2) for w in model.frequencies_rad_s],
-        mass_basis=build.mass_basis,
-        overrides=dict(model.coefficients.overrides),
-    )
-    return payload
-
-
-def paper_mechanism(model, res, density_kg_m3: float) -> tuple[str, str | None]:
-    """Mechanism of the free aircraft's crossing by the rule of
-    :class:`bioflex_jsb.aeroelasticity.free_aircraft.FreeFlutter` (static divergence,
-    body-freedom, coalescence within ``COALESCENCE_RELATIVE_GAP``, single-mode), on the
-    tracked roots of :func:`bioflex_jsb.flight_dynamics.eigen.track` at the crossing."""
-    from bioflex_jsb.aeroelasticity.free_aircraft import COALESCENCE_RELATIVE_GAP
-    from bioflex_jsb.flight_dynamics import eigen
-
-    if res.kind == "divergence":
-        return "static divergence", None
-    if res.mode in eigen.RIGID_LABELS:
-        return "body-freedom", None
-    v = float(res.flutter_speed_m_s)
-    grid = np.unique(np.append(np.arange(min(2.0, v), v, 0.1), v))
-    last = eigen.track("coupled", grid, model, density_kg_m3).at(len(grid) - 1)
-    names = [n for n in dict.fromkeys(m.mode for m in last.modes)
-             if n not in eigen.EXCLUDED_FROM_FLUTTER and n != res.mode]
-    w_u = float(res.frequency_rad_s)
-    gaps = {n: abs(last.get(n).im - w_u) / w_u for n in names}
-    nearest = min(gaps, key=gaps.get)
-    if gaps[nearest] < COALESCENCE_RELATIVE_GAP:
-        return "coalescence", nearest
-    return "single-mode", None
-
-
-def paper_unsteady_payload(args, build, model, rho: float, range_m_s) -> dict:
-    """The free aircraft on unsteady strips (Eq. 4 + Jones lag states,
-    :mod:`bioflex_jsb.aeroelasticity.free_aircraft`)."""
-    from bioflex_jsb.aeroelasticity.free_aircraft import free_flutter
-    from bioflex_jsb.parameters import prototype as P
-
-    res = free_flutter(build, aero="unsteady", structural_damping=args.structural_damping,
-                       range_m_s=range_m_s, density_kg_m3=rho)
-    b = P.MEAN_AERODYNAMIC_CHORD_M / 2.0
-    speed = res.speed_m_s
-    kind = None
-    if res.mechanism is not None:
-        kind = "divergence" if res.mechanism == "static divergence" else "flutter"
-    return {
-        "wing": build.variant.name,
-        "flutter_speed_m_s": None if speed is None else round(speed, 1),
-        "mode": res.mode,
-        "frequency_rad_s": res.frequency_rad_s,
-        "kind": kind,
-        "range_m_s": list(range_m_s),
-        "clamped": False,
-        "aero": "unsteady",
-        "method": "state-space",
-        "structural_damping": [float(z) for z in model.damping_ratios],
-        "density_kg_m3": rho,
-        "reduced_frequency": None if speed is None else round(
-            res.frequency_rad_s * b / speed, 4),
-        "semichord_m": b,
-        "mechanism": res.mechanism,
-        "partner_mode": res.partner_mode,
-        "wing_divergence_speed_m_s": None if res.wing_divergence_speed_m_s is None else round(
-            res.wing_divergence_speed_m_s, 2),
-        "natural_frequencies_rad_s": [round(float(w), 2) for w in model.frequencies_rad_s],
-        "mass_basis": build.mass_basis,
-        "overrides": dict(model.coefficients.overrides),
-    }
+        wing_divergence_speed_m_s=_round(res.wing_divergence_speed_m_s, 2),
+        mass_basis=build.mass_basis, overrides=dict(model.coefficients.overrides))
+    return d
 
 
 def text_report(p: dict) -> str:
@@ -342,14 +267,21 @@ def text_report(p: dict) -> str:
     nat = ", ".join(f"{w:.2f}" for w in p["natural_frequencies_rad_s"])
     lines = [f"{head}: {setup}", f"  natural frequencies [rad/s]: {nat}"]
     lo, hi = p["range_m_s"]
+    div = p.get("divergence_speed_m_s")
+    own_divergence = p.get("divergence_is_instability")
     if p["flutter_speed_m_s"] is None:
         lines.append(f"  no instability between {lo:g} and {hi:g} m/s")
     else:
         partner = f" with {p['partner_mode']}" if p.get("partner_mode") else ""
-        lines.append(
-            f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s, mode {p['mode']}, frequency "
-            f"{p['frequency_rad_s']:.2f} rad/s, k = {p['reduced_frequency']:.3f}, mechanism "
-            f"{p['mechanism']}{partner}")
+        what = (f"{p['kind']}, mode {p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, "
+                f"k = {p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
+        if p["present_at_lower_end"]:
+            lines.append(f"  unstable at and below {lo:g} m/s (already at the range's lower "
+                         f"end; lower LOW to find the onset): {what}")
+        else:
+            lines.append(f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s, mode "
+                         f"{p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, k = "
+                         f"{p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
     pub = p.get("published")
     if pub is not None:
         line = (f"  published: {pub['flutter_speed_m_s']} m/s, {pub['frequency_rad_s']} rad/s "
@@ -360,8 +292,9 @@ def text_report(p: dict) -> str:
         elif not pub["comparable"]:
             line += f"; applies to {pub['applies_to']}"
         lines.append(line)
-    if p.get("divergence_speed_m_s") is not None:
-        lines.append(f"  static divergence at {p['divergence_speed_m_s']:.1f} m/s")
+    if div is not None and own_divergence:
+        where = " (above the range)" if div > hi else ""
+        lines.append(f"  static divergence at {div:.1f} m/s{where}")
     if p.get("wing_divergence_speed_m_s") is not None:
         lines.append(f"  wing divergence with the body held at "
                      f"{p['wing_divergence_speed_m_s']:.1f} m/s")

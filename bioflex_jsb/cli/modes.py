@@ -77,13 +77,12 @@ def run(args: argparse.Namespace) -> int:
     speeds = args.speed or [DEFAULT_SPEED_M_S]
     check_plot_path(args.plot, args.force)
     build = wing_for_run(wing_from_args(args), args)
+    from bioflex_jsb import api
+
     results = []
     for model in args.models:
-        if model == "coupled" and args.aero == "unsteady":
-            results.extend(_unsteady_mode_sets(build, speeds))
-            continue
-        sets = eigen.modes_at(model, speeds, None if model == "rigid" else build.model)
-        results.extend(sets)
+        aero = args.aero if model == "coupled" else "quasi-steady"
+        results.extend(api.modes(build, v, model, aero=aero) for v in speeds)
     payload = {
         "wing": build.variant.name,
         "mass_basis": build.mass_basis,
@@ -117,29 +116,6 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         print(f"root loci written to {args.plot}")
     return 0
-
-
-def _unsteady_mode_sets(build, speeds) -> list:
-    """The coupled model on unsteady strips at ``speeds``: its labelled roots (short period,
-    phugoid, aeroelastic_i; the strips' lag roots left out) as :class:`eigen.ModeSet`s."""
-    from bioflex_jsb.aeroelasticity.free_aircraft import track_free
-
-    grid = eigen.sweep_grid(speeds)
-    track = track_free(build, grid, aero="unsteady")  # ζ already in the build
-    index = {float(v): k for k, v in enumerate(track.speeds_m_s)}
-    names = [lab for lab in dict.fromkeys(track.labels) if lab != "lag"]
-    out = []
-    for v in speeds:
-        k = index[float(v)]
-        modes = []
-        for name in names:
-            lam = track.mode(k, name)
-            unstable_real = lam.real > eigen.UNSTABLE_RE_RAD_S and abs(lam.imag) < 1e-6
-            modes.append(eigen.Mode("divergence" if unstable_real else name, lam.real,
-                                    abs(lam.imag), branch=name))
-        modes = tuple(modes)
-        out.append(eigen.ModeSet(float(v), "coupled-unsteady", modes))
-    return out
 
 
 def _plot(args, build, speeds) -> None:

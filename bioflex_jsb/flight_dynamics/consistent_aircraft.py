@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import brentq, linear_sum_assignment
+from scipy.optimize import brentq
 
 from bioflex_jsb.aerodynamics.wing_tail import (
     WingTailDerivatives,
@@ -29,7 +29,7 @@ from bioflex_jsb.aerodynamics.wing_tail import (
 )
 from bioflex_jsb.flight_dynamics import eigen
 from bioflex_jsb.flight_dynamics.elastic_trim import StaticWingLoads, linear_rigid_trim
-from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
+from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import (
     level_flight_condition,
     rigid_derivatives,
@@ -145,56 +145,13 @@ AIRCRAFT_SETS = {
 
 
 # --------------------------------------------------------------------------------------
-# eigen's labelling and tracking, with a parameter set's aero
+# eigen's labelling, tracking and flutter search (the one engine) with a set's aero
 # --------------------------------------------------------------------------------------
-def _eig(model, v, wing, aero, rho):
-    ss = build_state_space(model, level_flight_condition(float(v), rho, aero), wing, aero)
-    return np.linalg.eig(ss.a)
-
-
-def _reference(model, wing, cond, aero):
-    """As eigen._reference, with ``aero``."""
-    lam = np.linalg.eigvals(build_state_space("rigid", cond, aero=aero).a)
-    order = np.argsort(-np.abs(lam))
-    labels = [eigen.RIGID_LABELS[0]] * 2 + [eigen.RIGID_LABELS[1]] * 2
-    ref = [(labels[k], lam[i]) for k, i in enumerate(order)]
-    if model == "coupled":
-        blk = coupled_blocks(wing, cond, aero)
-        n = wing.n_modes
-        s = np.block([[np.zeros((n, n)), np.eye(n)], [blk.a_ee, blk.a_eedot]])
-        lam_e = np.linalg.eigvals(s)
-        for k, i in enumerate(np.argsort(np.abs(lam_e), kind="stable")):
-            ref.append((f"aeroelastic_{k // 2 + 1}", lam_e[i]))
-    return ref if model == "coupled" else ref[:4]
-
-
-def _track(model, speeds, wing, aero, rho):
-    lams, vecs, labels = [], [], []
-    for k, v in enumerate(speeds):
-        lam, vec = _eig(model, v, wing, aero, rho)
-        if k == 0:
-            ref = _reference(model, wing, level_flight_condition(float(v), rho, aero), aero)
-            ref_lam = np.array([r[1] for r in ref])
-            cost = np.abs(ref_lam[:, None] - lam[None, :]) / (1.0 + np.abs(ref_lam[:, None]))
-            rows, cols = linear_sum_assignment(cost)
-            perm = cols[np.argsort(rows)]
-            labels = [r[0] for r in ref]
-        else:
-            perm = eigen._match(lams[-1], vecs[-1], lam, vec)
-        lams.append(lam[perm])
-        vecs.append(vec[:, perm])
-    return np.array(lams), vecs, tuple(labels)
-
-
 def modes_with(model: str, speeds_m_s: Sequence[float], wing: ElasticWingModel | None,
                aero: RigidAerodynamics,
                density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> list[eigen.ModeSet]:
     """:func:`eigen.modes_at` with ``aero`` (labels tracked from 2 m/s, 0.25 m/s grid)."""
-    targets = sorted(set(float(v) for v in speeds_m_s))
-    grid = eigen.sweep_grid(targets)
-    lams, _, labels = _track(model, grid, wing, aero, density_kg_m3)
-    index = {float(v): k for k, v in enumerate(grid)}
-    return [eigen._collapse(float(v), model, labels, lams[index[float(v)]]) for v in speeds_m_s]
+    return eigen.modes_at(model, speeds_m_s, wing, density_kg_m3, aero)
 
 
 def flutter_with(wing: ElasticWingModel, aero: RigidAerodynamics,
@@ -202,36 +159,7 @@ def flutter_with(wing: ElasticWingModel, aero: RigidAerodynamics,
                  tol_m_s: float = 0.01,
                  density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> eigen.FlutterResult:
     """:func:`eigen.find_flutter` with ``aero`` (phugoid left out, as there)."""
-    lo, hi = range_m_s
-    grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
-    grid = grid[grid <= hi + 1e-12]
-    lams, vecs, labels = _track("coupled", grid, wing, aero, density_kg_m3)
-    considered = np.array([lab not in eigen.EXCLUDED_FROM_FLUTTER for lab in labels])
-    growth = lams[:, considered].real.max(axis=1)
-    unstable = np.nonzero((growth > 1e-9) & (grid >= lo - 1e-12))[0]
-    if len(unstable) == 0:
-        return eigen.FlutterResult(wing.name, None, None, None, None, (lo, hi))
-    k = int(unstable[0])
-
-    def continued(v):
-        lam, vec = _eig("coupled", v, wing, aero, density_kg_m3)
-        return lam[eigen._match(lams[k - 1], vecs[k - 1], lam, vec)]
-
-    if k == 0 or grid[k - 1] < lo - 1e-12:
-        v_cross, at = float(grid[k]), lams[k]
-    else:
-        a, b = float(grid[k - 1]), float(grid[k])
-        while b - a > tol_m_s:
-            mid = 0.5 * (a + b)
-            if continued(mid)[considered].real.max() > 1e-9:
-                b = mid
-            else:
-                a = mid
-        v_cross, at = b, continued(b)
-    j = int(np.argmax(np.where(considered, at.real, -np.inf)))
-    kind = "flutter" if abs(at[j].imag) > eigen.IMAG_TOL_RAD_S else "divergence"
-    return eigen.FlutterResult(wing.name, round(v_cross, 2), labels[j], float(abs(at[j].imag)),
-                               kind, (lo, hi))
+    return eigen.find_flutter(wing, range_m_s, step_m_s, tol_m_s, density_kg_m3, aero)
 
 
 def relative_error(model: complex, paper: complex) -> tuple[float, float]:

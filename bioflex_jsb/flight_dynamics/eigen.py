@@ -6,6 +6,10 @@ those of the *uncoupled* blocks (A_RR for the rigid modes; the structural block
 [[0, I], [A_EE, A_EĖ]] for the aeroelastic ones). From there every label is carried from one
 speed to the next by eigenvector correlation (modal assurance criterion) together with
 eigenvalue continuity, never by sort order, so crossings and coalescences do not swap labels.
+The tracking and the flutter search are the one engine's
+(:mod:`bioflex_jsb.flight_dynamics.flutter_engine`): this module supplies the paper model's
+state matrix and its reference labels (:class:`~bioflex_jsb.flight_dynamics.flutter_engine.
+EigenFamily`), for the default rigid parameter set or another one (``aero``).
 """
 
 from __future__ import annotations
@@ -14,17 +18,19 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.flight_dynamics import flutter_engine as engine
+from bioflex_jsb.flight_dynamics.flutter_engine import FlutterResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
 
 RIGID_LABELS = ("short_period", "phugoid")
 IMAG_TOL_RAD_S = 1e-6  # below this |Im λ| a root is reported as real [rad/s]
 EXCLUDED_FROM_FLUTTER = ("phugoid",)
-UNSTABLE_RE_RAD_S = 1e-9  # a root with Re λ above this is unstable [1/s] (find_flutter's tol)
+UNSTABLE_RE_RAD_S = engine.GROWTH_TOL_1_S  # Re λ above this is unstable [1/s]
 # The name of an unstable real root: a static divergence, whatever branch it was tracked on
 # (a real root at +39.5 rad/s is not a "short period" with damping -1). Its Mode keeps the
 # tracked identity in ``branch``.
@@ -105,16 +111,17 @@ class ModeSet:
         }
 
 
-def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition):
+def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition,
+               aero: RigidAerodynamics = RIGID_AERODYNAMICS):
     """Uncoupled reference eigenvalues with labels, for the first speed of a sweep."""
-    ss_rigid = build_state_space("rigid", cond)
+    ss_rigid = build_state_space("rigid", cond, aero=aero)
     lam = np.linalg.eigvals(ss_rigid.a)
     order = np.argsort(-np.abs(lam))  # short period: the two largest |λ|
     labels = [RIGID_LABELS[0]] * 2 + [RIGID_LABELS[1]] * 2
     ref = [(labels[k], lam[i]) for k, i in enumerate(order)]
     if model == "coupled":
         assert wing is not None
-        blk = coupled_blocks(wing, cond)
+        blk = coupled_blocks(wing, cond, aero)
         n = wing.n_modes
         s = np.block([[np.zeros((n, n)), np.eye(n)], [blk.a_ee, blk.a_eedot]])
         lam_e = np.linalg.eigvals(s)
@@ -122,14 +129,7 @@ def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition)
         order_e = np.argsort(np.abs(lam_e), kind="stable")
         for k, i in enumerate(order_e):
             ref.append((f"aeroelastic_{k // 2 + 1}", lam_e[i]))
-    return ref
-
-
-def _mac(v_prev: np.ndarray, v_now: np.ndarray) -> np.ndarray:
-    """Modal assurance criterion matrix between two sets of (column) eigenvectors."""
-    num = np.abs(v_prev.conj().T @ v_now) ** 2
-    den = np.outer(np.sum(np.abs(v_prev) ** 2, axis=0), np.sum(np.abs(v_now) ** 2, axis=0))
-    return num / den
+    return ref if model == "coupled" else ref[:4]
 
 
 def _collapse(speed: float, model: str, labels: Sequence[str], lam: np.ndarray) -> ModeSet:
@@ -148,6 +148,26 @@ def _collapse(speed: float, model: str, labels: Sequence[str], lam: np.ndarray) 
     return ModeSet(speed, model, tuple(modes))
 
 
+def paper_family(model: str, wing: ElasticWingModel | None, density_kg_m3: float,
+                 aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+                 start_m_s: float = 2.0) -> engine.EigenFamily:
+    """The paper model ``model`` (rigid, coupled, qsd) as the engine's family: its state
+    matrix A(V) and the reference labels of the uncoupled blocks at ``start_m_s``."""
+    def matrix(v: float) -> np.ndarray:
+        return build_state_space(model, level_flight_condition(v, density_kg_m3, aero), wing,
+                                 aero).a
+
+    ref = _reference(model, wing, level_flight_condition(float(start_m_s), density_kg_m3, aero),
+                     aero)
+    natural = () if wing is None else tuple(float(w) for w in wing.frequencies_rad_s)
+    return engine.EigenFamily(
+        matrix, np.array([r[1] for r in ref]), [r[0] for r in ref], rest_label="lag",
+        excluded=EXCLUDED_FROM_FLUTTER, rigid_labels=RIGID_LABELS,
+        natural_frequencies_rad_s=natural,
+        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, method="state-space",
+        aero="quasi-steady", name="" if wing is None else wing.name)
+
+
 @dataclass(frozen=True)
 class Sweep:
     """Tracked eigenvalues of one model over a speed grid.
@@ -163,6 +183,7 @@ class Sweep:
     eigenvectors: tuple[np.ndarray, ...]
     wing: ElasticWingModel | None
     density_kg_m3: float
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS
 
     def at(self, k: int) -> ModeSet:
         return _collapse(float(self.speeds_m_s[k]), self.model, self.labels, self.eigenvalues[k])
@@ -172,22 +193,11 @@ class Sweep:
 
     def continued(self, k: int, speed_m_s: float) -> np.ndarray:
         """Roots at ``speed_m_s``, ordered like the labels, continued from grid point ``k``."""
-        lam, vec = _eig(self.model, speed_m_s, self.wing, self.density_kg_m3)
-        perm = _match(self.eigenvalues[k], self.eigenvectors[k], lam, vec)
-        return lam[perm]
-
-
-def _eig(model: str, speed_m_s: float, wing, density_kg_m3: float):
-    ss = build_state_space(model, level_flight_condition(float(speed_m_s), density_kg_m3), wing)
-    return np.linalg.eig(ss.a)
-
-
-def _match(lam_prev, vec_prev, lam, vec) -> np.ndarray:
-    """Permutation of (lam, vec) that best continues (lam_prev, vec_prev)."""
-    mac = _mac(vec_prev, vec)
-    dist = np.abs(lam_prev[:, None] - lam[None, :]) / (1.0 + np.abs(lam_prev)[:, None])
-    rows, cols = linear_sum_assignment((1.0 - mac) + dist)
-    return cols[np.argsort(rows)]
+        fam = paper_family(self.model, self.wing, self.density_kg_m3, self.aero,
+                           float(self.speeds_m_s[0]))
+        prev = engine.Point(float(self.speeds_m_s[k]), self.eigenvalues[k],
+                            self.eigenvectors[k])
+        return fam.follow(float(speed_m_s), prev, prev.roots).roots
 
 
 def track(
@@ -195,8 +205,10 @@ def track(
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
     density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> Sweep:
-    """Eigenvalues of ``model`` at increasing ``speeds_m_s`` with labels tracked.
+    """Eigenvalues of ``model`` at increasing ``speeds_m_s`` with labels tracked (the
+    engine's :func:`~bioflex_jsb.flight_dynamics.flutter_engine.scan`), rigid set ``aero``.
 
     The grid should be fine enough that eigenvectors change little between neighbours
     (0.25 m/s is ample here; :func:`sweep_grid` makes one).
@@ -204,25 +216,10 @@ def track(
     speeds = np.asarray(speeds_m_s, dtype=float)
     if speeds.ndim != 1 or len(speeds) == 0 or np.any(np.diff(speeds) <= 0):
         raise ValueError("speeds_m_s must be a non-empty, strictly increasing sequence")
-    all_lam, all_vec = [], []
-    labels: list[str] = []
-    for k, v in enumerate(speeds):
-        lam, vec = _eig(model, float(v), wing, density_kg_m3)
-        if k == 0:
-            ref = _reference(model, wing, level_flight_condition(float(v), density_kg_m3))
-            if model == "qsd":
-                ref = ref[:4]
-            ref_lam = np.array([r[1] for r in ref])
-            cost = np.abs(ref_lam[:, None] - lam[None, :]) / (1.0 + np.abs(ref_lam[:, None]))
-            rows, cols = linear_sum_assignment(cost)
-            perm = cols[np.argsort(rows)]
-            labels = [r[0] for r in ref]
-        else:
-            perm = _match(all_lam[-1], all_vec[-1], lam, vec)
-        all_lam.append(lam[perm])
-        all_vec.append(vec[:, perm])
-    return Sweep(model, speeds, np.array(all_lam), tuple(labels), tuple(all_vec), wing,
-                 density_kg_m3)
+    fam = paper_family(model, wing, density_kg_m3, aero, float(speeds[0]))
+    tr = engine.scan(fam, speeds)
+    return Sweep(model, speeds, tr.roots, tr.labels, tuple(p.vectors for p in tr.points),
+                 wing, density_kg_m3, aero)
 
 
 def sweep_grid(
@@ -241,95 +238,81 @@ def modes_at(
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
     density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> list[ModeSet]:
     """Labelled modes of ``model`` at each speed in ``speeds_m_s`` (labels tracked from 2 m/s)."""
     targets = sorted(set(float(v) for v in speeds_m_s))
     grid = sweep_grid(targets)
-    sweep = track(model, grid, wing, density_kg_m3)
+    sweep = track(model, grid, wing, density_kg_m3, aero)
     index = {float(v): k for k, v in enumerate(grid)}
     by_speed = {v: sweep.at(index[v]) for v in targets}
     return [by_speed[float(v)] for v in speeds_m_s]
 
 
-@dataclass(frozen=True)
-class FlutterResult:
-    """Lowest airspeed at which a root crosses into the right half plane.
-
-    ``flutter_speed_m_s`` is None when no root crosses within ``range_m_s``; ``frequency_rad_s``
-    is |Im λ| at the crossing (0 for a static divergence, ``kind`` says which).
-    """
-
-    wing: str
-    flutter_speed_m_s: float | None
-    mode: str | None
-    frequency_rad_s: float | None
-    kind: str | None
-    range_m_s: tuple[float, float]
-
-    def as_dict(self) -> dict[str, object]:
-        return {
-            "wing": self.wing,
-            "flutter_speed_m_s": self.flutter_speed_m_s,
-            "mode": self.mode,
-            "frequency_rad_s": self.frequency_rad_s,
-            "kind": self.kind,
-            "range_m_s": list(self.range_m_s),
-        }
+# The free aircraft's search: labels fixed at this speed [m/s] (below every range), the
+# scan step [m/s] and the bisection tolerance [m/s]; the speed is reported to the
+# tolerance's 0.01 m/s.
+SCAN_START_M_S = 2.0
+SCAN_STEP_M_S = 0.1
+SCAN_TOL_M_S = 0.01
 
 
 def find_flutter(
     wing: ElasticWingModel,
     range_m_s: tuple[float, float] = (5.0, 40.0),
-    step_m_s: float = 0.1,
-    tol_m_s: float = 0.01,
+    step_m_s: float = SCAN_STEP_M_S,
+    tol_m_s: float = SCAN_TOL_M_S,
     density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
-    growth_tol_1_s: float = 1e-9,
+    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> FlutterResult:
-    """Scan the coupled model over ``range_m_s`` and bisect the first crossing to ``tol_m_s``.
+    """The coupled model's first instability in ``range_m_s`` (the engine's search: scan
+    from 2 m/s in ``step_m_s``, bisection to ``tol_m_s``, speed rounded to 0.01 m/s).
 
-    A root counts as unstable when Re λ > ``growth_tol_1_s`` [1/s]. The phugoid is left out
-    of the search, as the paper leaves it out of Figs. 15-19 (Section 3.2: the vortex model
-    cannot give the drag the phugoid depends on): in the linear model it goes unstable below
-    about 10 m/s, where the formal trim C_L exceeds 2, for the rigid aircraft as well.
+    The phugoid is left out of the search, as the paper leaves it out of Figs. 15-19
+    (Section 3.2: the vortex model cannot give the drag the phugoid depends on): in the
+    linear model it goes unstable below about 10 m/s, where the formal trim C_L exceeds 2,
+    for the rigid aircraft as well. ``divergence_speed_m_s`` is the wing's with the body
+    held (:func:`wing_divergence_speed_m_s`).
     """
+    from dataclasses import replace
+
     lo, hi = range_m_s
     if not (0.0 < lo < hi):
         raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
-    grid = np.arange(min(2.0, lo), hi + 0.5 * step_m_s, step_m_s)
-    grid = grid[grid <= hi + 1e-12]
-    sweep = track("coupled", grid, wing, density_kg_m3)
-    considered = np.array([lab not in EXCLUDED_FROM_FLUTTER for lab in sweep.labels])
-    growth = sweep.eigenvalues[:, considered].real.max(axis=1)
-    in_range = grid >= lo - 1e-12
-    unstable = np.nonzero((growth > growth_tol_1_s) & in_range)[0]
-    if len(unstable) == 0:
-        return FlutterResult(wing.name, None, None, None, None, (lo, hi))
-    k = int(unstable[0])
-    if k == 0 or not in_range[k - 1]:
-        v_cross = float(grid[k])  # already unstable at the bottom of the range
-    else:
-        a, b = float(grid[k - 1]), float(grid[k])
+    fam = paper_family("coupled", wing, density_kg_m3, aero,
+                       min(SCAN_START_M_S, lo))
+    fam.divergence_speed_m_s = wing_divergence_speed_m_s(wing, density_kg_m3)
+    res = engine.first_instability(
+        fam, engine.default_grid((lo, hi), step_m_s, SCAN_START_M_S), (lo, hi),
+        tol_m_s=tol_m_s, structural_damping=_common_zeta(wing),
+        density_kg_m3=density_kg_m3)
+    if res.speed_m_s is None:
+        return res
+    v = round(res.speed_m_s, 2)
+    return replace(res, speed_m_s=v, reduced_frequency=res.frequency_rad_s * res.semichord_m / v)
 
-        def max_re(v: float) -> float:
-            return float(sweep.continued(k - 1, v)[considered].real.max())
 
-        while b - a > tol_m_s:
-            mid = 0.5 * (a + b)
-            if max_re(mid) > growth_tol_1_s:
-                b = mid
-            else:
-                a = mid
-        v_cross = b
-    at_cross = sweep.continued(k - 1, v_cross) if k > 0 else sweep.eigenvalues[k]
-    masked = np.where(considered, at_cross.real, -np.inf)
-    j = int(np.argmax(masked))
-    root = at_cross[j]
-    kind = "flutter" if abs(root.imag) > IMAG_TOL_RAD_S else "divergence"
-    return FlutterResult(
-        wing.name,
-        round(v_cross, 2),
-        sweep.labels[j],
-        float(abs(root.imag)),
-        kind,
-        (lo, hi),
-    )
+def _common_zeta(wing: ElasticWingModel) -> float | None:
+    z = np.asarray(wing.damping_ratios, dtype=float)
+    return float(z[0]) if z.size and np.all(z == z[0]) else None
+
+
+def wing_divergence_speed_m_s(wing: ElasticWingModel,
+                              density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                              range_m_s: tuple[float, float] = (2.0, 60.0)) -> float | None:
+    """Speed [m/s] at which the wing's static stiffness in the aircraft, A_EE = −ω² + H_η
+    of Eq. (4), first becomes singular (its divergence with the body held); None in range.
+    The same for both aerodynamic models (the unsteady increments vanish in a steady state)."""
+    from scipy.optimize import brentq
+
+    def det(v):
+        return float(np.linalg.det(coupled_blocks(wing,
+                                                  level_flight_condition(v, density_kg_m3)).a_ee))
+
+    grid = np.arange(range_m_s[0], range_m_s[1] + 0.25, 0.5)
+    signs = np.sign([det(v) for v in grid])
+    flips = np.flatnonzero(signs[1:] != signs[:-1])
+    if flips.size == 0:
+        return None
+    k = int(flips[0])
+    return float(brentq(det, grid[k], grid[k + 1], xtol=1e-4))

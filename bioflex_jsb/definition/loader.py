@@ -1,0 +1,260 @@
+"""Reading a definition file (TOML, docs/aircraft.md) into a :class:`Definition`.
+
+Every field is checked when the file is read: its type, its unit's plausible range (a
+definition written in millimetres or in per cent is refused, not analysed), the structure's
+positive definiteness. A problem is one line naming the field and what is accepted
+(:class:`DefinitionError`, an :class:`~bioflex_jsb.errors.InputError`: exit 2 in the CLI).
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from bioflex_jsb.definition.model import (
+    AeroSettings,
+    Air,
+    AnalysisSettings,
+    BeamStructure,
+    Definition,
+    WingStation,
+)
+from bioflex_jsb.errors import InputError
+from bioflex_jsb.tomlfile import read_toml
+
+SHIPPED = ("goland",)  # definitions in bioflex_jsb/data/aircraft/<name>.toml
+FORMAT_VERSION = 1
+
+# Valid ranges [unit], each with its reason.
+# Semispan b/2 [m]: 0.05 m (a wind-tunnel model) to 100 m (the largest wings built are
+# about 40 m per side: A380 39.8 m, Helios 37.7 m); a file in mm (6096 for 6.096 m) is
+# outside.
+SEMISPAN_RANGE_M = (0.05, 100.0)
+CHORD_RANGE_M = (0.005, 30.0)  # a 5 mm model chord to a 30 m root chord
+LEADING_EDGE_RANGE_M = (-100.0, 100.0)
+TWIST_LIMIT_RAD = math.radians(30.0)  # beyond 30° the strip's attached flow is gone
+# Stiffnesses [N·m²]: 1e-3 (a foam-and-film model wing) to 1e12 (a transport's root
+# bending is about 1e10).
+STIFFNESS_RANGE_N_M2 = (1e-3, 1e12)
+MASS_PER_LENGTH_RANGE_KG_M = (1e-4, 1e5)  # 0.1 g/m (a model) to 100 t/m
+INERTIA_RANGE_KG_M = (1e-9, 1e6)
+# Structural damping ratio ζ [-]: built-up wings measure 0.005-0.05; 0.3 leaves room for a
+# heavily damped test article; 5 is a percentage or a typo (2 % is 0.02).
+DAMPING_RANGE = (0.0, 0.3)
+# Air density [kg/m³]: 0.01 (about 33 km, ISA; above it the atmosphere is no place for a
+# wing, and the strip models' dynamic pressure vanishes) to 2 (denser than any air at the
+# surface: -50 °C sea level is 1.58).
+DENSITY_RANGE_KG_M3 = (0.01, 2.0)
+LIFT_SLOPE_RANGE_PER_RAD = (1.0, 7.0)  # thin aerofoil 2π = 6.283; real sections 5.5-6.9
+STRIPS_RANGE = (4, 200)
+N_MODES_RANGE = (2, 20)
+N_ELEMENTS_RANGE = (4, 400)
+SPEED_LIMIT_M_S = 400.0  # the strip models are incompressible: above ~0.3 Mach, caution
+AERO_MODELS = ("unsteady", "quasi-steady")
+LIFT_SLOPES = ("strip", "vlm")
+METHODS = ("pk", "state-space")
+INERTIA_AXES = ("elastic-axis", "centre-of-mass")
+TWIST_UNITS = ("deg", "rad")
+
+
+class DefinitionError(InputError):
+    """A definition file that cannot be used; the message names the file and the field."""
+
+
+class _Reader:
+    def __init__(self, data: dict, where: str) -> None:
+        self.data = data
+        self.where = where
+
+    def fail(self, field: str, text: str) -> DefinitionError:
+        return DefinitionError(f"{self.where}: {field}: {text}")
+
+    def table(self, key: str, allowed: tuple[str, ...], required: bool = True) -> dict:
+        t = self.data.get(key)
+        if t is None:
+            if required:
+                raise self.fail(f"[{key}]", "missing table")
+            return {}
+        if not isinstance(t, dict):
+            raise self.fail(f"[{key}]", "must be a table")
+        self.keys(t, key, allowed)
+        return t
+
+    def keys(self, t: dict, where: str, allowed: tuple[str, ...]) -> None:
+        unknown = sorted(set(t) - set(allowed))
+        if unknown:
+            raise self.fail(f"{where}.{unknown[0]}", f"unknown field; accepted: "
+                            f"{', '.join(allowed)}")
+
+    def number(self, t: dict, where: str, key: str, lo: float, hi: float, unit: str,
+               default: float | None = None, hint: str = "") -> float:
+        v = t.get(key, default)
+        if v is None:
+            raise self.fail(f"{where}.{key}", f"missing (a number in {unit})")
+        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            raise self.fail(f"{where}.{key}", f"must be a finite number in {unit}, got {v!r}")
+        if not lo <= v <= hi:
+            raise self.fail(f"{where}.{key}", f"{v:g} {unit} is outside the valid range "
+                            f"{lo:g}..{hi:g} {unit}{hint}")
+        return float(v)
+
+    def integer(self, t: dict, where: str, key: str, lo: int, hi: int, default: int) -> int:
+        v = t.get(key, default)
+        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+            raise self.fail(f"{where}.{key}", f"must be an integer {lo}..{hi}, got {v!r}")
+        return int(v)
+
+    def choice(self, t: dict, where: str, key: str, choices: tuple[str, ...],
+               default: str | None) -> str:
+        v = t.get(key, default)
+        if v not in choices:
+            raise self.fail(f"{where}.{key}", f"must be one of {', '.join(choices)}, got {v!r}")
+        return str(v)
+
+    def text(self, t: dict, where: str, key: str, default: str | None = None) -> str:
+        v = t.get(key, default)
+        if not isinstance(v, str) or (default is None and not v.strip()):
+            raise self.fail(f"{where}.{key}", "must be a non-empty string")
+        return v
+
+
+def _per_station(r: _Reader, t: dict, key: str, n: int, lo: float, hi: float, unit: str,
+                 hint: str = "") -> np.ndarray:
+    """A number (uniform) or a list of one number per wing station."""
+    v = t.get(key)
+    where = "structure"
+    if v is None:
+        raise r.fail(f"{where}.{key}", f"missing (a number in {unit}, or one per station)")
+    values = v if isinstance(v, list) else [v] * n
+    if len(values) != n:
+        raise r.fail(f"{where}.{key}", f"has {len(values)} values for {n} wing stations")
+    out = [r.number({key: x}, where, key, lo, hi, unit, hint=hint) for x in values]
+    return np.array(out, dtype=float)
+
+
+def _stations(r: _Reader, wing: dict) -> tuple[WingStation, ...]:
+    unit = r.choice(wing, "wing", "twist_unit", TWIST_UNITS, "deg")
+    rows = wing.get("stations")
+    if not isinstance(rows, list) or len(rows) < 2 or not all(isinstance(x, dict)
+                                                              for x in rows):
+        raise r.fail("wing.stations", "need at least 2 stations (root y_m = 0, tip), each a "
+                     "table {y_m, chord_m, leading_edge_x_m, twist, elastic_axis, "
+                     "centre_of_mass}")
+    allowed = ("y_m", "chord_m", "leading_edge_x_m", "twist", "elastic_axis",
+               "centre_of_mass")
+    tip = rows[-1].get("y_m")
+    mm_hint = ""
+    if isinstance(tip, int | float) and tip > SEMISPAN_RANGE_M[1]:
+        mm_hint = " (the format is SI: is the file in millimetres?)"
+    out = []
+    for i, row in enumerate(rows):
+        w = f"wing.stations[{i}]"
+        r.keys(row, w, allowed)
+        y = r.number(row, w, "y_m", 0.0, SEMISPAN_RANGE_M[1], "m", hint=mm_hint)
+        c = r.number(row, w, "chord_m", *CHORD_RANGE_M, "m", hint=mm_hint)
+        x = r.number(row, w, "leading_edge_x_m", *LEADING_EDGE_RANGE_M, "m", default=0.0)
+        lim = TWIST_LIMIT_RAD if unit == "rad" else math.degrees(TWIST_LIMIT_RAD)
+        tw = r.number(row, w, "twist", -lim, lim, unit, default=0.0)
+        ea = r.number(row, w, "elastic_axis", 0.0, 1.0, "chord fraction")
+        cg = r.number(row, w, "centre_of_mass", 0.0, 1.0, "chord fraction")
+        out.append(WingStation(y, c, x, tw if unit == "rad" else math.radians(tw), ea, cg))
+    ys = [s.y_m for s in out]
+    if ys[0] != 0.0 or any(b <= a for a, b in zip(ys, ys[1:], strict=False)):
+        raise r.fail("wing.stations.y_m", f"must start at the root (0) and increase strictly, "
+                     f"got {ys}")
+    if not SEMISPAN_RANGE_M[0] <= ys[-1]:
+        raise r.fail(f"wing.stations[{len(ys) - 1}].y_m", f"semispan {ys[-1]:g} m is below "
+                     f"{SEMISPAN_RANGE_M[0]:g} m (is the file in another unit?)")
+    return tuple(out)
+
+
+def _structure(r: _Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
+    allowed = ("kind", "bending_stiffness_n_m2", "torsional_stiffness_n_m2",
+               "mass_per_length_kg_m", "pitch_inertia_kg_m", "inertia_axis", "damping_ratio",
+               "n_modes", "n_elements")
+    t = r.table("structure", allowed)
+    r.choice(t, "structure", "kind", ("beam",), "beam")
+    n = len(stations)
+    pure = (" (zero torsional stiffness or pitch inertia is a pure-bending structure: no "
+            "bending-torsion flutter to find)")
+    ei = _per_station(r, t, "bending_stiffness_n_m2", n, *STIFFNESS_RANGE_N_M2, "N m^2")
+    gj = _per_station(r, t, "torsional_stiffness_n_m2", n, *STIFFNESS_RANGE_N_M2, "N m^2",
+                      pure)
+    m = _per_station(r, t, "mass_per_length_kg_m", n, *MASS_PER_LENGTH_RANGE_KG_M, "kg/m")
+    inertia = _per_station(r, t, "pitch_inertia_kg_m", n, *INERTIA_RANGE_KG_M, "kg m", pure)
+    axis = r.choice(t, "structure", "inertia_axis", INERTIA_AXES, "elastic-axis")
+    zeta = r.number(t, "structure", "damping_ratio", *DAMPING_RANGE, "(ratio)", default=0.0,
+                    hint=" (a ratio, not a percentage: 2 % is 0.02)")
+    chord = np.array([s.chord_m for s in stations])
+    d = np.array([s.centre_of_mass - s.elastic_axis for s in stations]) * chord
+    i_ea = inertia + (m * d**2 if axis == "centre-of-mass" else 0.0)
+    bad = np.flatnonzero(i_ea < m * d**2 * (1.0 - 1e-12))
+    if bad.size:
+        k = int(bad[0])
+        raise r.fail("structure.pitch_inertia_kg_m", f"{inertia[k]:g} kg m about the elastic "
+                     f"axis at station {k} is below m'·d² = {m[k] * d[k] ** 2:g} kg m (d the "
+                     "centre of mass's offset): the section mass matrix is not positive "
+                     "definite")
+    return BeamStructure(ei, gj, m, inertia, axis, zeta,
+                         r.integer(t, "structure", "n_modes", *N_MODES_RANGE, 6),
+                         r.integer(t, "structure", "n_elements", *N_ELEMENTS_RANGE, 40))
+
+
+def parse_definition(data: dict, where: str, path: str = "") -> Definition:
+    """A :class:`Definition` from the parsed TOML ``data`` (``where`` names it in errors)."""
+    r = _Reader(data, where)
+    r.keys(data, "(top level)", ("format", "name", "description", "source", "wing",
+                                 "structure", "aero", "air", "analysis", "airframe"))
+    fmt = data.get("format", FORMAT_VERSION)
+    if fmt != FORMAT_VERSION:
+        raise r.fail("format", f"must be {FORMAT_VERSION}, got {fmt!r}")
+    if "airframe" in data:
+        raise r.fail("[airframe]", "not available yet: this version reads clamped wings "
+                     "(a definition without [airframe]); see docs/aircraft.md")
+    name = r.text(data, "", "name")
+    wing = r.table("wing", ("twist_unit", "stations"))
+    stations = _stations(r, wing)
+    structure = _structure(r, stations)
+    at = r.table("aero", ("model", "lift_slope", "section_lift_slope_per_rad", "strips"),
+                 required=False)
+    aero = AeroSettings(
+        r.choice(at, "aero", "model", AERO_MODELS, "unsteady"),
+        r.choice(at, "aero", "lift_slope", LIFT_SLOPES, "strip"),
+        r.number(at, "aero", "section_lift_slope_per_rad", *LIFT_SLOPE_RANGE_PER_RAD,
+                 "1/rad", default=2.0 * math.pi),
+        r.integer(at, "aero", "strips", *STRIPS_RANGE, 24))
+    air_t = r.table("air", ("density_kg_m3",))
+    air = Air(r.number(air_t, "air", "density_kg_m3", *DENSITY_RANGE_KG_M3, "kg/m^3"))
+    an = r.table("analysis", ("method", "speed_range_m_s"), required=False)
+    rng = an.get("speed_range_m_s")
+    if rng is not None:
+        ok = (isinstance(rng, list) and len(rng) == 2
+              and all(isinstance(v, int | float) and not isinstance(v, bool) for v in rng)
+              and 0.0 < rng[0] < rng[1] <= SPEED_LIMIT_M_S)
+        if not ok:
+            raise r.fail("analysis.speed_range_m_s", f"must be [low, high] m/s with 0 < low "
+                         f"< high <= {SPEED_LIMIT_M_S:g}, got {rng!r}")
+        rng = (float(rng[0]), float(rng[1]))
+    analysis = AnalysisSettings(r.choice(an, "analysis", "method", METHODS, "pk"), rng)
+    return Definition(name=name, description=r.text(data, "", "description", ""),
+                      source=r.text(data, "", "source", ""), stations=stations,
+                      structure=structure, aero=aero, air=air, analysis=analysis, path=path)
+
+
+def shipped_path(name: str) -> Path:
+    """The shipped definition file ``name`` (bioflex_jsb/data/aircraft/<name>.toml)."""
+    return Path(str(resources.files("bioflex_jsb") / "data" / "aircraft" / f"{name}.toml"))
+
+
+def load_definition(name_or_file: str | Path) -> Definition:
+    """A shipped definition by name (:data:`SHIPPED`) or a definition file (TOML)."""
+    text = str(name_or_file)
+    path = shipped_path(text) if text in SHIPPED else Path(text)
+    if text not in SHIPPED and path.suffix != ".toml" and not path.exists():
+        raise DefinitionError(f"unknown definition {text!r}: give a shipped name "
+                              f"({', '.join(SHIPPED)}) or a .toml definition file")
+    data = read_toml(path, "definition file", DefinitionError)
+    return parse_definition(data, f"definition file {str(path)!r}", str(path))
