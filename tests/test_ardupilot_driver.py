@@ -692,16 +692,17 @@ def test_session_events_are_in_the_log(wing, tmp_path):
     assert ph.summary()["stop_count"] == 1 and lk.server.stats.resets == 0
 
 
-def test_unsteady_wing_flies_on_the_python_step():
+@pytest.mark.parametrize("compiled, kind", [(True, "compiled kernel"), (False, "python")])
+def test_unsteady_wing_flies_and_the_summary_says_which_step(compiled, kind):
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 
     build = build_wing(VARIANTS["inertial-backward"])
-    ph = ad.ArduPilotPhysics(Airframe(), build, "coupled", aero="unsteady", compiled=False)
-    assert ph.step_kind == "python" and ph.core.aero == "unsteady"
+    ph = ad.ArduPilotPhysics(Airframe(), build, "coupled", aero="unsteady", compiled=compiled)
+    assert ph.step_kind == kind and ph.core.aero == "unsteady"
     _steps(ph, ph.launch_hold_steps + ph.stroke_steps + 480)
     s = ph.summary()
     assert s["phase"] == ad.FLIGHT and s["stop_count"] == 0
-    assert (s["aero"], s["step"]) == ("unsteady", "python")
+    assert (s["aero"], s["step"]) == ("unsteady", kind)
     assert np.any(ph.core.eta != 0.0)
 
 
@@ -773,3 +774,15 @@ def test_command_line_session_across_a_killed_and_restarted_arduPilot(tmp_path):
     # the 3.5 s of silence is in wall_s, not in the real-time factor's denominator
     assert s["connected_wall_s"] < s["wall_s"] - aj.PEER_SILENCE_S
     assert s["real_time_factor"] == pytest.approx(s["session_s"] / s["connected_wall_s"])
+
+
+def test_command_line_flies_the_unstable_wing_with_unsteady_strips(capsys):
+    """The refusal's advice taken: --wing inertial-backward --aero unsteady passes the
+    pre-flight check (stable to 18.9 m/s) and flies on the compiled unsteady step."""
+    rc, _ = _cli_session(["--wing", "inertial-backward", "--aero", "unsteady", "--duration",
+                          "0.1", "--json", "--no-log"], _free_port())
+    assert rc == 0
+    s = json.loads(capsys.readouterr().out)
+    assert (s["aero"], s["step"]) == ("unsteady", "compiled kernel")
+    assert s["preflight"]["stable"] and s["preflight"]["aero"] == "unsteady"
+    assert s["preflight"]["max_growth_1_s"] < 0.0

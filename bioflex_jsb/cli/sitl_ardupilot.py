@@ -22,7 +22,7 @@ from bioflex_jsb.cli.common import (
 HELP = """Be ArduPilot's physics: answer ArduPlane SITL started with --model JSON:127.0.0.1
 (UDP 9002 + 10 x --instance) lock-step, one co-simulation step per ArduPilot frame, with the
 JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native; --aero
-unsteady for the coupled wing's unsteady strips, which run on the Python step). The session
+unsteady for the coupled wing's unsteady strips; both run on the compiled step). The session
 binds to the first ArduPilot that sends (address and port); servo packets from any other
 source are counted and reported, never answered; a restart of that ArduPilot (frame 0
 again, or frame 0 from its address on a new port after 3 s of silence) resets the physics.
@@ -83,9 +83,9 @@ def register(sub) -> None:
     p.add_argument("--gust-repeat", action="store_true",
                    help="blow the gust after every launch (default: once per session)")
     p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
-                   help="the coupled wing's strips: quasi-steady (the paper's; compiled "
-                   "kernel) or unsteady (Jones lag states, apparent mass, Kuessner gust; the "
-                   "Python step); default quasi-steady")
+                   help="the coupled wing's strips: quasi-steady (the paper's) or unsteady "
+                   "(Jones lag states, apparent mass, Kuessner gust); both on the compiled "
+                   "step (the summary's 'step' says which ran); default quasi-steady")
     p.add_argument("--allow-unstable", action="store_true",
                    help="fly a model that is unstable at the trim speed (refused otherwise)")
     p.add_argument("--instance", type=int, default=0,
@@ -204,9 +204,9 @@ def _build(args: argparse.Namespace):
     check["allowed_unstable"] = bool(args.allow_unstable)
     if not check["stable"] and not args.allow_unstable:
         raise UsageError(_refusal(args, build, check))
-    # the unsteady strips are not in the compiled kernel: their Python step, asked for
-    # explicitly (the summary's "step" says which one flies)
-    compiled = args.aero == "quasi-steady"
+    # both strip models have a compiled step (CoupledStep(compiled=True); the unsteady one
+    # since simulation/unsteady_kernel.py); the summary's "step" says which one flew
+    compiled = True
     try:
         airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
         physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
