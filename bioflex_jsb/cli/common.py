@@ -32,6 +32,8 @@ import sys
 import threading
 from typing import Any, NoReturn
 
+from bioflex_jsb.interrupts import STOP, unsafe_frame
+
 EXIT_USAGE = 2
 EXIT_DIVERGED = 3
 EXIT_ENVIRONMENT = 4
@@ -70,8 +72,18 @@ def os_error_line(exc: OSError) -> str:
 
 # ---------------------------------------------------------------------------------------
 # Signals: the first SIGINT/SIGTERM stops the work (KeyboardInterrupt); later ones, and any
-# that arrive inside ``closing()`` or after the command returned, are deferred.
+# that arrive inside ``closing()`` or after the command returned, are deferred. The handler
+# raises only in a frame that can take an exception: landing in a callback from native code
+# (JSBSim's logger) or in an import it sets ``interrupts.STOP.pending`` instead, and the stop
+# is raised at the next safe point (a loop's check between steps, the end of JSBSim's
+# capture block) or, failing that, by a re-delivery of the signal REDELIVERY_S later.
 # ---------------------------------------------------------------------------------------
+# Re-delivery delay of a deferred stop [s]: JSBSim's callbacks last microseconds and an
+# import milliseconds to a second; 5 ms keeps a stop prompt at a negligible cost (one
+# thread per deferred signal, a few retries at most while an import completes).
+REDELIVERY_S = 0.005
+
+
 class _SignalState:
     def __init__(self) -> None:
         self.depth = 0  # nested main() calls (rerun runs a command inside its own)
@@ -79,6 +91,9 @@ class _SignalState:
         self.shield = 0  # closing() blocks entered
         self.previous: dict[int, Any] = {}
         self.command = ""
+        self.installed = False  # our stop handlers are in place (outermost main())
+        self.redelivered = False  # the next stop signal is our own re-delivery
+        self.lock = threading.Lock()  # re-delivery against uninstalling the handlers
 
 
 SIGNALS = _SignalState()
@@ -92,13 +107,39 @@ def _emergency_exit(reason: str) -> NoReturn:
 
 
 def _on_stop_signal(signum, frame) -> None:
-    SIGNALS.received += 1
-    if SIGNALS.shield or SIGNALS.received > 1:
-        if SIGNALS.received >= 3:
-            _emergency_exit("stopped at once (third signal while closing files); a log "
-                            "may need `bioflex-jsb info --recover`")
-        return  # deferred: the files are being closed; the exit status will be 130
+    if SIGNALS.redelivered:  # our own re-delivery of a deferred stop: not a new signal
+        SIGNALS.redelivered = False
+        if not STOP.pending:
+            return  # a check point raised it meanwhile
+    else:
+        SIGNALS.received += 1
+        if SIGNALS.shield or SIGNALS.received > 1 or STOP.pending:
+            if SIGNALS.received >= 3:
+                _emergency_exit("stopped at once (third signal while closing files); a "
+                                "log may need `bioflex-jsb info --recover`")
+            return  # deferred: the files are being closed; the exit status will be 130
+    if unsafe_frame(frame):  # inside a native callback or an import: never raise here
+        STOP.pending = True
+        _redeliver_later(signum)
+        return
+    STOP.pending = False
     raise KeyboardInterrupt
+
+
+def _redeliver_later(signum: int) -> None:
+    """Send ``signum`` to the main thread again in REDELIVERY_S unless the deferred stop was
+    raised by then (a real signal also wakes a blocking wait, which PEP 475 would resume)."""
+    main_id = threading.main_thread().ident
+
+    def send() -> None:
+        with SIGNALS.lock:
+            if STOP.pending and SIGNALS.installed and main_id is not None:
+                SIGNALS.redelivered = True
+                signal.pthread_kill(main_id, signum)
+
+    timer = threading.Timer(REDELIVERY_S, send)
+    timer.daemon = True
+    timer.start()
 
 
 def _on_late_signal(signum, frame) -> None:
@@ -117,7 +158,9 @@ def install_signal_handlers(command: str) -> bool:
     if SIGNALS.depth > 1 or threading.current_thread() is not threading.main_thread():
         return False
     SIGNALS.received, SIGNALS.shield, SIGNALS.command = 0, 0, command
+    SIGNALS.redelivered, STOP.pending = False, False
     SIGNALS.previous = {s: signal.signal(s, _on_stop_signal) for s in STOP_SIGNALS}
+    SIGNALS.installed = True
     return True
 
 
@@ -127,6 +170,9 @@ def uninstall_signal_handlers(installed: bool, own_process: bool) -> None:
     SIGNALS.depth -= 1
     if not installed:
         return
+    with SIGNALS.lock:  # no re-delivery reaches the caller's handlers
+        SIGNALS.installed = False
+        STOP.pending = False
     for s, h in SIGNALS.previous.items():
         signal.signal(s, _on_late_signal if own_process else h)
     SIGNALS.previous = {}

@@ -18,6 +18,7 @@ from typing import Protocol
 import numpy as np
 
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.interrupts import STOP, raise_if_stopped
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
@@ -203,18 +204,20 @@ def run_gust(
                 ws = gust.samples(min(block, n_steps - k), k).tolist()
                 stop = None
                 i = 0
+                # between steps: a stop signal deferred inside JSBSim's calls (STOP.pending,
+                # bioflex_jsb.interrupts) ends the block, and is raised once it is handed on
                 if on_sample is None:
                     for w in ws:
                         stop = advance_into(w, table, j0 + i)
                         i += 1
-                        if stop:
+                        if stop or STOP.pending:
                             break
                 else:
                     for w in ws:
                         stop = advance_into(w, table, j0 + i)
                         i += 1
                         on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
-                        if stop:
+                        if stop or STOP.pending:
                             break
                 m, i = i, 0
                 k += m
@@ -222,6 +225,7 @@ def run_gust(
                 if stop:
                     stopped = stop
                     break
+                raise_if_stopped()
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
         interrupted = True
     finally:

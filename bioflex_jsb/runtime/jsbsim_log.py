@@ -1,5 +1,10 @@
 """JSBSim's console output, captured instead of printed (it is very verbose): the records
-the runtime keeps for its one-line diagnoses (:attr:`Airframe.warnings`, trim failures)."""
+the runtime keeps for its one-line diagnoses (:attr:`Airframe.warnings`, trim failures).
+
+JSBSim calls the logger's methods from C++ (``set_level`` and ``flush`` on every step): each
+is a :func:`~bioflex_jsb.interrupts.native_callback`, so a stop signal landing in one is
+deferred (an exception raised there would end as a ``SystemError`` of ``FGFDMExec.run``) and
+raised at the end of the capture block, or by the loop's check between steps."""
 
 from __future__ import annotations
 
@@ -8,6 +13,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import jsbsim
+
+from bioflex_jsb.interrupts import native_callback, raise_if_stopped
 
 
 @dataclass(frozen=True)
@@ -27,19 +34,24 @@ class _CapturingLogger(jsbsim.FGLogger):
         self._level = int(jsbsim.LogLevel.INFO)
         self._parts: list[str] = []
 
+    @native_callback
     def set_level(self, level) -> None:
         self._level = int(level)
         self._parts = []
 
+    @native_callback
     def file_location(self, filename: str, line: int) -> None:
         self._parts.append(f"{filename}:{line}: ")
 
+    @native_callback
     def message(self, message: str) -> None:
         self._parts.append(message)
 
+    @native_callback
     def format(self, log_format) -> None:  # colours and emphasis are dropped
         return None
 
+    @native_callback
     def flush(self) -> None:
         text = "".join(self._parts)
         self._parts = []
@@ -55,3 +67,4 @@ def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
         yield logger
     finally:
         jsbsim.set_logger(previous)
+    raise_if_stopped()  # a stop signal deferred inside JSBSim's calls is raised here

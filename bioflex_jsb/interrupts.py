@@ -1,0 +1,71 @@
+"""A stop request (SIGINT/SIGTERM) that cannot be raised where it landed: the flag the loops
+check between steps, and the frames where a signal handler must not raise.
+
+A Python signal handler runs at the next bytecode boundary of the main thread, wherever
+that is. Two places cannot take an exception there:
+
+* a Python function that native code calls back (JSBSim's logger, :func:`native_callback`):
+  the C++ caller does not check for a Python error, so an exception raised inside ends as
+  ``SystemError: <cyfunction FGFDMExec.run> returned a result with an exception set``;
+* an import in progress: an extension module whose initialisation runs Python code turns the
+  exception into ``ImportError: initialization failed``.
+
+The CLI's handler (:mod:`bioflex_jsb.cli.common`) looks at the interrupted frame and its
+callers (:func:`unsafe_frame`); in such a frame it only sets :data:`STOP` ``.pending`` and
+returns. The stop is then raised as ``KeyboardInterrupt`` at the first safe point: a loop's
+check between steps (:func:`raise_if_stopped`, or ``STOP.pending`` read inline on a hot
+path), the end of a block that captures JSBSim's output, or a re-delivery of the signal a
+few milliseconds later (for code that has no check point, such as an import).
+
+This module imports nothing of the project: every layer may read the flag.
+"""
+
+from __future__ import annotations
+
+from types import CodeType, FrameType
+
+
+class StopFlag:
+    """``pending``: a stop signal arrived in a frame that could not raise, and has not been
+    raised yet (cleared by :func:`raise_if_stopped`)."""
+
+    __slots__ = ("pending",)
+
+    def __init__(self) -> None:
+        self.pending = False
+
+
+STOP = StopFlag()
+
+_CALLBACK_CODES: set[CodeType] = set()
+_IMPORT_FILES = ("<frozen importlib._bootstrap>", "<frozen importlib._bootstrap_external>")
+
+
+def native_callback(func):
+    """Mark ``func`` as called back by native code (decorator): a stop signal landing in it,
+    or in anything it calls, is deferred to the next safe point instead of raised."""
+    _CALLBACK_CODES.add(func.__code__)
+    return func
+
+
+def is_native_callback(func) -> bool:
+    """Whether ``func`` was marked with :func:`native_callback`."""
+    return getattr(func, "__code__", None) in _CALLBACK_CODES
+
+
+def unsafe_frame(frame: FrameType | None) -> bool:
+    """Whether an exception raised in ``frame`` now would cross native code that cannot
+    carry it: ``frame`` or one of its callers is a :func:`native_callback` or an import."""
+    while frame is not None:
+        code = frame.f_code
+        if code in _CALLBACK_CODES or code.co_filename in _IMPORT_FILES:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def raise_if_stopped() -> None:
+    """A safe point: raise the deferred stop (``KeyboardInterrupt``) if one is pending."""
+    if STOP.pending:
+        STOP.pending = False
+        raise KeyboardInterrupt
