@@ -833,3 +833,58 @@ def test_lock_file_is_not_a_regular_stat_problem(tmp_path):
     assert stat.S_ISREG(st.st_mode) and lock.path.read_text().strip() == str(os.getpid())
     lock.release()
     assert not lock.path.exists()
+
+
+# ---------------------------------------------------------------------------------------
+# A damaged numba cache of the compiled step kernel heals itself
+# ---------------------------------------------------------------------------------------
+KERNEL = ("from bioflex_jsb.simulation import step_kernel as K; K.compile_now(); "
+          "print(len(K.cache_files(K.step_kernel)))")
+
+
+def _kernel(cache_dir: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([PY, "-c", KERNEL], capture_output=True, text=True, timeout=600,
+                          env=env(NUMBA_CACHE_DIR=str(cache_dir)))
+
+
+@pytest.fixture(scope="module")
+def kernel_cache(tmp_path_factory):
+    """A good cache of the kernel, compiled once in a fresh NUMBA_CACHE_DIR."""
+    good = tmp_path_factory.mktemp("numba-good")
+    r = _kernel(good)
+    assert r.returncode == 0 and r.stdout.strip() == "2", r.stderr  # the index and the code
+    return good
+
+
+def _damage(path: Path, kind: str) -> None:
+    import random
+
+    data = path.read_bytes()
+    if kind == "truncated":
+        path.write_bytes(data[:len(data) // 2])
+    elif kind == "empty":
+        path.write_bytes(b"")
+    else:  # garbage: the same length of random bytes (a fixed seed: the same bytes each run)
+        path.write_bytes(random.Random(25).randbytes(len(data)))
+
+
+@pytest.mark.parametrize("suffix", [".nbi", ".nbc"])
+@pytest.mark.parametrize("kind", [
+    pytest.param("truncated", marks=pytest.mark.slow), pytest.param("empty"),
+    pytest.param("garbage", marks=pytest.mark.slow)])
+def test_a_damaged_kernel_cache_is_discarded_recompiled_and_said_once(
+        tmp_path, kernel_cache, kind, suffix):
+    """Before: every run exited 1 (UnpicklingError / EOFError) until the file was deleted."""
+    import shutil
+
+    cache = tmp_path / "numba"
+    shutil.copytree(kernel_cache, cache)
+    (victim,) = [p for p in cache.rglob(f"step_kernel.step_kernel-*{suffix}")]
+    _damage(victim, kind)
+    r = _kernel(cache)
+    assert r.returncode == 0, r.stderr[-3000:]
+    line = one_line(r.stderr)
+    assert "cache" in line and "damaged" in line and "compiling anew" in line, line
+    assert r.stdout.strip() == "2"  # cached anew: an index and a code file
+    again = _kernel(cache)  # healed: loaded from the new cache, nothing said
+    assert again.returncode == 0 and again.stderr.strip() == "", again.stderr

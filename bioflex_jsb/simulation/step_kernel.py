@@ -19,7 +19,11 @@ build step or compiler at install time.
 
 from __future__ import annotations
 
+import glob
 import math
+import os
+import pickle
+import sys
 
 import numba
 import numpy as np
@@ -186,6 +190,61 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
         if abs(x[i]) > consts[6]:
             return ETA_OUT
     return OK
+
+
+# ---------------------------------------------------------------------------------------
+# A damaged cache heals itself. numba keeps a kernel's machine code in two pickles in its
+# cache directory (``<module>.<function>-<line>.pyXY.nbi``, the index, and ``….N.nbc``, the
+# code); a truncated, empty or overwritten file made every run fail in numba's loader
+# (UnpicklingError, EOFError, MemoryError, ...) until it was deleted by hand. The guard wraps
+# the kernel's cache loader: a file that cannot be read is discarded (this kernel's files
+# only), one line says so on stderr, and numba compiles the kernel and caches it anew.
+# ---------------------------------------------------------------------------------------
+# What unpickling damaged bytes raises (pickle's own error, a stream cut short, a length or
+# an opcode argument out of range, an object built from nonsense): reading a file, nothing
+# else, happens inside the guarded call.
+DAMAGED_CACHE_ERRORS = (pickle.UnpicklingError, EOFError, ValueError, TypeError,
+                        AttributeError, ImportError, LookupError, MemoryError, OverflowError)
+
+
+def guard_cache(dispatcher) -> None:
+    """Make ``dispatcher`` (an ``@numba.njit(cache=True)`` function) discard and rebuild a
+    damaged on-disk cache instead of failing: see the section's comment."""
+    cache = dispatcher._cache
+    load = cache.load_overload
+
+    def load_overload(sig, target_context):
+        try:
+            return load(sig, target_context)
+        except DAMAGED_CACHE_ERRORS as exc:
+            _discard_cache(dispatcher, cache, exc)
+            return None  # numba compiles, then saves a fresh index and code
+
+    cache.load_overload = load_overload
+
+
+def cache_files(dispatcher) -> list[str]:
+    """The on-disk cache files of ``dispatcher`` (its index and code files) that exist."""
+    files = dispatcher._cache._cache_file
+    pattern = files._data_name_pattern.replace("{number:d}", "*")
+    found = glob.glob(os.path.join(glob.escape(files._cache_path), pattern))
+    return sorted([files._index_path] * os.path.exists(files._index_path) + found)
+
+
+def _discard_cache(dispatcher, cache, exc: BaseException) -> None:
+    names = cache_files(dispatcher)
+    for name in names:
+        try:
+            os.unlink(name)
+        except FileNotFoundError:  # another process discarded it first
+            pass
+    why = " ".join(f"{type(exc).__name__}: {exc}".split())[:160]
+    where = os.path.dirname(names[0]) if names else cache._cache_file._cache_path
+    sys.stderr.write(f"bioflex-jsb: numba's cache of the compiled {dispatcher.__name__} in "
+                     f"{where} was damaged ({why}); discarded it, compiling anew\n")
+
+
+guard_cache(step_kernel)
 
 
 def compile_now(n_modes: int = 3) -> None:
