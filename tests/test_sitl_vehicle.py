@@ -4,6 +4,7 @@ the ground, pacing statistics, parameters, peers and sticks."""
 from __future__ import annotations
 
 import math
+import re
 import time
 
 import pytest
@@ -53,15 +54,22 @@ def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
     heard = []  # the on_status hook (the session log's events): every STATUSTEXT, timed
     v.on_status = lambda t_s, severity, text: heard.append((t_s, severity, text))
     assert v.set_mode(MODES.MANUAL) is None
-    sim.manual(0.8, 0.0)  # stick forward: nose down into the ground
     with sim.airframe.capturing():
-        for _ in range(int(30.0 / sim.dt_s)):
+        for k in range(int(30.0 / sim.dt_s)):
+            if k % 96 == 0:  # stick forward, nose down into the ground, held (10 Hz, as a
+                sim.manual(0.8, 0.0)  # station: sticks older than 1 s wall mean RTL)
             sim.step()
             if sim.resets:
                 break
     assert sim.resets == 1 and sim.stopped is not None
     texts = [t for _, t in v.events]
-    assert any(t.startswith(("Crashed", "Diverged")) for t in texts), texts
+    # issue 25: the skid's reaction made α jump to -31°, reported as "Diverged: angle of
+    # attack ..."; it is a crash, with the impact's state
+    crash = next(t for t in texts if t.startswith(("Crashed", "Diverged")))
+    assert re.fullmatch(r"Crashed: ground contact at t = \d+\.\d{3} s: -?\d+\.\d\d m above "
+                        r"ground, \d+\.\d m/s, descending -?\d+\.\d m/s, pitch -?\d+ deg, "
+                        r"roll -?\d+ deg", crash), crash
+    assert sim.crashes == 1 and sim.last_reset.startswith("ground contact")
     assert "Reset to trim over home" in texts
     assert [(s, t) for _, s, t in heard] == list(v.events)
     assert heard[-1][0] == heard[-2][0] == sim.t_s > 0.0  # the crash and the reset: now

@@ -56,6 +56,9 @@ from bioflex_jsb import units as U
 from bioflex_jsb.drivers.sitl_vehicle import (
     AIRSPEED_RANGE_M_S,
     GUIDANCE_PERIOD_S,
+    HOME_ALTITUDE_RANGE_M,
+    HOME_LATITUDE_RANGE_DEG,
+    HOME_LONGITUDE_RANGE_DEG,
     SitlVehicle,
 )
 from bioflex_jsb.errors import InputError
@@ -215,12 +218,13 @@ class SitlParameters:
 
 def check_home(lat_deg: float, lon_deg: float, ground_m: float, start_height_m: float) -> None:
     """InputError (one line) for a home or start height outside the accepted ranges."""
-    if not (math.isfinite(lat_deg) and -85.0 <= lat_deg <= 85.0):
-        raise InputError(f"home latitude {lat_deg:g} deg is outside -85..85")
-    if not (math.isfinite(lon_deg) and -180.0 <= lon_deg <= 180.0):
-        raise InputError(f"home longitude {lon_deg:g} deg is outside -180..180")
-    if not (math.isfinite(ground_m) and -400.0 <= ground_m <= 5000.0):
-        raise InputError(f"home ground altitude {ground_m:g} m is outside -400..5000 m AMSL")
+    for label, value, (lo, hi), unit in (
+            ("latitude", lat_deg, HOME_LATITUDE_RANGE_DEG, " deg"),
+            ("longitude", lon_deg, HOME_LONGITUDE_RANGE_DEG, " deg"),
+            ("ground altitude", ground_m, HOME_ALTITUDE_RANGE_M, " m")):
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise InputError(f"home {label} {value:g}{unit} is outside {lo:g}..{hi:g}"
+                             + (" m AMSL" if unit == " m" else ""))
     lo, hi = START_HEIGHT_RANGE_M
     if not (math.isfinite(start_height_m) and lo <= start_height_m <= hi):
         raise InputError(f"start height {start_height_m:g} m is outside {lo:g}..{hi:g} m "
@@ -254,6 +258,7 @@ class SitlSim:
         self.speedup = float(speedup)
         self.resync = False
         self.resets = 0
+        self.crashes = 0  # resets after ground contact (the others: the model diverged)
         self.last_reset: str | None = None
         self.on_reset: Callable[[str], None] | None = None
         self._k_base = 0  # steps flown by the cores before the present one
@@ -389,15 +394,21 @@ class SitlSim:
         return values
 
     def reset(self, reason: str) -> None:
-        """Report ``reason``, put the aircraft back in trim at the start point over home."""
-        self.stopped = reason
+        """Report why the flight ended: a crash (STATUSTEXT CRITICAL "Crashed: ground
+        contact …", :meth:`ground_contact`) or the model leaving its valid range (ERROR
+        "Diverged: ``reason``"); put the aircraft back in trim at the start point over
+        home. ``stopped`` and ``last_reset`` say which."""
+        impact = self.ground_contact()
+        if impact is not None:  # the ground, not the model, ended the flight
+            self.crashes += 1
+            reason = f"ground contact at t = {self.t_s:.3f} s: {impact}"
+            self.vehicle.status(2, "Crashed: " + reason)
+        else:
+            self.vehicle.status(3, "Diverged: " + reason)
+        self.stopped = self.last_reset = reason
         self.resets += 1
-        self.last_reset = reason
         now = time.monotonic()
         self._reset_walls = [w for w in self._reset_walls if now - w < 60.0] + [now]
-        ground = "ground" in reason or "terrain" in reason or "altitude" in reason
-        self.vehicle.status(2 if ground else 3, ("Crashed: " if ground else "Diverged: ")
-                            + reason)
         model = self.core.model
         self._k_base += self.core.k
         self._gust = None
@@ -407,6 +418,23 @@ class SitlSim:
         self.resync = True  # the trim took wall time: a new schedule
         if self.on_reset is not None:
             self.on_reset(reason)
+
+    def ground_contact(self) -> str | None:
+        """The impact (height of the centre of gravity above the ground, airspeed, descent
+        rate, pitch, roll at this step) when the aircraft touches the ground: any of its
+        contact points (skids, wing tips) carries a ground force, or its centre of gravity
+        is at or below the ground; None when it is in the air. A ground contact makes the
+        angle of attack jump (the skid's reaction), so the valid range's message may name
+        α: the contact is what is reported."""
+        a = self.airframe
+        touching = any(a[f"forces/fb{c}-gear-lbs"] != 0.0 for c in "xyz")
+        agl_m = a["position/h-agl-ft"] * U.M_PER_FT
+        if not touching and agl_m > 0.0:
+            return None
+        return (f"{agl_m:.2f} m above ground, {a['velocities/vt-fps'] * U.M_PER_FT:.1f} m/s, "
+                f"descending {a['velocities/v-down-fps'] * U.M_PER_FT:.1f} m/s, pitch "
+                f"{round(math.degrees(a['attitude/theta-rad']))} deg, roll "
+                f"{round(math.degrees(a['attitude/phi-rad']))} deg")
 
     @property
     def resetting_too_often(self) -> bool:

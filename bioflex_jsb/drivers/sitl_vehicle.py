@@ -35,17 +35,22 @@ from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink_mission import (
     AMSL_FRAMES,
     DO_CHANGE_SPEED,
+    INVALID_PARAM,
+    INVALID_PARAM7,
     NAV_LOITER_TIME,
     NAV_LOITER_TURNS,
     NAV_LOITER_UNLIM,
     NAV_RETURN_TO_LAUNCH,
     NAV_TAKEOFF,
     NAV_WAYPOINT,
+    RELATIVE_FRAMES,
     MissionItem,
     check_item,
 )
 from bioflex_jsb.simulation import guidance as G
 from bioflex_jsb.simulation.battery import Battery
+
+M_INVALID_PARAM, M_INVALID_PARAM7 = INVALID_PARAM, INVALID_PARAM7
 
 GUIDANCE_PERIOD_S = 0.02  # simulated time between guidance updates [s]
 MANUAL_TIMEOUT_S = 1.0  # sticks older than this [wall s]: control lost → RTL
@@ -53,6 +58,15 @@ STICK_BANK_RAD = math.radians(30.0)
 STICK_PITCH_RAD = math.radians(15.0)
 FORCE_DISARM = 21196  # MAV_CMD_COMPONENT_ARM_DISARM param2: disarm in flight
 AIRSPEED_RANGE_M_S = (12.0, 22.0)
+# Home (--home, MAV_CMD_DO_SET_HOME): the local north-east frame divides by cos(latitude), so
+# the poles are kept out; ground altitudes from the Dead Sea shore to high plateaus [m AMSL].
+HOME_LATITUDE_RANGE_DEG = (-85.0, 85.0)
+HOME_LONGITUDE_RANGE_DEG = (-180.0, 180.0)
+HOME_ALTITUDE_RANGE_M = (-400.0, 5000.0)
+WP_RADIUS_RANGE_M = (5.0, 500.0)  # as the parameter WP_RADIUS_M
+LOITER_RADIUS_RANGE_M = (20.0, 1000.0)  # as LOIT_RAD_M
+LOITER_TURNS_MAX = 1000.0  # NAV_LOITER_TURNS param1
+LOITER_TIME_MAX_S = 86400.0  # NAV_LOITER_TIME param1: a day
 SEVERITY = {"error": 3, "warning": 4, "notice": 5, "info": 6}
 
 
@@ -92,6 +106,8 @@ class SitlVehicle:
         self._item_state: dict = {}
         self._last_t = 0.0
         self._guided_target: tuple[float, float] | None = None
+        self._guided_loiter = (0.0, True)  # radius [m] (0: LOIT_RAD_M), clockwise
+        self.refusals = 0  # commands, parameters, overrides and items refused
         self._battery_warned = False
         self.set_mode(start_mode, quiet=True)
 
@@ -102,6 +118,27 @@ class SitlVehicle:
         self.events.append((int(severity), str(text)))
         if self.on_status is not None:
             self.on_status(self.sim.t_s, int(severity), str(text))
+
+    def refused(self, text: str) -> None:
+        """A refusal the link has already told the ground station (STATUSTEXT WARNING):
+        counted, and handed to ``on_status`` (an event of the session log)."""
+        self.refusals += 1
+        if self.on_status is not None:
+            self.on_status(self.sim.t_s, 4, str(text))
+
+    @property
+    def mode_name(self) -> str:
+        return MODES.mode_name(self.mode)
+
+    @property
+    def altitude_range_m(self) -> tuple[float, float]:
+        """Altitudes commanded [m AMSL]: the ground + 20 … + 1500 m."""
+        return self.sim.altitude_hold_range_m
+
+    @property
+    def ground_altitude_m(self) -> float:
+        """The flat ground [m AMSL] (the start home's; DO_SET_HOME does not move it)."""
+        return self.sim.home_deg[2]
 
     # -- where it is --------------------------------------------------------------------
     def position_ne(self) -> tuple[float, float]:
@@ -226,13 +263,45 @@ class SitlVehicle:
         self.heading_target_rad = math.remainder(heading_rad, 2 * math.pi)
         self.sim.airframe["ap/heading-hold-rad"] = self.heading_target_rad
 
-    def reposition(self, lat_rad: float, lon_rad: float, alt_amsl_m: float | None) -> str | None:
+    def reposition(self, lat_rad: float, lon_rad: float, alt_amsl_m: float | None,
+                   radius_m: float = 0.0, clockwise: bool = True) -> str | None:
+        """GUIDED to (lat, lon) [rad] at ``alt_amsl_m`` (None: kept), then loiter there with
+        ``radius_m`` [m] (0: LOIT_RAD_M) in the direction ``clockwise``."""
+        if not (abs(lat_rad) <= 0.5 * math.pi and abs(lon_rad) <= math.pi):
+            return "position out of range"
+        if radius_m and not LOITER_RADIUS_RANGE_M[0] <= radius_m <= LOITER_RADIUS_RANGE_M[1]:
+            return f"loiter radius must be in {LOITER_RADIUS_RANGE_M[0]:g}.." \
+                   f"{LOITER_RADIUS_RANGE_M[1]:g} m"
         if alt_amsl_m is not None:
             reason = self.change_altitude(alt_amsl_m)
             if reason:
                 return reason
         self._guided_target = self._ne(lat_rad, lon_rad)
+        self._guided_loiter = (float(radius_m), bool(clockwise))
         return self.set_mode(MODES.GUIDED)
+
+    def guided_item(self, item: MissionItem) -> str | None:
+        """A MISSION_ITEM(_INT) with current = 2 (ArduPilot's guided "fly to": MAVProxy's
+        ``guided LAT LON ALT`` with guided_use_reposition off) or 3 (change the altitude
+        only); None, or why it is refused (naming the field and the range)."""
+        if item.frame not in AMSL_FRAMES | RELATIVE_FRAMES:
+            return f"guided: frame {item.frame} unsupported"
+        if not math.isfinite(item.z):
+            return f"guided: z altitude {item.z:g} is not a finite number"
+        alt = self._item_alt_m(item)
+        lo, hi = self.altitude_range_m
+        if not lo <= alt <= hi:
+            return f"guided: z altitude {item.z:g} m ({alt:.0f} m AMSL) outside " \
+                   f"{lo:.0f}..{hi:.0f} m AMSL"
+        if item.current == 3:
+            return self.change_altitude(alt)
+        if not -90e7 <= item.x <= 90e7:
+            return f"guided: latitude {item.x * 1e-7:g} deg outside -90..90"
+        if not -180e7 <= item.y <= 180e7:
+            return f"guided: longitude {item.y * 1e-7:g} deg outside -180..180"
+        if item.x == 0 and item.y == 0:
+            return "guided: no position (x, y = 0, 0)"
+        return self.reposition(item.lat_rad, item.lon_rad, alt)
 
     def loiter_at(self, lat_rad: float | None, lon_rad: float | None,
                   radius_m: float) -> str | None:
@@ -245,8 +314,14 @@ class SitlVehicle:
         return reason
 
     def set_home(self, lat_rad: float, lon_rad: float, alt_amsl_m: float) -> str | None:
-        if not (-0.5 * math.pi <= lat_rad <= 0.5 * math.pi and math.isfinite(alt_amsl_m)):
-            return "home position out of range"
+        """Home at (lat, lon) [rad], ``alt_amsl_m`` [m]; None, or why not (the field and its
+        range: HOME_*_RANGE, as ``--home``)."""
+        for label, value, (lo, hi), unit in (
+                ("latitude", math.degrees(lat_rad), HOME_LATITUDE_RANGE_DEG, " deg"),
+                ("longitude", math.degrees(lon_rad), HOME_LONGITUDE_RANGE_DEG, " deg"),
+                ("altitude", alt_amsl_m, HOME_ALTITUDE_RANGE_M, " m AMSL")):
+            if not (math.isfinite(value) and lo <= value <= hi):
+                return f"home {label} {value:g}{unit} outside {lo:g}..{hi:g}"
         self.home = (lat_rad, lon_rad, alt_amsl_m)
         self.status(6, "Home position set")
         return None
@@ -269,9 +344,47 @@ class SitlVehicle:
                            y=int(round(math.degrees(lon) * 1e7)), z=alt)
         return [home] + self.mission[1:]
 
+    def item_problem(self, item: MissionItem) -> tuple[int, str] | None:
+        """(MAV_MISSION_RESULT, reason naming the field and its range) when ``item`` (not
+        item 0, home) cannot be flown, else None: :func:`check_item`, then the altitude
+        range (:attr:`altitude_range_m`), acceptance and loiter radii, turns, times and
+        speeds within the ranges of the parameters that set their defaults."""
+        bad = check_item(item)
+        if bad is not None:
+            return bad
+        n, cmd = item.seq, item.command
+        if item.has_position or cmd == NAV_TAKEOFF:
+            alt = self._item_alt_m(item)
+            lo, hi = self.altitude_range_m
+            if not lo <= alt <= hi:
+                return (M_INVALID_PARAM7, f"item {n}: altitude {item.z:g} m ({alt:.0f} m AMSL) "
+                        f"outside {lo:.0f}..{hi:.0f} m AMSL")
+        checks = []
+        if cmd == NAV_WAYPOINT:
+            checks.append((2, "acceptance radius", item.param2, WP_RADIUS_RANGE_M, False))
+        if cmd in (NAV_LOITER_UNLIM, NAV_LOITER_TURNS, NAV_LOITER_TIME):
+            checks.append((3, "loiter radius", item.param3, LOITER_RADIUS_RANGE_M, True))
+        if cmd == NAV_LOITER_TURNS:
+            checks.append((1, "turns", item.param1, (0.0, LOITER_TURNS_MAX), None))
+        if cmd == NAV_LOITER_TIME:
+            checks.append((1, "time [s]", item.param1, (0.0, LOITER_TIME_MAX_S), None))
+        if cmd == DO_CHANGE_SPEED:
+            checks.append((2, "speed [m/s]", item.param2, AIRSPEED_RANGE_M_S, False))
+        for k, label, value, (lo, hi), signed in checks:
+            if signed is None:  # a count or a time: required, within lo..hi
+                ok = math.isfinite(value) and lo <= value <= hi
+            else:  # 0 or NaN (and < 0 for a speed: unchanged) means the default
+                ok = (math.isnan(value) or value == 0.0 or (not signed and value < 0
+                      and cmd == DO_CHANGE_SPEED and math.isfinite(value))
+                      or (math.isfinite(value) and lo <= (abs(value) if signed else value) <= hi))
+            if not ok:
+                return (M_INVALID_PARAM[k], f"item {n}: param{k} {label} {value:g} outside "
+                        f"{'±' if signed else ''}{lo:g}..{hi:g}")
+        return None
+
     def set_mission(self, items: list[MissionItem]) -> str | None:
         for it in items[1:]:
-            bad = check_item(it)
+            bad = self.item_problem(it)
             if bad is not None:
                 return bad[1]
         self.mission = list(items)
@@ -394,7 +507,8 @@ class SitlVehicle:
             self.status(6, "Home reached: loitering")
             self._nav = ("circle", (0.0, 0.0), s.loiter_radius_m, True)
         elif why == "guided":
-            self._nav = ("circle", target, s.loiter_radius_m, True)
+            r, cw = self._guided_loiter
+            self._nav = ("circle", target, r or s.loiter_radius_m, cw)
         elif why == "mission-rtl":
             self._advance_item() if self.mission_seq + 1 < len(self.mission) else None
             self._nav = ("circle", (0.0, 0.0), s.loiter_radius_m, True)

@@ -41,9 +41,11 @@ right). Peers (``udpin``) that stay silent for :data:`PEER_TIMEOUT_S` are droppe
 frees their slot; with signing on, only a peer whose message passed the signature check gets
 a slot (an unsigned RADIO_STATUS is accepted but adds no peer).
 
-MANUAL_CONTROL (and RC_CHANNELS_OVERRIDE) is obeyed from one ground station only: the first
-(system, component) that sends it, until that one is silent for :data:`CONTROLLER_TIMEOUT_S`;
-the vehicle obeys it only in its stick modes (MANUAL, STABILIZE, FBWA).
+MANUAL_CONTROL and RC_CHANNELS_OVERRIDE (:mod:`bioflex_jsb.links.mavlink_sticks`): obeyed
+from one ground station only, the first (system, component) that sends sticks, until that
+one is silent for :data:`CONTROLLER_TIMEOUT_S`, and only in the stick modes (MANUAL,
+STABILIZE, FBWA); override channels one by one (0 / UINT16_MAX as MAVLink defines them);
+refusals are said (STATUSTEXT) and logged.
 
 Signing (``signing_key``, :func:`read_signing_key`): MAVLink 2 message signing with one
 32-byte secret. Everything sent is signed (link id 0, timestamps from the wall clock in
@@ -83,6 +85,7 @@ from bioflex_jsb.links.mavlink_setup import (  # noqa: F401  (the link's set-up 
     read_signing_key,
     signing_time_10us,
 )
+from bioflex_jsb.links.mavlink_sticks import CONTROLLER_TIMEOUT_S, Sticks  # noqa: F401
 from bioflex_jsb.links.mavlink_telemetry import (  # noqa: F401
     CAPABILITIES,
     DEFAULT_RATES_HZ,
@@ -99,7 +102,6 @@ SYSTEM_ID = 1
 COMPONENT_ID = 1
 MAX_PEERS = 4
 PEER_TIMEOUT_S = 5.0  # a udpin peer silent this long [wall s] is dropped
-CONTROLLER_TIMEOUT_S = 3.0  # the stick-controlling station's claim lapses after [wall s]
 MAX_DATAGRAMS = 16  # datagrams read per service call
 MAX_PARSE_BYTES = 4096  # bytes handed to the parser per service call
 MAX_TCP_BACKLOG = 256 * 1024  # unsent bytes to one TCP client before it is dropped
@@ -198,8 +200,7 @@ class MavlinkLink:
         self._peers: list[_Peer] = []
         self._listener: socket.socket | None = None
         self._udp: socket.socket | None = None
-        self._controller: tuple[int, int] | None = None
-        self._controller_seen = 0.0
+        self.sticks = Sticks(self, vehicle)
         self._last_mission_seq: int | None = None
         self.mission = (MissionProtocol(self._mav, self._send, vehicle)
                         if vehicle is not None else None)
@@ -442,10 +443,7 @@ class MavlinkLink:
                 continue
             good += 1
             peer.last_seen = time.monotonic()
-            try:
-                self._handle(msg, state)
-            except (ValueError, TypeError, OverflowError, KeyError, struct.error):
-                self.stats.bad += 1
+            self._handle(msg, state)  # every field's value is checked where it is used
         return good
 
     def _handle_unsigned(self, msg) -> None:
@@ -491,7 +489,7 @@ class MavlinkLink:
                     except ValueError as exc:  # the PARAM_VALUE reports the value in force
                         self._param_error(msg, name.encode()[:16], -1,
                                           M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)
-                        self.statustext(M.MAV_SEVERITY_WARNING, str(exc))
+                        self.commands.refuse(f"PARAM_SET {exc}")
                     self._send_param(self.params.names.index(name))
                 else:
                     self._param_error(msg, name.encode()[:16], -1,
@@ -509,7 +507,7 @@ class MavlinkLink:
                 if msg.base_mode & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
                     reason = self.vehicle.set_mode(int(msg.custom_mode))
                     if reason:
-                        self.statustext(M.MAV_SEVERITY_WARNING, reason)
+                        self.commands.refuse(f"SET_MODE: {reason}")
         elif t == "TIMESYNC":
             if msg.tc1 == 0:  # a request: answer with the vehicle's (simulated) clock [ns]
                 self._send(self._mav.timesync_encode(max(1, int(state.time_s * 1e9)),
@@ -527,30 +525,11 @@ class MavlinkLink:
                 for mid in STREAMS.get(msg.req_stream_id, ()):
                     self.set_rate(mid, hz)
         elif t == "MANUAL_CONTROL":
-            if msg.target in (0, SYSTEM_ID) and self._may_steer(msg):
-                # x: pitch (forward stick = nose down), y: roll; -1000..1000
-                self.vehicle.manual(_clip_unit(msg.x / 1000.0), _clip_unit(msg.y / 1000.0))
+            if msg.target in (0, SYSTEM_ID) and self.vehicle is not None:
+                self.sticks.manual_control(msg)
         elif t == "RC_CHANNELS_OVERRIDE":
-            if self._for_us(msg) and self._may_steer(msg):
-                roll, pitch = msg.chan1_raw, msg.chan2_raw
-                if roll in (0, 65535) or pitch in (0, 65535):
-                    self.vehicle.manual(None, None)  # released: back to the autopilot
-                    self._controller = None
-                else:
-                    self.vehicle.manual(_clip_unit((pitch - 1500) / 500.0),
-                                        _clip_unit((roll - 1500) / 500.0))
-
-    def _may_steer(self, msg) -> bool:
-        """Sticks from the controlling station only (module docstring)."""
-        if self.vehicle is None:
-            return False
-        src, now = (msg.get_srcSystem(), msg.get_srcComponent()), time.monotonic()
-        if self._controller is None or now - self._controller_seen > CONTROLLER_TIMEOUT_S:
-            self._controller = src
-        if src != self._controller:
-            return False
-        self._controller_seen = now
-        return True
+            if self._for_us(msg) and self.vehicle is not None:
+                self.sticks.rc_override(msg)
 
     def _param_error(self, msg, name: bytes, index: int, error: int) -> None:
         self._send(self._mav.param_error_encode(msg.get_srcSystem(), msg.get_srcComponent(),
@@ -612,10 +591,6 @@ def _param_name(raw) -> str:
     if isinstance(raw, bytes):
         raw = raw.decode("ascii", "replace")
     return str(raw).split("\x00", 1)[0]
-
-
-def _clip_unit(x: float) -> float:
-    return max(-1.0, min(1.0, float(x)))
 
 
 # MAVLink constants the simulation side needs without importing pymavlink itself.

@@ -15,7 +15,13 @@ position — uploaded by ground stations, ignored in flight, downloaded as the c
 Validation at upload (the ACK's result): the frames of :data:`FRAMES`, the commands of
 :data:`NAV_COMMANDS` and :data:`DO_COMMANDS`; latitudes within ±90°, longitudes within ±180°;
 anything else is rejected with MAV_MISSION_UNSUPPORTED_FRAME, MAV_MISSION_UNSUPPORTED or
-MAV_MISSION_INVALID_PARAM5_X / PARAM6_Y, naming the item in a STATUSTEXT.
+MAV_MISSION_INVALID_PARAM5_X / PARAM6_Y, naming the item in a STATUSTEXT; the vehicle then
+checks altitudes, radii, turns, times and speeds against its ranges (``item_problem``,
+MAV_MISSION_INVALID_PARAMn naming the field and the range).
+
+Not an upload: an item with ``current`` = 2 is ArduPilot's guided "fly to" (GUIDED to its
+position and altitude), ``current`` = 3 changes the altitude only; either is answered by one
+MISSION_ACK (ACCEPTED, or DENIED with a STATUSTEXT giving the reason).
 """
 
 from __future__ import annotations
@@ -39,6 +45,15 @@ FRAMES = frozenset({
     M.MAV_FRAME_GLOBAL_TERRAIN_ALT_INT, M.MAV_FRAME_MISSION,
 })
 AMSL_FRAMES = frozenset({M.MAV_FRAME_GLOBAL, M.MAV_FRAME_GLOBAL_INT})
+RELATIVE_FRAMES = FRAMES - AMSL_FRAMES - {M.MAV_FRAME_MISSION}
+INVALID_PARAM = {1: M.MAV_MISSION_INVALID_PARAM1, 2: M.MAV_MISSION_INVALID_PARAM2,
+                 3: M.MAV_MISSION_INVALID_PARAM3, 4: M.MAV_MISSION_INVALID_PARAM4}
+INVALID_PARAM7 = M.MAV_MISSION_INVALID_PARAM7
+# MISSION_ITEM(_INT) ``current`` values that are not uploads (ArduPilot's convention, which
+# MAVProxy's ``guided`` uses with guided_use_reposition off): 2 fly there in GUIDED, 3 change
+# the altitude only
+GUIDED_CURRENT = 2
+ALTITUDE_CURRENT = 3
 NAV_WAYPOINT = M.MAV_CMD_NAV_WAYPOINT
 NAV_LOITER_UNLIM = M.MAV_CMD_NAV_LOITER_UNLIM
 NAV_LOITER_TURNS = M.MAV_CMD_NAV_LOITER_TURNS
@@ -101,9 +116,11 @@ def check_item(item: MissionItem) -> tuple[int, str] | None:
 
 
 def item_from_message(msg) -> MissionItem:
-    """A MISSION_ITEM_INT, or a legacy MISSION_ITEM (float degrees), as a MissionItem."""
+    """A MISSION_ITEM_INT, or a legacy MISSION_ITEM (float degrees), as a MissionItem (a
+    legacy latitude/longitude that is not finite, or beyond the int32 range of degE7,
+    becomes a value :func:`check_item` rejects)."""
     if msg.get_type() == "MISSION_ITEM":
-        x, y = int(round(msg.x * 1e7)), int(round(msg.y * 1e7))
+        x, y = (_deg_e7(float(v)) for v in (msg.x, msg.y))
     else:
         x, y = int(msg.x), int(msg.y)
     return MissionItem(int(msg.seq), int(msg.frame), int(msg.command), int(msg.current),
@@ -111,13 +128,22 @@ def item_from_message(msg) -> MissionItem:
                        float(msg.param3), float(msg.param4), x, y, float(msg.z))
 
 
+def _deg_e7(deg: float) -> int:
+    """Degrees as degE7, out-of-range (or NaN) values clamped to beyond ±180° (rejected)."""
+    if not math.isfinite(deg) or abs(deg) > 200.0:
+        return 2_000_000_001 if not deg < 0 else -2_000_000_001
+    return int(round(deg * 1e7))
+
+
 class MissionProtocol:
     """The vehicle's side of the mission protocol, serviced by the link.
 
     ``send(msg)`` sends a message built with ``mav`` (the link's encoder); ``vehicle`` has
     ``mission_items()`` (the stored list), ``set_mission(items)`` (returns None or a
-    one-line reason for rejecting it), ``set_mission_current(seq)`` (None or a reason) and
-    ``status(severity, text)``.
+    one-line reason for rejecting it), ``set_mission_current(seq)`` (None or a reason),
+    ``item_problem(item)`` ((MAV_MISSION_RESULT, reason) or None: the check of each item
+    uploaded), ``guided_item(item)`` (None or a reason: an item with ``current`` 2 or 3,
+    answered by a MISSION_ACK), ``refusals`` (a count) and ``status(severity, text)``.
     """
 
     def __init__(self, mav, send: Callable[[object], None], vehicle) -> None:
@@ -141,6 +167,16 @@ class MissionProtocol:
                 self._up = {"src": src, "n": int(msg.count), "items": [], "tries": 0,
                             "asked": 0.0, "int": True}
                 self._request(0)
+        elif t in ("MISSION_ITEM_INT", "MISSION_ITEM") and msg.current in (GUIDED_CURRENT,
+                                                                          ALTITUDE_CURRENT):
+            if mtype != M.MAV_MISSION_TYPE_MISSION:
+                self._ack(src, M.MAV_MISSION_UNSUPPORTED, mtype)
+                return True
+            reason = self.vehicle.guided_item(item_from_message(msg))
+            if reason is not None:
+                self.refuse(reason)
+            self._ack(src, M.MAV_MISSION_ACCEPTED if reason is None else M.MAV_MISSION_DENIED,
+                      mtype)
         elif t in ("MISSION_ITEM_INT", "MISSION_ITEM"):
             up = self._up
             if up is None or up["src"] != src or mtype != M.MAV_MISSION_TYPE_MISSION:
@@ -151,10 +187,10 @@ class MissionProtocol:
                 return True
             up["int"] = t == "MISSION_ITEM_INT"
             item = item_from_message(msg)
-            bad = None if k == 0 else check_item(item)
+            bad = None if k == 0 else self.vehicle.item_problem(item)
             if bad is not None:
                 self._up = None
-                self.vehicle.status(4, f"Mission rejected: {bad[1]}")
+                self.refuse(f"Mission rejected: {bad[1]}")
                 self._ack(src, bad[0], mtype)
                 return True
             up["items"].append(item)
@@ -184,13 +220,18 @@ class MissionProtocol:
         elif t == "MISSION_SET_CURRENT":
             reason = self.vehicle.set_mission_current(int(msg.seq))
             if reason is not None:
-                self.vehicle.status(4, reason)
+                self.refuse(reason)
         elif t == "MISSION_ACK":
             if self._down == src:
                 self._down = None
         else:
             return False
         return True
+
+    def refuse(self, text: str) -> None:
+        """A refusal: STATUSTEXT WARNING (queued by the vehicle) and an event of the log."""
+        self.vehicle.status(4, text)
+        self.vehicle.refusals += 1
 
     def service(self, now: float | None = None) -> None:
         """Re-request the awaited item of an upload that went quiet; give up after RETRIES."""
@@ -224,7 +265,7 @@ class MissionProtocol:
             self._ack(src, M.MAV_MISSION_ACCEPTED, M.MAV_MISSION_TYPE_MISSION)
             self.vehicle.status(6, f"Mission: {max(0, len(items) - 1)} items received")
         else:
-            self.vehicle.status(4, f"Mission rejected: {reason}")
+            self.refuse(f"Mission rejected: {reason}")
             self._ack(src, M.MAV_MISSION_ERROR, M.MAV_MISSION_TYPE_MISSION)
 
     def _ack(self, src, result: int, mtype: int) -> None:
