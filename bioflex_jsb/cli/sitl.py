@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
 from bioflex_jsb.cli.common import (
@@ -24,6 +23,7 @@ from bioflex_jsb.cli.common import (
 EVENT_LEVEL = {0: "FATAL", 1: "FATAL", 2: "ERROR", 3: "ERROR", 4: "WARNING", 5: "INFO",
                6: "INFO", 7: "DEBUG"}
 EVENT_NAME = "vehicle"  # the events' reporter (foxglove.Log name)
+LOG_MAX_MB_MIN = 0.1  # the smallest --log-max-mb: a file's fixed part (≈ 20 kB) and a chunk
 
 HELP = """Fly the JSBSim airframe with the elastic wing paced to the wall clock (--speedup N:
 N simulated seconds per second) and stream it as a MAVLink 2 vehicle (system 1, component 1,
@@ -102,6 +102,9 @@ def run(args: argparse.Namespace) -> int:
     lo, hi = SPEEDUP_RANGE
     if not lo <= args.speedup <= hi:
         raise UsageError(f"--speedup {args.speedup:g} is outside {lo:g}..{hi:g}")
+    if args.log_max_mb < LOG_MAX_MB_MIN:
+        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is below {LOG_MAX_MB_MIN:g} MB "
+                         "(a file holds its header, one chunk and its summary)")
     try:
         endpoint = parse_endpoint(args.mavlink)
         key = None if args.signing_key is None else read_signing_key(args.signing_key)
@@ -163,7 +166,9 @@ def run(args: argparse.Namespace) -> int:
             log.close()
     summary = {
         "resets": sim.resets,
+        "crashes": sim.crashes,
         "last_reset": sim.last_reset,
+        "refusals": sim.vehicle.refusals,
         "log_files": log.paths if log is not None else [],
         "simulated_s": sim.t_s,
         "steps": sim.k,
@@ -213,6 +218,16 @@ class SplitLog:
     run description records the reason (``extra.after_reset``). Chunks are written when the
     loop has slack (``idle``).
 
+    The size limit holds whether or not the loop has slack: before each step the file's
+    size if it were closed after that step is bounded from above (:meth:`RunLog.size_bound`:
+    what is written, the chunk in progress and the step uncompressed, their indexes, the
+    summary); when the bound passes ``max_mb`` the chunk in progress is written (its size
+    then exact) and, if the bound still passes it, the file is closed first. A file
+    therefore never exceeds the limit and ends below it by at most about one step and one
+    chunk's overhead, a few kB (docs/sitl.md gives the measured figures); near the limit a
+    few small chunks are written (the gap halves at each, ≈ log2(gap / step) of them). A file
+    holds at least one step.
+
     Every STATUSTEXT of the vehicle (``status``, its ``on_status`` hook) is an event
     (``RunLog.event``, level :data:`EVENT_LEVEL`) at its simulated time, written after the
     sample of the step it happened in (so a crash follows the last step flown); a reset
@@ -230,6 +245,7 @@ class SplitLog:
         self.max_bytes = int(max_mb * 1e6)
         self.paths: list[str] = []
         self._pending = 0
+        self._steps = 0  # steps in the file being written
         self._events: list[tuple[float, int, str]] = []  # (t_s, MAV_SEVERITY, text)
         self._reset: tuple[str, tuple[float, int, str] | None] | None = None
         self._log = self._next(None)
@@ -259,10 +275,21 @@ class SplitLog:
         return on_sample
 
     def sample(self, model, t, row) -> None:
+        if self._steps and self._bound() > self.max_bytes:
+            self._log.flush()  # the chunk in progress written: its size is now exact
+            self._pending = 0
+            if self._bound() > self.max_bytes:
+                self._roll(None)  # this step could take the file past max_bytes
         self._log.sample(model, t, row)
+        self._steps += 1
         self._pending += 1
         if self._events or self._reset is not None:
             self._write_events()
+
+    def _bound(self) -> int:
+        """The file's size bound after this step and the events waiting for it (a
+        ``foxglove.Log`` message: its text and < 128 bytes of fields and record)."""
+        return self._log.size_bound(1) + sum(128 + 4 * len(e[2]) for e in self._events)
 
     def status(self, t_s: float, severity: int, text: str) -> None:
         """A STATUSTEXT at ``t_s`` [s]: logged after the sample of the step in progress."""
@@ -288,13 +315,11 @@ class SplitLog:
         if log_flush_due(self._pending, slack_s):
             self._log.flush()
             self._pending = 0
-            if os.path.getsize(self.paths[-1]) >= self.max_bytes:
-                self._roll(None)
 
     def _roll(self, reason: str | None) -> None:
         self._log.close()
         self._log = self._next(reason)
-        self._pending = 0
+        self._pending = self._steps = 0
 
     def reset(self, reason: str) -> None:
         """The aircraft was reset (``reason``): a new file once the step's sample is in."""

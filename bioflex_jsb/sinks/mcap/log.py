@@ -75,6 +75,10 @@ class RunLog:
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
+        # the most bytes one step's messages took once formatted (size_bound's estimate of
+        # the steps kept but not formatted yet; before any is formatted: 4 kB, a step of
+        # ~0.6 kB with a wide margin)
+        self._row_bytes, self._row_bytes_measured = 4096, False
         self.closed = False
 
     @classmethod
@@ -178,10 +182,20 @@ class RunLog:
             self._set_origin(first[ch.i_lat], first[ch.i_lon], first[ch.i_alt])
         v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(ch.names))
         block, index = ch.format(ts[:n], v.reshape(n, len(ch.names)), ch.seq, self._origin)
+        if not self._row_bytes_measured or len(block) > n * self._row_bytes:
+            self._row_bytes = -(-len(block) // n)  # the first measure, then the largest
+            self._row_bytes_measured = True
         ch.seq += n
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
+
+    def size_bound(self, more_steps: int = 0) -> int:
+        """An upper bound [bytes] of this file's size if it were closed now after
+        ``more_steps`` more steps (:meth:`McapFileWriter.size_bound`; the steps kept and
+        the ones to come at the most bytes a step has taken, ``_row_bytes``). For a log of
+        :meth:`sample` steps (and events); autopilot frames are not counted."""
+        return self._writer.size_bound((len(self._rows) + more_steps) * self._row_bytes)
 
     def event(self, t_s: float, level: int | str, text: str, name: str = "bioflex-jsb") -> None:
         """An event at the log time ``t_s`` [s]: a ``foxglove.Log`` message on

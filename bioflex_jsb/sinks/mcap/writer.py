@@ -43,6 +43,16 @@ ZSTD_LEVEL = -3  # zstd's fast level: see McapFileWriter
 _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 0x03, 0x04, 0x05, 0x06
 _OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
 _MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
+# Upper bounds for McapFileWriter.size_bound [bytes]: a Message record is ≥ 31 bytes (its
+# header) and costs 16 bytes in its Message Index; a Message Index record has 15 bytes of its
+# own per channel; zstd's output is at most n + n/256 + 64 (ZSTD_compressBound, for
+# n ≥ 128 kB; less below); a Chunk record's header with "zstd" is 53 bytes; a Chunk Index
+# record is 77 bytes + 10 per channel + the compression name; DataEnd 13, the footer with
+# the magic 37, a Statistics record 58 + 10 per channel, a Metadata Index 25 + its name,
+# one Summary Offset 26 (five groups at most).
+_MSG_MIN_BYTES, _INDEX_ENTRY_BYTES, _INDEX_PER_CHANNEL = 31, 16, 15
+_CHUNK_HEADER_BYTES, _CHUNK_INDEX_BYTES, _PER_CHANNEL_BYTES = 53, 81, 10
+_FINISH_FIXED_BYTES = 13 + 37 + 58 + 5 * 26
 
 
 @contextmanager
@@ -97,6 +107,7 @@ class McapFileWriter:
                 ZSTD_LEVEL, window_log=17, hash_log=11, min_match=7)).compress
         self._crc = 0
         self._offset = 0
+        self._records_bytes = 0  # schema and channel records: repeated in the summary
         self._schemas: list[Schema] = []
         self._channels: list[Channel] = []
         self._chunk_indexes: list[ChunkIndex] = []
@@ -147,7 +158,9 @@ class McapFileWriter:
         """A Schema record (``encoding``: ``protobuf``, ``jsonschema``, …); its id."""
         schema = Schema(id=len(self._schemas) + 1, name=name, encoding=encoding, data=data)
         self._schemas.append(schema)
-        self._write(_record_bytes(schema))
+        record = _record_bytes(schema)
+        self._records_bytes += len(record)
+        self._write(record)
         return schema.id
 
     def add_channel(self, topic_name: str, schema_id: int, metadata: dict[str, str],
@@ -159,7 +172,9 @@ class McapFileWriter:
         self._index[channel.id] = []
         self._blocks[channel.id] = []
         self._counts[channel.id] = 0
-        self._write(_record_bytes(channel))
+        record = _record_bytes(channel)
+        self._records_bytes += len(record)
+        self._write(record)
         return channel.id
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
@@ -192,6 +207,24 @@ class McapFileWriter:
 
     def chunk_bytes(self) -> int:
         return self._size
+
+    def size_bound(self, more_bytes: int = 0) -> int:
+        """An upper bound [bytes] of the file's size if the chunk in progress, with
+        ``more_bytes`` more of message records, were closed and the file finished now (the
+        bounds of the constants above): what has been written, the chunk compressed (no
+        smaller than it is), its message indexes and its chunk index, and the summary."""
+        n = self._size + more_bytes
+        channels = len(self._channels)
+        per_index = _CHUNK_INDEX_BYTES + _PER_CHANNEL_BYTES * channels
+        chunk = 0
+        if n:
+            chunk = (_CHUNK_HEADER_BYTES + n + n // 256 + 64
+                     + (n // _MSG_MIN_BYTES) * _INDEX_ENTRY_BYTES
+                     + _INDEX_PER_CHANNEL * channels + per_index)
+        summary = (self._records_bytes + _FINISH_FIXED_BYTES + _PER_CHANNEL_BYTES * channels
+                   + per_index * len(self._chunk_indexes)
+                   + sum(25 + len(m.name) for m in self._metadata_indexes))
+        return self._offset + chunk + summary
 
     def close_chunk(self) -> None:
         """Compress and write the chunk in progress with its message indexes; flush."""
