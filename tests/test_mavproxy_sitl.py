@@ -110,64 +110,151 @@ WAYPOINTS = """QGC WPL 110
 """
 
 
-def test_mavproxy_names_and_sets_modes_uploads_a_mission_and_sees_no_loss(tmp_path):
-    """MAVProxy driven through its console (stdin): mode names from the HEARTBEAT, mode
-    changes, a mission upload and download, and its own link report: < 1 % loss."""
-    port_probe = __import__("socket").socket(2, 2)
-    port_probe.bind(("127.0.0.1", 0))
-    port = port_probe.getsockname()[1]
-    port_probe.close()
-    vehicle = subprocess.Popen(
-        [sys.executable, "-m", "bioflex_jsb", "sitl", "--mavlink", f"udpin:127.0.0.1:{port}",
-         "--speedup", "2", "--no-log", "--duration", "400"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    (tmp_path / "wp.txt").write_text(WAYPOINTS)
-    env = {**os.environ, "HOME": str(tmp_path)}
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "MAVProxy.mavproxy", f"--master=udpout:127.0.0.1:{port}",
-         f"--state-basedir={tmp_path}", "--aircraft=bioflex", "--dialect=common"],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-        env=env, cwd=tmp_path)
-    lines: list[str] = []
-    reader = threading.Thread(target=lambda: lines.extend(x.rstrip() for x in proc.stdout),
-                              daemon=True)
-    reader.start()
+class Console:
+    """A vehicle (``bioflex-jsb sitl`` on a free loopback udpin port, ``args`` more) and
+    MAVProxy driven through its console (stdin), its output lines collected."""
 
-    def wait(pattern: str, timeout: float = TIMEOUT_S) -> re.Match:
+    def __init__(self, tmp_path, *args: str) -> None:
+        probe = __import__("socket").socket(2, 2)
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+        probe.close()
+        self.vehicle = subprocess.Popen(
+            [sys.executable, "-m", "bioflex_jsb", "sitl", "--mavlink",
+             f"udpin:127.0.0.1:{port}", "--speedup", "2", "--duration", "400", *args],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        env = {**os.environ, "HOME": str(tmp_path)}
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "MAVProxy.mavproxy", f"--master=udpout:127.0.0.1:{port}",
+             f"--state-basedir={tmp_path}", "--aircraft=bioflex", "--dialect=common"],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            text=True, env=env, cwd=tmp_path)
+        self.lines: list[str] = []
+        threading.Thread(target=lambda: self.lines.extend(x.rstrip() for x in self.proc.stdout),
+                         daemon=True).start()
+
+    def wait(self, pattern: str, timeout: float = TIMEOUT_S) -> re.Match:
+        """The first output line matching ``pattern``; fails if the vehicle ended."""
         end = time.monotonic() + timeout
         while time.monotonic() < end:
-            for x in list(lines):
+            assert self.vehicle.poll() is None, ("the vehicle ended:\n"
+                                                 + self.vehicle.stderr.read())
+            for x in list(self.lines):
                 if (m := re.search(pattern, x)) is not None:
                     return m
             time.sleep(0.1)
-        raise AssertionError(f"MAVProxy never printed {pattern!r}:\n" + "\n".join(lines))
+        raise AssertionError(f"MAVProxy never printed {pattern!r}:\n" + "\n".join(self.lines))
 
-    def cmd(text: str) -> None:
-        proc.stdin.write(text + "\n")
-        proc.stdin.flush()
+    def cmd(self, text: str) -> None:
+        self.proc.stdin.write(text + "\n")
+        self.proc.stdin.flush()
 
+    def stop(self) -> tuple[int, str]:
+        """Stop MAVProxy, then the vehicle (SIGTERM); the vehicle's status and stderr."""
+        for p in (self.proc, self.vehicle):
+            if p.poll() is None:
+                p.terminate()
+        try:
+            self.proc.wait(5.0)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+        try:
+            _, err = self.vehicle.communicate(timeout=30.0)
+        except subprocess.TimeoutExpired:
+            self.vehicle.kill()
+            _, err = self.vehicle.communicate()
+        return self.vehicle.returncode, err
+
+
+def test_mavproxy_names_and_sets_modes_uploads_a_mission_and_sees_no_loss(tmp_path):
+    """MAVProxy driven through its console (stdin): mode names from the HEARTBEAT, mode
+    changes, a mission upload and download, and its own link report: < 1 % loss."""
+    (tmp_path / "wp.txt").write_text(WAYPOINTS)
+    c = Console(tmp_path, "--no-log")
+    try:
+        c.wait(r"Detected vehicle 1:1")
+        c.wait(r"Mode CRUISE")
+        c.cmd("mode LOITER")
+        c.wait(r"AP: Mode LOITER")
+        c.cmd("wp load wp.txt")
+        c.wait(r"MISSION_ACK: TYPE_MISSION: ACCEPTED")
+        c.cmd("wp list")
+        c.wait(r"Saved 4 waypoints")
+        c.cmd("mode AUTO")
+        c.wait(r"AP: Mode AUTO")
+        c.wait(r"AP: Reached waypoint #1", 60.0)
+        c.lines.clear()
+        c.cmd("link")
+        m = c.wait(r"link 1 OK \((\d+) packets.*?(\d+) lost, ([\d.]+)% loss")
+    finally:
+        c.stop()
+    packets, lost, loss_pct = int(m.group(1)), int(m.group(2)), float(m.group(3))
+    assert packets > 1000 and loss_pct < 1.0, (packets, lost, loss_pct)
+
+
+BAD_WAYPOINTS = """QGC WPL 110
+0\t1\t0\t16\t0\t0\t0\t0\t-35.363261\t149.165230\t584.000000\t1
+1\t0\t3\t16\t0\t30\t0\t0\t-35.360563\t149.165230\t1000000000.000000\t1
+"""
+
+
+def test_mavproxy_guided_wp_param_set_and_rc_never_end_the_vehicle(tmp_path):
+    """A MAVProxy session that uses ``guided`` (COMMAND_INT DO_REPOSITION, MAVProxy
+    1.8.75's default, and the MISSION_ITEM_INT current = 2 it sends with
+    guided_use_reposition off), ``wp`` with an out-of-range altitude, ``param set`` out of
+    range and ``rc`` overrides: the vehicle flies on, says each refusal, and logs them."""
+    log = tmp_path / "session.mcap"
+    (tmp_path / "bad.txt").write_text(BAD_WAYPOINTS)
+    c = Console(tmp_path, "--out", str(log))
+    wait, cmd = c.wait, c.cmd
     try:
         wait(r"Detected vehicle 1:1")
         wait(r"Mode CRUISE")
+        cmd("mode GUIDED")
+        wait(r"AP: Mode GUIDED")
+        cmd("guided -35.3600 149.1660 120")  # COMMAND_INT DO_REPOSITION, relative frame
+        wait(r"Got COMMAND_ACK: DO_REPOSITION: ACCEPTED")
+        cmd("guided -35.3600 149.1660 100000000")
+        wait(r"Got COMMAND_ACK: DO_REPOSITION: DENIED")
+        wait(r"AP: DO_REPOSITION: z altitude 1e\+08 m")
+        cmd("guided 1000 149.1660 120")  # latitude 1000°: MAVProxy itself cannot pack it
+        cmd("set guided_use_reposition 0")
+        cmd("guided -35.3620 149.1640 150")  # MISSION_ITEM_INT with current = 2
+        wait(r"MISSION_ACK: TYPE_MISSION: ACCEPTED")
+        cmd("wp load bad.txt")
+        wait(r"AP: Mission rejected: item 1: altitude 1e\+09 m")
+        wait(rf"Saved {len(SitlParameters.names)} parameters", 90.0)  # before param set
+        cmd("param set AIRSPEED_MS 99")
+        wait(r"AP: PARAM_SET AIRSPEED_MS must be in 12\.\.22 m/s")
+        cmd("param set AP_ALT_M 1e9")
+        wait(r"AP: PARAM_SET AP_ALT_M")
+        cmd("param set WP_RADIUS_M -5")
+        wait(r"AP: PARAM_SET WP_RADIUS_M must be in 5\.\.500 m")
+        cmd("rc 1 1800")  # in GUIDED: said, not obeyed
+        wait(r"AP: Sticks ignored in GUIDED")
+        cmd("mode FBWA")
+        wait(r"AP: Mode FBWA")
+        cmd("rc 1 1800")  # channel 1 alone (the others 0): rolls right
+        cmd("rc 2 4000")
+        wait(r"AP: RC override channel 2: 4000 us outside 800\.\.2200")
+        cmd("rc 3 1600")
+        wait(r"AP: RC override channel 3: not used")
+        cmd("rc all 0")
         cmd("mode LOITER")
         wait(r"AP: Mode LOITER")
-        cmd("wp load wp.txt")
-        wait(r"MISSION_ACK: TYPE_MISSION: ACCEPTED")
-        cmd("wp list")
-        wait(r"Saved 4 waypoints")
-        cmd("mode AUTO")
-        wait(r"AP: Mode AUTO")
-        wait(r"AP: Reached waypoint #1", 60.0)
-        lines.clear()
-        cmd("link")
-        m = wait(r"link 1 OK \((\d+) packets.*?(\d+) lost, ([\d.]+)% loss")
+        c.lines.clear()
+        cmd("status GLOBAL_POSITION_INT")
+        wait(r"GLOBAL_POSITION_INT")
+        assert c.vehicle.poll() is None
     finally:
-        for p in (proc, vehicle):
-            p.terminate()
-            try:
-                p.wait(5.0)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
-    packets, lost, loss_pct = int(m.group(1)), int(m.group(2)), float(m.group(3))
-    assert packets > 1000 and loss_pct < 1.0, (packets, lost, loss_pct)
+        status, err = c.stop()  # SIGTERM: exit 130, the log finished
+    assert status == 130, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 2, err  # start + stop
+    from bioflex_jsb.sinks.mcap.reader import summarise
+
+    events = [e["text"] for e in summarise(log)["events"]]
+    for start in ("DO_REPOSITION: z altitude", "Mission rejected: item 1",
+                  "PARAM_SET AIRSPEED_MS", "Sticks ignored in GUIDED",
+                  "RC override channel 2"):
+        assert any(t.startswith(start) for t in events), (start, events)
