@@ -15,12 +15,25 @@ import pytest
 
 from bioflex_jsb.drivers.native import native_airframe, repository_files
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.generators import native_aircraft as NA
 from bioflex_jsb.generators import native_wing as J
+from bioflex_jsb.generators.xml_writer import number_difference
+from tests.golden_cases import BUILT_WING_RTOL_OF_RANGE, channel_error
 
 REPO = Path(__file__).resolve().parents[1]
 DOCS = REPO / "docs" / "native.md"
 # A console run takes well under a second; this only stops a hung one.
 CONSOLE_TIMEOUT_S = 120
+# The repository's native files against the exporter's output on this processor, by value
+# (docs/validation.md, "Platform spread and golden tolerances"): the numbers derived from the
+# wing's modes move with the beam eigen-solution's platform noise, at most 3.7e-5 of a
+# number measured (scripts/platform_spread.py: OpenBLAS SandyBridge kernels, omega_1 moved
+# by 7.8e-7; the largest is an inverse 1/c of a small coupling in the elastic-backward
+# system; the trim-derived numbers of the initial condition and script did not move on any
+# configuration). The first-order bound of the frequency noise (omega_1 off by 5.9e-6 between
+# two platforms) gives 2.8e-4; 3e-4 holds it and is 3.3 times below what a 0.1 % change of
+# one Table B1 derivative does to the numbers it enters (1e-3: a stale file is still seen).
+NATIVE_FILE_RTOL = 3e-4
 
 
 def _exe(name: str) -> str:
@@ -64,11 +77,52 @@ CAPTIONS = ["Time", "vt [ft/s]", "u [ft/s]", "w [ft/s]", "q [rad/s]", "theta [ra
             "eta3 [rad]", "active [-]"]
 
 
+def _stale(files: dict[str, str], root: Path = REPO) -> dict[str, float | None]:
+    """The files of ``files`` (path → text) that ``root`` does not hold to within
+    NATIVE_FILE_RTOL: path → the largest relative change of a number (None: other text
+    between the numbers, or no such file)."""
+    out = {}
+    for rel, text in files.items():
+        path = root / rel
+        diff = number_difference(path.read_text(encoding="utf-8"), text) if path.is_file() else None
+        if diff is None or diff > NATIVE_FILE_RTOL:
+            out[rel] = diff
+    return out
+
+
 def test_repository_files_are_up_to_date():
-    """systems/, aircraft/bioflex_<variant>/ and the Fig. 21 script are the exporter's output."""
-    stale = [rel for rel, text in repository_files().items()
-             if not (REPO / rel).is_file() or (REPO / rel).read_text(encoding="utf-8") != text]
+    """systems/, aircraft/bioflex_<variant>/ and the Fig. 21 script are the exporter's output,
+    by value (NATIVE_FILE_RTOL)."""
+    stale = _stale(repository_files())
     assert not stale, f"regenerate with python -m bioflex_jsb.drivers.native: {stale}"
+
+
+def test_files_are_compared_by_the_numbers_and_the_text_between_them():
+    assert number_difference('<v a="2">1.5e-3</v>', '<v a="2">1.5000003e-3</v>') == (
+        pytest.approx(2e-7))
+    assert number_difference("<v>0</v>", "<v>0</v>") == 0.0
+    assert number_difference("<v>0</v>", "<v>1e-30</v>") == float("inf")
+    assert number_difference("<v>1</v>", "<w>1</w>") is None  # another structure
+    assert number_difference("<v>1</v>", "<v>1 2</v>") is None  # another count of numbers
+
+
+@pytest.mark.parametrize("key", ["C_eta1^Q1", "C_L_eta1", "C_etadot1^Q3"])
+def test_a_file_of_a_0_1_percent_different_wing_is_stale(key):
+    """The value comparison still sees a physics change: 0.1 % on one Table B1 derivative
+    changes the numbers it enters by 1e-3 (measured 9.93e-4 to 1.0e-3: 3.3 times
+    NATIVE_FILE_RTOL)."""
+    import dataclasses
+
+    from bioflex_jsb.flight_dynamics.modal_coefficients import parse_override_key
+
+    wing = build_wing(VARIANTS["optimised"]).model
+    attr, index = parse_override_key(key, wing.n_modes)
+    value = float(np.asarray(getattr(wing.coefficients, attr))[index])
+    changed = dataclasses.replace(
+        wing, coefficients=wing.coefficients.with_overrides({key: 1.001 * value}))
+    files = NA.render_aircraft_files(J.ExportSpec(changed, "optimised"), include_shared=False)
+    stale = _stale(files)
+    assert stale and all(v is not None and v > 3 * NATIVE_FILE_RTOL for v in stale.values()), stale
 
 
 def _spec(variant, **kw):
@@ -158,17 +212,22 @@ def test_native_xml_matches_the_cosimulation(variant, amplitude):
     assert nrmse(ref.channels["q"], flat.channels["q"]) > 0.05
 
 
-def test_published_modal_state_is_the_state_at_the_current_time():
+def test_published_modal_state_is_the_state_at_the_current_time(tmp_path):
     """``bioflex/modal/eta<i>`` (functions evaluated when read) are Φ_h⁻¹ of the stored
     half-step state, and the loads in the aerodynamics are those of the stored state."""
     from bioflex_jsb.runtime.fdm import Airframe
 
-    af = Airframe(root=REPO, aircraft=J.aircraft_name("optimised"))
+    # the aircraft exported here from the wing built here, so that the XML's coefficients and
+    # the spec below come from the same eigen-solution (the repository's files hold the
+    # recording machine's, within NATIVE_FILE_RTOL of this one's: issue 22)
+    spec = _spec("optimised")
+    root = tmp_path / "root"
+    NA.export(spec, root)
+    af = Airframe(root=root, aircraft=J.aircraft_name("optimised"))
     af.set_dt(J.DEFAULT_DT_S)
     af.trim(15.0)
     af["atmosphere/wind-down-fps"] = -3.0
     af.run(40)
-    spec = _spec("optimised")
     nums = J.modal_matrices(spec.wing, spec.cl_trim)
     co = spec.leapfrog(nums)
     for i in range(3):
@@ -257,12 +316,17 @@ def test_documented_export_flies_in_the_console_program(tmp_path, fig21_console_
     assert "bioflex: stopped" not in proc.stdout
     col = _read_csv(root / "bioflex_optimised.csv")
     assert list(col) == CAPTIONS
-    assert col["Time"].shape == fig21_console_csv["Time"].shape
-    for name in CAPTIONS:
-        np.testing.assert_array_equal(col[name], fig21_console_csv[name], err_msg=name)
-    # and the exported aircraft is the repository's
-    rel = "aircraft/bioflex_optimised/bioflex_optimised.xml"
-    assert (root / rel).read_text(encoding="utf-8") == (REPO / rel).read_text(encoding="utf-8")
+    np.testing.assert_array_equal(col["Time"], fig21_console_csv["Time"])
+    # row for row within the golden cases' tolerance for a wing built on another processor
+    # (the export is this machine's wing, the repository's files the recording machine's)
+    errors = {name: channel_error(name, fig21_console_csv[name], col[name])
+              for name in CAPTIONS[1:]}
+    assert max(errors.values()) <= BUILT_WING_RTOL_OF_RANGE, errors
+    # and the exported aircraft and system are the repository's, by value
+    rels = ["aircraft/bioflex_optimised/bioflex_optimised.xml",
+            "systems/bioflex_modal_optimised.xml"]
+    stale = _stale({rel: (root / rel).read_text(encoding="utf-8") for rel in rels})
+    assert not stale, stale
 
 
 def test_the_command_of_the_help_flies_the_export(tmp_path, capsys):
