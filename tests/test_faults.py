@@ -77,6 +77,11 @@ def one_line(err: str) -> str:
     return lines[0]
 
 
+def visible(out: Path) -> list[str]:
+    """What a dataset reader sees of a .parquet output (it skips names starting with '.')."""
+    return sorted(p.name for p in out.iterdir() if not p.name.startswith((".", "_")))
+
+
 def comparable(rows):
     return [{k: v for k, v in r.items() if k not in RUN_INFO_COLUMNS} for r in rows]
 
@@ -361,7 +366,7 @@ def test_full_log_tmpfs_stops_the_sweep_exit_4_and_resume_completes_it(
     r = bioflex("sweep", short, "--out", out, "--workers", 2, "--logs", fs.path, "--resume")
     assert r.returncode == 0, r.stderr
     assert comparable(read_results(out)) == reference
-    assert len(list(out.glob("part-*.parquet"))) == 1
+    assert visible(out) == ["results.parquet"] and not list(out.rglob("part-*"))
 
 
 def test_full_results_disk_keeps_whole_rows_exit_4(tmp_path, tmpfs):
@@ -459,15 +464,15 @@ def test_damaged_parquet_part_is_set_aside_and_its_case_run_again(short, tmp_pat
     store = open_store(out, campaign.columns(), resume=False)
     with LocalExecutor(2) as ex:
         run_sweep(campaign.cases(), store, ex)  # not closed: one part per case
-    parts = sorted(out.glob("part-*.parquet"))
-    assert len(parts) == 6
+    parts = sorted((out / ".parts").glob("part-*.parquet"))
+    assert len(parts) == 6 and visible(out) == []  # unmerged: nothing visible yet
     victim = parts[2]
     victim.write_bytes(victim.read_bytes()[: victim.stat().st_size // 2])  # half a file
     assert sweep([short, "--out", out, "--resume", "--json"], monkeypatch) == 0
     captured = capsys.readouterr()
     assert "damaged" in one_line(captured.err)
     assert json.loads(captured.out)["run"] == 1
-    assert (out / f".damaged-{victim.name}").is_file()
+    assert (victim.parent / f".damaged-{victim.name}").is_file()
     assert comparable(read_results(out)) == reference
 
 
@@ -483,10 +488,10 @@ def test_parquet_part_written_atomically_on_a_full_disk(short, tmp_path, tmpfs):
         for _ in range(50):
             store.append(row)
     assert exc.value.errno == errno.ENOSPC
-    assert not list(out.glob(".*.tmp"))  # no temporary left behind
+    assert not list(out.rglob(".*.tmp"))  # no temporary left behind
     import pyarrow.parquet as pq
 
-    for part in out.glob("part-*.parquet"):
+    for part in out.rglob("part-*.parquet"):
         pq.read_table(part)  # every part that exists is whole
 
 
@@ -769,7 +774,7 @@ def test_signal_while_a_sweep_compacts_its_table_defers_until_it_is_whole(short,
     r = harness(tmp_path, patch, "sweep", short, "--out", out, "--workers", 2)
     assert r.returncode == 130, r.stderr
     assert "closing its files" in one_line(r.stderr)
-    assert len(list(out.glob("part-*.parquet"))) == 1 and len(read_results(out)) == 6
+    assert visible(out) == ["results.parquet"] and len(read_results(out)) == 6
 
 
 def test_a_third_signal_while_closing_ends_at_once(tmp_path):
@@ -888,3 +893,95 @@ def test_a_damaged_kernel_cache_is_discarded_recompiled_and_said_once(
     assert r.stdout.strip() == "2"  # cached anew: an index and a code file
     again = _kernel(cache)  # healed: loaded from the new cache, nothing said
     assert again.returncode == 0 and again.stderr.strip() == "", again.stderr
+
+
+# ---------------------------------------------------------------------------------------
+# The Parquet merge is atomic: one visible result at every instant, whatever kills it
+# ---------------------------------------------------------------------------------------
+MERGE = """
+import os, signal, sys
+from bioflex_jsb.sweep import store
+from bioflex_jsb.sweep.campaign import load_campaign
+out, step, first, n = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+columns = load_campaign(sys.argv[5]).columns()
+s = store.open_store(out, columns, resume=True)
+for i in range(first, first + n):
+    s.append({"case_id": f"case{i:02d}", "case_index": i, "status": "ok"})
+def kill(reached):
+    if reached == step:
+        os.kill(os.getpid(), signal.SIGKILL)
+store.merge_checkpoint = kill
+s.close()
+"""
+MERGE_STEPS = ["read", "written", "renamed", "part deleted", "merged"]
+
+
+def _merge(out: Path, step: str, first: int, n: int, campaign: Path):
+    return subprocess.run([PY, "-c", MERGE, str(out), step, str(first), str(n), str(campaign)],
+                          capture_output=True, text=True, timeout=120, env=env())
+
+
+def _dataset_ids(out: Path) -> list[str]:
+    """The case ids an independent reader (pyarrow.dataset) sees in the output."""
+    import pyarrow.dataset as ds
+
+    return sorted(ds.dataset(out, format="parquet").to_table(columns=["case_id"])
+                  .column("case_id").to_pylist()) if visible(out) else []
+
+
+@pytest.mark.parametrize("step", MERGE_STEPS)
+def test_a_kill_at_any_step_of_the_merge_leaves_one_visible_result(short, tmp_path, step):
+    """A result of 3 cases, then 3 more cases merged and the process SIGKILLed at ``step``:
+    a dataset reader sees the old 3 rows or the new 6, each once, never both (before: 120
+    rows for 60 cases after a kill between the merged file and the parts' removal); resume
+    then merges to the 6."""
+    out = tmp_path / "r.parquet"
+    r = _merge(out, "none", 0, 3, short)  # the first session: merged, 3 rows
+    assert r.returncode == 0, r.stderr
+    old = [f"case{i:02d}" for i in range(3)]
+    assert _dataset_ids(out) == old
+    r = _merge(out, step, 3, 3, short)
+    assert r.returncode == -signal.SIGKILL, r.stderr
+    new = [f"case{i:02d}" for i in range(6)]
+    seen = _dataset_ids(out)
+    assert seen in (old, new), seen
+    assert visible(out) == ["results.parquet"]
+    assert [x["case_id"] for x in read_results(out)] == new  # our reader: every row, once
+    s = open_store(out, load_campaign(short).columns(), resume=True)
+    assert sorted(s.done_ids) == new
+    s.close()
+    assert _dataset_ids(out) == new and not list(out.rglob("part-*.parquet"))
+    assert not list(out.rglob(".*.tmp"))
+
+
+def test_sigkill_during_a_sweep_merge_then_resume(short, tmp_path):
+    """The whole command: a sweep killed right after its merged result replaced the old one
+    (the parts not yet deleted) shows 6 rows for 6 cases; --resume runs nothing again."""
+    patch = """
+    from bioflex_jsb.sweep import store as _store
+    def _kill(step):
+        if step == "renamed":
+            os.kill(os.getpid(), signal.SIGKILL)
+    _store.merge_checkpoint = _kill
+    """
+    out = tmp_path / "r.parquet"
+    r = harness(tmp_path, patch, "sweep", short, "--out", out, "--workers", 2)
+    assert r.returncode == -signal.SIGKILL, r.stderr
+    assert len(_dataset_ids(out)) == 6 == len(set(_dataset_ids(out)))
+    r = bioflex("sweep", short, "--out", out, "--workers", 2, "--resume", "--json")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["run"] == 0
+    assert len(_dataset_ids(out)) == 6 and not list(out.rglob("part-*.parquet"))
+
+
+@pytest.mark.parametrize("name", ["../../../x", "a/b", "..", ".hidden", "a\\b", "x\ny"])
+def test_a_campaign_name_that_is_not_a_plain_file_name_is_refused(tmp_path, name):
+    work = tmp_path / "deep" / "er"
+    work.mkdir(parents=True)
+    camp = work / "c.toml"
+    camp.write_text(SHORT.replace('name = "short"', f"name = {json.dumps(name)}"))
+    r = bioflex("sweep", camp, "--workers", 1, cwd=work)
+    assert r.returncode == 2, r.stderr
+    line = one_line(r.stderr)
+    assert "name" in line and "plain file name" in line
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["c.toml", "deep", "er"]

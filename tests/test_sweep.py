@@ -228,7 +228,9 @@ def test_resume_runs_only_the_missing_cases(small, tmp_path, monkeypatch, capsys
     assert sweep([small, "--out", out, "--resume", "--json"], monkeypatch) == 0
     assert '"run": 0' in capsys.readouterr().out
     if suffix == ".parquet":
-        assert len(list(out.glob("part-*.parquet"))) == 1  # compacted
+        assert [p.name for p in out.iterdir() if not p.name.startswith(".")] == [
+            "results.parquet"]  # merged: one visible file
+        assert not list(out.rglob("part-*.parquet"))
 
 
 def test_csv_row_cut_off_by_a_kill_is_dropped_on_resume(small, tmp_path):

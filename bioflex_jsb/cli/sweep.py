@@ -18,8 +18,9 @@ from bioflex_jsb.cli.common import (
 HELP = """Run every case of a campaign file (wings or axis positions x speeds [m/s] x gusts x
 turbulence seeds x models; docs/sweeps.md) and write one row per case with every input and
 the asked metrics (gust-run peaks in SI: m/s, rad, rad/s, load factor; flutter speed [m/s];
-LTI eigenvalues [rad/s]). Rows are written as cases finish, to --out (.parquet: a directory
-of part files compacted at the end; .csv: appended). A case that fails or diverges is
+LTI eigenvalues [rad/s]). Rows are written as cases finish, to --out (.parquet: a dataset
+directory whose one file results.parquet is merged at the end from hidden per-case parts;
+.csv: appended). A case that fails or diverges is
 recorded with its error; a worker process that dies has its case retried once. A case the
 machine could not run or record (no space for its log, an unwritable --logs directory, a
 lost Dask scheduler or workers, the results table itself unwritable) is not recorded: the
@@ -178,8 +179,8 @@ def _run_locked(args, campaign, out: Path) -> int:
         try:
             store.close()
         except OSError as exc:  # compaction failed (disk full): every part is still there
-            compacted = (f"--out {str(out)!r}: cannot compact the parts ({exc.strerror}); "
-                         "every row is kept in them: rerun with --resume to compact")
+            compacted = (f"--out {str(out)!r}: cannot merge the parts ({exc.strerror}); "
+                         "every row is kept in them: rerun with --resume to merge")
     if summary.stopped is None and compacted is not None:
         summary.stopped = compacted
     result = {"campaign": campaign.name, "out": str(out),

@@ -416,6 +416,24 @@ def _unique(values: list, key: str) -> list:
     return list(values)
 
 
+# The default --out "<name>.parquet" within the usual 255-byte file-name limit (ASCII names;
+# a longer UTF-8 name meets the file system's own limit, reported in one line).
+MAX_NAME_CHARS = 200
+
+
+def _check_plain_name(name: str) -> None:
+    """A campaign's ``name`` is the default output's file name (``<name>.parquet``): a plain
+    file-name component, so that it cannot point outside the current folder."""
+    bad = next((c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127), None)
+    if (bad is not None or name.strip() in (".", "..") or name.startswith(".")
+            or len(name) > MAX_NAME_CHARS):
+        why = (f"contains {bad!r}" if bad is not None else
+               f"is longer than {MAX_NAME_CHARS} characters" if len(name) > MAX_NAME_CHARS
+               else "begins with a dot")
+        raise CampaignError(f"name: {name[:60]!r} {why}; a campaign name is a plain file name "
+                            "(letters, digits, '-', '_', no '/' or '\\', not starting with '.')")
+
+
 def parse_campaign(
     data: dict, source: str = "campaign", base_dir: Path | None = None,
     default_name: str = "campaign",
@@ -425,6 +443,8 @@ def parse_campaign(
     name = data.get("name", default_name)
     if not isinstance(name, str) or not name.strip():
         raise CampaignError(f"name: must be a non-empty string, got {name!r}")
+    if "name" in data:
+        _check_plain_name(name)
     description = data.get("description", "")
     if not isinstance(description, str):
         raise CampaignError("description: must be a string")

@@ -5,18 +5,25 @@
   fails part-way (disk full) is cut back to the previous end of the file before the error
   is raised. A row cut off by a kill (power loss) is dropped when the file is reopened with
   ``resume``.
-* ``.parquet``: a Parquet *dataset*, a directory of part files (``part-*.parquet``), one per
-  finished case while the sweep runs: each is written to a hidden temporary name, flushed
-  and ``fsync``-ed, then renamed (and the directory ``fsync``-ed), so a reader never sees
-  half a file; at the end of the sweep the parts are compacted into one (written the same
-  way before the parts go). ``pyarrow.parquet.read_table(DIR)`` / ``pandas.read_parquet(DIR)``
-  read the directory. On ``resume`` every part is opened: a damaged one (a disk that
-  lost it, an editor) is renamed ``.damaged-<name>`` (hidden, so dataset readers skip it)
-  and its cases run again.
+* ``.parquet``: a Parquet *dataset*, a directory whose one visible file is the result,
+  ``RESULT_NAME`` (``results.parquet``): what ``pyarrow.dataset`` /
+  ``pyarrow.parquet.read_table(DIR)`` / ``pandas.read_parquet(DIR)`` read. While the sweep
+  runs, each finished case is a part file in the hidden folder ``PARTS_DIR`` (``.parts``:
+  dataset readers skip names that begin with a dot), written to a temporary name, flushed,
+  ``fsync``-ed and renamed (the folder ``fsync``-ed), so no part is ever half a file. At the
+  end the result and the parts are merged (:meth:`ParquetStore.close`): the new result is
+  written under a hidden temporary name, ``fsync``-ed, and *renamed over* the old one (one
+  atomic step), and only then are the parts deleted. A reader therefore sees exactly one
+  result at every instant (the previous one until the rename, the merged one after; a kill
+  between the steps leaves parts already merged, which :func:`read_results` and ``resume``
+  read once, the last row of a case winning). On ``resume`` the result and every part are
+  opened: a damaged one (a disk that lost it, an editor) is renamed ``.damaged-<name>``
+  (hidden) and its cases run again. Outputs of earlier versions (visible ``part-*.parquet``
+  files) are read as parts and merged.
 
-Rows are keyed by ``case_id``; if a case appears twice (a crash between writing the
-compacted file and removing the parts, or a failed case run again with
-``--retry-failed``), :func:`read_results` keeps the last one.
+Rows are keyed by ``case_id``; if a case appears twice (a kill between the merge's rename
+and the parts' removal, or a failed case run again with ``--retry-failed``),
+:func:`read_results` keeps the last one.
 
 :class:`OutputLock`: one sweep at a time writes an output (an ``flock`` on a hidden file
 beside it, released by the kernel if the sweep dies).
@@ -35,6 +42,17 @@ from pathlib import Path
 from typing import Any
 
 SUFFIXES = (".csv", ".parquet")
+RESULT_NAME = "results.parquet"  # the one visible file of a .parquet output
+PARTS_DIR = ".parts"  # hidden: finished cases not merged yet
+
+# Called with the name of each step of the merge (ParquetStore.close) as it is reached:
+# None in use; the fault tests kill the process at each step through it.
+merge_checkpoint = None
+
+
+def _checkpoint(step: str) -> None:
+    if merge_checkpoint is not None:
+        merge_checkpoint(step)
 
 
 class StoreError(ValueError):
@@ -269,8 +287,9 @@ class ParquetStore:
             if any(path.iterdir()):
                 if not resume:
                     raise _exists_error(path)
-                for tmp in path.glob(".*.tmp"):  # a part cut off by a kill
-                    tmp.unlink()
+                for folder in (path, path / PARTS_DIR):  # a part or a merge cut by a kill
+                    for tmp in folder.glob(".*.tmp"):
+                        tmp.unlink()
                 self._recover()
         _check_writable(path)
 
@@ -278,7 +297,7 @@ class ParquetStore:
         """Read the status of every case in every part; set damaged parts aside."""
         import pyarrow as pa
 
-        for part in self._parts():
+        for part in self._sources():
             try:
                 schema = self._pq.read_schema(part)
                 if schema.names != self.schema.names:
@@ -301,51 +320,74 @@ class ParquetStore:
                     self.failed_ids.discard(cid)
         if self.damaged:
             _fsync_dir(self.path)
+            _fsync_dir(self.path / PARTS_DIR)
 
     def _parts(self) -> list[Path]:
-        return sorted(self.path.glob("part-*.parquet"))
+        """The finished cases not merged yet, oldest first (and parts of earlier versions,
+        visible in the output folder)."""
+        return _part_files(self.path)
 
-    def _write(self, rows: list[dict[str, Any]], stem: str) -> Path:
-        """Write ``rows`` as the part ``stem``: temporary name, flush, fsync, rename, fsync
-        of the directory. A failure (disk full) removes the temporary file and raises."""
+    def _sources(self) -> list[Path]:
+        """Everything that holds rows: the result, then the parts (a later row wins)."""
+        result = self.path / RESULT_NAME
+        return ([result] if result.is_file() else []) + self._parts()
+
+    def _write(self, rows: list[dict[str, Any]], final: Path) -> Path:
+        """Write ``rows`` as ``final``: temporary name, flush, fsync, rename, fsync of the
+        folder. A failure (disk full) removes the temporary file and raises."""
         import pyarrow as pa
 
         table = pa.Table.from_pylist(
             [{k: r.get(k) for k in self.columns} for r in rows], schema=self.schema
         )
-        self.path.mkdir(parents=True, exist_ok=True)
-        final = self.path / f"{stem}.parquet"
-        tmp = self.path / f".{stem}.parquet.tmp"
+        final.parent.mkdir(parents=True, exist_ok=True)
+        tmp = final.with_name(f".{final.name}.{uuid.uuid4().hex[:8]}.tmp")
         renamed = False
         try:
             with open(tmp, "wb") as fh:
                 self._pq.write_table(table, fh)
                 fh.flush()
                 os.fsync(fh.fileno())
-            os.replace(tmp, final)
+            if final.name == RESULT_NAME:
+                _checkpoint("written")
+            os.replace(tmp, final)  # atomic: the old file or the new, never neither/both
             renamed = True
         finally:
             if not renamed:  # whatever stopped it (disk full, Ctrl-C): no temporary stays
                 tmp.unlink(missing_ok=True)
-        _fsync_dir(self.path)
+        _fsync_dir(final.parent)
         return final
 
     def append(self, row: dict[str, Any]) -> None:
-        self._write([row], f"part-{time.time_ns():020d}-{row['case_id']}")
+        name = f"part-{time.time_ns():020d}-{row['case_id']}.parquet"
+        self._write([row], self.path / PARTS_DIR / name)
         self._written += 1
 
     def close(self) -> None:
-        """Compact the part files into one (new file first, then the old ones go). A
-        failure here (disk full) loses nothing: the parts stay, ``--resume`` compacts."""
+        """Merge the result and the parts into a new result, renamed over the old one,
+        then delete the parts (module docstring: one visible result at every instant). A
+        failure here (disk full) loses nothing: the parts stay, ``--resume`` merges."""
         parts = self._parts() if self.path.is_dir() else []
-        if len(parts) <= 1:
+        if not parts:
             return
         rows = read_results(self.path, self.columns)
-        keep = self._write(rows, f"part-{time.time_ns():020d}-all-{uuid.uuid4().hex[:8]}")
-        for p in parts:
-            if p != keep:
-                p.unlink()
+        _checkpoint("read")
+        self._write(rows, self.path / RESULT_NAME)
+        _checkpoint("renamed")
+        for i, p in enumerate(parts):
+            p.unlink()
+            if i == 0:
+                _checkpoint("part deleted")
+        _fsync_dir(self.path / PARTS_DIR if (self.path / PARTS_DIR).is_dir() else self.path)
         _fsync_dir(self.path)
+        _checkpoint("merged")
+
+
+def _part_files(folder: Path) -> list[Path]:
+    """The part files of a .parquet output: in PARTS_DIR, and visible ones of earlier
+    versions; in the order they were written (their names begin with time.time_ns)."""
+    found = list((folder / PARTS_DIR).glob("part-*.parquet")) + list(folder.glob("part-*.parquet"))
+    return sorted(found, key=lambda p: p.name)
 
 
 def read_results(path: str | Path, columns: dict[str, str] | None = None) -> list[dict]:
@@ -364,7 +406,11 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
     else:
         import pyarrow.parquet as pq
 
-        files = sorted(p.glob("part-*.parquet")) if p.is_dir() else [p]
+        if p.is_dir():
+            result = p / RESULT_NAME
+            files = ([result] if result.is_file() else []) + _part_files(p)
+        else:
+            files = [p]
         rows = []
         for f in files:
             rows.extend(pq.read_table(f).to_pylist())
