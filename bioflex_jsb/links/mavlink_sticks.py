@@ -64,6 +64,8 @@ class Sticks:
             return False
         src, now = (msg.get_srcSystem(), msg.get_srcComponent()), time.monotonic()
         if self.controller is None or now - self._controller_seen > CONTROLLER_TIMEOUT_S:
+            if src != self.controller:  # a new station: nothing of the last one's holds
+                self._rc = dict.fromkeys(STICK_CHANNELS)
             self.controller = src
         if src != self.controller:
             self.refuse(f"other:{src}", f"Sticks from {src[0]}:{src[1]} ignored: "
