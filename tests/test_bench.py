@@ -96,6 +96,19 @@ def test_never_negative_whatever_the_timings(seed):
             assert d[key] is None or d[key] > 0.0
 
 
+def test_a_line_crossing_below_zero_is_fitted_through_the_origin():
+    """Long runs slowed more than short ones (a loaded machine: a long run is more often
+    interrupted, and comes back to cold caches): the least-squares line would give a
+    negative fixed cost; the fixed cost is held at zero instead, the per-step cost is then
+    an upper bound, and a residual within the bound keeps it trusted."""
+    n = np.asarray(LENGTHS, dtype=float)
+    times = np.tile(10e-6 * n * (1.0 + 0.05 * n / n[-1]), (3, 1))
+    assert np.polyfit(n, times[0], 1)[1] < 0.0  # the unconstrained line's fixed cost
+    est = estimate_per_step(LENGTHS, times)
+    assert est.trusted and est.fixed_s == 0.0
+    assert all(p == pytest.approx(10.5e-6, rel=1e-9) for p in est.per_repeat_s)
+
+
 def test_a_decreasing_time_is_not_trusted():
     est = estimate_per_step(LENGTHS, np.tile([0.05, 0.03, 0.01], (3, 1)))
     assert not est.trusted and "does not grow" in est.reason
@@ -156,6 +169,7 @@ def test_bench_json_has_every_figure(capsys):
     assert 0.0 <= data["sitl"]["p50_ms"] <= data["sitl"]["p99_ms"]
     assert data["steps"] == 100 and data["repeat"] == 2
     assert data["run_lengths"] == [100, 200, 400]
+    assert data["run_lengths_by_configuration"] == {"unsteady": [400, 800, 1600]}
     assert len(data["load_average"]) == 3 and all(math.isfinite(x)
                                                   for x in data["load_average"])
 

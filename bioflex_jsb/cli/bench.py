@@ -16,7 +16,8 @@ co-simulation (JSBSim + the compiled coupled step: flow, modal wing, loads, rang
 co-simulation with its MCAP log, the compiled unsteady wing (Jones lag and Küssner states),
 the readable Python step, and the native XML wing (JSBSim alone, the wing exported as JSBSim
 systems), all at the co-simulation's default step (1/960 s), interleaved --repeat times in one
-process, each at --steps, 2x and 4x --steps. Per-step costs: a line through the least time of
+process, each at --steps, 2x and 4x --steps (the unsteady wing, whose first reference step
+costs tens of ms, at 4x those). Per-step costs: a line through the least time of
 each run length (noise only adds time) separates the fixed cost per run; each repeat's
 per-step cost is its longest run less that fixed cost (never negative; an estimate the
 timings do not support is reported as not trusted, with the reason, instead of a figure).
