@@ -46,7 +46,6 @@ where the linear model leaves the nonlinear one. A nonlinear run that diverges h
 holds every step of the nonlinear run and the linear model's response on
 /bioflex/<model>/lti_prediction (docs/logging.md; --out, --no-log)."""
 
-CHANNELS = ("u", "alpha", "q", "theta", "eta1")
 # The table's unit of each channel's largest difference, and its factor from SI.
 DISPLAY_UNITS = {"u": ("m/s", 1.0), "alpha": ("deg", 57.29577951308232),
                  "q": ("deg/s", 57.29577951308232), "theta": ("deg", 57.29577951308232),
@@ -71,22 +70,16 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from bioflex_jsb.flight_dynamics.lti import build_state_space
-    from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-    from bioflex_jsb.runtime.fdm import Airframe, FdmError
-    from bioflex_jsb.simulation.lti_response import simulate
-    from bioflex_jsb.simulation.results import nrmse
+    from bioflex_jsb.drivers.compare import check_comparable, compare_run, linear_prediction
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.runtime.fdm import FdmError
 
     build = wing_for_run(wing_from_args(args), args)
-    if args.trim == "elastic" and (args.aero == "unsteady" or args.model == "rigid"):
-        raise UsageError("--trim elastic compares the quasi-steady coupled or qsd model "
-                         "(the rigid model has no wing; the unsteady one is linearised about "
-                         "the rigid trim)")
-    if args.aero == "unsteady" and args.model != "coupled":
-        raise UsageError("--aero unsteady compares the coupled model (rigid has no wing "
-                         "loads; the quasi-static model has no unsteady form)")
+    try:
+        check_comparable(args.model, args.aero, args.trim)
+    except InputError as exc:
+        raise UsageError(f"--model {args.model} --aero {args.aero} --trim {args.trim}: "
+                         f"{exc}") from None
     check_run_arguments(args)
     check_plot_path(args.plot, args.force)
     args.out = log_path(args, "compare", args.wing)
@@ -102,60 +95,24 @@ def run(args: argparse.Namespace) -> int:
             return 130
         nonlinear = runs[0]
         try:
-            lin = Airframe().linearize(args.speed)
+            linear = linear_prediction(build, nonlinear, args.model, args.speed, args.aero,
+                                       args.trim)
         except FdmError as exc:
             raise UsageError(str(exc)) from None
-        if args.aero == "unsteady":  # Eq. (4) on unsteady strips, Küssner's gust
-            from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space
-
-            ss = unsteady_state_space(build, args.speed, gust=True, a_rr=lin.a)
-        elif args.trim == "elastic":  # about the static aeroelastic equilibrium
-            from bioflex_jsb.flight_dynamics.elastic_trim import (
-                elastic_trim,
-                linearise_about_elastic_trim,
-            )
-
-            ss = linearise_about_elastic_trim(args.model, elastic_trim(build, args.speed),
-                                              build.model, a_rr=lin.a)
-        else:
-            ss = build_state_space(args.model, level_flight_condition(args.speed),
-                                   build.model, a_rr=lin.a)
-        linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
         if log is not None:
             log.prediction(args.model, linear)
     finally:
         if log is not None:
             with closing():  # a stop signal now waits until the log is finished
                 log.close()
-    strips = ", unsteady strips" if args.aero == "unsteady" else ""
-    linear.meta.update(label=f"LTI {args.model} (Eq. 4{strips})", linestyle="--",
-                       color="tab:orange", linewidth=1.6)
-    nonlinear.meta.update(label=f"JSBSim {args.model}", color="tab:blue", linestyle="-",
-                          linewidth=2.2)
-    channels = [c for c in CHANNELS if c in linear.channels and c in nonlinear.channels]
-    diverged = nonlinear.stopped is not None
-    errors: dict[str, float | None] = {}
-    worst: dict[str, dict[str, object]] = {}
-    for c in channels:
-        unit = nonlinear.units.get(c, linear.units.get(c, ""))
-        if diverged:  # a diverging run is no reference: no error to report
-            errors[c] = None
-            worst[c] = {"max_abs_difference": None, "unit": unit, "at_time_s": None}
-            continue
-        errors[c] = nrmse(nonlinear[c], linear[c])
-        diff = np.abs(linear[c] - nonlinear[c])
-        k = int(np.argmax(diff))
-        worst[c] = {"max_abs_difference": float(diff[k]), "unit": unit,
-                    "at_time_s": float(nonlinear.time_s[k])}
+    result = compare_run(build, nonlinear, args.model, args.speed, args.aero, args.trim,
+                         linear=linear)
+    channels, errors, worst, diverged = (result.channels, result.nrmse, result.worst,
+                                         result.diverged)
     if args.plot:
-        from bioflex_jsb.sinks import plotting
-
         try:
-            plotting.time_histories(
-                [nonlinear, linear], args.plot,
-                f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}: "
-                f"LTI (Eq. 4) vs JSBSim, {args.model} model",
-                nrmse=None if diverged else errors)
+            result.plot(args.plot, f"{build.variant.name} wing, {args.speed:g} m/s, gust "
+                        f"{args.gust.text()}: LTI (Eq. 4) vs JSBSim, {args.model} model")
         except OSError as exc:
             raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None
     payload = {
