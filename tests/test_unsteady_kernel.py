@@ -147,6 +147,37 @@ def test_layout_header_points_at_every_block():
     assert all(views[b].size == lay[b][1] for b in UK.BLOCKS)
 
 
+COMPILE = ("from bioflex_jsb.simulation import step_kernel as K, unsteady_kernel as UK; "
+           "UK.compile_now(); print(len(K.cache_files(UK.unsteady_kernel)))")
+
+
+def test_a_damaged_kernel_cache_is_discarded_recompiled_and_said_once(tmp_path):
+    """The unsteady kernel's cache heals as the quasi-steady kernel's (step_kernel.guard_cache;
+    tests/test_faults.py holds the kinds of damage): an emptied index is discarded with one
+    line on stderr, the kernel compiled and cached anew, the next run silent."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+
+    def compile_kernel():
+        return subprocess.run([sys.executable, "-c", COMPILE], capture_output=True, text=True,
+                              timeout=600, env=env)
+
+    first = compile_kernel()
+    assert first.returncode == 0 and first.stdout.strip() == "2", first.stderr[-2000:]
+    (index,) = tmp_path.rglob("unsteady_kernel.unsteady_kernel-*.nbi")
+    index.write_bytes(b"")
+    damaged = compile_kernel()
+    assert damaged.returncode == 0, damaged.stderr[-2000:]
+    lines = damaged.stderr.strip().splitlines()
+    assert len(lines) == 1 and "damaged" in lines[0] and "compiling anew" in lines[0], lines
+    assert damaged.stdout.strip() == "2"
+    again = compile_kernel()
+    assert again.returncode == 0 and again.stderr.strip() == "", again.stderr
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="Record or check the unsteady golden case.")
     parser.add_argument("--write", action="store_true", help="re-record the stored file")

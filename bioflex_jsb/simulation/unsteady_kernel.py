@@ -41,6 +41,7 @@ from bioflex_jsb.simulation.step_kernel import (
     NON_FINITE,
     OK,
     READ_KEYS,
+    guard_cache,
 )
 
 N_INPUTS = 8  # f = [Q Δα, Q q/V, ΔQ, α_i, q, α̇_i, q̇, w_g] (unsteady_wing.INPUTS)
@@ -245,6 +246,12 @@ def unsteady_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
         if abs(x[i]) > params[o_c + 6]:
             return ETA_OUT
     return OK
+
+
+# a damaged on-disk cache is discarded and compiled anew, as the quasi-steady kernel's (the
+# helper too: it is loaded from its own cache when the kernel is compiled)
+guard_cache(_advance)
+guard_cache(unsteady_kernel)
 
 
 def compile_now(n_modes: int = 3, n_strips: int = 40) -> None:
