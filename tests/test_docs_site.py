@@ -66,12 +66,15 @@ def site(executed_docs, tmp_path_factory) -> Path:
         if isinstance(plugin, dict) and "mkdocstrings" in plugin:
             options = plugin["mkdocstrings"]["handlers"]["python"]["options"]
             options["extensions"] = [str(REPO / e) for e in options.get("extensions", [])]
+    for ext in config["markdown_extensions"]:
+        if isinstance(ext, dict) and "pymdownx.snippets" in ext:
+            ext["pymdownx.snippets"]["base_path"] = [str(REPO)]  # the README
     cfg = out.parent / "mkdocs.yml"
     cfg.write_text(yaml.safe_dump(config, sort_keys=False))
     env = dict(os.environ, NO_MKDOCS_2_WARNING="1")
     proc = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-q",
                            "-f", str(cfg)],
-                          cwd=REPO, env=env, capture_output=True, text=True, timeout=900)
+                          cwd=out.parent, env=env, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
     return out
 
