@@ -121,10 +121,11 @@ def stored_wing():
 
 
 def built_wing():
-    """The optimised wing built now (modes, lifting line, Table B1), as the CLI builds it."""
-    from bioflex_jsb.api import load_wing
+    """The optimised wing built now (modes, lifting line, Table B1), as ``api.load_wing``
+    builds it (the named variant, the default mass basis)."""
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 
-    return load_wing("optimised").model
+    return build_wing(VARIANTS["optimised"]).model
 
 
 def wing_arrays(wing) -> dict[str, np.ndarray]:
