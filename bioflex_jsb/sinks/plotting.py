@@ -374,7 +374,7 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
     if any("eta1" in r.channels and r.model != "rigid" for r in runs):
         fig.text(0.5, 0.004, ETA1_NOTE, ha="center", va="bottom", fontsize=8, color="0.25",
                  wrap=True)
-    fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955))
+    fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955 if nrmse is None else 0.98))
     return _save(fig, path)
 
 
