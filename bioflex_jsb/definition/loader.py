@@ -14,6 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.definition.airframe import parse_airframe
+from bioflex_jsb.definition.flying import (
+    FLYING_AERO_FIELDS,
+    SHIPPED_AIRCRAFT,
+    check_span,
+    flying_structure,
+    flying_wing,
+)
 from bioflex_jsb.definition.model import (
     AeroSettings,
     Air,
@@ -22,10 +30,11 @@ from bioflex_jsb.definition.model import (
     Definition,
     WingStation,
 )
-from bioflex_jsb.errors import InputError
+from bioflex_jsb.definition.reader import DefinitionError, Reader
 from bioflex_jsb.tomlfile import read_toml
 
-SHIPPED = ("goland",)  # definitions in bioflex_jsb/data/aircraft/<name>.toml
+# definitions in bioflex_jsb/data/aircraft/<name>.toml: clamped wings, then aircraft
+SHIPPED = ("goland",) + SHIPPED_AIRCRAFT
 FORMAT_VERSION = 1
 
 # Valid ranges [unit], each with its reason.
@@ -60,68 +69,7 @@ INERTIA_AXES = ("elastic-axis", "centre-of-mass")
 TWIST_UNITS = ("deg", "rad")
 
 
-class DefinitionError(InputError):
-    """A definition file that cannot be used; the message names the file and the field."""
-
-
-class _Reader:
-    def __init__(self, data: dict, where: str) -> None:
-        self.data = data
-        self.where = where
-
-    def fail(self, field: str, text: str) -> DefinitionError:
-        return DefinitionError(f"{self.where}: {field}: {text}")
-
-    def table(self, key: str, allowed: tuple[str, ...], required: bool = True) -> dict:
-        t = self.data.get(key)
-        if t is None:
-            if required:
-                raise self.fail(f"[{key}]", "missing table")
-            return {}
-        if not isinstance(t, dict):
-            raise self.fail(f"[{key}]", "must be a table")
-        self.keys(t, key, allowed)
-        return t
-
-    def keys(self, t: dict, where: str, allowed: tuple[str, ...]) -> None:
-        unknown = sorted(set(t) - set(allowed))
-        if unknown:
-            raise self.fail(f"{where}.{unknown[0]}", f"unknown field; accepted: "
-                            f"{', '.join(allowed)}")
-
-    def number(self, t: dict, where: str, key: str, lo: float, hi: float, unit: str,
-               default: float | None = None, hint: str = "") -> float:
-        v = t.get(key, default)
-        if v is None:
-            raise self.fail(f"{where}.{key}", f"missing (a number in {unit})")
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise self.fail(f"{where}.{key}", f"must be a finite number in {unit}, got {v!r}")
-        if not lo <= v <= hi:
-            raise self.fail(f"{where}.{key}", f"{v:g} {unit} is outside the valid range "
-                            f"{lo:g}..{hi:g} {unit}{hint}")
-        return float(v)
-
-    def integer(self, t: dict, where: str, key: str, lo: int, hi: int, default: int) -> int:
-        v = t.get(key, default)
-        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-            raise self.fail(f"{where}.{key}", f"must be an integer {lo}..{hi}, got {v!r}")
-        return int(v)
-
-    def choice(self, t: dict, where: str, key: str, choices: tuple[str, ...],
-               default: str | None) -> str:
-        v = t.get(key, default)
-        if v not in choices:
-            raise self.fail(f"{where}.{key}", f"must be one of {', '.join(choices)}, got {v!r}")
-        return str(v)
-
-    def text(self, t: dict, where: str, key: str, default: str | None = None) -> str:
-        v = t.get(key, default)
-        if not isinstance(v, str) or (default is None and not v.strip()):
-            raise self.fail(f"{where}.{key}", "must be a non-empty string")
-        return v
-
-
-def _per_station(r: _Reader, t: dict, key: str, n: int, lo: float, hi: float, unit: str,
+def _per_station(r: Reader, t: dict, key: str, n: int, lo: float, hi: float, unit: str,
                  hint: str = "") -> np.ndarray:
     """A number (uniform) or a list of one number per wing station."""
     v = t.get(key)
@@ -135,7 +83,7 @@ def _per_station(r: _Reader, t: dict, key: str, n: int, lo: float, hi: float, un
     return np.array(out, dtype=float)
 
 
-def _stations(r: _Reader, wing: dict) -> tuple[WingStation, ...]:
+def _stations(r: Reader, wing: dict) -> tuple[WingStation, ...]:
     unit = r.choice(wing, "wing", "twist_unit", TWIST_UNITS, "deg")
     rows = wing.get("stations")
     if not isinstance(rows, list) or len(rows) < 2 or not all(isinstance(x, dict)
@@ -171,7 +119,7 @@ def _stations(r: _Reader, wing: dict) -> tuple[WingStation, ...]:
     return tuple(out)
 
 
-def _structure(r: _Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
+def _structure(r: Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
     allowed = ("kind", "bending_stiffness_n_m2", "torsional_stiffness_n_m2",
                "mass_per_length_kg_m", "pitch_inertia_kg_m", "inertia_axis", "damping_ratio",
                "n_modes", "n_elements")
@@ -205,27 +153,33 @@ def _structure(r: _Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
 
 def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     """A :class:`Definition` from the parsed TOML ``data`` (``where`` names it in errors)."""
-    r = _Reader(data, where)
+    r = Reader(data, where)
     r.keys(data, "(top level)", ("format", "name", "description", "source", "wing",
                                  "structure", "aero", "air", "analysis", "airframe"))
     fmt = data.get("format", FORMAT_VERSION)
     if fmt != FORMAT_VERSION:
         raise r.fail("format", f"must be {FORMAT_VERSION}, got {fmt!r}")
-    if "airframe" in data:
-        raise r.fail("[airframe]", "not available yet: this version reads clamped wings "
-                     "(a definition without [airframe]); see docs/aircraft.md")
     name = r.text(data, "", "name")
-    wing = r.table("wing", ("twist_unit", "stations"))
+    base_dir = Path(path).parent if path else None
+    airframe = parse_airframe(r, data, base_dir) if "airframe" in data else None
+    wing = r.table("wing", ("twist_unit", "stations") + (("name",) if airframe else ()))
     stations = _stations(r, wing)
-    structure = _structure(r, stations)
-    at = r.table("aero", ("model", "lift_slope", "section_lift_slope_per_rad", "strips"),
-                 required=False)
+    flying = None
+    if airframe is None:
+        structure = _structure(r, stations)
+    else:
+        check_span(r, stations, airframe)
+        structure = flying_structure(r, stations, base_dir)
+    at = r.table("aero", ("model", "lift_slope", "section_lift_slope_per_rad", "strips")
+                 + (FLYING_AERO_FIELDS if airframe else ()), required=False)
     aero = AeroSettings(
         r.choice(at, "aero", "model", AERO_MODELS, "unsteady"),
         r.choice(at, "aero", "lift_slope", LIFT_SLOPES, "strip"),
         r.number(at, "aero", "section_lift_slope_per_rad", *LIFT_SLOPE_RANGE_PER_RAD,
                  "1/rad", default=2.0 * math.pi),
         r.integer(at, "aero", "strips", *STRIPS_RANGE, 24))
+    if airframe is not None:
+        flying = flying_wing(r, wing, at, aero, name)
     air_t = r.table("air", ("density_kg_m3",))
     air = Air(r.number(air_t, "air", "density_kg_m3", *DENSITY_RANGE_KG_M3, "kg/m^3"))
     an = r.table("analysis", ("method", "speed_range_m_s"), required=False)
@@ -241,7 +195,8 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     analysis = AnalysisSettings(r.choice(an, "analysis", "method", METHODS, "pk"), rng)
     return Definition(name=name, description=r.text(data, "", "description", ""),
                       source=r.text(data, "", "source", ""), stations=stations,
-                      structure=structure, aero=aero, air=air, analysis=analysis, path=path)
+                      structure=structure, aero=aero, air=air, analysis=analysis,
+                      airframe=airframe, path=path, flying=flying)
 
 
 def shipped_path(name: str) -> Path:

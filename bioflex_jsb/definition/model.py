@@ -3,13 +3,19 @@
 A definition has a wing (planform by span stations, :class:`WingStation`), its structure
 (:class:`BeamStructure`: sections per station), the aerodynamic settings
 (:class:`AeroSettings`), the air (:class:`Air`) and the analysis settings
-(:class:`AnalysisSettings`). ``airframe`` is ``None`` for a clamped wing: "a clamped wing is
-the same definition without an airframe"; the airframe part (a JSBSim aircraft, reference
-geometry, mass properties) is the next step of the format and is refused until then.
+(:class:`AnalysisSettings`). ``airframe`` (:class:`Airframe`: the JSBSim aircraft,
+reference geometry, mass properties, the wing's attachment, the rigid derivatives) is
+``None`` for a clamped wing: "a clamped wing is the same definition without an airframe".
+The wing on an airframe has one more structure kind than a clamped wing
+(:class:`MembraneStructure`: the prototype's calibrated membrane; :class:`ModalStructure`: a
+modal file) and its flight-dynamics settings (:class:`FlyingWing`).
 
 SI throughout; frames: y [m] along the span from the clamped root (or the aircraft's plane
 of symmetry) to the tip; x [m] aft, from the root leading edge; chord positions are
 fractions of the local chord aft of its leading edge; twist [rad] positive leading edge up.
+Airframe positions are in the JSBSim aircraft's structural frame, in metres: x aft, y to
+starboard, z up, from that aircraft's own origin (the generated prototype's: the fuselage
+nose, parameters/airframe.py AirframeGeometry).
 """
 
 from __future__ import annotations
@@ -56,6 +62,84 @@ class BeamStructure:
 
 
 @dataclass(frozen=True)
+class MembraneStructure:
+    """The prototype's membrane half wing as calibrated to Table 2 (ribbed or not:
+    parameters/wing_structure.py, the beam of structures/wing_model.py); ``damping_ratio`` ζ
+    [-] of every mode; ``n_modes`` flown (3: Table 2's)."""
+
+    ribs: bool
+    damping_ratio: float
+    n_modes: int
+
+
+@dataclass(frozen=True)
+class ModalStructure:
+    """A modal file (docs/structures.md: shapes, frequencies, generalised masses, axes):
+    ``modes_file`` (absolute path), ``damping_ratio`` ζ [-] (the larger of it and each mode's
+    own), ``n_modes`` flown."""
+
+    modes_file: str
+    damping_ratio: float
+    n_modes: int
+
+
+@dataclass(frozen=True)
+class FlyingWing:
+    """The elastic wing's settings on an airframe: ``name`` (the wing's name in reports and
+    logs), ``pin_c_eta1_q1`` (C_η1^Q1 [-] pinned by a uniform shift of the aerodynamic
+    offset, as the paper did, or ``None``: the strip model's own value),
+    ``published_c_eta1_q1`` (the published value it is compared with, or ``None``)."""
+
+    name: str
+    pin_c_eta1_q1: float | None
+    published_c_eta1_q1: float | None
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """Inertia about the centre of gravity in body axes [kg·m²] (x forward, y starboard, z
+    down; ``ixz_kg_m2`` the product of inertia, JSBSim's sign: positive for a nose-down
+    principal axis)."""
+
+    ixx_kg_m2: float
+    iyy_kg_m2: float
+    izz_kg_m2: float
+    ixz_kg_m2: float
+
+
+@dataclass(frozen=True)
+class Airframe:
+    """The rigid aircraft the elastic wing is attached to.
+
+    ``jsbsim``: ``bioflex`` (the generated prototype), or the name of an aircraft in the
+    jsbsim package's ``aircraft/`` directory, or a directory holding ``<dir name>.xml``;
+    ``jsbsim_path``: the aircraft file found (empty for ``bioflex``: it is generated).
+    Reference geometry: ``reference_area_m2`` S [m²], ``span_m`` b [m], ``mean_chord_m`` c̄
+    [m]. ``mass_kg`` [kg], ``cg_m`` (x, y, z) [m] and ``wing_root_leading_edge_m`` (x, y, z)
+    [m] in the structural frame (module docstring), ``inertia`` (:class:`Inertia`).
+    ``derivatives``: the rigid aerodynamic derivatives of
+    :class:`~bioflex_jsb.parameters.airframe.RigidAerodynamics` by field name [per rad,
+    non-dimensional, moments about the CG], or ``None``: from JSBSim's linearisation of the
+    aircraft."""
+
+    jsbsim: str
+    jsbsim_path: str
+    reference_area_m2: float
+    span_m: float
+    mean_chord_m: float
+    mass_kg: float
+    cg_m: tuple[float, float, float]
+    inertia: Inertia
+    wing_root_leading_edge_m: tuple[float, float, float]
+    derivatives: dict[str, float] | None
+
+    @property
+    def wing_cg_x_m(self) -> float:
+        """The CG aft of the wing's root leading edge [m] (the wing frame's x_cg)."""
+        return self.cg_m[0] - self.wing_root_leading_edge_m[0]
+
+
+@dataclass(frozen=True)
 class AeroSettings:
     """``model`` (``unsteady``: Theodorsen / Jones; ``quasi-steady``: C = 1),
     ``lift_slope`` (``strip``: ``section_lift_slope_per_rad`` on every strip; ``vlm``: the
@@ -91,12 +175,13 @@ class Definition:
     description: str
     source: str
     stations: tuple[WingStation, ...]
-    structure: BeamStructure
+    structure: BeamStructure | MembraneStructure | ModalStructure
     aero: AeroSettings
     air: Air
     analysis: AnalysisSettings
-    airframe: None = None
+    airframe: Airframe | None = None
     path: str = ""
+    flying: FlyingWing | None = None  # with an airframe
 
     @property
     def clamped(self) -> bool:

@@ -1,0 +1,185 @@
+"""The aircraft as one object (AeroSandbox's ``Airplane`` in spirit): a definition with an
+airframe, loaded once and passed into every analysis (docs/aircraft.md).
+
+:class:`Aircraft` holds the :class:`~bioflex_jsb.definition.model.Definition` (airframe,
+wing planform, structure, settings) and builds what the analyses take: the elastic wing
+(:meth:`Aircraft.wing`: today's :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`,
+modes, strips, Table B1/B2 model), its :class:`~bioflex_jsb.flight_dynamics.wing_model.
+WingVariant` and :class:`~bioflex_jsb.parameters.wing.Planform`.
+
+What flies in this version (:meth:`Aircraft.flight_problem`): the analyses below the loader
+still take the prototype's airframe and planform from the parameter modules (the move is
+under way: tests/test_prototype_imports.py lists the modules left), so an aircraft flies
+when its airframe and planform are the prototype's (each field equal to 1e-9 relative: the
+rounding of a printed value); its wing (axes, ribs, damping, a modal file, the C_η1^Q1 pin)
+is free. Any other airframe is read and checked, and refused for flight in one line naming
+the first field that differs, never flown with the prototype's numbers in its place.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+from bioflex_jsb.definition.airframe import GENERATED
+from bioflex_jsb.definition.flying import FLYING_N_MODES, axes
+from bioflex_jsb.definition.loader import load_definition
+from bioflex_jsb.definition.model import Definition, MembraneStructure, ModalStructure
+from bioflex_jsb.definition.reader import DefinitionError
+from bioflex_jsb.flight_dynamics.wing_model import (
+    DEFAULT_MASS_BASIS,
+    WingBuild,
+    WingVariant,
+    build_wing,
+)
+from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY, MASS_PROPERTIES, RIGID_AERODYNAMICS
+from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
+
+# Equal to the prototype's: 1e-9 relative (printed values carry 4-10 digits; the shipped
+# files repeat parameters/ to the last digit: measured 0 difference).
+SAME_REL = 1e-9
+
+
+def _same(a: float, b: float) -> bool:
+    return abs(a - b) <= SAME_REL * max(abs(a), abs(b), 1e-12)
+
+
+class Aircraft:
+    """An aircraft definition and what the analyses build from it."""
+
+    def __init__(self, definition: Definition) -> None:
+        if definition.airframe is None:
+            raise DefinitionError(f"definition {definition.name!r} has no [airframe]: it is "
+                                  "a clamped wing (flutter --clamped, api.flutter(..., "
+                                  "clamped=True)); an aircraft needs [airframe]")
+        self.definition = definition
+
+    @property
+    def name(self) -> str:
+        return self.definition.name
+
+    @property
+    def airframe(self):
+        return self.definition.airframe
+
+    def __repr__(self) -> str:
+        return (f"Aircraft({self.name!r}, jsbsim={self.airframe.jsbsim!r}, "
+                f"wing={self.definition.flying.name!r})")
+
+    # -- the wing ---------------------------------------------------------------------
+    def planform(self) -> Planform:
+        """The wing's planform (constant chord, a straight inner and a swept outer panel:
+        the one form the flight model's strips take) with the CG from the airframe."""
+        d = self.definition
+        where = f"definition {d.name!r}"
+        chord = d.column("chord_m")
+        if float(chord.max() - chord.min()) > SAME_REL * float(chord.max()):
+            raise DefinitionError(f"{where}: wing.stations.chord_m varies along the span: the "
+                                  "flight model's planform has a constant chord")
+        y, x = d.column("y_m"), d.column("leading_edge_x_m")
+        if abs(x[0]) > 0.0:
+            raise DefinitionError(f"{where}: wing.stations[0].leading_edge_x_m must be 0 (the "
+                                  "wing frame's origin is the root leading edge)")
+        straight = [i for i in range(len(y)) if x[i] == 0.0]
+        k = straight[-1]
+        if straight != list(range(k + 1)):
+            raise DefinitionError(f"{where}: wing.stations.leading_edge_x_m: a straight inner "
+                                  "panel (x = 0) then one swept outer panel is accepted")
+        semispan, start = float(y[-1]), float(y[k])
+        sweep = math.atan(float(x[-1]) / (semispan - start)) if k < len(y) - 1 else 0.0
+        for i in range(k + 1, len(y)):
+            if abs(x[i] - (y[i] - start) * math.tan(sweep)) > 1e-9 * semispan:
+                raise DefinitionError(f"{where}: wing.stations[{i}].leading_edge_x_m is off "
+                                      "the straight outer panel: one swept panel is accepted")
+        return Planform(semispan_m=semispan, chord_m=float(chord[0]),
+                        outer_panel_start_m=start, outer_sweep_rad=sweep,
+                        x_cg_m=self.airframe.wing_cg_x_m)
+
+    def variant(self) -> WingVariant:
+        """The wing as a :class:`WingVariant` (its axes, structure, damping, pin)."""
+        d = self.definition
+        x_i, x_e = axes(d.stations)
+        s = d.structure
+        if isinstance(s, MembraneStructure):
+            ribs, modes_file = s.ribs, None
+        elif isinstance(s, ModalStructure):
+            ribs, modes_file = True, s.modes_file
+        else:
+            raise DefinitionError(f"definition {d.name!r}: structure.kind 'beam' on an "
+                                  "airframe is not modelled yet")
+        f = d.flying
+        return WingVariant(f.name, x_i, x_e, ribs=ribs, structural_damping=s.damping_ratio,
+                           modes_file=modes_file, pinned_c_eta1_q1=f.pin_c_eta1_q1,
+                           published_c_eta1_q1=f.published_c_eta1_q1,
+                           description=d.description)
+
+    def flight_problem(self) -> str | None:
+        """Why this aircraft cannot fly in this version (module docstring), or ``None``."""
+        a, d = self.airframe, self.definition
+        head = f"aircraft {d.name!r}: "
+        tail = (" (the analyses below the loader still read the prototype's airframe from "
+                "parameters/; only the prototype's airframe flies in this version, with any "
+                "wing: docs/aircraft.md)")
+        if a.jsbsim != GENERATED:
+            return (f"{head}airframe.jsbsim = {a.jsbsim!r}: the flight models of this version "
+                    f"are those of the generated prototype {GENERATED!r}{tail}")
+        g = AIRFRAME_GEOMETRY
+        rows = [
+            ("airframe.reference_area_m2", a.reference_area_m2, P.REFERENCE_AREA_M2),
+            ("airframe.span_m", a.span_m, P.SPAN_M),
+            ("airframe.mean_chord_m", a.mean_chord_m, P.MEAN_AERODYNAMIC_CHORD_M),
+            ("airframe.mass_kg", a.mass_kg, MASS_PROPERTIES.mass_kg),
+            ("airframe.cg_m[0]", a.cg_m[0], g.cg_x_m), ("airframe.cg_m[1]", a.cg_m[1], 0.0),
+            ("airframe.cg_m[2]", a.cg_m[2], g.cg_z_m),
+            ("airframe.wing_root_leading_edge_m[0]", a.wing_root_leading_edge_m[0],
+             g.wing_root_leading_edge_x_m),
+            ("airframe.wing_root_leading_edge_m[1]", a.wing_root_leading_edge_m[1], 0.0),
+            ("airframe.wing_root_leading_edge_m[2]", a.wing_root_leading_edge_m[2], 0.0),
+            ("air.density_kg_m3", d.air.density_kg_m3, P.SEA_LEVEL_DENSITY_KG_M3),
+        ]
+        rows += [(f"airframe.inertia_kg_m2.{k}", getattr(a.inertia, f"{k}_kg_m2"),
+                  getattr(MASS_PROPERTIES, f"{k}_kg_m2")) for k in ("ixx", "iyy", "izz", "ixz")]
+        if a.derivatives is None:
+            return (f"{head}airframe.derivatives = 'jsbsim': the prototype's LTI model takes "
+                    f"its rigid derivatives from the file{tail}")
+        rows += [(f"airframe.derivatives.{k}", v, getattr(RIGID_AERODYNAMICS, k))
+                 for k, v in a.derivatives.items()]
+        for field, mine, proto in rows:
+            if not _same(mine, proto):
+                return f"{head}{field} = {mine:g} differs from the prototype's {proto:g}{tail}"
+        pf = self.planform()
+        for field in ("semispan_m", "chord_m", "outer_panel_start_m", "outer_sweep_rad",
+                      "x_cg_m"):
+            mine, proto = getattr(pf, field), getattr(DEFAULT_PLANFORM, field)
+            if not _same(mine, proto):
+                return (f"{head}the wing's planform {field} = {mine:g} differs from the "
+                        f"prototype's {proto:g} (wing.stations, airframe.cg_m){tail}")
+        if isinstance(d.structure, MembraneStructure) and d.structure.n_modes != FLYING_N_MODES:
+            return f"{head}structure.n_modes must be {FLYING_N_MODES}"
+        return None
+
+    def wing(self, mass_basis: str = DEFAULT_MASS_BASIS) -> WingBuild:
+        """The elastic wing built for flight (modes, strips, the Table B1/B2 model); a
+        :class:`DefinitionError` with :meth:`flight_problem`'s line if it cannot fly."""
+        problem = self.flight_problem()
+        if problem:
+            raise DefinitionError(problem)
+        # the prototype's planform object itself: the analyses below read DEFAULT_PLANFORM,
+        # and flight_problem has checked this one equals it
+        return build_wing(self.variant(), FLYING_N_MODES, mass_basis, DEFAULT_PLANFORM)
+
+    def summary(self) -> dict[str, object]:
+        """The definition's airframe and wing as plain data (for logs and --json)."""
+        a = self.airframe
+        return {"name": self.name, "path": self.definition.path,
+                "airframe": {k: (dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v)
+                             for k, v in dataclasses.asdict(a).items()},
+                "wing": self.variant().as_dict()}
+
+
+def load_aircraft(name_or_file: str | Path) -> Aircraft:
+    """A shipped aircraft by name (``bioflex_<variant>``) or a definition file with an
+    ``[airframe]`` (docs/aircraft.md)."""
+    return Aircraft(load_definition(name_or_file))

@@ -1,0 +1,143 @@
+"""The elastic wing of a definition with an airframe (docs/aircraft.md, "The wing on an
+airframe"): its structure kinds, its flight-model settings, and its fit to the airframe.
+
+A wing that flies carries one chordwise position of each axis (the flight model's x_I, x_E:
+Eq. 11-12 of the paper), so the stations' ``elastic_axis`` and ``centre_of_mass`` are
+constant along the span (a modal file's [axes] may vary: their mean is the wing's, as for a
+variant file). Structure kinds: ``prototype-membrane`` (the prototype's membrane half wing
+as calibrated to Table 2, ribbed or not: parameters/wing_structure.py) and ``modal`` (a
+modal file, docs/structures.md). A ``beam`` on an airframe is not yet modelled (the flight
+build takes its modes from those two) and is refused in one line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bioflex_jsb.definition.model import (
+    AeroSettings,
+    Airframe,
+    FlyingWing,
+    MembraneStructure,
+    ModalStructure,
+    WingStation,
+)
+from bioflex_jsb.definition.reader import Reader
+from bioflex_jsb.errors import InputError
+
+# The prototype's six wing variants as shipped definitions
+# (bioflex_jsb/data/aircraft/bioflex_<variant>.toml).
+PROTOTYPE_VARIANTS = ("original", "optimised", "inertial-forward", "elastic-forward",
+                      "inertial-backward", "elastic-backward")
+SHIPPED_AIRCRAFT = tuple(f"bioflex_{v}" for v in PROTOTYPE_VARIANTS)
+FLYING_KINDS = ("prototype-membrane", "modal")
+FLYING_AERO_FIELDS = ("pin_c_eta1_q1", "published_c_eta1_q1")
+PHYSICAL_PIN = "physical"
+# The flight model's modal basis: the paper's three modes (Table 2); the coefficient names,
+# logs and exports are made for them (flight_dynamics/wing_model.py DEFAULT_N_MODES).
+FLYING_N_MODES = 3
+# Largest |C_η1^Q1| [-] that may be pinned: flight_dynamics/wing_model.py
+# MAX_PINNED_COEFFICIENT's reason (strip theory bounds it by 2π; 100 leaves 16 × that).
+PIN_LIMIT = 100.0
+# The wing's span (2 × the tip station) and the airframe's span_m agree within 5 %: the
+# elastic wing is the aircraft's main wing (b of S = b c̄); a wing in another unit than the
+# airframe is far outside.
+SPAN_TOLERANCE = 0.05
+# Axis positions constant along the span to 1e-9 of the chord (the rounding of the file).
+AXIS_TOLERANCE = 1e-9
+# A modal file's mean axes and the stations' agree within 1e-6 of the chord (files print
+# six or more digits).
+MODAL_AXIS_TOLERANCE = 1e-6
+
+
+def check_span(r: Reader, stations: tuple[WingStation, ...], airframe: Airframe) -> None:
+    """The wing's span matches the airframe's (:data:`SPAN_TOLERANCE`)."""
+    wing_span = 2.0 * stations[-1].y_m
+    if abs(wing_span / airframe.span_m - 1.0) > SPAN_TOLERANCE:
+        raise r.fail(f"wing.stations[{len(stations) - 1}].y_m", f"the wing's span 2 x "
+                     f"{stations[-1].y_m:g} = {wing_span:g} m differs from airframe.span_m "
+                     f"{airframe.span_m:g} m by more than {100 * SPAN_TOLERANCE:g} % (the "
+                     "elastic wing is the aircraft's main wing; y_m is the semispan)")
+
+
+def _constant(r: Reader, stations, key: str) -> float:
+    values = np.array([getattr(s, key) for s in stations])
+    if np.ptp(values) > AXIS_TOLERANCE:
+        raise r.fail(f"wing.stations.{key}", f"varies along the span ({values.min():g}.."
+                     f"{values.max():g}); a flying wing has one chordwise {key} (Eq. 11-12); "
+                     "use a modal file for axes that vary")
+    return float(values[0])
+
+
+def axes(stations: tuple[WingStation, ...]) -> tuple[float, float]:
+    """(x_inertial_frac, x_elastic_frac) [-] of a flying wing (constant along the span)."""
+    return float(stations[0].centre_of_mass), float(stations[0].elastic_axis)
+
+
+def flying_structure(r: Reader, stations: tuple[WingStation, ...], base_dir: Path | None
+                     ) -> MembraneStructure | ModalStructure:
+    """The ``[structure]`` of a wing on an airframe (module docstring)."""
+    from bioflex_jsb.definition.loader import DAMPING_RANGE
+
+    t = r.table("structure", ("kind", "ribs", "modes_file", "damping_ratio", "n_modes"))
+    kind = t.get("kind")
+    if kind == "beam":
+        raise r.fail("structure.kind", "'beam' on an airframe is not modelled yet (the flight "
+                     "model takes its modes from 'prototype-membrane' or a 'modal' file; "
+                     "write the beam's modes to a modal file, docs/structures.md)")
+    kind = r.choice(t, "structure", "kind", FLYING_KINDS, None)
+    zeta = r.number(t, "structure", "damping_ratio", *DAMPING_RANGE, "(ratio)",
+                    hint=" (a ratio, not a percentage: 2 % is 0.02)")
+    n = r.integer(t, "structure", "n_modes", FLYING_N_MODES, FLYING_N_MODES, FLYING_N_MODES)
+    if kind == "prototype-membrane":
+        r.keys(t, "structure", ("kind", "ribs", "damping_ratio", "n_modes"))
+        for key in ("centre_of_mass", "elastic_axis"):
+            _constant(r, stations, key)
+        return MembraneStructure(r.boolean(t, "structure", "ribs"), zeta, n)
+    r.keys(t, "structure", ("kind", "modes_file", "damping_ratio", "n_modes"))
+    path = Path(r.text(t, "structure", "modes_file"))
+    if base_dir is not None and not path.is_absolute():
+        path = base_dir / path
+    from bioflex_jsb.structures.modal_file import read_modal_file
+
+    try:
+        modes = read_modal_file(path)
+    except InputError as exc:  # the modal file's own one-line reason, under this field
+        raise r.fail("structure.modes_file", str(exc)) from None
+    for key, mine in (("centre_of_mass", modes.x_inertial_frac),
+                      ("elastic_axis", modes.x_elastic_frac)):
+        stated = _constant(r, stations, key)
+        if abs(float(np.mean(mine)) - stated) > MODAL_AXIS_TOLERANCE:
+            raise r.fail(f"wing.stations.{key}", f"{stated:g} differs from the modes file's "
+                         f"[axes] (mean {float(np.mean(mine)):g}): give the file's value")
+    return ModalStructure(str(path.resolve()), zeta, n)
+
+
+def _pin(r: Reader, at: dict, key: str) -> float | None:
+    v = at.get(key)
+    if v is None or (key == "pin_c_eta1_q1" and v == PHYSICAL_PIN):
+        return None
+    return r.number(at, "aero", key, -PIN_LIMIT, PIN_LIMIT, "(coefficient)",
+                    hint=" (a Table B1 coefficient of any wing is a few units at most)")
+
+
+def flying_wing(r: Reader, wing: dict, at: dict, aero: AeroSettings, name: str) -> FlyingWing:
+    """The flight-model settings of the wing (``[wing] name``, ``[aero]`` pins)."""
+    if "model" in at:
+        raise r.fail("aero.model", "is a clamped-wing setting; an aircraft's commands choose "
+                     "the aerodynamic model with --aero (docs/aircraft.md)")
+    if aero.lift_slope != "vlm":
+        raise r.fail("aero.lift_slope", "must be 'vlm' on an airframe: the flight model's "
+                     "strips take the vortex lattice's spanwise loading (Table B1)")
+    pin = at.get("pin_c_eta1_q1")
+    if isinstance(pin, str) and pin != PHYSICAL_PIN:
+        raise r.fail("aero.pin_c_eta1_q1", f"must be a number or {PHYSICAL_PIN!r}, got {pin!r}")
+    for key in ("strips", "section_lift_slope_per_rad"):
+        if key in at:
+            raise r.fail(f"aero.{key}", "is a clamped-wing setting (strip lift slope); an "
+                         "aircraft's wing takes the vortex lattice's (lift_slope = 'vlm')")
+    wing_name = r.text(wing, "wing", "name") if "name" in wing else name
+    return FlyingWing(wing_name, _pin(r, at, "pin_c_eta1_q1"),
+                      _pin(r, at, "published_c_eta1_q1"))
