@@ -4,8 +4,11 @@ checks, recovered files that independent tools accept; a long run's bounded hist
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -202,3 +205,208 @@ def test_a_long_run_keeps_an_envelope_with_the_exact_peaks():
         assert abs(a.settling_time_s - b.settling_time_s) <= ENVELOPE_S
     with pytest.raises(ValueError, match="keep"):
         run_gust(Airframe(), wing, "coupled", setup, keep="some")
+
+
+# ---------------------------------------------------------------------------------------
+# info / info --check: unfinished, still written, or damaged in any part
+# ---------------------------------------------------------------------------------------
+def _independent_reader_opens(path: Path) -> bool:
+    """Whether the mcap package's own indexed reader gets the file's summary."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    try:
+        with open(path, "rb") as f:
+            return make_reader(f).get_summary() is not None
+    except (McapError, ValueError, EOFError):
+        return False
+
+
+def _doctor(path: Path) -> int | None:
+    """pymcap-cli doctor's exit status (the tool beside this interpreter), None if absent."""
+    exe = Path(sys.executable).with_name("pymcap-cli")
+    if not exe.exists():
+        return None
+    return subprocess.run([str(exe), "doctor", str(path)], capture_output=True, text=True,
+                          timeout=120).returncode
+
+
+def _one_line(err: str) -> str:
+    lines = [x for x in err.strip().splitlines() if x.strip()]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]
+
+
+def _old(path: Path) -> Path:
+    """Set the file's modification time 1 h back (a log nobody has touched for long)."""
+    t = time.time() - 3600
+    os.utime(path, (t, t))
+    return path
+
+
+def test_check_reports_an_unfinished_log_as_not_ok(log2s, tmp_path, capsys):
+    """Before: "ok", exit 0, on a file no independent reader opens."""
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(log2s.read_bytes()[: log2s.stat().st_size * 2 // 3])
+    _old(cut)
+    assert not _independent_reader_opens(cut)
+    assert _doctor(cut) not in (0,)  # pymcap-cli doctor fails it too (None: not installed)
+    assert cli.main(["info", "--check", str(cut)]) == 1
+    captured = capsys.readouterr()
+    assert "unfinished" in captured.out
+    line = _one_line(captured.err)
+    assert "no Data End, summary, footer" in line and "--recover" in line
+    assert "writer was killed" in line
+    assert cli.main(["info", "--check", str(log2s)]) == 0  # a finished log is ok
+    assert capsys.readouterr().out.split(": ")[1] == "ok"
+
+
+WRITER = """
+import sys, time
+from bioflex_jsb.simulation.run import RunDescription
+from bioflex_jsb.sinks.mcap import RunLog
+log = RunLog.open(sys.argv[1], RunDescription(kind="gust", wing="optimised", speed_m_s=15.0,
+                  models=("coupled",), duration_s=2.0), {"name": "optimised"}, {})
+print("open", flush=True)
+time.sleep(120)
+"""
+
+
+def test_info_tells_a_log_being_written_from_one_whose_writer_was_killed(tmp_path, capsys):
+    """Before: "the writer was killed" while the writer was running."""
+    path = tmp_path / "live.mcap"
+    proc = subprocess.Popen([sys.executable, "-c", WRITER, str(path)], stdout=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout.readline().strip() == "open"
+        _old(path)  # not the modification time: the open descriptor tells
+        assert cli.main(["info", str(path)]) == 2
+        line = _one_line(capsys.readouterr().err)
+        assert f"still being written (open for writing by pid {proc.pid}" in line, line
+        assert "killed" not in line
+    finally:
+        proc.kill()
+        proc.wait()
+    # the writer is gone: a file touched seconds ago may still be written elsewhere ...
+    os.utime(path)
+    assert cli.main(["info", str(path)]) == 2
+    assert "probably still being written" in _one_line(capsys.readouterr().err)
+    # ... one untouched for long lost its writer
+    _old(path)
+    assert cli.main(["info", str(path)]) == 2
+    line = _one_line(capsys.readouterr().err)
+    assert "writer was killed" in line and "--recover" in line
+
+
+def _regions(path: Path) -> dict[str, tuple[int, int]]:
+    """Byte ranges [start, end) of the parts of a finished log: header, first chunk, the
+    metadata or records after the last chunk, the summary, the footer."""
+    import struct
+
+    from mcap.reader import make_reader
+
+    data = path.read_bytes()
+    with open(path, "rb") as f:
+        summary = make_reader(f).get_summary()
+    chunks = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
+    (summary_start,) = struct.unpack_from("<Q", data, len(data) - 8 - 20)
+    header_len = struct.unpack_from("<Q", data, 9)[0]
+    return {
+        "magic": (0, 8),
+        "header": (8, 8 + 9 + header_len),
+        "chunk": (chunks[0].chunk_start_offset,
+                  chunks[0].chunk_start_offset + chunks[0].chunk_length),
+        "last chunk": (chunks[-1].chunk_start_offset,
+                       chunks[-1].chunk_start_offset + chunks[-1].chunk_length),
+        "after the chunks": (chunks[-1].chunk_start_offset + chunks[-1].chunk_length,
+                             summary_start),
+        "summary": (summary_start, len(data) - 8 - 29),
+        "footer": (len(data) - 8 - 29, len(data)),
+    }
+
+
+def _flipped(src: Path, dst: Path, offsets) -> Path:
+    data = bytearray(src.read_bytes())
+    for at, bit in offsets:
+        data[at % len(data)] ^= 1 << bit
+    dst.write_bytes(bytes(data))
+    return dst
+
+
+@pytest.mark.parametrize("region", ["magic", "header", "chunk", "last chunk",
+                                    "after the chunks", "summary", "footer"])
+def test_one_flipped_bit_in_any_part_of_a_log_is_found(log2s, tmp_path, capsys, region):
+    lo, hi = _regions(log2s)[region]
+    assert hi > lo, region
+    for k, at in enumerate((lo, (lo + hi) // 2, hi - 1)):  # first, middle, last byte
+        for bit in (0, 7):
+            bad = _flipped(log2s, tmp_path / f"f{k}{bit}.mcap", [(at, bit)])
+            status = cli.main(["info", str(bad)])
+            err = capsys.readouterr().err
+            assert status == 2, (region, at, bit)
+            line = _one_line(err)
+            assert "damaged" in line or "not an MCAP file" in line, line
+            assert cli.main(["info", "--check", str(bad)]) in (1, 2)
+            capsys.readouterr()
+
+
+def test_random_flips_anywhere_are_found(log2s, tmp_path):
+    """Before: 400 flipped bytes and ``info`` reported the file as fine."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    size = log2s.stat().st_size
+
+    @settings(max_examples=30, deadline=None,
+              suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(st.lists(st.tuples(st.integers(0, size - 1), st.integers(0, 7)), min_size=1,
+                    max_size=400, unique=True))  # a bit flipped twice is no change
+    def flips(offsets):
+        bad = _flipped(log2s, tmp_path / "flipped.mcap", offsets)
+        with pytest.raises(sink.LogError):
+            sink.summarise(bad)
+
+    flips()
+
+
+FOREIGN_TOPICS = ["/bioflex/coupled/rigid_body", "/bioflex/coupled/modal",
+                  "/bioflex/coupled/gust", "/bioflex/events", "/bioflex/rigid_body"]
+
+
+def _foreign(path: Path, modal) -> Path:
+    """An MCAP another program wrote, on our topic names, JSON messages of its own."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="another program 1.0")
+        sid = w.register_schema(name="Other", encoding="jsonschema", data=b"{}")
+        ids = {t: w.register_channel(topic=t, message_encoding="json", schema_id=sid)
+               for t in FOREIGN_TOPICS}
+        w.add_metadata("bioflex.run", {"command": "gust", "argv": "[1, 2"})
+        for i in range(5):
+            for t, cid in ids.items():
+                body = modal(i) if t.endswith("/modal") else {"foo": i, "level": "x"}
+                w.add_message(cid, log_time=i * 10**6, publish_time=i * 10**6,
+                              data=json.dumps(body).encode())
+        w.finish()
+    return path
+
+
+@pytest.mark.parametrize("modal", [lambda i: [i, "x"], lambda i: {"eta_rad": "abc"},
+                                   lambda i: {"other": i}], ids=["list", "text", "missing"])
+@pytest.mark.parametrize("command", ["info", "plot", "rerun"])
+def test_another_programs_mcap_with_our_topics_is_one_line(tmp_path, capsys, command, modal):
+    path = _foreign(tmp_path / "foreign.mcap", modal)
+    argv = {"info": ["info", str(path)],
+            "plot": ["plot", str(path), "--out", str(tmp_path / "f.png")],
+            "rerun": ["rerun", str(path), "--out", str(tmp_path / "again.mcap")]}[command]
+    status = cli.main(argv)
+    captured = capsys.readouterr()
+    if command == "info":  # any MCAP is summarised
+        assert status == 0 and "another program 1.0" in captured.out
+        return
+    assert status == 2
+    line = _one_line(captured.err)
+    if command == "plot":
+        assert "'/bioflex/coupled/modal'" in line and "not one bioflex-jsb writes" in line

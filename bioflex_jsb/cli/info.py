@@ -16,9 +16,12 @@ mcap package's indexed reader. A log whose writer was killed (SIGKILL, power los
 summary; --recover FIXED.mcap copies every complete chunk of it into a new, finished file
 (at most the last chunk, 0.9 s of simulated time, is lost); a damaged chunk is skipped,
 every intact chunk after it kept, and the skipped ones are named. --check decompresses
-every chunk and verifies its CRC (and the data section's): exit status 1 and the damaged
-chunks if any fails. Logs in protobuf (this version) and JSON (older versions) are read
-alike."""
+every chunk and verifies its CRC, the data section's and the summary's, and that the file
+is finished (Data End, summary, footer): exit status 1 and one line saying what is wrong if
+not. Without --check, info verifies the same and refuses (exit 2, one line) a damaged or
+unfinished file; an unfinished one is told apart: still being written (a process has it
+open for writing, or it changed in the last 10 s) or cut off (its writer was killed). Logs
+in protobuf (this version) and JSON (older versions) are read alike."""
 
 
 def register(sub) -> None:
@@ -28,7 +31,7 @@ def register(sub) -> None:
     p.add_argument("--recover", metavar="FIXED.mcap",
                    help="write the complete records of a truncated FILE.mcap to FIXED.mcap")
     p.add_argument("--check", action="store_true",
-                   help="verify the CRC of every chunk (exit 1 if one fails)")
+                   help="verify every CRC and that the file is finished (exit 1 if not)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -59,18 +62,27 @@ def run(args: argparse.Namespace) -> int:
               + f" (read stopped at: {result['stopped_at']})"
               + (f"; skipped {len(skipped)} damaged: {'; '.join(skipped)}" if skipped else ""))
     elif args.check:
-        status = "damaged" if result["bad"] or result["data_crc"] == "bad" else "ok"
-        print(f"{result['file']}: {status}: {result['chunks']} chunks, "
+        print(f"{result['file']}: {_check_status(result)}: {result['chunks']} chunks, "
               f"{len(result['bad'])} with a bad CRC or record, data section CRC "
-              f"{result['data_crc']}" + (f" ({'; '.join(result['bad'])})"
-                                         if result["bad"] else ""))
+              f"{result['data_crc']}, summary CRC {result['summary_crc']}"
+              + (f" ({'; '.join(result['bad'])})" if result["bad"] else ""))
     else:
         print_summary(result)
-    if args.check and (result["bad"] or result["data_crc"] == "bad"):
-        print(f"bioflex-jsb info: {args.file}: damaged chunks: recover the intact ones with "
-              f"--recover FIXED.mcap", file=sys.stderr)
+    if args.check and _check_status(result) != "ok":  # one line: what is wrong, the repair
+        from bioflex_jsb.sinks.mcap.writers import unfinished_message
+
+        line = (unfinished_message(args.file, f"no {', '.join(result['missing'])}")
+                if _check_status(result) == "unfinished" else
+                f"{args.file!r} is damaged: {'; '.join(result['problems'])}; "
+                "--recover FIXED.mcap copies the intact chunks")
+        print(f"bioflex-jsb info: {line}", file=sys.stderr)
         return 1
     return 0
+
+
+def _check_status(result: dict) -> str:
+    """ok, unfinished (no Data End/summary/footer, nothing else wrong) or damaged."""
+    return "damaged" if result["problems"] else "unfinished" if not result["finished"] else "ok"
 
 
 def print_summary(s: dict) -> None:

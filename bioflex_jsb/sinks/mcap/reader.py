@@ -32,18 +32,36 @@ def check_file(path: str | Path) -> Path:
 
 
 def _truncated(p: Path) -> LogError:
-    return LogError(
-        f"{str(p)!r} is truncated (the writer was killed before finishing it); recover the "
-        f"complete chunks with: bioflex-jsb info {str(p)!r} --recover FIXED.mcap"
-    )
+    from bioflex_jsb.sinks.mcap.writers import unfinished_message
+
+    return LogError(unfinished_message(p))
+
+
+def verify(path: str | Path) -> dict:
+    """Every CRC and record of the log checked (:func:`.recover.check_chunks`); LogError,
+    one line, for a file that is unfinished (being written, or its writer killed:
+    :mod:`.writers`) or damaged anywhere (header, chunks, metadata, summary, footer)."""
+    from bioflex_jsb.sinks.mcap.recover import check_chunks
+    from bioflex_jsb.sinks.mcap.writers import unfinished_message
+
+    p = check_file(path)
+    result = check_chunks(p)
+    if result["missing"] and not result["problems"]:
+        raise LogError(unfinished_message(p, f"no {', '.join(result['missing'])}"))
+    if result["problems"]:
+        raise LogError(f"{str(p)!r} is damaged: {'; '.join(result['problems'])}; recover the "
+                       f"intact chunks with: bioflex-jsb info {str(p)!r} --recover FIXED.mcap")
+    return result
 
 
 @contextmanager
-def open_reader(path: str | Path):
-    """An indexed ``mcap`` reader of a finished log, with its summary; LogError otherwise."""
+def open_reader(path: str | Path, verified: bool = False):
+    """An indexed ``mcap`` reader of a finished log, with its summary; LogError otherwise.
+    ``verified``: check every CRC first (:func:`verify`); without it the chunks read are
+    checked against their CRCs as they are read."""
     from mcap.reader import make_reader
 
-    p = check_file(path)
+    p = verify(path) and Path(path) if verified else check_file(path)
     with open(p, "rb") as f:
         f.seek(0, 2)
         size = f.tell()
@@ -54,7 +72,7 @@ def open_reader(path: str | Path):
             raise _truncated(p)
         f.seek(0)
         try:
-            reader = make_reader(f)
+            reader = make_reader(f, validate_crcs=True)
             summary = reader.get_summary()
         except bad_data_errors() as exc:
             raise LogError(f"{str(p)!r}: unreadable MCAP summary ({exc})") from None
@@ -93,9 +111,46 @@ def iter_messages(reader, topics: list[str] | None = None
             decode = decoders.get(channel.id)
             if decode is None:
                 decode = decoders[channel.id] = message_decoder(schema, channel)
-            yield channel.topic, message.log_time, decode(message.data)
+            msg = decode(message.data)
+            if not isinstance(msg, dict):
+                raise NotOurs(channel.topic, message.log_time,
+                              f"a {type(msg).__name__}, not a message object")
+            yield channel.topic, message.log_time, msg
     except bad_data_errors() as exc:
+        if isinstance(exc, LogError):
+            raise
         raise LogError(f"unreadable message data ({exc})") from None
+
+
+class NotOurs(LogError):
+    """A record on one of our topics that bioflex-jsb did not write (another program's
+    MCAP with our topic names): one line naming the record."""
+
+    def __init__(self, topic: str, log_time_ns: int, why: str) -> None:
+        super().__init__(f"the message on {topic!r} at log time {log_time_ns * 1e-9:.6g} s is "
+                         f"not one bioflex-jsb writes ({why}); is this log from another "
+                         "program?")
+
+
+def _number(msg: dict, field: str, topic: str, ns: int, optional: bool = False):
+    """``msg[field]`` as a number (None if ``optional`` and absent); NotOurs otherwise."""
+    value = msg.get(field)
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise NotOurs(topic, ns, f"field {field!r} is {type(value).__name__}, not a number")
+    return value
+
+
+def _numbers(msg: dict, field: str, topic: str, ns: int, optional: bool = False) -> list:
+    """``msg[field]`` as a list of numbers; NotOurs otherwise."""
+    value = msg.get(field)
+    if value is None and optional:
+        return []
+    if not isinstance(value, (list, tuple)) or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+        raise NotOurs(topic, ns, f"field {field!r} is not a list of numbers")
+    return list(value)
 
 
 iter_json = iter_messages  # the name from when every log was JSON
@@ -109,17 +164,17 @@ def read_events(reader, summary) -> list[dict]:
     out = []
     for _, ns, msg in iter_messages(reader, [EVENTS_TOPIC]):
         level = msg.get("level", 0)
+        known = isinstance(level, int) and 0 <= level < len(EVENT_LEVELS)
         out.append({"time_s": ns * 1e-9,
-                    "level": EVENT_LEVELS[level] if 0 <= level < len(EVENT_LEVELS)
-                    else str(level),
-                    "text": msg.get("message", ""), "name": msg.get("name", "")})
+                    "level": EVENT_LEVELS[level] if known else str(level),
+                    "text": str(msg.get("message", "")), "name": str(msg.get("name", ""))})
     return out
 
 
 def summarise(path: str | Path) -> dict:
     """Channels (topic, schema, count), duration, chunks, metadata and events
     (:func:`read_events`) of a finished log."""
-    with open_reader(path) as (reader, summary):
+    with open_reader(path, verified=True) as (reader, summary):
         stats = summary.statistics
         counts = dict(stats.channel_message_counts) if stats else {}
         channels = []
@@ -153,9 +208,10 @@ def histories(path: str | Path) -> tuple[list, dict[str, str]]:
 
     with open_reader(path) as (reader, summary):
         meta = read_metadata(reader).get(RUN_METADATA, {})
+        # our run topics: /bioflex/<model>/<group> (docs/logging.md); any other is not read
         wanted = [ch.topic for ch in summary.channels.values()
-                  if ch.topic.rsplit("/", 1)[-1] in ("rigid_body", "modal", "gust",
-                                                      "lti_prediction")]
+                  if len(parts := ch.topic.split("/")) == 4 and parts[:2] == ["", "bioflex"]
+                  and parts[3] in ("rigid_body", "modal", "gust", "lti_prediction")]
         cols: dict[tuple[str, str], dict[str, list]] = {}
         for top, ns, msg in iter_messages(reader, wanted):
             _, _, model, group = top.split("/", 3)
@@ -165,15 +221,15 @@ def histories(path: str | Path) -> tuple[list, dict[str, str]]:
                 d.setdefault("time_s", []).append(ns * 1e-9)
                 for name, field in (("u", "du_m_s"), ("alpha", "dalpha_rad"), ("q", "q_rad_s"),
                                     ("theta", "dtheta_rad"), ("n_z", "n_z")):
-                    d.setdefault(name, []).append(msg.get(field))
+                    d.setdefault(name, []).append(_number(msg, field, top, ns, optional=True))
                 if group == "lti_prediction":
-                    for i, v in enumerate(msg.get("eta_rad") or []):
+                    for i, v in enumerate(_numbers(msg, "eta_rad", top, ns, optional=True)):
                         d.setdefault(f"eta{i + 1}", []).append(v)
             elif group == "modal":
-                for i, v in enumerate(msg["eta_rad"]):
+                for i, v in enumerate(_numbers(msg, "eta_rad", top, ns)):
                     d.setdefault(f"eta{i + 1}", []).append(v)
             elif group == "gust":
-                d.setdefault("w_g", []).append(msg["w_g_m_s"])
+                d.setdefault("w_g", []).append(_number(msg, "w_g_m_s", top, ns))
     units = {"u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-",
              "w_g": "m/s"}
     runs = []

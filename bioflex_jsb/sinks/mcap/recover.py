@@ -258,17 +258,26 @@ def recover(path: str | Path, out: str | Path) -> dict:
             "skipped": skipped}
 
 
+_FOOTER_BYTES = 9 + 20  # opcode, length, summary start, summary offset start, summary CRC
+
+
 def check_chunks(path: str | Path) -> dict:
-    """Every chunk of a log decompressed and its CRC checked (and the data section's CRC
-    where the file is finished): ``chunks``, ``bad`` (byte offset and why, per chunk that
-    fails), ``data_crc`` (``ok``, ``bad``, ``absent`` or ``unfinished``)."""
+    """Every byte of a log checked against its CRCs: each chunk decompressed and its CRC
+    checked, the data section's CRC (header, schemas, channels, chunks, metadata: every
+    byte before Data End), the summary's CRC (summary, summary offsets and the footer's
+    fields) and the footer's place and magic. Returns ``chunks``, ``bad`` (byte offset and
+    why, per chunk that fails), ``data_crc`` and ``summary_crc`` (``ok``, ``bad``,
+    ``absent`` (not written) or ``unfinished``), ``finished`` (Data End, summary and footer
+    present), ``missing`` (what an unfinished file lacks) and ``problems`` (one phrase each
+    for everything that does not check; empty for a sound, finished file)."""
     p = Path(path)
     if not p.exists():
         raise LogError(f"{str(p)!r}: no such file")
     if not p.is_file():
         raise LogError(f"{str(p)!r} is not a file")
     data = _open_data(p)
-    chunks, bad, data_crc, stop = 0, [], "unfinished", None
+    chunks, bad, data_crc, stop, data_end = 0, [], "unfinished", None, None
+    problems: list[str] = []
     for offset, op, body in scan(data):
         if isinstance(body, BaseException):
             if op == _OP_CHUNK:
@@ -277,6 +286,8 @@ def check_chunks(path: str | Path) -> dict:
                 continue
             stop = str(body)
             break
+        if offset == len(MAGIC) and op != _OP_HEADER:
+            problems.append(f"the first record is not a Header (opcode {op})")
         if op == _OP_CHUNK:
             chunks += 1
         elif op == _OP_DATA_END:
@@ -285,6 +296,54 @@ def check_chunks(path: str | Path) -> dict:
                 data_crc = "absent"
             else:
                 data_crc = "ok" if zlib.crc32(data[:offset]) == stored else "bad"
+            data_end = offset + 9 + len(body)
             break
+        elif op == _OP_FOOTER:
+            problems.append(f"a Footer at byte {offset} without a Data End record")
+            break
+    summary_crc, missing = _check_tail(data, data_end, problems)
+    if bad:
+        problems.append(f"{len(bad)} of {chunks} chunks fail their check ({bad[0]}"
+                        + (", …" if len(bad) > 1 else "") + ")")
+    if data_crc == "bad":
+        problems.append("the data section's CRC does not match")
+    if stop is not None and not missing:
+        problems.append(f"the data section is damaged ({stop})")
     return {"file": str(p), "chunks": chunks, "bad": bad, "data_crc": data_crc,
-            "stopped_at": stop}
+            "summary_crc": summary_crc, "stopped_at": stop, "finished": not missing,
+            "missing": missing, "problems": problems}
+
+
+def _check_tail(data, data_end: int | None, problems: list[str]) -> tuple[str, list[str]]:
+    """The summary's CRC and the footer: (summary_crc, what is missing). A file without
+    the closing magic and without Data End is unfinished (its writer stopped before the
+    end); a file that has one and not the other is damaged."""
+    size = len(data)
+    tail_magic = size >= len(MAGIC) * 2 + _FOOTER_BYTES and data[size - len(MAGIC):] == MAGIC
+    if not tail_magic:
+        if data_end is None:
+            return "unfinished", ["Data End", "summary", "footer"]
+        problems.append("the footer or the closing magic is damaged")
+        return "unfinished", []
+    at = size - len(MAGIC) - _FOOTER_BYTES
+    op, length = data[at], struct.unpack_from("<Q", data, at + 1)[0]
+    if op != _OP_FOOTER or length != 20:
+        problems.append(f"no Footer record before the closing magic (byte {at})")
+        return "unfinished", []
+    start, offsets, stored = struct.unpack_from("<QQI", data, at + 9)
+    if data_end is None:
+        problems.append("the data section ends without a Data End record")
+    elif start not in (0, data_end):
+        problems.append(f"the footer's summary start ({start}) is not the end of the data "
+                        f"section ({data_end})")
+        return "bad", []
+    if start and not start <= offsets <= at or not start and offsets:
+        problems.append("the footer's summary offsets point outside the summary")
+        return "bad", []
+    if stored == 0:
+        return "absent", []
+    crc = zlib.crc32(data[start if start else at:at + 9 + 16])
+    if crc != stored:
+        problems.append("the summary's CRC does not match (summary or footer damaged)")
+        return "bad", []
+    return "ok", []
