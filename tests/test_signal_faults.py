@@ -250,3 +250,31 @@ def test_a_signal_ends_a_blocking_wait_for_ardupilot_promptly(tmp_path, sig):
     # timeout would still pass 5 s; this bound is for a stop ignored by the wait (PEP 475)
     # and the summary's output under load
     assert waited_s < 20, waited_s
+
+
+def test_a_deferred_stop_never_cuts_a_close(tmp_path):
+    """A stop deferred in a callback whose re-delivery arrives while the command closes its
+    files (``closing()``): the close completes, then exit 130 (one line)."""
+    patch = """
+    from bioflex_jsb.cli import common
+    from bioflex_jsb.cli import info as _info
+    from bioflex_jsb.interrupts import native_callback
+
+    @native_callback
+    def callback():
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(1000):
+            pass
+
+    def run(args):
+        callback()  # deferred: STOP.pending, re-delivered in 5 ms
+        with common.closing():
+            time.sleep(0.5)  # the re-delivery lands here
+            print("closed", flush=True)
+        return 0
+    _info.run = run  # what register() hands to argparse
+    """
+    r = harness(tmp_path, patch, "info", tmp_path / "none.mcap")
+    assert r.returncode == 130, r.stderr
+    assert r.stdout.strip() == "closed"
+    assert "closing its files" in one_line(r.stderr)

@@ -109,8 +109,8 @@ def _emergency_exit(reason: str) -> NoReturn:
 def _on_stop_signal(signum, frame) -> None:
     if SIGNALS.redelivered:  # our own re-delivery of a deferred stop: not a new signal
         SIGNALS.redelivered = False
-        if not STOP.pending:
-            return  # a check point raised it meanwhile
+        if not STOP.pending or SIGNALS.shield:
+            return  # a check point raised it meanwhile, or files are being closed (130 after)
     else:
         SIGNALS.received += 1
         if SIGNALS.shield or SIGNALS.received > 1 or STOP.pending:
