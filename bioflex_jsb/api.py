@@ -323,3 +323,18 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope)
     return replace(res, settings=dict(res.settings, definition=d.path or d.name,
                                       range_derived=range_m_s is None
                                       and d.analysis.speed_range_m_s is None))
+
+
+def section_loads(wing, run: TimeHistory, stations=(0.0, 0.25, 0.5, 0.75), *,
+                  static: str | None = None, density_kg_m3: float | None = None):
+    """Wing section loads of the gust ``run`` (from :func:`fly_gust` with ``wing``) at the
+    monitoring ``stations`` (fractions of the semispan; default root, 25, 50, 75 %): shear
+    [N, up +], bending moment [N·m, tip up +] and torque about the elastic axis [N·m,
+    leading edge up +] by force summation and by mode displacement, with their difference
+    (:class:`bioflex_jsb.loads.SectionLoads`: ``.values``, ``.difference()``, ``.plot()``;
+    :func:`bioflex_jsb.loads.loads_metrics` the metrics' ``loads`` sub-dict; docs/loads.md).
+    ``static``: the 1 g part, ``elastic`` (default for coupled/qsd) or ``rigid``."""
+    from bioflex_jsb.loads import section_loads as _section_loads
+
+    build = wing.wing() if callable(getattr(wing, "wing", None)) else wing
+    return _section_loads(build, run, stations, static=static, density_kg_m3=density_kg_m3)

@@ -42,6 +42,7 @@ COMMAND_MODULES = (
     "sitl",
     "sitl_ardupilot",
     "compare",
+    "loads",
     "export_jsbsim",
     "info",
     "plot",

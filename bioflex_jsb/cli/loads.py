@@ -1,0 +1,265 @@
+"""``bioflex-jsb loads``: wing section loads of a gust run, or the tuned discrete gust."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+
+from bioflex_jsb.cli.case import (
+    DEFAULT_SPEED_M_S,
+    DEFAULT_WING,
+    add_force_argument,
+    airspeed,
+    check_plot_path,
+    speed_help,
+)
+from bioflex_jsb.cli.common import (
+    EXIT_DIVERGED,
+    UsageError,
+    add_wing_arguments,
+    check_output,
+    positive_float,
+    print_json,
+    wing_from_args,
+)
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+
+DEFAULT_GUST = "1cos:3:5"  # the paper's 3 m/s, 2.5 m gradient (between the tuned ends)
+
+HELP = f"""Fly one gust (--gust, default {DEFAULT_GUST}) with the elastic wing (--model,
+default coupled) and report the wing's section loads at the monitoring stations (--stations,
+fractions of the semispan, default 0,0.25,0.5,0.75): vertical shear V [N, up +], bending
+moment M [N*m, tip up +] and torque about the elastic axis T [N*m, leading edge up +], by
+force summation (FS: the strips' aerodynamic loads, the gust's included, less the inertia
+of the wing outboard) and by mode displacement (MD: EI phi'' eta, GJ theta' eta of the beam
+modes), with their difference: largest and smallest value after the gust start with its time,
+the 1 g value and the increments over it. With --tuned: 1-cos gusts over a range of gradient
+lengths H, up and down (default {{h_min:.2g}}..{{h_max:g}} m, {{n}} lengths; amplitude
+U_ref (H/H_max)^(1/6), U_ref = --amplitude, the airworthiness codes' shape; docs/loads.md
+for the rationale), the critical gradient per station, quantity and method (--csv FILE
+writes the table), and the correlated-load envelopes (bending vs torque per station) in
+--plot (default loads_envelope.png). The runs are sequential on this machine. No MCAP log
+is written (the loads are a post-process of the runs). Exit 3 if a run diverged."""
+
+
+def fractions(text: str) -> tuple[float, ...]:
+    """argparse type: comma-separated fractions of the semispan, 0 <= f < 1, increasing."""
+    from bioflex_jsb.errors import InputError, plain_number
+    from bioflex_jsb.loads.model import station_positions_m
+
+    try:
+        values = tuple(plain_number(t.strip(), "station") for t in text.split(","))
+        station_positions_m(values, 1.0)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(f"--stations {text!r}: {exc}") from None
+    return values
+
+
+def gradients(text: str) -> tuple[float, ...]:
+    """argparse type: ``MIN:MAX:N`` (log-spaced) or comma-separated gradients H [m]."""
+    import numpy as np
+
+    from bioflex_jsb.errors import InputError, plain_integer, plain_number
+    from bioflex_jsb.simulation.gusts import MAX_GUST_LENGTH_M, MIN_GUST_LENGTH_M
+
+    lo_h, hi_h = MIN_GUST_LENGTH_M / 2.0, MAX_GUST_LENGTH_M / 2.0
+    try:
+        if ":" in text:
+            parts = text.split(":")
+            if len(parts) != 3:
+                raise InputError("give MIN:MAX:N")
+            lo, hi = plain_number(parts[0], "MIN"), plain_number(parts[1], "MAX")
+            n = plain_integer(parts[2], "N")
+            if not (0 < lo < hi) or not 2 <= n <= 200:
+                raise InputError("need 0 < MIN < MAX and 2 <= N <= 200")
+            values = tuple(float(x) for x in np.geomspace(lo, hi, n))
+        else:
+            values = tuple(plain_number(t.strip(), "gradient") for t in text.split(","))
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(f"--gradients {text!r}: {exc} (MIN:MAX:N log-spaced, "
+                                         "or H1,H2,... in m)") from None
+    if any(not lo_h <= h <= hi_h for h in values):
+        raise argparse.ArgumentTypeError(
+            f"--gradients {text!r}: each H must be within {lo_h:g}..{hi_h:g} m (the 1-cos "
+            "gust's length 2H within the gust limits, docs/gusts.md)")
+    return values
+
+
+def register(sub) -> None:
+    from bioflex_jsb.loads.tuned import DEFAULT_H_MAX_M, DEFAULT_N_LENGTHS, default_gradients_m
+
+    text = HELP.format(h_min=default_gradients_m()[0], h_max=DEFAULT_H_MAX_M,
+                       n=DEFAULT_N_LENGTHS)
+    p = sub.add_parser("loads", help="wing section loads in a gust; --tuned: critical 1-cos "
+                       "gradients and load envelopes", description=text)
+    add_wing_arguments(p, default=DEFAULT_WING)
+    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
+                   help="trim " + speed_help())
+    p.add_argument("--gust", default=DEFAULT_GUST,
+                   help=f"gust specification (default {DEFAULT_GUST}; forms as in `gust`)")
+    p.add_argument("--duration", type=positive_float("duration", "s"), default=3.0,
+                   help="simulated time [s] of a single run (default 3)")
+    p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
+                   help="time the gust starts [s] (default 0.5)")
+    p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
+                   help=f"co-simulation step [s] (default {DEFAULT_DT_S:.6f})")
+    p.add_argument("--model", choices=("coupled", "qsd", "rigid"), default="coupled",
+                   help="wing model flown (default coupled; rigid: force summation only)")
+    p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
+                   help="the trim the run starts from (as `gust --trim`)")
+    p.add_argument("--stations", type=fractions, default=(0.0, 0.25, 0.5, 0.75),
+                   help="monitoring stations as fractions of the semispan (default "
+                   "0,0.25,0.5,0.75)")
+    p.add_argument("--static", choices=("elastic", "rigid"), default=None,
+                   help="the 1 g static part: elastic (the elastic trim's deflection, default "
+                   "for coupled/qsd) or rigid (undeformed wing; the rigid model's)")
+    p.add_argument("--tuned", action="store_true", help="the tuned discrete gust (above)")
+    p.add_argument("--gradients", type=gradients, default=None,
+                   help="--tuned gradients H [m]: MIN:MAX:N (log-spaced) or H1,H2,...")
+    p.add_argument("--amplitude", type=positive_float("amplitude", "m/s"), default=3.0,
+                   help="--tuned reference gust velocity U_ref [m/s] (default 3)")
+    p.add_argument("--scaling", choices=("cs25", "fixed"), default="cs25",
+                   help="--tuned amplitude: cs25 U_ref (H/H_max)^(1/6) (default) or fixed")
+    p.add_argument("--csv", metavar="FILE.csv", default=None,
+                   help="--tuned: the critical-case table as CSV")
+    p.add_argument("--plot", metavar="FILE.png", default=None,
+                   help="figure (loads time histories; --tuned: the envelopes); default "
+                   "loads.png / loads_envelope.png without --json")
+    add_force_argument(p)
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(run=run)
+
+
+def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
+    from bioflex_jsb import api
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.loads import section_loads
+    from bioflex_jsb.runtime.fdm import FdmError
+
+    try:
+        run = api.fly_gust(build, args.speed, gust_text, models=(args.model,),
+                           duration_s=duration_s, gust_start_s=gust_start_s, dt_s=args.dt,
+                           trim=args.trim)[args.model]
+        return run, section_loads(build, run, args.stations, static=args.static)
+    except (FdmError, InputError) as exc:
+        raise UsageError(str(exc)) from None
+
+
+def run(args: argparse.Namespace) -> int:
+    build = wing_from_args(args)
+    if args.model == "rigid" and args.static == "elastic":
+        raise UsageError("--model rigid has no static deflection; drop --static elastic")
+    if args.tuned:
+        return _tuned(args, build)
+    from bioflex_jsb.loads import loads_metrics
+    from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
+
+    try:
+        parse_gust(args.gust)
+    except GustSpecError as exc:
+        raise UsageError(f"--gust: {exc}") from None
+    if args.gust_start >= args.duration:
+        raise UsageError(f"--gust-start {args.gust_start:g} s must be before the end of the "
+                         f"run (--duration {args.duration:g} s)")
+    plot = args.plot if args.plot is not None else (None if args.json else "loads.png")
+    check_plot_path(plot, args.force)
+    run_, loads = _fly(args, build, args.gust, args.duration, args.gust_start)
+    metrics = loads_metrics(loads, args.gust_start)
+    if plot:
+        loads.plot(plot, args.gust_start)
+    if args.json:
+        print_json({"wing": build.variant.name, "speed_m_s": args.speed, "gust": args.gust,
+                    "model": args.model, "static": loads.meta["static"],
+                    "accelerations": loads.meta["accelerations"], "loads": metrics,
+                    "plot": plot})
+    else:
+        _print_metrics(build, args, loads, metrics)
+        if plot:
+            print(f"section loads written to {plot}")
+    if run_.stopped:
+        print(f"bioflex-jsb loads: diverged: {args.model} run stopped: {run_.stopped}",
+              file=sys.stderr)
+        return EXIT_DIVERGED
+    return 0
+
+
+def _print_metrics(build, args, loads, metrics) -> None:
+    print(f"Section loads: wing {build.variant.name}, {args.speed:g} m/s, gust {args.gust}, "
+          f"{args.model} model; static part: {loads.meta['static']}")
+    print("  V shear [N] up +, M bending [N*m] tip up +, T torque about the elastic axis "
+          "[N*m] leading edge up +; increments over 1 g (time of the peak [s])")
+    head = f"{'station':10s} {'load':3s} {'method':4s} {'1 g':>9s} {'incr up':>9s} " \
+           f"{'(t)':>6s} {'incr down':>9s} {'(t)':>6s} {'max|FS-MD|':>10s}"
+    print(head)
+    short = {"shear_n": "V", "bending_n_m": "M", "torque_n_m": "T"}
+    diff = metrics.get("max_abs_difference", {})
+    for j in range(len(loads.stations_m)):
+        for quantity in ("shear_n", "bending_n_m", "torque_n_m"):
+            for method in loads.methods:
+                r = metrics["methods"][method][quantity][j]
+                tag = "FS" if method == "force_summation" else "MD"
+                d = f"{diff[quantity][j]:10.4f}" if diff and tag == "FS" else ""
+                print(f"{r['station']:10s} {short[quantity]:3s} {tag:4s} {r['static_1g']:9.4f} "
+                      f"{r['increment_up']:+9.4f} {r['time_max_s']:6.3f} "
+                      f"{r['increment_down']:+9.4f} {r['time_min_s']:6.3f} {d}")
+
+
+def _tuned(args, build) -> int:
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.loads.tuned import plot_envelopes, tuned_gust
+
+    plot = args.plot if args.plot is not None else (None if args.json else "loads_envelope.png")
+    check_plot_path(plot, args.force)
+    if args.csv:
+        if not args.csv.lower().endswith(".csv"):
+            raise UsageError(f"--csv {args.csv!r}: the file name must end in .csv")
+        check_output(args.csv, args.force, "--csv")
+    stopped = []
+
+    def fly(gust_text, duration_s, gust_start_s):
+        run_, loads = _fly(args, build, gust_text, duration_s, gust_start_s)
+        if run_.stopped:
+            stopped.append(f"{gust_text}: {run_.stopped}")
+        return loads
+
+    def progress(k, n, text):
+        if sys.stderr.isatty():
+            print(f"\r  gust {k}/{n} {text}   ", end="", file=sys.stderr, flush=True)
+
+    try:
+        result = tuned_gust(fly, args.speed, args.gradients, u_ref_m_s=args.amplitude,
+                            scaling=args.scaling, progress=progress)
+    except InputError as exc:
+        raise UsageError(str(exc)) from None
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    if args.csv:
+        with open(args.csv, "w", newline="", encoding="utf-8") as f:
+            csv.writer(f).writerows(result.csv_rows())
+    if plot:
+        plot_envelopes(result, plot)
+    if args.json:
+        print_json(dict(result.as_dict(), plot=plot, csv=args.csv, stopped=stopped))
+    else:
+        st = result.settings
+        print(f"Tuned 1-cos gust: wing {build.variant.name}, {args.speed:g} m/s, "
+              f"{args.model} model, H = {', '.join(f'{h:.3g}' for h in st['gradients_m'])} m, "
+              f"U = {args.amplitude:g} m/s x (H/{st['h_max_m']:.3g} m)^(1/6)"
+              if args.scaling == "cs25" else
+              f"Tuned 1-cos gust: wing {build.variant.name}, {args.speed:g} m/s, fixed "
+              f"U = {args.amplitude:g} m/s")
+        print(f"{'station':10s} {'load':12s} {'method':4s} {'dir':4s} {'H [m]':>6s} "
+              f"{'gust':>4s} {'1 g':>9s} {'increment':>10s} {'t [s]':>6s}")
+        for r in result.critical:
+            tag = "FS" if r["method"] == "force_summation" else "MD"
+            print(f"{r['station']:10s} {r['quantity']:12s} {tag:4s} {r['direction']:4s} "
+                  f"{r['gradient_m']:6.3g} {r['sign']:>4s} {r['static_1g']:9.4f} "
+                  f"{r['increment']:+10.4f} {r['time_s']:6.3f}")
+        if args.csv:
+            print(f"critical cases written to {args.csv}")
+        if plot:
+            print(f"load envelopes written to {plot}")
+    for s in stopped:
+        print(f"bioflex-jsb loads: diverged: {s}", file=sys.stderr)
+    return EXIT_DIVERGED if stopped else 0

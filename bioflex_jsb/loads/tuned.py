@@ -1,0 +1,207 @@
+"""Tuned discrete gust: 1-cosine gusts over a range of gradient lengths, up and down; the
+critical gradient per station, load quantity and method; correlated-load envelopes.
+
+Gradient lengths (docs/loads.md, "Tuned gust"): the airworthiness codes (CS/FAR 25.341)
+scale the gradient H from 9 to 107 m (30 to 350 ft) for transport aircraft, with the design
+gust velocity U = U_ref (H / 107 m)^(1/6). Their range runs from gusts that are short for the
+aircraft (a few chords: they excite the wing's own modes) to gusts long enough for the
+short-period response to be quasi-static. For the 1.7 m span prototype at 15 m/s
+(c̄ = 0.183 m, first wing mode 31 Hz, short period about 0.75 s) the same two ends are
+
+* short: the gust time 2H/V at the first wing mode's period, H = V/(2 f₁) ≈ 0.24 m at 15 m/s
+  (1.3 chords); the default starts there, at DEFAULT_H_MIN_CHORDS c̄ = 0.27 m;
+* long: 2H/V two short-period periods, H = V T_sp ≈ 11 m; the default ends at
+  DEFAULT_H_MAX_M = 15 m, past which a gust is a slow change of angle of attack for this
+  aircraft.
+
+Amplitude: ``cs25`` scaling U = U_ref (H/H_max)^(1/6), the code's shape with the reference at
+the longest gradient (U_ref default 3 m/s, the paper's gust), or ``fixed`` (every gust U_ref).
+The 1-cos gust of ``simulation/gusts.py`` is given by its length L = 2H.
+
+The flying is the caller's: :func:`tuned_gust` takes ``fly(gust_text, duration_s) ->
+SectionLoads``, so it runs on any machinery (today the command runs it sequentially).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bioflex_jsb.errors import InputError
+from bioflex_jsb.loads.model import QUANTITIES
+from bioflex_jsb.parameters import prototype as P
+
+DEFAULT_H_MIN_CHORDS = 1.5  # shortest gradient [chords]: near the first wing mode (above)
+DEFAULT_H_MAX_M = 15.0  # longest gradient [m]: quasi-static short period at 15 m/s (above)
+DEFAULT_N_LENGTHS = 10  # gradients, log-spaced
+DEFAULT_AMPLITUDE_M_S = 3.0  # U_ref [m/s]: the paper's 3 m/s gust
+SCALINGS = ("cs25", "fixed")
+# After the gust has passed, the run goes on this long [s]: two short-period periods
+# (0.7-0.9 s at 15 m/s, Table 3) for the peak of the response that follows the gust.
+SETTLE_AFTER_S = 1.6
+GUST_START_S = 0.2  # time before the gust [s]: the trim (the loads are steady from t = 0)
+
+
+def default_gradients_m(n: int = DEFAULT_N_LENGTHS) -> np.ndarray:
+    """Log-spaced gradients H [m] from DEFAULT_H_MIN_CHORDS c̄ to DEFAULT_H_MAX_M."""
+    return np.geomspace(DEFAULT_H_MIN_CHORDS * P.MEAN_AERODYNAMIC_CHORD_M, DEFAULT_H_MAX_M, n)
+
+
+def gust_amplitude_m_s(h_m: float, u_ref_m_s: float, h_max_m: float, scaling: str) -> float:
+    """U [m/s] of the gradient ``h_m``: U_ref (H/H_max)^(1/6) (cs25) or U_ref (fixed)."""
+    if scaling not in SCALINGS:
+        raise InputError(f"unknown amplitude scaling {scaling!r}; accepted: {', '.join(SCALINGS)}")
+    return u_ref_m_s * (h_m / h_max_m) ** (1.0 / 6.0) if scaling == "cs25" else u_ref_m_s
+
+
+@dataclass
+class TunedGustResult:
+    """The sweep: ``cases`` (one per gust: gradient, sign, amplitude, gust text),
+    ``loads`` (the SectionLoads of each case), ``critical`` rows (docs: one per station,
+    quantity, method and direction)."""
+
+    cases: list[dict]
+    loads: list = field(repr=False)
+    critical: list[dict]
+    stations_m: list[float]
+    station_fractions: list[float]
+    settings: dict
+
+    def as_dict(self) -> dict:
+        return {"settings": self.settings, "stations_m": self.stations_m,
+                "station_fractions": self.station_fractions, "cases": self.cases,
+                "critical": self.critical}
+
+    def csv_rows(self) -> list[list]:
+        head = ["station", "y_m", "quantity", "method", "direction", "critical_H_m",
+                "gust_sign", "gust_amplitude_m_s", "gust", "value", "static_1g", "increment",
+                "time_s"]
+        rows = [head]
+        for r in self.critical:
+            rows.append([r[k] for k in ("station", "y_m", "quantity", "method", "direction",
+                                        "gradient_m", "sign", "amplitude_m_s", "gust",
+                                        "value", "static_1g", "increment", "time_s")])
+        return rows
+
+
+def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
+               u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
+               progress=None) -> TunedGustResult:
+    """Fly 1-cos gusts of every gradient in ``gradients_m`` [m] up and down through
+    ``fly(gust_text, duration_s, gust_start_s)`` (returns a SectionLoads) and find the
+    critical case per station, quantity, method and direction (largest increment up, largest
+    down) over the run after the gust start."""
+    h = default_gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
+    if h.ndim != 1 or h.size == 0 or not np.all(np.isfinite(h)) or np.any(h <= 0.0):
+        raise InputError("gust gradients must be positive lengths [m]")
+    if not (math.isfinite(u_ref_m_s) and u_ref_m_s > 0.0):
+        raise InputError(f"gust amplitude must be a positive speed [m/s], got {u_ref_m_s!r}")
+    h_max = float(h.max())
+    cases, loads = [], []
+    for hm in h:
+        u = gust_amplitude_m_s(float(hm), u_ref_m_s, h_max, scaling)
+        for sign in (1, -1):
+            text = f"1cos:{sign * u:.6g}:{2.0 * hm:.6g}"
+            duration = GUST_START_S + 2.0 * hm / speed_m_s + SETTLE_AFTER_S
+            sl = fly(text, duration, GUST_START_S)
+            cases.append({"gradient_m": float(hm), "sign": "up" if sign > 0 else "down",
+                          "amplitude_m_s": sign * u, "gust": text, "duration_s": duration,
+                          "stopped": sl.meta.get("stopped")})
+            loads.append(sl)
+            if progress is not None:
+                progress(len(cases), 2 * h.size, text)
+    first = loads[0]
+    critical = []
+    for method in first.methods:
+        for qi, quantity in enumerate(QUANTITIES):
+            for j in range(first.stations_m.size):
+                for direction in ("up", "down"):
+                    best = None
+                    for case, sl in zip(cases, loads, strict=True):
+                        after = sl.time_s >= GUST_START_S
+                        x = sl.values[method][after, qi, j]
+                        static = float(sl.static[method][qi, j])
+                        i = int(np.argmax(x) if direction == "up" else np.argmin(x))
+                        inc = float(x[i]) - static
+                        if best is None or (inc > best["increment"] if direction == "up"
+                                            else inc < best["increment"]):
+                            best = {"station": first.station_label(j),
+                                    "y_m": float(first.stations_m[j]), "quantity": quantity,
+                                    "method": method, "direction": direction,
+                                    "gradient_m": case["gradient_m"], "sign": case["sign"],
+                                    "amplitude_m_s": case["amplitude_m_s"],
+                                    "gust": case["gust"], "value": float(x[i]),
+                                    "static_1g": static, "increment": inc,
+                                    "time_s": float(sl.time_s[after][i])}
+                    critical.append(best)
+    settings = {"speed_m_s": speed_m_s, "gradients_m": h.tolist(), "u_ref_m_s": u_ref_m_s,
+                "scaling": scaling, "h_max_m": h_max, "gust_start_s": GUST_START_S,
+                "settle_after_s": SETTLE_AFTER_S, "model": first.model, "wing": first.wing,
+                "static": first.meta.get("static")}
+    return TunedGustResult(cases, loads, critical, first.stations_m.tolist(),
+                           list(first.station_fractions), settings)
+
+
+def plot_envelopes(result: TunedGustResult, path=None, method: str = "force_summation"):
+    """Correlated loads: bending moment against torque at every station, each gust's time
+    history thin, the convex hull of all of them, and the critical cases of bending and
+    torque (up and down) marked and labelled with their gradient and sign."""
+    from scipy.spatial import ConvexHull
+
+    from bioflex_jsb.loads.plots import _figure, save
+
+    stations = result.stations_m
+    cols = min(len(stations), 2)
+    rows = math.ceil(len(stations) / cols)
+    fig, ax = _figure(rows, cols, (5.6 * cols, 4.6 * rows))
+    qb, qt = QUANTITIES.index("bending_n_m"), QUANTITIES.index("torque_n_m")
+    h_all = np.array([c["gradient_m"] for c in result.cases])
+    norm = np.log(h_all / h_all.min()) / max(np.log(h_all.max() / h_all.min()), 1e-12)
+    import matplotlib.cm as cm
+
+    for j in range(len(stations)):
+        a = ax[j // cols, j % cols]
+        pts = []
+        for case, sl, c in zip(result.cases, result.loads, norm, strict=True):
+            m, t = sl.values[method][:, qb, j], sl.values[method][:, qt, j]
+            a.plot(t, m, lw=0.6, color=cm.viridis(c), alpha=0.8,
+                   ls="-" if case["sign"] == "up" else "--")
+            pts.append(np.column_stack([t, m]))
+        pts = np.concatenate(pts)
+        hull = ConvexHull(pts)
+        loop = np.append(hull.vertices, hull.vertices[0])
+        a.plot(pts[loop, 0], pts[loop, 1], color="k", lw=1.4, label="convex hull")
+        s0 = result.loads[0].static[method]
+        a.plot(s0[qt, j], s0[qb, j], "s", color="k", ms=6, mfc="w", label="1 g")
+        for r in result.critical:
+            if r["method"] != method or r["y_m"] != stations[j] or \
+                    r["quantity"] not in ("bending_n_m", "torque_n_m"):
+                continue
+            k = next(i for i, c in enumerate(result.cases) if c["gust"] == r["gust"])
+            sl = result.loads[k]
+            i = int(np.argmin(np.abs(sl.time_s - r["time_s"])))
+            x, y = sl.values[method][i, qt, j], sl.values[method][i, qb, j]
+            mark = "^" if r["direction"] == "up" else "v"
+            a.plot(x, y, mark, color="C3", ms=7)
+            name = "M" if r["quantity"] == "bending_n_m" else "T"
+            tag = f"{name}{'max' if r['direction'] == 'up' else 'min'}"
+            a.annotate(f"{tag} H={r['gradient_m']:.3g} m {r['sign']}", (x, y),
+                       textcoords="offset points", xytext=(4, 4), fontsize=7, color="C3")
+        a.set_title(f"{result.loads[0].station_label(j)} (y = {stations[j]:.3f} m)", fontsize=10)
+        a.set_xlabel("torque T [N·m] (leading edge up +)")
+        a.set_ylabel("bending moment M [N·m] (tip up +)")
+        a.grid(True, alpha=0.3)
+    for k in range(len(stations), rows * cols):
+        ax[k // cols, k % cols].axis("off")
+    handles, labels = ax[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=8)
+    st = result.settings
+    fig.suptitle(f"Correlated loads ({method.replace('_', ' ')}), wing {st['wing']}, "
+                 f"{st['speed_m_s']:g} m/s, 1-cos gusts H = {min(st['gradients_m']):.2g}-"
+                 f"{max(st['gradients_m']):.3g} m up (solid) and down (dashed), colour: H "
+                 "short (dark) to long (yellow)", fontsize=9)
+    if path is not None:
+        save(fig, path)
+    return fig
