@@ -410,3 +410,26 @@ def test_another_programs_mcap_with_our_topics_is_one_line(tmp_path, capsys, com
     line = _one_line(captured.err)
     if command == "plot":
         assert "'/bioflex/coupled/modal'" in line and "not one bioflex-jsb writes" in line
+
+
+@pytest.mark.parametrize("schema,body", [(b"\x00garbage", b"\x01\x02"), (b"", b"\xff\xff")],
+                         ids=["garbage-schema", "empty-schema"])
+@pytest.mark.parametrize("command", ["info", "plot"])
+def test_another_programs_protobuf_on_our_topics_names_the_record(tmp_path, capsys, command,
+                                                                  schema, body):
+    from mcap.writer import Writer
+
+    path = tmp_path / "foreign.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="another program 1.0")
+        sid = w.register_schema(name="foxglove.Log", encoding="protobuf", data=schema)
+        for topic in ("/bioflex/events", "/bioflex/coupled/modal"):
+            cid = w.register_channel(topic=topic, message_encoding="protobuf", schema_id=sid)
+            w.add_message(cid, log_time=10**6, publish_time=10**6, data=body)
+        w.finish()
+    argv = ["info", str(path)] if command == "info" else [
+        "plot", str(path), "--out", str(tmp_path / "f.png")]
+    assert cli.main(argv) == 2
+    line = _one_line(capsys.readouterr().err)
+    assert "message on '/bioflex/" in line and "at log time 0.001 s" in line, line

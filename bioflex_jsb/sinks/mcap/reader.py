@@ -105,9 +105,12 @@ def iter_messages(reader, topics: list[str] | None = None
                   ) -> Iterator[tuple[str, int, dict]]:
     """(topic, log time [ns], decoded message) of every message, in log-time order."""
     decoders: dict[int, object] = {}
+    where = ""  # the record being decoded, for the message of a failure
     try:
         for schema, channel, message in reader.iter_messages(topics=topics,
                                                              log_time_order=True):
+            where = f" of the message on {channel.topic!r} at log time " \
+                    f"{message.log_time * 1e-9:.6g} s"
             decode = decoders.get(channel.id)
             if decode is None:
                 decode = decoders[channel.id] = message_decoder(schema, channel)
@@ -119,7 +122,7 @@ def iter_messages(reader, topics: list[str] | None = None
     except bad_data_errors() as exc:
         if isinstance(exc, LogError):
             raise
-        raise LogError(f"unreadable message data ({exc})") from None
+        raise LogError(f"unreadable message data{where} ({exc})") from None
 
 
 class NotOurs(LogError):
