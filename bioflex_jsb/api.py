@@ -12,6 +12,8 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 >>> unsteady = api.fly_gust(wing, gust="sharp:0.3", aero="unsteady")  # Jones/Küssner strips
 >>> api.flutter(wing).flutter_speed_m_s  # [m/s]
 >>> api.flutter("goland", clamped=True).as_dict()  # a clamped wing from its definition
+>>> aircraft = api.load_aircraft("bioflex_optimised")  # an aircraft definition (TOML)
+>>> api.fly_gust(aircraft, models=("coupled",))  # every analysis takes it
 """
 
 from __future__ import annotations
@@ -30,6 +32,9 @@ from bioflex_jsb.aeroelasticity.free_aircraft import (
 )
 from bioflex_jsb.definition import Definition
 from bioflex_jsb.definition import load_definition as _load_definition
+from bioflex_jsb.definition.aircraft import Aircraft
+from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
+from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT
 from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
 from bioflex_jsb.drivers.compare import Comparison, check_comparable, compare_run
 from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
@@ -50,9 +55,9 @@ from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
 
 __all__ = [
-    "DEFAULT_DT_S", "Comparison", "FlutterResult", "GustMetrics", "StateSpace", "TimeHistory",
-    "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model", "load_definition",
-    "load_wing", "metrics", "modes", "to_python_control",
+    "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
+    "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
+    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "to_python_control",
 ]
 
 
@@ -61,8 +66,31 @@ def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BA
     """The elastic wing of a named variant (``original``, ``optimised``,
     ``inertial-forward``, ``elastic-forward``, ``inertial-backward``, ``elastic-backward``)
     or of a variant file (``docs/wing_variants.md``): modes, strips and the Table B1/B2
-    model. ``mass_basis``: ``consistent`` or ``paper`` (``docs/decisions.md``)."""
+    model. ``mass_basis``: ``consistent`` or ``paper`` (``docs/decisions.md``).
+
+    A shorthand: ``load_wing("optimised")`` is the wing of
+    ``load_aircraft("bioflex_optimised")``; a shipped aircraft name (``bioflex_<variant>``)
+    is accepted too."""
+    if name_or_file in SHIPPED_AIRCRAFT:
+        return _load_aircraft(name_or_file).wing(mass_basis)
     return build_wing(resolve_variant(name_or_file), mass_basis=mass_basis)
+
+
+def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
+    """An aircraft definition (docs/aircraft.md): a shipped one by name (``bioflex_original``,
+    ``bioflex_optimised``, ``bioflex_inertial-forward``, ``bioflex_elastic-forward``,
+    ``bioflex_inertial-backward``, ``bioflex_elastic-backward``) or a TOML file with an
+    ``[airframe]``: the JSBSim airframe, reference geometry, mass properties, the elastic
+    wing. Every field is checked when read (one line naming it). Pass the
+    :class:`Aircraft` to :func:`fly_gust`, :func:`compare`, :func:`linear_model`,
+    :func:`modes`, :func:`flutter` in place of a wing (``aircraft.wing()`` is its
+    :class:`WingBuild`)."""
+    return _load_aircraft(name_or_file)
+
+
+def _wing(wing):
+    """The :class:`WingBuild` of an :class:`Aircraft` (the wing itself otherwise)."""
+    return wing.wing() if isinstance(wing, Aircraft) else wing
 
 
 def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
@@ -84,6 +112,7 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
     reason, the time and the mode) and holds every step up to then."""
+    wing = _wing(wing)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if models is None:
@@ -129,6 +158,7 @@ def compare(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:0.3",
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
+    wing = _wing(wing)
     runs = fly_gust(wing, speed_m_s, gust, (model,), duration_s, gust_start_s,
                     recorders={model: recorder} if recorder is not None else None,
                     aero=aero, trim=trim)
@@ -155,6 +185,7 @@ def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "
     (:func:`bioflex_jsb.flight_dynamics.elastic_trim.linearise_about_elastic_trim`: the
     modes' force per unit airspeed from the deflected wing); ``notes["eta_static_rad"]``
     holds the static deflection η₀ the states are measured from."""
+    wing = _wing(wing)
     if trim not in ("rigid", "elastic"):
         raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
     if trim == "elastic":
@@ -226,6 +257,7 @@ def modes(wing, speed_m_s: float = 15.0, model: str = "coupled", *,
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if clamped:
         return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
+    wing = _wing(wing)
     if aero == "unsteady":
         if model != "coupled":
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
@@ -284,6 +316,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if clamped:
         return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
                                 density_kg_m3, lift_slope)
+    wing = _wing(wing)
     aero = aero or "quasi-steady"
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if method not in (None, "state-space"):

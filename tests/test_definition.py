@@ -206,3 +206,81 @@ def test_jsbsim_package_aircraft_by_name_is_found(tmp_path):
 def test_clamped_definition_is_not_an_aircraft():
     with pytest.raises(DefinitionError, match="no \\[airframe\\]"):
         Aircraft(load_definition("goland"))
+
+
+# ---------------------------------------------------------------------------------------
+# --aircraft on the commands, api.load_aircraft
+# ---------------------------------------------------------------------------------------
+WING_COMMANDS = ("gust", "compare", "modes", "flutter", "export", "export-jsbsim", "sitl",
+                 "ardupilot")
+
+
+@pytest.mark.parametrize("command", WING_COMMANDS)
+def test_aircraft_option_resolves_the_wing_when_parsed(command):
+    from bioflex_jsb.cli import build_parser
+
+    extra = ["--out", "x"] if command.startswith("export") else []  # their required option
+    args = build_parser().parse_args([command, "--aircraft", "bioflex_elastic-forward",
+                                      *extra])
+    assert args.wing == "elastic-forward"
+    assert args.aircraft_definition.variant() == wing_model.VARIANTS["elastic-forward"]
+
+
+@pytest.mark.parametrize("argv", [("modes", "--json"), ("flutter", "--json"),
+                                  ("gust", "--json", "--no-log", "--duration", "1")])
+def test_aircraft_option_flies_what_wing_flies(capsys, argv):
+    # the shipped definition and the --wing shorthand: the same output, character for character
+    code_a, out_a, _ = run_cli(capsys, *argv, "--aircraft", "bioflex_inertial-forward")
+    code_w, out_w, _ = run_cli(capsys, *argv, "--wing", "inertial-forward")
+    assert code_a == code_w == 0 and out_a == out_w and '"inertial-forward"' in out_a
+
+
+def _modal_aircraft(tmp_path):
+    """The prototype with the shipped example modal file as its wing, a user's own file."""
+    modes = shipped_path("goland").parent.parent / "modes" / "example_ribbed.toml"
+    text = PROTO_TEXT.replace('kind = "prototype-membrane"\nribs = true',
+                              f'kind = "modal"\nmodes_file = "{modes}"', 1)
+    text = text.replace('name = "original"', 'name = "my-wing"', 1)
+    text = text.replace("pin_c_eta1_q1 = -0.03", 'pin_c_eta1_q1 = "physical"', 1)
+    text = text.replace("published_c_eta1_q1 = -0.03\n", "", 1)
+    return _write(tmp_path, text), modes
+
+
+def test_user_aircraft_with_a_modal_wing(tmp_path, capsys):
+    path, modes = _modal_aircraft(tmp_path)
+    aircraft = api.load_aircraft(str(path))
+    build = aircraft.wing()
+    # the same wing as a variant file with that modes file (docs/wing_variants.md)
+    variant_file = tmp_path / "v.toml"
+    variant_file.write_text(f'name = "my-wing"\nmodes_file = "{modes}"\n'
+                            'pin_c_eta1_q1 = "physical"\n', encoding="utf-8")
+    ref = wing_model.build_wing(wing_model.load_variant_file(variant_file))
+    assert build.variant.modes_file == ref.variant.modes_file
+    assert build.model.coefficients.as_dict() == ref.model.coefficients.as_dict()
+    code, out, _ = run_cli(capsys, "modes", "--json", "--aircraft", str(path))
+    assert code == 0 and '"my-wing"' in out
+    args = __import__("bioflex_jsb.cli", fromlist=["x"]).build_parser().parse_args(
+        ["gust", "--aircraft", str(path)])
+    assert args.wing == "aircraft:bioflex_original"  # no variant's name: never mistaken
+
+
+def test_aircraft_option_errors_are_one_line(tmp_path, capsys):
+    bad = _write(tmp_path, PROTO_TEXT.replace("mass_kg = 2.5 ", "mass_kg = -1.0 ", 1))
+    code, _, err = run_cli(capsys, "modes", "--aircraft", str(bad))
+    assert_one_line_error(code, err, "airframe.mass_kg")
+    heavy = _write(tmp_path, PROTO_TEXT.replace("mass_kg = 2.5 ", "mass_kg = 2500.0 ", 1))
+    code, _, err = run_cli(capsys, "gust", "--no-log", "--aircraft", str(heavy))
+    assert_one_line_error(code, err, "airframe.mass_kg = 2500 differs")
+    code, _, err = run_cli(capsys, "gust", "--no-log", "--wing", "elastic-backward",
+                           "--aircraft", "bioflex_original")
+    assert_one_line_error(code, err, "give one of them")
+
+
+def test_api_takes_the_aircraft_and_load_wing_is_its_shorthand():
+    aircraft = api.load_aircraft("bioflex_optimised")
+    assert api.load_wing("bioflex_optimised") is api.load_wing("optimised")
+    assert api.modes(aircraft, 15.0).as_dict() == api.modes(api.load_wing("optimised"),
+                                                            15.0).as_dict()
+    ss_a = api.linear_model(aircraft, 15.0)
+    ss_w = api.linear_model(api.load_wing("optimised"), 15.0)
+    assert _rel(ss_a.a, ss_w.a) == 0.0

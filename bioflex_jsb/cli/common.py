@@ -284,10 +284,18 @@ def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original
         "the half-wing m_i as Table B2 reads literally (paper: every H term doubled); "
         f"docs/decisions.md; default {DEFAULT_MASS_BASIS}",
     )
+    from bioflex_jsb.cli.aircraft_option import add_aircraft_argument
+
+    add_aircraft_argument(parser, default)  # --aircraft NAME|FILE (cli/aircraft_option.py)
 
 
 def wing_from_args(args: argparse.Namespace):
-    """Build the wing named by --wing; any problem becomes a one-line UsageError."""
+    """Build the wing named by --wing (or --aircraft); any problem becomes a one-line
+    UsageError."""
+    if getattr(args, "aircraft_definition", None) is not None:
+        from bioflex_jsb.cli.aircraft_option import wing_from_aircraft
+
+        return wing_from_aircraft(args)
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.flight_dynamics.wing_model import VariantError, build_wing, resolve_variant
 

@@ -1,0 +1,83 @@
+"""``--aircraft NAME|FILE``: an aircraft definition (docs/aircraft.md) in place of ``--wing``.
+
+Every command that builds the elastic wing takes it through the shared ``--wing`` helpers of
+:mod:`bioflex_jsb.cli.common` (``add_wing_arguments`` adds this option, ``wing_from_args``
+builds its wing). The definition is read, checked and its wing resolved while the command
+line is parsed, so a bad file is one line and exit 2 before anything runs, and every part
+of a command that names the wing (log file names, run descriptions, the native-wing path)
+sees the aircraft's wing: ``args.wing`` becomes the wing's name when the wing is a named
+variant's (the shipped ``bioflex_<variant>`` files), else ``aircraft:<definition name>``
+(no variant has that name, so nothing can mistake it for one). ``--wing W --aircraft A``
+with W other than the command's default is refused (give one of them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+AIRCRAFT_PREFIX = "aircraft:"
+
+
+class _ShippedOrFile(tuple):
+    """The option's choices: it lists the shipped aircraft (for help and for tools that
+    enumerate choices) and admits any text, a definition file's path being checked when it
+    is read."""
+
+    def __contains__(self, value) -> bool:
+        return isinstance(value, str)
+
+
+class _AircraftAction(argparse._StoreAction):
+    """Reads the definition when the option is parsed (module docstring); a store action,
+    so that the shared parser refuses it given twice like every single-valued option."""
+
+    def __init__(self, *args, wing_default: str | None = None, **kwargs) -> None:
+        self.wing_default = wing_default
+        super().__init__(*args, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        from bioflex_jsb.definition.aircraft import load_aircraft
+        from bioflex_jsb.errors import InputError
+        from bioflex_jsb.flight_dynamics.wing_model import VARIANTS
+
+        given = getattr(namespace, "wing", None)
+        if given not in (None, self.wing_default):
+            parser.error(f"--aircraft {values} and --wing {given}: give one of them (the "
+                         "aircraft's definition holds its wing)")
+        try:
+            aircraft = load_aircraft(values)
+            problem = aircraft.flight_problem()
+            variant = aircraft.variant()
+        except InputError as exc:  # the definition's one line, naming the field
+            parser.error(f"--aircraft: {exc}")
+        if problem:
+            parser.error(f"--aircraft: {problem}")
+        named = VARIANTS.get(variant.name)
+        namespace.wing = variant.name if named == variant else AIRCRAFT_PREFIX + aircraft.name
+        namespace.aircraft = values
+        namespace.aircraft_definition = aircraft
+
+
+def add_aircraft_argument(parser: argparse.ArgumentParser, wing_default: str | None) -> None:
+    """``--aircraft NAME|FILE`` (``wing_default``: the command's ``--wing`` default)."""
+    from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT
+
+    parser.add_argument(
+        "--aircraft", action=_AircraftAction, wing_default=wing_default, default=None,
+        metavar="NAME|FILE.toml", choices=_ShippedOrFile(SHIPPED_AIRCRAFT),
+        help=f"an aircraft definition in place of --wing: {', '.join(SHIPPED_AIRCRAFT)}, or "
+        "a TOML file with [airframe] (docs/aircraft.md); its wing is flown")
+    parser.set_defaults(aircraft_definition=None)
+
+
+def wing_from_aircraft(args: argparse.Namespace):
+    """The elastic wing (a WingBuild) of ``--aircraft`` at ``--mass-basis``."""
+    from bioflex_jsb.flight_dynamics.wing_model import modes_used_note
+
+    aircraft = args.aircraft_definition
+    build = aircraft.wing(args.mass_basis)
+    note = modes_used_note(build.variant)
+    if note:  # as wing_from_args says it for --wing (stderr: stdout may be JSON)
+        print(f"bioflex-jsb: note: {note}", file=sys.stderr)
+    return build
