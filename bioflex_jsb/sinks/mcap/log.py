@@ -72,6 +72,7 @@ class RunLog:
         self._streams: list[AutopilotRecorder] = []  # their frames go into the same chunks
         self._events_id: int | None = None  # the events channel, made at the first event
         self.events = 0  # events logged
+        self.scene = None  # the aircraft in 3-D (scene.SceneLog, RunLog.open(scene=)) or None
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -84,10 +85,13 @@ class RunLog:
     @classmethod
     def open(cls, path: str | Path, description: RunDescription,
              wing_variant: Mapping[str, Any] | None = None,
-             overrides: Mapping[str, float] | None = None) -> RunLog:
+             overrides: Mapping[str, float] | None = None,
+             scene: float | None = None) -> RunLog:
         """Create ``path`` and write the ``bioflex.run`` metadata of the run ``description``
         (:func:`~bioflex_jsb.sinks.mcap.metadata.run_metadata`; ``wing_variant``: the wing
         build's variant as a dict, ``overrides``: its coefficient overrides, plain data).
+        ``scene``: also log the aircraft in 3-D (:mod:`.scene`, topics
+        ``/bioflex/<model>/scene``) with this exaggeration of the deformation [-]; None: not.
         A file that cannot be created is a :class:`LogWriteError` (one line)."""
         p = Path(path)
         meta = run_metadata(description, wing_variant, overrides)
@@ -95,7 +99,12 @@ class RunLog:
             stream = open(p, "wb")  # noqa: SIM115 - closed in close()
         except OSError as exc:
             raise LogWriteError(f"cannot write log {str(p)!r}: {exc.strerror}") from None
-        return cls.local(p, stream, meta)
+        log = cls.local(p, stream, meta)
+        if scene is not None:
+            from bioflex_jsb.sinks.mcap.scene import SceneLog
+
+            log.scene = SceneLog.for_run(log._writer, description, wing_variant, scene)
+        return log
 
     @classmethod
     def local(cls, path: Path, stream, meta: dict[str, str]) -> RunLog:
@@ -182,6 +191,9 @@ class RunLog:
             self._set_origin(first[ch.i_lat], first[ch.i_lon], first[ch.i_alt])
         v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(ch.names))
         block, index = ch.format(ts[:n], v.reshape(n, len(ch.names)), ch.seq, self._origin)
+        scene = None if self.scene is None else self.scene.build(
+            next(m for m, c in self._models.items() if c is ch), ch.names, ts[:n],
+            v.reshape(n, len(ch.names)))  # the 3-D scene's samples of these steps
         if not self._row_bytes_measured or len(block) > n * self._row_bytes:
             self._row_bytes = -(-len(block) // n)  # the first measure, then the largest
             self._row_bytes_measured = True
@@ -189,6 +201,8 @@ class RunLog:
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
+        if scene:
+            self._writer.append_block(*scene)
 
     def size_bound(self, more_steps: int = 0) -> int:
         """An upper bound [bytes] of this file's size if it were closed now after
@@ -330,6 +344,8 @@ class TableRecorder:
             block, index = ch.format(time_s, rows, ch.seq, log._origin)
             ch.seq += len(rows)
             log._writer.append_block(block, index)
+            if log.scene is not None:
+                log.scene.rows(self._model, ch.names, time_s, rows)
             log._writer.close_chunk()
             self.steps += len(rows)
 

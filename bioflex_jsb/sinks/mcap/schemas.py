@@ -23,6 +23,14 @@ AUTOPILOT_ENUMS = (("Action", AUTOPILOT_ACTIONS), ("Phase", AUTOPILOT_PHASES))
 EVENTS_TOPIC = "/bioflex/events"
 EVENT_SCHEMA = "foxglove.Log"
 EVENT_LEVELS = ("UNKNOWN", "DEBUG", "INFO", "WARNING", "ERROR", "FATAL")
+# The aircraft in 3-D (bioflex_jsb.sinks.mcap.scene): foxglove.SceneUpdate messages on
+# topic(model, SCENE_GROUP) (the wing, at the scene's rate) and topic(model, AIRFRAME_GROUP)
+# (the rigid parts), in the body frame; its settings
+# (the deformation's exaggeration, the rate, the geometry's sources) in SCENE_METADATA
+SCENE_GROUP = "scene"
+AIRFRAME_GROUP = "airframe"  # the rigid parts of the scene, once per chunk
+SCENE_SCHEMA = "foxglove.SceneUpdate"
+SCENE_METADATA = "bioflex.scene"
 
 
 def topic(model: str, group: str) -> str:
@@ -291,3 +299,14 @@ def _event_schema() -> tuple[str, bytes]:
 
 # the events topic's schema: (name, serialised FileDescriptorSet), schema encoding "protobuf"
 EVENTS_PROTO_SCHEMA: tuple[str, bytes] = _event_schema()
+
+
+def _scene_schema() -> tuple[str, bytes]:
+    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor_set
+
+    return SCENE_SCHEMA, file_descriptor_set(fox.files(fox.SCENE_UPDATE_FILES))
+
+
+# the scene topics' schema: (name, serialised FileDescriptorSet), schema encoding "protobuf"
+SCENE_PROTO_SCHEMA: tuple[str, bytes] = _scene_schema()

@@ -1,0 +1,483 @@
+"""The aircraft in 3-D: ``foxglove.SceneUpdate`` messages of the deformed aircraft.
+
+Two topics per wing model (``docs/logging.md``), both ``SceneUpdate`` messages of one entity
+in the body frame ``<model>_body`` (x forward, y left, z up, origin at the centre of gravity;
+``frame_locked``, so it rides on the ``pose`` transform): ``/bioflex/<model>/scene`` at
+:data:`SCENE_RATE_HZ` (not every step), entity ``wing``: both wing halves as triangle meshes
+deformed by the modal coordinates and the gust as an arrow (vertical in the world, up for an
+upward gust, its length proportional to w_g); ``/bioflex/<model>/airframe`` once per chunk
+(at its first step), entity ``airframe``: the rigid fuselage, horizontal tail and fin. The
+rigid parts are two thirds of the bytes of a whole aircraft; apart, they cost nothing per
+step, and a viewer that seeks gets them from the topic's last message.
+
+The wing's mesh has a leading-edge and a trailing-edge vertex at the root, at every strip's
+station of the lifting line (``WingBuild.aero.stations_m``: where the loads act) and at the
+tip. Each section is moved as the modes move it (``docs/conventions.md``): its elastic axis
+(at ``x_elastic_frac`` of the chord) rises by −Σ φ_i(y) η_i (``bending_m``, positive down)
+and the chord turns about it, leading edge up, by Σ θ_i(y) η_i (``twist_rad``), the shapes
+interpolated at the stations as the modal coefficients of the loads and the LTI model
+interpolate them (``flight_dynamics.modal_coefficients``); both multiplied by the
+exaggeration stored in the ``bioflex.scene`` metadata (1: true scale). η are the logged
+modal coordinates, perturbations from the trim; the two halves deform alike (the modes are
+symmetric). The messages are built a chunk at a time with numpy (:class:`Records` of
+:mod:`.formatting`: the byte layout is fixed, only the doubles and the timestamp move).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp
+from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
+from bioflex_jsb.sinks.mcap.schemas import (
+    AIRFRAME_GROUP,
+    SCENE_GROUP,
+    SCENE_METADATA,
+    SCENE_PROTO_SCHEMA,
+    body_frame,
+    topic,
+)
+
+if TYPE_CHECKING:
+    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+
+# DECISION: a display's frame rate. The 3-D panel draws at most this often; the wing modes
+# (31-107 Hz) are sampled, not resolved (the modal topic has every step).
+SCENE_RATE_HZ = 60.0
+# NUMERICAL: a step's sample bin is floor(t·rate + this): 1e-6 of a bin (17 ns at 60 Hz)
+# absorbs the rounding of t = k·dt, far below any step
+_BIN_EPS = 1e-6
+DEFAULT_EXAGGERATION = 1.0  # true scale: the logged twist is degrees already (η₁ ~ 0.3 rad)
+# DECISION (drawing only): the gust arrow is 0.1 m long per m/s (a 3 m/s gust: 0.3 m, a
+# third of the fuselage), its head 30 % of it, 15 mm shaft and 40 mm head diameters, ahead
+# of the nose by 0.1 m at the wing's height
+GUST_ARROW_M_PER_M_S = 0.1
+_ARROW_HEAD_FRACTION = 0.3
+_ARROW_SHAFT_DIAMETER_M = 0.015
+_ARROW_HEAD_DIAMETER_M = 0.04
+_ARROW_AHEAD_OF_NOSE_M = 0.1
+# NUMERICAL (drawing only): the fuselage's spheroid in rings along x and sides around
+_FUSELAGE_RINGS, _FUSELAGE_SIDES = 16, 12
+COLOURS = {  # r, g, b, a [0-1]
+    "fuselage": (0.55, 0.57, 0.60, 1.0), "tail": (0.35, 0.45, 0.60, 1.0),
+    "fin": (0.35, 0.45, 0.60, 1.0), "wing": (0.90, 0.55, 0.15, 1.0),
+    "gust": (0.20, 0.60, 1.00, 1.0),
+}
+ENTITY_ID = "wing"  # the scene topic's entity: triangle lists WING_PARTS, the gust arrow
+WING_PARTS = ("starboard_wing", "port_wing")
+AIRFRAME_ENTITY_ID = "airframe"  # the airframe topic's entity: triangle lists AIRFRAME_PARTS
+AIRFRAME_PARTS = ("fuselage", "tail", "fin")
+
+
+# -- the airframe's outline: the one place its dimensions are read --------------------------
+@dataclass(frozen=True)
+class AirframeOutline:
+    """What the scene draws of the rigid airframe [m]: the fuselage (a prolate spheroid of
+    ``fuselage_length_m`` and ``fuselage_max_diameter_m`` on the body x axis, z = 0, its nose
+    ``nose_ahead_of_root_le_m`` ahead of the wing's root leading edge), the wing plane at
+    ``wing_height_m`` above the fuselage axis, the rectangular horizontal tail (semispan,
+    chord, leading edge ``tail_le_x_m`` aft of the wing's root leading edge, on the axis) and
+    a fin on the tail (root chord = the tail's, ``fin_height_m`` tall, ``fin_tip_chord_m``)."""
+
+    fuselage_length_m: float
+    fuselage_max_diameter_m: float
+    nose_ahead_of_root_le_m: float
+    wing_height_m: float
+    tail_semispan_m: float
+    tail_chord_m: float
+    tail_le_x_m: float
+    fin_height_m: float
+    fin_tip_chord_m: float
+
+
+def airframe_outline() -> AirframeOutline:
+    """The prototype's outline from ``parameters/`` (the aircraft-as-data work replaces this
+    one function by the aircraft definition's)."""
+    from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY
+    from bioflex_jsb.parameters.airframe_consistent import FUSELAGE, TAIL
+
+    return AirframeOutline(
+        fuselage_length_m=FUSELAGE.length_m,  # Table 1
+        fuselage_max_diameter_m=FUSELAGE.max_diameter_m,  # ESTIMATE there (Fig. 1)
+        nose_ahead_of_root_le_m=AIRFRAME_GEOMETRY.wing_root_leading_edge_x_m,
+        # airframe_consistent.TAIL: "tail on the fuselage axis, wing on top of the fusiform
+        # fuselage: 3 cm between the planes"
+        wing_height_m=TAIL.height_m,
+        tail_semispan_m=TAIL.semispan_m, tail_chord_m=TAIL.chord_m,
+        tail_le_x_m=TAIL.leading_edge_x_m,
+        # ESTIMATE (drawing only, nothing is computed with it): "a small fin on a short
+        # arm" (airframe.py, C_nβ): as tall as the tail is half-wide, half its chord at the tip
+        fin_height_m=0.5 * TAIL.semispan_m, fin_tip_chord_m=0.5 * TAIL.chord_m,
+    )
+
+
+# -- the half wing at the mesh's stations ---------------------------------------------------
+@dataclass(frozen=True)
+class WingShape:
+    """The starboard half wing at the K stations of the mesh (root, the strips' stations,
+    tip) in the wing frame (x aft of the root leading edge, y to starboard) [m]: leading edge,
+    chord, elastic axis (fraction of the chord aft of the leading edge), the mode shapes
+    ``bending_m`` (n, K) [m/rad, down] and ``twist_rad`` (n, K) [rad/rad, leading edge up],
+    and the centre of gravity ``x_cg_m`` (the body frame's origin)."""
+
+    stations_m: np.ndarray
+    leading_edge_x_m: np.ndarray
+    chord_m: np.ndarray
+    x_elastic_frac: np.ndarray
+    bending_m: np.ndarray
+    twist_rad: np.ndarray
+    x_cg_m: float
+    source: str
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.bending_m.shape[0])
+
+
+def wing_shape(build, planform=None) -> WingShape:
+    """The mesh's half wing of the wing ``build`` (a ``WingBuild``: its modes and strips) on
+    ``planform`` (default: the prototype's, ``parameters.wing.DEFAULT_PLANFORM``, the one the
+    builds are made on)."""
+    if planform is None:
+        from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM as planform
+    modes, aero = build.modes, build.aero
+    y = np.concatenate([[0.0], np.asarray(aero.stations_m, dtype=float), [aero.semispan_m]])
+
+    def at(rows) -> np.ndarray:
+        return np.array([np.interp(y, modes.stations_m, r) for r in np.atleast_2d(rows)])
+
+    return WingShape(
+        stations_m=y, leading_edge_x_m=np.asarray(planform.leading_edge_x_at(y), dtype=float),
+        chord_m=np.asarray(planform.chord_at(y), dtype=float),
+        x_elastic_frac=at(np.broadcast_to(modes.x_elastic_frac, modes.stations_m.shape))[0],
+        bending_m=at(modes.bending_m), twist_rad=at(modes.twist_rad),
+        x_cg_m=float(planform.x_cg_m), source=f"wing {build.variant.name}: {modes.source}")
+
+
+# -- the mesh in the body frame ------------------------------------------------------------
+def _spheroid(length_m: float, diameter_m: float, nose_x_m: float):
+    """Points (P, 3) and triangle indices of a prolate spheroid along x, nose at nose_x."""
+    a, r = 0.5 * length_m, 0.5 * diameter_m
+    s = np.cos(np.linspace(0.0, math.pi, _FUSELAGE_RINGS + 1))[1:-1]  # x/a, nose to tail
+    phi = np.linspace(0.0, 2.0 * math.pi, _FUSELAGE_SIDES, endpoint=False)
+    rho = r * np.sqrt(1.0 - s**2)
+    ring = np.stack([np.repeat(nose_x_m - a + a * s, _FUSELAGE_SIDES),
+                     (rho[:, None] * np.cos(phi)).ravel(),
+                     (rho[:, None] * np.sin(phi)).ravel()], axis=1)
+    pts = np.vstack([[nose_x_m, 0.0, 0.0], ring, [nose_x_m - length_m, 0.0, 0.0]])
+    n, m = _FUSELAGE_SIDES, len(s)
+    tris = []
+    for k in range(n):
+        k2 = (k + 1) % n
+        tris.append((0, 1 + k, 1 + k2))
+        tris.append((len(pts) - 1, 1 + (m - 1) * n + k2, 1 + (m - 1) * n + k))
+        for i in range(m - 1):
+            p, q = 1 + i * n, 1 + (i + 1) * n
+            tris += [(p + k, q + k, q + k2), (p + k, q + k2, p + k2)]
+    return pts, np.array(tris, dtype=np.uint32).ravel()
+
+
+def _quads(n_stations: int) -> np.ndarray:
+    """Indices of a strip of quads between consecutive stations, vertices 2j (leading edge)
+    and 2j + 1 (trailing edge) at station j."""
+    j = np.arange(n_stations - 1)
+    le, te, le2, te2 = 2 * j, 2 * j + 1, 2 * j + 2, 2 * j + 3
+    return np.stack([le, te, te2, le, te2, le2], axis=1).astype(np.uint32).ravel()
+
+
+class AircraftMesh:
+    """The aircraft's vertices in the body frame (FLU, origin at the CG) [m]: the rigid
+    parts, once; the wing's, for given modal coordinates (:meth:`wing_xz`); the gust arrow
+    (:meth:`gust_arrow`)."""
+
+    def __init__(self, shape: WingShape, outline: AirframeOutline,
+                 exaggeration: float = DEFAULT_EXAGGERATION) -> None:
+        if not (math.isfinite(exaggeration) and exaggeration > 0.0):
+            raise ValueError(f"the scene's exaggeration must be a number > 0, not "
+                             f"{exaggeration!r}")
+        self.shape, self.outline, self.exaggeration = shape, outline, float(exaggeration)
+        c, xe = shape.chord_m, shape.x_elastic_frac
+        self.ea_x_m = shape.x_cg_m - (shape.leading_edge_x_m + xe * c)  # body x of the axis
+        self.chord_fwd_m = np.stack([xe * c, xe * c - c])  # (2, K): LE and TE ahead of it
+        self.y_m = shape.stations_m
+        self.z0_m = outline.wing_height_m
+        self.wing_indices = _quads(len(self.y_m))
+        o = outline
+        self.nose_x_m = shape.x_cg_m + o.nose_ahead_of_root_le_m
+        fus = _spheroid(o.fuselage_length_m, o.fuselage_max_diameter_m, self.nose_x_m)
+        x_le = shape.x_cg_m - o.tail_le_x_m
+        x_te = x_le - o.tail_chord_m
+        b = o.tail_semispan_m
+        tail = (np.array([[x_le, -b, 0], [x_te, -b, 0], [x_le, b, 0], [x_te, b, 0]], float),
+                np.array([0, 1, 3, 0, 3, 2], dtype=np.uint32))
+        h, ct = o.fin_height_m, o.fin_tip_chord_m
+        fin = (np.array([[x_le, 0, 0], [x_te, 0, 0], [x_te, 0, h], [x_te + ct, 0, h]], float),
+               np.array([0, 1, 2, 0, 2, 3], dtype=np.uint32))
+        self.rigid = {"fuselage": fus, "tail": tail, "fin": fin}
+        self.arrow_head_m = np.array([self.nose_x_m + _ARROW_AHEAD_OF_NOSE_M, 0.0, self.z0_m])
+
+    @property
+    def wing_vertices(self) -> int:
+        """Vertices of one wing half (two per station)."""
+        return 2 * len(self.y_m)
+
+    def wing_xz(self, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(x, z) [m] of one half's vertices, (m, K, 2) each (station, then leading/trailing
+        edge), for the modal coordinates ``eta`` (m, n) [rad]; y is ∓``y_m`` (starboard is
+        −y in the body frame)."""
+        eta = np.asarray(eta, dtype=float).reshape(len(eta), -1)
+        if eta.shape[1] != self.shape.n_modes:
+            raise ValueError(f"the scene's wing has {self.shape.n_modes} modes, the samples "
+                             f"{eta.shape[1]}")
+        e = self.exaggeration
+        twist = e * eta @ self.shape.twist_rad  # (m, K), leading edge up
+        heave = -e * eta @ self.shape.bending_m  # (m, K), up
+        d = self.chord_fwd_m.T[None]  # (1, K, 2)
+        x = self.ea_x_m[None, :, None] + d * np.cos(twist)[:, :, None]
+        z = self.z0_m + heave[:, :, None] + d * np.sin(twist)[:, :, None]
+        return x, z
+
+    def gust_arrow(self, w_g_m_s, roll_rad, pitch_rad) -> np.ndarray:
+        """(m, 9): the arrow's tail position (x, y, z) [m], its orientation (x, y, z, w) (its
+        +x along the gust: world up for w_g > 0, in the body frame of the NED Euler angles
+        roll φ and pitch θ), shaft and head lengths [m]."""
+        w = np.asarray(w_g_m_s, dtype=float)
+        ph, th = np.asarray(roll_rad, dtype=float), np.asarray(pitch_rad, dtype=float)
+        up = np.stack([np.sin(th), np.sin(ph) * np.cos(th), np.cos(ph) * np.cos(th)], axis=1)
+        d = np.where(w[:, None] < 0.0, -up, up)
+        length = GUST_ARROW_M_PER_M_S * np.abs(w)
+        tail = self.arrow_head_m[None] - length[:, None] * d
+        q = np.stack([np.zeros_like(w), -d[:, 2], d[:, 1], 1.0 + d[:, 0]], axis=1)
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        return np.column_stack([tail, q, (1 - _ARROW_HEAD_FRACTION) * length,
+                                _ARROW_HEAD_FRACTION * length])
+
+
+# -- the protobuf layout of one message ----------------------------------------------------
+def _size(parts) -> int:
+    return sum(8 if p == F else (p[1] if isinstance(p, tuple) else len(p)) for p in parts)
+
+
+def _sub(number: int, parts: list) -> list:
+    """A length-delimited sub-message of ``parts``."""
+    return [tag(number, LEN) + varint(_size(parts))] + parts
+
+
+def _dbl(number: int, value: float) -> bytes:
+    return tag(number, I64) + struct.pack("<d", value)
+
+
+def _consts(number: int, values) -> list:
+    return _sub(number, [b"".join(_dbl(i + 1, v) for i, v in enumerate(values))])
+
+
+_POSE = _sub(1, _consts(1, (0.0, 0.0, 0.0)) + _consts(2, (0.0, 0.0, 0.0, 1.0)))
+
+
+def _indices(number: int, idx: np.ndarray) -> bytes:
+    data = np.asarray(idx, dtype="<u4").tobytes()
+    return tag(number, LEN) + varint(len(data)) + data
+
+
+def _rigid_list(points: np.ndarray, idx: np.ndarray, colour) -> list:
+    body = [b"".join(b"".join(_consts(2, p)) for p in points)]
+    return _sub(12, _POSE + body + _consts(3, colour) + [_indices(5, idx)])
+
+
+def _wing_list(y_m: np.ndarray, idx: np.ndarray, colour) -> list:
+    """A wing half: its vertices' x and z are doubles of the chunk (y constant)."""
+    points: list = []
+    for y in y_m:
+        for _ in range(2):
+            points += _sub(2, [tag(1, I64), F, _dbl(2, float(y)) + tag(3, I64), F])
+    return _sub(12, _POSE + points + _consts(3, colour) + [_indices(5, idx)])
+
+
+def _arrow(colour) -> list:
+    pose = _sub(1, _sub(1, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
+                + _sub(2, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F, tag(4, I64), F]))
+    return _sub(7, pose + [tag(2, I64), F, _dbl(3, _ARROW_SHAFT_DIAMETER_M) + tag(4, I64), F,
+                           _dbl(5, _ARROW_HEAD_DIAMETER_M)] + _consts(6, colour))
+
+
+def text_primitive(text: str, position_m, size: float = 0.06) -> list:
+    """A ``TextPrimitive`` (field 13 of SceneEntity): ``text`` at ``position_m`` (body frame),
+    billboarded, ``size`` [m] high."""
+    pose = _sub(1, _consts(1, position_m) + _consts(2, (0.0, 0.0, 0.0, 1.0)))
+    return _sub(13, pose + [tag(2, VARINT) + b"\x01", _dbl(3, size)] + _consts(5, (1, 1, 1, 1))
+                + [string_field(6, text)])
+
+
+def _head(frame: str, entity_id: str) -> list:
+    return [string_field(2, frame) + string_field(3, entity_id) + tag(5, VARINT) + b"\x01"]
+
+
+def scene_pieces(mesh: AircraftMesh, frame: str, texts: list | None = None):
+    """``pieces(ls, ln)`` of one wing SceneUpdate for :class:`Records`: its doubles are the
+    gust arrow's 9 (:meth:`AircraftMesh.gust_arrow`) then each half's x, z per vertex
+    (starboard, port: :meth:`scene_floats`); ``texts``: constant text primitives
+    (:func:`text_primitive`)."""
+    wings = [part for sign in (-1.0, 1.0)
+             for part in _wing_list(sign * mesh.y_m, mesh.wing_indices, COLOURS["wing"])]
+    head = _head(frame, ENTITY_ID)
+    arrow = _arrow(COLOURS["gust"])
+    extra = list(texts or [])
+
+    def pieces(ls: int, ln: int) -> list[list]:
+        return [_sub(2, _timestamp(1, ls, ln) + head + arrow + wings + extra)]
+
+    return pieces
+
+
+def airframe_pieces(mesh: AircraftMesh, frame: str):
+    """``pieces(ls, ln)`` of the airframe's SceneUpdate (no doubles: every vertex is
+    constant)."""
+    rigid = [part for name in AIRFRAME_PARTS
+             for part in _rigid_list(*mesh.rigid[name], COLOURS[name])]
+    head = _head(frame, AIRFRAME_ENTITY_ID)
+
+    def pieces(ls: int, ln: int) -> list[list]:
+        return [_sub(2, _timestamp(1, ls, ln) + head + rigid)]
+
+    return pieces
+
+
+def scene_floats(mesh: AircraftMesh, eta, w_g_m_s, roll_rad, pitch_rad) -> np.ndarray:
+    """The doubles of m messages (rows of :func:`scene_pieces`' layout)."""
+    x, z = mesh.wing_xz(eta)
+    half = np.stack([x, z], axis=-1).reshape(len(x), -1)
+    return np.column_stack([mesh.gust_arrow(w_g_m_s, roll_rad, pitch_rad), half, half])
+
+
+# -- in a run log ---------------------------------------------------------------------------
+class _Channel:
+    def __init__(self, cid: int, records: Records, airframe_id: int, airframe: Records
+                 ) -> None:
+        self.id, self.records = cid, records
+        self.airframe_id, self.airframe = airframe_id, airframe
+        self.seq = self.airframe_seq = 0
+        self.last_bin = None  # the sample bin of the model's last step
+        self.names: tuple = ()
+        self.etas: list[int] = []
+        self.cols: list[int] = []
+
+
+class SceneLog:
+    """The scene topics of a log: ``rows`` takes each chunk of a model's steps (the
+    recorder's rows, in the channels' ``names`` order) and appends the samples' messages to
+    the writer's chunk in progress (the caller holds signals and closes the chunk)."""
+
+    def __init__(self, writer: McapFileWriter, mesh: AircraftMesh,
+                 rate_hz: float = SCENE_RATE_HZ) -> None:
+        self._writer, self.mesh, self.rate_hz = writer, mesh, float(rate_hz)
+        self._schema_id: int | None = None
+        self._channels: dict[str, _Channel] = {}
+        self.messages = 0
+        writer.add_metadata(SCENE_METADATA, scene_metadata(mesh, self.rate_hz))
+
+    @classmethod
+    def for_run(cls, writer: McapFileWriter, description, wing_variant=None,
+                exaggeration: float = DEFAULT_EXAGGERATION) -> SceneLog:
+        """The scene of the run ``description``: its wing built as the run built it (the
+        variant ``wing_variant``, a ``WingVariant.as_dict()``, or else the description's
+        ``wing``; the build cache returns the run's own build)."""
+        from bioflex_jsb.flight_dynamics.wing_model import (
+            WingVariant,
+            build_wing,
+            resolve_variant,
+        )
+
+        variant = (WingVariant(**dict(wing_variant)) if wing_variant is not None
+                   else resolve_variant(description.wing))
+        build = build_wing(variant, mass_basis=description.mass_basis)
+        return cls(writer, AircraftMesh(wing_shape(build), airframe_outline(), exaggeration))
+
+    def _channel(self, model: str) -> _Channel:
+        ch = self._channels.get(model)
+        if ch is None:
+            w = self._writer
+            if self._schema_id is None:
+                name, data = SCENE_PROTO_SCHEMA
+                self._schema_id = w.add_schema(name, "protobuf", data)
+            frame = body_frame(model)
+            cid = w.add_channel(topic(model, SCENE_GROUP), self._schema_id, {"model": model})
+            aid = w.add_channel(topic(model, AIRFRAME_GROUP), self._schema_id,
+                                {"model": model})
+            ch = self._channels[model] = _Channel(
+                cid, Records([cid], scene_pieces(self.mesh, frame), True),
+                aid, Records([aid], airframe_pieces(self.mesh, frame), True))
+        return ch
+
+    def rows(self, model: str, names, time_s, rows: np.ndarray) -> None:
+        """Log the samples among the steps ``rows`` (steps × channels) at ``time_s`` [s]
+        (:meth:`build`) into the chunk in progress."""
+        got = self.build(model, names, time_s, rows)
+        if got:
+            self._writer.append_block(*got)
+
+    def build(self, model: str, names, time_s, rows: np.ndarray):
+        """The records (and index entries) of the airframe at the first of the steps
+        ``rows`` (at ``time_s`` [s]) and of the wing at each step whose time enters a new
+        1/rate bin (a run's first step too); None if there are no steps."""
+        t = np.asarray(time_s, dtype=float)
+        if not len(t):
+            return None
+        ch = self._channel(model)
+        bins = np.floor(t * self.rate_hz + _BIN_EPS).astype(np.int64)
+        prev = np.concatenate([[bins[0] - 1 if ch.last_bin is None else ch.last_bin],
+                               bins[:-1]])
+        ch.last_bin = int(bins[-1])
+        pick = np.flatnonzero(bins != prev)
+        t0 = np.rint(t[:1] * 1e9).astype(np.int64)
+        air, air_index = ch.airframe.build(t0, np.empty((1, 0)), ch.airframe_seq)
+        ch.airframe_seq += 1
+        if not len(pick):
+            return air, air_index
+        names = tuple(names)
+        if ch.names != names:  # the columns read: η (none for a wing without modes), w_g, φ, θ
+            col = {n: i for i, n in enumerate(names)}
+            n_eta = sum(1 for n in names if n.startswith("eta") and n[3:].isdigit())
+            if n_eta not in (0, self.mesh.shape.n_modes):
+                raise ValueError(f"the {model} samples have {n_eta} modal coordinates, the "
+                                 f"scene's wing {self.mesh.shape.n_modes} modes")
+            ch.etas = [col[f"eta{i + 1}"] for i in range(self.mesh.shape.n_modes)
+                       if f"eta{i + 1}" in col]
+            ch.cols = [col["w_g"], col["phi_rad"], col["theta_rad"]]
+            ch.names = names
+        v = np.asarray(rows)[pick]
+        eta = v[:, ch.etas] if ch.etas else np.zeros((len(pick), self.mesh.shape.n_modes))
+        floats = scene_floats(self.mesh, eta, *v[:, ch.cols].T)
+        ns = np.rint(t[pick] * 1e9).astype(np.int64)
+        block, index = ch.records.build(ns, floats, ch.seq)
+        ch.seq += len(pick)
+        self.messages += len(pick)
+        index[ch.id] = index[ch.id] + np.array([0, len(air)], dtype=np.int64)
+        return b"".join((air, block)), {**air_index, **index}
+
+
+def scene_metadata(mesh: AircraftMesh, rate_hz: float) -> dict[str, str]:
+    """The ``bioflex.scene`` metadata record."""
+    o = mesh.outline
+    return {
+        "exaggeration": repr(mesh.exaggeration),
+        "rate_hz": repr(float(rate_hz)),
+        "topic": topic("<model>", SCENE_GROUP), "frame": body_frame("<model>"),
+        "entity": ENTITY_ID, "parts": ",".join(WING_PARTS) + ",gust_arrow",
+        "airframe_topic": topic("<model>", AIRFRAME_GROUP),
+        "airframe_entity": AIRFRAME_ENTITY_ID, "airframe_parts": ",".join(AIRFRAME_PARTS),
+        "airframe_rate": "once per chunk, at its first step",
+        "wing_stations": str(len(mesh.y_m)),
+        "wing_vertices_per_half": str(mesh.wing_vertices),
+        "deformation": "heave -exaggeration*sum(bending_m*eta), twist "
+                       "exaggeration*sum(twist_rad*eta) about the elastic axis, per station",
+        "gust_arrow_m_per_m_s": repr(GUST_ARROW_M_PER_M_S),
+        "wing_source": mesh.shape.source,
+        "airframe": (f"fuselage {o.fuselage_length_m:g} x {o.fuselage_max_diameter_m:g} m, "
+                     f"tail {2 * o.tail_semispan_m:g} x {o.tail_chord_m:g} m "
+                     "(parameters/airframe_consistent.py)"),
+    }
