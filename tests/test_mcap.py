@@ -253,7 +253,7 @@ def test_compare_logs_the_run_and_the_lti_prediction_and_reruns(tmp_path, capsys
 def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     from bioflex_jsb.cli.common import LOG_DIR_ENV_VAR
 
-    folder = tmp_path / "deep" / "logs"
+    folder = tmp_path / "logs"  # its parent exists: only the last directory is created
     monkeypatch.setenv(LOG_DIR_ENV_VAR, str(folder))
     args = ["gust", "--duration", "0.2", "--gust-start", "0.1", "--models", "rigid", "--json"]
     assert main(args) == 0

@@ -78,6 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     so a signal while the interpreter exits still ends with status 130 and one line. An
     in-process caller (tests, ``rerun``) passes ``argv`` and gets its handlers back."""
     installed = install_signal_handlers("")
+    if argv is None:
+        _escape_unencodable_output()
     try:
         return _main(argv)
     except KeyboardInterrupt:  # before a command was chosen (parsing the line, importing)
@@ -127,6 +129,16 @@ def _main(argv: list[str] | None) -> int:
               file=sys.stderr)
         return EXIT_INTERRUPTED
     return status
+
+
+def _escape_unencodable_output() -> None:
+    """stdout and stderr write ``\\u03b1`` for a character their encoding cannot hold
+    (``PYTHONIOENCODING=ascii``, a C locale, a Latin-1 terminal) instead of failing: our
+    tables and help texts use α, η, Δ, °, µ, ≤. Only for the program itself (``argv=None``);
+    an in-process caller keeps its own streams."""
+    for stream in (sys.stdout, sys.stderr):
+        if getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _is_log_write_error(exc: OSError) -> bool:

@@ -13,7 +13,7 @@ import argparse
 import math
 from pathlib import Path
 
-from bioflex_jsb.cli.common import UsageError, check_output
+from bioflex_jsb.cli.common import UsageError, check_file_name, check_output
 from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S
 
 DEFAULT_WING = "optimised"  # the paper's Fig. 21 case
@@ -35,19 +35,27 @@ MAX_TURBULENCE_DURATION_S = 3600.0
 
 
 def airspeed(text: str) -> float:
-    """argparse type: an airspeed in :data:`AIRSPEED_RANGE_M_S` [m/s]."""
+    """argparse type: an airspeed in :data:`AIRSPEED_RANGE_M_S` [m/s], a plain ASCII number
+    (:func:`bioflex_jsb.errors.plain_number`)."""
+    from bioflex_jsb.errors import PLAIN_NUMBER_HELP, InputError, is_plain_number, plain_number
+
     try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"speed must be a number in m/s, got {text!r}") from None
-    if not (math.isfinite(value) and SPEED_MIN_M_S <= value <= SPEED_MAX_M_S):
+        value = plain_number(text, "speed")
+    except InputError:
+        if not (is_plain_number(text) or text.strip().lstrip("+-").lower() in _NOT_FINITE):
+            raise argparse.ArgumentTypeError(
+                f"speed must be a number in m/s ({PLAIN_NUMBER_HELP}), got {text!r}") from None
+        value = math.nan  # nan, inf, 1e999: outside the range
+    if not SPEED_MIN_M_S <= value <= SPEED_MAX_M_S:
         raise argparse.ArgumentTypeError(
             f"speed {text} m/s is outside {SPEED_MIN_M_S:g}..{SPEED_MAX_M_S:g} m/s, the range "
             "every command accepts")
     return value
 
 
+_NOT_FINITE = ("nan", "inf", "infinity")
 airspeed.__name__ = "speed"
+airspeed.plain_numbers = True  # type: ignore[attr-defined]  # checks its own text
 
 
 def speed_help(default: float | None = DEFAULT_SPEED_M_S, extra: str = "") -> str:
@@ -63,27 +71,36 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
                             help="replace existing output files that bioflex-jsb did not write")
 
 
+# The figure formats every --plot help and docs/ list; matplotlib writes more (.jpg with
+# Pillow, .eps, .tif, ...), but a figure of ours is promised in these three: a PNG carries our
+# Software tag (an existing one is replaced without --force), PDF and SVG are vector.
+PLOT_FORMATS = ("png", "pdf", "svg")
+
+
 def plot_formats() -> dict[str, str]:
-    """File suffixes matplotlib can write (without the dot) and their descriptions."""
+    """The listed :data:`PLOT_FORMATS` that this matplotlib writes: suffix (no dot) ->
+    description."""
     from bioflex_jsb.sinks.plotting import supported_formats
 
-    return supported_formats()
+    available = supported_formats()
+    return {s: available[s] for s in PLOT_FORMATS if s in available}
 
 
 def check_plot_path(path: str | None, force: bool) -> None:
-    """Refuse a plot file before any work: a suffix matplotlib cannot write, or an existing
-    file that is not a plot of ours (:func:`~bioflex_jsb.sinks.plotting.is_our_plot`) without
-    --force. One-line UsageError."""
+    """Refuse a plot file before any work: a name that is not a usable file name
+    (:func:`~bioflex_jsb.cli.common.check_file_name`), a suffix not among
+    :data:`PLOT_FORMATS`, or an existing file that is not a plot of ours
+    (:func:`~bioflex_jsb.sinks.plotting.is_our_plot`) without --force. One-line
+    UsageError."""
     if not path:
         return
+    check_file_name(path, "plot file")
     suffix = Path(path).suffix.lower().lstrip(".")
     formats = plot_formats()
     if suffix not in formats:
-        shown = ", ".join(f".{s}" for s in ("png", "pdf", "svg") if s in formats)
         what = f".{suffix}" if suffix else "a file without a suffix"
-        raise UsageError(f"plot file {path!r}: cannot write {what}; "
-                         f"give a name ending in {shown} (or any of "
-                         f"{', '.join('.' + s for s in sorted(formats))})")
+        raise UsageError(f"plot file {path!r}: cannot write {what}; give a name ending in "
+                         f"{', '.join('.' + s for s in formats)}")
     from bioflex_jsb.sinks.plotting import is_our_plot
 
     check_output(path, force, "plot file", ours=is_our_plot)

@@ -27,6 +27,7 @@ import errno
 import json
 import math
 import os
+import re
 import signal
 import sys
 import threading
@@ -195,59 +196,150 @@ def closing():
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are a single line on stderr and exit status 2."""
+    """ArgumentParser whose errors are a single line on stderr and exit status 2.
+
+    Stricter than argparse's defaults, for every command and sub-command (sub-parsers are
+    of this class too): options are spelled out (no abbreviations: ``--spe`` is not
+    ``--speed``, so a later option cannot change what an old command line means); an option
+    that takes one value, or a flag, given twice is refused (argparse would keep the last
+    silently; options meant to repeat, ``action="append"``, may); and every typed value is
+    read with plain ASCII numbers only (:func:`check_plain_numbers`), also where an option's
+    own type calls ``float()`` or ``int()``."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+        self._given: dict[int, str] = {}
+        # a value that starts with "-" is a negative number, not an option, when it is a
+        # plain number (argparse's own rule misses "-20." and "-1e3")
+        self._negative_number_matcher = re.compile(r"\A-" + _UNSIGNED_PLAIN + r"\Z")
 
     def error(self, message: str) -> NoReturn:
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see --help)\n")
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {' '.join(message.split())} (see --help)\n")
+
+    def parse_known_args(self, args=None, namespace=None):
+        for action in self._actions:  # also those added through argument groups
+            if (action.option_strings and isinstance(action, _ONCE_ACTIONS)
+                    and type(action) not in _ONCE_CLASSES.values()):
+                action.__class__ = _once_class(type(action))
+        self._given = {}
+        return super().parse_known_args(args, namespace)
+
+    def _get_value(self, action, arg_string):
+        if (callable(action.type) and action.type is not str
+                and not getattr(action.type, "plain_numbers", False)):  # our own types check
+            problem = check_plain_numbers(arg_string)
+            if problem:
+                raise argparse.ArgumentError(action, problem)
+        return super()._get_value(action, arg_string)
+
+
+_UNSIGNED_PLAIN = r"(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+# Actions that keep one value: given twice, argparse silently keeps the last.
+_ONCE_ACTIONS = (argparse._StoreAction, argparse._StoreConstAction,
+                 argparse.BooleanOptionalAction)
+_ONCE_CLASSES: dict[type, type] = {}
+
+
+def _once_class(cls: type) -> type:
+    """``cls`` refusing a second occurrence of its option in one command line."""
+    if cls not in _ONCE_CLASSES:
+        def __call__(self, parser, namespace, values, option_string=None):
+            given = getattr(parser, "_given", None)
+            if given is not None:
+                if id(self) in given:
+                    first, again = given[id(self)], option_string
+                    both = f" (as {first} and {again})" if again and again != first else ""
+                    raise argparse.ArgumentError(
+                        self, f"given twice{both}; give it once")
+                given[id(self)] = option_string or "/".join(self.option_strings)
+            cls.__call__(self, parser, namespace, values, option_string)
+
+        _ONCE_CLASSES[cls] = type(f"Once{cls.__name__}", (cls,), {"__call__": __call__})
+    return _ONCE_CLASSES[cls]
+
+
+def check_plain_numbers(text: str) -> str | None:
+    """Why ``text`` (a typed option's value) holds a number only Python would read, or None.
+
+    Each ``:`` or ``,`` separated piece that ``float()`` reads (so also ``1_5``, ``１５``,
+    ``١٥``, `` 15 ``, ``nan``, ``inf``) must be a plain ASCII decimal
+    (:data:`bioflex_jsb.errors.PLAIN_NUMBER_PATTERN`) and finite (``1e999`` is infinite)."""
+    from bioflex_jsb.errors import PLAIN_NUMBER_HELP, is_plain_number
+
+    for piece in re.split(r"[:,]", text):
+        try:
+            value = float(piece)
+        except (ValueError, OverflowError):
+            continue  # not a number: the option's own type says what it accepts
+        where = "" if piece == text else f" in {text!r}"
+        if not is_plain_number(piece):
+            return f"{piece!r}{where} is not a plain number; accepted: {PLAIN_NUMBER_HELP}"
+        if not math.isfinite(value):
+            return f"{piece!r}{where} is beyond the range of a floating-point number"
+    return None
+
+
+def number_type(label: str, unit: str = "", *, low: float | None = None,
+                high: float | None = None, low_open: bool = False, high_open: bool = False,
+                integer: bool = False, symbol: str = ""):
+    """argparse type: a plain ASCII number (:func:`bioflex_jsb.errors.plain_number`) in
+    [low, high] (``low_open``/``high_open``: that end excluded), an int with ``integer``;
+    ``symbol`` names the value in the message (``0 <= Z < 1``; default: ``label``).
+    The one numeric type of the command line: every numeric option goes through it (or
+    through :func:`finite_float`/:func:`positive_float`, which are made of it)."""
+    from bioflex_jsb.errors import (
+        PLAIN_INTEGER_HELP,
+        PLAIN_NUMBER_HELP,
+        InputError,
+        is_plain_number,
+        plain_integer,
+        plain_number,
+    )
+
+    shown = f" {unit}" if unit else ""
+    kind = "whole number" if integer else "number"
+    help_text = PLAIN_INTEGER_HELP if integer else PLAIN_NUMBER_HELP
+    below, above = ("<" if low_open else "<="), ("<" if high_open else "<=")
+    cond = ""  # the range, as "0 <= Z < 1" or "> 0"
+    if low is not None and high is not None:
+        cond = f"{low:g} {below} {symbol or label} {above} {high:g}"
+    elif low is not None:
+        cond = f"{'>' if low_open else '>='} {low:g}"
+    elif high is not None:
+        cond = f"{above} {high:g}"
+    within = f" with {cond}" if cond else ""
+
+    def parse(text: str):
+        try:
+            value = plain_integer(text, label) if integer else plain_number(text, label)
+        except InputError:
+            if is_plain_number(text) and not integer:  # 1e999: overflows to infinity
+                raise argparse.ArgumentTypeError(
+                    f"{label} {text!r} is beyond the range of a floating-point number; give "
+                    f"a finite number{' in' + shown if unit else ''}") from None
+            raise argparse.ArgumentTypeError(
+                f"{label} must be a {kind}{' in' + shown if unit else ''}{within} "
+                f"({help_text}), got {text!r}") from None
+        if ((low is not None and (value <= low if low_open else value < low))
+                or (high is not None and (value >= high if high_open else value > high))):
+            verb = "satisfy" if low is not None and high is not None else "be"
+            raise argparse.ArgumentTypeError(f"{label} must {verb} {cond}{shown}, got {text!r}")
+        return value
+
+    parse.__name__ = label
+    parse.plain_numbers = True  # type: ignore[attr-defined]
+    return parse
 
 
 def finite_float(label: str, unit: str):
-    """argparse type: any finite number, e.g. an altitude (may be negative)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(
-                f"{label} must be a number in {unit}, got {text!r}"
-            ) from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(
-                f"{label} must be a finite number in {unit}, got {text!r}"
-            )
-        return value
-
-    parse.__name__ = label
-    return parse
+    """argparse type: any finite plain number, e.g. an altitude (may be negative)."""
+    return number_type(label, unit)
 
 
 def positive_float(label: str, unit: str):
-    """argparse type: a finite number > 0, e.g. ``positive_float('speed', 'm/s')``."""
-    finite = finite_float(label, unit)
-
-    def parse(text: str) -> float:
-        try:
-            value = finite(text)
-        except argparse.ArgumentTypeError:
-            if not _is_number(text):
-                raise  # not a number at all: finite_float's message
-            value = math.nan  # nan or inf
-        if not value > 0.0:
-            raise argparse.ArgumentTypeError(
-                f"{label} must be a finite number > 0 {unit}, got {text!r}"
-            )
-        return value
-
-    parse.__name__ = label
-    return parse
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    """argparse type: a finite plain number > 0, e.g. ``positive_float('speed', 'm/s')``."""
+    return number_type(label, unit, low=0.0, low_open=True)
 
 
 def print_json(payload: Any) -> None:
@@ -297,14 +389,24 @@ def wing_from_args(args: argparse.Namespace):
 
         return wing_from_aircraft(args)
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.flight_dynamics.wing_model import VariantError, build_wing, resolve_variant
+    from bioflex_jsb.flight_dynamics.wing_model import (
+        VariantError,
+        build_wing,
+        modes_used_note,
+        resolve_variant,
+    )
 
     try:
-        return build_wing(resolve_variant(args.wing), mass_basis=args.mass_basis)
+        variant = resolve_variant(args.wing)
+        build = build_wing(variant, mass_basis=args.mass_basis)
     except VariantError:
         raise
     except InputError as exc:  # modal-file and modal-data errors name their field
         raise UsageError(f"wing {args.wing!r}: {exc}") from None
+    note = modes_used_note(variant)
+    if note:  # accepted, and said: which modes fly and why (stderr: stdout may be JSON)
+        print(f"bioflex-jsb: note: {note}", file=sys.stderr)
+    return build
 
 
 LOG_DIR_ENV_VAR = "BIOFLEX_LOG_DIR"  # where runs write their logs by default (else ./logs)
@@ -332,8 +434,9 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
     new file ``<command>-<wing>-<UTC time>[-N].mcap`` in the log directory, *created here*
     with ``O_CREAT | O_EXCL`` (empty, for the log writer to fill): of runs started at the
     same second, in any number of processes, each gets its own file (the first free N), and
-    no run ever opens a file another created. A directory that cannot be created or written
-    is a UsageError."""
+    no run ever opens a file another created. The log directory (``$BIOFLEX_LOG_DIR``, else
+    ``./logs``) is created if missing, but only its last component: a parent that does not
+    exist (a mistyped path) is a UsageError, as is a directory that cannot be written."""
     import time
     from pathlib import Path
 
@@ -344,13 +447,25 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
     if args.out:
         check_output(args.out, getattr(args, "force", False), "--out")
         return args.out
-    folder = Path(os.environ.get(LOG_DIR_ENV_VAR) or "logs")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
+    from_env = os.environ.get(LOG_DIR_ENV_VAR)
+    folder = Path(from_env or "logs")
+    what = f"the log directory ${LOG_DIR_ENV_VAR}" if from_env else "the log directory"
+    check_file_name(str(folder), what)
+    try:  # the directory itself, never its parents: a mistyped path creates no tree
+        folder.mkdir(exist_ok=True)
+    except FileNotFoundError:
+        raise UsageError(f"{what} {str(folder)!r}: its parent {str(folder.parent)!r} does not "
+                         "exist (only the last directory is created); create it, or give "
+                         "--out FILE.mcap or --no-log") from None
+    except FileExistsError:
+        raise UsageError(f"{what} {str(folder)!r} exists and is not a directory; give "
+                         "--out FILE.mcap or --no-log") from None
     except OSError as exc:
-        raise UsageError(f"cannot create the log directory {str(folder)!r}: {exc.strerror}; "
-                         "give --out FILE.mcap or --no-log") from None
-    stem = f"{command}-{Path(wing).stem}-{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}"
+        kind = EnvironmentFault if environment_error(exc) else UsageError
+        raise kind(f"cannot create {what} {str(folder)!r}: {exc.strerror}; give --out "
+                   "FILE.mcap or --no-log") from None
+    stem = (f"{command}-{_name_part(Path(wing).stem)}-"
+            f"{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}")
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
     for n in range(1, MAX_LOG_NAME_TRIES + 1):
         path = folder / (f"{stem}.mcap" if n == 1 else f"{stem}-{n}.mcap")
@@ -368,6 +483,21 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
                      f"{stem}*.mcap; give --out FILE.mcap")
 
 
+# Longest wing-name part of a default log name [characters]: keeps the name, with the
+# command and the UTC time, well under NAME_MAX (255 bytes) for any variant file name.
+MAX_LOG_NAME_WING_CHARS = 64
+
+
+def _name_part(text: str) -> str:
+    """``text`` fit for a default file name: refused characters (a newline, ...) and path
+    separators replaced by ``_``, cut to :data:`MAX_LOG_NAME_WING_CHARS`."""
+    import unicodedata
+
+    safe = "".join("_" if unicodedata.category(c) in REFUSED_NAME_CATEGORIES or c in "/\\"
+                   else c for c in text)
+    return safe[:MAX_LOG_NAME_WING_CHARS] or "wing"
+
+
 def check_output(path: str, force: bool, what: str, ours=None) -> None:
     """Refuse to replace an existing file at ``path`` (a user's file is never overwritten
     without ``--force``): a UsageError naming it, unless ``force`` or ``ours(path)`` says it
@@ -375,6 +505,7 @@ def check_output(path: str, force: bool, what: str, ours=None) -> None:
     directory or a special file is refused even with ``--force``."""
     from pathlib import Path
 
+    check_file_name(path, what)
     p = Path(path)
     if not p.exists() and not p.is_symlink():
         return
@@ -384,3 +515,55 @@ def check_output(path: str, force: bool, what: str, ours=None) -> None:
         return
     raise UsageError(f"{what} {path!r} already exists; give another name or --force to "
                      "replace it")
+
+
+# Longest name of one path component and whole path [bytes] where the file system cannot be
+# asked (os.pathconf): Linux's NAME_MAX and PATH_MAX (<linux/limits.h>).
+NAME_MAX_BYTES = 255
+PATH_MAX_BYTES = 4096
+# Characters refused in a file name we create: control characters (Cc: newline, tab, escape,
+# NUL, DEL, C1), line and paragraph separators (Zl, Zp: str.splitlines breaks on them) and
+# surrogates (Cs: bytes that are not text in the file-system encoding). Each makes a file
+# whose name breaks a line of our own output or of `ls`, a shell loop, a CSV of log names.
+REFUSED_NAME_CATEGORIES = {"Cc": "a control character", "Zl": "a line separator",
+                           "Zp": "a paragraph separator", "Cs": "a byte that is not text"}
+
+
+def _name_max(path) -> int:
+    """NAME_MAX of the file system the nearest existing ancestor of ``path`` is on."""
+    from pathlib import Path
+
+    p = Path(path).absolute().parent
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    try:
+        return int(os.pathconf(p, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):  # not a POSIX system, or not answerable
+        return NAME_MAX_BYTES
+
+
+def check_file_name(path: str, what: str) -> None:
+    """Refuse, as one-line UsageError, a name for a file or directory we create that no file
+    system or reader would take: empty, a component longer than the file system's NAME_MAX
+    (ENAMETOOLONG), a path longer than PATH_MAX, or characters of
+    :data:`REFUSED_NAME_CATEGORIES` (a newline, ...)."""
+    import unicodedata
+
+    if not path:
+        raise UsageError(f"{what}: the file name is empty; give a file name")
+    for ch in path:
+        kind = REFUSED_NAME_CATEGORIES.get(unicodedata.category(ch))
+        if kind:
+            raise UsageError(f"{what} {path[:80]!r}: the name holds {kind} ({ascii(ch)}); "
+                             "accepted: printable characters only")
+    raw = os.fsencode(path)
+    if len(raw) > PATH_MAX_BYTES:
+        raise UsageError(f"{what} {path[:40]!r}...: the path is {len(raw)} bytes long; "
+                         f"accepted: up to {PATH_MAX_BYTES}")
+    limit = _name_max(path)
+    for part in raw.split(b"/"):
+        if len(part) > limit:
+            name = os.fsdecode(part)
+            raise UsageError(f"{what} {name[:40]!r}...: a name of {len(part)} bytes; accepted: "
+                             f"up to {limit} bytes per file or directory name (the file "
+                             "system's limit)")

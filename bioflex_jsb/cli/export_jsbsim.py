@@ -18,7 +18,9 @@ from bioflex_jsb.cli.case import (
 from bioflex_jsb.cli.common import (
     UsageError,
     add_wing_arguments,
+    check_file_name,
     check_output,
+    positive_float,
     print_json,
     wing_from_args,
 )
@@ -53,7 +55,7 @@ def register(sub) -> None:
                    help="coupled (modal states) or qsd (quasi-static deformation); "
                         "default coupled")
     p.add_argument("--out", required=True, metavar="DIR", help="JSBSim root to write into")
-    p.add_argument("--dt", type=float, default=DEFAULT_DT_S,
+    p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
                    help=f"JSBSim step the system is exported for [s] (default {DEFAULT_DT_S:.6g})")
     p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S,
                    help=speed_help(extra="; it sets the script's level trim (the airframe trims at "
@@ -102,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.generators import native_aircraft as NA
     from bioflex_jsb.generators import native_wing as J
 
+    check_file_name(args.out, "--out")
     build = wing_from_args(args)
     out = Path(args.out)
     if out.exists() and not out.is_dir():

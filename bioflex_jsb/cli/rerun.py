@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from bioflex_jsb.cli.common import UsageError, print_json
+from bioflex_jsb.cli.common import UsageError, check_file_name, number_type, print_json
 
 HELP = """Repeat the gust run, sweep case or comparison recorded in FILE.mcap from its metadata
 record bioflex.run (wing, mass basis, speed, gust and seed, duration, gust start, time step,
@@ -18,19 +18,8 @@ bad file."""
 LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold an argv
 
 
-def tolerance(text: str) -> float:
-    """argparse type: a relative tolerance, a finite number 0 <= rtol < 1."""
-    import math
-
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"rtol must be a number, got {text!r}") from None
-    if not (math.isfinite(value) and 0.0 <= value < 1.0):
-        raise argparse.ArgumentTypeError(
-            f"rtol must be a finite number with 0 <= rtol < 1 (a relative tolerance), "
-            f"got {text!r}")
-    return value
+tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
+"""argparse type: a relative tolerance 0 <= rtol < 1 [-]."""
 
 
 def register(sub) -> None:
@@ -133,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
 
     from bioflex_jsb import cli
 
+    check_file_name(args.out, "--out")
     argv = argv_from_log(args.file)  # also checks that the file is a finished log
     if Path(args.out).resolve() == Path(args.file).resolve():
         raise UsageError("--out must name a new file, not the original log")

@@ -153,8 +153,43 @@ _VARIANT_KEYS = {
 }
 
 
+# Largest |value| of a pinned coefficient (overrides, pin_c_eta1_q1) [-]. The named wings'
+# Table B1 coefficients are all below 1.2 in magnitude, and strip theory bounds a modal lift
+# derivative by the 2-D lift slope 2π per rad of unit twist (the modes are normalised to
+# max |twist| = 1): 100 leaves 16 times that for what-if studies. Beyond it the coefficient
+# describes no wing (1e308 overflows the state matrix to infinity).
+MAX_PINNED_COEFFICIENT = 100.0
+
+
+def _coefficient(value, what: str, source: str) -> float:
+    """A pinned coefficient: a finite number with |value| <= MAX_PINNED_COEFFICIENT."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise VariantError(f"{source}: {what} must be a finite number, got {value!r}")
+    if abs(value) > MAX_PINNED_COEFFICIENT:
+        raise VariantError(f"{source}: {what} = {value!r} is outside "
+                           f"-{MAX_PINNED_COEFFICIENT:g}..{MAX_PINNED_COEFFICIENT:g} (a Table B1 "
+                           "coefficient of any wing is a few units at most)")
+    return float(value)
+
+
+def _text(value, what: str, source: str) -> str:
+    """A name or description: text without control characters (it is printed and logged)."""
+    import unicodedata
+
+    if not isinstance(value, str):
+        raise VariantError(f"{source}: {what} must be a string, got {type(value).__name__}")
+    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in value):
+        raise VariantError(f"{source}: {what} holds a control character (a newline, ...); "
+                           "accepted: printable text")
+    return value
+
+
 def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) -> WingVariant:
     """Build a variant from a parsed variant file (see docs/wing_variants.md)."""
+    if not data:
+        raise VariantError(f"{source}: the variant file sets nothing (empty, or comments "
+                           f"only); give at least one of {', '.join(sorted(_VARIANT_KEYS))} "
+                           "(docs/wing_variants.md), or --wing NAME for a named wing")
     unknown = sorted(set(data) - _VARIANT_KEYS)
     if unknown:
         raise VariantError(
@@ -167,6 +202,7 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
     values: dict[str, object] = {"name": data.get("name", Path(source).stem)}
     if not isinstance(values["name"], str) or not values["name"]:
         raise VariantError(f"{source}: 'name' must be a non-empty string")
+    _text(values["name"], "'name'", source)
     for key in ("x_inertial_frac", "x_elastic_frac"):
         if key in data:
             v = data[key]
@@ -202,9 +238,7 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
                 parse_override_key(k, DEFAULT_N_MODES)
             except ValueError as exc:
                 raise VariantError(f"{source}: overrides: {exc}") from None
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise VariantError(f"{source}: overrides.{k} must be a finite number")
-            checked[k] = float(v)
+            checked[k] = _coefficient(v, f"overrides.{k}", source)
         values["overrides"] = checked
     if "modes_file" in data:
         moved = [k for k in ("x_inertial_frac", "x_elastic_frac", "ribs") if k in data]
@@ -229,11 +263,13 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
             raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
                                f"{PHYSICAL_PIN!r} (the strip model's own value)")
         else:
-            values["pinned_c_eta1_q1"] = float(pin)
+            values["pinned_c_eta1_q1"] = _coefficient(pin, "'pin_c_eta1_q1'", source)
     else:
         values["pinned_c_eta1_q1"] = _inherited_pin(base, values, source, modes)
     if "description" in data:
-        values["description"] = str(data["description"])
+        if not isinstance(data["description"], str):
+            raise VariantError(f"{source}: 'description' must be a string")
+        values["description"] = data["description"]
     return replace(base, published_c_eta1_q1=None, **values)
 
 
@@ -324,7 +360,34 @@ def _aero(planform: Planform):
 
 
 def structural_modes(variant: WingVariant, n_modes: int = DEFAULT_N_MODES):
-    """The variant's modes: its modal file, or the calibrated half-wing beam."""
+    """The variant's modes: its modal file, or the calibrated half-wing beam; the lowest
+    ``n_modes`` of them (:func:`modes_used_note` says so when a file holds more)."""
+    modes = _all_modes(variant, n_modes)
+    if modes.n_modes < n_modes:
+        raise VariantError(
+            f"wing {variant.name!r} has {modes.n_modes} modes, {n_modes} were asked for"
+        )
+    return modes.truncated(n_modes)
+
+
+def modes_used_note(variant: WingVariant, n_modes: int = DEFAULT_N_MODES) -> str | None:
+    """One line when the variant's modes file holds more than the ``n_modes`` the model
+    flies (which ones are used, and why); None otherwise."""
+    if not variant.modes_file:
+        return None
+    modes = _all_modes(variant, n_modes)
+    if modes.n_modes <= n_modes:
+        return None
+    f = modes.frequencies_hz
+    return (f"wing {variant.name!r}: the modes file holds {modes.n_modes} modes; the model "
+            f"uses the lowest {n_modes} ({f[0]:.4g}..{f[n_modes - 1]:.4g} Hz) and leaves out "
+            f"the other {modes.n_modes - n_modes} (from {f[n_modes]:.4g} Hz): the paper's wing "
+            f"model has {n_modes} modes (Table 2), and the coefficient names, logs and "
+            "exports are made for them")
+
+
+def _all_modes(variant: WingVariant, n_modes: int):
+    """Every mode of the variant's modal file, or ``n_modes`` of the calibrated beam."""
     if variant.modes_file:
         from bioflex_jsb.structures.modal_file import read_modal_file
 
@@ -339,11 +402,7 @@ def structural_modes(variant: WingVariant, n_modes: int = DEFAULT_N_MODES):
             x_inertial_frac=variant.x_inertial_frac,
             x_elastic_frac=variant.x_elastic_frac,
         )
-    if modes.n_modes < n_modes:
-        raise VariantError(
-            f"wing {variant.name!r} has {modes.n_modes} modes, {n_modes} were asked for"
-        )
-    return modes.truncated(n_modes)
+    return modes
 
 
 # Wings built in this process, most recently used last; bounded so that a long sweep over
@@ -364,7 +423,8 @@ def build_wing(
     """
     if mass_basis not in MASS_BASES:
         raise VariantError(f"unknown mass basis {mass_basis!r}; accepted: {', '.join(MASS_BASES)}")
-    key = (repr(sorted(variant.as_dict().items())), n_modes, mass_basis, planform)
+    key = (repr(sorted(variant.as_dict().items())), _file_version(variant.modes_file),
+           n_modes, mass_basis, planform)
     if key in _BUILD_CACHE:
         _BUILD_CACHE.move_to_end(key)
         return _BUILD_CACHE[key]
@@ -374,8 +434,47 @@ def build_wing(
     return build
 
 
+def _file_version(path: str | None) -> tuple | None:
+    """What identifies the contents of a modes file for the build cache (a file edited
+    between two builds in one process is read again): its size, change time and inode."""
+    if not path:
+        return None
+    try:
+        st = Path(path).stat()
+    except OSError:  # unreadable: the build reads it and reports why, in one line
+        return None
+    return (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino)
+
+
+# How far the stations of a modes file may be from the root (first) and the tip (last) of the
+# half wing, as a fraction of b/2: the strips interpolate the shapes at their own stations and
+# hold the end value beyond the last one, so a file that stops short of the tip, or runs past
+# it, would give a wing with shapes it does not have. 1 %: rounding of an FE mesh's nodes.
+STATION_SPAN_TOLERANCE = 0.01
+
+
+def _check_modes_fit(variant: WingVariant, modes: ModalData, planform: Planform) -> None:
+    """A modes file's stations span this half wing; a C_η1^Q1 pin needs twist in mode 1."""
+    half = planform.semispan_m
+    y = modes.stations_m
+    off = max(y[0], abs(y[-1] - half))  # from the root, and from the tip [m]
+    if variant.modes_file and off > STATION_SPAN_TOLERANCE * half:
+        raise VariantError(
+            f"wing {variant.name!r}: the modes file's stations run {y[0]:g}..{y[-1]:g} m; "
+            f"accepted: from the root (0 m) to the tip (b/2 = {half:g} m) within "
+            f"{100 * STATION_SPAN_TOLERANCE:g} % (stations.y, in its [units] length)")
+    if variant.pinned_c_eta1_q1 is not None and modes.twist_free()[0]:
+        raise VariantError(
+            f"wing {variant.name!r}: mode 1 is pure bending (no twist), so its C_eta1^Q1 (the "
+            "aerodynamic stiffness of its twist) is zero for any aerodynamic offset and cannot "
+            f"be pinned to {variant.pinned_c_eta1_q1:g}; set pin_c_eta1_q1 = "
+            f"\"{PHYSICAL_PIN}\" (the mode then flies with its plunge terms C_L_etadot, "
+            "C_etadot^Q) or give mode 1 its twist")
+
+
 def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planform) -> WingBuild:
     modes = structural_modes(variant, n_modes)
+    _check_modes_fit(variant, modes, planform)
     aero = _aero(planform)
     strips = spanwise_geometry(aero, planform, modes.x_elastic_frac, modes.stations_m)
     physical = modal_coefficients(modes, strips)

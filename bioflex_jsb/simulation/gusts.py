@@ -26,7 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bioflex_jsb.errors import InputError
+from bioflex_jsb.errors import InputError, plain_integer, plain_number
+from bioflex_jsb.parameters import prototype as P
 
 GUST_FORMS = (
     "sharp:AMPLITUDE_m_s",
@@ -36,6 +37,21 @@ GUST_FORMS = (
     "none",
 )
 MAX_GUST_M_S = 50.0  # beyond this the small-UAV model is meaningless (3x the cruise speed)
+# Shortest 1-cos length and turbulence scale [m]: one mean aerodynamic chord (Table 1,
+# c̄ = 0.183 m). Every wing model here treats the gust as uniform over the chord at each
+# instant (quasi-steady strips; the unsteady strips' Küssner penetration starts from the
+# same assumption of a gust wider than the section); a shorter gust is thinner than the wing
+# it crosses. For scale: the classic 1-cos gust of the airworthiness codes (FAR 23.341) is
+# 25 chords long, and MIL-F-8785C's smallest turbulence scale is 10 ft (3 m).
+MIN_GUST_LENGTH_M = P.MEAN_AERODYNAMIC_CHORD_M
+# Longest 1-cos length and turbulence scale [m]: 10 km, 13 times MIL-F-8785C's largest
+# scale (2500 ft = 762 m, von Kármán above 2000 ft); a longer gust is steady wind for any run.
+MAX_GUST_LENGTH_M = 10_000.0
+# A 1-cos gust must last at least this many steps of the run: sampled at Δt, its peak is then
+# met within Δt/2, i.e. within (1 − cos(π/10))/2 = 2.4 % of its amplitude; a gust shorter
+# than a step can fall between two samples and not be flown at all.
+MIN_GUST_STEPS = 10
+MAX_SEED = 2**63  # default_rng takes any int >= 0; sweep results store the seed as int64
 
 
 class GustSpecError(InputError):
@@ -67,13 +83,44 @@ class GustSpec:
 
 
 def _number(text: str, what: str, spec: str) -> float:
+    """A plain ASCII number of the gust ``spec`` (``1_5``, ``１５``, ``nan``, ``1e999``
+    refused: :func:`bioflex_jsb.errors.plain_number`)."""
     try:
-        value = float(text)
-    except ValueError:
-        raise GustSpecError(f"gust {spec!r}: {what} must be a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise GustSpecError(f"gust {spec!r}: {what} must be finite, got {text!r}")
+        return plain_number(text, what)
+    except InputError as exc:
+        raise GustSpecError(f"gust {spec!r}: {exc}") from None
+
+
+def _length(text: str, name: str, spec: str) -> float:
+    """A 1-cos length or turbulence scale [m] in MIN_GUST_LENGTH_M..MAX_GUST_LENGTH_M."""
+    value = _number(text, f"the {name} [m]", spec)
+    accepted = f"accepted: {MIN_GUST_LENGTH_M:g}..{MAX_GUST_LENGTH_M:g} m"
+    if value <= 0.0:
+        raise GustSpecError(f"gust {spec!r}: the {name} must be > 0 m ({accepted}), got "
+                            f"{value:g}")
+    if value < MIN_GUST_LENGTH_M:
+        raise GustSpecError(
+            f"gust {spec!r}: the {name} {value:g} m is shorter than one mean chord "
+            f"({accepted}): such a gust is thinner than the wing it crosses, which every wing "
+            "model here takes as uniform over the chord")
+    if value > MAX_GUST_LENGTH_M:
+        raise GustSpecError(f"gust {spec!r}: the {name} {value:g} m is too long ({accepted}; "
+                            "a longer gust is a steady wind for any run)")
     return value
+
+
+def check_gust_resolution(gust: GustSpec, speed_m_s: float, dt_s: float) -> None:
+    """A 1-cos ``gust`` flown at ``speed_m_s`` must last :data:`MIN_GUST_STEPS` steps of
+    ``dt_s`` [s]; else :class:`GustSpecError` naming the shortest length and the step."""
+    if gust.kind != "1cos":
+        return
+    steps = gust.length_m / speed_m_s / dt_s
+    if steps < MIN_GUST_STEPS:
+        shortest = MIN_GUST_STEPS * speed_m_s * dt_s
+        raise GustSpecError(
+            f"gust {gust.text()!r} lasts {steps:.3g} steps of {dt_s:g} s at {speed_m_s:g} m/s; "
+            f"accepted: at least {MIN_GUST_STEPS} steps (its peak is then sampled within "
+            f"2.4 %), a length >= {shortest:.3g} m or a smaller --dt")
 
 
 def parse_gust(spec: str) -> GustSpec:
@@ -93,10 +140,8 @@ def parse_gust(spec: str) -> GustSpec:
         if len(parts) != 3:
             raise GustSpecError(f"gust {spec!r}: 1cos takes amplitude and length; {accepted}")
         amp = _number(parts[1], "the amplitude [m/s]", spec)
-        length = _number(parts[2], "the gust length [m]", spec)
         _check_amplitude(amp, spec)
-        if length <= 0.0:
-            raise GustSpecError(f"gust {spec!r}: the gust length must be > 0 m, got {length:g}")
+        length = _length(parts[2], "gust length", spec)
         return GustSpec("1cos", amp, length)
     if kind in ("dryden", "vonkarman"):
         if len(parts) not in (3, 4):
@@ -104,21 +149,17 @@ def parse_gust(spec: str) -> GustSpec:
                 f"gust {spec!r}: {kind} takes SIGMA_m_s:SCALE_m[:SEED]; {accepted}"
             )
         sigma = _number(parts[1], "the RMS intensity sigma [m/s]", spec)
-        scale = _number(parts[2], "the length scale [m]", spec)
         if sigma < 0.0 or sigma > MAX_GUST_M_S:
             raise GustSpecError(f"gust {spec!r}: sigma must be 0..{MAX_GUST_M_S:g} m/s")
-        if scale <= 0.0:
-            raise GustSpecError(f"gust {spec!r}: the length scale must be > 0 m, got {scale:g}")
+        scale = _length(parts[2], "length scale", spec)
         seed = 0
         if len(parts) == 4:
             try:
-                seed = int(parts[3])
-            except ValueError:
-                raise GustSpecError(
-                    f"gust {spec!r}: the seed must be a whole number, got {parts[3]!r}"
-                ) from None
-            if seed < 0:
-                raise GustSpecError(f"gust {spec!r}: the seed must be ≥ 0")
+                seed = plain_integer(parts[3], "the seed")
+            except InputError as exc:
+                raise GustSpecError(f"gust {spec!r}: {exc}") from None
+            if not 0 <= seed < MAX_SEED:
+                raise GustSpecError(f"gust {spec!r}: the seed must be 0..{MAX_SEED - 1}")
         return GustSpec(kind, sigma, scale, seed)
     raise GustSpecError(f"unknown gust form {spec!r}; {accepted}")
 

@@ -76,6 +76,22 @@ _MODE_KEYS = {"frequency", "damping_ratio", "generalised_mass", "bending", "twis
 MAX_MODAL_BYTES = 64 * 1024 * 1024
 
 
+# Ranges of the numeric fields (SI, after the [units] conversion). These keep the model the
+# file builds inside floating-point range and conditioning; they are far wider than any wing
+# of this aircraft (Table 2: 31..107 Hz, generalised masses ~1e-5 kg·m² when normalised).
+# ω: the state matrix holds ω_i² and 2ζ_iω_i beside rigid-body terms of 0.1..10 rad/s;
+# past 1e5 rad/s (16 kHz) ω² = 1e10 and the eigenvalues lose 10 of their 16 digits; below
+# 1e-2 rad/s (a ten-minute period) it is no structural mode of a clamped wing.
+MIN_FREQUENCY_RAD_S = 1e-2
+MAX_FREQUENCY_RAD_S = 1e5
+# ζ: a structural mode is under-damped (0 <= ζ < 1), as the variant's structural_damping.
+MAX_DAMPING_RATIO = 1.0  # excluded
+# m_i of the normalised mode (max |twist| = 1 rad/rad, or bending-scaled): 7 decades either
+# side of Table 2's; the modal forces Q/m_i overflow to infinity near 5e-324.
+MIN_GENERALISED_MASS_KG_M2 = 1e-12
+MAX_GENERALISED_MASS_KG_M2 = 1e3
+
+
 class ModalFileError(InputError):
     """A modal-data file that cannot be used; one-line message naming key and line."""
 
@@ -232,10 +248,16 @@ class _Reader:
             f = self.number(mode["frequency"], f"{tag}.frequency", "mode", "frequency", i)
             if f <= 0.0:
                 self.fail(f"{tag}.frequency", "must be positive", "mode", "frequency", i)
+            if not MIN_FREQUENCY_RAD_S <= f * factor["frequency"] <= MAX_FREQUENCY_RAD_S:
+                self.fail(f"{tag}.frequency", f"{f:g} {units['frequency']} is outside "
+                          f"{MIN_FREQUENCY_RAD_S:g}..{MAX_FREQUENCY_RAD_S:g} rad/s (the range "
+                          "a structural mode of the model may have)", "mode", "frequency", i)
             z = self.number(mode.get("damping_ratio", 0.0), f"{tag}.damping_ratio", "mode",
                             "damping_ratio", i)
-            if z < 0.0:
-                self.fail(f"{tag}.damping_ratio", "must be ≥ 0", "mode", "damping_ratio", i)
+            if not 0.0 <= z < MAX_DAMPING_RATIO:
+                self.fail(f"{tag}.damping_ratio", f"must satisfy 0 <= damping_ratio < "
+                          f"{MAX_DAMPING_RATIO:g} (an under-damped mode), got {z:g}", "mode",
+                          "damping_ratio", i)
             m = self.number(mode["generalised_mass"], f"{tag}.generalised_mass", "mode",
                             "generalised_mass", i)
             if m <= 0.0:
@@ -268,9 +290,17 @@ class _Reader:
                 source=str(data.get("source", self.name)),
                 notes=str(data.get("notes", "")),
             )
-            return modal.normalised() if normalise else modal
+            scaled = modal.normalised()
         except ModalDataError as exc:  # should be caught above; keep the one-line promise
             self.fail("data", str(exc))
+        for i, m in enumerate(scaled.generalised_masses_kg_m2):
+            if not MIN_GENERALISED_MASS_KG_M2 <= m <= MAX_GENERALISED_MASS_KG_M2:
+                self.fail(f"mode[{i + 1}].generalised_mass",
+                          f"{m:g} kg*m^2 in the project normalisation (docs/structures.md) is "
+                          f"outside {MIN_GENERALISED_MASS_KG_M2:g}.."
+                          f"{MAX_GENERALISED_MASS_KG_M2:g}",
+                          "mode", "generalised_mass", i)
+        return scaled if normalise else modal
 
 
 def parse_modal_text(text: str, *, name: str = "<modal text>", normalise: bool = True) -> ModalData:
