@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 
@@ -19,12 +20,14 @@ from bioflex_jsb.cli.case import (
 from bioflex_jsb.cli.common import (
     UsageError,
     add_wing_arguments,
+    check_output,
     models_list,
     print_json,
     wing_from_args,
 )
 from bioflex_jsb.cli.gust import damping_ratio, wing_for_run
 from bioflex_jsb.flight_dynamics import eigen
+from bioflex_jsb.sinks.mcap import scene_modes
 
 PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
 
@@ -69,13 +72,47 @@ def register(sub) -> None:
         f"{PLOT_TOP_M_S:g} m/s) to FILE.png (.png, .pdf, .svg; an existing file is replaced "
         "only if bioflex-jsb wrote it)",
     )
+    p.add_argument(
+        "--animate", metavar="FILE.mcap",
+        help="write an MCAP in which each structural mode of the wing and each aeroelastic "
+        "mode of the coupled model at --speed (one speed) oscillates in turn, "
+        f"{scene_modes.CYCLES} cycles each shown at {scene_modes.DISPLAY_PERIOD_S:g} s a "
+        "cycle, labelled with frequency and damping ratio (a text in the 3-D scene and an "
+        "event); open it in Foxglove with docs/foxglove/layout.json, frame modes_body",
+    )
+    p.add_argument(
+        "--mode-sheet", metavar="FILE.png",
+        help="draw the twist and bending of those modes along the span to FILE.png (.png, "
+        ".pdf, .svg)",
+    )
     add_force_argument(p)
     p.set_defaults(run=run)
+
+
+def _check_shape_outputs(args, speeds) -> None:
+    """--animate and --mode-sheet: one --speed, the quasi-steady model, files we may write."""
+    if not (args.animate or args.mode_sheet):
+        return
+    if len(speeds) != 1:
+        raise UsageError(f"--animate and --mode-sheet show the modes at one --speed; "
+                         f"{len(speeds)} were given")
+    if args.aero != "quasi-steady":
+        raise UsageError("--animate and --mode-sheet show the quasi-steady coupled model's "
+                         "modes; drop --aero unsteady")
+    check_plot_path(args.mode_sheet, args.force)
+    if args.animate:
+        check_output(args.animate, args.force, "animation file")
+        if Path(args.animate).suffix.lower() != ".mcap":
+            raise UsageError(f"animation file {args.animate!r}: give a name ending in .mcap")
+        if not Path(args.animate).parent.is_dir():
+            raise UsageError(f"animation file {args.animate!r}: the directory "
+                             f"{str(Path(args.animate).parent)!r} does not exist")
 
 
 def run(args: argparse.Namespace) -> int:
     speeds = args.speed or [DEFAULT_SPEED_M_S]
     check_plot_path(args.plot, args.force)
+    _check_shape_outputs(args, speeds)
     build = wing_for_run(wing_from_args(args), args)
     from bioflex_jsb import api
 
@@ -95,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
     }
     if args.plot:
         _plot(args, build, speeds)
+    if args.animate or args.mode_sheet:
+        payload.update(_shapes(args, build, speeds[0]))
     if args.json:
         print_json(payload)
         return 0
@@ -115,7 +154,31 @@ def run(args: argparse.Namespace) -> int:
               "divergence, a complex one a flutter or an unstable oscillation")
     if args.plot:
         print(f"root loci written to {args.plot}")
+    if args.animate:
+        print(f"mode animation written to {args.animate} "
+              f"({', '.join(payload['animation']['modes'])})")
+    if args.mode_sheet:
+        print(f"mode sheet written to {args.mode_sheet}")
     return 0
+
+
+def _shapes(args, build, speed_m_s: float) -> dict:
+    from bioflex_jsb.sinks import plotting
+
+    shapes = scene_modes.mode_shapes(build, speed_m_s)
+    out: dict = {"mode_shapes": [s.as_dict() for s in shapes]}
+    try:
+        if args.animate:
+            out["animation"] = {"file": args.animate,
+                                **scene_modes.write_animation(args.animate, build, speed_m_s,
+                                                              shapes)}
+        if args.mode_sheet:
+            scene_modes.draw_mode_sheet(args.mode_sheet, build, speed_m_s, shapes,
+                                        software=plotting.SOFTWARE_TAG)
+            out["mode_sheet"] = args.mode_sheet
+    except OSError as exc:
+        raise UsageError(f"cannot write {exc.filename!r}: {exc.strerror}") from None
+    return out
 
 
 def _plot(args, build, speeds) -> None:

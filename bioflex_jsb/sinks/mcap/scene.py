@@ -326,7 +326,7 @@ def scene_pieces(mesh: AircraftMesh, frame: str, texts: list | None = None):
              for part in _wing_list(sign * mesh.y_m, mesh.wing_indices, COLOURS["wing"])]
     head = _head(frame, ENTITY_ID)
     arrow = _arrow(COLOURS["gust"])
-    extra = list(texts or [])
+    extra = [part for text in texts or [] for part in text]
 
     def pieces(ls: int, ln: int) -> list[list]:
         return [_sub(2, _timestamp(1, ls, ln) + head + arrow + wings + extra)]

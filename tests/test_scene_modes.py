@@ -1,0 +1,94 @@
+"""modes --animate and --mode-sheet (bioflex_jsb/sinks/mcap/scene_modes.py): every mode in
+turn, labelled with the frequency and damping the modes table gives, the wing twisting as the
+mode's shape; the sheet a PNG of ours; bad requests refused in one line."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bioflex_jsb import api, cli
+from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.sinks.mcap import scene_modes
+from tests.test_scene import decode_topic
+
+# Rounding only (a cosine and a few products of doubles below 1): see tests/test_scene.py
+TOL = 1e-12
+N_FRAMES = round(scene_modes.CYCLES * scene_modes.DISPLAY_PERIOD_S * scene_modes.FRAME_RATE_HZ)
+
+
+@pytest.fixture(scope="module")
+def animated(tmp_path_factory):
+    d = tmp_path_factory.mktemp("modes")
+    status = cli.main(["modes", "--animate", str(d / "modes.mcap"), "--mode-sheet",
+                       str(d / "sheet.png"), "--models", "coupled", "--json"])
+    assert status == 0
+    return d
+
+
+def test_each_mode_in_turn_labelled_with_the_tables_numbers(animated):
+    events = decode_topic(animated / "modes.mcap", "/bioflex/events")
+    frames = decode_topic(animated / "modes.mcap", "/bioflex/modes/scene")
+    assert len(events) == 6 and len(frames) == 6 * N_FRAMES
+    build = build_wing(VARIANTS["optimised"])
+    table = api.modes(build, 15.0, "coupled")
+    for i, (ns, ev) in enumerate(events[:3]):
+        f = build.modes.frequencies_rad_s[i] / (2 * math.pi)
+        assert ev.message.startswith(f"structural mode {i + 1} ") and f"{f:.2f} Hz" in ev.message
+        assert ns == round(i * scene_modes.CYCLES * scene_modes.DISPLAY_PERIOD_S * 1e9)
+    for i, (_, ev) in enumerate(events[3:]):
+        m = table.get(f"aeroelastic_{i + 1}")
+        assert ev.message.startswith(f"aeroelastic_{i + 1} at 15 m/s")
+        assert f"{m.frequency_rad_s / (2 * math.pi):.2f} Hz" in ev.message
+        assert f"damping ratio {m.damping:.3f}" in ev.message
+    for k, (ns, ev) in enumerate(events):  # the label in the scene is the event's text
+        assert frames[k * N_FRAMES][0] == ns
+        assert frames[k * N_FRAMES][1].entities[0].texts[0].text == ev.message
+
+
+def test_a_structural_mode_twists_the_wing_as_its_shape(animated):
+    build = build_wing(VARIANTS["optimised"])
+    frames = decode_topic(animated / "modes.mcap", "/bioflex/modes/scene")
+    y = np.concatenate([[0.0], build.aero.stations_m, [build.aero.semispan_m]])
+    peak = scene_modes.PEAK_TIP_TWIST_RAD
+    for i in range(3):
+        shape = np.interp(y, build.modes.stations_m, build.modes.twist_rad[i])
+        for frame, phase in ((0, 1.0), (N_FRAMES // (4 * scene_modes.CYCLES), 0.0)):
+            pts = frames[i * N_FRAMES + frame][1].entities[0].triangles[0].points
+            xz = np.array([(p.x, p.z) for p in pts]).reshape(-1, 2, 2)
+            twist = np.arctan2(xz[:, 0, 1] - xz[:, 1, 1], xz[:, 0, 0] - xz[:, 1, 0])
+            expect = peak * phase * shape / build.modes.twist_rad[i][-1]
+            assert twist == pytest.approx(expect, abs=TOL)
+
+
+def test_the_sheet_is_a_png_of_ours(animated):
+    from PIL import Image
+
+    from bioflex_jsb.sinks.plotting import is_our_plot
+
+    with Image.open(animated / "sheet.png") as im:
+        assert im.size[0] > 1500  # six panels at 150 dpi
+    assert is_our_plot(animated / "sheet.png")
+
+
+@pytest.mark.parametrize("extra, says", [
+    (["--speed", "12", "--speed", "15"], "at one --speed"),
+    (["--aero", "unsteady"], "drop --aero unsteady"),
+])
+def test_refused_in_one_line(tmp_path, capsys, extra, says):
+    status = cli.main(["modes", "--animate", str(tmp_path / "a.mcap"), *extra])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and says in err[0]
+    assert not (tmp_path / "a.mcap").exists()
+
+
+def test_a_users_file_is_not_replaced(tmp_path, capsys):
+    mine = tmp_path / "mine.mcap"
+    mine.write_text("keep me")
+    status = cli.main(["modes", "--animate", str(mine)])
+    out = capsys.readouterr()
+    err = out.err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "--force" in err[0]
+    assert mine.read_text() == "keep me" and out.out == ""  # refused before any work
