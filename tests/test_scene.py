@@ -199,3 +199,22 @@ def _rotate(q, v):
                   [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                   [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
     return r @ v
+
+
+def test_protobufjs_reads_the_scene_as_foxglove_does(gust_log, tmp_path_factory):
+    """@mcap/core's indexed reader and protobufjs (Foxglove's decoder) from the file's own
+    schema: every scene message decodes, in log-time order, to the vertices Google's
+    runtime reads."""
+    from tests.test_mcap import _node_checker
+
+    result = _node_checker(tmp_path_factory)(gust_log)
+    assert result["counts"]["/bioflex/coupled/scene"] == 72
+    assert result["counts"]["/bioflex/coupled/airframe"] == 2
+    assert result["ordered"] is True and result["dataCrcOk"] is True
+    theirs = result["samples"]["/bioflex/coupled/scene"]["entities"][0]  # the second message
+    mine = decode_topic(gust_log, "/bioflex/coupled/scene")[1][1].entities[0]
+    for t, m in zip(theirs["triangles"], mine.triangles, strict=True):
+        assert [tuple(p.get(k, 0.0) for k in "xyz") for p in t["points"]] == [
+            (p.x, p.y, p.z) for p in m.points]  # toObject leaves out zeros (defaults: false)
+        assert t["indices"] == list(m.indices)
+    assert theirs["arrows"][0].get("shaftLength", 0.0) == mine.arrows[0].shaft_length

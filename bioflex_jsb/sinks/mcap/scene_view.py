@@ -1,6 +1,6 @@
 """The logged aircraft drawn with matplotlib: a scene message decoded from the log by the log's
 own schemas and its triangles drawn as they are (``docs/img/scene.png``, made by
-``scripts/scene_screenshot.py``), and the sheet of mode shapes (``modes --mode-sheet``).
+``scripts/scene_screenshot.py``, which flies the case).
 
 Nothing here computes geometry: :func:`scene_at` reads the ``SceneUpdate`` entities of
 :mod:`.scene` back from a file, :func:`draw_scene` draws their triangle lists and the gust
@@ -131,32 +131,9 @@ def tip_twist_rad(wing_entity: dict) -> float:
     return math.atan2(le["z"] - te["z"], le["x"] - te["x"])
 
 
-def screenshot_log(path: str | Path, exaggeration: float = 1.0) -> Path:
-    """Fly :data:`SCREENSHOT_CASE` and log it with the scene to ``path``."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
-    from bioflex_jsb.flight_dynamics.wing_model import build_wing, resolve_variant
-    from bioflex_jsb.runtime.fdm import Airframe
-    from bioflex_jsb.simulation.gusts import parse_gust
-    from bioflex_jsb.simulation.run import RunDescription
-    from bioflex_jsb.sinks.mcap.log import RunLog
-
-    c = SCREENSHOT_CASE
-    build = build_wing(resolve_variant(c["wing"]))
-    desc = RunDescription("gust", c["wing"], c["speed_m_s"], gust=c["gust"],
-                          models=(c["model"],), duration_s=c["duration_s"],
-                          gust_start_s=c["gust_start_s"])
-    log = RunLog.open(path, desc, wing_variant=build.variant.as_dict(), scene=exaggeration)
-    try:
-        run_gust(Airframe(), build.model, c["model"],
-                 RunSetup(c["speed_m_s"], parse_gust(c["gust"]), c["duration_s"],
-                          c["gust_start_s"]), recorder=log.recorder(c["model"]))
-    finally:
-        log.close()
-    return Path(path)
-
-
 def render_screenshot(log_path: str | Path, png_path: str | Path) -> tuple[dict, dict]:
-    """``docs/img/scene.png`` from a log of :func:`screenshot_log`: the shot (decoded) and
+    """``docs/img/scene.png`` from a log of :data:`SCREENSHOT_CASE` (flown by
+    ``scripts/scene_screenshot.py``, which may import the drivers): the shot (decoded) and
     the triangles drawn; the PNG's Description holds the case, the time and the tip's
     twist, which the docs test compares with a fresh log."""
     c = SCREENSHOT_CASE
