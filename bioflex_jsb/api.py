@@ -106,7 +106,8 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     ``gust_start_s`` [s]. ``recorders``: a step recorder (an MCAP log) per model.
     ``aero``: the wing's strips, ``quasi-steady`` (the paper's) or ``unsteady`` (Jones lag
     states, apparent mass, Küssner gust: :mod:`bioflex_jsb.simulation.unsteady_wing`; the
-    coupled model only, compiled: :mod:`bioflex_jsb.simulation.unsteady_kernel`). ``trim``: ``rigid`` (the paper's reading) or
+    coupled model only, compiled: :mod:`bioflex_jsb.simulation.unsteady_kernel`).
+    ``trim``: ``rigid`` (the paper's reading) or
     ``elastic`` (start from the static aeroelastic equilibrium: the wing's static deflection
     and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
 
