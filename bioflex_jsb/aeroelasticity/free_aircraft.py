@@ -49,8 +49,8 @@ from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
+from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, REFERENCE_GEOMETRY, RIGID_AERODYNAMICS
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
 AERO_MODELS = engine.AERO_MODELS
@@ -120,7 +120,7 @@ class DescriptorSystem:
 
 
 def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float | None = None,
-                         density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                         density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                          geometry: StripGeometry | None = None,
                          gust: bool = False, a_rr: np.ndarray | None = None) -> StateSpace:
     """Eq. (4) of ``build`` (a WingBuild) at ``speed_m_s`` with unsteady strips
@@ -147,7 +147,7 @@ def unsteady_state_space(build, speed_m_s: float, *, structural_damping: float |
 
 
 def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | None = None,
-                        density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                        density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                         geometry: StripGeometry | None = None,
                         gust: bool = False, a_rr: np.ndarray | None = None
                         ) -> DescriptorSystem:
@@ -205,7 +205,7 @@ def _system(build, v, aero, zeta, rho) -> np.ndarray:
     return _quasi_steady_a(build, v, zeta, rho)
 
 
-def wing_divergence_speed_m_s(build, *, density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+def wing_divergence_speed_m_s(build, *, density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                               range_m_s: tuple[float, float] = (2.0, 60.0)) -> float | None:
     """:func:`bioflex_jsb.flight_dynamics.eigen.wing_divergence_speed_m_s` of ``build``'s
     model: the wing's divergence with the body held [m/s] (None in range)."""
@@ -213,7 +213,7 @@ def wing_divergence_speed_m_s(build, *, density_kg_m3: float = P.SEA_LEVEL_DENSI
 
 
 def free_family(build, *, aero: str = "unsteady", structural_damping: float | None = None,
-                density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                 start_m_s: float = eigen.SCAN_START_M_S) -> engine.EigenFamily:
     """The free aircraft (Eq. 4, ``aero`` strips) as the engine's family. Labels: the
     quasi-steady Eq. (4)'s at ``start_m_s`` (:func:`eigen.track`), given to the nearest
@@ -227,7 +227,7 @@ def free_family(build, *, aero: str = "unsteady", structural_damping: float | No
         ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=EXCLUDED,
         rigid_labels=eigen.RIGID_LABELS,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
-        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, method="state-space",
+        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, method="state-space",
         aero=aero, name=build.variant.name)
     fam.divergence_speed_m_s = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3)
     return fam
@@ -253,7 +253,7 @@ class FreeTrack:
 
 def track_free(build, speeds_m_s, *, aero: str = "unsteady",
                structural_damping: float | None = None,
-               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> FreeTrack:
+               density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> FreeTrack:
     """Eigenvalues over increasing ``speeds_m_s``, labels carried by the engine's tracker
     (eigenvector correlation + eigenvalue continuity)."""
     speeds = np.asarray(speeds_m_s, dtype=float)
@@ -264,7 +264,7 @@ def track_free(build, speeds_m_s, *, aero: str = "unsteady",
 
 
 def unsteady_mode_sets(build, speeds_m_s, structural_damping: float | None = None,
-                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> list:
+                       density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> list:
     """The coupled model on unsteady strips at ``speeds_m_s`` [m/s]: its labelled roots
     (short period, phugoid, aeroelastic_i; the strips' lag roots left out) as
     :class:`eigen.ModeSet`s (labels tracked from 2 m/s on a 0.25 m/s grid)."""
@@ -293,7 +293,7 @@ FREE_TOL_M_S = 1e-4
 def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | None = None,
                  range_m_s: tuple[float, float] = (5.0, 40.0),
                  step_m_s: float = eigen.SCAN_STEP_M_S,
-                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> engine.FlutterResult:
+                 density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> engine.FlutterResult:
     """First instability of the free aircraft (phugoid left out, as in the paper): the
     engine's scan from 2 m/s in ``step_m_s``, bisection to :data:`FREE_TOL_M_S`;
     mechanism by the engine's rule (body-freedom when the short period goes unstable)."""

@@ -24,14 +24,18 @@ import numpy as np
 from bioflex_jsb.aeroelasticity import free_aircraft as fa
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.parameters.wing import Planform
 
 
 def unsteady_state_space_with(build, speed_m_s: float, aero: RigidAerodynamics,
                               planform: Planform, *, structural_damping: float | None = None,
-                              density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> StateSpace:
+                              density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> StateSpace:
     """:func:`free_aircraft.unsteady_state_space` (paper's gust input) with the rigid set
     ``aero`` and the CG of ``planform``; ``build`` must be built on ``planform``."""
     v = float(speed_m_s)
@@ -70,7 +74,7 @@ def unsteady_flutter_with(build, aero: RigidAerodynamics, planform: Planform, *,
                           structural_damping: float | None = None,
                           range_m_s: tuple[float, float] = (5.0, 40.0),
                           step_m_s: float = 0.25, tol_m_s: float = 0.01,
-                          density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3):
+                          density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3):
     """The first instability of the exchanged unsteady system in ``range_m_s`` (the
     engine's search: labels from the set's quasi-steady Eq. 4 at 2 m/s, phugoid and lag
     roots left out, scan in ``step_m_s``, bisection to ``tol_m_s``)."""
@@ -88,7 +92,7 @@ def unsteady_flutter_with(build, aero: RigidAerodynamics, planform: Planform, *,
         ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=fa.EXCLUDED,
         rigid_labels=eigen.RIGID_LABELS,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
-        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, aero="unsteady",
+        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, aero="unsteady",
         name=build.variant.name)
     return engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, start), (lo, hi), tol_m_s=tol_m_s,

@@ -38,10 +38,16 @@ from bioflex_jsb.flight_dynamics.rigid import (
 from bioflex_jsb.parameters import airframe as default_set
 from bioflex_jsb.parameters import airframe_consistent as consistent_set
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    CRUISE_SPEED_M_S,
+    MASS_PROPERTIES,
+    REFERENCE_GEOMETRY,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
 
-CBAR_M = P.MEAN_AERODYNAMIC_CHORD_M
+CBAR_M = REFERENCE_GEOMETRY.mean_chord_m
 TABLE3_RIGID_15 = complex(*P.TABLE3_SHORT_PERIOD[(15.0, "rigid")])
 
 
@@ -62,13 +68,13 @@ class ConsistentDerivatives:
 
 
 def cm0_for_elevator(aero: RigidAerodynamics, elevator_rad: float,
-                     speed_m_s: float = P.CRUISE_SPEED_M_S) -> float:
+                     speed_m_s: float = CRUISE_SPEED_M_S) -> float:
     """C_m0 [-] that makes the linear rigid trim of ``aero`` at ``speed_m_s`` need
     ``elevator_rad`` (the tail incidence that does it)."""
     cond = level_flight_condition(speed_m_s, aero=aero)
     # α from the lift balance with that elevator, then C_m0 from the moment balance
-    qs = cond.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-    alpha = ((P.MASS_KG * P.STANDARD_GRAVITY_M_S2 / qs - aero.cl0
+    qs = cond.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    alpha = ((MASS_PROPERTIES.mass_kg * STANDARD_GRAVITY_M_S2 / qs - aero.cl0
               - aero.cl_delta_e_per_rad * elevator_rad) / aero.cl_alpha_per_rad)
     return -(aero.cm_alpha_per_rad * alpha + aero.cm_delta_e_per_rad * elevator_rad)
 
@@ -89,7 +95,7 @@ def consistent_derivatives(
         tail_efficiency=tail.efficiency, elevator_chord_fraction=tail.elevator_chord_fraction,
     )
     k = prolate_spheroid_apparent_mass_factor(fuselage.fineness_ratio)
-    d_cm_f = munk_moment_slope_per_rad(fuselage.volume_m3, k, P.REFERENCE_AREA_M2, CBAR_M)
+    d_cm_f = munk_moment_slope_per_rad(fuselage.volume_m3, k, REFERENCE_GEOMETRY.area_m2, CBAR_M)
     aero = replace(
         base,
         cl_alpha_per_rad=lat.cl_alpha,
@@ -99,14 +105,14 @@ def consistent_derivatives(
         cl_delta_e_per_rad=lat.cl_delta_e,
         cm_delta_e_per_rad=lat.cm_delta_e,
     )
-    base_trim = linear_rigid_trim(level_flight_condition(P.CRUISE_SPEED_M_S, aero=base),
+    base_trim = linear_rigid_trim(level_flight_condition(CRUISE_SPEED_M_S, aero=base),
                                   base)(StaticWingLoads())
     aero = replace(aero, cm0=cm0_for_elevator(aero, base_trim.elevator_rad))
     return ConsistentDerivatives(cg_fraction, lat, d_cm_f, aero)
 
 
 def rigid_short_period(aero: RigidAerodynamics, speed_m_s: float,
-                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> complex:
+                       density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> complex:
     """The rigid short-period root (upper half plane) of A_RR with ``aero`` [rad/s]."""
     cond = level_flight_condition(speed_m_s, density_kg_m3, aero)
     lam = np.linalg.eigvals(rigid_matrices(rigid_derivatives(cond, aero))[0])
@@ -149,7 +155,7 @@ AIRCRAFT_SETS = {
 # --------------------------------------------------------------------------------------
 def modes_with(model: str, speeds_m_s: Sequence[float], wing: ElasticWingModel | None,
                aero: RigidAerodynamics,
-               density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> list[eigen.ModeSet]:
+               density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> list[eigen.ModeSet]:
     """:func:`eigen.modes_at` with ``aero`` (labels tracked from 2 m/s, 0.25 m/s grid)."""
     return eigen.modes_at(model, speeds_m_s, wing, density_kg_m3, aero)
 
@@ -157,7 +163,7 @@ def modes_with(model: str, speeds_m_s: Sequence[float], wing: ElasticWingModel |
 def flutter_with(wing: ElasticWingModel, aero: RigidAerodynamics,
                  range_m_s: tuple[float, float] = (5.0, 40.0), step_m_s: float = 0.1,
                  tol_m_s: float = 0.01,
-                 density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3) -> eigen.FlutterResult:
+                 density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> eigen.FlutterResult:
     """:func:`eigen.find_flutter` with ``aero`` (phugoid left out, as there)."""
     return eigen.find_flutter(wing, range_m_s, step_m_s, tol_m_s, density_kg_m3, aero)
 

@@ -24,8 +24,12 @@ from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.flutter_engine import FlutterResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 
 RIGID_LABELS = ("short_period", "phugoid")
 IMAG_TOL_RAD_S = 1e-6  # below this |Im λ| a root is reported as real [rad/s]
@@ -164,7 +168,7 @@ def paper_family(model: str, wing: ElasticWingModel | None, density_kg_m3: float
         matrix, np.array([r[1] for r in ref]), [r[0] for r in ref], rest_label="lag",
         excluded=EXCLUDED_FROM_FLUTTER, rigid_labels=RIGID_LABELS,
         natural_frequencies_rad_s=natural,
-        reference_semichord_m=P.MEAN_AERODYNAMIC_CHORD_M / 2.0, method="state-space",
+        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, method="state-space",
         aero="quasi-steady", name="" if wing is None else wing.name)
 
 
@@ -204,7 +208,7 @@ def track(
     model: str,
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> Sweep:
     """Eigenvalues of ``model`` at increasing ``speeds_m_s`` with labels tracked (the
@@ -237,7 +241,7 @@ def modes_at(
     model: str,
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> list[ModeSet]:
     """Labelled modes of ``model`` at each speed in ``speeds_m_s`` (labels tracked from 2 m/s)."""
@@ -262,7 +266,7 @@ def find_flutter(
     range_m_s: tuple[float, float] = (5.0, 40.0),
     step_m_s: float = SCAN_STEP_M_S,
     tol_m_s: float = SCAN_TOL_M_S,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
 ) -> FlutterResult:
     """The coupled model's first instability in ``range_m_s`` (the engine's search: scan
@@ -298,7 +302,7 @@ def _common_zeta(wing: ElasticWingModel) -> float | None:
 
 
 def wing_divergence_speed_m_s(wing: ElasticWingModel,
-                              density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                              density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                               range_m_s: tuple[float, float] = (2.0, 60.0)) -> float | None:
     """Speed [m/s] at which the wing's static stiffness in the aircraft, A_EE = −ω² + H_η
     of Eq. (4), first becomes singular (its divergence with the body held); None in range.

@@ -57,8 +57,13 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    MASS_PROPERTIES,
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
 
 # NUMERICAL: the fixed point's tolerance on α [rad]; 1e-12 rad is ~1e-10 of a trim α and
 # far below anything the loads or the tables resolve. A JSBSim rigid trim resolves α to its
@@ -112,9 +117,9 @@ def linear_rigid_trim(
     :func:`~bioflex_jsb.flight_dynamics.rigid.level_flight_condition` the elevator's lift is
     kept, as JSBSim's trim keeps it (JSBSim at 15 m/s: α 1.77°, δe 1.12°; this: 1.79°, 1.00°).
     """
-    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-    qsc = qs * P.MEAN_AERODYNAMIC_CHORD_M
-    weight = mass_kg * P.STANDARD_GRAVITY_M_S2
+    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    qsc = qs * REFERENCE_GEOMETRY.mean_chord_m
+    weight = mass_kg * STANDARD_GRAVITY_M_S2
     matrix = np.array([[aero.cl_alpha_per_rad, aero.cl_delta_e_per_rad],
                        [aero.cm_alpha_per_rad, aero.cm_delta_e_per_rad]])
 
@@ -138,7 +143,7 @@ def divergence_dynamic_pressure_pa(mm: ModalMatrices) -> float:
 
 
 def divergence_speed_m_s(wing, cl_trim: float = 0.5,
-                         density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                         density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
                          aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> float:
     """The wing's static divergence speed with the body held [m/s] (inf if none).
 
@@ -151,7 +156,7 @@ def divergence_speed_m_s(wing, cl_trim: float = 0.5,
 def trimmed_divergence_speed_m_s(
     wing,
     *,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     range_m_s: tuple[float, float] = (1.0, 60.0),
     step_m_s: float = 0.05,
@@ -166,7 +171,7 @@ def trimmed_divergence_speed_m_s(
     """
     mm = modal_matrices(wing, 0.5, aero)  # K_a, b_α and the load rows do not depend on C_L0
     n = mm.n
-    cb = P.MEAN_AERODYNAMIC_CHORD_M
+    cb = REFERENCE_GEOMETRY.mean_chord_m
 
     def det(v: float) -> float:
         q = 0.5 * density_kg_m3 * v * v
@@ -287,7 +292,7 @@ def elastic_trim(
     build,
     speed_m_s: float,
     *,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     rigid_trim: RigidTrim | None = None,
     tol_rad: float = DEFAULT_TOL_RAD,
@@ -315,7 +320,7 @@ def elastic_trim(
     trim_fn = linear_rigid_trim(condition, aero) if rigid_trim is None else rigid_trim
     rigid = trim_fn(StaticWingLoads())
     stiffness = np.diag(mm.omega**2) - q * mm.k_aero
-    qs = q * P.REFERENCE_AREA_M2
+    qs = q * REFERENCE_GEOMETRY.area_m2
 
     def eta_of(alpha: float) -> np.ndarray:
         return np.linalg.solve(stiffness, q * (mm.b_0 + mm.b_alpha * (alpha - rigid.alpha_rad)))
@@ -354,7 +359,7 @@ def elastic_trim(
         )
     eta = eta_of(alpha)
     loads = loads_of(eta)
-    sc = P.REFERENCE_AREA_M2 * P.MEAN_AERODYNAMIC_CHORD_M
+    sc = REFERENCE_GEOMETRY.area_m2 * REFERENCE_GEOMETRY.mean_chord_m
     c0_rigid = mm.b_0 * mm.mass_kg_m2 / sc
     c0_elastic = mm.mass_kg_m2 * mm.omega**2 * eta / (q * sc)
     forcing = q * (mm.b_0 + mm.b_alpha * (alpha - rigid.alpha_rad) + mm.k_aero @ eta)

@@ -37,8 +37,13 @@ from bioflex_jsb.flight_dynamics.rigid import (
     rigid_derivatives,
     rigid_matrices,
 )
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    MASS_PROPERTIES,
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 
 MODELS = ("rigid", "coupled", "qsd")
 
@@ -131,8 +136,8 @@ def elastic_derivatives(
     """Table B2 derivatives of the structural modes at ``condition``."""
     c = wing.coefficients
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-    cb = P.MEAN_AERODYNAMIC_CHORD_M
+    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    cb = REFERENCE_GEOMETRY.mean_chord_m
     mi = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
     c_d_eta = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_eta
     c_d_etadot = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_etadot
@@ -241,8 +246,8 @@ def control_columns(condition: FlightCondition, aero: RigidAerodynamics = RIGID_
     of gravity (no moment). Units: per rad of elevator, per unit throttle.
     """
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-    cb = P.MEAN_AERODYNAMIC_CHORD_M
+    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    cb = REFERENCE_GEOMETRY.mean_chord_m
     z_de = -aero.cl_delta_e_per_rad * qs / mass_kg
     x_de = -2.0 * aero.k_induced * condition.cl_trim * aero.cl_delta_e_per_rad * qs / mass_kg
     m_de = aero.cm_delta_e_per_rad * qs * cb / iyy_kg_m2
@@ -262,7 +267,7 @@ def _drive(condition: FlightCondition):
 
     j_tab, ct_tab, cp_tab = _propeller_tables_cached(propeller_tables)
     rho, d = condition.density_kg_m3, PROPULSION.prop_diameter_m
-    drag = condition.cd_trim * condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
+    drag = condition.cd_trim * condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
 
     def thrust(j: float, v: float) -> float:
         return float(np.interp(j, j_tab, ct_tab)) * rho * (v / (j * d)) ** 2 * d**4
@@ -329,7 +334,7 @@ def _with_outputs(ss: StateSpace, a_alpha_row: np.ndarray, b_alpha_row: np.ndarr
     """``ss`` with the outputs n_z [-] and tip_twist [rad] appended (see the module
     docstring): Δn_z = u_0 (q − α̇)/g from the inertial α̇ of the α row (in level flight the
     α row has no gravity term)."""
-    g = P.STANDARD_GRAVITY_M_S2
+    g = STANDARD_GRAVITY_M_S2
     u0 = ss.speed_m_s
     iq = ss.states.index("q")
     e_q = np.zeros(ss.n_states)

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
 
 
 @dataclass(frozen=True)
@@ -168,8 +168,8 @@ def modal_coefficients(
     modes,
     strips: SpanwiseGeometry,
     *,
-    reference_area_m2: float = P.REFERENCE_AREA_M2,
-    cbar_m: float = P.MEAN_AERODYNAMIC_CHORD_M,
+    reference_area_m2: float = REFERENCE_GEOMETRY.area_m2,
+    cbar_m: float = REFERENCE_GEOMETRY.mean_chord_m,
 ) -> ModalCoefficients:
     """Table B1 coefficients of ``modes`` (a :class:`~bioflex_jsb.structures.modal_data.ModalData`).
 
@@ -215,8 +215,8 @@ def modal_coefficients(
 
 
 def offset_shift_for_c_eta11(modes, strips: SpanwiseGeometry, target: float,
-                             reference_area_m2: float = P.REFERENCE_AREA_M2,
-                             cbar_m: float = P.MEAN_AERODYNAMIC_CHORD_M) -> float:
+                             reference_area_m2: float = REFERENCE_GEOMETRY.area_m2,
+                             cbar_m: float = REFERENCE_GEOMETRY.mean_chord_m) -> float:
     """Uniform shift Δe [m] of the aerodynamic-centre offset e(y) that makes C_η1^Q1 = target.
 
     C_η1^Q1 = (1/(S c̄)) ∫ θ_1 (e θ_1 − φ_1) C_lα c dy is linear in e, so

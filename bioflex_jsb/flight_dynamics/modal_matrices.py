@@ -31,8 +31,11 @@ import numpy as np
 from scipy.linalg import expm
 
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,7 +96,7 @@ def modal_matrices(wing: ElasticWingModel, cl_trim: float,
                    aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> ModalMatrices:
     """Per-unit modal matrices of ``wing`` with the trim lift coefficient ``cl_trim`` [-]."""
     c = wing.coefficients
-    s, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
+    s, cb = REFERENCE_GEOMETRY.area_m2, REFERENCE_GEOMETRY.mean_chord_m
     m = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
     c_alpha = np.asarray(c.c_alpha_q, dtype=float)
     alpha_wing = cl_trim / wing.wing_lift_slope_per_rad

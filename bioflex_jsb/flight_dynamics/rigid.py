@@ -19,8 +19,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    MASS_PROPERTIES,
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
 
 RIGID_STATES = ("u", "alpha", "q", "theta")
 RIGID_STATE_UNITS = ("m/s", "rad", "rad/s", "rad")
@@ -52,7 +57,7 @@ class FlightCondition:
 
 def level_flight_condition(
     speed_m_s: float,
-    density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+    density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics = RIGID_AERODYNAMICS,
     mass_kg: float = MASS_PROPERTIES.mass_kg,
 ) -> FlightCondition:
@@ -66,7 +71,7 @@ def level_flight_condition(
     if not (np.isfinite(speed_m_s) and speed_m_s > 0.0):
         raise ValueError(f"speed_m_s must be finite and > 0, got {speed_m_s!r}")
     q_pa = 0.5 * density_kg_m3 * speed_m_s**2
-    cl = mass_kg * P.STANDARD_GRAVITY_M_S2 / (q_pa * P.REFERENCE_AREA_M2)
+    cl = mass_kg * STANDARD_GRAVITY_M_S2 / (q_pa * REFERENCE_GEOMETRY.area_m2)
     cd = aero.cd0 + aero.k_induced * cl**2
     alpha = (cl - aero.cl0) / aero.cl_alpha_per_rad
     return FlightCondition(speed_m_s, density_kg_m3, cl, cd, alpha)
@@ -101,8 +106,8 @@ def rigid_derivatives(
     C_Dα = 2 k C_L0 C_Lα from the parabolic polar; thrust is taken speed-independent
     (Table B2 has no thrust term)."""
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-    cbar = P.MEAN_AERODYNAMIC_CHORD_M
+    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    cbar = REFERENCE_GEOMETRY.mean_chord_m
     cd_alpha = 2.0 * aero.k_induced * condition.cl_trim * aero.cl_alpha_per_rad
     return RigidDerivatives(
         condition=condition,
@@ -120,7 +125,7 @@ def rigid_derivatives(
 def rigid_matrices(d: RigidDerivatives) -> tuple[np.ndarray, np.ndarray]:
     """A_RR (4×4) and G_R (4×1) of Appendix B, states [u, α, q, θ], input w_g [m/s]."""
     u0 = d.condition.speed_m_s
-    g = P.STANDARD_GRAVITY_M_S2
+    g = STANDARD_GRAVITY_M_S2
     a = np.array(
         [
             [d.x_u, d.x_alpha, 0.0, -g],

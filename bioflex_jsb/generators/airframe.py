@@ -112,13 +112,14 @@ from bioflex_jsb import units as U
 from bioflex_jsb.aerodynamics.airframe_polars import alpha_peak_rad, lift_curve, separated_drag
 from bioflex_jsb.aerodynamics.propeller import propeller_tables
 from bioflex_jsb.generators.xml_writer import XmlWriter, num_9g, serialise
-from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import (
     AIRFRAME_GEOMETRY,
     CONTROL_LIMITS,
+    CRUISE_SPEED_M_S,
     MASS_PROPERTIES,
     POST_STALL,
     PROPULSION,
+    REFERENCE_GEOMETRY,
     RIGID_AERODYNAMICS,
     AirframeGeometry,
     ControlLimits,
@@ -127,6 +128,7 @@ from bioflex_jsb.parameters.airframe import (
     Propulsion,
     RigidAerodynamics,
 )
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 
 AIRCRAFT_NAME = "bioflex"
 ENGINE_FILE = "bioflex_motor"
@@ -161,7 +163,7 @@ def external_property(name: str) -> str:
 
 
 # Initial condition of reset_cruise.xml: Table 1 cruise speed, sea level (ISA).
-INIT_SPEED_M_S = P.CRUISE_SPEED_M_S
+INIT_SPEED_M_S = CRUISE_SPEED_M_S
 INIT_ALTITUDE_M = 0.0  # sea level: the paper's Q uses ρ = 1.225 kg/m³ (prototype.py)
 # JSBSim's WGS84 gravity at sea level is 9.780 m/s² at the equator and 9.806 m/s² at 45°
 # latitude, within 0.01 % of the standard gravity the paper's model (and prototype.py) uses.
@@ -292,9 +294,9 @@ def airframe_tree(
     # ---- metrics ----
     met = el(root, "metrics")
     comment(met, "S = b*cbar (prototype.REFERENCE_AREA_M2, DECISION), b and cbar: Table 1")
-    el(met, "wingarea", P.REFERENCE_AREA_M2 * U.FT2_PER_M2, unit="FT2")
-    el(met, "wingspan", P.SPAN_M * U.FT_PER_M, unit="FT")
-    el(met, "chord", P.MEAN_AERODYNAMIC_CHORD_M * U.FT_PER_M, unit="FT")
+    el(met, "wingarea", REFERENCE_GEOMETRY.area_m2 * U.FT2_PER_M2, unit="FT2")
+    el(met, "wingspan", REFERENCE_GEOMETRY.span_m * U.FT_PER_M, unit="FT")
+    el(met, "chord", REFERENCE_GEOMETRY.mean_chord_m * U.FT_PER_M, unit="FT")
     comment(met, "aerodynamic reference point at the CG: moment coefficients are about the CG")
     _xyz(met, "location", cg, name="AERORP")
     _xyz(met, "location", cg, name="EYEPOINT")
@@ -308,7 +310,7 @@ def airframe_tree(
     el(mb, "izz", mass.izz_kg_m2 * U.SLUG_FT2_PER_KG_M2, unit="SLUG*FT2")
     el(mb, "ixz", mass.ixz_kg_m2 * U.SLUG_FT2_PER_KG_M2, unit="SLUG*FT2")
     comment(mb, "emptywt is the weight at standard gravity: m*g0 [N] in lbs; m = 2.5 kg Table 1")
-    el(mb, "emptywt", mass.mass_kg * P.STANDARD_GRAVITY_M_S2 * U.LBF_PER_N, unit="LBS")
+    el(mb, "emptywt", mass.mass_kg * STANDARD_GRAVITY_M_S2 * U.LBF_PER_N, unit="LBS")
     _xyz(mb, "location", cg, name="CG")
 
     # ---- ground reactions ----

@@ -28,6 +28,28 @@ AIRSPEED_RANGE_M_S = (5.0, 40.0)
 
 
 @dataclass(frozen=True)
+class ReferenceGeometry:
+    """The reference geometry of the aerodynamic coefficients [m², m]: area S, span b, mean
+    aerodynamic chord c̄ (pitch rates non-dimensional with c̄/(2V), roll/yaw with b/(2V))."""
+
+    area_m2: float
+    span_m: float
+    mean_chord_m: float
+
+    @property
+    def aspect_ratio(self) -> float:
+        """b²/S [-]."""
+        return self.span_m**2 / self.area_m2
+
+
+# Table 1: b, c̄; S = b·c̄ (DECISION "Reference area", parameters/prototype.py).
+REFERENCE_GEOMETRY = ReferenceGeometry(area_m2=P.REFERENCE_AREA_M2, span_m=P.SPAN_M,
+                                       mean_chord_m=P.MEAN_AERODYNAMIC_CHORD_M)
+CRUISE_SPEED_M_S = P.CRUISE_SPEED_M_S  # Table 1, u_0: the airframe's initial/trim speed
+FUSELAGE_LENGTH_M = P.FUSELAGE_LENGTH_M  # Table 1
+
+
+@dataclass(frozen=True)
 class MassProperties:
     """Rigid-body mass data about the centre of gravity, body axes [kg, kg·m²]."""
 

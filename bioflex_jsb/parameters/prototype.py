@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from bioflex_jsb.parameters import constants as _C
+
 # --------------------------------------------------------------------------------------
 # Table 1: general parameters of the prototype
 # --------------------------------------------------------------------------------------
@@ -127,10 +129,11 @@ SECTION5_AIRSPEED_M_S = 15.0
 # Section 3.2 / Figs. 15-19: the airspeed range of the root loci.
 ROOT_LOCUS_SPEED_RANGE_M_S = (5.0, 25.0)
 
-# Standard sea-level atmosphere (ISA), the paper's flight condition is unstated; we fly at
-# sea level ISA unless told otherwise.
-SEA_LEVEL_DENSITY_KG_M3 = 1.225
-STANDARD_GRAVITY_M_S2 = 9.80665
+# Physical constants (ISA sea-level density, standard gravity): parameters/constants.py;
+# kept under these names for the paper-data readers (the paper's flight condition is
+# unstated; we fly at sea level ISA unless told otherwise).
+SEA_LEVEL_DENSITY_KG_M3 = _C.SEA_LEVEL_DENSITY_KG_M3
+STANDARD_GRAVITY_M_S2 = _C.STANDARD_GRAVITY_M_S2
 
 
 def table2_frequencies_rad_s(ribs: bool = True) -> tuple[float, float, float]:

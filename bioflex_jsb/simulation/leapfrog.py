@@ -18,7 +18,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 
 # Speed range of the export [m/s]: its QSD tables are uniform in V_ref = sqrt(2Q/ρ_ref) from
 # 0 to this speed (the aircraft's speed range with margin: Table 1 flies 10-25 m/s; JSBSim
@@ -112,7 +112,7 @@ def _continuous_eigenvalues(m: np.ndarray, dt_s: float) -> np.ndarray:
 
 def leapfrog_eigen_error(nums: ModalMatrices, co: LeapfrogCoefficients,
                          speed_max_m_s: float = GRID_SPEED_MAX_M_S,
-                         rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3) -> tuple[float, float]:
+                         rho_ref: float = SEA_LEVEL_DENSITY_KG_M3) -> tuple[float, float]:
     """(largest relative error of the step's eigenvalues against the exact e^{A(Q, V) Δt},
     the speed [m/s] where it is largest) over level flight at ``rho_ref`` from 0 to
     ``speed_max_m_s`` in 0.5 m/s steps. Eigenvalues compared as λ = ln(μ)/Δt [1/s], each

@@ -6,7 +6,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from bioflex_jsb.flight_dynamics.lti import StateSpace
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.simulation.results import TimeHistory
 
 
@@ -46,7 +46,7 @@ def simulate(ss: StateSpace, time_s: np.ndarray, w_g_m_s: np.ndarray) -> TimeHis
     units["alpha_inertial"] = "rad"
     channels["alpha"] = x[:, i_a] + w / ss.speed_m_s
     u0 = ss.speed_m_s
-    channels["n_z"] = 1.0 + u0 * (x[:, i_q] - xdot[:, i_a]) / P.STANDARD_GRAVITY_M_S2
+    channels["n_z"] = 1.0 + u0 * (x[:, i_q] - xdot[:, i_a]) / STANDARD_GRAVITY_M_S2
     units["n_z"] = "-"
     channels["w_g"] = w
     units["w_g"] = "m/s"

@@ -51,8 +51,11 @@ from threadpoolctl import ThreadpoolController
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    RigidAerodynamics,
+)
 
 WING_MODELS = ("rigid", "coupled", "qsd")
 
@@ -278,8 +281,8 @@ class ModalWing:
             return WingLoads(0.0, 0.0, 0.0)
         if self.model == "qsd":
             self.eta = self.quasi_static_eta(flow)
-        qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-        rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
+        qs = flow.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+        rate = REFERENCE_GEOMETRY.mean_chord_m / (2.0 * flow.airspeed_m_s)
         self._load_x[:, self.n_modes :] = self._load_etadot * rate  # rates scale with c̄/2V
         lift, drag, moment = (self._load_x @ self._x + self._static_load).tolist()
         return WingLoads(qs * lift, qs * drag, qs * moment)
