@@ -33,8 +33,16 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     WingVariant,
     build_wing,
 )
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY, MASS_PROPERTIES, RIGID_AERODYNAMICS
+from bioflex_jsb.parameters.airframe import (
+    AIRFRAME_GEOMETRY,
+    MASS_PROPERTIES,
+    REFERENCE_GEOMETRY,
+    RIGID_AERODYNAMICS,
+    MassProperties,
+    ReferenceGeometry,
+    RigidAerodynamics,
+)
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
 
 # Equal to the prototype's: 1e-9 relative (printed values carry 4-10 digits; the shipped
@@ -67,6 +75,22 @@ class Aircraft:
     def __repr__(self) -> str:
         return (f"Aircraft({self.name!r}, jsbsim={self.airframe.jsbsim!r}, "
                 f"wing={self.definition.flying.name!r})")
+
+    # -- the airframe as the analyses' parameter types ---------------------------------
+    def reference_geometry(self) -> ReferenceGeometry:
+        """S [m²], b [m], c̄ [m] of the coefficients."""
+        a = self.airframe
+        return ReferenceGeometry(a.reference_area_m2, a.span_m, a.mean_chord_m)
+
+    def mass_properties(self) -> MassProperties:
+        """Mass [kg] and inertia about the CG [kg·m²]."""
+        a, i = self.airframe, self.airframe.inertia
+        return MassProperties(a.mass_kg, i.ixx_kg_m2, i.iyy_kg_m2, i.izz_kg_m2, i.ixz_kg_m2)
+
+    def rigid_aerodynamics(self) -> RigidAerodynamics | None:
+        """The rigid derivatives of the file, or ``None`` (from JSBSim's linearisation)."""
+        d = self.airframe.derivatives
+        return None if d is None else RigidAerodynamics(**d)
 
     # -- the wing ---------------------------------------------------------------------
     def planform(self) -> Planform:
@@ -108,7 +132,10 @@ class Aircraft:
             ribs, modes_file = True, s.modes_file
         else:
             raise DefinitionError(f"definition {d.name!r}: structure.kind 'beam' on an "
-                                  "airframe is not modelled yet")
+                                  "airframe is not flown yet (the flight model takes its "
+                                  "modes from 'prototype-membrane' or a 'modal' file; the "
+                                  "beam wing is analysed clamped: api.flutter(definition, "
+                                  "clamped=True))")
         f = d.flying
         return WingVariant(f.name, x_i, x_e, ribs=ribs, structural_damping=s.damping_ratio,
                            modes_file=modes_file, pinned_c_eta1_q1=f.pin_c_eta1_q1,
@@ -122,14 +149,19 @@ class Aircraft:
         tail = (" (the analyses below the loader still read the prototype's airframe from "
                 "parameters/; only the prototype's airframe flies in this version, with any "
                 "wing: docs/aircraft.md)")
+        if not isinstance(d.structure, MembraneStructure | ModalStructure):
+            return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
+                    "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
+                    f"in flight the wing's modes come from 'prototype-membrane' or a 'modal' "
+                    f"file{tail}")
         if a.jsbsim != GENERATED:
             return (f"{head}airframe.jsbsim = {a.jsbsim!r}: the flight models of this version "
                     f"are those of the generated prototype {GENERATED!r}{tail}")
-        g = AIRFRAME_GEOMETRY
+        g, ref = AIRFRAME_GEOMETRY, REFERENCE_GEOMETRY
         rows = [
-            ("airframe.reference_area_m2", a.reference_area_m2, P.REFERENCE_AREA_M2),
-            ("airframe.span_m", a.span_m, P.SPAN_M),
-            ("airframe.mean_chord_m", a.mean_chord_m, P.MEAN_AERODYNAMIC_CHORD_M),
+            ("airframe.reference_area_m2", a.reference_area_m2, ref.area_m2),
+            ("airframe.span_m", a.span_m, ref.span_m),
+            ("airframe.mean_chord_m", a.mean_chord_m, ref.mean_chord_m),
             ("airframe.mass_kg", a.mass_kg, MASS_PROPERTIES.mass_kg),
             ("airframe.cg_m[0]", a.cg_m[0], g.cg_x_m), ("airframe.cg_m[1]", a.cg_m[1], 0.0),
             ("airframe.cg_m[2]", a.cg_m[2], g.cg_z_m),
@@ -137,7 +169,7 @@ class Aircraft:
              g.wing_root_leading_edge_x_m),
             ("airframe.wing_root_leading_edge_m[1]", a.wing_root_leading_edge_m[1], 0.0),
             ("airframe.wing_root_leading_edge_m[2]", a.wing_root_leading_edge_m[2], 0.0),
-            ("air.density_kg_m3", d.air.density_kg_m3, P.SEA_LEVEL_DENSITY_KG_M3),
+            ("air.density_kg_m3", d.air.density_kg_m3, SEA_LEVEL_DENSITY_KG_M3),
         ]
         rows += [(f"airframe.inertia_kg_m2.{k}", getattr(a.inertia, f"{k}_kg_m2"),
                   getattr(MASS_PROPERTIES, f"{k}_kg_m2")) for k in ("ixx", "iyy", "izz", "ixz")]

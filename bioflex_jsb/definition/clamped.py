@@ -21,7 +21,7 @@ import numpy as np
 from bioflex_jsb.aeroelasticity.clamped_wing import ClampedWingModel, clamped_wing_model
 from bioflex_jsb.aeroelasticity.strip_aero import divergence_speed_m_s
 from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S, DefinitionError
-from bioflex_jsb.definition.model import Definition
+from bioflex_jsb.definition.model import BeamStructure, Definition
 from bioflex_jsb.structures.beam import BeamSections
 
 TOP_OVER_DIVERGENCE = 1.5
@@ -52,6 +52,10 @@ def clamped_model(d: Definition, lift_slope: str | None = None) -> ClampedWingMo
     """The modal model with strips of the clamped wing ``d``; refuses what the clamped
     strip analysis does not model (a swept leading edge, no torsion mode)."""
     where = f"definition {d.name!r}" + (f" ({d.path})" if d.path else "")
+    if not isinstance(d.structure, BeamStructure):
+        raise DefinitionError(f"{where}: structure.kind: a clamped analysis needs beam "
+                              "sections (kind = 'beam'); this wing's structure is the "
+                              "aircraft's flight model (fly it: --aircraft)")
     x_le = d.column("leading_edge_x_m")
     if np.ptp(x_le) > 1e-9 * max(1.0, d.semispan_m):
         raise DefinitionError(f"{where}: wing.stations.leading_edge_x_m varies along the "

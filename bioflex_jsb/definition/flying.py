@@ -6,8 +6,9 @@ Eq. 11-12 of the paper), so the stations' ``elastic_axis`` and ``centre_of_mass`
 constant along the span (a modal file's [axes] may vary: their mean is the wing's, as for a
 variant file). Structure kinds: ``prototype-membrane`` (the prototype's membrane half wing
 as calibrated to Table 2, ribbed or not: parameters/wing_structure.py) and ``modal`` (a
-modal file, docs/structures.md). A ``beam`` on an airframe is not yet modelled (the flight
-build takes its modes from those two) and is refused in one line.
+modal file, docs/structures.md), and ``beam`` (beam sections as a clamped wing has them:
+read and checked, analysed clamped; not flown yet: the flight build takes its modes from the
+other two, and :meth:`~bioflex_jsb.definition.aircraft.Aircraft.flight_problem` says so).
 """
 
 from __future__ import annotations
@@ -77,17 +78,16 @@ def axes(stations: tuple[WingStation, ...]) -> tuple[float, float]:
 
 
 def flying_structure(r: Reader, stations: tuple[WingStation, ...], base_dir: Path | None
-                     ) -> MembraneStructure | ModalStructure:
-    """The ``[structure]`` of a wing on an airframe (module docstring)."""
+                     ) -> MembraneStructure | ModalStructure | None:
+    """The ``[structure]`` of a wing on an airframe (module docstring); ``None`` for beam
+    sections (the loader reads them as a clamped wing's)."""
     from bioflex_jsb.definition.loader import DAMPING_RANGE
 
-    t = r.table("structure", ("kind", "ribs", "modes_file", "damping_ratio", "n_modes"))
-    kind = t.get("kind")
-    if kind == "beam":
-        raise r.fail("structure.kind", "'beam' on an airframe is not modelled yet (the flight "
-                     "model takes its modes from 'prototype-membrane' or a 'modal' file; "
-                     "write the beam's modes to a modal file, docs/structures.md)")
-    kind = r.choice(t, "structure", "kind", FLYING_KINDS, None)
+    t = r.table("structure", None)
+    if t.get("kind", "beam") == "beam":
+        return None  # beam sections, read as for a clamped wing (analysed clamped)
+    r.keys(t, "structure", ("kind", "ribs", "modes_file", "damping_ratio", "n_modes"))
+    kind = r.choice(t, "structure", "kind", FLYING_KINDS + ("beam",), None)
     zeta = r.number(t, "structure", "damping_ratio", *DAMPING_RANGE, "(ratio)",
                     hint=" (a ratio, not a percentage: 2 % is 0.02)")
     n = r.integer(t, "structure", "n_modes", FLYING_N_MODES, FLYING_N_MODES, FLYING_N_MODES)
@@ -123,19 +123,21 @@ def _pin(r: Reader, at: dict, key: str) -> float | None:
                     hint=" (a Table B1 coefficient of any wing is a few units at most)")
 
 
-def flying_wing(r: Reader, wing: dict, at: dict, aero: AeroSettings, name: str) -> FlyingWing:
-    """The flight-model settings of the wing (``[wing] name``, ``[aero]`` pins)."""
-    if "model" in at:
+def flying_wing(r: Reader, wing: dict, at: dict, aero: AeroSettings, name: str,
+                beam: bool = False) -> FlyingWing:
+    """The flight-model settings of the wing (``[wing] name``, ``[aero]`` pins); a ``beam``
+    wing keeps the clamped wing's [aero] settings (it is analysed clamped)."""
+    if not beam and "model" in at:
         raise r.fail("aero.model", "is a clamped-wing setting; an aircraft's commands choose "
                      "the aerodynamic model with --aero (docs/aircraft.md)")
-    if aero.lift_slope != "vlm":
+    if not beam and aero.lift_slope != "vlm":
         raise r.fail("aero.lift_slope", "must be 'vlm' on an airframe: the flight model's "
                      "strips take the vortex lattice's spanwise loading (Table B1)")
     pin = at.get("pin_c_eta1_q1")
     if isinstance(pin, str) and pin != PHYSICAL_PIN:
         raise r.fail("aero.pin_c_eta1_q1", f"must be a number or {PHYSICAL_PIN!r}, got {pin!r}")
     for key in ("strips", "section_lift_slope_per_rad"):
-        if key in at:
+        if key in at and not beam:
             raise r.fail(f"aero.{key}", "is a clamped-wing setting (strip lift slope); an "
                          "aircraft's wing takes the vortex lattice's (lift_slope = 'vlm')")
     wing_name = r.text(wing, "wing", "name") if "name" in wing else name

@@ -169,7 +169,7 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
         structure = _structure(r, stations)
     else:
         check_span(r, stations, airframe)
-        structure = flying_structure(r, stations, base_dir)
+        structure = flying_structure(r, stations, base_dir) or _structure(r, stations)
     at = r.table("aero", ("model", "lift_slope", "section_lift_slope_per_rad", "strips")
                  + (FLYING_AERO_FIELDS if airframe else ()), required=False)
     aero = AeroSettings(
@@ -179,7 +179,7 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
                  "1/rad", default=2.0 * math.pi),
         r.integer(at, "aero", "strips", *STRIPS_RANGE, 24))
     if airframe is not None:
-        flying = flying_wing(r, wing, at, aero, name)
+        flying = flying_wing(r, wing, at, aero, name, isinstance(structure, BeamStructure))
     air_t = r.table("air", ("density_kg_m3",))
     air = Air(r.number(air_t, "air", "density_kg_m3", *DENSITY_RANGE_KG_M3, "kg/m^3"))
     an = r.table("analysis", ("method", "speed_range_m_s"), required=False)

@@ -20,7 +20,9 @@ class Reader:
     def fail(self, field: str, text: str) -> DefinitionError:
         return DefinitionError(f"{self.where}: {field}: {text}")
 
-    def table(self, key: str, allowed: tuple[str, ...], required: bool = True) -> dict:
+    def table(self, key: str, allowed: tuple[str, ...] | None, required: bool = True
+              ) -> dict:
+        """The table ``key`` (its fields checked against ``allowed`` unless None)."""
         t = self.data.get(key)
         if t is None:
             if required:
@@ -28,7 +30,8 @@ class Reader:
             return {}
         if not isinstance(t, dict):
             raise self.fail(f"[{key}]", "must be a table")
-        self.keys(t, key, allowed)
+        if allowed is not None:
+            self.keys(t, key, allowed)
         return t
 
     def keys(self, t: dict, where: str, allowed: tuple[str, ...]) -> None:
