@@ -33,8 +33,10 @@ from bioflex_jsb.definition.model import (
 from bioflex_jsb.definition.reader import DefinitionError, Reader
 from bioflex_jsb.tomlfile import read_toml
 
-# definitions in bioflex_jsb/data/aircraft/<name>.toml: clamped wings, then aircraft
-SHIPPED = ("goland",) + SHIPPED_AIRCRAFT
+# Definitions in bioflex_jsb/data/aircraft/<name>.toml: the clamped (benchmark) wings, and
+# the aircraft (definition.flying.SHIPPED_AIRCRAFT: the prototype's six variants).
+SHIPPED = ("goland",)
+ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT
 FORMAT_VERSION = 1
 
 # Valid ranges [unit], each with its reason.
@@ -205,11 +207,11 @@ def shipped_path(name: str) -> Path:
 
 
 def load_definition(name_or_file: str | Path) -> Definition:
-    """A shipped definition by name (:data:`SHIPPED`) or a definition file (TOML)."""
+    """A shipped definition by name (:data:`ALL_SHIPPED`) or a definition file (TOML)."""
     text = str(name_or_file)
-    path = shipped_path(text) if text in SHIPPED else Path(text)
-    if text not in SHIPPED and path.suffix != ".toml" and not path.exists():
+    path = shipped_path(text) if text in ALL_SHIPPED else Path(text)
+    if text not in ALL_SHIPPED and path.suffix != ".toml" and not path.exists():
         raise DefinitionError(f"unknown definition {text!r}: give a shipped name "
-                              f"({', '.join(SHIPPED)}) or a .toml definition file")
+                              f"({', '.join(ALL_SHIPPED)}) or a .toml definition file")
     data = read_toml(path, "definition file", DefinitionError)
     return parse_definition(data, f"definition file {str(path)!r}", str(path))
