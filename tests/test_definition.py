@@ -172,6 +172,7 @@ AIRFRAME_BAD = [
     (('kind = "prototype-membrane"\nribs = true', 'kind = "beam"'),
      "structure.bending_stiffness_n_m2", "missing"),
     (('lift_slope = "vlm"', 'lift_slope = "strip"'), "aero.lift_slope", "vlm"),
+    (('name = "original"', 'name = "orig\\ninal"'), "wing.name", "control character"),
     (("y_m = 0.85,", "y_m = 850.0,"), "wing.stations[2].y_m", "millimetres"),
     (("y_m = 0.85,", "y_m = 1.7,"), "wing.stations[2].y_m", "semispan"),
     (("elastic_axis = 0.5, centre_of_mass = 0.5 },\n  { y_m = 0.85",
