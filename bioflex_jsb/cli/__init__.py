@@ -11,6 +11,7 @@ SIGINT and SIGTERM, at any moment of the command, exit 130. The full rule is in
 
 from __future__ import annotations
 
+import errno
 import importlib
 import signal
 import sys
@@ -20,6 +21,8 @@ from bioflex_jsb.cli.common import (
     EXIT_ENVIRONMENT,
     EXIT_INTERRUPTED,
     EXIT_USAGE,
+    NAME_MAX_BYTES,
+    PATH_MAX_BYTES,
     EnvironmentFault,
     OneLineParser,
     UsageError,
@@ -118,6 +121,10 @@ def _main(argv: list[str] | None) -> int:
         _silence_stdout()
         return 128 + signal.SIGPIPE
     except OSError as exc:
+        if exc.errno == errno.ENAMETOOLONG:  # only ever a path the user gave: bad input
+            print(f"{name}: error: {os_error_line(exc)[:200]}; accepted: names of at most "
+                  f"{NAME_MAX_BYTES} bytes, paths of {PATH_MAX_BYTES}", file=sys.stderr)
+            return EXIT_USAGE
         if not (environment_error(exc) or _is_log_write_error(exc)):
             raise  # a bug: its traceback
         print(f"{name}: error: {os_error_line(exc)} (what was written before is kept; "
