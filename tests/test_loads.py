@@ -257,3 +257,50 @@ def test_tuned_command_table_csv_and_envelope(tmp_path, capsys):
     lines = csv_path.read_text().splitlines()
     assert len(lines) == 1 + len(data["critical"])
     assert png.stat().st_size > 10_000
+
+
+# ---- frequency domain -------------------------------------------------------------------
+def test_gust_psd_in_time_holds_the_spatial_spectrum():
+    """S_w(f) df = Φ_w(Ω) dΩ with Ω = 2π f / V: the temporal PSD over 0.02-150 Hz holds
+    the spatial spectrum's σ² less its parts outside 2π (0.02..150 Hz)/V (at 15 m/s, L = 30 m
+    the low end misses 8 % of σ²), to the quadrature's 1e-4."""
+    from scipy.integrate import quad
+
+    from bioflex_jsb.loads.spectral import frequency_grid_hz, gust_psd_hz, spectral_moments
+    from bioflex_jsb.simulation.gusts import turbulence_psd
+
+    f = frequency_grid_hz()
+    rms, _ = spectral_moments(f, gust_psd_hz("vonkarman", f, 1.0, 30.0, 15.0), 150.0)
+    lo, hi = 2 * math.pi * 0.02 / 15.0, 2 * math.pi * 150.0 / 15.0
+    inside = quad(lambda w: float(turbulence_psd("vonkarman", np.array([w]), 1.0, 30.0)[0]),
+                  lo, hi, limit=200, points=[1 / 30.0])[0]
+    assert rms**2 == pytest.approx(inside, rel=1e-4)
+    assert 0.9 < inside < 0.93
+
+
+def test_frequency_response_at_low_frequency_is_the_dc_gain(optimised):
+    """H(f → 0) = D − C A⁻¹ B: at 1e-9 Hz (the first-order term j2πf C A⁻² B is 4e-4 of
+    the airspeed's gain at 1e-5 Hz, the slow phugoid; at 1e-9 Hz 4e-8)."""
+    from bioflex_jsb import api
+    from bioflex_jsb.loads.spectral import frequency_response
+
+    ss = api.linear_model(optimised, 15.0, "coupled")
+    h = frequency_response(ss, ss.outputs, np.array([1e-9]))[:, 0]
+    dc = ss.d[:, 0] - ss.c @ np.linalg.solve(ss.a, ss.b[:, 0])
+    np.testing.assert_allclose(h, dc, rtol=0, atol=1e-6 * np.max(np.abs(dc)))
+    assert np.max(np.abs(dc)) > 0.0
+
+
+def test_small_turbulence_lti_and_nonlinear_psds_agree(capsys):
+    """vonkarman 0.1 m/s, L = 30 m, 40 s (four 8 s segments, ν = 8): the LTI PSD of q, n_z
+    and the root bending moment lies inside the Welch 95 % band in at least 85 % of the
+    bins of 0.25-100 Hz (measured 120 s: 98, 97, 95 %) and the band RMS agree within 15 %
+    (measured 120 s: +6.8, +3.4, +3.4 %: the rest is the airframes' difference, as in
+    `compare`); they part at σ_w = 2.5 m/s (79-88 % of bins) and σ_w = 3 m/s leaves the
+    wing's linear range after 76 s (docs/loads.md)."""
+    code, out = _cli(["--frequency", "--sigmas", "0.1", "--record", "40", "--json"], capsys)
+    assert code == 0, out.err
+    (case,) = json.loads(out.out)["cases"]
+    for name, row in case["outputs"].items():
+        assert row["fraction_in_band"] >= 0.85, (name, row)
+        assert 0.85 < row["rms_ratio_band"] < 1.15, (name, row)

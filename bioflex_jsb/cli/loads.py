@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import math
+import re
 import sys
 
 from bioflex_jsb.cli.case import (
@@ -25,6 +27,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
+_PLAIN = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
 DEFAULT_GUST = "1cos:3:5"  # the paper's 3 m/s, 2.5 m gradient (between the tuned ends)
 
 HELP = f"""Fly one gust (--gust, default {DEFAULT_GUST}) with the elastic wing (--model,
@@ -39,17 +42,39 @@ lengths H, up and down (default {{h_min:.2g}}..{{h_max:g}} m, {{n}} lengths; amp
 U_ref (H/H_max)^(1/6), U_ref = --amplitude, the airworthiness codes' shape; docs/loads.md
 for the rationale), the critical gradient per station, quantity and method (--csv FILE
 writes the table), and the correlated-load envelopes (bending vs torque per station) in
---plot (default loads_envelope.png). The runs are sequential on this machine. No MCAP log
+--plot (default loads_envelope.png). With --frequency: the LTI model's frequency response
+from the gust to q, n_z and the root bending moment (--bode), the output PSDs under the
+--spectrum turbulence, their RMS and N0, against Welch estimates (95 % bands) from nonlinear
+runs of --record seconds at each of --sigmas (--plot, default loads_psd.png). The runs are
+sequential on this machine. No MCAP log
 is written (the loads are a post-process of the runs). Exit 3 if a run diverged."""
+
+
+def plain_number(text: str, what: str) -> float:
+    """A finite plain ASCII decimal (``0.25``, ``-1e3``; not ``1_5``, ``nan``, ``0x10``)."""
+    from bioflex_jsb.errors import InputError
+
+    if not _PLAIN.fullmatch(text) or not math.isfinite(float(text)):
+        raise InputError(f"{what} must be a plain decimal number, got {text!r}")
+    return float(text)
+
+
+def plain_integer(text: str, what: str) -> int:
+    """A whole number of up to four ASCII digits."""
+    from bioflex_jsb.errors import InputError
+
+    if not re.fullmatch(r"[0-9]{1,4}", text):
+        raise InputError(f"{what} must be a whole number, got {text!r}")
+    return int(text)
 
 
 def fractions(text: str) -> tuple[float, ...]:
     """argparse type: comma-separated fractions of the semispan, 0 <= f < 1, increasing."""
-    from bioflex_jsb.errors import InputError, plain_number
+    from bioflex_jsb.errors import InputError
     from bioflex_jsb.loads.model import station_positions_m
 
     try:
-        values = tuple(plain_number(t.strip(), "station") for t in text.split(","))
+        values = tuple(plain_number(t, "a station") for t in text.split(","))
         station_positions_m(values, 1.0)
     except InputError as exc:
         raise argparse.ArgumentTypeError(f"--stations {text!r}: {exc}") from None
@@ -60,7 +85,7 @@ def gradients(text: str) -> tuple[float, ...]:
     """argparse type: ``MIN:MAX:N`` (log-spaced) or comma-separated gradients H [m]."""
     import numpy as np
 
-    from bioflex_jsb.errors import InputError, plain_integer, plain_number
+    from bioflex_jsb.errors import InputError
     from bioflex_jsb.simulation.gusts import MAX_GUST_LENGTH_M, MIN_GUST_LENGTH_M
 
     lo_h, hi_h = MIN_GUST_LENGTH_M / 2.0, MAX_GUST_LENGTH_M / 2.0
@@ -75,7 +100,7 @@ def gradients(text: str) -> tuple[float, ...]:
                 raise InputError("need 0 < MIN < MAX and 2 <= N <= 200")
             values = tuple(float(x) for x in np.geomspace(lo, hi, n))
         else:
-            values = tuple(plain_number(t.strip(), "gradient") for t in text.split(","))
+            values = tuple(plain_number(t, "a gradient") for t in text.split(","))
     except InputError as exc:
         raise argparse.ArgumentTypeError(f"--gradients {text!r}: {exc} (MIN:MAX:N log-spaced, "
                                          "or H1,H2,... in m)") from None
@@ -83,6 +108,20 @@ def gradients(text: str) -> tuple[float, ...]:
         raise argparse.ArgumentTypeError(
             f"--gradients {text!r}: each H must be within {lo_h:g}..{hi_h:g} m (the 1-cos "
             "gust's length 2H within the gust limits, docs/gusts.md)")
+    return values
+
+
+def sigma_list(text: str) -> tuple[float, ...]:
+    """argparse type: comma-separated turbulence intensities sigma_w [m/s], 0 < sigma <= 10."""
+    from bioflex_jsb.errors import InputError
+
+    try:
+        values = tuple(plain_number(t, "an intensity") for t in text.split(","))
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(f"--sigmas {text!r}: {exc}") from None
+    if any(not 0.0 < v <= 10.0 for v in values):
+        raise argparse.ArgumentTypeError(f"--sigmas {text!r}: each sigma_w must satisfy "
+                                         "0 < sigma <= 10 m/s")
     return values
 
 
@@ -115,6 +154,20 @@ def register(sub) -> None:
                    help="the 1 g static part: elastic (the elastic trim's deflection, default "
                    "for coupled/qsd) or rigid (undeformed wing; the rigid model's)")
     p.add_argument("--tuned", action="store_true", help="the tuned discrete gust (above)")
+    p.add_argument("--frequency", action="store_true",
+                   help="continuous turbulence in the frequency domain (above)")
+    p.add_argument("--sigmas", type=sigma_list, default=(0.1, 3.0),
+                   help="--frequency: turbulence intensities sigma_w [m/s] (default 0.1,3)")
+    p.add_argument("--scale", type=positive_float("turbulence scale", "m"), default=30.0,
+                   help="--frequency: turbulence length scale L_w [m] (default 30: "
+                   "MIL-F-8785C's L_w = h at 30 m above ground)")
+    p.add_argument("--spectrum", choices=("vonkarman", "dryden"), default="vonkarman",
+                   help="--frequency: turbulence spectrum (default vonkarman)")
+    p.add_argument("--record", type=positive_float("record", "s"), default=120.0,
+                   help="--frequency: length of each nonlinear run [s] (default 120; at "
+                   "least 2 Welch segments of 8 s)")
+    p.add_argument("--bode", metavar="FILE.png", default=None,
+                   help="--frequency: Bode plots (default loads_bode.png without --json)")
     p.add_argument("--gradients", type=gradients, default=None,
                    help="--tuned gradients H [m]: MIN:MAX:N (log-spaced) or H1,H2,...")
     p.add_argument("--amplitude", type=positive_float("amplitude", "m/s"), default=3.0,
@@ -150,8 +203,12 @@ def run(args: argparse.Namespace) -> int:
     build = wing_from_args(args)
     if args.model == "rigid" and args.static == "elastic":
         raise UsageError("--model rigid has no static deflection; drop --static elastic")
+    if args.tuned and args.frequency:
+        raise UsageError("--tuned and --frequency are two studies; give one")
     if args.tuned:
         return _tuned(args, build)
+    if args.frequency:
+        return _frequency(args, build)
     from bioflex_jsb.loads import loads_metrics
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 
@@ -194,6 +251,10 @@ def _print_metrics(build, args, loads, metrics) -> None:
     print(head)
     short = {"shear_n": "V", "bending_n_m": "M", "torque_n_m": "T"}
     diff = metrics.get("max_abs_difference", {})
+    if not metrics["methods"]:
+        print(f"  no loads after the gust start: the run stopped at "
+              f"{loads.time_s[-1] if len(loads.time_s) else 0.0:.3f} s")
+        return
     for j in range(len(loads.stations_m)):
         for quantity in ("shear_n", "bending_n_m", "torque_n_m"):
             for method in loads.methods:
@@ -262,4 +323,81 @@ def _tuned(args, build) -> int:
             print(f"load envelopes written to {plot}")
     for s in stopped:
         print(f"bioflex-jsb loads: diverged: {s}", file=sys.stderr)
+    return EXIT_DIVERGED if stopped else 0
+
+
+FREQUENCY_OUTPUTS = ("q", "n_z", "fs_bending_n_m_s0")  # pitch rate, load factor, root M (FS)
+FREQUENCY_UNITS = ("rad/s", "-", "N*m")
+FREQUENCY_START_S = 1.0  # the record analysed starts here [s] (turbulence from 0.5 s)
+
+
+def _frequency(args, build) -> int:
+    """The LTI model (Eq. 4 with JSBSim's rigid block, as `compare`) in the frequency domain
+    against long nonlinear turbulence runs (bioflex_jsb.loads.spectral)."""
+    import numpy as np
+
+    from bioflex_jsb.flight_dynamics.lti import build_state_space
+    from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+    from bioflex_jsb.loads.lti import with_load_outputs
+    from bioflex_jsb.loads.model import build_loads_model
+    from bioflex_jsb.loads.spectral import compare_spectra, plot_bode, plot_psd
+    from bioflex_jsb.runtime.fdm import Airframe, FdmError
+
+    if args.model != "coupled":
+        raise UsageError("--frequency compares the coupled model (give --model coupled)")
+    if args.record < 2 * 8.0 + FREQUENCY_START_S:
+        raise UsageError(f"--record {args.record:g} s is too short: at least "
+                         f"{2 * 8.0 + FREQUENCY_START_S:g} s (two Welch segments of 8 s)")
+    plot = args.plot if args.plot is not None else (None if args.json else "loads_psd.png")
+    bode = args.bode if args.bode is not None else (None if args.json else "loads_bode.png")
+    check_plot_path(plot, args.force)
+    check_plot_path(bode, args.force)
+    try:
+        a_rr = Airframe().linearize(args.speed).a
+    except FdmError as exc:
+        raise UsageError(str(exc)) from None
+    ss = build_state_space("coupled", level_flight_condition(args.speed), build.model,
+                           a_rr=a_rr, controls=True)
+    ss = with_load_outputs(ss, build_loads_model(build, args.speed, (0.0,)))
+    cases, stopped = [], []
+    args.stations = (0.0,)
+    for sigma in args.sigmas:
+        text = f"{args.spectrum}:{sigma:g}:{args.scale:g}:1"
+        run_, loads = _fly(args, build, text, args.record, 0.5)
+        if run_.stopped:
+            stopped.append(f"{text}: {run_.stopped}")
+            continue
+        keep = run_.time_s >= FREQUENCY_START_S
+        series = np.column_stack([run_["q"][keep], run_["n_z"][keep] - 1.0,
+                                  loads.values["force_summation"][keep, 1, 0]])
+        cases.append(compare_spectra(ss, FREQUENCY_OUTPUTS, FREQUENCY_UNITS, series,
+                                     run_.meta["dt_s"], kind=args.spectrum, sigma_m_s=sigma,
+                                     scale_m=args.scale, speed_m_s=args.speed))
+    if bode:
+        plot_bode(ss, FREQUENCY_OUTPUTS, FREQUENCY_UNITS, bode)
+    if plot and cases:
+        plot_psd(cases, plot)
+    if args.json:
+        print_json({"wing": build.variant.name, "speed_m_s": args.speed,
+                    "rigid_block": "JSBSim linearization", "cases": [c.as_dict() for c in cases],
+                    "stopped": stopped, "plot": plot, "bode": bode})
+    else:
+        print(f"Continuous turbulence ({args.spectrum}, L = {args.scale:g} m): wing "
+              f"{build.variant.name}, {args.speed:g} m/s; LTI (Eq. 4, JSBSim's rigid block) vs "
+              f"nonlinear runs of {args.record:g} s")
+        print(f"{'sigma':>6s} {'output':18s} {'RMS LTI':>10s} {'RMS run':>10s} {'ratio':>6s} "
+              f"{'N0 LTI':>7s} {'N0 run':>7s} {'in band':>7s}   (RMS, N0 [Hz] above "
+              f"{cases[0].check_band_hz[0] if cases else 0.25:g} Hz)")
+        for c in cases:
+            d = c.as_dict()["outputs"]
+            for o in c.outputs:
+                r = d[o]
+                print(f"{c.sigma_m_s:6.3g} {o:18s} {r['lti_rms_band']:10.4g} "
+                      f"{r['run_rms_band']:10.4g} {r['rms_ratio_band']:6.3f} "
+                      f"{r['lti_n0_hz']:7.3g} {r['run_n0_hz']:7.3g} {r['fraction_in_band']:7.1%}")
+        for path, what in ((bode, "Bode plots"), (plot if cases else None, "PSDs")):
+            if path:
+                print(f"{what} written to {path}")
+    for s_ in stopped:
+        print(f"bioflex-jsb loads: diverged: {s_}", file=sys.stderr)
     return EXIT_DIVERGED if stopped else 0

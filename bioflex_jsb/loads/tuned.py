@@ -121,6 +121,8 @@ def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
                     best = None
                     for case, sl in zip(cases, loads, strict=True):
                         after = sl.time_s >= GUST_START_S
+                        if not np.any(after):  # stopped before the gust (case["stopped"])
+                            continue
                         x = sl.values[method][after, qi, j]
                         static = float(sl.static[method][qi, j])
                         i = int(np.argmax(x) if direction == "up" else np.argmin(x))
@@ -135,7 +137,8 @@ def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
                                     "gust": case["gust"], "value": float(x[i]),
                                     "static_1g": static, "increment": inc,
                                     "time_s": float(sl.time_s[after][i])}
-                    critical.append(best)
+                    if best is not None:
+                        critical.append(best)
     settings = {"speed_m_s": speed_m_s, "gradients_m": h.tolist(), "u_ref_m_s": u_ref_m_s,
                 "scaling": scaling, "h_max_m": h_max, "gust_start_s": GUST_START_S,
                 "settle_after_s": SETTLE_AFTER_S, "model": first.model, "wing": first.wing,
