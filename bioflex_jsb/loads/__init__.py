@@ -6,7 +6,12 @@ no JSBSim, no files but the figures asked for; the flying is the caller's
 from __future__ import annotations
 
 from bioflex_jsb.errors import InputError
-from bioflex_jsb.loads.history import SectionLoads, loads_metrics, section_loads_of_run
+from bioflex_jsb.loads.history import (
+    SectionLoads,
+    loads_metrics,
+    section_loads_of_run,
+    with_load_channels,
+)
 from bioflex_jsb.loads.model import (
     DEFAULT_STATION_FRACTIONS,
     METHODS,
@@ -17,7 +22,8 @@ from bioflex_jsb.loads.model import (
 from bioflex_jsb.parameters import prototype as P
 
 __all__ = ["DEFAULT_STATION_FRACTIONS", "METHODS", "QUANTITIES", "LoadsModel", "SectionLoads",
-           "build_loads_model", "loads_metrics", "section_loads", "section_loads_of_run"]
+           "build_loads_model", "loads_metrics", "section_loads", "section_loads_of_run",
+           "with_load_channels"]
 
 # Highest start altitude [m] at which a run's loads are taken at sea-level density without
 # being told the density: 100 m of ISA lowers ρ by 1 % (and Q, the aerodynamic loads, alike).

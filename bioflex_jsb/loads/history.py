@@ -179,6 +179,19 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
                         lm.force_summation(z, "inertia").reshape(shape), meta)
 
 
+def with_load_channels(run: TimeHistory, loads: SectionLoads) -> TimeHistory:
+    """A copy of ``run`` with the loads as channels (:meth:`SectionLoads.channels`:
+    ``loads_<fs|md>_<quantity>_s<j>``, units N and N*m; the stations in
+    ``meta['loads_stations_m']``): what a gust run would carry and a log would write."""
+    if loads.time_s.shape != run.time_s.shape or not np.array_equal(loads.time_s, run.time_s):
+        raise InputError("the loads were not computed from this run (other samples)")
+    chans, units = loads.channels()
+    return TimeHistory(run.model, run.time_s, {**run.channels, **chans},
+                       {**run.units, **units},
+                       {**run.meta, "loads_stations_m": loads.stations_m.tolist(),
+                        "loads_static": loads.meta.get("static")}, run.stopped)
+
+
 def loads_metrics(loads: SectionLoads, gust_start_s: float = 0.5) -> dict[str, object]:
     """The ``loads`` sub-dict of a run's metrics: per method, quantity and station the
     largest and smallest value after ``gust_start_s`` [s] with their times [s], the 1 g
