@@ -317,3 +317,15 @@ def test_beam_wing_on_an_airframe_is_analysed_clamped_not_flown(tmp_path):
     ref = goland_flutter()
     res = api.flutter(aircraft.definition, clamped=True)
     assert res.speed_m_s == pytest.approx(ref.speed_m_s, abs=1e-6)
+
+
+def test_jsbsim_aircraft_by_directory(tmp_path):
+    # a directory holding <its name>.xml, relative to the definition file; one without it
+    # is refused naming the field
+    plane = tmp_path / "planes" / "myplane"
+    plane.mkdir(parents=True)
+    text = PROTO_TEXT.replace('jsbsim = "bioflex"', 'jsbsim = "./planes/myplane"', 1)
+    path = _write(tmp_path, text)
+    _assert_refused(lambda: load_aircraft(path), "airframe.jsbsim", "neither")
+    (plane / "myplane.xml").write_text("<fdm_config/>", encoding="utf-8")
+    assert load_aircraft(path).airframe.jsbsim_path == str((plane / "myplane.xml").resolve())
