@@ -375,3 +375,78 @@ def test_measure_pacing_for_bench():
     assert r["steps"] == 480 and r["resyncs"] == 0
     # shape of the result only: the 2 ms target is judged by `bioflex-jsb bench`, not here
     assert 0.0 <= r["p50_ms"] <= r["p99_ms"] <= r["max_ms"]
+
+
+# ------------------------------------------------------------------ --aero, pre-flight check
+def _udp_sink():
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    return s
+
+
+def test_cli_sitl_refuses_a_wing_its_strips_cannot_fly(monkeypatch, capsys):
+    """--wing inertial-backward: quasi-steady flutter at 14.9 m/s, below the 15 m/s trim;
+    refused in one line by the ardupilot command's pre-flight check, which names the way
+    out (the unsteady strips, stable to 18.9 m/s)."""
+    assert run_cli(["sitl", "--wing", "inertial-backward", "--duration", "0.1", "--no-log"],
+                   monkeypatch) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    for word in ("aeroelastic_1", "14.9 m/s", "--aero unsteady", "18.9 m/s",
+                 "--allow-unstable"):
+        assert word in err, err
+
+
+def test_cli_sitl_flies_it_with_unsteady_strips(monkeypatch, capsys):
+    sink = _udp_sink()
+    try:
+        rc = run_cli(["sitl", "--wing", "inertial-backward", "--aero", "unsteady",
+                      "--duration", "0.5", "--speedup", "5", "--no-log", "--json",
+                      "--mavlink", f"udpout:127.0.0.1:{sink.getsockname()[1]}"], monkeypatch)
+    finally:
+        sink.close()
+    assert rc == 0
+    import json
+
+    s = json.loads(capsys.readouterr().out)
+    assert s["aero"] == "unsteady" and s["preflight"]["stable"]
+    assert s["preflight"]["aero"] == "unsteady" and s["preflight"]["max_growth_1_s"] < 0.0
+    assert s["resets"] == 0 and s["steps"] == 480
+
+
+def test_cli_sitl_allow_unstable_warns(monkeypatch, capsys):
+    sink = _udp_sink()
+    try:
+        rc = run_cli(["sitl", "--wing", "inertial-backward", "--allow-unstable",
+                      "--duration", "0.1", "--speedup", "5", "--no-log", "--json",
+                      "--mavlink", f"udpout:127.0.0.1:{sink.getsockname()[1]}"], monkeypatch)
+    finally:
+        sink.close()
+    assert rc == 0
+    cap = capsys.readouterr()
+    assert "warning: flying a model unstable at the trim speed" in cap.err
+    import json
+
+    s = json.loads(cap.out)
+    assert not s["preflight"]["stable"] and s["preflight"]["allowed_unstable"]
+
+
+@pytest.mark.parametrize("argv", [["--model", "rigid"], ["--trim", "elastic"]])
+def test_cli_sitl_unsteady_combinations_refused_in_one_line(argv, monkeypatch, capsys):
+    assert run_cli(["sitl", "--aero", "unsteady", *argv, "--duration", "0.1", "--no-log"],
+                   monkeypatch) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--aero unsteady is for --model coupled" in err
+
+
+def test_unsteady_sitl_wing_flies_and_cannot_be_switched():
+    b = build_wing(VARIANTS["inertial-backward"])
+    sim = SitlSim(b, b.modes, aero="unsteady", speedup=10.0)
+    assert sim.core.aero == "unsteady" and sim.core.compiled
+    params = SitlParameters(sim)
+    with pytest.raises(ValueError, match="cannot be switched"):
+        params.set("WING_COUPLED", 0.0)
+    assert params.get("WING_COUPLED") == 1.0
+    for _ in range(240):
+        sim.step()
+    assert sim.resets == 0 and abs(float(sim.core.eta[0])) > 0.0

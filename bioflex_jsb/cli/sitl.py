@@ -14,6 +14,10 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
+from bioflex_jsb.cli.preflight import add_allow_unstable, checked
+
+AERO_CHOICES = ("quasi-steady", "unsteady")
 
 # The log is written in small chunks when the loop has time for them (a chunk of 0.5 s, 480
 # steps, takes ≈ 10 ms to format and compress and would make the steps after it late):
@@ -42,7 +46,12 @@ since the start, the time axis of the MCAP log that every session writes (--out,
 hexadecimal digits (to share it with MAVProxy's "signing key P", the SHA-256 of the
 passphrase P: python -c "import hashlib; print(hashlib.sha256(b'P').hexdigest())"); the
 vehicle then signs all it sends and ignores unsigned or wrongly signed messages
-(except RADIO_STATUS)."""
+(except RADIO_STATUS). --aero unsteady flies the coupled wing with unsteady strips (Jones lag
+states, apparent mass, Kuessner gust) on the compiled step: the backward-axis wings,
+unstable with quasi-steady strips at their cruise, fly that way. Before the session the
+chosen model's stability at the trim speed is checked (eigenvalues of the linear model, the
+phugoid left out, as the ardupilot command does): an unstable one is refused (exit 2, one
+line) unless --allow-unstable."""
 
 
 def register(sub) -> None:
@@ -58,6 +67,11 @@ def register(sub) -> None:
                    "trim --wing W` shows it)")
     p.add_argument("--model", choices=("coupled", "rigid"), default="coupled",
                    help="elastic wing coupled (default) or rigid; parameter WING_COUPLED")
+    p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
+                   help="the coupled wing's strips: quasi-steady (the paper's, default) or "
+                   "unsteady (Jones lag states, apparent mass, Kuessner gust; --model "
+                   "coupled, --trim rigid); both on the compiled step")
+    add_allow_unstable(p)
     p.add_argument("--mavlink", default="udpout:127.0.0.1:14550", metavar="ENDPOINT",
                    help="udpout:HOST:PORT, udpin:HOST:PORT or tcpin:HOST:PORT "
                    "(default udpout:127.0.0.1:14550)")
@@ -78,6 +92,7 @@ def register(sub) -> None:
                    help="MAVLink 2 signing key file: 64 hex digits (32 bytes); sign what is "
                    "sent, accept only signed messages")
     add_log_arguments(p)
+    add_live_arguments(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=run)
 
@@ -111,11 +126,16 @@ def run(args: argparse.Namespace) -> int:
     except LinkError as exc:
         raise UsageError(str(exc)) from None
     home = _parse_home(args.home, DEFAULT_HOME)
+    if args.aero == "unsteady" and (args.model != "coupled" or args.trim != "rigid"):
+        raise UsageError(f"--aero unsteady is for --model coupled from --trim rigid, not "
+                         f"--model {args.model} --trim {args.trim} (its lag states are "
+                         "linearised about the rigid trim; the rigid wing is quasi-steady)")
     build = wing_from_args(args)
+    check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     try:
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
-                      trim_mode=args.trim)
+                      trim_mode=args.trim, aero=args.aero)
     except (FdmError, InputError) as exc:  # the airframe cannot trim, a home out of range
         raise UsageError(str(exc)) from None
     try:
@@ -125,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
     log = None
     on_sample = idle = None
     try:
+        start_live(args, "sitl")  # before log_path creates the file: a refusal leaves none
         args.out = log_path(args, "sitl", args.wing)
     except UsageError:
         link.close()
@@ -140,9 +161,11 @@ def run(args: argparse.Namespace) -> int:
             **({} if args.duration is None else {"duration_s": args.duration}),
             extra={"until_stopped": args.duration is None, "speedup": args.speedup,
                    "mavlink": endpoint.text(), "signed": key is not None,
-                   "trim": args.trim})
+                   "trim": args.trim, "aero": args.aero,
+                   "preflight_stable": check["stable"]})
         try:
-            log = SplitLog(args.out, description, build, args.log_max_mb, open_log)
+            log = SplitLog(args.out, description, build, args.log_max_mb,
+                           live_opener(args, open_log))
         except UsageError:
             link.close()
             raise
@@ -152,7 +175,11 @@ def run(args: argparse.Namespace) -> int:
     host, port = link.local_address
     if not args.json:
         print(f"bioflex-jsb sitl: MAVLink 2 on {endpoint.text()} (local {host}:{port}"
-              f"{', signed' if key else ''}), {args.speedup:g}x real time; Ctrl-C stops",
+              f"{', signed' if key else ''}), {args.speedup:g}x real time, {args.aero} "
+              f"{args.model} wing; Ctrl-C stops", file=sys.stderr)
+    if not check["stable"]:
+        print(f"bioflex-jsb sitl: warning: flying a model unstable at the trim speed "
+              f"(--allow-unstable): largest growth {check['max_growth_1_s']:+.3g} 1/s",
               file=sys.stderr)
     interrupted = False
     try:
@@ -164,6 +191,7 @@ def run(args: argparse.Namespace) -> int:
         link.close()
         if log is not None:
             log.close()
+        stop_live(args)
     summary = {
         "resets": sim.resets,
         "crashes": sim.crashes,
@@ -172,6 +200,8 @@ def run(args: argparse.Namespace) -> int:
         "log_files": log.paths if log is not None else [],
         "simulated_s": sim.t_s,
         "steps": sim.k,
+        "aero": args.aero,
+        "preflight": check,
         "pacing": stats.summary() if stats else None,
         "link": {"received": link.stats.received, "bad": link.stats.bad,
                  "rejected_signature": link.stats.rejected_signature,

@@ -18,6 +18,10 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
+from bioflex_jsb.cli.preflight import NATIVE, add_allow_unstable, checked, preflight
+
+__all__ = ("preflight", "register", "run", "session_summary")
 
 HELP = """Be ArduPilot's physics: answer ArduPlane SITL started with --model JSON:127.0.0.1
 (UDP 9002 + 10 x --instance) lock-step, one co-simulation step per ArduPilot frame, with the
@@ -48,12 +52,7 @@ every --record-every-th frame (servos 1-4, ArduPilot's frame count, the step's c
 a numpy table. Never expose ArduPlane's TCP ports: run both inside a loopback-only network
 namespace (scripts/ardupilot_sitl.py fly)."""
 
-NATIVE = "native"
 AERO_CHOICES = ("quasi-steady", "unsteady")
-# DEFINITION: a root is unstable when Re(lambda) exceeds this [1/s] (the flutter search's
-# threshold, bioflex_jsb.flight_dynamics.eigen.find_flutter / free_aircraft.GROWTH_TOL_1_S).
-GROWTH_TOL_1_S = 1e-9
-PREFLIGHT_GRID_STEP_M_S = 0.5  # mode tracking from 2 m/s to the trim speed (labels only)
 RTF_DEFINITION = (
     "session_s / connected_wall_s: the physics time advanced (every frame stepped, across "
     "ArduPilot restarts) over the wall time while an ArduPilot peer was connected (gaps "
@@ -86,8 +85,7 @@ def register(sub) -> None:
                    help="the coupled wing's strips: quasi-steady (the paper's) or unsteady "
                    "(Jones lag states, apparent mass, Kuessner gust); both on the compiled "
                    "step (the summary's 'step' says which ran); default quasi-steady")
-    p.add_argument("--allow-unstable", action="store_true",
-                   help="fly a model that is unstable at the trim speed (refused otherwise)")
+    add_allow_unstable(p)
     p.add_argument("--instance", type=int, default=0,
                    help="ArduPilot SITL instance (-I): UDP port 9002 + 10 x N (default 0)")
     p.add_argument("--port", type=int, default=None,
@@ -103,67 +101,13 @@ def register(sub) -> None:
                    help="also write the summary to this file")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_log_arguments(p)
+    add_live_arguments(p)
     p.set_defaults(run=run)
-
-
-def preflight(build, model: str, aero: str, speed_m_s: float) -> dict:
-    """The chosen model's stability at the trim speed ``speed_m_s`` [m/s], phugoid left out
-    (the autopilot flies it; the flutter search leaves it out too).
-
-    Quasi-steady: the labelled eigenvalues of the linear model (``api.modes``; ``native``
-    is the coupled wing JSBSim carries, ``rigid`` the short period alone). Unsteady (coupled
-    only): Eq. 4 with the Jones lag states (``aeroelasticity.free_aircraft.track_free``).
-    Returns ``stable``, the unstable roots (mode, Re [1/s], Im [rad/s]) and the largest
-    growth rate [1/s] of the roots considered."""
-    import numpy as np
-
-    from bioflex_jsb import api
-
-    if aero == "unsteady":
-        from bioflex_jsb.aeroelasticity.free_aircraft import EXCLUDED, track_free
-
-        grid = np.append(np.arange(2.0, speed_m_s, PREFLIGHT_GRID_STEP_M_S), speed_m_s)
-        tr = track_free(build, grid, aero="unsteady")
-        roots = [(lab, float(lam.real), float(lam.imag))
-                 for lab, lam in zip(tr.labels, tr.eigenvalues[-1], strict=True)
-                 if lab not in EXCLUDED]
-    else:
-        lti = "coupled" if model == NATIVE else model
-        roots = [(m.mode, float(m.re), float(m.im)) for m in api.modes(build, speed_m_s, lti).modes
-                 if m.mode != "phugoid"]
-    unstable = sorted((r for r in roots if r[1] > GROWTH_TOL_1_S), key=lambda r: -r[1])
-    return {"model": model, "aero": aero, "speed_m_s": speed_m_s, "stable": not unstable,
-            "max_growth_1_s": max(r[1] for r in roots),
-            "unstable": [{"mode": m, "re_1_s": re, "im_rad_s": im} for m, re, im in unstable]}
-
-
-def _refusal(args: argparse.Namespace, build, check: dict) -> str:
-    """The one line that refuses an unstable model, with the speeds that say why."""
-    from bioflex_jsb import api
-    from bioflex_jsb.aeroelasticity.free_aircraft import free_flutter
-
-    worst = check["unstable"][0]
-    text = (f"--wing {args.wing} cannot be flown at {args.speed:g} m/s with the {args.aero} "
-            f"{args.model} wing: its {worst['mode']} root is unstable there "
-            f"(Re = {worst['re_1_s']:+.3g} 1/s)")
-    if args.model in ("coupled", NATIVE):
-        first = api.flutter(build).flutter_speed_m_s if args.aero == "quasi-steady" \
-            else free_flutter(build, aero="unsteady").speed_m_s
-        if first is not None:
-            text += f"; its {args.aero} flutter speed is {first:.1f} m/s"
-        if args.aero == "quasi-steady":
-            other = free_flutter(build, aero="unsteady").speed_m_s
-            if other is None or other > args.speed:
-                how = "--aero unsteady" if args.model == "coupled" else \
-                    "--model coupled --aero unsteady"
-                stable_to = "up to 40 m/s" if other is None else f"to {other:.1f} m/s"
-                text += f"; try {how} (stable {stable_to})"
-    return text + "; --allow-unstable flies it anyway"
 
 
 def _build(args: argparse.Namespace):
     """The physics, the wing's variant and coefficient overrides for the log (dicts), and
-    the pre-flight check (:func:`preflight`)."""
+    the pre-flight check (:func:`~bioflex_jsb.cli.preflight.preflight`)."""
     from bioflex_jsb.drivers.ardupilot import ArduPilotPhysics, Launcher
     from bioflex_jsb.runtime.fdm import Airframe, FdmError
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
@@ -200,10 +144,7 @@ def _build(args: argparse.Namespace):
         aircraft, wing = None, build
         variant = build.variant.as_dict()
         overrides = dict(build.model.coefficients.overrides)
-    check = preflight(build, args.model, args.aero, args.speed)
-    check["allowed_unstable"] = bool(args.allow_unstable)
-    if not check["stable"] and not args.allow_unstable:
-        raise UsageError(_refusal(args, build, check))
+    check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     # both strip models have a compiled step (CoupledStep(compiled=True); the unsteady one
     # since simulation/unsteady_kernel.py); the summary's "step" says which one flew
     compiled = True
@@ -243,7 +184,8 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "duration": ("until stopped: the flown duration is in the session-end event "
                             "(session_s)") if args.duration is None else "--duration"})
     try:
-        return RunLog.open(args.out, description, wing_variant=variant, overrides=overrides)
+        return live_opener(args, RunLog.open)(args.out, description, wing_variant=variant,
+                                              overrides=overrides)
     except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 
@@ -305,6 +247,7 @@ def run(args: argparse.Namespace) -> int:
     log = None
     opened = False
     try:
+        start_live(args, "ardupilot")  # before the log file is made: a refusal leaves none
         log = _open_log(args, physics, variant, overrides, port)
         opened = True
     finally:
@@ -339,6 +282,7 @@ def run(args: argparse.Namespace) -> int:
                 log.event(physics.session_t_s, "INFO", "session end: " + json.dumps(
                     summary, allow_nan=False, separators=(",", ":")))
                 log.close()
+            stop_live(args)
     if args.table is not None:
         _write_table(args.table, physics)
     if args.json:

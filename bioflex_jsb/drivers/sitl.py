@@ -243,12 +243,17 @@ class SitlSim:
                  home: tuple[float, float, float] = DEFAULT_HOME,
                  start_height_m: float = DEFAULT_START_HEIGHT_M, dt_s: float = DEFAULT_DT_S,
                  speedup: float = 1.0, airframe: Airframe | None = None,
-                 trim_mode: str = "rigid") -> None:
+                 trim_mode: str = "rigid", aero: str = "quasi-steady") -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
-        :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``)."""
+        :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
+        ``aero="unsteady"``). ``aero``: the coupled wing's strips, ``quasi-steady`` or
+        ``unsteady`` (Jones lag states, apparent mass, Küssner gust), handed to the coupled
+        step as they are (an unsupported combination is refused there in one line,
+        InputError; both strips run on the compiled step)."""
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
+        self.aero = aero
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
         self._wing_model, self._model0 = wing_model, model
         self.home_deg = tuple(float(x) for x in home)
@@ -302,11 +307,11 @@ class SitlSim:
 
         elastic = self.trim_mode == "elastic" and model != "rigid"
         wing = self._wing_model
-        if not elastic and hasattr(wing, "model"):  # a WingBuild: the model is enough
-            wing = wing.model
+        if not elastic and self.aero != "unsteady" and hasattr(wing, "model"):
+            wing = wing.model  # a WingBuild: the model is enough for the quasi-steady strips
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
-                                trim_mode="elastic" if elastic else "rigid")
+                                trim_mode="elastic" if elastic else "rigid", aero=self.aero)
         self.trim = self.core.trim
         self._relocate()
         self._get = self.core.get
@@ -371,6 +376,11 @@ class SitlSim:
                                f"{self.gust_length_m:g} m")
 
     def set_wing_model(self, model: str) -> None:
+        """Switch the wing (WING_COUPLED); the unsteady wing cannot be switched
+        (ValueError: the parameter is refused, the session goes on)."""
+        if self.aero == "unsteady" and model != self.core.model:
+            raise ValueError(f"WING_COUPLED: the unsteady coupled wing cannot be switched to "
+                             f"{model} (the session flies --aero unsteady)")
         self.core.set_model(model)
 
     def manual(self, pitch: float | None, roll: float | None) -> bool:
