@@ -92,3 +92,18 @@ def test_a_users_file_is_not_replaced(tmp_path, capsys):
     err = out.err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "--force" in err[0]
     assert mine.read_text() == "keep me" and out.out == ""  # refused before any work
+
+
+def test_the_modes_layout_names_what_the_animation_holds(animated):
+    import json
+    from pathlib import Path
+
+    from bioflex_jsb.sinks import mcap as sink
+
+    layout = json.loads((Path(__file__).resolve().parents[1] / "docs" / "foxglove"
+                         / "modes_layout.json").read_text())
+    have = {c["topic"] for c in sink.summarise(animated / "modes.mcap")["channels"]}
+    three = layout["configById"]["3D!bioflexmodes"]
+    assert three["followTf"] == sink.body_frame(scene_modes.MODEL)
+    assert set(three["topics"]) <= have
+    assert layout["configById"]["RosOut!bioflexmodesevents"]["topicToRender"] in have

@@ -78,7 +78,7 @@ def register(sub) -> None:
         "mode of the coupled model at --speed (one speed) oscillates in turn, "
         f"{scene_modes.CYCLES} cycles each shown at {scene_modes.DISPLAY_PERIOD_S:g} s a "
         "cycle, labelled with frequency and damping ratio (a text in the 3-D scene and an "
-        "event); open it in Foxglove with docs/foxglove/layout.json, frame modes_body",
+        "event); open it in Foxglove with docs/foxglove/modes_layout.json",
     )
     p.add_argument(
         "--mode-sheet", metavar="FILE.png",
