@@ -29,6 +29,7 @@ import re
 import select
 import socket
 import struct
+import time
 from dataclasses import dataclass, field
 
 MAGIC_16 = 18458  # SIM_JSON.h servo_packet_16
@@ -297,3 +298,167 @@ class ArduPilotStandin:
         self.frame_counter += 1
         self.last_parsed = parsed
         return parsed
+
+
+# ------------------------------------------------------------------ flying at a speed-up
+# ArduPilot SITL paces its frames to --speedup (SIM_Aircraft.cpp, Aircraft::sync_frame_time,
+# described here in our own words): each frame adds (target frame time - the wall time since
+# the last frame) to a sleep debt, target = 1 / (rate x speed-up), rate the physics rate it
+# adopted from the timestamps' steps; the debt is floored at -0.1 s (a slow stretch is not
+# made up for ever after) and slept off whenever it exceeds 5 ms (its min_sleep_time).
+SLEEP_DEBT_FLOOR_S = -0.1
+MIN_SLEEP_S = 0.005
+LAUNCH_SWITCH_US = 1900  # servo 5 in the backend's launch window (1880..1920 us)
+RESEND_S = 1.0  # JSON::recv_fdm sends the frame again after 1 s without a reply
+PATIENCE = 60  # re-sends before the stand-in gives up (a backend still starting up)
+
+
+@dataclass
+class FlightStats:
+    """One paced (or free) run of the stand-in: ``frames`` answered in ``wall_s`` [s] of
+    wall time, ``physics_s`` [s] of the backend's time advanced; ``answer_s`` [s] the sum of
+    the waits for the replies (send to reply: the backend's share and loopback UDP);
+    ``grounded`` frames whose reply had no airspeed (the aircraft was not flying)."""
+
+    speedup: float | None
+    frames: int
+    wall_s: float
+    physics_s: float
+    answer_s: float
+    grounded: int
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.physics_s / self.wall_s
+
+    @property
+    def frames_per_s(self) -> float:
+        """Frames the loop completed per wall second (the stand-in's own work included)."""
+        return self.frames / self.wall_s
+
+    @property
+    def answered_per_s(self) -> float:
+        """Frames the backend answers per second of waiting for it."""
+        return self.frames / self.answer_s
+
+    def as_dict(self) -> dict:
+        return {"speedup": self.speedup, "frames": self.frames, "wall_s": self.wall_s,
+                "physics_s": self.physics_s, "answer_s": self.answer_s,
+                "grounded": self.grounded, "real_time_factor": self.real_time_factor,
+                "frames_per_s": self.frames_per_s, "answered_per_s": self.answered_per_s}
+
+
+def reply_timestamp(datagram: bytes) -> tuple[float, float]:
+    """(timestamp [s], airspeed [m/s]) of one reply, read as ``parse_sensors`` reads those two
+    keys (strstr, skip the key's length + 2, atof) without the other fields: the cheap read
+    for the frames between two full parses."""
+    line = datagram.strip(b"\n")
+    values = []
+    for key in (b"timestamp", b"airspeed"):
+        q = line.find(key)
+        values.append(c_atof(line[q + len(key) + 2:]) if q >= 0 else 0.0)
+    return values[0], values[1]
+
+
+class PacedStandin(ArduPilotStandin):
+    """The stand-in flying the backend frame after frame, free (as fast as the backend
+    answers) or paced to a speed-up as ArduPilot paces itself, every ``check_every``-th reply
+    parsed in full (:meth:`accept`) and the others by :func:`reply_timestamp`."""
+
+    def __init__(self, target, throttle_us: int = 1500, check_every: int = 100, **kw) -> None:
+        super().__init__(target, timeout_s=RESEND_S, **kw)
+        self.patience = PATIENCE
+        self.pwm = [1500, 1500, int(throttle_us), 1500, LAUNCH_SWITCH_US]
+        self.check_every = check_every
+        self._debt_s = 0.0
+        self.clock = time.perf_counter  # wall clock and sleep: a test passes its own
+        self.sleep = time.sleep
+
+    def _frame(self, full: bool) -> tuple[float, float, float]:
+        """One frame: (wait for the reply [s], timestamp [s], airspeed [m/s])."""
+        t0 = self.clock()
+        self.send_servos(self.pwm)
+        for _ in range(self.patience):  # as recv_fdm: the same frame again after 1 s
+            try:
+                data = self.read_datagram()
+                break
+            except TimeoutError:
+                self.resend()
+        else:
+            raise TimeoutError(f"no reply from {self.target} in {self.patience} s")
+        wait = self.clock() - t0
+        if full:
+            parsed = self.accept(data)
+            if parsed is None:
+                raise RuntimeError(f"reply not accepted: {self.messages[-1:]}")
+            return wait, float(parsed.values["timestamp"]), float(
+                parsed.values.get("airspeed", 0.0))
+        ts, airspeed = reply_timestamp(data)
+        self.frame_counter += 1
+        self.time_now_us += max(0.0, ts - self.last_timestamp_s) * 1e6
+        self.last_timestamp_s = ts
+        return wait, ts, airspeed
+
+    def fly(self, frames: int, speedup: float | None = None) -> FlightStats:
+        """``frames`` frames, paced to ``speedup`` (None: free)."""
+        grounded = 0
+        answer = 0.0
+        t_start = self.last_timestamp_s
+        clock = self.clock
+        wall0 = last = clock()
+        self._debt_s = 0.0
+        prev_ts = self.last_timestamp_s
+        for i in range(frames):
+            wait, ts, airspeed = self._frame(i % self.check_every == 0)
+            answer += wait
+            grounded += airspeed <= 0.0
+            if speedup is not None:
+                step = ts - prev_ts
+                now = clock()
+                if 0.0 < step < 0.1:  # the rate ArduPilot adopts from the timestamps
+                    self._debt_s += step / speedup - (now - last)
+                    self._debt_s = max(self._debt_s, SLEEP_DEBT_FLOOR_S)
+                    if self._debt_s > MIN_SLEEP_S:
+                        self.sleep(self._debt_s)
+                        self._debt_s -= clock() - now
+                last = clock()
+            prev_ts = ts
+        wall = clock() - wall0
+        return FlightStats(speedup, frames, wall, self.last_timestamp_s - t_start, answer,
+                           grounded)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python tests/ardupilot_standin.py --target HOST:PORT [--warmup N] [--frames N]
+    [--speedups S,S,...] [--repeat N] [--throttle-us US]``: fly the backend (the launch
+    switch held, the surfaces at trim), ``--warmup`` frames first (launch and settle), then
+    ``--repeat`` rounds of a free run and a run at each speed-up, ``--frames`` each; one JSON
+    document on stdout (the runs in order, :meth:`FlightStats.as_dict`)."""
+    import argparse
+    import json
+
+    p = argparse.ArgumentParser(description=main.__doc__.split("\n")[0])
+    p.add_argument("--target", required=True)
+    p.add_argument("--warmup", type=int, default=2000)
+    p.add_argument("--frames", type=int, default=4000)
+    p.add_argument("--speedups", default="")
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--throttle-us", type=int, default=1500)
+    args = p.parse_args(argv)
+    host, port = args.target.rsplit(":", 1)
+    speedups = [float(s) for s in args.speedups.split(",") if s]
+    ap = PacedStandin((host, int(port)), throttle_us=args.throttle_us)
+    runs = []
+    try:
+        warm = ap.fly(args.warmup)
+        for _ in range(args.repeat):
+            for s in (None, *speedups):
+                runs.append(ap.fly(args.frames, s).as_dict())
+    finally:
+        ap.close()
+    print(json.dumps({"warmup": warm.as_dict(), "runs": runs}))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

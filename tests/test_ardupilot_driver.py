@@ -786,3 +786,27 @@ def test_command_line_flies_the_unstable_wing_with_unsteady_strips(capsys):
     assert (s["aero"], s["step"]) == ("unsteady", "compiled kernel")
     assert s["preflight"]["stable"] and s["preflight"]["aero"] == "unsteady"
     assert s["preflight"]["max_growth_1_s"] < 0.0
+
+
+def test_unchanged_servo_outputs_are_not_written_again_and_fly_the_same(wing):
+    """ArduPlane's outputs change at its loop rate, not every frame: a PWM equal to the last
+    one written is skipped (the controls already hold it); the flight is the same, bit for
+    bit, as writing every frame, through PWM changes and a restart's new core."""
+    rng = np.random.default_rng(3)
+    held = [tuple(int(x) for x in rng.integers(1400, 1600, 4)) for _ in range(10)]
+    # the last PWM held across the restart: after it, the first flight frame repeats it
+    frames = [ARMED_IDLE] * 600 + [p for p in held for _ in range(20)] + [held[-1]] * 1000
+    rows = []
+    for always in (False, True):
+        ph = _physics(wing, launcher=ad.Launcher(height_m=100.0))
+        out = []
+        for i, pwm in enumerate(frames):
+            if i == 900:
+                ph.reset()  # ArduPilot restarted: a new core, trimmed, its trim controls in
+            if always:
+                ph._written_pwm = None
+            ph.step(pwm + (0,) * 12, 1200)
+            out.append((ph.phase, *ph.state().position_ned_m))
+        assert ph.phase == ad.FLIGHT
+        rows.append(out)
+    assert rows[0] == rows[1]

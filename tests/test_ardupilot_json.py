@@ -574,3 +574,104 @@ def test_a_slow_step_of_ours_counts_as_connected_time():
             ap.close()
     assert server.stats.connected_wall_s == pytest.approx(19e-3 + 4.0, rel=1e-9)
     assert server.stats.rebinds == 0 and physics.resets == 0
+
+
+# ------------------------------------------------------------------ the fast reply, pacing
+def _states(n: int, seed: int = 1):
+    """Random states: every number class (zero, -0.0, subnormal, 1e±300, long mantissas),
+    each optional field present or not."""
+    rng = np.random.default_rng(seed)
+    picks = (lambda: rng.uniform(-1e3, 1e3), lambda: 0.0, lambda: -0.0, lambda: 5e-324,
+             lambda: rng.standard_normal() * 10.0 ** rng.integers(-300, 300),
+             lambda: 123456789.123456789, lambda: 1e16)
+
+    def f() -> float:
+        return float(picks[rng.integers(len(picks))]())
+
+    for _ in range(n):
+        q = rng.standard_normal(4)
+        q = tuple(q / np.linalg.norm(q))
+        has_q = rng.uniform() < 0.7
+        yield aj.JsonState(
+            abs(f()), (f(), f(), f()), (f(), f(), f()), (f(), f(), f()), (f(), f(), f()),
+            quaternion=q if has_q else None,
+            attitude_rad=(f(), f(), f()) if not has_q or rng.uniform() < 0.5 else None,
+            airspeed_m_s=abs(f()) if rng.uniform() < 0.5 else None)
+
+
+def test_the_format_string_reply_is_json_dumps_byte_for_byte():
+    for state in _states(5000):
+        assert aj.encode_reply(state) == aj.encode_reply_json(state)
+
+
+def test_the_standins_cheap_read_agrees_with_its_full_parse():
+    from tests.ardupilot_standin import reply_timestamp
+
+    rng = np.random.default_rng(2)
+    for _ in range(500):  # magnitudes a flight sends (ArduPilot's floats are single)
+        v = tuple(map(float, rng.uniform(-1e3, 1e3, 13)))
+        state = aj.JsonState(abs(v[0]), v[1:4], v[4:7], v[7:10], v[10:13],
+                             attitude_rad=(0.1, 0.2, 0.3),
+                             airspeed_m_s=float(rng.uniform(0, 40)) if v[0] > 0 else None)
+        data = aj.encode_reply(state)
+        parsed = parse_sensors(data.strip(b"\n"))
+        ts, airspeed = reply_timestamp(data)
+        assert ts == parsed.values["timestamp"]
+        assert airspeed == pytest.approx(parsed.values.get("airspeed", 0.0), rel=1e-7)
+
+
+class _FakeBackend:
+    """The stand-in's frames against a simulated clock: each reply takes ``cost_s`` [s]
+    and advances the physics by DT_S (no sockets, no wall clock)."""
+
+    def __init__(self, ap, cost_s: float) -> None:
+        self.now = 0.0
+        self.ts = 0.0
+        self.cost_s = cost_s
+        self.ap = ap
+        ap.clock = lambda: self.now
+        ap.sleep = self.sleep
+        ap._frame = self.frame
+
+    def sleep(self, s: float) -> None:
+        self.now += s
+
+    def frame(self, full: bool):
+        self.now += self.cost_s
+        self.ts += DT_S
+        self.ap.last_timestamp_s = self.ts  # what the stand-in's own read keeps
+        return self.cost_s, self.ts, 15.0
+
+
+@pytest.mark.parametrize("cost_s, speedup", [(10e-6, 1.0), (10e-6, 10.0), (10e-6, 50.0),
+                                             (100e-6, 5.0)])
+def test_paced_standin_holds_a_speedup_the_backend_can_answer(cost_s, speedup):
+    """Paced as ArduPilot paces itself (sleep debt, slept off above 5 ms): the real-time
+    factor is the speed-up asked for, within the 5 ms of debt left at the end."""
+    from tests.ardupilot_standin import MIN_SLEEP_S, PacedStandin
+
+    ap = PacedStandin(("127.0.0.1", 9))
+    try:
+        _FakeBackend(ap, cost_s)
+        st = ap.fly(20000, speedup)
+    finally:
+        ap.close()
+    target_wall = st.physics_s / speedup
+    assert st.wall_s == pytest.approx(target_wall, abs=MIN_SLEEP_S + 2 * cost_s)
+    assert st.answered_per_s == pytest.approx(1.0 / cost_s)
+
+
+@pytest.mark.parametrize("speedup", [None, 20.0])
+def test_paced_standin_runs_at_the_backends_rate_when_asked_for_more(speedup):
+    """A backend of 100 µs a frame (9.6 x real time at 960 Hz) asked for 20 x, or free: the
+    real-time factor is what it answers, 9.6 (a slow frame is never made up by sleeping)."""
+    from tests.ardupilot_standin import PacedStandin
+
+    ap = PacedStandin(("127.0.0.1", 9))
+    try:
+        _FakeBackend(ap, 100e-6)
+        st = ap.fly(5000, speedup)
+    finally:
+        ap.close()
+    assert st.real_time_factor == pytest.approx(DT_S / 100e-6, rel=1e-9)
+    assert st.grounded == 0 and st.frames_per_s == pytest.approx(1e4, rel=1e-9)

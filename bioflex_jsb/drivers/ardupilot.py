@@ -340,6 +340,7 @@ class ArduPilotPhysics:
             else:
                 writers.append(node(ch.prop).set_double_value)
         self._controls = writers
+        self._written_pwm: tuple[int, ...] | None = None  # the trim's controls are in now
         blows = self.gust_spec is not None and (self.gust_repeat or not self._gust_applied)
         self.gust = None if not blows else GustField(
             self.gust_spec, self.speed_m_s, self.gust_at_s, self.gust_at_s + 600.0,
@@ -446,8 +447,11 @@ class ArduPilotPhysics:
                 self.phase = FLIGHT
             return
         core = self.core
-        for ch, write in zip(CHANNEL_MAP, self._controls, strict=True):
-            write(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0))
+        if pwm_us != self._written_pwm:  # ArduPlane's outputs change at its loop rate
+            # (50-400 Hz) against 960 frames a second: the same PWM is not written again
+            for ch, write in zip(CHANNEL_MAP, self._controls, strict=True):
+                write(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0))
+            self._written_pwm = pwm_us
         k = core.k
         w_g = self.gust.at_step(k) if self.gust is not None else 0.0
         self._last_row = self._step_row = core.advance(w_g)
@@ -524,7 +528,8 @@ class ArduPilotPhysics:
         k = U.M_PER_FT / m
         phi, theta = get["phi"](), get["theta"]()
         psi = math.remainder(get["psi"](), 2.0 * math.pi)
-        s_n, s_e, s_d = (self.stroke_m * c for c in self._exit_dir)
+        stroke = self.stroke_m
+        s_n, s_e, s_d = (stroke * c for c in self._exit_dir)
         north = (get["lat"]() - self._lat0) * self._m_per_rad_n + s_n
         east = math.remainder(get["lon"]() - self._lon0, 2.0 * math.pi) * self._m_per_rad_e + s_e
         down = self._h_launch_m - get["h"]() * U.M_PER_FT + s_d

@@ -168,14 +168,17 @@ def parse_servo_packet(data: bytes) -> ServoPacket:
 
 def _vector(name: str, value, length: int) -> tuple[float, ...]:
     try:
-        out = tuple(float(v) for v in value)
+        out = tuple(map(float, value))  # (map: a third of a generator's cost, per frame)
     except TypeError as exc:
         raise JsonStateError(f"{name} must be a sequence of {length} numbers: {exc}") from None
     if len(out) != length:
         raise JsonStateError(f"{name} must have {length} components, got {len(out)}")
-    if not all(math.isfinite(v) for v in out):
+    if not all(map(_isfinite, out)):
         raise JsonStateError(f"{name} must be finite, got {out}")
     return out
+
+
+_isfinite = math.isfinite
 
 
 @dataclass(frozen=True)
@@ -234,8 +237,49 @@ def encode_reply(state: JsonState) -> bytes:
     """The datagram answering one servo frame: ``\\n`` + compact JSON + ``\\n`` (ASCII).
 
     Keys in this order: timestamp, imu (gyro, accel_body), position, quaternion, attitude,
-    velocity, airspeed (the optional ones only when set).
+    velocity, airspeed (the optional ones only when set). The text is exactly
+    ``json.dumps(doc, separators=(",", ":"))`` of those keys (:func:`encode_reply_json`,
+    tested equal), written by one format string: ``json``'s encoder walks the document in
+    Python, ≈ 40 % of a frame's cost in the faster-than-real-time lock step; a float is
+    written as ``json`` writes it, ``float.__repr__``, and every number was checked finite
+    by :class:`JsonState`.
     """
+    quat, att, air = state.quaternion, state.attitude_rad, state.airspeed_m_s
+    values = (state.timestamp_s, *state.gyro_rad_s, *state.accel_body_m_s2,
+              *state.position_ned_m, *(quat or ()), *(att or ()), *state.velocity_ned_m_s,
+              *(() if air is None else (air,)))
+    data = (_reply_format(quat is not None, att is not None, air is not None)
+            % values).encode("ascii")
+    if len(data) > MAX_REPLY_BYTES:  # cannot happen with the fixed fields above
+        raise JsonStateError(f"reply of {len(data)} bytes exceeds {MAX_REPLY_BYTES}")
+    return data
+
+
+_FORMATS: dict[tuple[bool, bool, bool], str] = {}
+
+
+def _reply_format(quaternion: bool, attitude: bool, airspeed: bool) -> str:
+    """The reply's %-format for the optional fields present (``%r`` of a float is its
+    ``float.__repr__``, as ``json`` writes it), built once per combination."""
+    key = (quaternion, attitude, airspeed)
+    if key not in _FORMATS:
+        vec = lambda n: "[" + ",".join(["%r"] * n) + "]"  # noqa: E731
+        text = ('\n{"timestamp":%r,"imu":{"gyro":' + vec(3) + ',"accel_body":' + vec(3)
+                + '},"position":' + vec(3))
+        if quaternion:
+            text += ',"quaternion":' + vec(4)
+        if attitude:
+            text += ',"attitude":' + vec(3)
+        text += ',"velocity":' + vec(3)
+        if airspeed:
+            text += ',"airspeed":%r'
+        _FORMATS[key] = text + "}\n"
+    return _FORMATS[key]
+
+
+def encode_reply_json(state: JsonState) -> bytes:
+    """:func:`encode_reply` through ``json.dumps``: the reference its format string is held
+    to (tests/test_ardupilot_json.py)."""
     doc: dict[str, object] = {
         "timestamp": state.timestamp_s,
         "imu": {"gyro": list(state.gyro_rad_s), "accel_body": list(state.accel_body_m_s2)},
