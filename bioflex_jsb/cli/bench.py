@@ -30,8 +30,15 @@ against it. Also: µs per step through sharp:0.3, sharp:3 and Dryden gusts (a la
 renews the wing's reference step more often), the cost of one reference renewal [ms] of
 both wings, the step kernels' cold compile and cached load [s], the load average, and the
 SITL pacing error (step start against the wall clock, p50/p99 [ms] and resyncs) over
---sitl-seconds of simulated time at --sitl-speedup. Machines are shared and noisy: compare
-the ratios, not the absolute times."""
+--sitl-seconds of simulated time at --sitl-speedup. Autopilots faster than real time
+(--ardupilot-frames, 0 skips): the ardupilot backend (its log written, as a session logs)
+lock-stepped with the stand-in of ArduPilot's side (tests/ardupilot_standin.py, in its own
+process as ArduPlane is): frames per second it answers, and the highest --speedup at which
+its real-time factor stays within 5 % of the speed-up asked for (ArduPilot's own pacing:
+sleep debt), each over --ardupilot-repeat rounds (median [min .. max]); and the sitl
+vehicle's pacing error at speed-ups 1..30 (--sitl-speedups-seconds of wall time each, 0
+skips): the highest with p99 <= 5 ms. Each with the load average. Machines are shared and
+noisy: compare the ratios, not the absolute times."""
 
 
 def _int_in(label: str, lo: int, hi: int):
@@ -62,6 +69,13 @@ def register(sub) -> None:
                    help="simulated seconds of the SITL pacing run, 0..3600 (0: skip; default 2)")
     p.add_argument("--sitl-speedup", type=positive_float("SITL speed-up", ""), default=1.0,
                    help="SITL speed-up of the pacing run, 0.1..50 (default 1)")
+    p.add_argument("--ardupilot-frames", type=_int_in("--ardupilot-frames", 0, 100_000),
+                   default=3000, help="frames of each run against the ArduPilot stand-in, "
+                   "0..100000 (0: skip; default 3000)")
+    p.add_argument("--ardupilot-repeat", type=_int_in("--ardupilot-repeat", 1, 20), default=3,
+                   help="rounds of the ArduPilot speed-up runs, 1..20 (default 3)")
+    p.add_argument("--sitl-speedups-seconds", type=float, default=1.0,
+                   help="wall seconds of each sitl speed-up run, 0..60 (0: skip; default 1)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -78,6 +92,9 @@ def run(args: argparse.Namespace) -> int:
     lo, hi = SPEEDUP_RANGE
     if not lo <= args.sitl_speedup <= hi:
         raise UsageError(f"--sitl-speedup {args.sitl_speedup:g} is outside {lo:g}..{hi:g}")
+    if not 0.0 <= args.sitl_speedups_seconds <= 60.0:
+        raise UsageError(f"--sitl-speedups-seconds {args.sitl_speedups_seconds:g} is outside "
+                         "0..60 s")
     build = build_wing(VARIANTS["optimised"])
     compile_s = bench.compile_cost_s()
     sb = bench.StepBench(build, args.speed, args.steps)
@@ -101,6 +118,11 @@ def run(args: argparse.Namespace) -> int:
             payload["sitl"] = measure_pacing(duration_s=args.sitl_seconds,
                                              speedup=args.sitl_speedup,
                                              log_path=str(Path(tmp) / "sitl.mcap"))
+    if args.ardupilot_frames:
+        payload["ardupilot"] = bench.ardupilot_speedup(args.ardupilot_frames,
+                                                       args.ardupilot_repeat)
+    if args.sitl_speedups_seconds > 0.0:
+        payload["sitl_speedup"] = bench.sitl_speedup(args.sitl_speedups_seconds)
     if args.json:
         print_json(payload)
     else:
@@ -167,3 +189,40 @@ def _print(p: dict) -> None:
         s = p["sitl"]
         print(f"SITL pacing ({s['speedup']:g}x, logged, {s['steps']} steps): p50 "
               f"{s['p50_ms']:.3f} ms, p99 {s['p99_ms']:.3f} ms, resyncs {s['resyncs']}")
+    _print_speedups(p)
+
+
+def _load(values) -> str:
+    return ", ".join(f"{x:.2f}" for x in values)
+
+
+def _print_speedups(p: dict) -> None:
+    a = p.get("ardupilot")
+    if a is not None and not a["available"]:
+        print(f"ArduPilot backend: not measured ({a['reason']})")
+    elif a is not None:
+        n = a["answered_per_s"]
+        m = a["max_speedup_held"]
+        print(f"ArduPilot backend ({'logged' if a['logged'] else 'no log'}, "
+              f"{a['physics_rate_hz']:.0f} Hz physics, {a['repeat']} rounds of "
+              f"{a['frames_per_run']} frames; load average {_load(a['load_average_before'])} "
+              f"-> {_load(a['load_average'])}):")
+        print(f"  frames answered per second {n['median']:8.0f}  [{n['min']:.0f} .. "
+              f"{n['max']:.0f}]  (free run, real-time factor "
+              f"{a['free_real_time_factor']['median']:.2f})")
+        trust = "" if a["trusted"] else f"  NOT TRUSTED: {a['reason']}"
+        print(f"  highest --speedup held within {100 * a['tolerance']:.0f} %: "
+              f"{m['median']:g}  [{m['min']:g} .. {m['max']:g}]{trust}")
+        for s_, r in a["real_time_factor_by_speedup"].items():
+            print(f"    {s_:>4s}x: real-time factor {r['median']:6.2f}  [{r['min']:.2f} .. "
+                  f"{r['max']:.2f}]")
+    s = p.get("sitl_speedup")
+    if s is not None:
+        m = s["max_speedup_p99_within_bar"]
+        print(f"sitl vehicle (logged): highest --speedup with pacing p99 <= "
+              f"{s['bar_p99_ms']:g} ms and no resync: {m['median']:g}  [{m['min']:g} .. "
+              f"{m['max']:g}] (load average {_load(s['load_average_before'])} -> "
+              f"{_load(s['load_average'])})")
+        for r in s["runs"]:
+            print(f"    {r['speedup']:>4g}x: p50 {r['p50_ms']:.3f} ms, p99 {r['p99_ms']:.3f} ms, "
+                  f"resyncs {r['resyncs']} (load {r['load_average']:.2f})")
