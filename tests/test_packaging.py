@@ -88,8 +88,12 @@ def installed(dists, tmp_path_factory) -> Path:
     python = venv / "bin" / "python"
     borrowed = [p for p in sys.path if p.endswith("site-packages") and Path(p).is_dir()]
     (_site_packages(python) / "borrowed_deps.pth").write_text("\n".join(borrowed) + "\n")
+    # --ignore-installed: pip sees the borrowed directories, and in CI they hold a
+    # non-editable bioflex-jsb of the same version, which it would take as "already
+    # satisfied" and install nothing
     proc = subprocess.run([str(python), "-m", "pip", "install", "--no-deps", "--no-index", "-q",
-                           str(dists["wheel"])], capture_output=True, text=True, timeout=600)
+                           "--ignore-installed", str(dists["wheel"])],
+                          capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return venv / "bin"
 
