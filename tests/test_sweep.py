@@ -7,6 +7,7 @@ not skip without them.
 from __future__ import annotations
 
 import os
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -330,3 +331,117 @@ def test_lti_only_campaign_and_per_case_logs(tmp_path, monkeypatch, capsys):
     (row,) = read_results(tmp_path / "one.csv")
     log = logs / f"{row['case_id']}.mcap"
     assert log.is_file() and log.read_bytes()[:8] == b"\x89MCAP0\r\n"
+
+
+# ------------------------------------------------------------------ unsteady strips, reuse
+REUSE = """
+name = "reuse"
+metrics = ["gust", "eigenvalues", "coefficients"]
+
+[run]
+duration_s = 0.6
+gust_start_s = 0.1
+
+[axes]
+wings = ["optimised"]
+speeds_m_s = [15.0]
+gusts = ["sharp:1", "sharp:3"]
+models = ["coupled", "qsd"]
+"""
+
+
+@pytest.mark.parametrize("extra, needle", [
+    ('aero = "lagged"', "run.aero: unknown aerodynamics 'lagged'"),
+    ('aero = "unsteady"', "run.aero: 'unsteady' is for the coupled model"),
+])
+def test_unsupported_aero_is_refused_in_one_line(extra, needle):
+    data = tomllib.loads(REUSE.replace("[run]", f"[run]\n{extra}"))
+    with pytest.raises(CampaignError) as err:
+        parse_campaign(data)
+    assert needle in str(err.value) and "\n" not in str(err.value)
+
+
+def test_unsteady_with_the_lti_metrics_is_refused():
+    data = tomllib.loads(REUSE.replace("[run]", '[run]\naero = "unsteady"')
+                         .replace('"coupled", "qsd"', '"coupled"'))
+    with pytest.raises(CampaignError, match="metric 'eigenvalues' is the quasi-steady"):
+        parse_campaign(data)
+
+
+def test_the_default_aero_keeps_case_ids_and_columns():
+    """aero = "quasi-steady" written out is the campaign without the key: same ids, same
+    columns (old results resume); "unsteady" gives new ids and an aero column."""
+    plain = parse_campaign(tomllib.loads(REUSE))
+    said = parse_campaign(tomllib.loads(REUSE.replace("[run]", '[run]\naero = "quasi-steady"')))
+    assert [c.case_id for c in plain.cases()] == [c.case_id for c in said.cases()]
+    assert plain.columns() == said.columns() and "aero" not in plain.columns()
+    from bioflex_jsb.sweep.campaign import case_id
+
+    assert all(case_id(c) == c.case_id for c in said.cases())
+    uns = parse_campaign(tomllib.loads(
+        REUSE.replace("[run]", '[run]\naero = "unsteady"').replace('"coupled", "qsd"',
+                                                                    '"coupled"')
+        .replace('"gust", "eigenvalues", "coefficients"', '"gust"')))
+    assert "aero" in uns.columns()
+    assert not {c.case_id for c in uns.cases()} & {c.case_id for c in plain.cases()}
+
+
+def test_unsteady_campaign_flies_the_unsteady_strips(monkeypatch):
+    """The case's aero reaches the coupled step (recorded from CoupledStep's constructor)
+    and its row says so; the quasi-steady case of the same inputs flies quasi-steady."""
+    from bioflex_jsb.runtime import coupled_step
+    from bioflex_jsb.sweep.evaluate import run_case
+
+    seen = []
+    real_init = coupled_step.CoupledStep.__init__
+
+    def spy(self, *a, **kw):
+        seen.append(kw.get("aero"))
+        real_init(self, *a, **kw)
+
+    monkeypatch.setattr(coupled_step.CoupledStep, "__init__", spy)
+    text = REUSE.replace('"coupled", "qsd"', '"coupled"').replace(
+        '"gust", "eigenvalues", "coefficients"', '"gust"')
+    rows = {}
+    for aero in ("quasi-steady", "unsteady"):
+        camp = parse_campaign(tomllib.loads(text.replace("[run]", f'[run]\naero = "{aero}"')))
+        rows[aero] = run_case(camp.cases()[1])
+    assert seen == ["quasi-steady", "unsteady"]
+    assert rows["unsteady"]["aero"] == "unsteady" and "aero" not in rows["quasi-steady"]
+    assert rows["unsteady"]["status"] == rows["quasi-steady"]["status"] == "ok"
+    assert rows["unsteady"]["peak_dn_z"] != rows["quasi-steady"]["peak_dn_z"]
+
+
+def test_a_worker_reuses_the_wing_its_eigenvalues_and_the_kernel(monkeypatch):
+    """The second case of a wing in a worker builds nothing again: one wing build, one
+    eigenvalue search per (wing, model, speed), the kernel loaded before the first case
+    (counted calls); the rows equal those of cases run with every cache emptied."""
+    from bioflex_jsb.flight_dynamics import eigen, wing_model
+    from bioflex_jsb.simulation import step_kernel
+    from bioflex_jsb.sweep import evaluate
+
+    cases = parse_campaign(tomllib.loads(REUSE)).cases()
+    calls = {"build": 0, "modes": 0, "compile": 0}
+
+    def counting(name, fn):
+        def wrapper(*a, **kw):
+            calls[name] += 1
+            return fn(*a, **kw)
+        return wrapper
+
+    monkeypatch.setattr(eigen, "modes_at", counting("modes", eigen.modes_at))
+    monkeypatch.setattr(step_kernel, "compile_now", counting("compile", step_kernel.compile_now))
+    monkeypatch.setattr(wing_model, "_build", counting("build", wing_model._build))
+    wing_model._BUILD_CACHE.clear()
+    evaluate._EIGEN_CACHE.clear()
+    evaluate.warm_worker()
+    reused = [evaluate.run_case(c) for c in cases]
+    assert calls == {"build": 1, "modes": 2, "compile": 1}  # 1 wing; coupled and qsd
+    fresh = []
+    for c in cases:
+        wing_model._BUILD_CACHE.clear()
+        evaluate._EIGEN_CACHE.clear()
+        fresh.append(evaluate.run_case(c))
+    assert calls["build"] == 1 + len(cases) and calls["modes"] == 2 + len(cases)
+    assert comparable(reused) == comparable(fresh)
+    assert {r["status"] for r in reused} == {"ok"}

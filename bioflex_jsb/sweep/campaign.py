@@ -55,7 +55,13 @@ MAX_DT_S = 0.02  # as the gust command: coarser co-simulation steps are refused
 
 METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
 TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
-RUN_KEYS = {"duration_s", "gust_start_s", "dt_s", "mass_basis", "flutter_range_m_s"}
+RUN_KEYS = {"duration_s", "gust_start_s", "dt_s", "mass_basis", "flutter_range_m_s", "aero"}
+AERO_MODELS = ("quasi-steady", "unsteady")  # the coupled step's strips (run.aero)
+DEFAULT_AERO = "quasi-steady"
+# the metrics the unsteady strips are offered for: the gust run (the coupled step) and the
+# wing's coefficients (no aerodynamics); flutter and eigenvalues are the quasi-steady LTI
+# model's, so with run.aero = "unsteady" they are refused rather than given quasi-steady
+UNSTEADY_METRICS = ("gust", "coefficients")
 AXIS_KEYS = {"wings", "x_inertial_frac", "x_elastic_frac", "speeds_m_s", "gusts", "seeds",
              "models"}
 RANGE_KEYS = {"start", "stop", "step", "num"}
@@ -152,9 +158,13 @@ RUN_INFO_COLUMNS: dict[str, str] = {
 }
 
 
-def result_columns(metrics: Sequence[str]) -> dict[str, str]:
-    """Every column of a results table for ``metrics``, in order, with its type."""
+def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO) -> dict[str, str]:
+    """Every column of a results table for ``metrics``, in order, with its type. A campaign
+    of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``; the
+    quasi-steady default's table is the one it always was (its files resume as before)."""
     cols = dict(INPUT_COLUMNS)
+    if aero != DEFAULT_AERO:
+        cols["aero"] = "str"
     cols.update(STATUS_COLUMNS)
     for m in METRICS:
         if m in metrics:
@@ -169,13 +179,24 @@ def result_columns(metrics: Sequence[str]) -> dict[str, str]:
 @dataclass(frozen=True)
 class RunSettings:
     """Settings shared by every case: gust-run duration and gust start [s], co-simulation
-    step [s], mass basis, flutter search range [m/s]."""
+    step [s], mass basis, flutter search range [m/s], the coupled step's strips
+    (``aero``: quasi-steady or unsteady)."""
 
     duration_s: float = 5.0
     gust_start_s: float = 0.5
     dt_s: float = DEFAULT_DT_S
     mass_basis: str = DEFAULT_MASS_BASIS
     flutter_range_m_s: tuple[float, float] = (5.0, 40.0)
+    aero: str = DEFAULT_AERO
+
+
+def settings_identity(settings: RunSettings) -> dict[str, Any]:
+    """The settings as hashed into case ids: ``aero`` only when it is not the default, so
+    every quasi-steady case keeps the id it had before the option existed."""
+    d = dataclasses.asdict(settings)
+    if d["aero"] == DEFAULT_AERO:
+        del d["aero"]
+    return d
 
 
 @dataclass(frozen=True)
@@ -212,6 +233,7 @@ class Case:
             "gust_start_s": self.settings.gust_start_s,
             "dt_s": self.settings.dt_s,
             "mass_basis": self.settings.mass_basis,
+            **({} if self.settings.aero == DEFAULT_AERO else {"aero": self.settings.aero}),
         }
 
 
@@ -263,7 +285,7 @@ def case_id(case: Case) -> str:
         "speed_m_s": case.speed_m_s,
         "gust": case.gust,
         "model": case.model,
-        "settings": dataclasses.asdict(case.settings),
+        "settings": settings_identity(case.settings),
         "metrics": sorted(case.metrics),
     }
     text = json.dumps(payload, sort_keys=True, default=str)
@@ -272,7 +294,8 @@ def case_id(case: Case) -> str:
 
 def failed_row(case: Case, error: str) -> dict[str, Any]:
     """The row of a case that produced no result (every metric None)."""
-    row: dict[str, Any] = {name: None for name in result_columns(case.metrics)}
+    row: dict[str, Any] = {name: None for name in result_columns(case.metrics,
+                                                                  case.settings.aero)}
     row.update(case.inputs())
     row["status"] = "failed"
     row["error"] = " ".join(str(error).split())  # one line
@@ -300,7 +323,7 @@ class Campaign:
         """The cases one at a time, in campaign order: a million-case campaign starts its
         first case at once and never holds every case in memory (≈ 2 µs a case)."""
         dumps = json.dumps
-        settings_json = dumps(dataclasses.asdict(self.settings), sort_keys=True, default=str)
+        settings_json = dumps(settings_identity(self.settings), sort_keys=True, default=str)
         metrics_json = dumps(sorted(self.metrics))
         index = 0
         for wing in self.wings:
@@ -320,7 +343,7 @@ class Campaign:
         return len(self.wings) * len(self.speeds_m_s) * len(self.gusts) * len(self.models)
 
     def columns(self) -> dict[str, str]:
-        return result_columns(self.metrics)
+        return result_columns(self.metrics, self.settings.aero)
 
 
 # ---------------------------------------------------------------------------------------
@@ -483,6 +506,17 @@ def parse_campaign(
             raise CampaignError(
                 f"axes.models[{i}]: unknown model {m!r}; accepted: {', '.join(MODELS)}")
     models = _unique(models_raw, "axes.models")
+    if settings.aero != DEFAULT_AERO:
+        other = next((m for m in models if m != "coupled"), None)
+        if other is not None:
+            raise CampaignError(f"run.aero: {settings.aero!r} is for the coupled model, and "
+                                f"axes.models has {other!r} (the rigid and qsd wings are "
+                                "quasi-steady); accepted with it: models = [\"coupled\"]")
+        extra = next((m for m in metrics if m not in UNSTEADY_METRICS), None)
+        if extra is not None:
+            raise CampaignError(f"run.aero: {settings.aero!r} flies the gust runs; metric "
+                                f"{extra!r} is the quasi-steady LTI model's; accepted with it: "
+                                f"metrics from {', '.join(UNSTEADY_METRICS)}")
 
     n = len(wings) * len(speeds) * len(gusts) * len(models)
     if n > MAX_CASES:
@@ -513,7 +547,11 @@ def _settings(run: Any) -> RunSettings:
             or not 0.0 < fr[0] < fr[1]:
         raise CampaignError(f"run.flutter_range_m_s: must be [low, high] with 0 < low < high "
                             f"m/s, got {fr!r}")
-    return RunSettings(duration, start, dt, basis, (float(fr[0]), float(fr[1])))
+    aero = run.get("aero", d.aero)
+    if aero not in AERO_MODELS:
+        raise CampaignError(f"run.aero: unknown aerodynamics {aero!r}; accepted: "
+                            f"{', '.join(AERO_MODELS)}")
+    return RunSettings(duration, start, dt, basis, (float(fr[0]), float(fr[1])), aero)
 
 
 def _wings(axes: dict, base_dir: Path | None) -> list[WingVariant]:

@@ -98,7 +98,11 @@ class DaskExecutor:
 
     def _warm_up(self) -> None:
         """Import the simulation on every worker now (as the local forkserver does), which
-        also fails early, in one line, on workers that cannot import bioflex-jsb."""
+        also fails early, in one line, on workers that cannot import bioflex-jsb. The rest
+        of what a case needs and the compiled kernel load with a worker's first case, as
+        they would here: a Dask worker is a process of its own, nothing is shared by a fork
+        (and a scheduler lost during a long warm-up here would be reported as a worker that
+        cannot import)."""
         import importlib
 
         try:

@@ -4,11 +4,24 @@ This is the code both executors (local processes, Dask) ship to their workers. I
 the wing (cached per process), computes the LTI metrics and flies the gust run through
 JSBSim (``bioflex_jsb.drivers.gust``).
 
-Each case loads its own :class:`Airframe`. Reusing one airframe per worker would save the
-load (≈ 4 ms, against 0.3-1 s for a case) but JSBSim's trim starts from the state the
-previous run left, so the last digits of a case's result would depend on which cases its
-worker ran before: the local and the Dask executors, which share the cases out
-differently, would then not give identical tables.
+What a worker process keeps from case to case (the fixed cost of a case, measured in
+``docs/sweeps.md``): the imports and the compiled step kernel (:func:`warm_worker`, run once
+in the local forkserver before it forks the workers, so every worker has them for nothing;
+a Dask worker loads them with its first case), the wing's build (``build_wing``'s cache), its
+flutter search (:data:`_FLUTTER_CACHE`) and the eigenvalues of a wing, model and speed
+(:data:`_EIGEN_CACHE`: a campaign's gusts and seeds share them). Each is a pure function of
+its key, so a row does not depend on which cases its worker ran before.
+
+Each case still loads its own :class:`Airframe`. Reusing one per worker would save the load
+(≈ 11 ms of a ≈ 200 ms case, measured) but JSBSim's trim starts from the state the previous
+run left (the propellers' RPM), so the last digits of a case's result would depend on which
+cases its worker ran before (up to 4.5e-9 in the example campaign's histories, measured):
+the local and the Dask executors, which share the cases out differently, would then not
+give identical tables.
+
+``run.aero = "unsteady"`` flies the gust runs with the unsteady strips
+(:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``aero``, on its compiled step;
+the campaign refuses it with other models or the LTI metrics).
 
 A case never raises for a problem of its own: a failing build or run is a row with status
 ``failed`` and the error; a run that leaves the model's valid range is a row with status
@@ -36,6 +49,25 @@ from bioflex_jsb.sweep.campaign import (
 )
 
 _FLUTTER_CACHE: dict[tuple, Any] = {}
+_EIGEN_CACHE: dict[tuple, Any] = {}
+# What a case imports beyond the executors' preload (measured: a first case imported these
+# and numba, 1-2 s under load): imported, and the step kernel loaded, once per worker.
+WARM_MODULES = ("bioflex_jsb.flight_dynamics.eigen", "bioflex_jsb.flight_dynamics.flutter_engine",
+                "bioflex_jsb.flight_dynamics.wing_model", "bioflex_jsb.structures.wing_model",
+                "bioflex_jsb.simulation.results", "bioflex_jsb.drivers.gust")
+
+
+def warm_worker() -> None:
+    """Import what a case needs and load the compiled step kernel (numba's cache, or a
+    compile on a fresh machine) before the first case: the local executor's forkserver runs
+    it once, before it forks its workers (:mod:`bioflex_jsb.sweep.worker_warm`)."""
+    import importlib
+
+    for name in WARM_MODULES:
+        importlib.import_module(name)
+    from bioflex_jsb.simulation import step_kernel
+
+    step_kernel.compile_now()
 
 
 def airframe():
@@ -91,10 +123,16 @@ def run_case(case: Case, log_dir: str | None = None) -> dict[str, Any]:
     return row
 
 
+def _wing_key(case: Case) -> tuple:
+    """What identifies a case's wing build (the per-process caches' key)."""
+    return (repr(sorted(case.wing.as_dict().items())), case.settings.mass_basis)
+
+
 def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
     from bioflex_jsb.flight_dynamics.wing_model import build_wing
 
-    row: dict[str, Any] = {name: None for name in result_columns(case.metrics)}
+    row: dict[str, Any] = {name: None for name in result_columns(case.metrics,
+                                                                  case.settings.aero)}
     row.update(case.inputs())
     row["status"] = "ok"
     s = case.settings
@@ -108,9 +146,7 @@ def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
             if key in row:
                 row[key] = float(w) / (2.0 * math.pi)
     if "eigenvalues" in case.metrics:
-        from bioflex_jsb.flight_dynamics.eigen import modes_at
-
-        mode_set = modes_at(case.model, [case.speed_m_s], build.model)[0]
+        mode_set = _modes(case, build)
         for name in EIGEN_MODES:
             try:
                 m = mode_set.get(name)
@@ -131,12 +167,22 @@ def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
     return row
 
 
+def _modes(case: Case, build):
+    """The case's LTI modes at its speed (cached per process, wing, model and speed: the
+    gusts and seeds of a campaign share them)."""
+    from bioflex_jsb.flight_dynamics.eigen import modes_at
+
+    key = (*_wing_key(case), case.model, case.speed_m_s)
+    if key not in _EIGEN_CACHE:
+        _EIGEN_CACHE[key] = modes_at(case.model, [case.speed_m_s], build.model)[0]
+    return _EIGEN_CACHE[key]
+
+
 def _flutter(case: Case, build):
     """Flutter of the case's wing (the coupled model; cached per process and wing)."""
     from bioflex_jsb.flight_dynamics.eigen import find_flutter
 
-    key = (repr(sorted(case.wing.as_dict().items())), case.settings.mass_basis,
-           case.settings.flutter_range_m_s)
+    key = (*_wing_key(case), case.settings.flutter_range_m_s)
     if key not in _FLUTTER_CACHE:
         _FLUTTER_CACHE[key] = find_flutter(build.model, case.settings.flutter_range_m_s)
     return _FLUTTER_CACHE[key]
@@ -152,7 +198,8 @@ def case_description(case: Case):
     return RunDescription(kind="sweep", wing=case.wing.name, speed_m_s=case.speed_m_s,
                           gust=parse_gust(case.gust).text(), models=(case.model,),
                           duration_s=s.duration_s, gust_start_s=s.gust_start_s,
-                          dt_s=s.dt_s, mass_basis=s.mass_basis, extra={"case_id": case.case_id})
+                          dt_s=s.dt_s, mass_basis=s.mass_basis,
+                          extra={"case_id": case.case_id, "aero": s.aero})
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
@@ -175,7 +222,9 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         recorder = log.recorder(case.model)
 
     try:
-        run = run_gust(airframe(), build.model, case.model, setup, recorder=recorder)
+        # the unsteady strips need the wing's build (its strips); the quasi-steady its model
+        wing = build if s.aero == "unsteady" else build.model
+        run = run_gust(airframe(), wing, case.model, setup, recorder=recorder, aero=s.aero)
     finally:
         if log is not None:
             log.close()

@@ -37,7 +37,10 @@ from typing import Any
 from bioflex_jsb.sweep.campaign import Case, RecordingError, failed_row
 from bioflex_jsb.sweep.evaluate import run_case
 
-PRELOAD = ["bioflex_jsb.sweep.evaluate", "bioflex_jsb.drivers.gust"]
+# imported by the forkserver before it forks a worker: the simulation, and (worker_warm)
+# the rest of what a case imports with the compiled step kernel loaded
+PRELOAD = ["bioflex_jsb.sweep.evaluate", "bioflex_jsb.drivers.gust",
+           "bioflex_jsb.sweep.worker_warm"]
 # One BLAS/OpenMP thread per worker process, as Dask's nanny sets for its workers
 # (distributed.nanny.pre-spawn-environ): no oversubscription of the cores, and the same
 # LAPACK code path, so eigenvalues agree to the last bit between the two executors.

@@ -401,7 +401,7 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
         if columns is None:
             from bioflex_jsb.sweep.campaign import METRIC_COLUMNS, result_columns
 
-            columns = result_columns(list(METRIC_COLUMNS))
+            columns = result_columns(list(METRIC_COLUMNS), "unsteady")  # aero: text
         rows = [{k: _parse(v, columns.get(k, "float")) for k, v in r.items()} for r in raw]
     else:
         import pyarrow.parquet as pq
