@@ -445,3 +445,20 @@ def test_a_worker_reuses_the_wing_its_eigenvalues_and_the_kernel(monkeypatch):
     assert calls["build"] == 1 + len(cases) and calls["modes"] == 2 + len(cases)
     assert comparable(reused) == comparable(fresh)
     assert {r["status"] for r in reused} == {"ok"}
+
+
+def kernel_loaded(case, log_dir):
+    """A worker's view before it runs ``case``: is the step kernel already compiled/loaded?"""
+    from bioflex_jsb.simulation import step_kernel
+
+    return {"case_id": case.case_id, "pid": os.getpid(),
+            "signatures": len(step_kernel.step_kernel.signatures)}
+
+
+def test_local_workers_start_with_the_kernel_loaded():
+    """The forkserver warms the workers (sweep.worker_warm): the first case a worker is
+    handed finds the compiled kernel loaded (numba's dispatcher has its signature)."""
+    cases = parse_campaign(tomllib.loads(REUSE)).cases()[:2]
+    with LocalExecutor(2, fn=kernel_loaded) as ex:
+        rows = [row for _, row in ex.run(cases)]
+    assert len(rows) == 2 and all(r["signatures"] >= 1 for r in rows), rows
