@@ -31,6 +31,7 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 HELP = f"""Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic
@@ -87,6 +88,7 @@ def register(sub) -> None:
                    "with --aero unsteady: rigid,coupled)")
     add_aero_arguments(p)
     add_log_arguments(p)
+    add_live_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="time histories to FILE.png (.png, .pdf, .svg; default gust.png when "
                    "run without --json; an existing file is replaced only if bioflex-jsb "
@@ -279,9 +281,11 @@ def run(args: argparse.Namespace) -> int:
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     check_plot_path(plot, args.force)
     log = None
+    start_live(args, "gust")  # before log_path creates the file: a refusal leaves none
     args.out = log_path(args, "gust", args.wing)
     if args.out:
-        log = open_log(args.out, run_description(args, "gust", args.models), build)
+        log = live_opener(args, open_log)(args.out, run_description(args, "gust", args.models),
+                                          build)
     try:
         runs, stops = fly(args, build, args.models, log)
     except Interrupted as stop:
@@ -294,6 +298,7 @@ def run(args: argparse.Namespace) -> int:
         if log is not None:
             with closing():  # a stop signal now waits until the log is finished
                 log.close()
+        stop_live(args)
     summary = {}
     for r in runs:
         summary[r.model] = gust_metrics(r, args.gust_start).as_json()

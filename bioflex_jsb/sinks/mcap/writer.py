@@ -122,6 +122,10 @@ class McapFileWriter:
         self._index: dict[int, list[tuple[int, int]]] = {}
         self._blocks: dict[int, list[np.ndarray]] = {}
         self.finished = False
+        # the tee (bioflex_jsb.sinks.live): called on the run's thread with each closed
+        # chunk's uncompressed message records (bytes: Message records back to back, as in
+        # the file) and the channel and schema records so far (lists, id = index + 1)
+        self.on_chunk = None
         self._pending = None  # the Future of the chunk being written in the background
         # background=True: one writer thread compresses and writes a closed chunk (zstd and
         # the file write release the GIL) while the run flies the next, at most one pending;
@@ -260,6 +264,8 @@ class McapFileWriter:
         self._size = 0
         if not indexes:
             return
+        if self.on_chunk is not None:
+            self.on_chunk(data, self._channels, self._schemas)
         start = int(min(e[:, 0].min() for e in indexes.values()))
         end = int(max(e[:, 0].max() for e in indexes.values()))
         for cid, entries in indexes.items():
