@@ -49,6 +49,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     build_wing,
     resolve_variant,
 )
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
@@ -89,8 +90,36 @@ def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
 
 
 def _wing(wing):
-    """The :class:`WingBuild` of an :class:`Aircraft` (the wing itself otherwise)."""
+    """The :class:`WingBuild` of an :class:`Aircraft` (the wing itself otherwise): its
+    model carries the aircraft's :class:`~bioflex_jsb.parameters.airframe.AirframeData`,
+    which every linear analysis below takes."""
     return wing.wing() if isinstance(wing, Aircraft) else wing
+
+
+def _flying_wing(wing):
+    """:func:`_wing` for the nonlinear JSBSim runs, which fly the prototype's airframe only
+    (docs/aircraft.md, "What runs with another airframe"): another one is refused in one
+    line (:meth:`Aircraft.flight_problem`), never flown with the prototype's numbers."""
+    if isinstance(wing, Aircraft):
+        problem = wing.flight_problem()
+        if problem:
+            raise InputError(problem)
+    build = _wing(wing)
+    if build is not None and build.model.airframe is not PROTOTYPE_AIRFRAME:
+        raise InputError(f"wing {build.variant.name!r} is built for airframe "
+                         f"{build.model.airframe.name!r}: the nonlinear runs fly the "
+                         "prototype's airframe only in this version (docs/aircraft.md)")
+    return build
+
+
+def _density(wing, density_kg_m3: float | None) -> dict:
+    """The air density of an analysis: given, else an :class:`Aircraft` definition's
+    [air], else none (the analyses' sea-level default)."""
+    if density_kg_m3 is not None:
+        return {"density_kg_m3": _check_density(density_kg_m3)}
+    if isinstance(wing, Aircraft):
+        return {"density_kg_m3": float(wing.definition.air.density_kg_m3)}
+    return {}
 
 
 def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
@@ -112,8 +141,9 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
-    reason, the time and the mode) and holds every step up to then."""
-    wing = _wing(wing)
+    reason, the time and the mode) and holds every step up to then. The prototype's airframe
+    only (another is refused in one line: docs/aircraft.md)."""
+    wing = _flying_wing(wing)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if models is None:
@@ -159,7 +189,7 @@ def compare(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:0.3",
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
-    wing = _wing(wing)
+    wing = _flying_wing(wing)
     runs = fly_gust(wing, speed_m_s, gust, (model,), duration_s, gust_start_s,
                     recorders={model: recorder} if recorder is not None else None,
                     aero=aero, trim=trim)
@@ -185,7 +215,12 @@ def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "
     ``trim="elastic"`` (``coupled``, ``qsd``): linearised about the elastic trim
     (:func:`bioflex_jsb.flight_dynamics.elastic_trim.linearise_about_elastic_trim`: the
     modes' force per unit airspeed from the deflected wing); ``notes["eta_static_rad"]``
-    holds the static deflection η₀ the states are measured from."""
+    holds the static deflection η₀ the states are measured from.
+
+    ``wing`` an :class:`Aircraft` (or its wing): the model is its own (S, c̄, mass, I_yy, the
+    derivatives of its file, its planform; the air of its [air]); ``None`` the prototype's
+    rigid aircraft."""
+    air = _density(wing, None)
     wing = _wing(wing)
     if trim not in ("rigid", "elastic"):
         raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
@@ -198,7 +233,8 @@ def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "
             linearise_about_elastic_trim,
         )
 
-        return linearise_about_elastic_trim(model, elastic_trim(wing, speed_m_s), wing.model)
+        return linearise_about_elastic_trim(model, elastic_trim(wing, speed_m_s, **air),
+                                            wing.model)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if model not in MODELS:
@@ -206,8 +242,9 @@ def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "
     if aero == "unsteady":
         if model != "coupled" or wing is None:
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
-        return unsteady_state_space(wing, speed_m_s, gust=True)
-    return build_state_space(model, level_flight_condition(speed_m_s),
+        return unsteady_state_space(wing, speed_m_s, gust=True, **air)
+    airframe = PROTOTYPE_AIRFRAME if wing is None else wing.model.airframe
+    return build_state_space(model, level_flight_condition(speed_m_s, airframe=airframe, **air),
                              None if wing is None else wing.model)
 
 
@@ -254,17 +291,21 @@ def modes(wing, speed_m_s: float = 15.0, model: str = "coupled", *,
     paper (short period, phugoid, aeroelastic_i), ``aero="unsteady"`` the coupled model on
     unsteady strips (lag roots left out). Clamped (``clamped=True``, ``wing`` a definition
     or its name/file): the wing's branches tracked from the bottom of its derived range by
-    ``method`` (``pk`` or ``state-space``) on ``aero`` strips (lag roots left out)."""
+    ``method`` (``pk`` or ``state-space``) on ``aero`` strips (lag roots left out).
+    An :class:`Aircraft` is analysed with its own airframe, planform and air."""
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if clamped:
         return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
+    air = _density(wing, None)
     wing = _wing(wing)
     if aero == "unsteady":
         if model != "coupled":
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
-        return unsteady_mode_sets(wing, [speed_m_s], structural_damping)[0]
+        return unsteady_mode_sets(wing, [speed_m_s], structural_damping, **air)[0]
     w = wing.model if structural_damping is None else with_damping(wing, structural_damping)
-    return modes_at(model, [speed_m_s], None if model == "rigid" else w)[0]
+    if model == "rigid":
+        return modes_at(model, [speed_m_s], None, airframe=w.airframe, **air)[0]
+    return modes_at(model, [speed_m_s], w, **air)[0]
 
 
 def _clamped_modes(definition, speed_m_s, aero, method, structural_damping) -> ModeSet:
@@ -317,6 +358,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if clamped:
         return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
                                 density_kg_m3, lift_slope)
+    air = _density(wing, density_kg_m3)
     wing = _wing(wing)
     aero = aero or "quasi-steady"
     _check_choice("aerodynamics", aero, AERO_MODELS)
@@ -327,7 +369,6 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
         raise InputError("lift_slope is for clamped wings; the free aircraft takes the "
                          "vortex lattice's span loading (Table B1)")
     rng = (5.0, 40.0) if range_m_s is None else range_m_s
-    air = {} if density_kg_m3 is None else {"density_kg_m3": float(density_kg_m3)}
     if aero == "unsteady":
         return free_flutter(wing, aero="unsteady", structural_damping=structural_damping,
                             range_m_s=rng, **air)

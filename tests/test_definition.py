@@ -189,14 +189,29 @@ def test_bad_airframe_is_one_line_naming_the_field(tmp_path, edit, field, reason
 
 def test_unusual_but_valid_airframe_is_read_and_not_flown(tmp_path):
     # 2500 kg on the 1.7 m prototype is a valid definition (no unit is wrong), read and kept;
-    # flying it is refused in one line naming the field, never flown with 2.5 kg instead.
+    # flying it is refused in one line naming the field, never flown with 2.5 kg instead;
+    # the linear analyses take it with its own 2500 kg (H15: the AirframeData passed down)
+    from bioflex_jsb.errors import InputError
+
     path = _write(tmp_path, PROTO_TEXT.replace("mass_kg = 2.5 ", "mass_kg = 2500.0 ", 1))
     aircraft = load_aircraft(path)
     assert aircraft.airframe.mass_kg == 2500.0
     problem = aircraft.flight_problem()
     assert problem and "airframe.mass_kg = 2500 differs from the prototype's 2.5" in problem
-    with pytest.raises(DefinitionError, match="airframe.mass_kg"):
-        aircraft.wing()
+    with pytest.raises(InputError, match="airframe.mass_kg"):
+        api.fly_gust(aircraft, duration_s=0.1)
+    build = aircraft.wing()
+    assert build.model.airframe.mass.mass_kg == 2500.0
+    with pytest.raises(InputError, match="prototype's airframe only"):
+        api.fly_gust(build, duration_s=0.1)
+    # its rigid alpha row is the 2500 kg one: Z_alpha/u0 = -(C_L_alpha + C_D) Q S / (m u0),
+    # C_D = C_D0 + k C_L^2 at C_L = m g / (Q S) (flight_dynamics/rigid.py, Table B2)
+    a = api.linear_model(aircraft, 15.0, "rigid").a
+    d = aircraft.rigid_aerodynamics()
+    q_s = 0.5 * 1.225 * 15.0**2 * 0.3111
+    cl = 2500.0 * 9.80665 / q_s
+    z_alpha = -(d.cl_alpha_per_rad + d.cd0 + d.k_induced * cl**2) * q_s / 2500.0
+    assert a[1, 1] == pytest.approx(z_alpha / 15.0, rel=1e-12)
 
 
 def test_jsbsim_package_aircraft_by_name_is_found(tmp_path):

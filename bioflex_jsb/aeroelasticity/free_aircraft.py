@@ -49,9 +49,7 @@ from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, REFERENCE_GEOMETRY, RIGID_AERODYNAMICS
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
-from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
 AERO_MODELS = engine.AERO_MODELS
 EXCLUDED = eigen.EXCLUDED_FROM_FLUTTER
@@ -74,9 +72,11 @@ class StripGeometry:
     theta: np.ndarray  # (n, K) twist per unit η (LE up) [rad]
 
 
-def strip_geometry(build, planform=DEFAULT_PLANFORM) -> StripGeometry:
+def strip_geometry(build, planform=None) -> StripGeometry:
     """The η → (h, α) per-strip projection of a :class:`WingBuild` (its modes sampled at the
-    lattice's strips) and the strips' arms."""
+    lattice's strips) and the strips' arms; ``planform`` (default the build's) replaces the
+    wing's planform and CG (aeroelasticity/parameter_set.py)."""
+    planform = build.planform if planform is None else planform
     modes = build.modes
     strips = spanwise_geometry(build.aero, planform, modes.x_elastic_frac, modes.stations_m)
     pinned = shifted(strips, build.e_shift_frac * planform.chord_m)
@@ -155,7 +155,7 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
     strips' increments (:func:`~bioflex_jsb.aeroelasticity.strip_increments.strip_increments`)
     through the rigid and modal equations."""
     model = with_damping(build, structural_damping)
-    cond = level_flight_condition(float(speed_m_s), density_kg_m3)
+    cond = level_flight_condition(float(speed_m_s), density_kg_m3, airframe=model.airframe)
     base = build_state_space("coupled", cond, model, a_rr=a_rr)
     g = strip_geometry(build) if geometry is None else geometry
     n = model.n_modes
@@ -164,10 +164,11 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
     v = float(speed_m_s)
     ia, iq = 1, 2
     ied = slice(4 + n, 4 + 2 * n)
-    mass, iyy = MASS_PROPERTIES.mass_kg, MASS_PROPERTIES.iyy_kg_m2
-    rd = rigid_derivatives(cond, RIGID_AERODYNAMICS)
+    af = cond.airframe
+    mass, iyy = af.mass.mass_kg, af.mass.iyy_kg_m2
+    rd = rigid_derivatives(cond)
     mi = np.asarray(model.generalised_masses_kg_m2, dtype=float)
-    k_ind = RIGID_AERODYNAMICS.k_induced
+    k_ind = af.aero.k_induced
 
     def rates(z, m, q) -> np.ndarray:
         """Rows of ẋ from loads: u̇, α̇, q̇ and η̈ (θ̇, η̇ kinematic rows untouched)."""
@@ -195,7 +196,7 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
 
 
 def _quasi_steady_a(build, v, zeta, rho):
-    cond = level_flight_condition(float(v), rho)
+    cond = level_flight_condition(float(v), rho, airframe=build.model.airframe)
     return build_state_space("coupled", cond, with_damping(build, zeta)).a
 
 
@@ -214,7 +215,8 @@ def wing_divergence_speed_m_s(build, *, density_kg_m3: float = SEA_LEVEL_DENSITY
 
 def free_family(build, *, aero: str = "unsteady", structural_damping: float | None = None,
                 density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-                start_m_s: float = eigen.SCAN_START_M_S) -> engine.EigenFamily:
+                start_m_s: float = eigen.SCAN_START_M_S,
+                divergence_range_m_s: tuple[float, float] = (2.0, 60.0)) -> engine.EigenFamily:
     """The free aircraft (Eq. 4, ``aero`` strips) as the engine's family. Labels: the
     quasi-steady Eq. (4)'s at ``start_m_s`` (:func:`eigen.track`), given to the nearest
     roots of this system there; the strips' lag roots are ``lag``."""
@@ -227,9 +229,10 @@ def free_family(build, *, aero: str = "unsteady", structural_damping: float | No
         ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=EXCLUDED,
         rigid_labels=eigen.RIGID_LABELS,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
-        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, method="state-space",
-        aero=aero, name=build.variant.name)
-    fam.divergence_speed_m_s = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3)
+        reference_semichord_m=model.airframe.reference.mean_chord_m / 2.0,
+        method="state-space", aero=aero, name=build.variant.name)
+    fam.divergence_speed_m_s = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3,
+                                                         range_m_s=divergence_range_m_s)
     return fam
 
 
@@ -298,8 +301,10 @@ def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | N
     engine's scan from 2 m/s in ``step_m_s``, bisection to :data:`FREE_TOL_M_S`;
     mechanism by the engine's rule (body-freedom when the short period goes unstable)."""
     lo, hi = range_m_s
+    top = max(eigen.DIVERGENCE_SEARCH_TOP_M_S, eigen.DIVERGENCE_TOP_OVER_RANGE * hi)
     fam = free_family(build, aero=aero, structural_damping=structural_damping,
-                      density_kg_m3=density_kg_m3, start_m_s=min(eigen.SCAN_START_M_S, lo))
+                      density_kg_m3=density_kg_m3, start_m_s=min(eigen.SCAN_START_M_S, lo),
+                      divergence_range_m_s=(2.0, top))
     return engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, eigen.SCAN_START_M_S), (lo, hi),
         tol_m_s=FREE_TOL_M_S, structural_damping=structural_damping,

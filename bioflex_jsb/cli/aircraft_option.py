@@ -17,6 +17,10 @@ import argparse
 import sys
 
 AIRCRAFT_PREFIX = "aircraft:"
+# The commands whose analyses are linear and take the aircraft's own airframe
+# (definition/aircraft.py: Aircraft.linear_problem); the others fly JSBSim's prototype
+# airframe and refuse another one (Aircraft.flight_problem).
+LINEAR_COMMANDS = ("modes", "flutter")
 
 
 class _ShippedOrFile(tuple):
@@ -47,7 +51,9 @@ class _AircraftAction(argparse._StoreAction):
                          "aircraft's definition holds its wing)")
         try:
             aircraft = load_aircraft(values)
-            problem = aircraft.flight_problem()
+            # the linear analyses take any airframe; the flight commands the prototype's
+            linear = parser.prog.rsplit(" ", 1)[-1] in LINEAR_COMMANDS
+            problem = aircraft.linear_problem() if linear else aircraft.flight_problem()
             variant = aircraft.variant()
         except InputError as exc:  # the definition's one line, naming the field
             parser.error(f"--aircraft: {exc}")

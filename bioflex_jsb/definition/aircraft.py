@@ -7,13 +7,22 @@ wing planform, structure, settings) and builds what the analyses take: the elast
 modes, strips, Table B1/B2 model), its :class:`~bioflex_jsb.flight_dynamics.wing_model.
 WingVariant` and :class:`~bioflex_jsb.parameters.wing.Planform`.
 
-What flies in this version (:meth:`Aircraft.flight_problem`): the analyses below the loader
-still take the prototype's airframe and planform from the parameter modules (the move is
-under way: tests/test_prototype_imports.py lists the modules left), so an aircraft flies
-when its airframe and planform are the prototype's (each field equal to 1e-9 relative: the
-rounding of a printed value); its wing (axes, ribs, damping, a modal file, the C_η1^Q1 pin)
-is free. Any other airframe is read and checked, and refused for flight in one line naming
-the first field that differs, never flown with the prototype's numbers in its place.
+What runs with another airframe (docs/aircraft.md): the LINEAR analyses (``modes``,
+``flutter`` of the free aircraft on quasi-steady and unsteady strips, ``linear_model``, the
+elastic trim) take the aircraft's values, passed down as one
+:class:`~bioflex_jsb.parameters.airframe.AirframeData` (:meth:`Aircraft.airframe_data`:
+S, b, c̄, mass, inertia, the 22 rigid derivatives) carried by the wing's model and by every
+flight condition built for it, and the wing's planform (:meth:`Aircraft.planform`) carried
+by the :class:`WingBuild`; :meth:`Aircraft.linear_problem` says what they cannot take (a
+beam structure, derivatives from JSBSim, the prototype's membrane on another airframe).
+
+What flies (:meth:`Aircraft.flight_problem`): the nonlinear co-simulation (the JSBSim runs
+of ``gust``, ``compare``, ``sitl``, ``trim``) still takes the prototype's airframe and
+planform from the parameter modules (tests/test_prototype_imports.py lists the modules
+left), so an aircraft flies when its airframe and planform are the prototype's (each field
+equal to 1e-9 relative: the rounding of a printed value); its wing (axes, ribs, damping, a
+modal file, the C_η1^Q1 pin) is free. Any other airframe is refused for flight in one line
+naming the first field that differs, never flown with the prototype's numbers in its place.
 """
 
 from __future__ import annotations
@@ -36,8 +45,10 @@ from bioflex_jsb.flight_dynamics.wing_model import (
 from bioflex_jsb.parameters.airframe import (
     AIRFRAME_GEOMETRY,
     MASS_PROPERTIES,
+    PROTOTYPE_AIRFRAME,
     REFERENCE_GEOMETRY,
     RIGID_AERODYNAMICS,
+    AirframeData,
     MassProperties,
     ReferenceGeometry,
     RigidAerodynamics,
@@ -92,6 +103,20 @@ class Aircraft:
         d = self.airframe.derivatives
         return None if d is None else RigidAerodynamics(**d)
 
+    def airframe_data(self) -> AirframeData:
+        """The airframe as the linear analyses take it (module docstring): the prototype's
+        own :data:`~bioflex_jsb.parameters.airframe.PROTOTYPE_AIRFRAME` object when this
+        airframe is the prototype's (:meth:`flight_problem` is ``None``: its numbers are
+        then the same to the last bit), else built from the file (no propulsion model:
+        the LTI's throttle column is zero; the JSBSim aircraft's engine is JSBSim's)."""
+        if self.flight_problem() is None:
+            return PROTOTYPE_AIRFRAME
+        problem = self.linear_problem()
+        if problem:
+            raise DefinitionError(problem)
+        return AirframeData(self.name, self.reference_geometry(), self.mass_properties(),
+                            self.rigid_aerodynamics(), None)
+
     # -- the wing ---------------------------------------------------------------------
     def planform(self) -> Planform:
         """The wing's planform (constant chord, a straight inner and a swept outer panel:
@@ -142,13 +167,35 @@ class Aircraft:
                            published_c_eta1_q1=f.published_c_eta1_q1,
                            description=d.description)
 
+    def linear_problem(self) -> str | None:
+        """Why the linear analyses (``modes``, ``flutter``, ``linear_model``: module
+        docstring) cannot take this aircraft, or ``None``."""
+        a, d = self.airframe, self.definition
+        head = f"aircraft {d.name!r}: "
+        if not isinstance(d.structure, MembraneStructure | ModalStructure):
+            return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
+                    "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
+                    "on the aircraft the wing's modes come from 'prototype-membrane' or a "
+                    "'modal' file (docs/aircraft.md: write the beam's modes to one)")
+        if a.derivatives is None:
+            return (f"{head}airframe.derivatives = 'jsbsim': the linear analyses take the "
+                    "rigid derivatives from the file (a table of the 22: docs/aircraft.md)")
+        if isinstance(d.structure, MembraneStructure) and a.jsbsim != GENERATED:
+            return (f"{head}structure.kind = 'prototype-membrane' is the prototype's wing "
+                    "(its calibrated half-wing beam); on another airframe give the wing's "
+                    "modes in a 'modal' file")
+        if isinstance(d.structure, MembraneStructure) and d.structure.n_modes != FLYING_N_MODES:
+            return f"{head}structure.n_modes must be {FLYING_N_MODES}"
+        return None
+
     def flight_problem(self) -> str | None:
         """Why this aircraft cannot fly in this version (module docstring), or ``None``."""
         a, d = self.airframe, self.definition
         head = f"aircraft {d.name!r}: "
-        tail = (" (the analyses below the loader still read the prototype's airframe from "
+        tail = (" (the nonlinear co-simulation still reads the prototype's airframe from "
                 "parameters/; only the prototype's airframe flies in this version, with any "
-                "wing: docs/aircraft.md)")
+                "wing; the linear analyses modes, flutter and linear_model take this one: "
+                "docs/aircraft.md)")
         if not isinstance(d.structure, MembraneStructure | ModalStructure):
             return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
                     "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
@@ -193,14 +240,19 @@ class Aircraft:
         return None
 
     def wing(self, mass_basis: str = DEFAULT_MASS_BASIS) -> WingBuild:
-        """The elastic wing built for flight (modes, strips, the Table B1/B2 model); a
-        :class:`DefinitionError` with :meth:`flight_problem`'s line if it cannot fly."""
-        problem = self.flight_problem()
-        if problem:
-            raise DefinitionError(problem)
-        # the prototype's planform object itself: the analyses below read DEFAULT_PLANFORM,
-        # and flight_problem has checked this one equals it
-        return build_wing(self.variant(), FLYING_N_MODES, mass_basis, DEFAULT_PLANFORM)
+        """The elastic wing on this airframe (modes, strips, the Table B1/B2 model, the
+        :class:`AirframeData` its model carries); a :class:`DefinitionError` with
+        :meth:`linear_problem`'s line if the linear analyses cannot take it. Flying it
+        is a separate check (:meth:`flight_problem`: the CLI's flight commands and
+        ``api.fly_gust``/``compare`` make it)."""
+        if self.flight_problem() is None:
+            # the prototype's own planform and airframe objects: flight_problem has checked
+            # these equal them, and the nonlinear runs read those objects
+            return build_wing(self.variant(), FLYING_N_MODES, mass_basis, DEFAULT_PLANFORM,
+                              PROTOTYPE_AIRFRAME)
+        airframe = self.airframe_data()
+        return build_wing(self.variant(), FLYING_N_MODES, mass_basis, self.planform(),
+                          airframe)
 
     def summary(self) -> dict[str, object]:
         """The definition's airframe and wing as plain data (for logs and --json)."""

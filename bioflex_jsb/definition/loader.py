@@ -36,7 +36,11 @@ from bioflex_jsb.tomlfile import read_toml
 # Definitions in bioflex_jsb/data/aircraft/<name>.toml: the clamped (benchmark) wings, and
 # the aircraft (definition.flying.SHIPPED_AIRCRAFT: the prototype's six variants).
 SHIPPED = ("goland",)
-ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT
+# The second aircraft (JSBSim's SGS glider with an estimated elastic wing: docs/aircraft.md)
+# and its wing clamped: loaded by name too (load_aircraft("sgs_elastic"),
+# load_definition("sgs_wing")); not benchmark wings.
+OTHER_SHIPPED = ("sgs_wing", "sgs_elastic")
+ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT + OTHER_SHIPPED
 FORMAT_VERSION = 1
 
 # Valid ranges [unit], each with its reason.

@@ -25,8 +25,8 @@ from bioflex_jsb.flight_dynamics.flutter_engine import FlutterResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
 from bioflex_jsb.parameters.airframe import (
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
+    PROTOTYPE_AIRFRAME,
+    AirframeData,
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
@@ -115,8 +115,20 @@ class ModeSet:
         }
 
 
+def airframe_of(wing: ElasticWingModel | None, airframe: AirframeData | None) -> AirframeData:
+    """The aircraft of an analysis: the wing's (it was built for it), else ``airframe``,
+    else the prototype's (a rigid analysis called without one); a different ``airframe``
+    beside a wing is a caller's bug (ValueError)."""
+    if wing is None:
+        return PROTOTYPE_AIRFRAME if airframe is None else airframe
+    if airframe is not None and airframe.reference != wing.airframe.reference:
+        raise ValueError(f"wing {wing.name!r} was built for airframe {wing.airframe.name!r}, "
+                         f"not {airframe.name!r}")
+    return wing.airframe
+
+
 def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition,
-               aero: RigidAerodynamics = RIGID_AERODYNAMICS):
+               aero: RigidAerodynamics | None = None):
     """Uncoupled reference eigenvalues with labels, for the first speed of a sweep."""
     ss_rigid = build_state_space("rigid", cond, aero=aero)
     lam = np.linalg.eigvals(ss_rigid.a)
@@ -153,22 +165,26 @@ def _collapse(speed: float, model: str, labels: Sequence[str], lam: np.ndarray) 
 
 
 def paper_family(model: str, wing: ElasticWingModel | None, density_kg_m3: float,
-                 aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-                 start_m_s: float = 2.0) -> engine.EigenFamily:
+                 aero: RigidAerodynamics | None = None,
+                 start_m_s: float = 2.0, airframe: AirframeData | None = None
+                 ) -> engine.EigenFamily:
     """The paper model ``model`` (rigid, coupled, qsd) as the engine's family: its state
-    matrix A(V) and the reference labels of the uncoupled blocks at ``start_m_s``."""
-    def matrix(v: float) -> np.ndarray:
-        return build_state_space(model, level_flight_condition(v, density_kg_m3, aero), wing,
-                                 aero).a
+    matrix A(V) and the reference labels of the uncoupled blocks at ``start_m_s``; the
+    aircraft is the wing's (:func:`airframe_of`), ``aero`` replaces its derivatives."""
+    af = airframe_of(wing, airframe)
 
-    ref = _reference(model, wing, level_flight_condition(float(start_m_s), density_kg_m3, aero),
-                     aero)
+    def matrix(v: float) -> np.ndarray:
+        return build_state_space(model, level_flight_condition(v, density_kg_m3, aero,
+                                                               airframe=af), wing, aero).a
+
+    ref = _reference(model, wing, level_flight_condition(float(start_m_s), density_kg_m3, aero,
+                                                         airframe=af), aero)
     natural = () if wing is None else tuple(float(w) for w in wing.frequencies_rad_s)
     return engine.EigenFamily(
         matrix, np.array([r[1] for r in ref]), [r[0] for r in ref], rest_label="lag",
         excluded=EXCLUDED_FROM_FLUTTER, rigid_labels=RIGID_LABELS,
         natural_frequencies_rad_s=natural,
-        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, method="state-space",
+        reference_semichord_m=af.reference.mean_chord_m / 2.0, method="state-space",
         aero="quasi-steady", name="" if wing is None else wing.name)
 
 
@@ -187,7 +203,8 @@ class Sweep:
     eigenvectors: tuple[np.ndarray, ...]
     wing: ElasticWingModel | None
     density_kg_m3: float
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS
+    aero: RigidAerodynamics | None = None
+    airframe: AirframeData | None = None
 
     def at(self, k: int) -> ModeSet:
         return _collapse(float(self.speeds_m_s[k]), self.model, self.labels, self.eigenvalues[k])
@@ -198,7 +215,7 @@ class Sweep:
     def continued(self, k: int, speed_m_s: float) -> np.ndarray:
         """Roots at ``speed_m_s``, ordered like the labels, continued from grid point ``k``."""
         fam = paper_family(self.model, self.wing, self.density_kg_m3, self.aero,
-                           float(self.speeds_m_s[0]))
+                           float(self.speeds_m_s[0]), self.airframe)
         prev = engine.Point(float(self.speeds_m_s[k]), self.eigenvalues[k],
                             self.eigenvectors[k])
         return fam.follow(float(speed_m_s), prev, prev.roots).roots
@@ -209,7 +226,8 @@ def track(
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
+    airframe: AirframeData | None = None,
 ) -> Sweep:
     """Eigenvalues of ``model`` at increasing ``speeds_m_s`` with labels tracked (the
     engine's :func:`~bioflex_jsb.flight_dynamics.flutter_engine.scan`), rigid set ``aero``.
@@ -220,10 +238,10 @@ def track(
     speeds = np.asarray(speeds_m_s, dtype=float)
     if speeds.ndim != 1 or len(speeds) == 0 or np.any(np.diff(speeds) <= 0):
         raise ValueError("speeds_m_s must be a non-empty, strictly increasing sequence")
-    fam = paper_family(model, wing, density_kg_m3, aero, float(speeds[0]))
+    fam = paper_family(model, wing, density_kg_m3, aero, float(speeds[0]), airframe)
     tr = engine.scan(fam, speeds)
     return Sweep(model, speeds, tr.roots, tr.labels, tuple(p.vectors for p in tr.points),
-                 wing, density_kg_m3, aero)
+                 wing, density_kg_m3, aero, airframe)
 
 
 def sweep_grid(
@@ -242,12 +260,14 @@ def modes_at(
     speeds_m_s: Sequence[float],
     wing: ElasticWingModel | None = None,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
+    airframe: AirframeData | None = None,
 ) -> list[ModeSet]:
-    """Labelled modes of ``model`` at each speed in ``speeds_m_s`` (labels tracked from 2 m/s)."""
+    """Labelled modes of ``model`` at each speed in ``speeds_m_s`` (labels tracked from 2 m/s);
+    the aircraft is the wing's, or ``airframe`` for the rigid model (:func:`airframe_of`)."""
     targets = sorted(set(float(v) for v in speeds_m_s))
     grid = sweep_grid(targets)
-    sweep = track(model, grid, wing, density_kg_m3, aero)
+    sweep = track(model, grid, wing, density_kg_m3, aero, airframe)
     index = {float(v): k for k, v in enumerate(grid)}
     by_speed = {v: sweep.at(index[v]) for v in targets}
     return [by_speed[float(v)] for v in speeds_m_s]
@@ -267,7 +287,7 @@ def find_flutter(
     step_m_s: float = SCAN_STEP_M_S,
     tol_m_s: float = SCAN_TOL_M_S,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
 ) -> FlutterResult:
     """The coupled model's first instability in ``range_m_s`` (the engine's search: scan
     from 2 m/s in ``step_m_s``, bisection to ``tol_m_s``, speed rounded to 0.01 m/s).
@@ -285,7 +305,8 @@ def find_flutter(
         raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
     fam = paper_family("coupled", wing, density_kg_m3, aero,
                        min(SCAN_START_M_S, lo))
-    fam.divergence_speed_m_s = wing_divergence_speed_m_s(wing, density_kg_m3)
+    fam.divergence_speed_m_s = wing_divergence_speed_m_s(
+        wing, density_kg_m3, (2.0, max(DIVERGENCE_SEARCH_TOP_M_S, DIVERGENCE_TOP_OVER_RANGE * hi)))
     res = engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, SCAN_START_M_S), (lo, hi),
         tol_m_s=tol_m_s, structural_damping=_common_zeta(wing),
@@ -294,6 +315,13 @@ def find_flutter(
         return res
     v = round(res.speed_m_s, 2)
     return replace(res, speed_m_s=v, reduced_frequency=res.frequency_rad_s * res.semichord_m / v)
+
+
+# The wing's divergence (body held) is searched from 2 m/s to the larger of 60 m/s (the
+# prototype's: 1.5 x its 40 m/s range) and 1.5 x the flutter range's top (a larger aircraft
+# scanned over a wider range: its divergence beside a flutter found up there).
+DIVERGENCE_SEARCH_TOP_M_S = 60.0
+DIVERGENCE_TOP_OVER_RANGE = 1.5
 
 
 def _common_zeta(wing: ElasticWingModel) -> float | None:
@@ -310,8 +338,8 @@ def wing_divergence_speed_m_s(wing: ElasticWingModel,
     from scipy.optimize import brentq
 
     def det(v):
-        return float(np.linalg.det(coupled_blocks(wing,
-                                                  level_flight_condition(v, density_kg_m3)).a_ee))
+        cond = level_flight_condition(v, density_kg_m3, airframe=wing.airframe)
+        return float(np.linalg.det(coupled_blocks(wing, cond).a_ee))
 
     grid = np.arange(range_m_s[0], range_m_s[1] + 0.25, 0.5)
     signs = np.sign([det(v) for v in grid])

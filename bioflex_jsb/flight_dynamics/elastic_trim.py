@@ -58,9 +58,6 @@ from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space, coupl
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
 from bioflex_jsb.parameters.airframe import (
-    MASS_PROPERTIES,
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
@@ -106,8 +103,8 @@ RigidTrim = Callable[[StaticWingLoads], RigidTrimPoint]
 
 def linear_rigid_trim(
     condition: FlightCondition,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    mass_kg: float = MASS_PROPERTIES.mass_kg,
+    aero: RigidAerodynamics | None = None,
+    mass_kg: float | None = None,
 ) -> RigidTrim:
     """Level-flight trim of the linear airframe model with extra loads.
 
@@ -116,9 +113,13 @@ def linear_rigid_trim(
     ``AIRFRAME_GEOMETRY``; drag only sets the throttle). Unlike
     :func:`~bioflex_jsb.flight_dynamics.rigid.level_flight_condition` the elevator's lift is
     kept, as JSBSim's trim keeps it (JSBSim at 15 m/s: α 1.77°, δe 1.12°; this: 1.79°, 1.00°).
+    S, c̄, the mass and the derivatives are the condition's airframe's unless given.
     """
-    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
-    qsc = qs * REFERENCE_GEOMETRY.mean_chord_m
+    af = condition.airframe
+    aero = af.aero if aero is None else aero
+    mass_kg = af.mass.mass_kg if mass_kg is None else mass_kg
+    qs = condition.dynamic_pressure_pa * af.reference.area_m2
+    qsc = qs * af.reference.mean_chord_m
     weight = mass_kg * STANDARD_GRAVITY_M_S2
     matrix = np.array([[aero.cl_alpha_per_rad, aero.cl_delta_e_per_rad],
                        [aero.cm_alpha_per_rad, aero.cm_delta_e_per_rad]])
@@ -144,7 +145,7 @@ def divergence_dynamic_pressure_pa(mm: ModalMatrices) -> float:
 
 def divergence_speed_m_s(wing, cl_trim: float = 0.5,
                          density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-                         aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> float:
+                         aero: RigidAerodynamics | None = None) -> float:
     """The wing's static divergence speed with the body held [m/s] (inf if none).
 
     ``wing`` an :class:`~bioflex_jsb.flight_dynamics.lti.ElasticWingModel`. K_a does not
@@ -157,7 +158,7 @@ def trimmed_divergence_speed_m_s(
     wing,
     *,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
     range_m_s: tuple[float, float] = (1.0, 60.0),
     step_m_s: float = 0.05,
 ) -> float:
@@ -170,8 +171,9 @@ def trimmed_divergence_speed_m_s(
     determinant is scanned on a ``step_m_s`` grid and the first sign change bisected.
     """
     mm = modal_matrices(wing, 0.5, aero)  # K_a, b_α and the load rows do not depend on C_L0
+    aero = wing.airframe.aero if aero is None else aero
     n = mm.n
-    cb = REFERENCE_GEOMETRY.mean_chord_m
+    cb = wing.airframe.reference.mean_chord_m
 
     def det(v: float) -> float:
         q = 0.5 * density_kg_m3 * v * v
@@ -293,7 +295,7 @@ def elastic_trim(
     speed_m_s: float,
     *,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
     rigid_trim: RigidTrim | None = None,
     tol_rad: float = DEFAULT_TOL_RAD,
     max_iterations: int = DEFAULT_MAX_ITERATIONS,
@@ -306,7 +308,9 @@ def elastic_trim(
     point does not converge in ``max_iterations``.
     """
     wing, modes = build.model, build.modes
-    condition = level_flight_condition(float(speed_m_s), density_kg_m3, aero)
+    condition = level_flight_condition(float(speed_m_s), density_kg_m3, aero,
+                                       airframe=wing.airframe)
+    ref = condition.airframe.reference
     q = condition.dynamic_pressure_pa
     mm = modal_matrices(wing, condition.cl_trim, aero)
     q_div = divergence_dynamic_pressure_pa(mm)
@@ -320,7 +324,7 @@ def elastic_trim(
     trim_fn = linear_rigid_trim(condition, aero) if rigid_trim is None else rigid_trim
     rigid = trim_fn(StaticWingLoads())
     stiffness = np.diag(mm.omega**2) - q * mm.k_aero
-    qs = q * REFERENCE_GEOMETRY.area_m2
+    qs = q * ref.area_m2
 
     def eta_of(alpha: float) -> np.ndarray:
         return np.linalg.solve(stiffness, q * (mm.b_0 + mm.b_alpha * (alpha - rigid.alpha_rad)))
@@ -359,7 +363,7 @@ def elastic_trim(
         )
     eta = eta_of(alpha)
     loads = loads_of(eta)
-    sc = REFERENCE_GEOMETRY.area_m2 * REFERENCE_GEOMETRY.mean_chord_m
+    sc = ref.area_m2 * ref.mean_chord_m
     c0_rigid = mm.b_0 * mm.mass_kg_m2 / sc
     c0_elastic = mm.mass_kg_m2 * mm.omega**2 * eta / (q * sc)
     forcing = q * (mm.b_0 + mm.b_alpha * (alpha - rigid.alpha_rad) + mm.k_aero @ eta)
@@ -398,7 +402,7 @@ def linearise_about_elastic_trim(
     model: str,
     trim: ElasticTrim,
     wing,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
     a_rr: np.ndarray | None = None,
 ) -> StateSpace:
     """The ``coupled`` or ``qsd`` model of Eq. (4) linearised about ``trim`` (module
@@ -411,7 +415,8 @@ def linearise_about_elastic_trim(
     if model not in ("coupled", "qsd"):
         raise InputError(f"linearising about the elastic trim needs a wing model "
                          f"(coupled or qsd), not {model!r}")
-    condition = level_flight_condition(trim.speed_m_s, trim.density_kg_m3, aero)
+    condition = level_flight_condition(trim.speed_m_s, trim.density_kg_m3, aero,
+                                       airframe=wing.airframe)
     base = build_state_space(model, condition, wing, aero, a_rr=a_rr)
     blk = coupled_blocks(wing, condition, aero)
     n = wing.n_modes

@@ -38,9 +38,8 @@ from bioflex_jsb.flight_dynamics.rigid import (
     rigid_matrices,
 )
 from bioflex_jsb.parameters.airframe import (
-    MASS_PROPERTIES,
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
+    PROTOTYPE_AIRFRAME,
+    AirframeData,
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
@@ -87,7 +86,8 @@ class ElasticWingModel:
     in H_i (see :mod:`bioflex_jsb.flight_dynamics.wing_model` for the convention);
     coefficients: Table B1; wing_lift_slope_per_rad: C_Lα of the wing alone (lifting line),
     used for the trim lift distribution in C_0^Q; cm_ac: section moment coefficient about the
-    aerodynamic centre [-].
+    aerodynamic centre [-]; airframe: the aircraft the wing was built for (its S and c̄
+    non-dimensionalise ``coefficients``; the flight condition must carry the same).
     """
 
     name: str
@@ -98,10 +98,21 @@ class ElasticWingModel:
     wing_lift_slope_per_rad: float
     cm_ac: float
     tip_twist_per_eta: np.ndarray | None = None  # θ_i at the tip per unit η_i [rad/rad]
+    airframe: AirframeData = PROTOTYPE_AIRFRAME
 
     @property
     def n_modes(self) -> int:
         return int(len(self.frequencies_rad_s))
+
+
+def check_same_reference(wing: ElasticWingModel, condition: FlightCondition) -> None:
+    """The wing's coefficients and the condition's derivatives share S and c̄ (a wing built
+    for one aircraft at another's flight condition is a caller's bug: ValueError)."""
+    mine, theirs = wing.airframe.reference, condition.airframe.reference
+    if mine != theirs:
+        raise ValueError(f"wing {wing.name!r} was built for airframe {wing.airframe.name!r} "
+                         f"({mine}) but the flight condition is {condition.airframe.name!r}'s "
+                         f"({theirs}): build the condition with airframe=wing.airframe")
 
 
 @dataclass(frozen=True)
@@ -129,15 +140,21 @@ class ElasticDerivatives:
 def elastic_derivatives(
     wing: ElasticWingModel,
     condition: FlightCondition,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    mass_kg: float = MASS_PROPERTIES.mass_kg,
-    iyy_kg_m2: float = MASS_PROPERTIES.iyy_kg_m2,
+    aero: RigidAerodynamics | None = None,
+    mass_kg: float | None = None,
+    iyy_kg_m2: float | None = None,
 ) -> ElasticDerivatives:
-    """Table B2 derivatives of the structural modes at ``condition``."""
+    """Table B2 derivatives of the structural modes at ``condition`` (S, c̄, mass, I_yy and
+    k of the condition's airframe unless given)."""
+    check_same_reference(wing, condition)
+    af = condition.airframe
+    aero = af.aero if aero is None else aero
+    mass_kg = af.mass.mass_kg if mass_kg is None else mass_kg
+    iyy_kg_m2 = af.mass.iyy_kg_m2 if iyy_kg_m2 is None else iyy_kg_m2
     c = wing.coefficients
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
-    cb = REFERENCE_GEOMETRY.mean_chord_m
+    qs = condition.dynamic_pressure_pa * af.reference.area_m2
+    cb = af.reference.mean_chord_m
     mi = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
     c_d_eta = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_eta
     c_d_etadot = 2.0 * aero.k_induced * condition.cl_trim * c.c_l_etadot
@@ -177,7 +194,7 @@ class CoupledBlocks:
 def coupled_blocks(
     wing: ElasticWingModel,
     condition: FlightCondition,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
     a_rr: np.ndarray | None = None,
     elastic: ElasticDerivatives | None = None,
 ) -> CoupledBlocks:
@@ -234,25 +251,31 @@ AERODYNAMIC_MODEL = ("quasi-steady: Table B1/B2 derivatives (strip/vortex-lattic
                      "(flight_dynamics/rigid.py)")
 
 
-def control_columns(condition: FlightCondition, aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-                    mass_kg: float = MASS_PROPERTIES.mass_kg,
-                    iyy_kg_m2: float = MASS_PROPERTIES.iyy_kg_m2) -> np.ndarray:
+def control_columns(condition: FlightCondition, aero: RigidAerodynamics | None = None,
+                    mass_kg: float | None = None,
+                    iyy_kg_m2: float | None = None) -> np.ndarray:
     """B columns of the rigid states [u, α, q, θ] for the elevator [rad] and the throttle [-].
 
     Elevator: the tail's lift C_Lδe and moment C_mδe (the pitch row also through M_ẇ Z_δe)
     and the induced drag of that lift, 2 k C_L0 C_Lδe; the tail does not load the wing's
     modes. Throttle: X_δt = ∂T/∂δt / m at the trim airspeed with the propeller RPM
     quasi-static (:func:`thrust_per_throttle_n`); the thrust line passes through the centre
-    of gravity (no moment). Units: per rad of elevator, per unit throttle.
+    of gravity (no moment); an airframe without propulsion (a glider) has a zero throttle
+    column. Units: per rad of elevator, per unit throttle. S, c̄, mass, I_yy and the
+    derivatives are the condition's airframe's unless given.
     """
+    af = condition.airframe
+    aero = af.aero if aero is None else aero
+    mass_kg = af.mass.mass_kg if mass_kg is None else mass_kg
+    iyy_kg_m2 = af.mass.iyy_kg_m2 if iyy_kg_m2 is None else iyy_kg_m2
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
-    cb = REFERENCE_GEOMETRY.mean_chord_m
+    qs = condition.dynamic_pressure_pa * af.reference.area_m2
+    cb = af.reference.mean_chord_m
     z_de = -aero.cl_delta_e_per_rad * qs / mass_kg
     x_de = -2.0 * aero.k_induced * condition.cl_trim * aero.cl_delta_e_per_rad * qs / mass_kg
     m_de = aero.cm_delta_e_per_rad * qs * cb / iyy_kg_m2
     m_wdot = aero.cm_alphadot_per_rad * qs * cb**2 / (2.0 * iyy_kg_m2 * u0**2)
-    x_dt = thrust_per_throttle_n(condition) / mass_kg
+    x_dt = 0.0 if af.propulsion is None else thrust_per_throttle_n(condition) / mass_kg
     return np.array([[x_de, x_dt], [z_de / u0, 0.0], [m_de + m_wdot * z_de, 0.0], [0.0, 0.0]])
 
 
@@ -263,11 +286,14 @@ def _drive(condition: FlightCondition):
     from scipy.optimize import brentq
 
     from bioflex_jsb.aerodynamics.propeller import propeller_tables
-    from bioflex_jsb.parameters.airframe import PROPULSION
 
+    prop = condition.airframe.propulsion
+    if prop is None or prop is not PROTOTYPE_AIRFRAME.propulsion:
+        raise ValueError(f"airframe {condition.airframe.name!r}: the propeller tables are "
+                         "the prototype's (aerodynamics/propeller.py); another drive has none")
     j_tab, ct_tab, cp_tab = _propeller_tables_cached(propeller_tables)
-    rho, d = condition.density_kg_m3, PROPULSION.prop_diameter_m
-    drag = condition.cd_trim * condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
+    rho, d = condition.density_kg_m3, prop.prop_diameter_m
+    drag = condition.cd_trim * condition.dynamic_pressure_pa * condition.airframe.reference.area_m2
 
     def thrust(j: float, v: float) -> float:
         return float(np.interp(j, j_tab, ct_tab)) * rho * (v / (j * d)) ** 2 * d**4
@@ -290,15 +316,13 @@ def thrust_per_throttle_n(condition: FlightCondition) -> float:
     """∂T/∂δt [N per unit throttle] at the level-flight trim ``condition``, airspeed held,
     RPM in equilibrium (shaft power = δt × PROPULSION.motor_max_shaft_power_w):
     P_max (∂T/∂J)/(∂P/∂J) (:func:`_drive`); NaN if the propeller cannot trim there."""
-    from bioflex_jsb.parameters.airframe import PROPULSION
-
     thrust, power, j, _ = _drive(condition)
     if j is None:
         return float("nan")
     v, h = condition.speed_m_s, 1e-4
     dt_dj = (thrust(j + h, v) - thrust(j - h, v)) / (2 * h)
     dp_dj = (power(j + h, v) - power(j - h, v)) / (2 * h)
-    return float(PROPULSION.motor_max_shaft_power_w * dt_dj / dp_dj)
+    return float(condition.airframe.propulsion.motor_max_shaft_power_w * dt_dj / dp_dj)
 
 
 def thrust_speed_derivative_n_s_m(condition: FlightCondition) -> float:
@@ -360,7 +384,7 @@ def build_state_space(
     model: str,
     condition: FlightCondition,
     wing: ElasticWingModel | None = None,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+    aero: RigidAerodynamics | None = None,
     a_rr: np.ndarray | None = None,
     controls: bool = False,
     elastic: ElasticDerivatives | None = None,

@@ -32,8 +32,6 @@ from scipy.linalg import expm
 
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.parameters.airframe import (
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
     RigidAerodynamics,
 )
 
@@ -93,10 +91,12 @@ class ModalMatrices:
 
 
 def modal_matrices(wing: ElasticWingModel, cl_trim: float,
-                   aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> ModalMatrices:
-    """Per-unit modal matrices of ``wing`` with the trim lift coefficient ``cl_trim`` [-]."""
+                   aero: RigidAerodynamics | None = None) -> ModalMatrices:
+    """Per-unit modal matrices of ``wing`` with the trim lift coefficient ``cl_trim`` [-]
+    (S, c̄ and k of the wing's airframe; ``aero`` replaces its derivatives)."""
+    aero = wing.airframe.aero if aero is None else aero
     c = wing.coefficients
-    s, cb = REFERENCE_GEOMETRY.area_m2, REFERENCE_GEOMETRY.mean_chord_m
+    s, cb = wing.airframe.reference.area_m2, wing.airframe.reference.mean_chord_m
     m = np.asarray(wing.generalised_masses_kg_m2, dtype=float)
     c_alpha = np.asarray(c.c_alpha_q, dtype=float)
     alpha_wing = cl_trim / wing.wing_lift_slope_per_rad

@@ -15,14 +15,13 @@ Z-derivatives are accelerations [m/s² per unit], M-derivatives angular accelera
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from bioflex_jsb.parameters.airframe import (
-    MASS_PROPERTIES,
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
+    PROTOTYPE_AIRFRAME,
+    AirframeData,
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
@@ -41,6 +40,8 @@ class FlightCondition:
         cl_trim: lift coefficient in trim, C_L0 = W/(Q S) [-] (level flight).
         cd_trim: drag coefficient in trim [-].
         alpha_trim_rad: angle of attack in trim [rad] (linear lift curve).
+        airframe: the aircraft trimmed (S, c̄, mass, I_yy, rigid derivatives): what the
+            derivatives built at this condition read.
     """
 
     speed_m_s: float
@@ -48,6 +49,7 @@ class FlightCondition:
     cl_trim: float
     cd_trim: float
     alpha_trim_rad: float
+    airframe: AirframeData = PROTOTYPE_AIRFRAME
 
     @property
     def dynamic_pressure_pa(self) -> float:
@@ -58,8 +60,9 @@ class FlightCondition:
 def level_flight_condition(
     speed_m_s: float,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    mass_kg: float = MASS_PROPERTIES.mass_kg,
+    aero: RigidAerodynamics | None = None,
+    mass_kg: float | None = None,
+    airframe: AirframeData = PROTOTYPE_AIRFRAME,
 ) -> FlightCondition:
     """Level-flight trim of the linear aerodynamic model at ``speed_m_s`` [m/s].
 
@@ -70,11 +73,16 @@ def level_flight_condition(
     """
     if not (np.isfinite(speed_m_s) and speed_m_s > 0.0):
         raise ValueError(f"speed_m_s must be finite and > 0, got {speed_m_s!r}")
+    if aero is not None and aero is not airframe.aero:
+        airframe = replace(airframe, aero=aero)
+    if mass_kg is not None and mass_kg != airframe.mass.mass_kg:
+        airframe = replace(airframe, mass=replace(airframe.mass, mass_kg=float(mass_kg)))
+    aero = airframe.aero
     q_pa = 0.5 * density_kg_m3 * speed_m_s**2
-    cl = mass_kg * STANDARD_GRAVITY_M_S2 / (q_pa * REFERENCE_GEOMETRY.area_m2)
+    cl = airframe.mass.mass_kg * STANDARD_GRAVITY_M_S2 / (q_pa * airframe.reference.area_m2)
     cd = aero.cd0 + aero.k_induced * cl**2
     alpha = (cl - aero.cl0) / aero.cl_alpha_per_rad
-    return FlightCondition(speed_m_s, density_kg_m3, cl, cd, alpha)
+    return FlightCondition(speed_m_s, density_kg_m3, cl, cd, alpha, airframe)
 
 
 @dataclass(frozen=True)
@@ -98,16 +106,21 @@ class RigidDerivatives:
 
 def rigid_derivatives(
     condition: FlightCondition,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    mass_kg: float = MASS_PROPERTIES.mass_kg,
-    iyy_kg_m2: float = MASS_PROPERTIES.iyy_kg_m2,
+    aero: RigidAerodynamics | None = None,
+    mass_kg: float | None = None,
+    iyy_kg_m2: float | None = None,
 ) -> RigidDerivatives:
     """Table B2 derivatives. C_Du = C_Lu = C_mu = 0 (incompressible, no Reynolds effect);
     C_Dα = 2 k C_L0 C_Lα from the parabolic polar; thrust is taken speed-independent
-    (Table B2 has no thrust term)."""
+    (Table B2 has no thrust term). S, c̄, the mass, I_yy and the derivatives are the
+    condition's airframe's; ``aero``, ``mass_kg``, ``iyy_kg_m2`` replace them."""
+    af = condition.airframe
+    aero = af.aero if aero is None else aero
+    mass_kg = af.mass.mass_kg if mass_kg is None else mass_kg
+    iyy_kg_m2 = af.mass.iyy_kg_m2 if iyy_kg_m2 is None else iyy_kg_m2
     u0 = condition.speed_m_s
-    qs = condition.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
-    cbar = REFERENCE_GEOMETRY.mean_chord_m
+    qs = condition.dynamic_pressure_pa * af.reference.area_m2
+    cbar = af.reference.mean_chord_m
     cd_alpha = 2.0 * aero.k_induced * condition.cl_trim * aero.cl_alpha_per_rad
     return RigidDerivatives(
         condition=condition,

@@ -36,8 +36,13 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
     shifted,
     spanwise_geometry,
 )
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, MODAL_DAMPING_RATIO, Planform
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME, AirframeData
+from bioflex_jsb.parameters.wing import (
+    DEFAULT_PLANFORM,
+    MODAL_DAMPING_RATIO,
+    PUBLISHED_C_ETA1_Q1,
+    Planform,
+)
 from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.tomlfile import read_toml
 
@@ -93,7 +98,7 @@ class WingVariant:
 
 
 def _pub(name: str) -> float:
-    return P.PUBLISHED_VARIANTS[name].c_eta1_q1
+    return PUBLISHED_C_ETA1_Q1[name]
 
 
 # The named variants. Axis positions of ``original`` and ``optimised`` are Table 8's; the
@@ -335,6 +340,12 @@ class WingBuild:
     mass_basis: str
     physical_c_eta1_q1: float
     e_shift_frac: float = 0.0  # pin of C_η1^Q1: shift of e(y) [fraction of chord]
+    planform: Planform = DEFAULT_PLANFORM  # the strips' planform (and the CG's x_cg_m)
+
+    @property
+    def airframe(self) -> AirframeData:
+        """The aircraft the wing was built for (its S, c̄, mass, I_yy, derivatives)."""
+        return self.model.airframe
 
     def summary(self) -> dict[str, object]:
         c = self.model.coefficients
@@ -416,19 +427,23 @@ def build_wing(
     n_modes: int = DEFAULT_N_MODES,
     mass_basis: str = DEFAULT_MASS_BASIS,
     planform: Planform = DEFAULT_PLANFORM,
+    airframe: AirframeData = PROTOTYPE_AIRFRAME,
 ) -> WingBuild:
-    """Structure → lifting line → Table B1 → :class:`ElasticWingModel` for ``variant``.
+    """Structure → lifting line → Table B1 → :class:`ElasticWingModel` for ``variant`` on
+    ``airframe`` (its S and c̄ non-dimensionalise Table B1; the model carries it, so every
+    analysis of the wing takes the airframe's mass, inertia and derivatives).
 
-    Results are cached per (variant, n_modes, mass basis, planform): building is pure.
+    Results are cached per (variant, n_modes, mass basis, planform, airframe): building is
+    pure.
     """
     if mass_basis not in MASS_BASES:
         raise VariantError(f"unknown mass basis {mass_basis!r}; accepted: {', '.join(MASS_BASES)}")
     key = (repr(sorted(variant.as_dict().items())), _file_version(variant.modes_file),
-           n_modes, mass_basis, planform)
+           n_modes, mass_basis, planform, airframe)
     if key in _BUILD_CACHE:
         _BUILD_CACHE.move_to_end(key)
         return _BUILD_CACHE[key]
-    build = _BUILD_CACHE[key] = _build(variant, n_modes, mass_basis, planform)
+    build = _BUILD_CACHE[key] = _build(variant, n_modes, mass_basis, planform, airframe)
     while len(_BUILD_CACHE) > BUILD_CACHE_SIZE:
         _BUILD_CACHE.popitem(last=False)
     return build
@@ -472,17 +487,20 @@ def _check_modes_fit(variant: WingVariant, modes: ModalData, planform: Planform)
             "C_etadot^Q) or give mode 1 its twist")
 
 
-def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planform) -> WingBuild:
+def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planform,
+           airframe: AirframeData) -> WingBuild:
     modes = structural_modes(variant, n_modes)
     _check_modes_fit(variant, modes, planform)
     aero = _aero(planform)
     strips = spanwise_geometry(aero, planform, modes.x_elastic_frac, modes.stations_m)
-    physical = modal_coefficients(modes, strips)
+    ref = dict(reference_area_m2=airframe.reference.area_m2,
+               cbar_m=airframe.reference.mean_chord_m)
+    physical = modal_coefficients(modes, strips, **ref)
     coeffs = physical
     e_shift_m = 0.0
     if variant.pinned_c_eta1_q1 is not None:
-        e_shift_m = offset_shift_for_c_eta11(modes, strips, variant.pinned_c_eta1_q1)
-        coeffs = modal_coefficients(modes, shifted(strips, e_shift_m))
+        e_shift_m = offset_shift_for_c_eta11(modes, strips, variant.pinned_c_eta1_q1, **ref)
+        coeffs = modal_coefficients(modes, shifted(strips, e_shift_m), **ref)
         coeffs = coeffs.with_overrides({"C_eta1^Q1": variant.pinned_c_eta1_q1})
     if variant.overrides:
         coeffs = coeffs.with_overrides(variant.overrides)
@@ -503,6 +521,7 @@ def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planfo
         wing_lift_slope_per_rad=float(aero.wing_lift_slope_per_rad),
         cm_ac=CM_AC_SECTION,
         tip_twist_per_eta=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
+        airframe=airframe,
     )
     return WingBuild(variant, modes, aero, model, mass_basis, float(physical.c_eta_q[0, 0]),
-                     e_shift_m / planform.chord_m)
+                     e_shift_m / planform.chord_m, planform)

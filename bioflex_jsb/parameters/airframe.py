@@ -366,3 +366,30 @@ CONTROL_LIMITS = ControlLimits(
     aileron_max_rad=math.radians(20.0),  # ESTIMATE
     rudder_max_rad=math.radians(25.0),  # ESTIMATE
 )
+
+
+# --------------------------------------------------------------------------------------
+# One aircraft's rigid data as one object (passed into every linear analysis)
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AirframeData:
+    """What the linear analyses take from an aircraft besides its elastic wing: the reference
+    geometry of the coefficients (S [m²], b [m], c̄ [m]), the mass properties about the CG
+    [kg, kg·m²], the rigid derivatives (per rad, moments about the CG) and the propulsion
+    (``None``: no engine, a glider: the throttle column of the LTI model is zero).
+
+    Built by the loader (:meth:`bioflex_jsb.definition.aircraft.Aircraft.airframe_data`);
+    :data:`PROTOTYPE_AIRFRAME` is the prototype's, the default of the two constructors
+    that start an analysis (:func:`bioflex_jsb.flight_dynamics.rigid.level_flight_condition`
+    and :func:`bioflex_jsb.flight_dynamics.wing_model.build_wing`); everything below reads
+    the object it is handed (the flight condition's or the wing's)."""
+
+    name: str
+    reference: ReferenceGeometry
+    mass: MassProperties
+    aero: RigidAerodynamics
+    propulsion: Propulsion | None = None
+
+
+PROTOTYPE_AIRFRAME = AirframeData("bioflex", REFERENCE_GEOMETRY, MASS_PROPERTIES,
+                                  RIGID_AERODYNAMICS, PROPULSION)

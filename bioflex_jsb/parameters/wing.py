@@ -81,3 +81,7 @@ DEFAULT_PLANFORM = Planform(
 # 2 % of critical damping typical of cured carbon-fibre laminates (1–3 %); it moves the
 # short-period roots of Tables 3 and 6 by less than 0.01 rad/s.
 MODAL_DAMPING_RATIO = 0.02
+
+# The published C_η1^Q1 [-] of the paper's six named variants (Table 8; parameters/
+# prototype.py PUBLISHED_VARIANTS, the paper's data): what a named variant pins.
+PUBLISHED_C_ETA1_Q1 = {name: v.c_eta1_q1 for name, v in P.PUBLISHED_VARIANTS.items()}
