@@ -156,9 +156,11 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
         elastic = trim == "elastic" and model != "rigid"
         if aero == "unsteady" or elastic:
             out[model] = run_gust(airframe, wing, model, setup, recorder=recorder,
-                                  aero=aero, trim_mode="elastic" if elastic else "rigid")
+                                  aero=aero, trim_mode="elastic" if elastic else "rigid",
+                                  loads=wing)
         else:
-            out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder)
+            out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder,
+                                  loads=wing)
     return out
 
 

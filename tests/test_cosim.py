@@ -78,8 +78,9 @@ def test_small_gust_lti_and_nonlinear_agree_within_5_percent(capsys, wing):
     code = main(["compare", "--wing", wing, "--speed", "15", "--gust", "sharp:0.3", "--json"])
     data = json.loads(capsys.readouterr().out)
     assert code == 0
-    assert set(data["nrmse"]) == {"u", "alpha", "q", "theta", "eta1"}
-    for channel, value in data["nrmse"].items():
+    flight = {c: v for c, v in data["nrmse"].items() if not c.startswith("loads_")}
+    assert set(flight) == {"u", "alpha", "q", "theta", "eta1"}  # and the section loads:
+    for channel, value in flight.items():  # tests/test_loads_run.py
         assert value <= 0.05, (channel, value)
 
 

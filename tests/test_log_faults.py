@@ -24,11 +24,38 @@ DESCRIPTION = RunDescription(kind="gust", wing="optimised", speed_m_s=15.0, gust
 
 @pytest.fixture(scope="module")
 def log2s(tmp_path_factory) -> Path:
-    """A 2 s coupled run: three chunks (864 + 864 + 192 steps)."""
+    """A 2 s coupled run: the steps in three chunks (864 + 864 + 192 steps), each followed
+    by a chunk of the section loads (sinks/mcap/loads_topic.py)."""
     path = tmp_path_factory.mktemp("faults") / "run.mcap"
     assert cli.main(["gust", "--duration", "2", "--models", "coupled", "--out", str(path),
                      "--json", "--plot", ""]) == 0
     return path
+
+
+def _chunk_messages(path: Path) -> list[dict[str, list[int]]]:
+    """Per chunk, in file order: {topic: log times [ns] of its messages} (from the message
+    index records after each chunk), so that the expectations below follow the file."""
+    from mcap.records import Channel, Chunk, MessageIndex
+    from mcap.stream_reader import StreamReader
+
+    topics: dict[int, str] = {}
+    out: list[dict[str, list[int]]] = []
+    with open(path, "rb") as f:
+        for rec in StreamReader(f, emit_chunks=True).records:
+            if isinstance(rec, Channel):
+                topics[rec.id] = rec.topic
+            elif isinstance(rec, Chunk):
+                out.append({})
+            elif isinstance(rec, MessageIndex) and out:
+                out[-1][topics[rec.channel_id]] = [t for t, _ in rec.records]
+    return out
+
+
+def _count(chunks: list[dict[str, list[int]]]) -> int:
+    return sum(len(v) for c in chunks for v in c.values())
+
+
+RIGID = "/bioflex/coupled/rigid_body"
 
 
 def _chunks(path: Path) -> list:
@@ -79,31 +106,34 @@ def test_an_empty_file_is_one_line_exit_2(tmp_path, capsys):
 def test_recover_skips_a_damaged_chunk_and_keeps_every_intact_one_after_it(log2s, tmp_path,
                                                                            capsys):
     chunks = _chunks(log2s)
-    assert len(chunks) == 3
+    contents = _chunk_messages(log2s)
+    assert len(chunks) == len(contents) >= 3
+    assert [len(c.get(RIGID, [])) for c in contents if RIGID in c] == [864, 864, 192]
     data = bytearray(log2s.read_bytes())
     data[chunks[0].chunk_start_offset + 400] ^= 0xFF  # inside the compressed records
     damaged = tmp_path / "damaged.mcap"
     damaged.write_bytes(bytes(data))
     # info --check finds it (exit 1), the intact file passes (exit 0)
     assert cli.main(["info", str(log2s), "--check"]) == 0
-    assert "ok: 3 chunks" in capsys.readouterr().out
+    assert f"ok: {len(chunks)} chunks" in capsys.readouterr().out
     assert cli.main(["info", str(damaged), "--check", "--json"]) == 1
     check = json.loads(capsys.readouterr().out)
-    assert check["chunks"] == 3 and len(check["bad"]) == 1
+    assert check["chunks"] == len(chunks) and len(check["bad"]) == 1
     assert str(chunks[0].chunk_start_offset) in check["bad"][0]
     fixed = tmp_path / "fixed.mcap"
     assert cli.main(["info", str(damaged), "--recover", str(fixed), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert len(report["skipped"]) == 1 and "CRC" in report["skipped"][0]
-    kept = 1920 - 864  # the second and third chunks
-    assert report["messages"] == 7 * kept and report["chunks"] == 2
-    rigid = sink.messages_by_topic(fixed)["/bioflex/coupled/rigid_body"]
-    assert [ns for ns, _ in rigid] == [round(k / 960 * 1e9) for k in range(864, 1920)]
+    assert report["messages"] == _count(contents[1:]) and report["chunks"] == len(chunks) - 1
+    rigid = sink.messages_by_topic(fixed)[RIGID]
+    assert [ns for ns, _ in rigid] == [t for c in contents[1:] for t in c.get(RIGID, [])]
+    assert [ns for ns, _ in rigid][0] == round(864 / 960 * 1e9)  # the first chunk's steps
     _doctor_ok(fixed)
 
 
 def test_recover_resyncs_after_a_damaged_record_length(log2s, tmp_path, capsys):
     chunks = _chunks(log2s)
+    contents = _chunk_messages(log2s)
     data = bytearray(log2s.read_bytes())
     data[chunks[1].chunk_start_offset + 6] = 0x7F  # the second chunk's length: nonsense
     damaged = tmp_path / "length.mcap"
@@ -111,22 +141,25 @@ def test_recover_resyncs_after_a_damaged_record_length(log2s, tmp_path, capsys):
     fixed = tmp_path / "fixed.mcap"
     assert cli.main(["info", str(damaged), "--recover", str(fixed), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
-    assert report["chunks"] == 2 and len(report["skipped"]) == 1
-    assert report["messages"] == 7 * (864 + 192)
+    assert report["chunks"] == len(chunks) - 1 and len(report["skipped"]) == 1
+    assert report["messages"] == _count(contents[:1] + contents[2:])
     _doctor_ok(fixed)
 
 
 def test_a_truncated_log_recovers_every_complete_chunk(log2s, tmp_path, capsys):
     chunks = _chunks(log2s)
+    contents = _chunk_messages(log2s)
+    last = len(chunks) - 1  # cut inside the last chunk: every one before it is complete
     cut = tmp_path / "cut.mcap"
-    cut.write_bytes(log2s.read_bytes()[:chunks[2].chunk_start_offset + 100])
+    cut.write_bytes(log2s.read_bytes()[:chunks[last].chunk_start_offset + 100])
     assert cli.main(["info", str(cut)]) == 2  # no summary: says how to recover
     assert "--recover" in capsys.readouterr().err
     fixed = tmp_path / "fixed.mcap"
     assert cli.main(["info", str(cut), "--recover", str(fixed), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
-    assert report["messages"] == 7 * 1728 and report["skipped"] == []
-    assert report["last_time_s"] == pytest.approx(1727 / 960, abs=1e-9)
+    assert report["messages"] == _count(contents[:last]) and report["skipped"] == []
+    assert report["last_time_s"] == pytest.approx(
+        max(t for c in contents[:last] for v in c.values() for t in v) * 1e-9, abs=1e-9)
     _doctor_ok(fixed)
 
 
@@ -177,7 +210,9 @@ def test_protobuf_messages_decode_with_the_protobuf_package(log2s):
                     assert list(getattr(msg, field)) == value
                 else:
                     assert getattr(msg, field) == value, field
-    assert len(seen) == 7
+    # the seven step topics and the section loads (sinks/mcap/loads_topic.py)
+    assert {t.rsplit("/", 1)[1] for t in seen} >= {
+        "rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location", "loads"}
 
 
 def test_a_long_run_keeps_an_envelope_with_the_exact_peaks():

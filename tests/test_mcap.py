@@ -23,6 +23,9 @@ from bioflex_jsb.sinks import mcap as sink
 ROOT = Path(__file__).resolve().parents[1]
 JS_CHECK = ROOT / "tests" / "js" / "check_mcap.cjs"
 RUN_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
+# a gust run's log: the steps' topics and the wing's section loads (sinks/mcap/loads_topic.py,
+# one message per step, a chunk of their own per block)
+LOG_GROUPS = RUN_GROUPS + ("loads",)
 NEW_COMMANDS = ("info", "plot", "rerun")
 
 
@@ -59,7 +62,7 @@ def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
 def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
     info = sink.summarise(gust_log)
     counts = {c["topic"]: c["messages"] for c in info["channels"]}
-    assert counts == {sink.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    assert counts == {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
     schemas = {c["topic"]: c["schema"] for c in info["channels"]}
     assert schemas["/bioflex/coupled/pose"] == "foxglove.FrameTransform"
     assert schemas["/bioflex/coupled/location"] == "foxglove.LocationFix"
@@ -74,7 +77,7 @@ def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
                                        gust="sharp:3", models=("coupled",), duration_s=1.0)
     assert "arguments" not in run and "argv" not in run
     # chunks close every CHUNK_SPAN_S of simulated time: what a SIGKILL can lose
-    assert info["chunks"] == math.ceil(1.0 / sink.CHUNK_SPAN_S)
+    assert info["chunks"] == 2 * math.ceil(1.0 / sink.CHUNK_SPAN_S)  # steps, then loads
 
 
 def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
@@ -166,7 +169,7 @@ def node_check(tmp_path_factory):
 
 def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
     result = node_check(gust_log)
-    expected = {sink.topic("coupled", g): STEPS_1S for g in RUN_GROUPS}
+    expected = {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
     assert result["counts"] == expected  # read through the chunk indexes, CRCs checked
     assert result["statistics"] == expected
     assert result["dataCrcOk"] is True and result["ordered"] is True
@@ -204,7 +207,7 @@ def test_pymcap_cli_doctor(gust_log):
 def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     assert main(["info", str(gust_log), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["messages"] == STEPS_1S * len(RUN_GROUPS)
+    assert info["messages"] == STEPS_1S * len(LOG_GROUPS)
     png = tmp_path / "run.png"
     assert main(["plot", str(gust_log), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000
@@ -214,14 +217,14 @@ def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["equal"] is True and result["first_difference"] is None
     assert result["command"][1:3] == ["gust", "--wing"]
-    assert sink.summarise(again)["messages"] == STEPS_1S * len(RUN_GROUPS)
+    assert sink.summarise(again)["messages"] == STEPS_1S * len(LOG_GROUPS)
 
 
 def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
     from bioflex_jsb.cli.rerun import compare_logs
 
     same = compare_logs(str(gust_log), str(gust_log), 1e-8)
-    assert same["equal"] and same["messages"] == STEPS_1S * len(RUN_GROUPS)
+    assert same["equal"] and same["messages"] == STEPS_1S * len(LOG_GROUPS)
     other = tmp_path / "other.mcap"
     assert cli.main(["gust", "--duration", "1", "--models", "coupled", "--gust", "sharp:2",
                      "--out", str(other), "--json"]) == 0
@@ -262,7 +265,7 @@ def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     second = json.loads(capsys.readouterr().out)["out"]
     logs = sorted(folder.glob("gust-optimised-*.mcap"))
     assert {str(p) for p in logs} == {first, second} and first != second
-    assert sink.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(RUN_GROUPS)
+    assert sink.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(LOG_GROUPS)
     assert main([*args, "--no-log"]) == 0
     assert json.loads(capsys.readouterr().out)["out"] is None
     assert len(list(folder.iterdir())) == 2
@@ -399,7 +402,8 @@ def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
         # printed and the last step logged can be one step apart (either way), no more
         assert abs(rigid[-1][0] * 1e-9 - flown[-1]) <= DEFAULT_DT_S + 1e-9
     counts = node_check(path)["counts"]
-    assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
+    # the loads too: the run hands on its last row's loads when it is stopped
+    assert counts == {sink.topic("coupled", g): n for g in LOG_GROUPS}
     assert "interrupted" in err and "holds every step" in err
 
 
@@ -431,7 +435,11 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     assert 0.0 <= lost_s <= sink.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
     counts = node_check(fixed)["counts"]
     n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
+    loads = counts.pop(sink.topic("coupled", "loads"))
     assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
+    # the loads' chunk follows its steps' one step behind: killed between the two writes, a
+    # block (864 steps) more is lost
+    assert n - 1 - 864 <= loads <= n - 1
 
 
 def test_varints_are_canonical_protobuf():

@@ -138,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
                 unit, scale = DISPLAY_UNITS.get(c, (worst[c]["unit"], 1.0))
                 print(f"{c:<8} {errors[c]:9.4f} {worst[c]['max_abs_difference'] * scale:11.5f} "
                       f"{unit:<6} {worst[c]['at_time_s']:9.3f}")
+            print(result.loads_table(), end="")  # section loads (drivers/compare.py)
             print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
                   "largest difference and when it occurs")
         if args.plot:

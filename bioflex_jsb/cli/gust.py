@@ -252,7 +252,7 @@ def fly(args, build, models, log=None):
                 run = run_gust(airframe, build if unsteady or elastic else build.model, model,
                                setup, on_sample, recorder=recorder,
                                aero="unsteady" if unsteady else "quasi-steady",
-                               trim_mode="elastic" if elastic else "rigid")
+                               trim_mode="elastic" if elastic else "rigid", loads=build)
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -372,6 +372,10 @@ def print_summary(build, args, summary) -> None:
              "settling time)" if turbulence else
              "overshoot: of α past trim after its first peak [% of that peak]; settling: "
              "until |Δα| stays within 5 % of its peak, '-' = not settled by the end of the run"))
+    from bioflex_jsb.loads.summary import root_loads_lines
+
+    for line in root_loads_lines(summary):  # root M and T peaks, both methods
+        print(line)
     for model, m in summary.items():
         if m["time_beyond_stall_s"] > 0.0:
             print(f"note: {model}: angle of attack beyond the lift peak for "

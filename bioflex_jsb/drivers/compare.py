@@ -10,6 +10,14 @@ linearisation of the airframe at that trim, so the two differ only by the nonlin
 Errors: NRMSE = RMS(linear − nonlinear) / RMS(nonlinear) [-] per channel over the run, and the
 largest absolute difference (in the channel's SI unit) with its time [s]. A nonlinear run that
 diverged is no reference: its errors are None.
+
+Section loads: a nonlinear run with load channels (``loads_<fs|md>_<quantity>_s<j>``,
+``drivers/gust.py``) is compared on them too. The LTI model's loads are its load outputs
+(:func:`bioflex_jsb.loads.lti.with_load_outputs`: y = C x + D w_g, perturbations from 1 g)
+plus the same 1 g values as the run's (the same loads model: stations, static part,
+density), for the methods the run reports (the unsteady wing: mode displacement only, K_md
+on its η outputs). Their NRMSE is that of the **increments over 1 g** (the static part,
+common to both, would only dilute it); the largest difference is the same either way.
 """
 
 from __future__ import annotations
@@ -23,11 +31,14 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
+from bioflex_jsb.loads.lti import with_load_outputs
+from bioflex_jsb.loads.model import QUANTITIES, LoadsModel, build_loads_model
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.lti_response import simulate
 from bioflex_jsb.simulation.results import TimeHistory, nrmse
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
+LOADS_PREFIX = "loads_"
 
 
 @dataclass
@@ -35,7 +46,9 @@ class Comparison:
     """A nonlinear run and the LTI model's prediction of it, with the errors per channel.
 
     ``nrmse[c]`` [-] and ``worst[c]`` (``max_abs_difference`` in ``unit``, ``at_time_s``) for
-    each compared channel ``c``; both None for a run that diverged (``diverged``)."""
+    each compared channel ``c``; both None for a run that diverged (``diverged``). The
+    section loads compared (``load_channels``, module docstring: NRMSE of the increments
+    over 1 g) are in the same two dicts."""
 
     model: str
     nonlinear: TimeHistory
@@ -43,14 +56,34 @@ class Comparison:
     nrmse: dict[str, float | None]
     worst: dict[str, dict[str, object]]
     channels: tuple[str, ...] = field(default=CHANNELS)
+    load_channels: tuple[str, ...] = ()
 
     @property
     def diverged(self) -> bool:
         return self.nonlinear.stopped is not None
 
+    def loads_table(self) -> str:
+        """The section loads' rows of the comparison as text (one per load channel: NRMSE
+        of the increments, largest difference [N or N*m] and its time), ending in a
+        newline; empty without load channels or for a run that diverged."""
+        if self.diverged or not self.load_channels:
+            return ""
+        lines = [f"{'section load':<24} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} "
+                 f"{'at t [s]':>9}"]
+        for c in self.load_channels:
+            w = self.worst[c]
+            lines.append(f"{c[len(LOADS_PREFIX):]:<24} {self.nrmse[c]:9.4f} "
+                         f"{w['max_abs_difference']:11.5f} {w['unit']:<6} "
+                         f"{w['at_time_s']:9.3f}")
+        lines.append("section loads: <fs|md>_<quantity>_s<station> (docs/loads.md); their "
+                     "NRMSE is that of the increments over 1 g")
+        return "\n".join(lines) + "\n"
+
     def as_dict(self) -> dict[str, object]:
-        """Plain data (JSON-ready): model, channels, nrmse, worst, diverged and when."""
-        return {"model": self.model, "channels": list(self.channels), "nrmse": self.nrmse,
+        """Plain data (JSON-ready): model, channels, load channels, nrmse, worst, diverged
+        and when."""
+        return {"model": self.model, "channels": list(self.channels),
+                "load_channels": list(self.load_channels), "nrmse": self.nrmse,
                 "worst": self.worst, "diverged": self.diverged,
                 "divergence_time_s": self.nonlinear.stop_time_s,
                 "duration_s": float(self.nonlinear.time_s[-1])
@@ -101,7 +134,49 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     else:
         ss = build_state_space(model, level_flight_condition(speed_m_s), build.model,
                                a_rr=lin.a)
-    return simulate(ss, nonlinear.time_s, nonlinear["w_g"])
+    layout = nonlinear.meta.get("loads")
+    lm = None if layout is None else _loads_model(build, nonlinear, model, speed_m_s)
+    if lm is not None and aero != "unsteady":
+        ss = with_load_outputs(ss, lm)
+    linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
+    if lm is not None:
+        _add_linear_loads(linear, lm, layout)
+    return linear
+
+
+def _loads_model(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float
+                 ) -> LoadsModel:
+    """The loads model of the nonlinear run's loads (its stations, density, static part)."""
+    layout = nonlinear.meta["loads"]
+    return build_loads_model(build, speed_m_s, layout["station_fractions"],
+                             density_kg_m3=layout["density_kg_m3"],
+                             static="rigid" if model == "rigid" else "elastic")
+
+
+def _add_linear_loads(linear: TimeHistory, lm, layout: dict) -> None:
+    """The LTI loads as the run's channels (totals: the run's 1 g values plus the LTI's
+    perturbations), for the run's methods; mode displacement of an LTI model without load
+    outputs (the unsteady one) from its η outputs."""
+    static = layout["static_1g"]
+    s = lm.n_stations
+    for name in layout["names"]:
+        row = name[len(LOADS_PREFIX):]
+        if row in linear.channels:
+            perturbation = linear.channels.pop(row)
+            linear.units.pop(row, None)
+        elif row.startswith("md_"):
+            quantity, j = row[3:].rsplit("_s", 1)
+            k = QUANTITIES.index(quantity) * s + int(j)
+            eta = np.column_stack([linear[f"eta{i + 1}"] for i in range(lm.n_modes)])
+            perturbation = eta @ lm.md_matrix[k]
+        else:
+            raise InputError(f"the LTI model has no output for the run's {name!r}")
+        linear.channels[name] = static[name] + perturbation
+        linear.units[name] = layout["units"][name]
+    for row in [c for c in linear.channels if c[:3] in ("fs_", "md_")]:  # not the run's
+        linear.channels.pop(row)
+        linear.units.pop(row, None)
+    linear.meta["loads"] = dict(layout)
 
 
 def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
@@ -112,16 +187,20 @@ def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s:
     if linear is None:
         linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim)
     channels = tuple(c for c in CHANNELS if c in linear.channels and c in nonlinear.channels)
+    load_channels = tuple(c for c in nonlinear.channels
+                          if c.startswith(LOADS_PREFIX) and c in linear.channels)
+    static = (nonlinear.meta.get("loads") or {}).get("static_1g", {})
     errors: dict[str, float | None] = {}
     worst: dict[str, dict[str, object]] = {}
     diverged = nonlinear.stopped is not None
-    for c in channels:
+    for c in channels + load_channels:
         unit = nonlinear.units.get(c, linear.units.get(c, ""))
         if diverged:
             errors[c] = None
             worst[c] = {"max_abs_difference": None, "unit": unit, "at_time_s": None}
             continue
-        errors[c] = nrmse(nonlinear[c], linear[c])
+        base = static.get(c, 0.0)  # a load: its increment over 1 g (module docstring)
+        errors[c] = nrmse(nonlinear[c] - base, linear[c] - base)
         diff = np.abs(linear[c] - nonlinear[c])
         k = int(np.argmax(diff))
         worst[c] = {"max_abs_difference": float(diff[k]), "unit": unit,
@@ -131,4 +210,4 @@ def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s:
                        color="tab:orange", linewidth=1.6, source="lti")
     nonlinear.meta.update(label=f"JSBSim {model}", color="tab:blue", linestyle="-",
                           linewidth=2.2)
-    return Comparison(model, nonlinear, linear, errors, worst, channels)
+    return Comparison(model, nonlinear, linear, errors, worst, channels, load_channels)

@@ -7,6 +7,13 @@ block is handed to a recorder (an MCAP log), and the run stops when the step lea
 range. Short runs keep every row; long ones keep one block plus a bounded envelope for their
 summary (``keep``), so memory stays flat however long the run. The Fig. 21 run is within
 1 % NRMSE of the same run at a quarter of the step (``tests/test_cosim.py``).
+
+Given the wing's build (``loads=``), a run also reports the wing's **section loads** at the
+monitoring stations (``docs/loads.md``): computed block by block as the run is flown
+(:class:`bioflex_jsb.loads.stream.LoadStream`, a row's loads once the next row's q is
+known), kept as channels ``loads_<fs|md>_<quantity>_s<j>`` (every step, or their extremes
+in the envelope) and handed to a recorder that takes them (the log's ``/bioflex/<model>/
+loads`` topic).
 """
 
 from __future__ import annotations
@@ -17,8 +24,12 @@ from typing import Protocol
 
 import numpy as np
 
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
+from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.interrupts import STOP, raise_if_stopped
+from bioflex_jsb.loads.model import LoadsModel, build_loads_model
+from bioflex_jsb.loads.stream import LoadStream
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
@@ -50,6 +61,11 @@ ENVELOPE_S = 0.25
 # span doubles), so the envelope of a run of any length stays under ~6 MB; its peaks stay
 # those of every step.
 ENVELOPE_MAX_WINDOWS = 2048
+# … and at most this many rows: a run with section loads keeps the extremes of 36 more
+# selectors per window (24 loads, 12 FS − MD differences, up to 84 rows a window), so its
+# windows are merged by the rows they hold too; the bound stays that of the run without
+# loads, 2048 windows × 12 rows (24576 rows of 55 doubles with loads: 10.8 MB).
+ENVELOPE_MAX_ROWS = 12 * ENVELOPE_MAX_WINDOWS
 SUMMARY_CHANNELS = ("u", "alpha", "q", "theta", "n_z")  # what gust_metrics reads
 WINDOW_S = 0.9  # rows per block without a recorder [s of simulated time]
 KEEP_CHOICES = ("auto", "all", "envelope")
@@ -67,6 +83,13 @@ class StepRecorder(Protocol):
     returns), and with the rows left when the run stops; ``stop(n)`` once at the end,
     however the run ends (finished, stopped, interrupted, failed), with the number of
     complete rows.
+
+    A recorder that also logs section loads has ``loads(layout)`` (optional): called once
+    before the first step of a run with loads (``layout``: the run's ``meta["loads"]``,
+    channel names, units, stations, 1 g values), it returns an object whose ``rows(time_s,
+    values)`` is handed the loads (rows × ``layout["names"]``) a block at a time, one step
+    behind the steps (:class:`~bioflex_jsb.loads.stream.LoadStream`), and whose ``stop()``
+    is called once at the end, before the recorder's own.
     """
 
     def start(self, names: tuple[str, ...], dt_s: float) -> int: ...
@@ -78,13 +101,19 @@ class StepRecorder(Protocol):
 
 class _Envelope:
     """A bounded history of a long run: per window of steps (ENVELOPE_S, doubled each time
-    more than ENVELOPE_MAX_WINDOWS are kept), the first and last step and the steps where
-    each of :data:`SUMMARY_CHANNELS` is smallest and largest, so the peaks (and the
-    overshoot) that ``gust_metrics`` reports are those of every step; its settling time is
-    resolved to the window (``span_s``)."""
+    more than ENVELOPE_MAX_WINDOWS windows or ENVELOPE_MAX_ROWS rows are kept), the first and last step and the steps where
+    each of :data:`SUMMARY_CHANNELS` (and each of ``extra``, the load channels) is smallest
+    and largest, and where the difference of each column pair of ``pairs`` (force
+    summation − mode displacement) is, so the peaks (and the overshoot) that
+    ``gust_metrics`` reports are those of every step; its settling time is resolved to the
+    window (``span_s``)."""
 
-    def __init__(self, names: tuple[str, ...], dt_s: float) -> None:
+    def __init__(self, names: tuple[str, ...], dt_s: float, extra: tuple[str, ...] = (),
+                 pairs: tuple[tuple[int, int], ...] = ()) -> None:
         self.cols = [names.index(c) for c in SUMMARY_CHANNELS if c in names]
+        self.cols += [names.index(c) for c in extra]
+        self.pair_a = np.array([a for a, _ in pairs], dtype=np.intp)
+        self.pair_b = np.array([b for _, b in pairs], dtype=np.intp)
         self.every = max(1, int(round(ENVELOPE_S / dt_s)))
         self.span_s = self.every * dt_s
         self._t: list[np.ndarray] = []
@@ -92,6 +121,8 @@ class _Envelope:
 
     def _keep(self, t: np.ndarray, seg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x = seg[:, self.cols]
+        if self.pair_a.size:
+            x = np.hstack([x, seg[:, self.pair_a] - seg[:, self.pair_b]])
         nan = np.isnan(x)
         hi = np.argmax(np.where(nan, -np.inf, x), axis=0)
         lo = np.argmin(np.where(nan, np.inf, x), axis=0)
@@ -103,7 +134,8 @@ class _Envelope:
             t, seg = self._keep(time_s[a:a + self.every], rows[a:a + self.every])
             self._t.append(t)
             self._rows.append(seg.copy())
-        if len(self._rows) > ENVELOPE_MAX_WINDOWS:
+        while (len(self._rows) > ENVELOPE_MAX_WINDOWS
+               or (sum(len(r) for r in self._rows) > ENVELOPE_MAX_ROWS and len(self._rows) > 1)):
             self._coarsen()
 
     def _coarsen(self) -> None:
@@ -129,7 +161,7 @@ class _Envelope:
 
 def run_gust(
     airframe: Airframe,
-    wing: ElasticWingModel | None,
+    wing: ElasticWingModel | WingBuild | None,
     model: str,
     setup: RunSetup,
     on_sample: Callable[[int, float, np.ndarray], None] | None = None,
@@ -139,6 +171,7 @@ def run_gust(
     keep: str = "auto",
     aero: str = "quasi-steady",
     trim_mode: str = "rigid",
+    loads: WingBuild | LoadsModel | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
     aircraft with the wing in its XML, ``wing`` then None).
@@ -156,6 +189,17 @@ def run_gust(
     settling time to ENVELOPE_S; ``meta["history"]`` says which) while the run itself keeps
     only one block of rows; ``"auto"`` (default): ``"all"`` up to KEEP_ALL_MAX_S of
     duration, else ``"envelope"``.
+
+    ``loads``: also report the wing's section loads (module docstring): the wing's
+    :class:`WingBuild` (the default stations, root, 25, 50, 75 % semispan; the 1 g part the
+    elastic trim's for the coupled and qsd wings, the undeformed wing's for the rigid model;
+    the run's own air density) or a :class:`~bioflex_jsb.loads.model.LoadsModel` of the
+    run's speed. The history then has the channels ``loads_<fs|md>_<quantity>_s<j>`` [N,
+    N·m] and ``meta["loads"]`` (stations, methods, 1 g values); a wing without section loads
+    (a modes file, no static equilibrium at this speed) or the native model has
+    ``meta["loads_unavailable"]`` (why) instead. Methods: both for the quasi-steady coupled
+    and qsd wings, force summation for the rigid model, mode displacement for the unsteady
+    wing (:mod:`bioflex_jsb.loads.stream`).
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
@@ -166,30 +210,70 @@ def run_gust(
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
     n_steps = int(round(setup.duration_s / dt))
     names = step.names
+    refused = True
+    try:
+        stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
+        refused = False
+    finally:
+        if refused:  # a loads model refused (InputError): the step's hold goes with it
+            step.release()
     keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
     stopped = None
     interrupted = False
     block = max(1, int(round(WINDOW_S / dt)))
+    loads_out = None  # the recorder's loads topic
     if recorder is not None:
         block = max(1, int(recorder.start(names, dt)))
+        if stream is not None and hasattr(recorder, "loads"):
+            loads_out = recorder.loads(loads_meta["loads"])
     block = min(block, max(n_steps, 1))
+    load_names = stream.names if stream is not None else ()
+    loads_table = None
     if keep_all:  # row k: step k, columns in names' order
         table = np.full((n_steps, len(names)), np.nan)
+        if stream is not None:
+            loads_table = np.full((n_steps, len(load_names)), np.nan)
         envelope = None
     else:  # one block of rows, refilled block after block
         table = np.full((block, len(names)), np.nan)
-        envelope = _Envelope(names, dt)
+        both = names + load_names
+        pairs = tuple((both.index(c), both.index(c.replace("loads_fs_", "loads_md_")))
+                      for c in load_names if c.startswith("loads_fs_")
+                      and c.replace("loads_fs_", "loads_md_") in load_names)
+        envelope = _Envelope(both, dt, load_names, pairs)
+    k_loads = 0  # rows whose loads are out
 
-    def hand(k0: int, m: int, j0: int) -> None:
+    def hand_loads(time_s: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
+        """Rows whose loads are known (one behind the steps): to the loads topic, the
+        loads table or the envelope."""
+        nonlocal k_loads
+        if not len(time_s):
+            return
+        if loads_out is not None:
+            loads_out.rows(time_s, values)
+        if loads_table is not None:
+            loads_table[k_loads:k_loads + len(time_s)] = values
+        if envelope is not None:
+            envelope.add(time_s, np.hstack([rows, values]))
+        k_loads += len(time_s)
+
+    def hand(k0: int, m: int, j0: int, last: bool = False) -> None:
         """Rows [k0, k0 + m) of the run, complete in the table from row j0: to the
-        recorder and the envelope."""
+        recorder and the envelope (and their loads, those known, to theirs; with the
+        ``last`` block, every one: the loads topic gets no chunk of a single step)."""
         if m <= 0:
             return
         rows = table[j0:j0 + m]
         time_s = (k0 + np.arange(m)) * dt
         if recorder is not None:
             recorder.rows(time_s, rows)
-        if envelope is not None:
+        if stream is not None:
+            known = stream.add(time_s, rows)
+            if last:
+                end = stream.finish()
+                known = tuple(np.concatenate([a, b]) for a, b in zip(known, end, strict=True))
+            hand_loads(*known)
+        elif envelope is not None:
             envelope.add(time_s, rows)
 
     advance_into = step.stepper()  # the step, bound once (compiled or Python)
@@ -221,7 +305,7 @@ def run_gust(
                             break
                 m, i = i, 0
                 k += m
-                hand(k - m, m, j0)
+                hand(k - m, m, j0, last=bool(stop) or k >= n_steps)
                 if stop:
                     stopped = stop
                     break
@@ -234,27 +318,39 @@ def run_gust(
             if i:  # the block in progress when the loop failed or was interrupted
                 m, i = i, 0
                 k += m
-                hand(k - m, m, j0)
+                hand(k - m, m, j0, last=True)
+            if stream is not None and stream.holding:  # interrupted between blocks
+                hand_loads(*stream.finish())
         finally:
-            if recorder is not None:
-                recorder.stop(k)  # also when the loop failed: every complete step kept
+            try:
+                if loads_out is not None:
+                    loads_out.stop()
+            finally:
+                if recorder is not None:
+                    recorder.stop(k)  # also when the loop failed: every complete step kept
     n = k
     if interrupted:
         stopped = f"interrupted at t = {n * dt:.3f} s"
     trim = step.trim
+    units = dict(step.units)
     if envelope is None:
         time_s = np.arange(n) * dt
         channels = {name: table[:n, c].copy() for c, name in enumerate(names)}
+        if loads_table is not None:
+            channels.update({name: loads_table[:n, c].copy()
+                             for c, name in enumerate(load_names)})
         history = "all"
     else:
-        time_s, rows = envelope.history(len(names))
-        channels = {name: rows[:, c].copy() for c, name in enumerate(names)}
+        time_s, rows = envelope.history(len(names) + len(load_names))
+        channels = {name: rows[:, c].copy() for c, name in enumerate(names + load_names)}
         history = "envelope"
+    if stream is not None:
+        units.update(stream.units)
     return TimeHistory(
         model=model,
         time_s=time_s,
         channels=channels,
-        units=dict(step.units),
+        units=units,
         meta={
             "source": "jsbsim-native" if model == "native" else "jsbsim-cosim",
             "speed_m_s": setup.speed_m_s,
@@ -274,6 +370,46 @@ def run_gust(
                                else [float(e) for e in step.elastic_trim.eta_rad]),
             "steps": n,
             "envelope_s": envelope.span_s if envelope is not None else None,
+            **loads_meta,
         },
         stopped=stopped,
     )
+
+
+def _load_stream(loads, step: CoupledStep, model: str, speed_m_s: float, aero: str
+                 ) -> tuple[LoadStream | None, dict[str, object]]:
+    """The run's :class:`LoadStream` and its meta entries (``run_gust``'s ``loads``): None
+    and ``{}`` without ``loads``; None and ``loads_unavailable`` (why) for a wing or model
+    that has no section loads."""
+    if loads is None:
+        return None, {}
+    if model == "native":
+        return None, {"loads_unavailable": "the native wing (in the aircraft's XML) has no "
+                                           "section loads model; fly the coupled model"}
+    if isinstance(loads, LoadsModel):
+        lm = loads
+        if abs(lm.speed_m_s - speed_m_s) > 1e-9:
+            raise InputError(f"the loads model is for {lm.speed_m_s:g} m/s, the run is "
+                             f"trimmed at {speed_m_s:g} m/s")
+        if model == "rigid" and np.any(lm.static_eta_rad != 0.0):
+            raise InputError("a rigid-wing run has no static deflection: give a loads model "
+                             "with static='rigid'")
+    elif isinstance(loads, WingBuild):
+        # the run's own density: JSBSim's at the trim (its dynamic pressure is the run's)
+        rho = 2.0 * step.reference.dynamic_pressure_pa / speed_m_s**2
+        try:
+            lm = build_loads_model(loads, speed_m_s, density_kg_m3=rho,
+                                   static="rigid" if model == "rigid" else "elastic")
+        except InputError as exc:  # a modes-file wing, no static equilibrium: said why
+            return None, {"loads_unavailable": str(exc)}
+    else:
+        raise TypeError(f"loads must be a WingBuild or a LoadsModel, not "
+                        f"{type(loads).__name__}")
+    static_eta = None if step.elastic_trim is None else step.elastic_trim.eta_rad
+    stream = LoadStream(lm, step.names, step.dt_s, model, static_eta, aero)
+    layout = {"names": list(stream.names), "units": dict(stream.units),
+              "methods": list(stream.methods), "stations_m": lm.stations_m.tolist(),
+              "station_fractions": list(lm.station_fractions),
+              "static_1g": dict(stream.static_1g), "note": lm.static_note,
+              "density_kg_m3": lm.density_kg_m3, "wing": lm.wing}
+    return stream, {"loads": layout}

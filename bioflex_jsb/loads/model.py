@@ -241,6 +241,34 @@ def _md_matrix(sections, modes, stations_m: np.ndarray) -> np.ndarray:
     return out.reshape(3 * stations_m.size, n)
 
 
+# The MD matrices built so far: the beam's eigen-solution is 90 % of a LoadsModel's cost
+# (0.135 of 0.15 s, measured) and depends on the wing's structure, modes and stations only,
+# not on the speed or the static part, so the rigid, coupled and qsd runs of one wing (and a
+# gust run after its loads post-process) share it. Keyed by the values it is built from;
+# at most _MD_CACHE_SIZE entries (≈ 1 kB each), the oldest dropped first.
+_MD_CACHE: dict[tuple, np.ndarray] = {}
+_MD_CACHE_SIZE = 32
+
+
+def _md_matrix_cached(sections, modes, stations_m: np.ndarray) -> np.ndarray:
+    """:func:`_md_matrix`, memoised on every array it is built from: the beam's sections,
+    the modes' samples and the stations (a copy is returned: callers may not change the
+    kept one)."""
+    arrays = (sections.stations_m, sections.bending_stiffness_n_m2,
+              sections.torsional_stiffness_n_m2, sections.mass_per_length_kg_m,
+              sections.torsional_inertia_kg_m, sections.chord_m, sections.x_elastic_frac,
+              sections.x_inertial_frac, modes.stations_m, modes.bending_m, modes.twist_rad,
+              stations_m)
+    key = tuple((np.shape(a), np.asarray(a, dtype=float).tobytes()) for a in arrays)
+    got = _MD_CACHE.get(key)
+    if got is None:
+        got = _md_matrix(sections, modes, stations_m)
+        if len(_MD_CACHE) >= _MD_CACHE_SIZE:
+            _MD_CACHE.pop(next(iter(_MD_CACHE)))
+        _MD_CACHE[key] = got
+    return got.copy()
+
+
 def _n_elements(modes) -> int:
     """The FE mesh of the beam modes: their stations are the nodes (``beam_modes``)."""
     return int(modes.stations_m.size - 1)
@@ -331,7 +359,7 @@ def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTION
         cl_trim=condition.cl_trim,
         alpha_wing_rad=condition.cl_trim / build.model.wing_lift_slope_per_rad,
         static_eta_rad=eta0, static_alpha_rad=float(dalpha0), fs_matrix=fs,
-        fs_aero_columns=aero_cols, md_matrix=_md_matrix(sections, modes, ys),
+        fs_aero_columns=aero_cols, md_matrix=_md_matrix_cached(sections, modes, ys),
         matrices=modal_matrices(build.model, condition.cl_trim), n_modes=n,
         static_note=note, half_wing_mass_kg=sections.half_wing_mass_kg,
         cells_m=yc, cell_widths_m=wc, cell_coefficients=(f_coef, t_coef),

@@ -126,6 +126,12 @@ class GustMetrics:
     None: a peak of a diverging response measures the divergence, not the gust response.
     ``divergence_time_s`` [s] and ``divergence_mode`` (:func:`divergence_mode`) say when and
     how, ``divergence`` the full reason.
+
+    ``loads``: the wing's section loads (:func:`section_load_metrics`, ``docs/loads.md``):
+    per method, quantity and monitoring station the largest and smallest value after the
+    gust start with their times, the 1 g value and the increments over it; None for a run
+    without load channels or one that diverged; ``{"unavailable": why}`` for a run whose
+    wing has no section loads (a modes-file wing, the native wing).
     """
 
     kind: str
@@ -146,6 +152,7 @@ class GustMetrics:
     divergence_time_s: float | None = None
     divergence_mode: str | None = None
     divergence: str | None = None
+    loads: dict[str, object] | None = None
 
     def as_dict(self) -> dict[str, float | None]:
         """The numeric metrics only (:data:`NUMERIC_METRICS`: numbers or None)."""
@@ -172,6 +179,7 @@ def gust_metrics(run: TimeHistory, gust_start_s: float,
     if turbulence is None:
         turbulence = is_turbulence(str(run.meta.get("gust", "")))
     kind = "turbulence" if turbulence else "discrete"
+    loads = None if run.stopped is not None else section_load_metrics(run, gust_start_s)
     if run.stopped is not None:
         return GustMetrics(kind, None, None, None, None, None, diverged=True,
                            divergence_time_s=run.stop_time_s,
@@ -179,7 +187,7 @@ def gust_metrics(run: TimeHistory, gust_start_s: float,
                            divergence=" ".join(str(run.stopped).split()))
     after = run.time_s >= gust_start_s
     if not np.any(after):
-        return GustMetrics(kind, None, None, None, None, None)
+        return GustMetrics(kind, None, None, None, None, None, loads=loads)
     ta = run.time_s[after]
     du, alpha, dq, dtheta = (run[c][after] for c in ("u", "alpha", "q", "theta"))
     dn_z = run["n_z"][after] - 1.0
@@ -192,6 +200,7 @@ def gust_metrics(run: TimeHistory, gust_start_s: float,
 
     common = dict(peak_du_m_s=peak(du), peak_dalpha_rad=peak(alpha), peak_dq_rad_s=peak(dq),
                   peak_dtheta_rad=peak(dtheta), peak_dn_z=peak(dn_z))
+    common["loads"] = loads
     if turbulence:
         return GustMetrics(kind, **common, rms_du_m_s=rms(du), rms_dalpha_rad=rms(alpha),
                            rms_dq_rad_s=rms(dq), rms_dtheta_rad=rms(dtheta), rms_dn_z=rms(dn_z))
@@ -208,6 +217,62 @@ def gust_metrics(run: TimeHistory, gust_start_s: float,
         overshoot, settling, sp_settling = 0.0, 0.0, 0.0
     return GustMetrics(kind, **common, overshoot=overshoot, settling_time_s=settling,
                        short_period_settling_time_s=sp_settling)
+
+
+LOAD_METHODS = (("force_summation", "fs"), ("mode_displacement", "md"))
+LOAD_QUANTITIES = ("shear_n", "bending_n_m", "torque_n_m")  # bioflex_jsb.loads.QUANTITIES
+
+
+def section_load_metrics(run: TimeHistory, gust_start_s: float) -> dict[str, object] | None:
+    """The section-load metrics of a run with load channels ``loads_<fs|md>_<quantity>_s<j>``
+    [N, N·m] and their layout in ``run.meta["loads"]`` (stations_m, station_fractions,
+    methods, static_1g per channel: :mod:`bioflex_jsb.loads.stream`): per method, quantity
+    and station the largest and smallest value at or after ``gust_start_s`` [s] with their
+    times [s], the 1 g value and the increments over it (``increment_up`` = max − 1 g,
+    ``increment_down`` = min − 1 g); ``max_abs_difference`` the largest |FS − MD| per
+    quantity and station when both methods are there. None without load channels;
+    ``{"unavailable": why}`` when the run says why it has none. An envelope history
+    (``keep="envelope"``) keeps every load's and difference's extremes, so these are those
+    of every step."""
+    layout = run.meta.get("loads")
+    if layout is None:
+        why = run.meta.get("loads_unavailable")
+        return None if why is None else {"unavailable": str(why)}
+    fractions = list(layout["station_fractions"])
+    out: dict[str, object] = {"stations_m": list(layout["stations_m"]),
+                              "station_fractions": fractions,
+                              "static": layout.get("note"), "methods": {}}
+    after = run.time_s >= gust_start_s
+    if not np.any(after):
+        return out
+    t = run.time_s[after]
+    static = layout["static_1g"]
+    labels = ["root" if f == 0.0 else f"{100 * f:g}% b/2" for f in fractions]
+    for method, tag in LOAD_METHODS:
+        if method not in layout["methods"]:
+            continue
+        per_q = {}
+        for quantity in LOAD_QUANTITIES:
+            rows = []
+            for j, label in enumerate(labels):
+                name = f"loads_{tag}_{quantity}_s{j}"
+                x = run.channels[name][after]
+                i_hi, i_lo = int(np.argmax(x)), int(np.argmin(x))
+                s_1g = float(static[name])
+                rows.append({"station": label, "max": float(x[i_hi]),
+                             "time_max_s": float(t[i_hi]), "min": float(x[i_lo]),
+                             "time_min_s": float(t[i_lo]), "static_1g": s_1g,
+                             "increment_up": float(x[i_hi]) - s_1g,
+                             "increment_down": float(x[i_lo]) - s_1g})
+            per_q[quantity] = rows
+        out["methods"][method] = per_q
+    if all(m in layout["methods"] for m, _ in LOAD_METHODS):
+        out["max_abs_difference"] = {
+            quantity: [float(np.max(np.abs(run.channels[f"loads_fs_{quantity}_s{j}"][after]
+                                           - run.channels[f"loads_md_{quantity}_s{j}"][after])))
+                       for j in range(len(labels))]
+            for quantity in LOAD_QUANTITIES}
+    return out
 
 
 def _settling_time(t: np.ndarray, x: np.ndarray, band: float, start_s: float) -> float | None:

@@ -363,6 +363,13 @@ class TableRecorder:
         """The run is over (``n`` complete rows): nothing is pending, every chunk was
         written by :meth:`rows`."""
 
+    def loads(self, layout: dict):
+        """The run's section loads on ``/bioflex/<model>/loads`` (``layout``: the run's
+        ``meta["loads"]``), a chunk per block after the steps' (:mod:`.loads_topic`)."""
+        from bioflex_jsb.sinks.mcap.loads_topic import LoadsTopic
+
+        return LoadsTopic(self._log, self._model, layout)
+
 
 class AutopilotRecorder:
     """Logs an autopilot's servo frames (ArduPilot's JSON SITL) on

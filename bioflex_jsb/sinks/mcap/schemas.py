@@ -12,7 +12,7 @@ RUN_METADATA = "bioflex.run"
 FRAME_METADATA = "bioflex.world_frame"
 WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
-          "lti_prediction", "autopilot")
+          "lti_prediction", "autopilot", "loads")
 # The autopilot topic's enums: (JSON schema / protobuf enum name, value names from 0); the
 # values are the drivers' codes (bioflex_jsb.drivers.ardupilot ACTIONS and PHASES)
 AUTOPILOT_ACTIONS = ("ACTION_STEP", "ACTION_RESEND", "ACTION_RESET")
@@ -224,6 +224,38 @@ SCHEMAS: dict[str, dict] = {
             "timestamp_s": _num("physics time of the state in the reply [s] (0 at ArduPilot's "
                                 "start and restarts)"),
         },
+    },
+}
+
+
+def _station_loads(method: str, what: str, unit: str, sign: str) -> dict:
+    return {"type": "array", "items": {"type": "number"},
+            "description": f"{what} by {method} at each monitoring station, {sign}; element j "
+            f"is station j (the channel's metadata: stations_m [m from the root], "
+            f"station_fractions of the semispan); empty when the run has no {method} [{unit}]"}
+
+
+# The wing's section loads of a gust run (bioflex_jsb.sinks.mcap.loads_topic; docs/loads.md
+# has the methods, frames and signs): totals, the 1 g part included
+SCHEMAS["loads"] = {
+    "title": "bioflex.SectionLoads",
+    "description": "Section loads of the starboard half wing at its monitoring stations, "
+    "the 1 g static part included (its values in the channel's metadata static_1g), by force "
+    "summation (fs: the strips' aerodynamic loads, the gust's included, minus the wing's "
+    "inertia) and by mode displacement (md: EI phi'' eta, GJ theta' eta); wing frame x aft, "
+    "y starboard, z up. One message per step at the step's log time, in chunks of their "
+    "own written after the steps' (a step's pitch acceleration is the central difference "
+    "of q: its loads wait for the next step).",
+    "type": "object",
+    "properties": {
+        f"{tag}_{quantity}": _station_loads(method, what, unit, sign)
+        for tag, method in (("fs", "force summation"), ("md", "mode displacement"))
+        for quantity, what, unit, sign in (
+            ("shear_n", "vertical shear of the wing outboard", "N", "up positive"),
+            ("bending_n_m", "bending moment about the station's x axis", "N*m",
+             "tip up positive (upper surface in compression)"),
+            ("torque_n_m", "torque about the elastic axis", "N*m",
+             "leading edge up positive"))
     },
 }
 for _s in SCHEMAS.values():
