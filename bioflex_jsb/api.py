@@ -141,7 +141,10 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
-    reason, the time and the mode) and holds every step up to then. The prototype's airframe
+    reason, the time and the mode) and holds every step up to then. Each run carries the
+    wing's section loads at the root, 25, 50 and 75 % semispan as channels
+    ``loads_<fs|md>_<quantity>_s<j>`` (:func:`bioflex_jsb.drivers.gust.run_gust`'s
+    ``loads``; docs/loads.md), and :func:`metrics` their peaks. The prototype's airframe
     only (another is refused in one line: docs/aircraft.md)."""
     wing = _flying_wing(wing)
     if aero not in AERO_MODELS:
