@@ -101,12 +101,12 @@ class StepRecorder(Protocol):
 
 class _Envelope:
     """A bounded history of a long run: per window of steps (ENVELOPE_S, doubled each time
-    more than ENVELOPE_MAX_WINDOWS windows or ENVELOPE_MAX_ROWS rows are kept), the first and last step and the steps where
-    each of :data:`SUMMARY_CHANNELS` (and each of ``extra``, the load channels) is smallest
-    and largest, and where the difference of each column pair of ``pairs`` (force
-    summation − mode displacement) is, so the peaks (and the overshoot) that
-    ``gust_metrics`` reports are those of every step; its settling time is resolved to the
-    window (``span_s``)."""
+    more than ENVELOPE_MAX_WINDOWS windows or ENVELOPE_MAX_ROWS rows are kept), the first
+    and last step and the steps where each of :data:`SUMMARY_CHANNELS` (and each of
+    ``extra``, the load channels) is smallest and largest, and where the difference of each
+    column pair of ``pairs`` (force summation − mode displacement) is, so the peaks (and
+    the overshoot) that ``gust_metrics`` reports are those of every step; its settling time
+    is resolved to the window (``span_s``)."""
 
     def __init__(self, names: tuple[str, ...], dt_s: float, extra: tuple[str, ...] = (),
                  pairs: tuple[tuple[int, int], ...] = ()) -> None:
