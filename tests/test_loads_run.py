@@ -135,6 +135,10 @@ def test_the_metrics_report_peaks_times_and_increments(wing, coupled_run):
                     assert mine[k] == pytest.approx(theirs[k], rel=1e-12, abs=1e-12), (q, k)
                 assert mine["time_max_s"] == theirs["time_max_s"]
                 assert mine["station"] == theirs["station"]
+    # the post-process of a run with loads takes the run's own density by default
+    again = section_loads(wing, run).values["force_summation"][:, 1, 0]
+    ref_m = run["loads_fs_bending_n_m_s0"]
+    assert np.max(np.abs(again - ref_m)) <= ROUNDING * np.max(np.abs(ref_m))
     root = m.loads["methods"]["force_summation"]["bending_n_m"][0]
     assert root["station"] == "root" and root["time_max_s"] == pytest.approx(0.5)
     assert root["max"] == pytest.approx(10.42, abs=0.01)

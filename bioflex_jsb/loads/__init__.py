@@ -35,8 +35,11 @@ def section_loads(build, run, stations=DEFAULT_STATION_FRACTIONS, *, static: str
     """Section loads of the nonlinear ``run`` (a TimeHistory of ``build``'s wing) at
     ``stations`` (fractions of the semispan) by both methods. ``static``: the 1 g part,
     ``elastic`` (default for the coupled and qsd models) or ``rigid`` (the rigid model's
-    only choice). ``density_kg_m3`` [kg/m³]: default sea level (refused for a run starting
-    above SEA_LEVEL_ALTITUDE_MAX_M without it)."""
+    only choice). ``density_kg_m3`` [kg/m³]: default the density of the run's own loads
+    (``meta["loads"]``, a run of ``run_gust(loads=...)``: JSBSim's at its trim), else sea
+    level (refused for a run starting above SEA_LEVEL_ALTITUDE_MAX_M without it)."""
+    if density_kg_m3 is None and run.meta.get("loads"):
+        density_kg_m3 = float(run.meta["loads"]["density_kg_m3"])
     if density_kg_m3 is None:
         alt = run.channels.get("altitude_m")
         if alt is not None and len(alt) and float(alt[0]) > SEA_LEVEL_ALTITUDE_MAX_M:
