@@ -77,9 +77,6 @@ class WsClient:
 
     def _take(self, n: int) -> bytes:
         while len(self._buf) - self._pos < n:
-            if self._pos:  # the bytes read are dropped only before a refill: no quadratic copy
-                del self._buf[:self._pos]
-                self._pos = 0
             self._fill()
         out = bytes(self._buf[self._pos:self._pos + n])
         self._pos += n
@@ -104,7 +101,19 @@ class WsClient:
                           + bytes(b ^ mask[i % 4] for i, b in enumerate(payload)))
 
     def recv(self) -> tuple[str, bytes]:
-        """The next whole message: ("text" | "binary" | "close", payload)."""
+        """The next whole message: ("text" | "binary" | "close", payload). A timeout leaves
+        the message unread (the next call reads it from its start)."""
+        if self._pos == len(self._buf) or self._pos > 1 << 20:  # read bytes dropped now and
+            del self._buf[:self._pos]  # then, not per message (no quadratic copying)
+            self._pos = 0
+        mark = self._pos
+        try:
+            return self._recv()
+        except TimeoutError:
+            self._pos = mark
+            raise
+
+    def _recv(self) -> tuple[str, bytes]:
         parts, kind = [], None
         while True:
             b0, b1 = self._take(2)
@@ -459,3 +468,61 @@ def test_one_server_serves_a_sitl_session_across_its_log_files(tmp_path):
     # the steps of the later files reached the one connection: the last step at least 3 s
     # into the session (of 6)
     assert times and times[-1] >= 3e9 and times == sorted(times)
+
+
+@pytest.mark.slow
+def test_an_ardupilot_session_is_served_live(tmp_path):
+    """``ardupilot --live``, flown by the ArduPilot stand-in (tests/ardupilot_standin.py)
+    in this process: a client subscribed to the autopilot topic receives the file's
+    messages, one per servo frame answered."""
+    from bioflex_jsb.cli import build_parser
+    from tests.ardupilot_standin import ArduPilotStandin
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        udp_port = s.getsockname()[1]
+    out = tmp_path / "ap.mcap"
+    args = build_parser().parse_args(["ardupilot", "--port", str(udp_port), "--duration", "3",
+                                      "--out", str(out), "--live", "127.0.0.1:0"])
+    result: dict = {}
+    th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
+    th.start()
+    end = time.monotonic() + START_S
+    while getattr(args, "live_server", None) is None:
+        assert th.is_alive() and time.monotonic() < end, "no live server"
+        time.sleep(0.01)
+    client = WsClient("127.0.0.1", args.live_server.port, timeout_s=0.05)
+    ap = ArduPilotStandin(("127.0.0.1", udp_port), timeout_s=0.5)
+    channels: dict[int, dict] = {}
+    got: list[tuple[int, bytes]] = []
+    autopilot = "/bioflex/coupled/autopilot"
+    try:
+        while th.is_alive() and time.monotonic() < end + RUN_S:
+            ap.send_servos((1500, 1500, 1000, 1500) + (1000,) * 12)  # disarmed: at rest
+            try:
+                ap.receive()
+            except TimeoutError:
+                pass
+            try:  # what the server sent meanwhile (the client's timeout: 50 ms)
+                while True:
+                    kind, payload = client.recv()
+                    if kind == "text":
+                        message = json.loads(payload)
+                        if message["op"] == "advertise":
+                            _subscribe_new(client, message, channels)
+                        else:
+                            _resubscribe(client, message)
+                    elif kind == "binary" and channels[struct.unpack_from(
+                            "<I", payload, 1)[0]]["topic"] == autopilot:
+                        got.append((struct.unpack_from("<Q", payload, 5)[0], payload[13:]))
+            except (TimeoutError, ConnectionError):
+                pass
+    finally:
+        ap.close()
+        client.close()
+    th.join(30.0)
+    assert result.get("rc") == 0
+    raw, _ = _file_messages(out)
+    assert got and all(raw[(autopilot, ns)] == data for ns, data in got)
+    on_file = sum(1 for t, _ in raw if t == autopilot)
+    assert 2 * len(got) >= on_file  # subscribed after the first chunk of a few
