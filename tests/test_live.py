@@ -13,6 +13,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import importlib
+import importlib.util
 import json
 import os
 import queue
@@ -147,6 +148,10 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+# The server's tests need the optional extra `live` (foxglove-sdk); the refusals do not
+NEEDS_SDK = pytest.mark.skipif(importlib.util.find_spec("foxglove") is None,
+                               reason="foxglove-sdk (bioflex-jsb[live]) is not installed")
+
 # Wall-time bounds [s]: a command starts (imports, wing build, trim) in 3-10 s on this
 # shared 2-core machine at load 4-6 (measured); the bounds are ~10x that, only so that a
 # hang ends the test instead of the suite.
@@ -265,6 +270,7 @@ def _same_fields(ours: dict, theirs) -> None:
 
 
 @pytest.mark.slow
+@NEEDS_SDK
 def test_a_gust_run_is_served_live_with_the_logs_bytes_and_schemas(tmp_path):
     """An independent client subscribes to every channel of a running ``gust --live``; every
     message it gets is the file's message (same topic, log time and bytes), decodes with
@@ -348,6 +354,7 @@ def test_a_gust_run_is_served_live_with_the_logs_bytes_and_schemas(tmp_path):
 
 
 @pytest.mark.slow
+@NEEDS_SDK
 def test_a_client_that_stops_reading_never_stalls_a_sitl_session(tmp_path):
     """A client subscribes to every channel of a live SITL session with a 4 kB receive
     buffer and never reads again: the paced session still flies all its steps in its time
@@ -389,6 +396,7 @@ def test_a_client_that_stops_reading_never_stalls_a_sitl_session(tmp_path):
 
 
 @pytest.mark.slow
+@NEEDS_SDK
 def test_no_client_costs_no_errors(tmp_path):
     out = tmp_path / "quiet.mcap"
     cmd = Command(tmp_path, "gust", "--models", "coupled", "--duration", "2", "--json",
@@ -429,6 +437,7 @@ def test_loopback_rule():
 
 
 @pytest.mark.slow
+@NEEDS_SDK
 def test_one_server_serves_a_sitl_session_across_its_log_files(tmp_path):
     """A session whose log rolls to a new file every ~0.35 s (--log-max-mb 0.3): one client
     connection receives the steps of all the files (the server is the session's, not a
@@ -471,6 +480,7 @@ def test_one_server_serves_a_sitl_session_across_its_log_files(tmp_path):
 
 
 @pytest.mark.slow
+@NEEDS_SDK
 def test_an_ardupilot_session_is_served_live(tmp_path):
     """``ardupilot --live``, flown by the ArduPilot stand-in (tests/ardupilot_standin.py)
     in this process: a client subscribed to the autopilot topic receives the file's
@@ -526,3 +536,13 @@ def test_an_ardupilot_session_is_served_live(tmp_path):
     assert got and all(raw[(autopilot, ns)] == data for ns, data in got)
     on_file = sum(1 for t, _ in raw if t == autopilot)
     assert 2 * len(got) >= on_file  # subscribed after the first chunk of a few
+
+
+def test_live_without_the_sdk_is_refused_in_one_line(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "foxglove", None)  # import foxglove: ImportError
+    code, _, err = run_cli(capsys, "gust", "--models", "coupled", "--duration", "1",
+                           "--live", "0")
+    assert_one_line_error(code, err, "--live needs the Foxglove SDK: pip install "
+                          "'bioflex-jsb[live]'")
+    assert not list(tmp_path.iterdir())  # refused before the log file was made
