@@ -58,7 +58,8 @@ from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metric
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
     "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
-    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "to_python_control",
+    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "section_loads",
+    "to_python_control",
 ]
 
 

@@ -26,6 +26,20 @@ RUN_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", 
 # a gust run's log: the steps' topics and the wing's section loads (sinks/mcap/loads_topic.py,
 # one message per step, a chunk of their own per block)
 LOG_GROUPS = RUN_GROUPS + ("loads",)
+# The 3-D scene (sinks/mcap/scene.py) in every gust log: the wing at SCENE_RATE_HZ, the rigid
+# parts once per chunk; not one message per step, so counted apart.
+SCENE_GROUPS = ("scene", "airframe")
+
+
+def per_step(counts: dict[str, int]) -> dict[str, int]:
+    """The topics' message counts without the scene's (which are not one per step)."""
+    return {t: n for t, n in counts.items() if t.rsplit("/", 1)[-1] not in SCENE_GROUPS}
+
+
+def step_messages(path) -> int:
+    """Messages of a log on its per-step topics (the scene's left out)."""
+    info = sink.summarise(path)
+    return sum(per_step({c["topic"]: c["messages"] for c in info["channels"]}).values())
 NEW_COMMANDS = ("info", "plot", "rerun")
 
 
@@ -62,8 +76,12 @@ def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
 def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
     info = sink.summarise(gust_log)
     counts = {c["topic"]: c["messages"] for c in info["channels"]}
-    assert counts == {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
+    assert per_step(counts) == {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
+    # the scene: 60 samples over the second flown, the rigid parts once per chunk of steps
+    assert counts[sink.topic("coupled", "scene")] == 60
+    assert counts[sink.topic("coupled", "airframe")] == math.ceil(1.0 / sink.CHUNK_SPAN_S)
     schemas = {c["topic"]: c["schema"] for c in info["channels"]}
+    assert schemas[sink.topic("coupled", "scene")] == "foxglove.SceneUpdate"
     assert schemas["/bioflex/coupled/pose"] == "foxglove.FrameTransform"
     assert schemas["/bioflex/coupled/location"] == "foxglove.LocationFix"
     assert info["duration_s"] == pytest.approx((STEPS_1S - 1) * DEFAULT_DT_S, abs=1e-9)
@@ -77,7 +95,8 @@ def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
                                        gust="sharp:3", models=("coupled",), duration_s=1.0)
     assert "arguments" not in run and "argv" not in run
     # chunks close every CHUNK_SPAN_S of simulated time: what a SIGKILL can lose
-    assert info["chunks"] == 2 * math.ceil(1.0 / sink.CHUNK_SPAN_S)  # steps, then loads
+    # steps, then their scene, then their loads
+    assert info["chunks"] == 3 * math.ceil(1.0 / sink.CHUNK_SPAN_S)
 
 
 def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
@@ -170,14 +189,16 @@ def node_check(tmp_path_factory):
 def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
     result = node_check(gust_log)
     expected = {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
-    assert result["counts"] == expected  # read through the chunk indexes, CRCs checked
-    assert result["statistics"] == expected
+    assert per_step(result["counts"]) == expected  # through the chunk indexes, CRCs checked
+    assert per_step(result["statistics"]) == expected
     assert result["dataCrcOk"] is True and result["ordered"] is True
     assert result["schemas"]["/bioflex/coupled/location"] == "foxglove.LocationFix"
     assert set(result["encodings"].values()) == {"protobuf"}
     # protobufjs (Foxglove's decoder) reads every message as our own reader does
     ours = read_all(gust_log)
     for top, theirs in result["samples"].items():
+        if top.rsplit("/", 1)[-1] in SCENE_GROUPS:
+            continue  # nested messages: tests/test_scene.py compares their vertices
         mine = ours[top][1][1]
         if "timestamp" in theirs:  # google.protobuf.Timestamp: seconds/nanos
             ts = theirs.pop("timestamp")
@@ -207,7 +228,8 @@ def test_pymcap_cli_doctor(gust_log):
 def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     assert main(["info", str(gust_log), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["messages"] == STEPS_1S * len(LOG_GROUPS)
+    assert info["messages"] == step_messages(gust_log) + 60 + 2  # + the scene's
+    assert step_messages(gust_log) == STEPS_1S * len(LOG_GROUPS)
     png = tmp_path / "run.png"
     assert main(["plot", str(gust_log), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000
@@ -217,14 +239,14 @@ def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["equal"] is True and result["first_difference"] is None
     assert result["command"][1:3] == ["gust", "--wing"]
-    assert sink.summarise(again)["messages"] == STEPS_1S * len(LOG_GROUPS)
+    assert step_messages(again) == STEPS_1S * len(LOG_GROUPS)
 
 
 def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
     from bioflex_jsb.cli.rerun import compare_logs
 
     same = compare_logs(str(gust_log), str(gust_log), 1e-8)
-    assert same["equal"] and same["messages"] == STEPS_1S * len(LOG_GROUPS)
+    assert same["equal"] and same["messages"] == sink.summarise(gust_log)["messages"]
     other = tmp_path / "other.mcap"
     assert cli.main(["gust", "--duration", "1", "--models", "coupled", "--gust", "sharp:2",
                      "--out", str(other), "--json"]) == 0
@@ -265,7 +287,7 @@ def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     second = json.loads(capsys.readouterr().out)["out"]
     logs = sorted(folder.glob("gust-optimised-*.mcap"))
     assert {str(p) for p in logs} == {first, second} and first != second
-    assert sink.summarise(first)["messages"] == round(0.2 / DEFAULT_DT_S) * len(LOG_GROUPS)
+    assert step_messages(first) == round(0.2 / DEFAULT_DT_S) * len(LOG_GROUPS)
     assert main([*args, "--no-log"]) == 0
     assert json.loads(capsys.readouterr().out)["out"] is None
     assert len(list(folder.iterdir())) == 2
@@ -401,7 +423,7 @@ def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
         # the signal lands between two statements of the instrumented loop: the last step
         # printed and the last step logged can be one step apart (either way), no more
         assert abs(rigid[-1][0] * 1e-9 - flown[-1]) <= DEFAULT_DT_S + 1e-9
-    counts = node_check(path)["counts"]
+    counts = per_step(node_check(path)["counts"])
     # the loads too: the run hands on its last row's loads when it is stopped
     assert counts == {sink.topic("coupled", g): n for g in LOG_GROUPS}
     assert "interrupted" in err and "holds every step" in err
@@ -433,7 +455,7 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     print(f"SIGKILL at t = {last_flown_s:.3f} s simulated: recovered up to "
           f"{report['last_time_s']:.3f} s, lost {lost_s:.3f} s")
     assert 0.0 <= lost_s <= sink.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
-    counts = node_check(fixed)["counts"]
+    counts = per_step(node_check(fixed)["counts"])
     n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
     loads = counts.pop(sink.topic("coupled", "loads"))
     assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}

@@ -73,6 +73,10 @@ class RunLog:
         self._events_id: int | None = None  # the events channel, made at the first event
         self.events = 0  # events logged
         self.scene = None  # the aircraft in 3-D (scene.SceneLog, RunLog.open(scene=)) or None
+        # the scene's samples of the steps kept, written as a chunk of their own after the
+        # steps' chunk (in it they would follow later steps and autopilot frames: out of
+        # log-time order, which readers and `doctor --strict-message-order` refuse)
+        self._scene_blocks: list = []
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -204,22 +208,25 @@ class RunLog:
         scene = None if self.scene is None else self.scene.build(
             next(m for m, c in self._models.items() if c is ch), ch.names, ts[:n],
             v.reshape(n, len(ch.names)))  # the 3-D scene's samples of these steps
-        if not self._row_bytes_measured or len(block) > n * self._row_bytes:
-            self._row_bytes = -(-len(block) // n)  # the first measure, then the largest
+        size = len(block) + (len(scene[0]) if scene else 0)  # the scene's bytes count too
+        if not self._row_bytes_measured or size > n * self._row_bytes:
+            self._row_bytes = -(-size // n)  # the first measure, then the largest
             self._row_bytes_measured = True
         ch.seq += n
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
         if scene:
-            self._writer.append_block(*scene)
+            self._scene_blocks.append(scene)
 
     def size_bound(self, more_steps: int = 0) -> int:
         """An upper bound [bytes] of this file's size if it were closed now after
         ``more_steps`` more steps (:meth:`McapFileWriter.size_bound`; the steps kept and
         the ones to come at the most bytes a step has taken, ``_row_bytes``). For a log of
         :meth:`sample` steps (and events); autopilot frames are not counted."""
-        return self._writer.size_bound((len(self._rows) + more_steps) * self._row_bytes)
+        scene = sum(len(block) for block, _ in self._scene_blocks)  # not yet in the writer
+        return self._writer.size_bound((len(self._rows) + more_steps) * self._row_bytes
+                                       + scene)
 
     def event(self, t_s: float, level: int | str, text: str, name: str = "bioflex-jsb") -> None:
         """An event at the log time ``t_s`` [s]: a ``foxglove.Log`` message on
@@ -292,6 +299,11 @@ class RunLog:
             for stream in self._streams:
                 stream._format()
             self._writer.close_chunk()
+            if self._scene_blocks:
+                for scene in self._scene_blocks:
+                    self._writer.append_block(*scene)
+                self._scene_blocks.clear()
+                self._writer.close_chunk()
         self._pending = None
 
     def close(self) -> None:
@@ -354,9 +366,11 @@ class TableRecorder:
             block, index = ch.format(time_s, rows, ch.seq, log._origin)
             ch.seq += len(rows)
             log._writer.append_block(block, index)
-            if log.scene is not None:
-                log.scene.rows(self._model, ch.names, time_s, rows)
             log._writer.close_chunk()
+            if log.scene is not None:  # its samples in a chunk of their own, after the
+                # steps' (in one chunk they would follow later steps: out of log-time order)
+                log.scene.rows(self._model, ch.names, time_s, rows)
+                log._writer.close_chunk()
             self.steps += len(rows)
 
     def stop(self, n: int) -> None:
