@@ -1,7 +1,7 @@
-"""Per-step cost of the 3-D scene and of the live server (docs/logging.md): 10 s gust runs
-(coupled, the Fig. 21 case) without a log, logged, logged with the scene, logged and served
-live with no client; interleaved repeats after one warm-up round; process CPU time of
-run_gust. Writes cost_*.mcap in the current directory.
+"""Per-step cost of the 3-D scene (docs/logging.md): 10 s gust runs (coupled, the Fig. 21
+case) without a log, logged, logged with the scene; interleaved repeats after one warm-up
+round; process CPU time of run_gust. Writes cost_*.mcap in the current directory. (The live
+server's cost with no client: tests/test_live.py and docs/logging.md, "Live view".)
 
     python scripts/scene_cost.py [REPEATS]   (default 7)
 """
@@ -22,7 +22,7 @@ from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks.mcap import RunLog
 
-MODES = ("none", "log", "scene", "live")
+MODES = ("none", "log", "scene")
 DURATION_S = 10.0
 
 
@@ -45,8 +45,7 @@ def main(argv: list[str]) -> int:
             log = None
             if mode != "none":
                 log = RunLog.open(f"cost_{mode}.mcap", desc, wing_variant=build.variant.as_dict(),
-                                  scene=1.0 if mode == "scene" else None,
-                                  live=("127.0.0.1", 0) if mode == "live" else None)
+                                  scene=1.0 if mode == "scene" else None)
             t0 = time.process_time()
             run_gust(air, build.model, "coupled", setup,
                      recorder=log.recorder("coupled") if log else None, keep="envelope")
@@ -60,7 +59,6 @@ def main(argv: list[str]) -> int:
     res = {f"{m}_us_per_step": _spread(per[m]) for m in MODES}
     res["log_cost_us_per_step"] = _spread(per["log"] - per["none"])
     res["scene_cost_us_per_step"] = _spread(per["scene"] - per["log"])
-    res["live_no_client_cost_us_per_step"] = _spread(per["live"] - per["log"])
     res["logged_ratio_no_scene"] = float(np.median(per["log"] / per["none"]))
     res["logged_ratio_scene"] = float(np.median(per["scene"] / per["none"]))
     res["sizes_bytes"] = sizes

@@ -90,13 +90,13 @@ class RunLog:
     def open(cls, path: str | Path, description: RunDescription,
              wing_variant: Mapping[str, Any] | None = None,
              overrides: Mapping[str, float] | None = None,
-             scene: float | None = None, live: tuple[str, int] | None = None) -> RunLog:
+             scene: float | None = None) -> RunLog:
         """Create ``path`` and write the ``bioflex.run`` metadata of the run ``description``
         (:func:`~bioflex_jsb.sinks.mcap.metadata.run_metadata`; ``wing_variant``: the wing
         build's variant as a dict, ``overrides``: its coefficient overrides, plain data).
         ``scene``: also log the aircraft in 3-D (:mod:`.scene`, topics
         ``/bioflex/<model>/scene``) with this exaggeration of the deformation [-]; None: not.
-        ``live``: (host, port) to serve the log live as it is written (:mod:`.live`).
+        Served live (``--live``): :mod:`bioflex_jsb.sinks.live`, teed at the writer.
         A file that cannot be created is a :class:`LogWriteError` (one line)."""
         p = Path(path)
         meta = run_metadata(description, wing_variant, overrides)
@@ -104,7 +104,7 @@ class RunLog:
             stream = open(p, "wb")  # noqa: SIM115 - closed in close()
         except OSError as exc:
             raise LogWriteError(f"cannot write log {str(p)!r}: {exc.strerror}") from None
-        log = cls.local(p, stream, meta, live)
+        log = cls.local(p, stream, meta)
         if scene is not None:
             from bioflex_jsb.sinks.mcap.scene import SceneLog
 
@@ -112,17 +112,8 @@ class RunLog:
         return log
 
     @classmethod
-    def local(cls, path: Path, stream, meta: dict[str, str],
-              live: tuple[str, int] | None = None) -> RunLog:
+    def local(cls, path: Path, stream, meta: dict[str, str]) -> RunLog:
         writer = McapFileWriter(stream, library=f"bioflex-jsb {__version__}")
-        if live is not None:  # the same messages over the Foxglove WebSocket protocol
-            from bioflex_jsb.sinks.mcap.live import LiveWriter
-
-            try:
-                writer = LiveWriter(writer, *live)
-            except LogWriteError:
-                stream.close()
-                raise
         log = cls(path, stream, writer)
         writer.add_metadata(RUN_METADATA, meta)
         writer.flush()  # header and run metadata on disk before the first step
