@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import shutil
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -17,6 +16,7 @@ from bioflex_jsb.generators import airframe as X
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import POST_STALL, PROPULSION, RIGID_AERODYNAMICS
 from bioflex_jsb.runtime import fdm as jsbsim_fdm
+from tests.tools import env_program
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -106,8 +106,7 @@ def test_trim_companion_differs_only_in_the_rotor_inertia():
 
 
 def test_console_program_runs_a_script_without_warnings(tmp_path):
-    exe = shutil.which("jsbsim")
-    assert exe is not None, "the jsbsim console script of the pip package is not on PATH"
+    exe = env_program("jsbsim")  # the jsbsim package's console script
     script = tmp_path / "smoke.xml"
     script.write_text(
         '<?xml version="1.0"?>\n'

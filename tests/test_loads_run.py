@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import subprocess
 
 import numpy as np
@@ -21,6 +20,7 @@ from bioflex_jsb.loads.stream import LoadStream, channel_names
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.results import TimeHistory, gust_metrics, section_load_metrics
+from tests.tools import env_program
 
 # Rounding only: the stream and the post-process do the same products on the same numbers,
 # in other groupings (a block's rows at a time, numpy.gradient's non-uniform formula for
@@ -259,9 +259,7 @@ def test_info_lists_the_topic_and_doctor_passes(logged, capsys):
     out = capsys.readouterr().out
     for model in ("coupled", "rigid"):
         assert f"/bioflex/{model}/loads" in out and "bioflex.SectionLoads" in out
-    exe = shutil.which("pymcap-cli")
-    if exe is None:
-        pytest.fail("pymcap-cli is missing: install the test extra (pip install '.[test]')")
+    exe = env_program("pymcap-cli")
     # strict: every chunk in log-time order (the loads have chunks of their own)
     res = subprocess.run([exe, "doctor", "--strict-message-order", str(path)],
                          capture_output=True, text=True, timeout=120)

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -17,6 +16,7 @@ import pytest
 from bioflex_jsb import cli
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
+from tests.tools import env_program
 
 DESCRIPTION = RunDescription(kind="gust", wing="optimised", speed_m_s=15.0, gust="sharp:3",
                              models=("coupled",), duration_s=2.0)
@@ -66,9 +66,7 @@ def _chunks(path: Path) -> list:
 
 
 def _doctor_ok(path: Path) -> None:
-    exe = shutil.which("pymcap-cli")
-    if exe is None:
-        return  # the test extra is not installed here: the other checks still run
+    exe = env_program("pymcap-cli")
     out = subprocess.run([exe, "doctor", str(path)], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 0 and "passed" in out.stdout, out.stdout + out.stderr

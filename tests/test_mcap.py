@@ -19,6 +19,7 @@ from bioflex_jsb import cli
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
+from tests.tools import env_program
 
 ROOT = Path(__file__).resolve().parents[1]
 JS_CHECK = ROOT / "tests" / "js" / "check_mcap.cjs"
@@ -216,9 +217,7 @@ def test_old_json_log_reads_with_mcap_core(node_check):
 
 
 def test_pymcap_cli_doctor(gust_log):
-    exe = shutil.which("pymcap-cli")
-    if exe is None:
-        pytest.fail("pymcap-cli is missing: install the test extra (pip install '.[test]')")
+    exe = env_program("pymcap-cli")
     out = subprocess.run([exe, "doctor", str(gust_log)], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 0, out.stdout + out.stderr
