@@ -19,6 +19,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # executes the notebooks (SITL, gusts): not in the fast subset
+
 REPO = Path(__file__).resolve().parents[1]
 TUTORIALS = sorted(p.name for p in (REPO / "docs" / "tutorials").glob("*.ipynb"))
 CELL_TIMEOUT_S = 600  # generous: a loaded machine (load 10 on 2 cores) was seen 3x slower
