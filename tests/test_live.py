@@ -30,6 +30,7 @@ import pytest
 from bioflex_jsb.sinks.mcap import summarise
 from bioflex_jsb.sinks.mcap.protobuf import decoder
 from tests.cli_helpers import assert_one_line_error, run_cli
+from tests.tools import protobuf_class
 
 WS_GUID = b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11"  # RFC 6455, section 1.3
 # The Foxglove WebSocket protocol v1 goes by two names: ``foxglove.websocket.v1`` (the
@@ -239,13 +240,7 @@ def _file_messages(path) -> tuple[dict, dict]:
 def _runtime_class(channel: dict):
     """The message class of an advertised channel, built by Google's protobuf runtime from
     the advertised FileDescriptorSet (Foxglove's published schema for ``foxglove.*``)."""
-    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-
-    pool = descriptor_pool.DescriptorPool()
-    for fd in descriptor_pb2.FileDescriptorSet.FromString(
-            base64.b64decode(channel["schema"])).file:
-        pool.Add(fd)
-    return message_factory.GetMessageClass(pool.FindMessageTypeByName(channel["schemaName"]))
+    return protobuf_class(channel["schemaName"], base64.b64decode(channel["schema"]))
 
 
 def _same_fields(ours: dict, theirs) -> None:

@@ -20,7 +20,7 @@ from bioflex_jsb.loads.stream import LoadStream, channel_names
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.results import TimeHistory, gust_metrics, section_load_metrics
-from tests.tools import env_program
+from tests.tools import channel_metadata, decode_topic, env_program
 
 # Rounding only: the stream and the post-process do the same products on the same numbers,
 # in other groupings (a block's rows at a time, numpy.gradient's non-uniform formula for
@@ -187,26 +187,6 @@ def test_a_wing_without_section_loads_says_why(wing):
     assert "native wing" in native.meta["loads_unavailable"]
 
 
-def decode_topic(path, topic_name):
-    """[(log time ns, message)] of a topic, decoded by the protobuf runtime from the file's
-    own FileDescriptorSet; and the channel's metadata."""
-    pytest.importorskip("google.protobuf")
-    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-    from mcap.reader import make_reader
-
-    out, cls, meta = [], None, None
-    with open(path, "rb") as f:
-        for schema, channel, message in make_reader(f).iter_messages(topics=[topic_name]):
-            if cls is None:
-                pool = descriptor_pool.DescriptorPool()
-                for fd in descriptor_pb2.FileDescriptorSet.FromString(schema.data).file:
-                    pool.Add(fd)
-                cls = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
-                meta = dict(channel.metadata)
-            out.append((message.log_time, cls.FromString(message.data)))
-    return out, meta
-
-
 @pytest.fixture(scope="module")
 def logged(wing, tmp_path_factory):
     """A coupled and a rigid run logged through the log's recorder, with their histories."""
@@ -235,7 +215,8 @@ def test_the_log_topic_is_the_runs_load_channels(logged, model):
     bit for bit; the channel's metadata names the stations and the 1 g values."""
     path, runs = logged
     run = runs[model]
-    msgs, meta = decode_topic(path, f"/bioflex/{model}/loads")
+    msgs = decode_topic(path, f"/bioflex/{model}/loads")
+    meta = channel_metadata(path, f"/bioflex/{model}/loads")
     assert [ns for ns, _ in msgs] == [round(t * 1e9) for t in run.time_s]
     assert json.loads(meta["stations_m"]) == run.meta["loads"]["stations_m"]
     assert meta["methods"].split(",") == run.meta["loads"]["methods"]

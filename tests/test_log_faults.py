@@ -16,7 +16,7 @@ import pytest
 from bioflex_jsb import cli
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
-from tests.tools import env_program
+from tests.tools import env_program, protobuf_class, published_files
 
 DESCRIPTION = RunDescription(kind="gust", wing="optimised", speed_m_s=15.0, gust="sharp:3",
                              models=("coupled",), duration_s=2.0)
@@ -167,22 +167,13 @@ def test_embedded_foxglove_schemas_are_the_published_ones():
 
     from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
 
-    published = {}
-
-    def add(fd):
-        for dep in fd.dependencies:
-            add(dep)
-        published[fd.name] = fd.serialized_pb
-
-    add(FrameTransform_pb2.DESCRIPTOR)
-    add(LocationFix_pb2.DESCRIPTOR)
+    published = published_files(FrameTransform_pb2.DESCRIPTOR, LocationFix_pb2.DESCRIPTOR)
     assert fox.FILES == published, pb.__name__
 
 
 def test_protobuf_messages_decode_with_the_protobuf_package(log2s):
     """Google's own protobuf runtime reads our messages with the file's schemas."""
     pytest.importorskip("google.protobuf")
-    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
     from mcap.reader import make_reader
 
     ours = sink.messages_by_topic(log2s)
@@ -192,10 +183,7 @@ def test_protobuf_messages_decode_with_the_protobuf_package(log2s):
             if channel.topic in seen or channel.topic.rsplit("/", 1)[1] in ("scene", "airframe"):
                 continue  # the 3-D scene's nested messages: tests/test_scene.py decodes them
             seen.add(channel.topic)
-            pool = descriptor_pool.DescriptorPool()
-            for fd in descriptor_pb2.FileDescriptorSet.FromString(schema.data).file:
-                pool.Add(fd)
-            cls = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
+            cls = protobuf_class(schema.name, schema.data)
             msg = cls.FromString(message.data)
             mine = ours[channel.topic][0][1]
             for field, value in mine.items():

@@ -14,6 +14,7 @@ from bioflex_jsb.simulation.channels import channel_units
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
 from bioflex_jsb.sinks.mcap import scene
+from tests.tools import decode_topic, published_files
 
 pytest.importorskip("google.protobuf")
 pytest.importorskip("foxglove_schemas_protobuf")
@@ -23,24 +24,6 @@ EXAGGERATION = 4.0
 # (and 1e-12 rad) holds with a margin of 1e3 over the ~1e-15 seen; the tip's bending
 # displacement being checked is ~1e-4 m, its twist ~1 rad.
 TOL = 1e-12
-
-
-def decode_topic(path, topic_name):
-    """[(log time ns, message)] of a topic, decoded by the protobuf runtime from the file's
-    own FileDescriptorSet."""
-    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-    from mcap.reader import make_reader
-
-    out, cls = [], None
-    with open(path, "rb") as f:
-        for schema, _channel, message in make_reader(f).iter_messages(topics=[topic_name]):
-            if cls is None:
-                pool = descriptor_pool.DescriptorPool()
-                for fd in descriptor_pb2.FileDescriptorSet.FromString(schema.data).file:
-                    pool.Add(fd)
-                cls = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
-            out.append((message.log_time, cls.FromString(message.data)))
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -75,14 +58,7 @@ def test_embedded_scene_schemas_are_the_published_ones():
 
     from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
 
-    published = {}
-
-    def add(fd):
-        for dep in fd.dependencies:
-            add(dep)
-        published[fd.name] = fd.serialized_pb
-
-    add(SceneUpdate_pb2.DESCRIPTOR)
+    published = published_files(SceneUpdate_pb2.DESCRIPTOR)
     assert list(published) == list(fox.SCENE_UPDATE_FILES)
     assert fox.files(fox.SCENE_UPDATE_FILES) == list(published.values())
 

@@ -81,7 +81,7 @@ def test_layout_names_only_what_a_log_holds(shot_log):
 
 
 def test_the_screenshot_is_drawn_from_the_log(shot_log, tmp_path):
-    from tests.test_scene import decode_topic
+    from tests.tools import decode_topic
 
     shot, drawn = scene_view.render_screenshot(shot_log, tmp_path / "scene.png")
     ns = round(shot["time_s"] * 1e9)

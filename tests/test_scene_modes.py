@@ -12,7 +12,7 @@ import pytest
 from bioflex_jsb import api, cli
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.sinks.mcap import scene_modes
-from tests.test_scene import decode_topic
+from tests.tools import decode_topic
 
 # Rounding only (a cosine and a few products of doubles below 1): see tests/test_scene.py
 TOL = 1e-12
