@@ -188,8 +188,10 @@ def _plot(args, build, speeds) -> None:
     grid = np.arange(SPEED_MIN_M_S, top + 1e-9, 0.5)
     sweeps = []
     for model in args.models:
+        # the rigid track needs the aircraft's airframe: it has no wing to carry it
         full = eigen.track(model, np.concatenate([np.arange(2.0, SPEED_MIN_M_S, 0.5), grid]),
-                           None if model == "rigid" else build.model)
+                           None if model == "rigid" else build.model,
+                           airframe=build.model.airframe)
         k0 = int(np.searchsorted(full.speeds_m_s, SPEED_MIN_M_S))
         sweeps.append(eigen.Sweep(model, full.speeds_m_s[k0:], full.eigenvalues[k0:],
                                   full.labels, full.eigenvectors[k0:], full.wing,
