@@ -73,6 +73,10 @@ LIFT_SLOPES = ("strip", "vlm")
 METHODS = ("pk", "state-space")
 INERTIA_AXES = ("elastic-axis", "centre-of-mass")
 TWIST_UNITS = ("deg", "rad")
+# Monitoring stations of the section loads [fraction of the semispan]: the root and the
+# quarter points (issue 24's stations; the tip, s = 1, carries no load and is refused).
+DEFAULT_MONITORING_STATIONS = (0.0, 0.25, 0.5, 0.75)
+MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distribution
 
 
 def _per_station(r: Reader, t: dict, key: str, n: int, lo: float, hi: float, unit: str,
@@ -157,11 +161,27 @@ def _structure(r: Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
                          r.integer(t, "structure", "n_elements", *N_ELEMENTS_RANGE, 40))
 
 
+def _monitoring_stations(r: Reader) -> tuple[float, ...]:
+    """``[loads] stations``: fractions of the semispan, each 0 <= s < 1, sorted, distinct."""
+    t = r.table("loads", ("stations",), required=False)
+    v = t.get("stations", list(DEFAULT_MONITORING_STATIONS))
+    accepted = (f"a list of 1..{MAX_MONITORING_STATIONS} fractions of the semispan, each "
+                "0 <= s < 1, sorted and distinct, e.g. [0.0, 0.25, 0.5, 0.75]")
+    if not isinstance(v, list) or not 1 <= len(v) <= MAX_MONITORING_STATIONS:
+        raise r.fail("loads.stations", f"must be {accepted}; got {v!r}")
+    out = tuple(r.number({"stations": x}, "loads", "stations", 0.0, 1.0, "(fraction of the "
+                         "semispan)") for x in v)
+    if out[-1] >= 1.0 or any(b <= a for a, b in zip(out, out[1:], strict=False)):
+        raise r.fail("loads.stations", f"must be {accepted}; got {list(out)!r}")
+    return out
+
+
 def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     """A :class:`Definition` from the parsed TOML ``data`` (``where`` names it in errors)."""
     r = Reader(data, where)
     r.keys(data, "(top level)", ("format", "name", "description", "source", "wing",
-                                 "structure", "aero", "air", "analysis", "airframe"))
+                                 "structure", "aero", "air", "analysis", "airframe",
+                                 "loads"))
     fmt = data.get("format", FORMAT_VERSION)
     if fmt != FORMAT_VERSION:
         raise r.fail("format", f"must be {FORMAT_VERSION}, got {fmt!r}")
@@ -202,7 +222,8 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     return Definition(name=name, description=r.text(data, "", "description", ""),
                       source=r.text(data, "", "source", ""), stations=stations,
                       structure=structure, aero=aero, air=air, analysis=analysis,
-                      airframe=airframe, path=path, flying=flying)
+                      airframe=airframe, path=path, flying=flying,
+                      monitoring_stations=_monitoring_stations(r))
 
 
 def shipped_path(name: str) -> Path:

@@ -182,6 +182,10 @@ class Definition:
     airframe: Airframe | None = None
     path: str = ""
     flying: FlyingWing | None = None  # with an airframe
+    # [loads] stations: the monitoring stations of the wing's section loads, fractions of
+    # the semispan from the root [-], sorted, distinct, each 0 <= s < 1 (the tip carries no
+    # load); the default is the loader's DEFAULT_MONITORING_STATIONS.
+    monitoring_stations: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
 
     @property
     def clamped(self) -> bool:
