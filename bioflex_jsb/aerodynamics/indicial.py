@@ -41,6 +41,7 @@ from bioflex_jsb.aerodynamics.theodorsen import (
     section_matrices,
     theodorsen_c,
 )
+from bioflex_jsb.state_space import StateSpace, with_motion_inputs
 
 
 @dataclass(frozen=True)
@@ -219,6 +220,16 @@ class StripStateSpace:
         iw = 1j * float(frequency_rad_s)
         resolvent = np.linalg.solve(iw * np.eye(self.n_states) - self.a, self.b_g)
         return self.c @ resolvent + self.d_g
+
+    def to_state_space(self) -> StateSpace:
+        """This strip as the package's :class:`~bioflex_jsb.state_space.StateSpace`: inputs
+        (h [m], α [rad], their rates and accelerations, w_g [m/s]), outputs
+        (``minus_lift_n_per_m`` −L' [N/m], ``moment_n_m_per_m`` M' [N·m/m], nose up about the
+        elastic axis), states the lag states [m]
+        (:func:`~bioflex_jsb.state_space.with_motion_inputs`)."""
+        return with_motion_inputs("strip", self.speed_m_s, self, ("h", "alpha"), ("m", "rad"),
+                                  ("minus_lift_n_per_m", "moment_n_m_per_m"),
+                                  ("N/m", "N m/m"))
 
 
 def strip_state_space(

@@ -35,6 +35,7 @@ from bioflex_jsb.aeroelasticity.strip_aero import (
     finite_state_model,
 )
 from bioflex_jsb.flight_dynamics import flutter_engine as engine
+from bioflex_jsb.state_space import StateSpace
 
 # Speed step of the tracking sweep [m/s]. ESTIMATE: as for the p-k sweep (2 m/s: no branch
 # swaps on the Goland wing).
@@ -43,7 +44,8 @@ DEFAULT_SPEED_STEP_M_S = 2.0
 
 @dataclass(frozen=True, eq=False)
 class AeroelasticSystem:
-    """ż = A z + B_g w_g of the wing at one speed; ``state_names`` / ``state_units``."""
+    """ż = A z + B_g w_g of the wing at one speed; ``state_names`` / ``state_units``;
+    ``b_gust`` [per m/s] is zero unless built with ``gust=True``."""
 
     a: np.ndarray
     b_gust: np.ndarray
@@ -51,6 +53,19 @@ class AeroelasticSystem:
     state_units: tuple[str, ...]
     n_modes: int
     speed_m_s: float
+    gust: bool = False
+
+    def to_state_space(self) -> StateSpace:
+        """This system as the package's :class:`~bioflex_jsb.state_space.StateSpace`: the
+        input w_g [m/s] (positive up, met by every strip's leading edge at once), the outputs
+        the states themselves (C = I, D = 0; names and units those of the states)."""
+        n = self.a.shape[0]
+        return StateSpace(model="clamped-aeroelastic", speed_m_s=self.speed_m_s, a=self.a,
+                          b=np.reshape(self.b_gust, (n, 1)), c=np.eye(n), d=np.zeros((n, 1)),
+                          states=self.state_names, state_units=self.state_units,
+                          inputs=("w_g",), input_units=("m/s",), outputs=self.state_names,
+                          output_units=self.state_units,
+                          notes={"n_modes": self.n_modes, "gust": self.gust})
 
 
 def aeroelastic_system(
@@ -79,7 +94,7 @@ def aeroelastic_system(
     names = tuple(f"eta_{i + 1}" for i in range(n)) + tuple(
         f"eta_dot_{i + 1}" for i in range(n)) + fs.state_names
     units = ("kg^0.5 m",) * n + ("kg^0.5 m/s",) * n + fs.state_units
-    return AeroelasticSystem(a, b_g, names, units, n, float(speed_m_s))
+    return AeroelasticSystem(a, b_g, names, units, n, float(speed_m_s), bool(gust))
 
 
 def state_space_family(model: ClampedWingModel, *, density_kg_m3: float,

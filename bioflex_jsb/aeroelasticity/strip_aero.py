@@ -30,6 +30,7 @@ import numpy as np
 from bioflex_jsb.aerodynamics.indicial import jones_c, strip_state_space
 from bioflex_jsb.aerodynamics.theodorsen import sears_s, section_matrices, theodorsen_c
 from bioflex_jsb.aeroelasticity.clamped_wing import ClampedWingModel
+from bioflex_jsb.state_space import StateSpace, with_motion_inputs
 
 AERO_MODELS = ("unsteady", "quasi-steady")
 
@@ -149,6 +150,7 @@ class ModalAeroStateSpace:
     apparent_mass: np.ndarray
     state_names: tuple[str, ...] = field(default=())
     state_units: tuple[str, ...] = field(default=())
+    speed_m_s: float | None = None  # [m/s] the airspeed it was built at
 
     @property
     def n_states(self) -> int:
@@ -162,6 +164,21 @@ class ModalAeroStateSpace:
             res = np.linalg.solve(iw * np.eye(self.n_states) - self.a, self.b_q + iw * self.b_qd)
             out = out + self.c @ res
         return out
+
+    def to_state_space(self) -> StateSpace:
+        """These forces as the package's :class:`~bioflex_jsb.state_space.StateSpace`
+        (``speed_m_s`` set: :func:`finite_state_model`'s): inputs (η_i [kg^½·m], the M-orthonormal
+        modal coordinates of :mod:`~bioflex_jsb.aeroelasticity.clamped_wing`, their rates and
+        accelerations, w_g [m/s]), outputs ``Q_i`` the generalised aerodynamic forces
+        [kg^½·m/s²] (:func:`~bioflex_jsb.state_space.with_motion_inputs`)."""
+        if self.speed_m_s is None:
+            raise ValueError("ModalAeroStateSpace.to_state_space needs speed_m_s (the airspeed "
+                             "the forces were built at)")
+        n = int(self.apparent_mass.shape[0])
+        return with_motion_inputs("modal-aero", self.speed_m_s, self,
+                                  tuple(f"eta_{i + 1}" for i in range(n)), ("kg^0.5 m",) * n,
+                                  tuple(f"Q_{i + 1}" for i in range(n)),
+                                  ("kg^0.5 m/s^2",) * n)
 
 
 def finite_state_model(
@@ -219,7 +236,7 @@ def finite_state_model(
         units.extend(un)
         i = j
     return ModalAeroStateSpace(a, b_q, b_qd, b_g, c, d_q, d_qd, d_g, m_a, tuple(names),
-                               tuple(units))
+                               tuple(units), float(speed_m_s))
 
 
 def divergence_speed_m_s(model: ClampedWingModel, density_kg_m3: float) -> float:

@@ -1,6 +1,7 @@
 """The coupled LTI model of Eq. (4), its rigid part and the QSD reduction of Eq. (9)–(10).
 
-State order (named in every :class:`StateSpace`):
+Every model here is the package's one :class:`~bioflex_jsb.state_space.StateSpace`
+(continuous; ``.to_control()`` gives python-control's). State order (named in every one):
     x = [u, α, q, θ, η_1 … η_n, η̇_1 … η̇_n]
     u [m/s], α [rad], q [rad/s], θ [rad], η_i [rad] (modes normalised on twist), η̇_i [rad/s].
 Input: w_g [m/s], vertical gust velocity, positive **upward** (raises α by w_g/u_0).
@@ -23,7 +24,7 @@ C_Dη̇_i = 2 k C_L0 C_Lη̇_i (induced drag of the extra lift, parabolic polar)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -43,39 +44,9 @@ from bioflex_jsb.parameters.airframe import (
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
+from bioflex_jsb.state_space import StateSpace  # the one state-space type (re-exported)
 
 MODELS = ("rigid", "coupled", "qsd")
-
-
-@dataclass(frozen=True)
-class StateSpace:
-    """ẋ = A x + B u, y = C x + D u with named signals and units.
-
-    ``model`` is ``rigid``, ``coupled`` or ``qsd``; ``speed_m_s`` the trim airspeed;
-    ``notes`` what the model was built from (wing, overrides, aerodynamic model, …).
-    """
-
-    model: str
-    speed_m_s: float
-    a: np.ndarray
-    b: np.ndarray
-    c: np.ndarray
-    d: np.ndarray
-    states: tuple[str, ...]
-    state_units: tuple[str, ...]
-    inputs: tuple[str, ...]
-    input_units: tuple[str, ...]
-    outputs: tuple[str, ...]
-    output_units: tuple[str, ...]
-    notes: dict[str, object] = field(default_factory=dict)
-
-    @property
-    def n_states(self) -> int:
-        return int(self.a.shape[0])
-
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of A [rad/s]."""
-        return np.linalg.eigvals(self.a)
 
 
 @dataclass(frozen=True)
