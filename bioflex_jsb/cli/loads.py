@@ -18,6 +18,7 @@ from bioflex_jsb.cli.case import (
 )
 from bioflex_jsb.cli.common import (
     EXIT_DIVERGED,
+    EnvironmentFault,
     UsageError,
     add_wing_arguments,
     check_output,
@@ -25,6 +26,7 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.sweep import positive_int, scheduler_address
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 _PLAIN = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
@@ -45,8 +47,10 @@ writes the table), and the correlated-load envelopes (bending vs torque per stat
 --plot (default loads_envelope.png). With --frequency: the LTI model's frequency response
 from the gust to q, n_z and the root bending moment (--bode), the output PSDs under the
 --spectrum turbulence, their RMS and N0, against Welch estimates (95 % bands) from nonlinear
-runs of --record seconds at each of --sigmas (--plot, default loads_psd.png). The runs are
-sequential on this machine. No MCAP log
+runs of --record seconds at each of --sigmas (--plot, default loads_psd.png). The tuned gusts
+run in parallel on the sweep's executors (--workers local processes, default one per core, or
+--scheduler a Dask cluster; a progress bar on a terminal), the table the same whatever the
+number of workers; the --frequency runs are sequential. No MCAP log
 is written (the loads are a post-process of the runs). Exit 3 if a run diverged."""
 
 
@@ -176,6 +180,13 @@ def register(sub) -> None:
                    help="--tuned amplitude: cs25 U_ref (H/H_max)^(1/6) (default) or fixed")
     p.add_argument("--csv", metavar="FILE.csv", default=None,
                    help="--tuned: the critical-case table as CSV")
+    p.add_argument("--workers", type=positive_int, default=None,
+                   help="--tuned: local worker processes (default: one per core); with "
+                   "--scheduler local, the LocalCluster's workers (default 2)")
+    p.add_argument("--scheduler", type=scheduler_address, default=None,
+                   metavar="tcp://HOST:PORT",
+                   help="--tuned: fly the gusts on this Dask scheduler ('local': a Dask "
+                   "LocalCluster), as `sweep`")
     p.add_argument("--plot", metavar="FILE.png", default=None,
                    help="figure (loads time histories; --tuned: the envelopes); default "
                    "loads.png / loads_envelope.png without --json")
@@ -205,6 +216,12 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("--model rigid has no static deflection; drop --static elastic")
     if args.tuned and args.frequency:
         raise UsageError("--tuned and --frequency are two studies; give one")
+    for opt in ("workers", "scheduler"):
+        if getattr(args, opt) is not None and not args.tuned:
+            raise UsageError(f"--{opt} applies to --tuned (its gusts run in parallel)")
+    if args.scheduler and args.scheduler != "local" and args.workers is not None:
+        raise UsageError("--workers applies to local processes and --scheduler local; a "
+                         "cluster's workers are started with it (dask worker)")
     if args.tuned:
         return _tuned(args, build)
     if args.frequency:
@@ -268,7 +285,7 @@ def _print_metrics(build, args, loads, metrics) -> None:
 
 def _tuned(args, build) -> int:
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.loads.tuned import plot_envelopes, tuned_gust
+    from bioflex_jsb.loads.tuned import plot_envelopes, tuned_cases, tuned_result
 
     plot = args.plot if args.plot is not None else (None if args.json else "loads_envelope.png")
     check_plot_path(plot, args.force)
@@ -276,25 +293,21 @@ def _tuned(args, build) -> int:
         if not args.csv.lower().endswith(".csv"):
             raise UsageError(f"--csv {args.csv!r}: the file name must end in .csv")
         check_output(args.csv, args.force, "--csv")
-    stopped = []
-
-    def fly(gust_text, duration_s, gust_start_s):
-        run_, loads = _fly(args, build, gust_text, duration_s, gust_start_s)
-        if run_.stopped:
-            stopped.append(f"{gust_text}: {run_.stopped}")
-        return loads
-
-    def progress(k, n, text):
-        if sys.stderr.isatty():
-            print(f"\r  gust {k}/{n} {text}   ", end="", file=sys.stderr, flush=True)
-
     try:
-        result = tuned_gust(fly, args.speed, args.gradients, u_ref_m_s=args.amplitude,
-                            scaling=args.scaling, progress=progress)
+        cases = tuned_cases(args.speed, args.gradients, u_ref_m_s=args.amplitude,
+                            scaling=args.scaling)
     except InputError as exc:
         raise UsageError(str(exc)) from None
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
+    rows = _fly_tuned(args, build, cases)
+    lost = [r for r in rows if r.get("lost")]
+    if lost:  # the machine's: a worker process died twice (crash, out of memory)
+        raise EnvironmentFault(f"{lost[0]['gust']}: {lost[0]['error']}")
+    failed = [r for r in rows if r["status"] == "failed"]
+    if failed:  # as a single run's problem: one line (the first), exit 2
+        raise UsageError(f"{failed[0]['gust']}: {failed[0]['error']}")
+    stopped = [f"{r['gust']}: {r['error']}" for r in rows if r["status"] == "diverged"]
+    result = tuned_result(cases, [r["loads"] for r in rows], args.speed,
+                          u_ref_m_s=args.amplitude, scaling=args.scaling)
     if args.csv:
         with open(args.csv, "w", newline="", encoding="utf-8") as f:
             csv.writer(f).writerows(result.csv_rows())
@@ -324,6 +337,56 @@ def _tuned(args, build) -> int:
     for s in stopped:
         print(f"bioflex-jsb loads: diverged: {s}", file=sys.stderr)
     return EXIT_DIVERGED if stopped else 0
+
+
+def _fly_tuned(args, build, cases: list[dict]) -> list[dict]:
+    """The tuned gusts on the sweep executors (``--workers``, ``--scheduler``; as `sweep`):
+    their rows in the cases' order (:mod:`bioflex_jsb.sweep.tuned_loads`)."""
+    import hashlib
+
+    from bioflex_jsb.cli.sweep import executor_errors, progress_bar
+    from bioflex_jsb.sweep.tuned_loads import (
+        fly_tuned_case,
+        run_tuned,
+        tuned_case_list,
+        tuned_failed_row,
+    )
+
+    aircraft = getattr(args, "aircraft_definition", None)
+    wing = aircraft if aircraft is not None else build.variant
+    key = hashlib.sha256(repr(aircraft.definition if aircraft is not None
+                              else sorted(build.variant.as_dict().items())).encode())
+    todo = tuned_case_list(cases, wing, key.hexdigest()[:16], args.mass_basis, args.speed,
+                           args.dt, args.model, args.trim, args.stations, args.static)
+    executor = tuned_executor(args, fly_tuned_case, tuned_failed_row)
+    bar = progress_bar(len(todo), 0, "tuned gust")
+
+    def on_row(done, total, row):
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix_str(row["gust"], refresh=False)
+
+    try:
+        with executor:
+            return run_tuned(todo, executor, on_row)
+    except executor_errors() as exc:  # the cluster cannot be reached: nothing ran
+        raise UsageError(str(exc)) from None
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def tuned_executor(args, fn, failed):
+    """The executor of ``--workers``/``--scheduler`` (as `sweep`'s) running ``fn``."""
+    if args.scheduler:
+        from bioflex_jsb.sweep.dask_cluster import DaskExecutor
+
+        workers = args.workers or 2
+        return DaskExecutor(None if args.scheduler == "local" else args.scheduler,
+                            workers=workers, fn=fn, failed=failed)
+    from bioflex_jsb.sweep.local import LocalExecutor
+
+    return LocalExecutor(args.workers, fn=fn, failed=failed)
 
 
 FREQUENCY_OUTPUTS = ("q", "n_z", "fs_bending_n_m_s0")  # pitch rate, load factor, root M (FS)

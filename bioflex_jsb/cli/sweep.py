@@ -75,7 +75,7 @@ def register(sub) -> None:
     p.set_defaults(run=run)
 
 
-def _progress(total: int, initial: int, label: str):
+def progress_bar(total: int, initial: int, label: str):
     """tqdm bar on a terminal (done/failed/remaining and ETA), None otherwise."""
     if not sys.stderr.isatty():
         return None
@@ -152,7 +152,7 @@ def _run_locked(args, campaign, out: Path) -> int:
     total = campaign.n_cases
 
     executor = _executor(args)
-    bar = _progress(total, 0, campaign.name)
+    bar = progress_bar(total, 0, campaign.name)
     if bar is not None:
         todo.on_skip = lambda: bar.update(1)
 
@@ -169,7 +169,7 @@ def _run_locked(args, campaign, out: Path) -> int:
                 summary = run_sweep(todo, store, executor, total=total, on_row=on_row)
         else:
             summary = run_sweep(todo, store, executor, total=total)
-    except _executor_errors() as exc:  # the cluster cannot be reached: nothing ran
+    except executor_errors() as exc:  # the cluster cannot be reached: nothing ran
         raise UsageError(str(exc)) from None
     finally:
         if bar is not None:
@@ -217,7 +217,7 @@ def _executor(args):
     return LocalExecutor(args.workers, log_dir=args.logs)
 
 
-def _executor_errors() -> tuple[type[Exception], ...]:
+def executor_errors() -> tuple[type[Exception], ...]:
     from bioflex_jsb.sweep.dask_cluster import DaskUnavailable
 
     return (DaskUnavailable,)

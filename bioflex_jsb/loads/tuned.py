@@ -19,7 +19,9 @@ the longest gradient (U_ref default 3 m/s, the paper's gust), or ``fixed`` (ever
 The 1-cos gust of ``simulation/gusts.py`` is given by its length L = 2H.
 
 The flying is the caller's: :func:`tuned_gust` takes ``fly(gust_text, duration_s) ->
-SectionLoads``, so it runs on any machinery (today the command runs it sequentially).
+SectionLoads``, so it runs on any machinery; :func:`tuned_cases` and :func:`tuned_result`
+are the two ends the command joins through the sweep executors (local processes or Dask:
+:mod:`bioflex_jsb.sweep.tuned_loads`).
 """
 
 from __future__ import annotations
@@ -86,32 +88,57 @@ class TunedGustResult:
         return rows
 
 
-def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
-               u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
-               progress=None) -> TunedGustResult:
-    """Fly 1-cos gusts of every gradient in ``gradients_m`` [m] up and down through
-    ``fly(gust_text, duration_s, gust_start_s)`` (returns a SectionLoads) and find the
-    critical case per station, quantity, method and direction (largest increment up, largest
-    down) over the run after the gust start."""
+def tuned_cases(speed_m_s: float, gradients_m=None, *,
+                u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25") -> list[dict]:
+    """The sweep's gusts, in order: every gradient of ``gradients_m`` [m] (default
+    :func:`default_gradients_m`) up then down, each a dict of its gradient [m], sign,
+    amplitude [m/s, up +], gust text (``1cos:U:L``, L = 2H), duration [s] and gust start [s]."""
     h = default_gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
     if h.ndim != 1 or h.size == 0 or not np.all(np.isfinite(h)) or np.any(h <= 0.0):
         raise InputError("gust gradients must be positive lengths [m]")
     if not (math.isfinite(u_ref_m_s) and u_ref_m_s > 0.0):
         raise InputError(f"gust amplitude must be a positive speed [m/s], got {u_ref_m_s!r}")
     h_max = float(h.max())
-    cases, loads = [], []
+    cases = []
     for hm in h:
         u = gust_amplitude_m_s(float(hm), u_ref_m_s, h_max, scaling)
         for sign in (1, -1):
-            text = f"1cos:{sign * u:.6g}:{2.0 * hm:.6g}"
-            duration = GUST_START_S + 2.0 * hm / speed_m_s + SETTLE_AFTER_S
-            sl = fly(text, duration, GUST_START_S)
             cases.append({"gradient_m": float(hm), "sign": "up" if sign > 0 else "down",
-                          "amplitude_m_s": sign * u, "gust": text, "duration_s": duration,
-                          "stopped": sl.meta.get("stopped")})
-            loads.append(sl)
-            if progress is not None:
-                progress(len(cases), 2 * h.size, text)
+                          "amplitude_m_s": sign * u,
+                          "gust": f"1cos:{sign * u:.6g}:{2.0 * hm:.6g}",
+                          "duration_s": GUST_START_S + 2.0 * hm / speed_m_s + SETTLE_AFTER_S,
+                          "gust_start_s": GUST_START_S})
+    return cases
+
+
+def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
+               u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
+               progress=None) -> TunedGustResult:
+    """Fly 1-cos gusts of every gradient in ``gradients_m`` [m] up and down through
+    ``fly(gust_text, duration_s, gust_start_s)`` (returns a SectionLoads), one after the
+    other, and find the critical cases (:func:`tuned_result`). The command flies the same
+    cases on the sweep executors (:mod:`bioflex_jsb.sweep.tuned_loads`)."""
+    cases = tuned_cases(speed_m_s, gradients_m, u_ref_m_s=u_ref_m_s, scaling=scaling)
+    loads = []
+    for case in cases:
+        loads.append(fly(case["gust"], case["duration_s"], case["gust_start_s"]))
+        if progress is not None:
+            progress(len(loads), len(cases), case["gust"])
+    return tuned_result(cases, loads, speed_m_s, u_ref_m_s=u_ref_m_s, scaling=scaling)
+
+
+def tuned_result(cases: list[dict], loads: list, speed_m_s: float, *,
+                 u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S,
+                 scaling: str = "cs25") -> TunedGustResult:
+    """The critical case per station, quantity, method and direction (largest increment up,
+    largest down, over the run after the gust start) of ``cases`` (:func:`tuned_cases`, in
+    their order) and their SectionLoads ``loads`` (the same order)."""
+    if len(cases) != len(loads) or not cases:
+        raise ValueError(f"{len(cases)} cases and {len(loads)} section loads")
+    cases = [dict(c, stopped=sl.meta.get("stopped")) for c, sl in zip(cases, loads,
+                                                                      strict=True)]
+    h = np.array(sorted({c["gradient_m"] for c in cases}))
+    h_max = float(h.max())
     first = loads[0]
     critical = []
     for method in first.methods:
@@ -139,10 +166,13 @@ def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
                                     "time_s": float(sl.time_s[after][i])}
                     if best is not None:
                         critical.append(best)
-    settings = {"speed_m_s": speed_m_s, "gradients_m": h.tolist(), "u_ref_m_s": u_ref_m_s,
+    gradients = list(dict.fromkeys(c["gradient_m"] for c in cases))
+    settings = {"speed_m_s": speed_m_s, "gradients_m": gradients, "u_ref_m_s": u_ref_m_s,
                 "scaling": scaling, "h_max_m": h_max, "gust_start_s": GUST_START_S,
                 "settle_after_s": SETTLE_AFTER_S, "model": first.model, "wing": first.wing,
                 "static": first.meta.get("static")}
+    for c in cases:
+        del c["gust_start_s"]
     return TunedGustResult(cases, loads, critical, first.stations_m.tolist(),
                            list(first.station_fractions), settings)
 

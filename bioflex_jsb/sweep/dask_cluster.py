@@ -46,7 +46,8 @@ class DaskUnavailable(RuntimeError):
 
 
 class DaskExecutor:
-    """Run cases on a Dask cluster; ``fn(case, log_dir) -> row``."""
+    """Run cases on a Dask cluster; ``fn(case, log_dir) -> row``; a case whose workers died
+    is ``failed(case, error)``."""
 
     name = "dask"
     no_workers_s = 60.0  # a cluster with no worker this long stops the sweep
@@ -54,11 +55,13 @@ class DaskExecutor:
 
     def __init__(self, scheduler: str | None = None, workers: int = 2,
                  log_dir: str | None = None,
-                 fn: Callable[[Case, str | None], dict[str, Any]] = run_case) -> None:
+                 fn: Callable[[Case, str | None], dict[str, Any]] = run_case,
+                 failed: Callable[[Any, str], dict[str, Any]] = failed_row) -> None:
         self.scheduler = scheduler
         self.workers = workers
         self.log_dir = log_dir
         self.fn = fn
+        self.failed = failed  # failed(case, error) -> the row of a case that gave none
         self.cluster = None
         self.client = None
         self._client_log_level: int | None = None
@@ -184,7 +187,7 @@ class DaskExecutor:
                     try:
                         row = fut.result()
                     except KilledWorker as exc:
-                        row = failed_row(c, f"worker died running this case, also on retry "
+                        row = self.failed(c, f"worker died running this case, also on retry "
                                             f"(Dask KilledWorker: {exc})")
                     except RecordingError as exc:
                         raise RecordingError(str(exc)) from None

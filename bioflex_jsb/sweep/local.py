@@ -88,15 +88,18 @@ def _init_worker(lifeline=None) -> None:
 
 
 class LocalExecutor:
-    """Run cases on ``workers`` local processes; ``fn(case, log_dir) -> row``."""
+    """Run cases on ``workers`` local processes; ``fn(case, log_dir) -> row``; a case that
+    gave no row (its worker died twice, it could not be sent) is ``failed(case, error)``."""
 
     name = "local"
 
     def __init__(self, workers: int | None = None, log_dir: str | None = None,
-                 fn: Callable[[Case, str | None], dict[str, Any]] = run_case) -> None:
+                 fn: Callable[[Case, str | None], dict[str, Any]] = run_case,
+                 failed: Callable[[Any, str], dict[str, Any]] = failed_row) -> None:
         self.workers = workers or default_workers()
         self.log_dir = log_dir
         self.fn = fn
+        self.failed = failed  # failed(case, error) -> the row of a case that gave none
         self._pool: ProcessPoolExecutor | None = None
         self._lifeline = None  # the write end of the current pool's lifeline …
         self._reader = None  # … and its read end, handed to each worker as it starts
@@ -194,14 +197,14 @@ class LocalExecutor:
                     elif isinstance(exc, OSError):  # the machine, not the case
                         raise RecordingError(f"case {c.case_id}: {exc.strerror or exc}")
                     else:  # e.g. the case could not be sent to the worker
-                        yield c, failed_row(c, f"{type(exc).__name__}: {exc}")
+                        yield c, self.failed(c, f"{type(exc).__name__}: {exc}")
                 if broken:
                     lost.extend(in_flight.values())  # their futures fail the same way
                     in_flight.clear()
                     for c in lost:
                         deaths[c.case_id] = deaths.get(c.case_id, 0) + 1
                         if deaths[c.case_id] >= 2:
-                            yield c, failed_row(c, "worker process died twice running this "
+                            yield c, self.failed(c, "worker process died twice running this "
                                                    "case (crash or out of memory)")
                         else:
                             suspects.append(c)
