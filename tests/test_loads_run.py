@@ -271,6 +271,46 @@ def test_compare_covers_the_loads(wing):
         c.load_channels)
 
 
+def test_the_lti_prediction_topic_carries_the_lti_loads(wing, tmp_path):
+    """compare's log: /bioflex/<model>/lti_prediction holds the LTI model's section loads
+    under the loads topic's field names, at the run's log times, equal to the prediction's
+    load channels bit for bit (totals: the run's 1 g part plus C x + D w_g), its channel's
+    metadata naming the same stations and 1 g values as the run's loads channel; a
+    prediction without loads has the fields empty."""
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks.mcap import RunLog
+
+    path = tmp_path / "compare.mcap"
+    desc = RunDescription("compare", "optimised", 15.0, gust="sharp:0.3", models=("coupled",),
+                          duration_s=1.0, gust_start_s=0.5)
+    log = RunLog.open(path, desc, wing_variant=wing.variant.as_dict())
+    try:
+        c = api.compare(wing, 15.0, "sharp:0.3", "coupled", duration_s=1.0,
+                        recorder=log.recorder("coupled"))
+        log.prediction("coupled", c.linear)
+        log.prediction("rigid", _without_loads(c.linear))  # another channel, no loads
+    finally:
+        log.close()
+    lti = decode_topic(path, "/bioflex/coupled/lti_prediction")
+    run = decode_topic(path, "/bioflex/coupled/loads")
+    assert len(lti) == len(c.linear.time_s) > 0
+    assert [ns for ns, _ in lti] == [ns for ns, _ in run]
+    meta_lti = channel_metadata(path, "/bioflex/coupled/lti_prediction")
+    meta_run = channel_metadata(path, "/bioflex/coupled/loads")
+    assert meta_lti == meta_run
+    for tag in ("fs", "md"):
+        for q in QUANTITIES:
+            field = f"{tag}_{q}"
+            got = np.array([list(getattr(m, field)) for _, m in lti])
+            want = np.column_stack([c.linear[f"loads_{field}_s{j}"] for j in range(4)])
+            np.testing.assert_array_equal(got, want)
+            assert len(getattr(run[0][1], field)) == got.shape[1] == 4
+    assert lti[10][1].q_rad_s == c.linear["q"][10]
+    bare = decode_topic(path, "/bioflex/rigid/lti_prediction")
+    assert len(bare) == len(lti) and all(len(m.fs_bending_n_m) == 0 for _, m in bare)
+    assert "stations_m" not in channel_metadata(path, "/bioflex/rigid/lti_prediction")
+
+
 def test_compare_command_json_and_table(capsys):
     assert cli.main(["compare", "--gust", "sharp:0.3", "--duration", "1.5", "--no-log",
                      "--json"]) == 0

@@ -262,13 +262,16 @@ class _ModelChannels:
         return self.records.build(ns, self.floats(v, origin), seq0)
 
 
-def lti_records(channel_id: int, n_eta: int) -> Records:
-    """The records of ``bioflex.LtiPrediction`` with ``n_eta`` modal coordinates."""
+def lti_records(channel_id: int, n_eta: int, loads: tuple[tuple[str, int], ...] = ()
+                ) -> Records:
+    """The records of ``bioflex.LtiPrediction`` with ``n_eta`` modal coordinates and the
+    section loads ``loads`` ((field, stations) in column order; none: empty fields)."""
     number = {name: num for name, num, _ in PROTO_FIELDS["lti_prediction"]}
     scalars = [number[f] for f in ("du_m_s", "dalpha_rad", "q_rad_s", "dtheta_rad", "n_z")]
-    return Records([channel_id],
-                   lambda ls, ln: [_doubles(scalars) + _packed(number["eta_rad"], n_eta)],
-                   timestamped=False)
+    pieces = _doubles(scalars) + _packed(number["eta_rad"], n_eta)
+    for field, n in loads:
+        pieces += _packed(number[field], n)
+    return Records([channel_id], lambda ls, ln: [pieces], timestamped=False)
 
 
 class AutopilotRecords:

@@ -9,6 +9,10 @@ step's pitch acceleration is the central difference of q), and each block is wri
 chunk of its own right after the steps' chunk, so every chunk is in log-time order. The
 channel's metadata holds what a reader needs to label the arrays: the stations, the
 methods, the 1 g values and where the static part comes from.
+
+The LTI prediction of ``compare`` carries its loads under the same field names on
+``/bioflex/<model>/lti_prediction`` (:func:`prediction_loads`, written by
+``RunLog.prediction``), so the nonlinear and the linear loads plot side by side.
 """
 
 from __future__ import annotations
@@ -48,6 +52,36 @@ def channel_metadata(model: str, layout: dict) -> dict[str, str]:
             "units": "shear N, bending N*m, torque N*m (docs/loads.md)"}
 
 
+def _fields(layout: dict) -> tuple[list[str], list[str]]:
+    """The topic's fields of ``layout``'s methods and the load columns they hold, in the
+    topic's order (method, quantity, station)."""
+    s = len(layout["stations_m"])
+    fields = [f"{TAGS[m]}_{q}" for m in ("force_summation", "mode_displacement")
+              if m in layout["methods"] for q in QUANTITIES]
+    return fields, [f"loads_{f}_s{j}" for f in fields for j in range(s)]
+
+
+def prediction_loads(history) -> tuple[tuple[tuple[str, int], ...], list[np.ndarray],
+                                       dict[str, str]]:
+    """The section loads of an LTI prediction (``drivers.compare.linear_prediction``: the
+    run's load channels, totals with the run's 1 g part) for ``bioflex.LtiPrediction``:
+    ((field, stations) in column order, the columns, the channel's metadata as the loads
+    channel's). A prediction without loads (its run had none): empty."""
+    layout = history.meta.get("loads")
+    if not layout:
+        return (), [], {}
+    fields, names = _fields(layout)
+    missing = [n for n in names if n not in history.channels]
+    if missing:
+        raise ValueError(f"the LTI prediction lacks the load channels {missing[:3]} of its "
+                         "layout")
+    n = len(layout["stations_m"])
+    metadata = channel_metadata(history.model, layout)
+    del metadata["model"]  # the prediction channel's own
+    return (tuple((f, n) for f in fields),
+            [np.asarray(history.channels[c], dtype=float) for c in names], metadata)
+
+
 class LoadsTopic:
     """The loads of one run on ``/bioflex/<model>/loads`` (module docstring): ``layout`` is
     the run's ``meta["loads"]`` (names in column order: method, quantity, station)."""
@@ -63,9 +97,7 @@ class LoadsTopic:
         w.flush()  # the channel on disk before its first message
         s = len(layout["stations_m"])
         number = {name: num for name, num, _ in PROTO_FIELDS[GROUP]}
-        fields = [f"{TAGS[m]}_{q}" for m in ("force_summation", "mode_displacement")
-                  if m in layout["methods"] for q in QUANTITIES]
-        expected = [f"loads_{f}_s{j}" for f in fields for j in range(s)]
+        fields, expected = _fields(layout)
         if list(layout["names"]) != expected:
             raise ValueError(f"load columns {list(layout['names'])[:3]}… are not in the "
                              "topic's order (method, quantity, station)")

@@ -43,7 +43,6 @@ from bioflex_jsb.sinks.mcap.schemas import (
 )
 from bioflex_jsb.sinks.mcap.writer import (
     CHUNK_SPAN_S,
-    CHUNK_WALL_S,
     McapFileWriter,
     _signals_deferred,
 )
@@ -120,12 +119,13 @@ class RunLog:
         return log
 
     # -- channels -----------------------------------------------------------------------
-    def _channel_id(self, model: str, group: str) -> int:
+    def _channel_id(self, model: str, group: str, metadata: dict[str, str] | None = None
+                    ) -> int:
         if group not in self._schema_ids:
             name, data = PROTO_SCHEMAS[group]
             self._schema_ids[group] = self._writer.add_schema(name, "protobuf", data)
         return self._writer.add_channel(topic(model, group), self._schema_ids[group],
-                                        {"model": model})
+                                        {"model": model, **(metadata or {})})
 
     def _model(self, model: str, names) -> _ModelChannels:
         ch = self._models.get(model)
@@ -180,8 +180,9 @@ class RunLog:
         self._first_t = t_s
         # closes at the first step ≥ CHUNK_SPAN_S later (as in ns; a step's time is
         # rounded to ns), or after _MAX_PENDING_STEPS steps, or CHUNK_WALL_S of wall time
+        # (LIVE_CHUNK_WALL_S while a live client is subscribed: writer.chunk_wall_s)
         self._due_t = t_s + CHUNK_SPAN_S - 0.5e-9
-        self._due_wall = time.monotonic() + CHUNK_WALL_S
+        self._due_wall = time.monotonic() + self._writer.chunk_wall_s  # short when live
 
     def _format_pending(self) -> None:
         """Serialise the kept steps into the chunk in progress (see _ModelChannels.format)."""
@@ -263,16 +264,20 @@ class RunLog:
 
     def prediction(self, model: str, history) -> None:
         """Log the LTI prediction ``history`` (a ``TimeHistory`` of the linear model of
-        ``model``) on ``/bioflex/<model>/lti_prediction``, one message per sample."""
-        cid = self._channel_id(model, "lti_prediction")
+        ``model``) on ``/bioflex/<model>/lti_prediction``, one message per sample, with its
+        section loads where it has them (:func:`~.loads_topic.prediction_loads`)."""
+        from bioflex_jsb.sinks.mcap.loads_topic import prediction_loads
+
+        fields, load_cols, metadata = prediction_loads(history)
+        cid = self._channel_id(model, "lti_prediction", metadata)
         etas = sorted((k for k in history.channels if k.startswith("eta") and k[3:].isdigit()),
                       key=lambda k: int(k[3:]))
         t = np.asarray(history.time_s, dtype=float)
         zeros = np.zeros(len(t))
         cols = [np.asarray(history.channels.get(c, zeros), dtype=float)
-                for c in ("u", "alpha", "q", "theta", "n_z", *etas)]
+                for c in ("u", "alpha", "q", "theta", "n_z", *etas)] + load_cols
         values = np.column_stack(cols) if cols else np.empty((len(t), 0))
-        records = lti_records(cid, len(etas))
+        records = lti_records(cid, len(etas), fields)
         ns = np.rint(t * 1e9).astype(np.int64)
         w = self._writer
         self.flush()

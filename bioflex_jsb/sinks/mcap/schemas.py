@@ -258,6 +258,14 @@ SCHEMAS["loads"] = {
              "leading edge up positive"))
     },
 }
+# The LTI model's section loads on its prediction topic, under the loads topic's field names
+# (Foxglove plots /bioflex/<model>/lti_prediction.fs_bending_n_m[0] beside
+# /bioflex/<model>/loads.fs_bending_n_m[0]): totals, the run's 1 g part added to the LTI's
+# perturbation (drivers/compare.py; the channel's metadata as the loads channel's)
+SCHEMAS["lti_prediction"]["properties"].update({
+    name: dict(prop, description="the linear model's (the run's 1 g part plus the LTI load "
+               "output C x + D w_g) " + prop["description"])
+    for name, prop in SCHEMAS["loads"]["properties"].items()})
 for _s in SCHEMAS.values():
     _s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
 
