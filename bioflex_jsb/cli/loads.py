@@ -34,7 +34,8 @@ DEFAULT_GUST = "1cos:3:5"  # the paper's 3 m/s, 2.5 m gradient (between the tune
 
 HELP = f"""Fly one gust (--gust, default {DEFAULT_GUST}) with the elastic wing (--model,
 default coupled) and report the wing's section loads at the monitoring stations (--stations,
-fractions of the semispan, default 0,0.25,0.5,0.75): vertical shear V [N, up +], bending
+fractions of the semispan; default the --aircraft definition's [loads] stations, else
+0,0.25,0.5,0.75): vertical shear V [N, up +], bending
 moment M [N*m, tip up +] and torque about the elastic axis T [N*m, leading edge up +], by
 force summation (FS: the strips' aerodynamic loads, the gust's included, less the inertia
 of the wing outboard) and by mode displacement (MD: EI phi'' eta, GJ theta' eta of the beam
@@ -151,9 +152,9 @@ def register(sub) -> None:
                    help="wing model flown (default coupled; rigid: force summation only)")
     p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
                    help="the trim the run starts from (as `gust --trim`)")
-    p.add_argument("--stations", type=fractions, default=(0.0, 0.25, 0.5, 0.75),
-                   help="monitoring stations as fractions of the semispan (default "
-                   "0,0.25,0.5,0.75)")
+    p.add_argument("--stations", type=fractions, default=None,
+                   help="monitoring stations as fractions of the semispan (default: the "
+                   "--aircraft definition's [loads] stations, else 0,0.25,0.5,0.75)")
     p.add_argument("--static", choices=("elastic", "rigid"), default=None,
                    help="the 1 g static part: elastic (the elastic trim's deflection, default "
                    "for coupled/qsd) or rigid (undeformed wing; the rigid model's)")
@@ -211,7 +212,11 @@ def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.loads import monitoring_stations
+
     build = wing_from_args(args)
+    if args.stations is None:  # the aircraft definition's, else the default stations
+        args.stations = monitoring_stations(getattr(args, "aircraft_definition", None))
     if args.model == "rigid" and args.static == "elastic":
         raise UsageError("--model rigid has no static deflection; drop --static elastic")
     if args.tuned and args.frequency:

@@ -22,12 +22,23 @@ from bioflex_jsb.loads.model import (
 from bioflex_jsb.parameters import prototype as P
 
 __all__ = ["DEFAULT_STATION_FRACTIONS", "METHODS", "QUANTITIES", "LoadsModel", "SectionLoads",
-           "build_loads_model", "loads_metrics", "section_loads", "section_loads_of_run",
-           "with_load_channels"]
+           "build_loads_model", "loads_metrics", "monitoring_stations", "section_loads",
+           "section_loads_of_run", "with_load_channels"]
 
 # Highest start altitude [m] at which a run's loads are taken at sea-level density without
 # being told the density: 100 m of ISA lowers ρ by 1 % (and Q, the aerodynamic loads, alike).
 SEA_LEVEL_ALTITUDE_MAX_M = 100.0
+
+
+def monitoring_stations(aircraft=None) -> tuple[float, ...]:
+    """The monitoring stations [fractions of the semispan, root 0] of ``aircraft``: its
+    definition's ``[loads] stations`` (an :class:`~bioflex_jsb.definition.aircraft.Aircraft`
+    or a :class:`~bioflex_jsb.definition.Definition`; the definition's default is
+    :data:`DEFAULT_STATION_FRACTIONS`'s), or with none the default stations."""
+    if aircraft is None:
+        return tuple(DEFAULT_STATION_FRACTIONS)
+    definition = getattr(aircraft, "definition", aircraft)
+    return tuple(float(s) for s in definition.monitoring_stations)
 
 
 def section_loads(build, run, stations=DEFAULT_STATION_FRACTIONS, *, static: str | None = None,
