@@ -33,14 +33,12 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import (
-    ALPHA_OUT,
-    ETA_OUT,
     KERNEL_SLOTS,
     N_CONSTS,
     NEEDS_REFRESH,
-    NON_FINITE,
-    OK,
     READ_KEYS,
+    air_flow,
+    finish_row,
     guard_cache,
 )
 
@@ -169,21 +167,13 @@ def unsteady_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     o_c, o_trim, o_key = int(params[H_C]), int(params[H_TRIM]), int(params[H_KEY])
     o_out, o_flow, o_last = int(params[H_REACT]), int(params[H_FLOW]), int(params[H_LAST])
     o_f = int(params[H_F])
-    m_per_ft, rho_si, s_ref, cbar = (params[o_c], params[o_c + 1], params[o_c + 2],
-                                     params[o_c + 3])
+    consts = params[o_c:o_c + N_CONSTS]
+    s_ref, cbar = consts[2], consts[3]
     key0, key1 = params[o_key], params[o_key + 1]
     refresh_rel = params[int(params[H_RR])]
     row = table[k]
-    # the flow at the wing: the body velocity against the NED wind seen in body axes
-    u, v, w, q = reads[0], reads[1], reads[2], reads[3]
-    theta, phi = reads[6], reads[7]
-    ua = u + wind_down_fps * math.sin(theta)
-    va = v - wind_down_fps * math.sin(phi) * math.cos(theta)
-    wa = w - wind_down_fps * math.cos(phi) * math.cos(theta)
-    vt_fps = math.sqrt(ua * ua + va * va + wa * wa)
-    vt = vt_fps * m_per_ft
-    alpha = math.atan2(wa, ua)
-    qbar = 0.5 * reads[9] * rho_si * vt * vt
+    q = reads[3]
+    va, vt_fps, vt, alpha, qbar = air_flow(reads, wind_down_fps, consts[0], consts[1])
     params[o_flow], params[o_flow + 1] = alpha, q
     params[o_flow + 2], params[o_flow + 3] = qbar, vt
     # "not within", so that the NaN key of a wing with no reference yet refreshes
@@ -224,28 +214,13 @@ def unsteady_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     drag = qs * (l1 + rate * r1) - params[int(params[H_K2])] * z_inc
     moment = qs * (l2 + rate * r2) + m_inc
     ca, sa = math.cos(alpha), math.sin(alpha)
-    params[o_out] = (lift * ca + drag * sa) * params[o_c + 4]
-    params[o_out + 1] = (drag * ca - lift * sa) * params[o_c + 4]
-    params[o_out + 2] = moment * params[o_c + 5]
-    trim = params[o_trim:o_trim + 4]
-    vals = (vt - trim[3], alpha - trim[0], q, theta - trim[1], reads[10], w_g, vt,
-            reads[11] * m_per_ft, lift, drag, moment, reads[13], reads[14], phi, theta,
-            reads[8], reads[4], reads[5], reads[18], reads[19], alpha,
-            math.asin(va / vt_fps) if vt_fps > 0.0 else 0.0,
-            reads[15] * m_per_ft, reads[16] * m_per_ft, reads[17] * m_per_ft)
-    for s in range(len(vals)):
-        row[cols[s]] = vals[s]
-    if alpha > params[o_c + 9]:
+    params[o_out] = (lift * ca + drag * sa) * consts[4]
+    params[o_out + 1] = (drag * ca - lift * sa) * consts[4]
+    params[o_out + 2] = moment * consts[5]
+    if alpha > consts[9]:
         params[int(params[H_STALL])] += 1.0  # steps beyond the lift peak
-    for c in range(len(cols)):
-        if not math.isfinite(row[cols[c]]):
-            return NON_FINITE
-    if not params[o_c + 7] <= alpha <= params[o_c + 8]:
-        return ALPHA_OUT
-    for i in range(n):
-        if abs(x[i]) > params[o_c + 6]:
-            return ETA_OUT
-    return OK
+    return finish_row(row, cols, reads, params[o_trim:o_trim + 4], consts, x, n, va, vt_fps,
+                      vt, alpha, w_g, lift, drag, moment)
 
 
 # a damaged on-disk cache is discarded and compiled anew, as the quasi-steady kernel's (the
