@@ -41,7 +41,12 @@ step at which the integration's eigenvalues are more than 1 % off the exact ones
 is refused, naming a halved step that is not); the trim lift coefficient and the reference
 flow of the exact part are those of level flight at --speed, {AIRSPEED_RANGE_M_S[0]:g} to
 {AIRSPEED_RANGE_M_S[1]:g} m/s (the airframe trims at about 9.4 to 32.7 m/s: outside, the export
-refuses with the trim's reason). For `--model qsd` the names end in _qsd. See docs/native.md."""
+refuses with the trim's reason). For `--model qsd` the names end in _qsd. --aircraft NAME|FILE
+exports a definition's wing with its values (S, c-bar, mass, derivatives, modes): on the
+generated airframe as --wing does; on a JSBSim aircraft file (e.g. sgs_elastic: the jsbsim
+package's SGS glider) as aircraft/<definition name>/, a copy of that file with the wing added
+(the original is never written), its glide trim as the initial condition, flown from t = 0
+(no engine to spin up; coupled model only). See docs/native.md."""
 
 
 def register(sub) -> None:
@@ -100,8 +105,7 @@ def _check_csv_target(path: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.drivers.native import export_flight, write_export
-    from bioflex_jsb.generators import native_aircraft as NA
+    from bioflex_jsb.drivers.native import aircraft_spec, export_flight, write_export
     from bioflex_jsb.generators import native_wing as J
 
     check_file_name(args.out, "--out")
@@ -110,11 +114,19 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} is not a directory")
     gust_up = _gust_up_m_s(args.gust)
+    aircraft = getattr(args, "aircraft_definition", None)
     try:
-        spec = J.ExportSpec(build.model, build.variant.name, args.model, args.dt, args.speed)
+        if aircraft is not None:  # the definition's values (DefinitionError: one line)
+            spec = aircraft_spec(aircraft, build, args.model, args.dt, args.speed)
+        else:
+            spec = J.ExportSpec(build.model, build.variant.name, args.model, args.dt,
+                                args.speed)
     except J.ExportError as exc:
         raise UsageError(str(exc)) from None
-    case, state, files = export_flight(spec, gust_up)  # TrimError: one line, nothing written
+    try:
+        case, state, files = export_flight(spec, gust_up)  # TrimError: one line, no file
+    except J.ExportError as exc:  # an aircraft file that cannot take the wing
+        raise UsageError(str(exc)) from None
     for rel in files:
         check_output(str(out / rel), args.force, "file", ours=_ours)
     _check_csv_target(out / case.output)
@@ -139,10 +151,10 @@ def run(args: argparse.Namespace) -> int:
         "columns": [{"column": "Time", "property": "simulation/sim-time-sec",
                      "meaning": "simulation time [s]"}]
                    + [{"column": c.caption, "property": c.prop, "meaning": c.meaning}
-                      for c in NA.COLUMNS],
+                      for c in case.columns],
         "trim": {"propeller_rpm": state.propeller_rpm,
-                 "throttle": state.controls["fcs/throttle-cmd-norm[0]"],
-                 "theta_rad": state.ic["theta"][1]},
+                 "throttle": state.controls.get("fcs/throttle-cmd-norm[0]"),  # None: no engine
+                 "theta_rad": state.ic["theta"][1], "gamma_rad": state.gamma_rad},
         "files": [str(p) for p in written],
     }
     if spec.model == "coupled":

@@ -64,9 +64,12 @@ def _p(name: str) -> str:
 def render_aircraft_files(spec: ExportSpec, include_shared: bool = True) -> dict[str, str]:
     """Files of ``aircraft/bioflex_<variant>/`` (the generated rigid airframe with the modal
     system included) and ``systems/``: path relative to the JSBSim root → text.
-    ``include_shared``: also the airframe's own systems (flight controls), for a new root."""
+    ``include_shared``: also the airframe's own systems (flight controls), for a new root.
+    An aircraft file's wing (``spec.jsbsim_path``): :func:`render_jsbsim_aircraft_files`."""
+    if spec.jsbsim_path:
+        return render_jsbsim_aircraft_files(spec)
     base = airframe_xml.AIRCRAFT_NAME
-    craft = aircraft_name(spec.variant, spec.model)
+    craft = spec.aircraft_name
     sysname = system_name(spec.variant, spec.model)
     out: dict[str, str] = {}
     for rel, text in airframe_xml.render_all().items():
@@ -119,19 +122,97 @@ def _add_modal_wing(root: ET.Element, sysname: str, spec: ExportSpec) -> None:
     if len(hooks) != 1:
         raise ExportError("the generated airframe has no single <external_reactions>")
     root.remove(hooks[0])
-    nums = modal_matrices(spec.wing, spec.cl_trim)
-    parts = modal_wing_aerodynamics(nums, spec.leapfrog(nums))
+    aero, axes = _modal_axes(root, "the generated airframe")
+    k = list(aero).index(axes["LIFT"])
+    _add_modal_loads(aero, axes, k, spec)
+
+
+def _modal_axes(root: ET.Element, what: str) -> tuple[ET.Element, dict[str, ET.Element]]:
+    """The ``<aerodynamics>`` of ``root`` and its LIFT, DRAG and PITCH axes (the wind axes
+    the modal loads go into); ExportError (one line, naming ``what``) without them."""
     aero = root.find("aerodynamics")
     axes = {} if aero is None else {a.get("name"): a for a in aero.findall("axis")}
     for axis in ("LIFT", "DRAG", "PITCH"):
         if axis not in axes:
-            raise ExportError(f"the generated airframe has no {axis} axis")
-    k = list(aero).index(axes["LIFT"])
+            raise ExportError(f"{what} has no {axis} axis in <aerodynamics> (the modal loads "
+                              "go into the LIFT, DRAG and PITCH axes)")
+    return aero, axes
+
+
+def _add_modal_loads(aero: ET.Element, axes: dict[str, ET.Element], k: int,
+                     spec: ExportSpec) -> None:
+    """The modal loads' functions into ``aero`` at child index ``k``, a term into each of
+    the LIFT, DRAG and PITCH ``axes``."""
+    nums = modal_matrices(spec.wing, spec.cl_trim)
+    parts = modal_wing_aerodynamics(nums, spec.leapfrog(nums), spec.reference)
     aero.insert(k, ET.Comment(f" modal wing '{spec.variant}': its loads "
                               "(bioflex_jsb.generators.native_wing) "))
     aero.insert(k + 1, parts["functions"])
     for axis in ("LIFT", "DRAG", "PITCH"):
         axes[axis].insert(0, parts[axis])
+
+
+def render_jsbsim_aircraft_files(spec: ExportSpec) -> dict[str, str]:
+    """Files of an aircraft file's wing (``spec.jsbsim_path``, e.g. the jsbsim package's
+    SGS.xml): ``aircraft/<aircraft>/<aircraft>.xml``, a COPY of that file renamed, with the
+    modal system included after its last flight-control section and the modal loads in its
+    aerodynamics, and ``systems/<system>.xml``. A copy, not a wrapper: JSBSim includes
+    sections from files (``<system file>``, ``<aerodynamics file>``), not a whole aircraft,
+    and the loads go into the file's own axes; the copy also keeps the aircraft the wing
+    was exported against when the original changes. Nothing is written to the original.
+    ExportError (one line) for a file that cannot take the wing: not readable XML, no
+    LIFT/DRAG/PITCH axes, or a reference to another file (the copy would lose it)."""
+    src = spec.jsbsim_path
+    try:
+        parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
+        root = ET.parse(src, parser=parser).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise ExportError(f"cannot read the aircraft file {src!r}: {exc}") from None
+    if root.tag != "fdm_config":
+        raise ExportError(f"{src!r} is no JSBSim aircraft (its root is <{root.tag}>, "
+                          "not <fdm_config>)")
+    for e in root.iter():
+        if isinstance(e.tag, str) and e.get("file"):
+            raise ExportError(f"{src!r} includes the file {e.get('file')!r} (<{e.tag} "
+                              "file>): the export copies one aircraft file; accepted: an "
+                              "aircraft in one file (the jsbsim package's SGS)")
+    sysname = system_name(spec.variant, spec.model)
+    root.set("name", spec.aircraft_name)
+    kids = list(root)
+    controls = [i for i, e in enumerate(kids) if e.tag in ("flight_control", "autopilot",
+                                                            "system")]
+    aero, axes = _modal_axes(root, repr(src))
+    at = controls[-1] + 1 if controls else kids.index(aero)
+    root.insert(at, ET.Comment(f" modal wing '{spec.variant}' ({spec.model}), step "
+                               f"{num(spec.dt_s)} s: bioflex_jsb.generators.native_wing "))
+    root.insert(at + 1, ET.Element("system", file=sysname))
+    first_axis = next(i for i, e in enumerate(aero) if e.tag == "axis")
+    _add_modal_loads(aero, axes, first_axis, spec)
+    note = (f"<!-- GENERATED by bioflex_jsb.generators.native_aircraft (bioflex-jsb "
+            f"export-jsbsim): a copy of\n     {src}\n     renamed {spec.aircraft_name!r}, "
+            f"with the modal wing '{spec.variant}' added (system {sysname}, loads in the "
+            "LIFT, DRAG and PITCH axes). Do not edit. -->\n")
+    return {f"aircraft/{spec.aircraft_name}/{spec.aircraft_name}.xml": serialise(root, note),
+            f"systems/{sysname}.xml": render_system(spec)}
+
+
+def jsbsim_chord_m(path: str) -> float:
+    """c̄ [m] of an aircraft file's ``<metrics><chord>`` (JSBSim's ``metrics/cbarw-ft``, from
+    which it forms ``aero/ci2vel``); ExportError (one line) when it has none."""
+    try:
+        chord = ET.parse(path).getroot().find("metrics/chord")
+    except (OSError, ET.ParseError) as exc:
+        raise ExportError(f"cannot read the aircraft file {path!r}: {exc}") from None
+    scale = {"FT": U.M_PER_FT, "IN": U.M_PER_FT / 12.0, "M": 1.0}
+    unit = "FT" if chord is None else chord.get("unit", "FT").upper()
+    try:
+        value = float(chord.text) * scale[unit]
+    except (AttributeError, TypeError, ValueError, KeyError):
+        raise ExportError(f"{path!r}: <metrics><chord> must be a number in FT, IN or M (the "
+                          "chord of JSBSim's aero/ci2vel)") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise ExportError(f"{path!r}: <metrics><chord> must be positive, got {value:g} m")
+    return value
 
 
 # ======================================================================================
@@ -147,8 +228,9 @@ class TrimState:
     ic: dict[str, tuple[str, float]]  # IC element → (unit, value)
     controls: dict[str, float]  # control command property → value
     speed_m_s: float  # trim true airspeed [m/s], ISA sea level
-    propeller_rpm: float  # trim propeller RPM [rev/min]
+    propeller_rpm: float  # trim propeller RPM [rev/min] (0: a glider)
     rpm_settle_s: float  # time the propellers took from rest to the trim RPM, airframe held [s]
+    gamma_rad: float = 0.0  # flight-path angle, climb positive [rad] (a glide's is negative)
 
 
 @dataclass(frozen=True)
@@ -176,6 +258,15 @@ COLUMNS = (
     Column("active [-]", f"{PREFIX}/active",
            "1 while the wing flies (simulation/dt is the exported step), else 0: rigid"),
 )
+# A glider (an aircraft file's export: no engine) is held at its trim for GLIDE_HOLD_S [s]
+# before it flies: JSBSim's initial-condition run evaluates the derivatives before the
+# script's first event sets the trim controls, and the Adams-Bashforth integrators would
+# start from that history (measured: q 1e-4 rad/s after the first step from the elevator's
+# zero); held, the history is the trim's (q then < 3e-5 rad/s over 2 s). 0.1 s: 96 steps at
+# the default step, where AB2 needs one.
+GLIDE_HOLD_S = 0.1
+# A glider's CSV: no propeller column.
+GLIDER_COLUMNS = tuple(c for c in COLUMNS if not c.prop.startswith("propulsion/"))
 
 
 @dataclass(frozen=True)
@@ -198,10 +289,17 @@ class FlightCase:
     settle_s: float = FIG21_SETTLE_S
     gust_start_s: float = FIG21_GUST_START_S
     duration_s: float = FIG21_DURATION_S
+    craft: str = ""  # the aircraft's name (empty: aircraft_name of the variant)
+    glider: bool = False  # no engine (an aircraft file's export): held GLIDE_HOLD_S only
 
     @property
     def aircraft(self) -> str:
-        return aircraft_name(self.variant, self.model)
+        return self.craft or aircraft_name(self.variant, self.model)
+
+    @property
+    def columns(self) -> tuple[Column, ...]:
+        """The CSV's columns after ``Time``."""
+        return GLIDER_COLUMNS if self.glider else COLUMNS
 
     @property
     def end_s(self) -> float:
@@ -236,11 +334,16 @@ def export_case(spec: ExportSpec, state: TrimState,
     """The case ``bioflex-jsb export-jsbsim`` writes for ``spec``: ``scripts/<aircraft>.xml``,
     ``aircraft/<aircraft>/trim.xml``, ``<aircraft>.csv``; held ``FIG21_SETTLE_S``, or longer
     (whole seconds, 0.5 s of margin) where the propellers took longer to settle on the trim
-    RPM from rest in the trim (``state``: 4.2 s at 9.4 m/s, 1.7 s at 32 m/s)."""
+    RPM from rest in the trim (``state``: 4.2 s at 9.4 m/s, 1.7 s at 32 m/s). An aircraft
+    file's export (a glider: ``spec.jsbsim_path``) is not held: it glides from its trim."""
     if abs(state.speed_m_s - spec.speed_m_s) > 1e-9 * spec.speed_m_s:
         raise ExportError(f"the trim is at {state.speed_m_s:g} m/s, the export at "
                           f"{spec.speed_m_s:g} m/s")
-    craft = aircraft_name(spec.variant, spec.model)
+    craft = spec.aircraft_name
+    if spec.jsbsim_path:
+        return FlightCase(spec.variant, spec.model, spec.speed_m_s, spec.dt_s,
+                          f"scripts/{craft}.xml", "trim", f"{craft}.csv", float(gust_up_m_s),
+                          settle_s=GLIDE_HOLD_S, craft=craft, glider=True)
     settle = max(FIG21_SETTLE_S, float(math.ceil(state.rpm_settle_s + 0.5)))
     return FlightCase(spec.variant, spec.model, spec.speed_m_s, spec.dt_s,
                       f"scripts/{craft}.xml", "trim", f"{craft}.csv", float(gust_up_m_s),
@@ -256,9 +359,11 @@ def _trim_num(x: float) -> str:
 def render_initial_condition(state: TrimState, case: FlightCase) -> str:
     """Text of the case's initial condition (:attr:`FlightCase.ic_path`): the trimmed state."""
     root = ET.Element("initialize", name=case.initialize)
-    root.append(ET.Comment(f" trim at {state.speed_m_s:g} m/s, ISA sea level, by "
-                           "Airframe.trim (bioflex_jsb.runtime.fdm); JSBSim reads "
-                           "<elevation> before <altitudeMSL> "))
+    how = ("Airframe.trim (bioflex_jsb.runtime.fdm)" if not case.glider else
+           f"the glide trim of bioflex_jsb.drivers.native (flight path "
+           f"{math.degrees(state.gamma_rad):.3f} deg)")
+    root.append(ET.Comment(f" trim at {state.speed_m_s:g} m/s, ISA sea level, by {how}; "
+                           "JSBSim reads <elevation> before <altitudeMSL> "))
     for name, (unit, value) in state.ic.items():
         el(root, name, _trim_num(value), unit=unit)
     el(root, "running", "-1")
@@ -283,6 +388,15 @@ def render_script(state: TrimState, case: FlightCase) -> str:
             "the release" if amp else "in still air")
     title = f"{case.aircraft} at {case.speed_m_s:g} m/s" + (
         ", Fig. 21" if case == fig21_case() else "")
+    if case.glider:
+        held = (f"Glide trim (flight path {math.degrees(state.gamma_rad):.3f} deg) from "
+                f"{case.initialize}.xml; no engine; held for the first {t_fly:g} s (the "
+                "integrators' history at the trim controls); the flight starts at "
+                f"t = {t_fly:g} s and ends at {case.end_s:g} s.")
+    else:
+        held = (f"Trimmed state from {case.initialize}.xml; the airframe is held for the first "
+                f"{t_fly:g} s (propeller spin-up to the trim RPM, {state.propeller_rpm:.1f} "
+                f"rev/min); the flight starts at t = {t_fly:g} s and ends at {case.end_s:g} s.")
     root = ET.Element("runscript", name=title)
     el(root, "description",
         f"Wing '{case.variant}' ({case.model}) at {case.speed_m_s:g} m/s {gust}, the modal wing "
@@ -292,16 +406,14 @@ def render_script(state: TrimState, case: FlightCase) -> str:
         "would stay rigid: such a run stops at its first step with a message). Writes "
         f"{case.output} (one row per step; columns: docs/native.md) in ROOT, or in "
         "--outputpath, which JSBSim takes relative to ROOT, not to the working directory, and "
-        "which must exist (else JSBSim writes nothing and still exits 0). Trimmed state from "
-        f"{case.initialize}.xml; the airframe is held for the first {t_fly:g} s (propeller "
-        f"spin-up to the trim RPM, {state.propeller_rpm:.1f} rev/min); the flight starts at "
-        f"t = {t_fly:g} s and ends at {case.end_s:g} s.")
+        f"which must exist (else JSBSim writes nothing and still exits 0). {held}")
     el(root, "use", aircraft=case.aircraft, initialize=case.initialize)
     run = el(root, "run", start="0", end=num(case.end_s), dt=num(dt_s))
     ev = el(run, "event", name="trim controls, airframe held")
     el(ev, "description", "trim controls of the Python trim; JSBSim's integrators of the "
                            "airframe state off (0): the state stays at the trim while the "
-                           "propellers spin up to the trim RPM")
+                           + ("integrators' history fills at the trim controls" if case.glider
+                              else "propellers spin up to the trim RPM"))
     el(ev, "condition", "simulation/sim-time-sec ge 0")
     for name, value in state.controls.items():
         el(ev, "set", name=name, value=_trim_num(value))
@@ -328,7 +440,7 @@ def render_script(state: TrimState, case: FlightCase) -> str:
         el(ev, "condition", f"simulation/sim-time-sec ge {num(t_gust - 0.5 * dt_s)}")
         el(ev, "set", name="atmosphere/wind-down-fps", value=num(-amp * U.FT_PER_M))
     out = el(root, "output", name=case.output, type="CSV", rate=num(1.0 / dt_s))
-    for c in COLUMNS:
+    for c in case.columns:
         el(out, "property", c.prop, caption=c.caption)
     return serialise(root, _HEADER)
 

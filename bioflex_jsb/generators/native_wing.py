@@ -72,10 +72,12 @@ K(Q)⁻¹ tabulated against Q (rows every 0.5 m/s of V up to :data:`GRID_SPEED_M
 
 Properties (all under ``bioflex/modal/``), ``coupled``: ``eta<i>``, ``eta<i>-dot`` [rad,
 rad/s] (functions of the stored ``y-eta<i>-scaled`` = y_η/c_i, c_i = Φ_s[0,1]/Φ_s[1,1] ≈ Δt,
-and ``y-eta<i>-dot``), ``alpha0-rad``, ``qbar0-pa``
-(latched trim reference), ``active``, ``idle``, ``enabled`` (set 0 to fly the rigid airframe
-with the same file); the loads are ``aero/bioflex/modal-lift-lbs``, ``aero/force/modal-lift``,
-``aero/force/modal-drag`` [lbs] and ``aero/moment/modal-pitch`` [lbs ft].
+and ``y-eta<i>-dot``), ``alpha0-rad``, ``qbar0-pa`` (latched trim reference), ``active``,
+``idle``, ``enabled`` (0: the rigid airframe with the same file), for an aircraft file's wing
+``omega<i>-sq-rad2_s2`` (ω_i² [rad²/s²], 17 digits: its modes, stated); the loads are
+``aero/bioflex/modal-lift-lbs``, ``aero/force/modal-lift``, ``aero/force/modal-drag`` [lbs]
+and ``aero/moment/modal-pitch`` [lbs ft]. The values (S, c̄, mass, derivatives, modes) are
+the wing's airframe's (``ExportSpec.wing.airframe``: the prototype's or a definition's).
 """
 
 from __future__ import annotations
@@ -94,7 +96,11 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.generators.xml_writer import XmlWriter, collapse, num_12g, serialise
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S
+from bioflex_jsb.parameters.airframe import (
+    AIRSPEED_RANGE_M_S,
+    REFERENCE_GEOMETRY,
+    ReferenceGeometry,
+)
 from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for the checks)
     GRID_SPEED_MAX_M_S,
     GRID_SPEED_STEP_M_S,
@@ -184,8 +190,11 @@ def _p(name: str) -> str:
 
 @dataclass(frozen=True)
 class ExportSpec:
-    """What to export: the wing, its name, the model, the step [s], the trim speed [m/s] of
-    the trim lift coefficient (C_0^Q and the induced-drag slope), the reference density."""
+    """What to export: the wing (``wing.airframe``: S, c̄, mass, derivatives), its name, the
+    model, the step [s], the trim speed [m/s] of the trim C_L (C_0^Q, induced-drag slope), the
+    reference density [kg/m³]; ``jsbsim_path``: the aircraft file it is attached to (empty:
+    the generated prototype), ``aircraft``: the exported aircraft's name (empty:
+    :func:`aircraft_name`), ``jsbsim_chord_m``: c̄ [m] of the file's ``aero/ci2vel`` (0: c̄)."""
 
     wing: ElasticWingModel
     variant: str
@@ -193,6 +202,9 @@ class ExportSpec:
     dt_s: float = DEFAULT_DT_S
     speed_m_s: float = P.CRUISE_SPEED_M_S
     rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3
+    jsbsim_path: str = ""
+    aircraft: str = ""
+    jsbsim_chord_m: float = 0.0
 
     def __post_init__(self) -> None:
         if self.model not in EXPORT_MODELS:
@@ -203,7 +215,10 @@ class ExportSpec:
         if not (math.isfinite(self.speed_m_s) and lo <= self.speed_m_s <= hi):
             raise ExportError(f"speed {self.speed_m_s:g} m/s is outside {lo:g}..{hi:g} m/s, "
                               "the range every command accepts")
-
+        if self.jsbsim_path and self.model != "coupled":
+            raise ExportError(f"model {self.model!r} puts the wing's loads into the generated "
+                              "airframe's external reactions; an aircraft file's wing exports "
+                              "the coupled model (its loads in the file's aerodynamics)")
         if self.model == "coupled":
             self._check_step()
 
@@ -226,7 +241,28 @@ class ExportSpec:
 
     @property
     def cl_trim(self) -> float:
-        return level_flight_condition(self.speed_m_s, self.rho_ref).cl_trim
+        return level_flight_condition(self.speed_m_s, self.rho_ref,
+                                      airframe=self.wing.airframe).cl_trim
+
+    @property
+    def reference(self) -> ReferenceGeometry:
+        """S [m²], b [m], c̄ [m] of the wing's airframe (the modal coefficients')."""
+        return self.wing.airframe.reference
+
+    @property
+    def ci2vel_chord_m(self) -> float:
+        """c̄ [m] of JSBSim's ``aero/ci2vel`` = c̄/(2V) in the aircraft file."""
+        return self.jsbsim_chord_m or self.reference.mean_chord_m
+
+    @property
+    def aircraft_name(self) -> str:
+        """Name (directory and file) of the exported aircraft."""
+        return self.aircraft or aircraft_name(self.variant, self.model)
+
+    @property
+    def airframe_label(self) -> str:
+        name = self.wing.airframe.name
+        return "the bioflex UAV" if name == airframe_xml.AIRCRAFT_NAME else f"aircraft {name!r}"
 
     def leapfrog(self, nums: ModalMatrices, dt_s: float | None = None) -> LeapfrogCoefficients:
         """The coupled model's step of ``dt_s`` [s] (default the exported step), its exact
@@ -242,7 +278,8 @@ def render_system(spec: ExportSpec) -> str:
     n = nums.n
     root = ET.Element("system", name=system_name(spec.variant, spec.model))
     el(root, "description",
-        f"Modal wing '{spec.variant}' ({spec.model}, {n} modes) of the bioflex UAV, generated by "
+        f"Modal wing '{spec.variant}' ({spec.model}, {n} modes) of {spec.airframe_label}, "
+        "generated by "
         "bioflex_jsb.generators.native_wing (see its docstring and docs/native.md). "
         f"Exported for a time step of {num(spec.dt_s)} s (simulation/dt must equal it; else "
         f"{PREFIX}/active = 0 and the wing is rigid), trim C_L {spec.cl_trim:.6g} "
@@ -445,7 +482,7 @@ def _qsd_state(ch, spec: ExportSpec, nums: ModalMatrices, eta: list[str]) -> Non
 
 
 def _loads(ch, spec: ExportSpec, nums: ModalMatrices, eta: list[str], etad: list[str]) -> None:
-    s_ref, cb = P.REFERENCE_AREA_M2, P.MEAN_AERODYNAMIC_CHORD_M
+    s_ref, cb = spec.reference.area_m2, spec.reference.mean_chord_m
     W.comment(ch, "incremental loads: Q S (C_eta eta + C_etadot etadot cbar/(2V)), wind axes, SI")
     names = (("lift-n", "lift, up, normal to the air velocity [N]"),
              ("drag-n", "drag, aft, along the air velocity [N]"),
@@ -503,6 +540,9 @@ def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalMatrices, eta
     for name in ("alpha0-rad", "qbar0-pa", "never"):
         el(root, "property", _p(name), value="0")
     el(root, "property", _p("enabled"), value="1")
+    if spec.jsbsim_path:  # an aircraft file's wing states its modes (not read by the step)
+        for i, w in enumerate(nums.omega):
+            el(root, "property", _p(f"omega{i + 1}-sq-rad2_s2"), value=repr(float(w * w)))
 
     W.comment(root, "system functions, evaluated once per step before the channels")
     fn = el(root, "function", name=_p("active"))
@@ -551,7 +591,8 @@ def _coupled_system(root: ET.Element, spec: ExportSpec, nums: ModalMatrices, eta
             W.combination(s, [(h[row, 0] * co.eta_rate[i], y_eta[i]), (h[row, 1], y_rate[i])],
                          name=name)
 
-    pa, c_bar = U.PA_PER_PSF, P.MEAN_AERODYNAMIC_CHORD_M
+    # c̄ of JSBSim's aero/ci2vel (the aircraft file's): Q/V = Q (2/c̄) aero/ci2vel exactly
+    pa, c_bar = U.PA_PER_PSF, spec.ci2vel_chord_m
     ch = el(root, "channel", name="Modal wing", execute=_p("active"))
     W.comment(ch, "leapfrog step (Strang splitting) of the stored half-step state y: the rate "
                  "kicked by the aerodynamic acceleration of y and advanced by the exact "
@@ -595,8 +636,9 @@ def _stored_state(n: int) -> tuple[list[str], list[str]]:
             [_p(f"y-eta{i + 1}-dot") for i in range(n)])
 
 
-def modal_wing_aerodynamics(nums: ModalMatrices,
-                            co: LeapfrogCoefficients) -> dict[str, ET.Element]:
+def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
+                            reference: ReferenceGeometry = REFERENCE_GEOMETRY,
+                            ) -> dict[str, ET.Element]:
     """The native modal wing's loads as JSBSim aerodynamics of the airframe: ``<function>``
     elements keyed by where they go (``functions``: before the first axis; ``LIFT``, ``DRAG``,
     ``PITCH``: into those axes).
@@ -608,17 +650,22 @@ def modal_wing_aerodynamics(nums: ModalMatrices,
     (C_m_η·η + C_m_η̇·η̇ c̄/(2V)) in the PITCH axis (about the aerodynamic reference point,
     which is the CG); Q and V JSBSim's air data of this step; × ``enabled``. The lift
     is an aerodynamics function evaluated once per step (``aero/bioflex/modal-lift-lbs``),
-    read by the LIFT and DRAG axes."""
+    read by the LIFT and DRAG axes. ``reference``: S [m²] and c̄ [m] of the modal coefficients
+    (the wing's airframe's; default the prototype's)."""
     n = nums.n
     y_eta, y_rate = _stored_state(n)
-    k2 = float(nums.load_eta[1, 0] / nums.load_eta[0, 0]) if nums.load_eta[0, 0] else 0.0
+    # k₂ from the largest lift term (a pure bending mode's C_L_η is 0: the SGS's first)
+    lift_terms = np.concatenate([nums.load_eta[0], nums.load_etadot[0]])
+    drag_terms = np.concatenate([nums.load_eta[1], nums.load_etadot[1]])
+    big = int(np.argmax(np.abs(lift_terms)))
+    k2 = float(drag_terms[big] / lift_terms[big]) if lift_terms[big] else 0.0
     if not (np.allclose(nums.load_eta[1], k2 * nums.load_eta[0])
             and np.allclose(nums.load_etadot[1], k2 * nums.load_etadot[0])):
         raise ExportError("the modal drag is not proportional to the modal lift")
-    s_ref, qbar = P.REFERENCE_AREA_M2, "aero/qbar-psf"
+    s_ref, qbar = reference.area_m2, "aero/qbar-psf"
     # c̄/(2V) from this step's airspeed: JSBSim updates aero/ci2vel only after the
     # aerodynamics' own functions have run, so it would be the previous step's
-    half_chord_ft = 0.5 * P.MEAN_AERODYNAMIC_CHORD_M * U.FT_PER_M
+    half_chord_ft = 0.5 * reference.mean_chord_m * U.FT_PER_M
 
     def loads(fn: ET.Element, r: int, gain: float) -> None:
         c = gain * U.PA_PER_PSF * s_ref
