@@ -8,25 +8,33 @@ from bioflex_jsb.cli.common import UsageError, positive_float, print_json
 
 STEPS_RANGE = (100, 100_000)
 REPEAT_RANGE = (1, 50)
+# drivers.bench.DEFAULT_STEPS and DEFAULT_REPEAT (not imported at start-up: it loads JSBSim;
+# tests/test_bench.py holds them equal)
+DEFAULT_STEPS = 300
+DEFAULT_REPEAT = 12
 SITL_SECONDS_RANGE = (0.0, 3600.0)
 SPEEDUP_RANGE = (0.1, 50.0)
 
 HELP = """Time bare JSBSim (the same airframe and step, no Python beyond the step call), the
 co-simulation (JSBSim + the compiled coupled step: flow, modal wing, loads, range checks), the
-co-simulation with its MCAP log, the compiled unsteady wing (Jones lag and Küssner states),
-the readable Python step, and the native XML wing (JSBSim alone, the wing exported as JSBSim
-systems), all at the co-simulation's default step (1/960 s), interleaved --repeat times in one
-process, each at --steps, 2x and 4x --steps (the unsteady wing, whose first reference step
-costs tens of ms, at 4x those). Per-step costs: a line through the least time of
-each run length (noise only adds time) separates the fixed cost per run; each repeat's
-per-step cost is its longest run less that fixed cost (never negative; an estimate the
-timings do not support is reported as not trusted, with the reason, instead of a figure).
-Timed on the process's CPU clock (a run preempted by other work is not charged for the wait;
-wall-clock figures beside them in --json). Ratios, repeat by repeat (median [min .. max]):
-ratio = co-simulation / bare, logged_ratio = logged co-simulation / bare, log_ratio = logged
-/ unlogged, unsteady_ratio = unsteady co-simulation / bare, native_ratio = native / bare,
-python_ratio = Python step / bare; each ratio with a bar (on a quiet 2-core machine) printed
-against it. Also: µs per step through sharp:0.3, sharp:3 and Dryden gusts (a large gust
+co-simulation logged as a gust run logs (its rows, the section loads and the 3-D scene; also
+with the rows alone and without the scene, for the cost of each), the compiled unsteady wing
+(Jones lag and Küssner states), the readable Python step, and the native XML wing (JSBSim
+alone, the wing exported as JSBSim systems), all at the co-simulation's default step (1/960
+s), interleaved --repeat times in one process, each at --steps, 2x and 4x --steps (the
+unsteady wing, whose first reference step costs tens of ms, at 4x those). The runs are short
+(the machine's own speed changes in states of ~10-50 ms on a shared host: a run that long
+mixes them) and many: per-step costs are the slope of a line through the least time of each
+run length (noise only adds time; the line's offset is the fixed cost per run), for all the
+repeats (the figure) and for 3 interleaved groups of them (its spread: median [min .. max]);
+an estimate the timings do not support is reported as not trusted, with the reason, instead
+of a figure (never negative). Timed on the process's CPU clock (a run preempted by other
+work is not charged for the wait; wall-clock figures beside them in --json). Ratios, the
+figure and its groups': ratio = co-simulation / bare, logged_ratio = logged co-simulation /
+bare, log_ratio = logged / unlogged, unsteady_ratio = unsteady co-simulation / bare,
+native_ratio = native / bare, python_ratio = Python step / bare; each ratio with a bar (on a
+quiet 2-core machine) printed against it; the logging costs [µs/step]: the rows, the section
+loads, the scene. Also: µs per step through sharp:0.3, sharp:3 and Dryden gusts (a large gust
 renews the wing's reference step more often), the cost of one reference renewal [ms] of
 both wings, the step kernels' cold compile and cached load [s], the load average, and the
 SITL pacing error (step start against the wall clock, p50/p99 [ms] and resyncs) over
@@ -58,11 +66,12 @@ def _int_in(label: str, lo: int, hi: int):
 def register(sub) -> None:
     p = sub.add_parser("bench", help="µs per step: bare JSBSim vs co-simulation",
                        description=HELP)
-    p.add_argument("--steps", type=_int_in("--steps", *STEPS_RANGE), default=1200,
+    p.add_argument("--steps", type=_int_in("--steps", *STEPS_RANGE), default=DEFAULT_STEPS,
                    help=f"steps of the shortest timing, {STEPS_RANGE[0]}..{STEPS_RANGE[1]} "
-                   "(default 1200; the others are 2x and 4x that)")
-    p.add_argument("--repeat", type=_int_in("--repeat", *REPEAT_RANGE), default=5,
-                   help=f"interleaved repeats, {REPEAT_RANGE[0]}..{REPEAT_RANGE[1]} (default 5)")
+                   f"(default {DEFAULT_STEPS}; the others are 2x and 4x that)")
+    p.add_argument("--repeat", type=_int_in("--repeat", *REPEAT_RANGE), default=DEFAULT_REPEAT,
+                   help=f"interleaved repeats, {REPEAT_RANGE[0]}..{REPEAT_RANGE[1]} (default "
+                   f"{DEFAULT_REPEAT}; 3 groups of them give each figure's spread)")
     p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
                    help="trim airspeed [m/s], 5..40 (default 15)")
     p.add_argument("--sitl-seconds", type=float, default=2.0,
@@ -142,10 +151,10 @@ def _progress(args):
 
 
 def _spread(d: dict, unit: str = "") -> str:
-    """median [min .. max] of a figure, or why it is not trusted."""
-    if d["median"] is None:
+    """value [min .. max of its groups] of a figure, or why it is not trusted."""
+    if d["value"] is None:
         return f"not trusted: {d['reason']}"
-    return f"{d['median']:7.2f}{unit}  [{d['min']:.2f} .. {d['max']:.2f}]"
+    return f"{d['value']:7.2f}{unit}  [{d['min']:.2f} .. {d['max']:.2f}]"
 
 
 def _against_bar(d: dict) -> str:
@@ -160,10 +169,10 @@ def _print(p: dict) -> None:
     us = p["us_per_step"]
     load = ", ".join(f"{x:.2f}" for x in p["load_average"])
     print(f"time step {p['dt_s']:.6f} s; runs of {', '.join(map(str, p['run_lengths']))} "
-          f"steps, {p['repeat']} interleaved repeats; CPU clock; median [min .. max]; "
-          f"load average after the runs {load}")
+          f"steps, {p['repeat']} interleaved repeats; CPU clock; figure [min .. max of its "
+          f"groups]; load average before {_load(p['load_average_before'])}, after {load}")
     rows = (("bare JSBSim", "bare", None), ("co-simulation", "cosim", "ratio"),
-            ("  with its MCAP log", "logged", "logged_ratio"),
+            ("  logged (gust log)", "logged", "logged_ratio"),
             ("  unsteady strips", "unsteady", "unsteady_ratio"),
             ("  Python step", "python", "python_ratio"),
             ("native XML wing", "native", "native_ratio"))
@@ -173,6 +182,9 @@ def _print(p: dict) -> None:
             r = p[ratio_key]
             print(f"{'':20s} {ratio_key:14s} {_spread(r)}{_against_bar(r)}")
     print(f"{'':20s} {'log_ratio':14s} {_spread(p['log_ratio'])}")
+    for key, label in (("rows", "the rows"), ("section_loads", "section loads"),
+                       ("scene", "3-D scene"), ("all", "the whole log")):
+        print(f"  logging cost, {label:15s} {_spread(p['log_costs_us_per_step'][key], ' µs/step')}")
     for gust, d in p["cosim_us_per_step_by_gust"].items():
         print(f"co-simulation, {gust:18s} {_spread(d, ' µs/step')}")
     fixed = ", ".join(f"{k} {us[k]['fixed_ms']:.2f} ms" for k in ("cosim", "logged", "unsteady")

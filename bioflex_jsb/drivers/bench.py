@@ -21,8 +21,19 @@ a median of 2.3) when one of the two runs was slowed. Here:
   the slope is not positive, the fit's residual is more than :data:`MAX_RESIDUAL` of the
   times, or the slope and the least per-repeat cost differ by more than
   :data:`MAX_DISAGREEMENT`;
-* ratios are taken repeat by repeat (configurations timed back to back: the load changes
-  less within a repeat than across the run) and given as median, min and max.
+* the machine's own speed changes under the code: on the 2-core KVM machine of the project
+  a fixed pure-Python workload ran 1.0-1.65 ms, in states of ~10-50 ms (a host core
+  shared with other guests), and bare JSBSim's per-step time over 300-step blocks went
+  6.8-13.7 µs with it (correlation 0.6-0.7 with the workload's, measured 2026-12-02,
+  load 0.4-2): runs as long as those states mix them in proportions that differ from run
+  to run and from length to length, which bent the least times off a line (the residual
+  of 11 % on a quiet machine). Runs are therefore short (:data:`DEFAULT_STEPS`: 3-25 ms)
+  and many, so that the least time of each length is one of the fast state, the state in
+  which the code's own cost shows;
+* every figure is the slope of the least times of all the repeats, its spread the slopes
+  of :data:`GROUPS` interleaved groups of the repeats (median, min, max: how well the
+  estimator itself reproduces); ratios and differences the same, group by group (the
+  groups span the same stretch of time).
 """
 
 from __future__ import annotations
@@ -52,6 +63,9 @@ from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks.mcap import RunLog
 
 LENGTH_FACTORS = (1, 2, 4)  # run lengths, × ``steps``
+DEFAULT_STEPS = 300  # the shortest run (module docstring: shorter than the speed states)
+DEFAULT_REPEAT = 12  # 4 repeats in each of the GROUPS groups
+GROUPS = 3  # interleaved groups of the repeats: the spread of every figure
 # The unsteady wing's first reference step costs 50-100 ms per run (a 356-state exponential
 # and the Fréchet derivative), ~25 times the quasi-steady run's fixed cost: its runs are 4
 # times longer, or the fixed cost's own noise (±10 ms under load) bends the line (residual
@@ -65,6 +79,17 @@ MAX_DISAGREEMENT = 0.25
 # The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step.
 BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2}
 CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
+LOGS = (None, "rows", "loads", "gust")  # StepBench.cosim's logs
+# figure → (numerator, denominator) configurations
+RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
+          "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
+          "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare")}
+# the logging costs [µs/step]: name → (with, without)
+LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
+             "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
+# The 3-D scene of a gust log at true scale: cli.gust.SCENE_EXAGGERATION (the CLI is above
+# this layer; tests/test_bench.py holds the two equal).
+GUST_SCENE_EXAGGERATION = 1.0
 
 
 @dataclass(frozen=True)
@@ -161,14 +186,82 @@ def estimate_per_step(lengths: Sequence[int], times_s) -> PerStep:
     return PerStep(tuple(float(p) for p in per), float(slope), f, residual, None)
 
 
-def ratio(num: PerStep, den: PerStep) -> dict[str, object]:
-    """num / den repeat by repeat: median, min, max, or None and the reason when either
-    estimate is not trusted."""
-    if num.per_repeat_s is None or den.per_repeat_s is None:
-        why = num.reason if num.reason is not None else den.reason
-        return {"median": None, "min": None, "max": None, "trusted": False, "reason": why}
-    values = [a / b for a, b in zip(num.per_repeat_s, den.per_repeat_s, strict=True)]
-    return {**Spread.of(values).as_dict(), "trusted": True, "reason": None}
+@dataclass(frozen=True)
+class Figure:
+    """A per-step cost from every repeat (``all``) with the same estimate made on each of
+    the interleaved groups of the repeats (``groups``): :func:`estimate_figure`."""
+
+    all: PerStep
+    groups: tuple[PerStep, ...]
+
+    @property
+    def reason(self) -> str | None:
+        """Why the figure is not trusted (the first estimate that is not), or None."""
+        if self.all.reason is not None:
+            return self.all.reason
+        for i, g in enumerate(self.groups):
+            if g.reason is not None:
+                return f"group {i + 1} of {len(self.groups)}: {g.reason}"
+        return None
+
+    def slopes(self) -> tuple[float, ...]:
+        return tuple(g.slope_s for g in self.groups)
+
+    def as_dict(self, scale: float = 1e6) -> dict[str, object]:
+        """value: the slope of every repeat's least times, median/min/max: the groups'
+        (× ``scale``, µs per step by default); the fit of every repeat (fixed cost [ms],
+        residual); None and the reason when not trusted."""
+        trusted = self.reason is None
+        spread = (Spread.of(self.slopes()).as_dict() if trusted
+                  else {"median": None, "min": None, "max": None})
+        return {"value": _scaled(self.all.slope_s, scale) if trusted else None,
+                **{k: _scaled(v, scale) for k, v in spread.items()}, "trusted": trusted,
+                "reason": self.reason, "slope": _scaled(self.all.slope_s, scale),
+                "fixed_ms": _scaled(self.all.fixed_s, 1e3),
+                "residual": _finite(self.all.residual), "groups": len(self.groups)}
+
+
+def estimate_figure(lengths: Sequence[int], times_s, groups: int = GROUPS) -> Figure:
+    """:func:`estimate_per_step` of every repeat of ``times_s`` (repeats × lengths [s]) and
+    of each of ``groups`` interleaved groups (repeats g, g + groups, ...; as many groups as
+    repeats when there are fewer)."""
+    t = np.asarray(times_s, dtype=float)
+    if t.ndim != 2 or t.shape[0] < 1:
+        raise ValueError(f"times of shape {t.shape}: repeats × run lengths expected")
+    k = max(1, min(int(groups), t.shape[0]))
+    return Figure(estimate_per_step(lengths, t),
+                  tuple(estimate_per_step(lengths, t[g::k]) for g in range(k)))
+
+
+def _untrusted(reason: str | None) -> dict[str, object]:
+    return {"value": None, "median": None, "min": None, "max": None, "trusted": False,
+            "reason": reason}
+
+
+def ratio(num: Figure, den: Figure) -> dict[str, object]:
+    """num / den: value (of every repeat's slopes) and median, min, max of the groups'
+    ratios; None and the reason when either figure is not trusted."""
+    why = num.reason if num.reason is not None else den.reason
+    if why is not None:
+        return _untrusted(why)
+    values = [a / b for a, b in zip(num.slopes(), den.slopes(), strict=True)]
+    return {"value": num.all.slope_s / den.all.slope_s, **Spread.of(values).as_dict(),
+            "trusted": True, "reason": None}
+
+
+def difference(a: Figure, b: Figure, scale: float = 1e6) -> dict[str, object]:
+    """The cost a − b per step (× ``scale``: µs), as :func:`ratio`; not resolved (no figure,
+    the reason) when any group's difference or the whole one is not positive: the two
+    cannot be told apart at that noise (a cost never comes out negative)."""
+    why = a.reason if a.reason is not None else b.reason
+    if why is not None:
+        return _untrusted(why)
+    values = [(x - y) * scale for x, y in zip(a.slopes(), b.slopes(), strict=True)]
+    value = (a.all.slope_s - b.all.slope_s) * scale
+    if not (value > 0.0 and min(values) > 0.0):
+        return _untrusted(f"not resolved: the difference is {value:.3g} µs/step, its groups' "
+                          f"{min(values):.3g} .. {max(values):.3g}")
+    return {"value": value, **Spread.of(values).as_dict(), "trusted": True, "reason": None}
 
 
 class BenchmarkStopped(RuntimeError):
@@ -184,7 +277,8 @@ class StepBench:
     strips), logged, and the native XML wing, on one airframe at the co-simulation's step.
     Every timed method returns (CPU seconds, wall seconds) of a run of ``n`` steps."""
 
-    def __init__(self, build: WingBuild, speed_m_s: float = 15.0, steps: int = 1200) -> None:
+    def __init__(self, build: WingBuild, speed_m_s: float = 15.0,
+                 steps: int = DEFAULT_STEPS) -> None:
         self.build = build
         self.speed_m_s = speed_m_s
         self.steps = steps
@@ -217,30 +311,43 @@ class StepBench:
             c1, w1 = _clocks()
         return c1 - c0, w1 - w0
 
-    def cosim(self, n: int, gust: str = "sharp:0.3", logged: bool = False,
+    def cosim(self, n: int, gust: str = "sharp:0.3", log: str | None = None,
               compiled: bool = True, aero: str = "quasi-steady") -> tuple[float, float]:
         """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
-        at half the shortest run; with an MCAP log when ``logged``; ``aero`` the strips."""
+        at half the shortest run; ``aero`` the strips; ``log``: None (no log, no section
+        loads), ``"rows"`` (an MCAP log of the run's rows), ``"loads"`` (and the section
+        loads, computed and logged) or ``"gust"`` (and the 3-D scene: what ``bioflex-jsb
+        gust`` logs, cli/gust.py)."""
+        if log not in LOGS:
+            raise ValueError(f"log must be one of {LOGS}, not {log!r}")
         dt = DEFAULT_DT_S
         setup = RunSetup(self.speed_m_s, parse_gust(gust), duration_s=n * dt,
                          gust_start_s=0.5 * self.steps * dt, dt_s=dt)
         trim = self.airframe.trim(self.speed_m_s)  # outside the timing, as for bare()
-        log = None
-        if logged:
+        run_log = None
+        if log is not None:
             self._logs += 1
             desc = RunDescription("bench", self.build.variant.name, self.speed_m_s, gust=gust,
                                   models=("coupled",), duration_s=n * dt)
-            log = RunLog.open(Path(self._tmp.name) / f"bench{self._logs}.mcap", desc)
+            run_log = RunLog.open(
+                Path(self._tmp.name) / f"bench{self._logs}.mcap", desc,
+                wing_variant=self.build.variant.as_dict(),
+                overrides=dict(self.build.model.coefficients.overrides),
+                scene=GUST_SCENE_EXAGGERATION if log == "gust" else None)
         wing = self.build if aero == "unsteady" else self.build.model
         try:
             c0, w0 = _clocks()
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
-                           recorder=log.recorder("coupled") if log else None,
-                           compiled=compiled, aero=aero)
+                           recorder=run_log.recorder("coupled") if run_log else None,
+                           compiled=compiled, aero=aero,
+                           loads=self.build if log in ("loads", "gust") else None)
+            if run_log is not None:  # closing writes the last chunks: part of the log's cost
+                run_log.close()
+                run_log = None
             c1, w1 = _clocks()
         finally:
-            if log is not None:
-                log.close()
+            if run_log is not None:
+                run_log.close()
         if run.stopped:
             raise BenchmarkStopped(f"benchmark run stopped: {run.stopped}")
         return c1 - c0, w1 - w0
@@ -250,7 +357,9 @@ class StepBench:
         configs: dict[str, Callable[[int], tuple]] = {
             "bare": self.bare,
             "cosim": lambda n: self.cosim(n),
-            "logged": lambda n: self.cosim(n, logged=True),
+            "logged": lambda n: self.cosim(n, log="gust"),
+            "logged_rows": lambda n: self.cosim(n, log="rows"),
+            "logged_no_scene": lambda n: self.cosim(n, log="loads"),
             "unsteady": lambda n: self.cosim(n, aero="unsteady"),
             "native": self.native_run,
             "python": lambda n: self.cosim(n, compiled=False),
@@ -260,8 +369,8 @@ class StepBench:
                 configs[f"gust:{g}"] = lambda n, g=g: self.cosim(n, gust=g)
         return configs
 
-    def measure(self, repeat: int = 5, gusts: tuple[str, ...] = ("sharp:0.3", "sharp:3",
-                                                                    "dryden:1.5:100:7"),
+    def measure(self, repeat: int = DEFAULT_REPEAT,
+                gusts: tuple[str, ...] = ("sharp:0.3", "sharp:3", "dryden:1.5:100:7"),
                 progress=None) -> dict[str, object]:
         """Every figure of ``bioflex-jsb bench`` (module docstring; per-step costs in µs)."""
         configs = self.configurations(gusts)
@@ -270,6 +379,7 @@ class StepBench:
         # [clock][config] → repeats × lengths [s]
         times = {c: {k: np.zeros((repeat, len(LENGTH_FACTORS))) for k in configs}
                  for c in CLOCKS}
+        load0 = list(os.getloadavg())
         # warm-up, not timed: the first run pays one-time costs (lazy imports, the kernels'
         # load, the first reference step, the log writer's first chunk)
         for run in configs.values():
@@ -283,32 +393,35 @@ class StepBench:
                 progress.update(1)
         if progress is not None:
             progress.close()
-        est = {c: {k: estimate_per_step(lengths[k], v) for k, v in times[c].items()}
+        est = {c: {k: estimate_figure(lengths[k], v) for k, v in times[c].items()}
                for c in CLOCKS}
         cpu = est["cpu"]
-        pairs = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
-                 "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
-                 "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare")}
         figures: dict[str, object] = {}
-        for key, (num, den) in pairs.items():
+        for key, (num, den) in RATIOS.items():
             figures[key] = ratio(cpu[num], cpu[den])
             if key in BARS:
                 figures[key]["bar"] = BARS[key]
-                med = figures[key]["median"]
-                figures[key]["meets_bar"] = None if med is None else bool(med <= BARS[key])
+                value = figures[key]["value"]
+                figures[key]["meets_bar"] = None if value is None else bool(value <= BARS[key])
         plain = [k for k in configs if not k.startswith("gust:")]
         return {
             **figures,
             "clock": "process CPU time (time.process_time); wall-clock figures in 'wall'",
+            "estimator": f"slope of the least time of each run length over {repeat} "
+                         f"repeats (value); median, min, max of the same over "
+                         f"{min(GROUPS, repeat)} interleaved groups of them",
             "us_per_step": {k: cpu[k].as_dict() for k in plain},
+            "log_costs_us_per_step": {k: difference(cpu[a], cpu[b])
+                                      for k, (a, b) in LOG_COSTS.items()},
             "wall": {"us_per_step": {k: est["wall"][k].as_dict() for k in plain},
                      **{key: ratio(est["wall"][a], est["wall"][b])
-                        for key, (a, b) in pairs.items()}},
+                        for key, (a, b) in RATIOS.items()}},
             "cosim_us_per_step_by_gust": {
                 g: cpu["cosim" if g == "sharp:0.3" else f"gust:{g}"].as_dict() for g in gusts},
             "run_lengths": lengths["bare"],
             "run_lengths_by_configuration": {k: v for k, v in lengths.items()
                                              if v != lengths["bare"]},
+            "load_average_before": load0,
             "load_average": list(os.getloadavg()),
         }
 
