@@ -34,7 +34,7 @@ from bioflex_jsb.definition import Definition
 from bioflex_jsb.definition import load_definition as _load_definition
 from bioflex_jsb.definition.aircraft import Aircraft
 from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
-from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT
+from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
 from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
 from bioflex_jsb.drivers.compare import Comparison, check_comparable, compare_run
 from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
@@ -49,8 +49,9 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     build_wing,
     resolve_variant,
 )
-from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
+from bioflex_jsb.runtime.other_airframe import airframe_for
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
@@ -98,19 +99,38 @@ def _wing(wing):
 
 
 def _flying_wing(wing):
-    """:func:`_wing` for the nonlinear JSBSim runs, which fly the prototype's airframe only
-    (docs/aircraft.md, "What runs with another airframe"): another one is refused in one
-    line (:meth:`Aircraft.flight_problem`), never flown with the prototype's numbers."""
+    """:func:`_wing` for the nonlinear JSBSim runs (docs/aircraft.md, "What runs with
+    another airframe"): an :class:`Aircraft` flies on its own JSBSim airframe when
+    :func:`~bioflex_jsb.definition.flying.flight_refusal` has no objection (else one line);
+    a bare WingBuild only on the prototype's (another airframe's wing needs its Aircraft:
+    the JSBSim aircraft is in the definition), never with the prototype's numbers."""
     if isinstance(wing, Aircraft):
-        problem = wing.flight_problem()
+        problem = flight_refusal(wing)
         if problem:
             raise InputError(problem)
     build = _wing(wing)
-    if build is not None and build.model.airframe is not PROTOTYPE_AIRFRAME:
+    if (not isinstance(wing, Aircraft) and build is not None
+            and build.model.airframe is not PROTOTYPE_AIRFRAME):
         raise InputError(f"wing {build.variant.name!r} is built for airframe "
-                         f"{build.model.airframe.name!r}: the nonlinear runs fly the "
-                         "prototype's airframe only in this version (docs/aircraft.md)")
+                         f"{build.model.airframe.name!r}: a bare wing flies on the "
+                         "prototype's airframe only; pass its Aircraft (api.load_aircraft), "
+                         "whose definition names the JSBSim aircraft")
     return build
+
+
+def _flight(wing, speed_m_s: float | None):
+    """(the WingBuild, the JSBSim airframe, the trim speed [m/s]) of a nonlinear run of
+    ``wing``: an :class:`Aircraft`'s own airframe and cruise speed (the default of
+    ``speed_m_s``), else the prototype's (15 m/s, Table 1)."""
+    build = _flying_wing(wing)
+    if isinstance(wing, Aircraft):
+        cruise, (lo, hi) = flight_speeds(wing)
+        v = cruise if speed_m_s is None else float(speed_m_s)
+        if not lo <= v <= hi:
+            raise InputError(f"speed {v:g} m/s is outside aircraft {wing.name!r}'s flight "
+                             f"speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
+        return build, airframe_for(wing), v
+    return build, Airframe(), CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
 
 
 def _density(wing, density_kg_m3: float | None) -> dict:
@@ -123,7 +143,7 @@ def _density(wing, density_kg_m3: float | None) -> dict:
     return {}
 
 
-def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
+def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:3",
              models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
@@ -140,20 +160,30 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
     ``trim``: ``rigid`` (the paper's reading) or
     ``elastic`` (start from the static aeroelastic equilibrium: the wing's static deflection
     and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
+    ``speed_m_s`` None: the aircraft's cruise speed (the prototype's 15 m/s).
 
     Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
     reason, the time and the mode) and holds every step up to then. Each run carries the
     wing's section loads at the root, 25, 50 and 75 % semispan as channels
     ``loads_<fs|md>_<quantity>_s<j>`` (:func:`bioflex_jsb.drivers.gust.run_gust`'s
-    ``loads``; docs/loads.md), and :func:`metrics` their peaks. The prototype's airframe
-    only (another is refused in one line: docs/aircraft.md)."""
-    wing = _flying_wing(wing)
+    ``loads``; docs/loads.md), and :func:`metrics` their peaks. An :class:`Aircraft` flies
+    on its own JSBSim airframe (an aircraft without an engine in its steady glide;
+    docs/aircraft.md)."""
+    return _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m,
+                     dt_s, recorders, aero, trim)[0]
+
+
+def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
+              recorders, aero, trim):
+    """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build."""
+    wing, airframe, speed_m_s = _flight(wing, speed_m_s)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
-    setup = RunSetup(speed_m_s, parse_gust(gust), duration_s, gust_start_s, altitude_m, dt_s)
-    airframe = Airframe()
+    chord = wing.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
+    setup = RunSetup(speed_m_s, parse_gust(gust, chord), duration_s, gust_start_s,
+                     altitude_m, dt_s)
     out = {}
     for model in models:
         recorder = (recorders or {}).get(model)
@@ -165,7 +195,7 @@ def fly_gust(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:3",
         else:
             out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder,
                                   loads=wing)
-    return out
+    return out, airframe, wing, speed_m_s
 
 
 def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
@@ -180,7 +210,7 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
     return run_gust(Airframe(), load_wing("optimised").model, model, setup)
 
 
-def compare(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:0.3",
+def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:0.3",
             model: str = "coupled", duration_s: float = 5.0, gust_start_s: float = 0.5,
             aero: str = "quasi-steady", trim: str = "rigid",
             recorder: StepRecorder | None = None) -> Comparison:
@@ -191,15 +221,20 @@ def compare(wing: WingBuild, speed_m_s: float = 15.0, gust: str = "sharp:0.3",
     largest difference of u, α, q, θ, η₁ (:class:`Comparison`; ``.plot(path, title)``).
     Small gusts (``sharp:0.3``) agree to a few per cent; a diverged run has no errors (None).
     ``aero``/``trim`` as for :func:`fly_gust` (unsteady: coupled only; elastic: coupled or
-    qsd)."""
+    qsd). ``wing`` an :class:`Aircraft`: its own airframe, linearised at its trim (a
+    glider's steady glide), ``speed_m_s`` None its cruise speed."""
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
-    wing = _flying_wing(wing)
-    runs = fly_gust(wing, speed_m_s, gust, (model,), duration_s, gust_start_s,
-                    recorders={model: recorder} if recorder is not None else None,
-                    aero=aero, trim=trim)
-    return compare_run(wing, runs[model], model, speed_m_s, aero, trim)
+    runs, airframe, build, speed = _fly_gust(
+        wing, speed_m_s, gust, (model,), duration_s, gust_start_s, 0.0, DEFAULT_DT_S,
+        {model: recorder} if recorder is not None else None, aero, trim)
+    drift = None
+    if airframe.glider:  # the glide's own drift in calm air (drivers/compare.py)
+        drift = _fly_gust(wing, speed, "none", (model,), duration_s, gust_start_s, 0.0,
+                          DEFAULT_DT_S, None, aero, trim)[0][model]
+    return compare_run(build, runs[model], model, speed, aero, trim, airframe=airframe,
+                       drift=drift)
 
 
 def metrics(run: TimeHistory, gust_start_s: float = 0.5) -> GustMetrics:

@@ -13,7 +13,9 @@ and the physical constants from :mod:`bioflex_jsb.parameters.constants`.
 
 Before the move: 22 modules outside definition/ and parameters/ imported it; after: the 10
 listed here, besides the loads package written meanwhile (H10); then 9 (H15:
-flight_dynamics/wing_model.py reads the published C_eta1^Q1 from parameters/wing.py). The
+flight_dynamics/wing_model.py reads the published C_eta1^Q1 from parameters/wing.py); then
+6 (issue 23, the second aircraft flies: runtime/coupled_step.py, simulation/unsteady_wing.py
+and simulation/gusts.py take S, c-bar and the derivatives from the wing's AirframeData). The
 linear analyses below the loader (flight_dynamics/rigid, lti, eigen, modal_matrices,
 elastic_trim, wing_model; aeroelasticity/free_aircraft) take the aircraft's values from the
 ``AirframeData`` their wing model and flight condition carry
@@ -45,11 +47,6 @@ PAPER_RESULT_READERS = {
 
 # Still to move (shrinks to empty): each reads the aircraft's description from prototype.py.
 STILL_TO_MOVE = {
-    "runtime/coupled_step.py": "S, c-bar of the wing's loads; file owned by H8 (unsteady "
-                               "kernel) during issue 23: REFERENCE_GEOMETRY of "
-                               "parameters.airframe, then the Aircraft's",
-    "simulation/unsteady_wing.py": "S, c-bar; owned by H8 during issue 23",
-    "simulation/gusts.py": "c-bar of the gust penetration; owned by H6 during issue 23",
     "generators/native_wing.py": "S, c-bar, cruise speed, sea-level density of the native "
                                  "XML wing; owned by H1 during issue 23",
     "generators/native_aircraft.py": "the Section 5 gust case of the native aircraft; owned "
@@ -129,5 +126,6 @@ def test_nothing_below_the_loader_reads_the_prototype_directly():
     stale = sorted(e for e in allowed if not any(_allowed_by(e, u) for u in outside))
     assert not stale, f"{stale} no longer import parameters.prototype: remove them here"
     # 22 outside definition/ and parameters/ before issue 23's move (module docstring), 10
-    # after, 9 after H15's, besides the loads package
-    assert len([u for u in outside if not u.startswith("loads/")]) <= 9
+    # after, 9 after H15's, 6 after the second aircraft flew (coupled_step, unsteady_wing and
+    # gusts take S, c-bar from the wing's AirframeData), besides the loads package
+    assert len([u for u in outside if not u.startswith("loads/")]) <= 6

@@ -21,6 +21,10 @@ AIRCRAFT_PREFIX = "aircraft:"
 # (definition/aircraft.py: Aircraft.linear_problem); the others fly JSBSim's prototype
 # airframe and refuse another one (Aircraft.flight_problem).
 LINEAR_COMMANDS = ("modes", "flutter")
+# The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
+# flight_refusal: its own JSBSim aircraft, a glider in its steady glide); the others
+# (export, export-jsbsim, ardupilot, loads) refuse an airframe other than the prototype's.
+FLIGHT_COMMANDS = ("gust", "compare", "trim", "sitl")
 
 
 class _ShippedOrFile(tuple):
@@ -42,6 +46,7 @@ class _AircraftAction(argparse._StoreAction):
 
     def __call__(self, parser, namespace, values, option_string=None) -> None:
         from bioflex_jsb.definition.aircraft import load_aircraft
+        from bioflex_jsb.definition.flying import flight_refusal
         from bioflex_jsb.errors import InputError
         from bioflex_jsb.flight_dynamics.wing_model import VARIANTS
 
@@ -52,8 +57,13 @@ class _AircraftAction(argparse._StoreAction):
         try:
             aircraft = load_aircraft(values)
             # the linear analyses take any airframe; the flight commands the prototype's
-            linear = parser.prog.rsplit(" ", 1)[-1] in LINEAR_COMMANDS
-            problem = aircraft.linear_problem() if linear else aircraft.flight_problem()
+            command = parser.prog.rsplit(" ", 1)[-1]
+            if command in LINEAR_COMMANDS:
+                problem = aircraft.linear_problem()
+            elif command in FLIGHT_COMMANDS:
+                problem = flight_refusal(aircraft)
+            else:
+                problem = aircraft.flight_problem()
             variant = aircraft.variant()
         except InputError as exc:  # the definition's one line, naming the field
             parser.error(f"--aircraft: {exc}")
@@ -87,3 +97,43 @@ def wing_from_aircraft(args: argparse.Namespace):
     if note:  # as wing_from_args says it for --wing (stderr: stdout may be JSON)
         print(f"bioflex-jsb: note: {note}", file=sys.stderr)
     return build
+
+
+def resolve_flight(args: argparse.Namespace) -> None:
+    """The trim speed and gust of a flight command from the aircraft (``--aircraft``, else
+    the prototype): ``--speed`` not given is the aircraft's cruise speed (the prototype's
+    15 m/s, Table 1), a given one must lie in its ``airframe.speed_range_m_s`` (the
+    prototype's 5-40 m/s: the option's own check), and a 1-cos length or turbulence scale
+    must be at least the aircraft's mean chord (simulation/gusts.py). One line (a
+    UsageError, exit 2) otherwise."""
+    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S
+    from bioflex_jsb.cli.common import UsageError
+    from bioflex_jsb.definition.flying import flight_speeds
+
+    aircraft = getattr(args, "aircraft_definition", None)
+    if aircraft is None:
+        cruise, speeds, chord = DEFAULT_SPEED_M_S, None, None
+    else:
+        (cruise, speeds), chord = flight_speeds(aircraft), aircraft.airframe.mean_chord_m
+    if args.speed is None:
+        args.speed = cruise
+    elif speeds is not None and not speeds[0] <= args.speed <= speeds[1]:
+        raise UsageError(f"--speed {args.speed:g} m/s is outside aircraft {aircraft.name!r}'s "
+                         f"speeds {speeds[0]:g}..{speeds[1]:g} m/s (its airframe."
+                         "speed_range_m_s)")
+    gust = getattr(args, "gust", None)
+    if chord is not None and gust is not None:
+        from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
+
+        try:
+            args.gust = parse_gust(gust.text(), chord)
+        except GustSpecError as exc:
+            raise UsageError(f"--gust: {exc} (aircraft {aircraft.name!r})") from None
+
+
+def airframe_from_args(args: argparse.Namespace):
+    """The JSBSim airframe of ``--aircraft`` (its own aircraft; the generated prototype
+    without the option): runtime/other_airframe.py ``airframe_for``."""
+    from bioflex_jsb.runtime.other_airframe import airframe_for
+
+    return airframe_for(getattr(args, "aircraft_definition", None))

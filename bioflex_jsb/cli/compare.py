@@ -70,10 +70,13 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.cli.aircraft_option import airframe_from_args, resolve_flight
     from bioflex_jsb.drivers.compare import check_comparable, compare_run, linear_prediction
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.simulation.gusts import parse_gust
 
+    resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
     try:
         check_comparable(args.model, args.aero, args.trim)
@@ -84,11 +87,19 @@ def run(args: argparse.Namespace) -> int:
     check_plot_path(args.plot, args.force)
     args.out = log_path(args, "compare", args.wing)
     log = None
+    try:
+        airframe = airframe_from_args(args)
+    except FdmError as exc:
+        raise UsageError(str(exc)) from None
     if args.out:
         log = open_log(args.out, run_description(args, "compare", (args.model,)), build)
+    drift = None
     try:
         try:
-            runs, stops = fly(args, build, (args.model,), log)
+            runs, stops = fly(args, build, (args.model,), log, airframe)
+            if airframe.glider and not stops:  # a glide's drift in calm air (drivers/compare)
+                calm = argparse.Namespace(**{**vars(args), "gust": parse_gust("none")})
+                drift = fly(calm, build, (args.model,), None, airframe)[0][0]
         except Interrupted:
             kept = f"; the log {args.out} holds every step flown" if args.out else ""
             print(f"bioflex-jsb compare: interrupted{kept}", file=sys.stderr)
@@ -96,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         nonlinear = runs[0]
         try:
             linear = linear_prediction(build, nonlinear, args.model, args.speed, args.aero,
-                                       args.trim)
+                                       args.trim, airframe)
         except FdmError as exc:
             raise UsageError(str(exc)) from None
         if log is not None:
@@ -106,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
             with closing():  # a stop signal now waits until the log is finished
                 log.close()
     result = compare_run(build, nonlinear, args.model, args.speed, args.aero, args.trim,
-                         linear=linear)
+                         linear=linear, drift=drift)
     channels, errors, worst, diverged = (result.channels, result.nrmse, result.worst,
                                          result.diverged)
     if args.plot:

@@ -67,8 +67,9 @@ gust_type.plain_numbers = True  # type: ignore[attr-defined]  # parse_gust reads
 
 
 def add_run_arguments(p: argparse.ArgumentParser, default_gust: str = DEFAULT_GUST) -> None:
-    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
-                   help="trim " + speed_help())
+    p.add_argument("--speed", type=airspeed, default=None, metavar="V",
+                   help="trim " + speed_help(extra="; with --aircraft: within its airframe."
+                                             "speed_range_m_s, default its cruise_speed_m_s"))
     p.add_argument("--gust", type=gust_type, default=gust_type(default_gust),
                    help=f"gust specification (default {default_gust}); see above")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=5.0,
@@ -233,16 +234,20 @@ def open_log(path: str, description, build):
         raise UsageError(str(exc)) from None
 
 
-def fly(args, build, models, log=None):
-    """Run each model (all of them, also after one stops); return (runs, stop messages)."""
+def fly(args, build, models, log=None, airframe=None):
+    """Run each model (all of them, also after one stops) on ``airframe`` (default: the
+    JSBSim airframe of ``--aircraft``, the prototype's without it); return (runs, stop
+    messages)."""
+    from bioflex_jsb.cli.aircraft_option import airframe_from_args
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
-    from bioflex_jsb.runtime.fdm import Airframe, FdmError
+    from bioflex_jsb.runtime.fdm import FdmError
 
     check_run_arguments(args)
     setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
     runs, stops = [], []
     try:
-        airframe = Airframe()
+        if airframe is None:
+            airframe = airframe_from_args(args)
         for model in models:
             steps = int(round(args.duration / args.dt))
             bar = progress_bar(steps, f"{build.variant.name} {model}")
@@ -279,8 +284,10 @@ def fly(args, build, models, log=None):
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.simulation.results import gust_metrics
 
+    resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
     args.models = resolve_models(args)
     check_run_arguments(args)

@@ -22,7 +22,12 @@ equilibrium under the trim loads, with the aerodynamic stiffness at the trim's d
 pressure, iterated with the rigid trim to a fixed point): the modal deflections eta_i [rad],
 the tip twist [deg, leading edge up], alpha and elevator rigid -> elastic, the wing's loads
 and its static divergence speed; at or beyond that speed it ends with one line naming it
-(docs/decisions.md, "Elastic trim")."""
+(docs/decisions.md, "Elastic trim"). With --aircraft NAME|FILE.toml naming an aircraft
+definition (docs/aircraft.md; a name that is not a JSBSim aircraft under aircraft/): its own
+JSBSim airframe, its speeds (--speed within its airframe.speed_range_m_s, default its
+cruise_speed_m_s) and the elastic trim of its wing; an aircraft without an engine (the SGS
+glider) is trimmed to its steady glide at --speed (the flight-path angle gamma < 0 that
+holds the speed: runtime/other_airframe.py), the throttle row then 0."""
 
 
 def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
@@ -42,7 +47,8 @@ def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--aircraft", metavar="NAME", default=None,
-        help="aircraft name under aircraft/ (default: bioflex)",
+        help="aircraft name under aircraft/ (default: bioflex); trim: also an aircraft "
+        "definition, NAME|FILE.toml (docs/aircraft.md)",
     )  # fmt: skip
 
 
@@ -61,6 +67,7 @@ def register(sub) -> None:
 
     p = sub.add_parser("trim", help="level-flight trim of the JSBSim airframe", description=HELP)
     add_flight_condition_arguments(p)
+    p.set_defaults(speed=None)  # DEFAULT_SPEED_M_S, or an aircraft definition's cruise speed
     p.add_argument("--wing", default=None, metavar="NAME|FILE.toml",
                    help=f"also the elastic trim of this wing: {', '.join(VARIANTS)}, or a "
                    "variant file (default: the rigid trim only)")
@@ -85,13 +92,67 @@ def trim_payload(result) -> dict:
         "thrust_n": result.thrust_n,
         "converged": result.converged,
         "residuals": dict(result.residuals),
+        "flight_path_rad": result.flight_path_rad,
     }
 
 
+def _definition(args: argparse.Namespace):
+    """The aircraft definition ``--aircraft`` names (``None``: a JSBSim aircraft name or no
+    option): a ``.toml`` file, or a shipped definition that is no JSBSim aircraft of the
+    root (``bioflex_optimised`` is both: the native aircraft, as before). Read and checked
+    for flight (one line, exit 2)."""
+    from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT
+    from bioflex_jsb.runtime import fdm as jsbsim_fdm
+
+    name = args.aircraft
+    if name is None:
+        return None
+    if not name.endswith(".toml"):
+        try:
+            root = jsbsim_fdm.locate_root(args.jsbsim_root, name)
+        except jsbsim_fdm.FdmError:
+            root = None
+        if root is not None or name in SHIPPED_AIRCRAFT:
+            return None
+    from bioflex_jsb.definition.aircraft import load_aircraft
+    from bioflex_jsb.definition.flying import flight_refusal
+    from bioflex_jsb.errors import InputError
+
+    try:
+        aircraft = load_aircraft(name)
+    except InputError as exc:
+        raise UsageError(f"--aircraft: {exc}") from None
+    problem = flight_refusal(aircraft)
+    if problem:
+        raise UsageError(f"--aircraft: {problem}")
+    if args.wing is not None:
+        raise UsageError(f"--aircraft {name} and --wing {args.wing}: give one of them (the "
+                         "aircraft's definition holds its wing)")
+    return aircraft
+
+
 def run(args: argparse.Namespace) -> int:
-    airframe = load_airframe(args)
+    aircraft = _definition(args)
+    if aircraft is None:
+        airframe = load_airframe(args)
+        if args.speed is None:
+            args.speed = DEFAULT_SPEED_M_S
+    else:
+        from bioflex_jsb.cli.aircraft_option import resolve_flight
+        from bioflex_jsb.runtime.fdm import FdmError
+        from bioflex_jsb.runtime.other_airframe import airframe_for
+
+        args.aircraft_definition = aircraft
+        resolve_flight(args)
+        try:
+            airframe = airframe_for(aircraft, args.jsbsim_root)
+        except FdmError as exc:
+            raise UsageError(str(exc)) from None
     result = airframe.trim(args.speed, args.altitude)
-    elastic = _elastic_trim(args, airframe) if args.wing else None
+    if aircraft is not None:
+        elastic = _elastic_trim(args, airframe, aircraft.wing(args.mass_basis))
+    else:
+        elastic = _elastic_trim(args, airframe) if args.wing else None
     if args.json:
         payload = trim_payload(result)
         if elastic is not None:
@@ -110,7 +171,15 @@ def run(args: argparse.Namespace) -> int:
         ("propeller", f"{result.propeller_rpm:.0f}", "rev/min"),
         ("thrust", f"{result.thrust_n:.3f}", "N"),
     ]
-    print(f"Trim (JSBSim, wings level, level flight), converged: {result.converged}")
+    if airframe.glider:  # no engine: the steady glide (runtime/other_airframe.py)
+        rows[6:9] = [("gamma", f"{deg(result.flight_path_rad):.3f}", "deg (flight path, + up)"),
+                     ("sink", f"{-result.speed_m_s * math.sin(result.flight_path_rad):.3f}",
+                      "m/s"),
+                     ("L/D", f"{-1.0 / math.tan(result.flight_path_rad):.2f}", "-")]
+        print(f"Trim ({airframe.aircraft}, wings level, steady glide: no engine), converged: "
+              f"{result.converged}")
+    else:
+        print(f"Trim (JSBSim, wings level, level flight), converged: {result.converged}")
     for name, value, unit in rows:
         print(f"  {name:<10} {value:>10}  {unit}")
     if elastic is not None:
@@ -118,14 +187,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _elastic_trim(args, airframe):
-    """The elastic trim of --wing at --speed, at the density JSBSim's trim flew in."""
+def _elastic_trim(args, airframe, build=None):
+    """The elastic trim of --wing (or ``build``, an aircraft definition's wing) at --speed,
+    at the density JSBSim's trim flew in."""
     from bioflex_jsb import units as U
     from bioflex_jsb.cli.common import wing_from_args
     from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
 
     rho = airframe["atmosphere/rho-slugs_ft3"] * U.KG_M3_PER_SLUG_FT3
-    return elastic_trim(wing_from_args(args), args.speed, density_kg_m3=rho)
+    wing = wing_from_args(args) if build is None else build
+    return elastic_trim(wing, args.speed, density_kg_m3=rho)
 
 
 def _print_elastic(e: dict) -> None:

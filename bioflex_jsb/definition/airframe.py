@@ -50,8 +50,42 @@ DERIVATIVE_RANGES = {
 DERIVATIVE_FIELDS = tuple(f.name for f in dataclasses.fields(RigidAerodynamics))
 FROM_JSBSIM = "jsbsim"  # derivatives = "jsbsim": from JSBSim's linearisation
 AIRFRAME_FIELDS = ("jsbsim", "reference_area_m2", "span_m", "mean_chord_m", "mass_kg",
-                   "cg_m", "inertia_kg_m2", "wing_root_leading_edge_m", "derivatives")
+                   "cg_m", "inertia_kg_m2", "wing_root_leading_edge_m", "derivatives",
+                   "cruise_speed_m_s", "speed_range_m_s")
+# The speeds the flight commands trim at [m/s] (gust, compare, trim, sitl): above 0 and at
+# most airframe.py's runtime limit of the incompressible model, 110 m/s (1/3 of the speed of
+# sound; runtime/fdm.py SPEED_MAX_M_S, repeated here: the loader does not import the
+# runtime). Optional: a file without them is analysed (modes, flutter) but not flown.
+FLIGHT_SPEED_MAX_M_S = 110.0
 INERTIA_FIELDS = ("ixx", "iyy", "izz", "ixz")
+
+
+@dataclasses.dataclass(frozen=True)
+class FlightAirframe(Airframe):
+    """The ``[airframe]`` table with the flight commands' speeds: ``cruise_speed_m_s``
+    [m/s] (the default trim speed of gust, compare, trim and sitl) and ``speed_range_m_s``
+    (low, high) [m/s] (the speeds they accept), or ``None`` when the file gives none (the
+    aircraft is then analysed, not flown: definition/flying.py ``flight_refusal``)."""
+
+    cruise_speed_m_s: float | None = None
+    speed_range_m_s: tuple[float, float] | None = None
+
+
+def _flight_speeds(r: Reader, t: dict) -> tuple[float | None, tuple[float, float] | None]:
+    """``cruise_speed_m_s`` and ``speed_range_m_s`` (both or neither; the cruise inside)."""
+    w = "airframe"
+    if "cruise_speed_m_s" not in t and "speed_range_m_s" not in t:
+        return None, None
+    rng = t.get("speed_range_m_s")
+    ok = (isinstance(rng, list | tuple) and len(rng) == 2
+          and all(isinstance(x, int | float) and not isinstance(x, bool) for x in rng))
+    if not ok or not 0.0 < rng[0] < rng[1] <= FLIGHT_SPEED_MAX_M_S:
+        raise r.fail(f"{w}.speed_range_m_s", f"must be [low, high] m/s with 0 < low < high "
+                     f"<= {FLIGHT_SPEED_MAX_M_S:g} (given with cruise_speed_m_s), got {rng!r}")
+    lo, hi = float(rng[0]), float(rng[1])
+    cruise = r.number(t, w, "cruise_speed_m_s", lo, hi, "m/s",
+                      hint=" (inside airframe.speed_range_m_s)")
+    return cruise, (lo, hi)
 
 
 def jsbsim_aircraft_dir() -> Path | None:
@@ -149,6 +183,8 @@ def parse_airframe(r: Reader, data: dict, base_dir: Path | None) -> Airframe:
     mass = r.number(t, w, "mass_kg", *MASS_RANGE_KG, "kg", hint=" (the format is SI: kg)")
     cg = r.vector(t, w, "cg_m", *POSITION_RANGE_M, "m")
     root = r.vector(t, w, "wing_root_leading_edge_m", *POSITION_RANGE_M, "m")
-    return Airframe(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
-                    mean_chord_m=chord, mass_kg=mass, cg_m=cg, inertia=_inertia(r, t),
-                    wing_root_leading_edge_m=root, derivatives=_derivatives(r, t))
+    cruise, speeds = _flight_speeds(r, t)
+    return FlightAirframe(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
+                          mean_chord_m=chord, mass_kg=mass, cg_m=cg, inertia=_inertia(r, t),
+                          wing_root_leading_edge_m=root, derivatives=_derivatives(r, t),
+                          cruise_speed_m_s=cruise, speed_range_m_s=speeds)

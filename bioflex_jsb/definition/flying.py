@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.definition.airframe import GENERATED
 from bioflex_jsb.definition.model import (
     AeroSettings,
     Airframe,
@@ -143,3 +144,43 @@ def flying_wing(r: Reader, wing: dict, at: dict, aero: AeroSettings, name: str,
     wing_name = r.text(wing, "wing", "name") if "name" in wing else name
     return FlyingWing(wing_name, _pin(r, at, "pin_c_eta1_q1"),
                       _pin(r, at, "published_c_eta1_q1"))
+
+
+def flight_refusal(aircraft) -> str | None:
+    """Why the nonlinear co-simulation (``gust``, ``compare``, ``trim --wing``, ``sitl``)
+    cannot fly ``aircraft`` (an :class:`~bioflex_jsb.definition.aircraft.Aircraft`), or
+    ``None``. The prototype's airframe (``aircraft.flight_problem()`` is None: every field
+    the prototype's) flies with any wing. Another airframe flies on its own JSBSim aircraft
+    (``airframe.jsbsim``: a package aircraft or a directory) when the linear analyses take
+    it (:meth:`~bioflex_jsb.definition.aircraft.Aircraft.linear_problem`: a modal wing, the
+    derivatives as a table: the wing's loads are built from them) and the file gives the
+    speeds it flies at (``airframe.cruise_speed_m_s``, ``speed_range_m_s``). The generated
+    ``bioflex`` airframe with other numbers cannot fly: its JSBSim model holds the
+    prototype's numbers (:meth:`flight_problem`'s line says which field differs)."""
+    prototype = aircraft.flight_problem()
+    if prototype is None:
+        return None
+    problem = aircraft.linear_problem()
+    if problem:
+        return problem
+    a = aircraft.airframe
+    if a.jsbsim == GENERATED:
+        return prototype
+    if getattr(a, "cruise_speed_m_s", None) is None:
+        return (f"aircraft {aircraft.name!r}: airframe.cruise_speed_m_s and "
+                "airframe.speed_range_m_s are needed to fly it (the speeds gust, compare, "
+                "trim and sitl trim at; docs/aircraft.md)")
+    aircraft.planform()  # the flight model's planform, or its one-line DefinitionError
+    return None
+
+
+def flight_speeds(aircraft) -> tuple[float, tuple[float, float]]:
+    """(cruise speed [m/s], (lowest, highest) trim speed [m/s]) of an aircraft that flies
+    (:func:`flight_refusal` is None): the prototype's (Table 1's 15 m/s; 5-40 m/s,
+    parameters/airframe.py AIRSPEED_RANGE_M_S) on its airframe, else the file's."""
+    from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S, CRUISE_SPEED_M_S
+
+    if aircraft.flight_problem() is None:
+        return CRUISE_SPEED_M_S, AIRSPEED_RANGE_M_S
+    a = aircraft.airframe
+    return a.cruise_speed_m_s, a.speed_range_m_s

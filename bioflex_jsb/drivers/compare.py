@@ -11,6 +11,15 @@ Errors: NRMSE = RMS(linear − nonlinear) / RMS(nonlinear) [-] per channel over 
 largest absolute difference (in the channel's SI unit) with its time [s]. A nonlinear run that
 diverged is no reference: its errors are None.
 
+A glide (an aircraft without an engine, trimmed to its steady glide: runtime/other_airframe.py)
+is not steady in the nonlinear run: as it sinks the air gets denser (ISA: +0.0096 % per m)
+and at a constant attitude the glider slows (SGS at 25 m/s, 1.0 m/s sink: u −0.011 m/s, θ
++0.26 mrad in 8 s of calm air), a drift the LTI model (ρ held) cannot have and that is no
+gust's response. :func:`compare_run`'s ``drift`` is the calm-air run of the same trim;
+it is added to the linear prediction (the nonlinear run stays as flown), so the errors are
+those of the gust's increments. The CLI and :func:`bioflex_jsb.api.compare` fly it for a
+glider.
+
 Section loads: a nonlinear run with load channels (``loads_<fs|md>_<quantity>_s<j>``,
 ``drivers/gust.py``) is compared on them too. The LTI model's loads are its load outputs
 (:func:`bioflex_jsb.loads.lti.with_load_outputs`: y = C x + D w_g, perturbations from 1 g)
@@ -118,6 +127,8 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     linearised about the static aeroelastic equilibrium. Raises InputError for a combination
     that has no linear model (:func:`check_comparable`)."""
     check_comparable(model, aero, trim)
+    # the JSBSim airframe the run flew (the prototype's by default): A_RR at its trim (an
+    # aircraft without an engine: its steady glide, runtime/other_airframe.py)
     lin = (airframe or Airframe()).linearize(speed_m_s)
     if aero == "unsteady":
         from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space
@@ -132,8 +143,9 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         ss = linearise_about_elastic_trim(model, elastic_trim(build, speed_m_s), build.model,
                                           a_rr=lin.a)
     else:
-        ss = build_state_space(model, level_flight_condition(speed_m_s), build.model,
-                               a_rr=lin.a)
+        ss = build_state_space(model, level_flight_condition(speed_m_s,
+                                                             airframe=build.airframe),
+                               build.model, a_rr=lin.a)
     layout = nonlinear.meta.get("loads")
     lm = None if layout is None else _loads_model(build, nonlinear, model, speed_m_s)
     if lm is not None and aero != "unsteady":
@@ -179,13 +191,32 @@ def _add_linear_loads(linear: TimeHistory, lm, layout: dict) -> None:
     linear.meta["loads"] = dict(layout)
 
 
+def _add_drift(linear: TimeHistory, nonlinear: TimeHistory, drift: TimeHistory) -> None:
+    """``linear`` += the calm-air run ``drift`` on the compared channels (the same steps as
+    ``nonlinear``: a drift that stopped early, or of other times, is refused)."""
+    n = len(nonlinear.time_s)
+    if drift.stopped is not None or len(drift.time_s) < n or not np.array_equal(
+            drift.time_s[:n], nonlinear.time_s):
+        raise InputError(f"the calm-air run is no reference for the comparison "
+                         f"({drift.stopped or 'other times than the gust run'})")
+    for c in CHANNELS:
+        if c in linear.channels and c in drift.channels:
+            linear.channels[c] = linear.channels[c] + drift[c][:n]
+    linear.meta["drift"] = "calm-air run of the same trim added (a glide's drift)"
+
+
 def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
                 aero: str = "quasi-steady", trim: str = "rigid",
-                linear: TimeHistory | None = None) -> Comparison:
+                linear: TimeHistory | None = None, airframe: Airframe | None = None,
+                drift: TimeHistory | None = None) -> Comparison:
     """Compare ``nonlinear`` (a gust run of ``model``) with the LTI prediction (``linear``,
-    computed by :func:`linear_prediction` when not given); see the module docstring."""
+    computed by :func:`linear_prediction` on ``airframe``, the JSBSim airframe flown, when
+    not given); ``drift``: the calm-air run of the same trim and steps, added to the
+    prediction (a glide's drift: module docstring); see the module docstring."""
     if linear is None:
-        linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim)
+        linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim, airframe)
+    if drift is not None:
+        _add_drift(linear, nonlinear, drift)
     channels = tuple(c for c in CHANNELS if c in linear.channels and c in nonlinear.channels)
     load_channels = tuple(c for c in nonlinear.channels
                           if c.startswith(LOADS_PREFIX) and c in linear.channels)

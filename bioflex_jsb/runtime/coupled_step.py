@@ -41,12 +41,12 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
-from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD, ETA_LIMIT_RAD, out_of_range
+from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
 from bioflex_jsb.simulation.modal_wing import (
     DEFAULT_DT_S,
     WING_MODELS,
@@ -223,13 +223,21 @@ class CoupledStep:
         self.trim_mode = trim_mode
         self.speed_m_s = float(speed_m_s)
         self.dt_s = airframe.dt_s
-        nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()}
+        nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()
+                 if not (k == "throttle" and airframe.glider)}
+        if airframe.glider:  # no engine, no throttle property: the throttle channel is 0
+            nodes["throttle"] = _NO_THROTTLE
+        # the aircraft's own data (S, c̄, derivatives): its wing model's AirframeData
+        self.airframe_data = PROTOTYPE_AIRFRAME if wing is None else wing.airframe
+        self.alpha_range_rad = airframe.alpha_table_range_rad
         self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
         self._read = state_reader(self.get)
         self._set_wind = airframe.property_node(WIND_DOWN).set_double_value
         # the reference dynamic pressure is JSBSim's own at trim (same density as the run)
         rho0 = self.get["rho"]() * U.KG_M3_PER_SLUG_FT3
-        cl_trim = level_flight_condition(speed_m_s).cl_trim
+        # C_L0 of the linear model's level flight, W/(Q S) at sea level, as the LTI model
+        # takes it; a glide's W cos γ/(Q S) differs by 1 − cos γ (γ −2.3°: 0.08 %)
+        cl_trim = level_flight_condition(speed_m_s, airframe=self.airframe_data).cl_trim
         self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
         if native:
             self.wing = None
@@ -245,13 +253,14 @@ class CoupledStep:
             # ~15 MB a quasi-steady run does not need
             from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
 
-            self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s)
+            self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s,
+                                                     aero=self.airframe_data.aero)
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
         else:
             static = None if self.elastic_trim is None else self.elastic_trim.eta_rad
             self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s,
-                                  static_eta=static)
+                                  static_eta=static, aero=self.airframe_data.aero)
             self.n_modes = wing.n_modes
             self._write_reactions = airframe.external_reaction_writer()
         self.model = model
@@ -261,7 +270,7 @@ class CoupledStep:
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
-        self.alpha_peak_rad = alpha_peak_rad()
+        self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
         self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         if self.compiled:
             self._setup_kernel(nodes)
@@ -358,7 +367,7 @@ class CoupledStep:
         alpha = flow.alpha_rad
         self._stall_steps += alpha > self.alpha_peak_rad
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
-                                    self._agl_m() * U.M_PER_FT)
+                                    self._agl_m() * U.M_PER_FT, self.alpha_range_rad)
         return values
 
     def _row_dict(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot) -> dict:
@@ -418,9 +427,10 @@ class CoupledStep:
             v["model"][0] = K.MODEL_CODES[mw.model]
             mw.prepare_arrays()
         self._views = v
-        lo, hi = ALPHA_TABLE_RANGE_RAD
-        v["consts"][:] = (U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, P.REFERENCE_AREA_M2,
-                          P.MEAN_AERODYNAMIC_CHORD_M, U.LBF_PER_N, U.LBF_FT_PER_N_M,
+        lo, hi = self.alpha_range_rad
+        ref = self.airframe_data.reference
+        v["consts"][:] = (U.M_PER_FT, U.KG_M3_PER_SLUG_FT3, ref.area_m2,
+                          ref.mean_chord_m, U.LBF_PER_N, U.LBF_FT_PER_N_M,
                           ETA_LIMIT_RAD, lo, hi, self.alpha_peak_rad)
         v["trim"][:] = (self.trim.alpha_rad, self.trim.theta_rad,
                         self.reference.dynamic_pressure_pa, self.speed_m_s)
@@ -480,7 +490,7 @@ class CoupledStep:
         set_wind, jsbsim_step, agl = self._set_wind, self.airframe.step_function(), self._agl_m
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow
-        ft_per_m = U.FT_PER_M
+        ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
 
         def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
             wind_down_fps = -w_g_m_s * ft_per_m
@@ -501,7 +511,8 @@ class CoupledStep:
             agl_ft = agl()
             if status != ok or agl_ft <= 0.0:
                 self.stopped = out_of_range(self.names, table[k].tolist(), step_k * self.dt_s,
-                                            out_flow[0], self.wing.eta, agl_ft * U.M_PER_FT)
+                                            out_flow[0], self.wing.eta, agl_ft * U.M_PER_FT,
+                                            alpha_range)
                 return self.stopped
             return None
 
@@ -543,6 +554,17 @@ def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitu
                            tol_rad=ELASTIC_TRIM_TOL_RAD)
     jsbsim_trim(elastic.loads)  # leave the airframe trimmed with the final loads
     return state["trim"], elastic
+
+
+class _ZeroNode:
+    """A property node that reads 0: the throttle of an aircraft without an engine."""
+
+    @staticmethod
+    def get_double_value() -> float:
+        return 0.0
+
+
+_NO_THROTTLE = _ZeroNode()
 
 
 def _native_mode_count(airframe: Airframe) -> int:

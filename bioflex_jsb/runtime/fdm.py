@@ -95,6 +95,7 @@ from bioflex_jsb.runtime.roots import (  # noqa: F401  (where the JSBSim files a
     locate_root,
 )
 from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure
+from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD
 
 DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
 
@@ -117,12 +118,8 @@ TRIM_TOLERANCE_RAD_S2 = 1e-4
 RPM_SETTLE_REL_TOL = 1e-9
 RPM_SETTLE_MAX_S = 60.0
 # JSBSim's integrator choices (FGPropagate) and the one that holds a state: 0 = eNone.
-_INTEGRATOR_PROPERTIES = (
-    "simulation/integrator/rate/rotational",
-    "simulation/integrator/rate/translational",
-    "simulation/integrator/position/rotational",
-    "simulation/integrator/position/translational",
-)
+_INTEGRATOR_PROPERTIES = tuple(f"simulation/integrator/{a}/{b}" for a in ("rate", "position")
+                               for b in ("rotational", "translational"))
 _INTEGRATOR_NONE = 0
 # Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
 # throttle commands of every engine are added per aircraft.
@@ -285,6 +282,11 @@ class Airframe:
             self._trim_fdm = self._fdm
         self._nodes: dict[str, object] = {}
         self.last_rpm_settle_s = 0.0  # time the flying instance's RPM took to settle [s]
+        # α range of the aerodynamic tables [rad] (the generated prototype's: limits.py)
+        self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
+        self.glider = self.engine_count == 0  # trimmed to a glide (runtime/other_airframe.py)
+        self._workdir = None  # the temporary root of an aircraft from a file (other_airframe.py)
+
 
     # ---- JSBSim messages ----------------------------------------------------------
     @property
@@ -401,6 +403,14 @@ class Airframe:
                 fdm[name] = 0.0
         tfdm = self._trim_fdm
         self._set_level_ic(tfdm, v, h)
+        if self.glider:  # no engine: the steady glide at v (runtime/other_airframe.py)
+            from bioflex_jsb.runtime.other_airframe import glide_trim
+
+            with _captured(self._log):
+                glide_trim(tfdm, v)
+            result = self._trim_result(v, h)
+            self._check_in_trim(result)
+            return result
         self._spin_up_propeller(tfdm, v)
         self._log.records.clear()
         with _captured(self._log):
@@ -495,9 +505,10 @@ class Airframe:
             theta_rad=float(fdm["attitude/theta-rad"]),
             elevator_norm=float(fdm["fcs/elevator-pos-norm"]),
             elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
-            throttle=float(fdm["fcs/throttle-pos-norm"]),
+            throttle=0.0 if self.glider else float(fdm["fcs/throttle-pos-norm"]),
             aileron_norm=float(fdm["fcs/left-aileron-pos-norm"]),
-            propeller_rpm=float(fdm["propulsion/engine[0]/propeller-rpm"]),
+            propeller_rpm=(0.0 if self.glider
+                           else float(fdm["propulsion/engine[0]/propeller-rpm"])),
             thrust_n=self.total_thrust_n,
             converged=True,
             residuals={
@@ -507,6 +518,7 @@ class Airframe:
                 "pdot_rad_s2": float(fdm["accelerations/pdot-rad_sec2"]),
                 "rdot_rad_s2": float(fdm["accelerations/rdot-rad_sec2"]),
             },
+            flight_path_rad=float(fdm["flight-path/gamma-rad"]) if self.glider else 0.0,
         )
 
     def _diagnose_trim_failure(self, v: float) -> str:
@@ -525,13 +537,18 @@ class Airframe:
                 cannot be residualised.
         """
         trim = self.trim(speed_m_s, altitude_m)
-        with _captured(self._log):  # the companion, at its trim (module docstring)
-            lin = jsbsim.FGLinearization(self._trim_fdm)
-            a_full = np.array(lin.system_matrix, dtype=float)
-            names = tuple(lin.x_names)
-            units = tuple(lin.x_units)
-        self._restore_time_step()
-        a, residualised = reduce_to_rigid(a_full, names, units)
+        if self.glider:  # FGLinearization needs an engine: runtime/other_airframe.py
+            from bioflex_jsb.runtime.other_airframe import rigid_jacobian
+
+            with _captured(self._log):
+                a, names, residualised = rigid_jacobian(self._fdm), RIGID_STATES, ()
+        else:
+            with _captured(self._log):  # the companion, at its trim (module docstring)
+                lin = jsbsim.FGLinearization(self._trim_fdm)
+                a_full = np.array(lin.system_matrix, dtype=float)
+                names, units = tuple(lin.x_names), tuple(lin.x_units)
+            self._restore_time_step()
+            a, residualised = reduce_to_rigid(a_full, names, units)
         eig = label_modes(np.linalg.eigvals(a))
         return RigidLinearization(
             speed_m_s=trim.speed_m_s,

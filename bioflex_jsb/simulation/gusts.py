@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bioflex_jsb.errors import InputError, plain_integer, plain_number
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
 
 GUST_FORMS = (
     "sharp:AMPLITUDE_m_s",
@@ -37,13 +37,14 @@ GUST_FORMS = (
     "none",
 )
 MAX_GUST_M_S = 50.0  # beyond this the small-UAV model is meaningless (3x the cruise speed)
-# Shortest 1-cos length and turbulence scale [m]: one mean aerodynamic chord (Table 1,
-# c̄ = 0.183 m). Every wing model here treats the gust as uniform over the chord at each
-# instant (quasi-steady strips; the unsteady strips' Küssner penetration starts from the
+# Shortest 1-cos length and turbulence scale [m]: one mean aerodynamic chord of the aircraft
+# flown (parse_gust's min_length_m; the prototype's by default: Table 1, c̄ = 0.183 m).
+# Every wing model here treats the gust as uniform over the chord at each instant
+# (quasi-steady strips; the unsteady strips' Küssner penetration starts from the
 # same assumption of a gust wider than the section); a shorter gust is thinner than the wing
 # it crosses. For scale: the classic 1-cos gust of the airworthiness codes (FAR 23.341) is
 # 25 chords long, and MIL-F-8785C's smallest turbulence scale is 10 ft (3 m).
-MIN_GUST_LENGTH_M = P.MEAN_AERODYNAMIC_CHORD_M
+MIN_GUST_LENGTH_M = REFERENCE_GEOMETRY.mean_chord_m
 # Longest 1-cos length and turbulence scale [m]: 10 km, 13 times MIL-F-8785C's largest
 # scale (2500 ft = 762 m, von Kármán above 2000 ft); a longer gust is steady wind for any run.
 MAX_GUST_LENGTH_M = 10_000.0
@@ -91,14 +92,14 @@ def _number(text: str, what: str, spec: str) -> float:
         raise GustSpecError(f"gust {spec!r}: {exc}") from None
 
 
-def _length(text: str, name: str, spec: str) -> float:
-    """A 1-cos length or turbulence scale [m] in MIN_GUST_LENGTH_M..MAX_GUST_LENGTH_M."""
+def _length(text: str, name: str, spec: str, min_length_m: float) -> float:
+    """A 1-cos length or turbulence scale [m] in min_length_m..MAX_GUST_LENGTH_M."""
     value = _number(text, f"the {name} [m]", spec)
-    accepted = f"accepted: {MIN_GUST_LENGTH_M:g}..{MAX_GUST_LENGTH_M:g} m"
+    accepted = f"accepted: {min_length_m:g}..{MAX_GUST_LENGTH_M:g} m"
     if value <= 0.0:
         raise GustSpecError(f"gust {spec!r}: the {name} must be > 0 m ({accepted}), got "
                             f"{value:g}")
-    if value < MIN_GUST_LENGTH_M:
+    if value < min_length_m:
         raise GustSpecError(
             f"gust {spec!r}: the {name} {value:g} m is shorter than one mean chord "
             f"({accepted}): such a gust is thinner than the wing it crosses, which every wing "
@@ -123,8 +124,10 @@ def check_gust_resolution(gust: GustSpec, speed_m_s: float, dt_s: float) -> None
             f"2.4 %), a length >= {shortest:.3g} m or a smaller --dt")
 
 
-def parse_gust(spec: str) -> GustSpec:
-    """Parse a command-line gust; raises :class:`GustSpecError` naming what is accepted."""
+def parse_gust(spec: str, min_length_m: float = MIN_GUST_LENGTH_M) -> GustSpec:
+    """Parse a command-line gust; raises :class:`GustSpecError` naming what is accepted.
+    ``min_length_m``: the shortest 1-cos length and turbulence scale [m], one mean chord of
+    the aircraft flown (:data:`MIN_GUST_LENGTH_M`: the prototype's)."""
     accepted = "accepted forms: " + ", ".join(GUST_FORMS)
     parts = spec.strip().split(":")
     kind = parts[0].lower()
@@ -141,7 +144,7 @@ def parse_gust(spec: str) -> GustSpec:
             raise GustSpecError(f"gust {spec!r}: 1cos takes amplitude and length; {accepted}")
         amp = _number(parts[1], "the amplitude [m/s]", spec)
         _check_amplitude(amp, spec)
-        length = _length(parts[2], "gust length", spec)
+        length = _length(parts[2], "gust length", spec, min_length_m)
         return GustSpec("1cos", amp, length)
     if kind in ("dryden", "vonkarman"):
         if len(parts) not in (3, 4):
@@ -151,7 +154,7 @@ def parse_gust(spec: str) -> GustSpec:
         sigma = _number(parts[1], "the RMS intensity sigma [m/s]", spec)
         if sigma < 0.0 or sigma > MAX_GUST_M_S:
             raise GustSpecError(f"gust {spec!r}: sigma must be 0..{MAX_GUST_M_S:g} m/s")
-        scale = _length(parts[2], "length scale", spec)
+        scale = _length(parts[2], "length scale", spec, min_length_m)
         seed = 0
         if len(parts) == 4:
             try:

@@ -22,15 +22,18 @@ ETA_LIMIT_RAD = 0.52
 ALPHA_TABLE_RANGE_RAD = (POST_STALL.alpha_table_min_rad, POST_STALL.alpha_table_max_rad)
 
 
-def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float) -> str | None:
+def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float,
+                 alpha_range_rad: tuple[float, float] = ALPHA_TABLE_RANGE_RAD) -> str | None:
     """Why the run must stop after the step whose row is ``values`` (``names`` its channel
     names) at ``t_s`` [s], with the angle of attack ``alpha_rad`` [rad], the new modal
-    state ``eta`` [rad] and the height above ground ``agl_m`` [m]; None if it may go on."""
+    state ``eta`` [rad] and the height above ground ``agl_m`` [m]; None if it may go on.
+    ``alpha_range_rad``: the α range of the airframe's tables [rad] (the generated
+    prototype's by default; another aircraft's from its XML: runtime/other_airframe.py)."""
     isfinite = math.isfinite
     if not all(map(isfinite, values)):
         bad = next(n for n, v in zip(names, values, strict=True) if not isfinite(v))
         return f"the state became non-finite ({bad}) at t = {t_s:.3f} s"
-    lo, hi = ALPHA_TABLE_RANGE_RAD
+    lo, hi = alpha_range_rad
     if not lo <= alpha_rad <= hi:
         return (
             f"angle of attack {math.degrees(alpha_rad):.1f} deg left the aerodynamic model "

@@ -51,11 +51,7 @@ from threadpoolctl import ThreadpoolController
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
-from bioflex_jsb.parameters.airframe import (
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import RigidAerodynamics
 
 WING_MODELS = ("rigid", "coupled", "qsd")
 
@@ -121,11 +117,13 @@ class ModalWing:
         trim: TrimReference,
         model: str = "coupled",
         dt_s: float = 1.0 / 120.0,
-        aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+        aero: RigidAerodynamics | None = None,
         refresh_rel: float = 0.05,
         static_eta: np.ndarray | None = None,
     ) -> None:
-        """``static_eta``: the static deflection η₀ [rad] of an elastic trim
+        """``aero``: the rigid aerodynamics (the induced-drag factor k of the loads); None:
+        those of the wing's aircraft (``wing.airframe``: S, c̄ and k are the aircraft's).
+        ``static_eta``: the static deflection η₀ [rad] of an elastic trim
         (:mod:`bioflex_jsb.flight_dynamics.elastic_trim`), from which Δη is measured: its
         loads join the incremental ones and the ΔQ forcing becomes ω²η₀/Q₀ (the whole
         aerodynamic generalised force at trim per unit Q); None: the rigid trim (η₀ = 0,
@@ -281,8 +279,9 @@ class ModalWing:
             return WingLoads(0.0, 0.0, 0.0)
         if self.model == "qsd":
             self.eta = self.quasi_static_eta(flow)
-        qs = flow.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
-        rate = REFERENCE_GEOMETRY.mean_chord_m / (2.0 * flow.airspeed_m_s)
+        ref = self.wing.airframe.reference  # S, c̄ of the wing's aircraft
+        qs = flow.dynamic_pressure_pa * ref.area_m2
+        rate = ref.mean_chord_m / (2.0 * flow.airspeed_m_s)
         self._load_x[:, self.n_modes :] = self._load_etadot * rate  # rates scale with c̄/2V
         lift, drag, moment = (self._load_x @ self._x + self._static_load).tolist()
         return WingLoads(qs * lift, qs * drag, qs * moment)

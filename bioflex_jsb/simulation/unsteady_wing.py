@@ -51,8 +51,7 @@ from bioflex_jsb.aeroelasticity.strip_increments import lag_state_names, strip_i
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
-from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS, RigidAerodynamics
+from bioflex_jsb.parameters.airframe import RigidAerodynamics
 from bioflex_jsb.simulation.modal_wing import (
     FlowState,
     TrimReference,
@@ -73,14 +72,15 @@ class UnsteadyModalWing:
         geometry: the strips of the same build
             (:func:`~bioflex_jsb.aeroelasticity.free_aircraft.strip_geometry`).
         trim: the trim the perturbations are taken from.
-        dt_s: the step [s]; aero: the rigid aerodynamics (induced drag factor);
+        dt_s: the step [s]; aero: the rigid aerodynamics (induced drag factor; None: those
+            of the wing's aircraft, ``wing.airframe``);
         refresh_rel: relative change of Q or V that renews the reference.
     """
 
     model = "coupled"
 
     def __init__(self, wing: ElasticWingModel, geometry: StripGeometry, trim: TrimReference,
-                 dt_s: float = 1.0 / 120.0, aero: RigidAerodynamics = RIGID_AERODYNAMICS,
+                 dt_s: float = 1.0 / 120.0, aero: RigidAerodynamics | None = None,
                  refresh_rel: float = 0.05) -> None:
         if not (np.isfinite(dt_s) and dt_s > 0.0):
             raise InputError(f"time step must be finite and > 0 s, got {dt_s!r}")
@@ -92,6 +92,7 @@ class UnsteadyModalWing:
         self.refresh_rel = float(refresh_rel)
         self.n_modes = n = wing.n_modes
         self.n_strips = geometry.chord_m.size
+        aero = wing.airframe.aero if aero is None else aero
         self.matrices = modal_matrices(wing, trim.cl_trim, aero)
         self._k2 = 2.0 * aero.k_induced * trim.cl_trim  # induced drag per unit lift [-]
         eta = tuple(f"eta{i + 1}" for i in range(n))
@@ -231,8 +232,9 @@ class UnsteadyModalWing:
             self._reference(flow.dynamic_pressure_pa, flow.airspeed_m_s)
         f = self._f if self._last is not None else self._inputs(flow, gust_m_s)
         mm, n = self.matrices, self.n_modes
-        qs = flow.dynamic_pressure_pa * P.REFERENCE_AREA_M2
-        rate = P.MEAN_AERODYNAMIC_CHORD_M / (2.0 * flow.airspeed_m_s)
+        ref = self.wing.airframe.reference  # S, c̄ of the wing's aircraft
+        qs = flow.dynamic_pressure_pa * ref.area_m2
+        rate = ref.mean_chord_m / (2.0 * flow.airspeed_m_s)
         eta, eta_dot = self._x[:n], self._x[n:2 * n]
         lift, drag, moment = qs * (mm.load_eta @ eta + rate * (mm.load_etadot @ eta_dot))
         v = flow.airspeed_m_s
