@@ -15,6 +15,7 @@ import hashlib
 import importlib
 import importlib.util
 import json
+import math
 import os
 import queue
 import re
@@ -541,3 +542,64 @@ def test_live_without_the_sdk_is_refused_in_one_line(capsys, tmp_path, monkeypat
     assert_one_line_error(code, err, "--live needs the Foxglove SDK: pip install "
                           "'bioflex-jsb[live]'")
     assert not list(tmp_path.iterdir())  # refused before the log file was made
+
+
+class _Clock:
+    """The log's wall clock (its module's ``time.monotonic``), advanced by the test [s]."""
+
+    def __init__(self) -> None:
+        self.t = 100.0
+
+    def monotonic(self) -> float:
+        return self.t
+
+
+class _TeeStub:
+    """A writer's ``on_chunk`` recording the steps of each chunk it is handed."""
+
+    def __init__(self, subscribed: bool) -> None:
+        self.subscribed = subscribed
+        self.chunks: list[int] = []  # messages per chunk
+
+    def __call__(self, data, channels, schemas) -> None:
+        from bioflex_jsb.sinks.live import _count
+
+        self.chunks.append(_count(data))
+
+
+@pytest.mark.parametrize("subscribed", [False, True])
+def test_chunks_close_within_the_live_span_only_while_a_client_listens(
+        tmp_path, monkeypatch, subscribed):
+    """A real-time session (a step every 1/960 s of wall time, the dict path of SITL and
+    ArduPilot): while the tee has a subscribed client the chunks close every
+    LIVE_CHUNK_WALL_S of wall time (20 steps: 20.8 ms ≥ 20 ms), so a live client sees each
+    message within that; without one, every CHUNK_SPAN_S of simulated time (864 steps).
+    The clock is the test's, so the figures do not depend on the machine's load."""
+    import bioflex_jsb.sinks.mcap.log as log_module
+    from bioflex_jsb.simulation.channels import channel_units
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks import mcap as sink
+    from bioflex_jsb.sinks.mcap.writer import CHUNK_WALL_S, LIVE_CHUNK_WALL_S
+
+    clock = _Clock()
+    monkeypatch.setattr(log_module, "time", clock)
+    desc = RunDescription("sitl", "optimised", 15.0, models=("coupled",), duration_s=2.0)
+    log = sink.RunLog.open(tmp_path / "live.mcap", desc)
+    tee = _TeeStub(subscribed)
+    log._writer.on_chunk = tee
+    assert log._writer.chunk_wall_s == (LIVE_CHUNK_WALL_S if subscribed else CHUNK_WALL_S)
+    names = tuple(channel_units(3))
+    row = dict.fromkeys(names, 0.0)
+    row.update(latitude_rad=0.7, longitude_rad=0.2, altitude_m=100.0, airspeed_m_s=15.0)
+    dt = 1 / 960
+    for k in range(1920):  # 2 s
+        log.sample("coupled", k * dt, row)
+        clock.t += dt
+    log.close()
+    per_step = 7  # the run topics of a step (rigid_body ... location)
+    steps = [n // per_step for n in tee.chunks]
+    assert sum(steps) == 1920
+    if subscribed:
+        assert steps[:-1] == [math.ceil(LIVE_CHUNK_WALL_S / dt - 1e-9)] * (len(steps) - 1)
+    else:
+        assert steps == [864, 864, 192]  # CHUNK_SPAN_S = 0.9 s of simulated time

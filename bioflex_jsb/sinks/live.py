@@ -238,6 +238,12 @@ class _Tee:
         self._server = server
         self._by_id: dict[int, object] = {}
 
+    @property
+    def subscribed(self) -> bool:
+        """A client subscribes to something: the writer then closes its chunks every
+        LIVE_CHUNK_WALL_S of wall time (McapFileWriter.chunk_wall_s)."""
+        return self._server._listener.subscriptions > 0
+
     def __call__(self, data: bytes, channels, schemas) -> None:
         by_id = self._by_id
         if len(by_id) < len(channels):  # channels new since the last chunk: advertised now

@@ -37,6 +37,11 @@ MAGIC = b"\x89MCAP0\r\n"
 # chunks spread the fixed cost of writing one (≈ 0.7 ms measured in a run) over more steps
 CHUNK_SPAN_S = 0.9
 CHUNK_WALL_S = 0.9  # wall time per chunk [s] (runs slower than real time, SITL sessions)
+# DECISION: wall time per chunk [s] while a live client is subscribed (the tee's
+# ``subscribed``): a message reaches it at most this long after its step (plus the send),
+# within the ~50 ms a live plot looks immediate at (issue 26); a chunk's fixed cost (≈ 0.7
+# ms, see above) every 20 ms of a real-time session is ≈ 3 % of a core, only while watched
+LIVE_CHUNK_WALL_S = 0.02
 CHUNK_MAX_BYTES = 4 * 1024 * 1024  # uncompressed chunk size limit [bytes]
 COMPRESSION = "zstd"
 ZSTD_LEVEL = -3  # zstd's fast level: see McapFileWriter
@@ -124,7 +129,8 @@ class McapFileWriter:
         self.finished = False
         # the tee (bioflex_jsb.sinks.live): called on the run's thread with each closed
         # chunk's uncompressed message records (bytes: Message records back to back, as in
-        # the file) and the channel and schema records so far (lists, id = index + 1)
+        # the file) and the channel and schema records so far (lists, id = index + 1); its
+        # ``subscribed`` (bool) shortens the chunks while a client listens (chunk_wall_s)
         self.on_chunk = None
         self._pending = None  # the Future of the chunk being written in the background
         # background=True: one writer thread compresses and writes a closed chunk (zstd and
@@ -136,6 +142,14 @@ class McapFileWriter:
                       if background else None)
         self._write(MAGIC + _record_bytes(Header(profile="", library=library)))
         self._stream.flush()
+
+    @property
+    def chunk_wall_s(self) -> float:
+        """The wall time [s] a chunk begun now may stay open (the run log's policy):
+        :data:`LIVE_CHUNK_WALL_S` while the tee has a subscribed client, so that it sees each
+        message within that; :data:`CHUNK_WALL_S` otherwise (fewer, cheaper chunks)."""
+        tee = self.on_chunk
+        return LIVE_CHUNK_WALL_S if tee is not None and tee.subscribed else CHUNK_WALL_S
 
     def _write(self, data: bytes) -> None:
         self._wait()
