@@ -11,6 +11,7 @@ A campaign is a TOML file (``docs/sweeps.md``)::
 
     [axes]                      # lists, or ranges {start, stop, step} / {start, stop, num}
     wings = ["original", "optimised"]
+    aircraft = ["bioflex_original"]   # definitions: shipped or files (sweep/aircraft_axis.py)
     speeds_m_s = [15.0, 18.0]
     gusts = ["sharp:3", "dryden:1:100"]
     seeds = [1, 2]              # turbulence seeds (dryden / vonkarman gusts only)
@@ -62,8 +63,8 @@ DEFAULT_AERO = "quasi-steady"
 # wing's coefficients (no aerodynamics); flutter and eigenvalues are the quasi-steady LTI
 # model's, so with run.aero = "unsteady" they are refused rather than given quasi-steady
 UNSTEADY_METRICS = ("gust", "coefficients")
-AXIS_KEYS = {"wings", "x_inertial_frac", "x_elastic_frac", "speeds_m_s", "gusts", "seeds",
-             "models"}
+AXIS_KEYS = {"wings", "aircraft", "x_inertial_frac", "x_elastic_frac", "speeds_m_s", "gusts",
+             "seeds", "models"}
 RANGE_KEYS = {"start", "stop", "step", "num"}
 TURBULENCE = ("dryden", "vonkarman")
 
@@ -158,11 +159,18 @@ RUN_INFO_COLUMNS: dict[str, str] = {
 }
 
 
-def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO) -> dict[str, str]:
+def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
+                   aircraft: bool = False) -> dict[str, str]:
     """Every column of a results table for ``metrics``, in order, with its type. A campaign
-    of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``; the
-    quasi-steady default's table is the one it always was (its files resume as before)."""
-    cols = dict(INPUT_COLUMNS)
+    of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``, one with
+    an ``aircraft`` axis an ``aircraft`` column after ``wing`` (the definition's name, empty
+    for the wings of ``axes.wings``); other tables are the ones they always were (their
+    files resume as before)."""
+    cols = {}
+    for name, kind in INPUT_COLUMNS.items():
+        cols[name] = kind
+        if name == "wing" and aircraft:
+            cols["aircraft"] = "str"
     if aero != DEFAULT_AERO:
         cols["aero"] = "str"
     cols.update(STATUS_COLUMNS)
@@ -201,7 +209,10 @@ def settings_identity(settings: RunSettings) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class Case:
-    """One point of a campaign: a wing at a speed through a gust, as one model."""
+    """One point of a campaign: a wing at a speed through a gust, as one model. A case of
+    the ``aircraft`` axis has its :class:`~bioflex_jsb.definition.aircraft.Aircraft` in
+    ``aircraft`` (``wing`` its wing's variant); ``aircraft_column``: the campaign's table has
+    the ``aircraft`` column."""
 
     index: int
     wing: WingVariant
@@ -211,6 +222,12 @@ class Case:
     settings: RunSettings
     metrics: tuple[str, ...]
     case_id: str = ""
+    aircraft: Any = None
+    aircraft_column: bool = False
+
+    def columns(self) -> dict[str, str]:
+        """The columns of this case's results table."""
+        return result_columns(self.metrics, self.settings.aero, self.aircraft_column)
 
     def inputs(self) -> dict[str, Any]:
         """The input columns of this case's row."""
@@ -234,13 +251,20 @@ class Case:
             "dt_s": self.settings.dt_s,
             "mass_basis": self.settings.mass_basis,
             **({} if self.settings.aero == DEFAULT_AERO else {"aero": self.settings.aero}),
+            **({"aircraft": self.aircraft.name if self.aircraft is not None else None}
+               if self.aircraft_column else {}),
         }
 
 
-def _wing_identity(wing: WingVariant) -> dict[str, Any]:
+def _wing_identity(wing: WingVariant, aircraft=None) -> dict[str, Any]:
     """The wing's definition for hashing; a modes file enters by its content, not its path
-    (read once per process and file: a regular file within the modal-file size limit)."""
+    (read once per process and file: a regular file within the modal-file size limit); an
+    aircraft's wing also by its definition file's content (``sweep/aircraft_axis.py``)."""
     d = wing.as_dict()
+    if aircraft is not None:
+        from bioflex_jsb.sweep.aircraft_axis import aircraft_identity
+
+        d["aircraft"] = aircraft_identity(aircraft)
     d.pop("description", None)
     if wing.modes_file:
         digest = _modes_digest(wing.modes_file)
@@ -281,7 +305,7 @@ def case_id(case: Case) -> str:
     """Stable id of ``case``: 16 hex digits of the SHA-256 of its inputs."""
     payload = {
         "v": CASE_ID_VERSION,
-        "wing": _wing_identity(case.wing),
+        "wing": _wing_identity(case.wing, case.aircraft),
         "speed_m_s": case.speed_m_s,
         "gust": case.gust,
         "model": case.model,
@@ -294,8 +318,7 @@ def case_id(case: Case) -> str:
 
 def failed_row(case: Case, error: str) -> dict[str, Any]:
     """The row of a case that produced no result (every metric None)."""
-    row: dict[str, Any] = {name: None for name in result_columns(case.metrics,
-                                                                  case.settings.aero)}
+    row: dict[str, Any] = {name: None for name in case.columns()}
     row.update(case.inputs())
     row["status"] = "failed"
     row["error"] = " ".join(str(error).split())  # one line
@@ -313,6 +336,7 @@ class Campaign:
     gusts: tuple[str, ...]
     models: tuple[str, ...]
     source: str = ""
+    aircraft: tuple = ()  # Aircraft of the aircraft axis (sweep/aircraft_axis.py)
 
     def cases(self) -> list[Case]:
         """The Cartesian product wings × speeds × gusts × models, with ids (a list; a sweep
@@ -326,8 +350,10 @@ class Campaign:
         settings_json = dumps(settings_identity(self.settings), sort_keys=True, default=str)
         metrics_json = dumps(sorted(self.metrics))
         index = 0
-        for wing in self.wings:
-            wing_json = dumps(_wing_identity(wing), sort_keys=True, default=str)
+        column = bool(self.aircraft)
+        wings = [(w, None) for w in self.wings] + [(a.variant(), a) for a in self.aircraft]
+        for wing, aircraft in wings:
+            wing_json = dumps(_wing_identity(wing, aircraft), sort_keys=True, default=str)
             for speed in self.speeds_m_s:
                 for gust in self.gusts:
                     for model in self.models:
@@ -335,15 +361,16 @@ class Campaign:
                                         metrics_json)
                         cid = hashlib.sha256(text.encode()).hexdigest()[:16]
                         yield Case(index, wing, speed, gust, model, self.settings,
-                                   self.metrics, cid)
+                                   self.metrics, cid, aircraft, column)
                         index += 1
 
     @property
     def n_cases(self) -> int:
-        return len(self.wings) * len(self.speeds_m_s) * len(self.gusts) * len(self.models)
+        return (len(self.wings) + len(self.aircraft)) * len(self.speeds_m_s) * \
+            len(self.gusts) * len(self.models)
 
     def columns(self) -> dict[str, str]:
-        return result_columns(self.metrics, self.settings.aero)
+        return result_columns(self.metrics, self.settings.aero, bool(self.aircraft))
 
 
 # ---------------------------------------------------------------------------------------
@@ -490,7 +517,12 @@ def parse_campaign(
                             "models)")
     _unknown(axes, AXIS_KEYS, "axes")
 
-    wings = _wings(axes, base_dir)
+    aircraft: list = []
+    if "aircraft" in axes:
+        from bioflex_jsb.sweep.aircraft_axis import aircraft_axis
+
+        aircraft = aircraft_axis(_values(axes["aircraft"], "axes.aircraft"), base_dir, metrics)
+    wings = _wings(axes, base_dir, required=not aircraft)
 
     if "speeds_m_s" not in axes:
         raise CampaignError("axes.speeds_m_s: missing; give the airspeeds [m/s]")
@@ -518,11 +550,11 @@ def parse_campaign(
                                 f"{extra!r} is the quasi-steady LTI model's; accepted with it: "
                                 f"metrics from {', '.join(UNSTEADY_METRICS)}")
 
-    n = len(wings) * len(speeds) * len(gusts) * len(models)
+    n = (len(wings) + len(aircraft)) * len(speeds) * len(gusts) * len(models)
     if n > MAX_CASES:
         raise CampaignError(f"axes: {n} cases is more than {MAX_CASES}")
     return Campaign(name.strip(), description, metrics, settings, tuple(wings), tuple(speeds),
-                    tuple(gusts), tuple(models), source)
+                    tuple(gusts), tuple(models), source, tuple(aircraft))
 
 
 def _settings(run: Any) -> RunSettings:
@@ -554,7 +586,7 @@ def _settings(run: Any) -> RunSettings:
     return RunSettings(duration, start, dt, basis, (float(fr[0]), float(fr[1])), aero)
 
 
-def _wings(axes: dict, base_dir: Path | None) -> list[WingVariant]:
+def _wings(axes: dict, base_dir: Path | None, required: bool = True) -> list[WingVariant]:
     wings: list[WingVariant] = []
     if "wings" in axes:
         for i, w in enumerate(_values(axes["wings"], "axes.wings")):
@@ -589,9 +621,9 @@ def _wings(axes: dict, base_dir: Path | None) -> list[WingVariant]:
         for xi in grids["x_inertial_frac"]:
             for xe in grids["x_elastic_frac"]:
                 wings.append(axis_variant(xi, xe))
-    if not wings:
-        raise CampaignError("axes.wings: missing; give axes.wings or axes.x_inertial_frac and "
-                            "axes.x_elastic_frac")
+    if not wings and required:
+        raise CampaignError("axes.wings: missing; give axes.wings, axes.aircraft or "
+                            "axes.x_inertial_frac and axes.x_elastic_frac")
     names: set[str] = set()
     for w in wings:
         if w.name in names:

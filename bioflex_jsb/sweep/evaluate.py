@@ -45,11 +45,11 @@ from bioflex_jsb.sweep.campaign import (
     Case,
     RecordingError,
     failed_row,
-    result_columns,
 )
 
 _FLUTTER_CACHE: dict[tuple, Any] = {}
 _EIGEN_CACHE: dict[tuple, Any] = {}
+_AIRCRAFT_BUILDS: dict[tuple, Any] = {}  # an aircraft's wing (its own airframe's model)
 # What a case imports beyond the executors' preload (measured: a first case imported these
 # and numba, 1-2 s under load): imported, and the step kernel loaded, once per worker.
 WARM_MODULES = ("bioflex_jsb.flight_dynamics.eigen", "bioflex_jsb.flight_dynamics.flutter_engine",
@@ -125,18 +125,32 @@ def run_case(case: Case, log_dir: str | None = None) -> dict[str, Any]:
 
 def _wing_key(case: Case) -> tuple:
     """What identifies a case's wing build (the per-process caches' key)."""
-    return (repr(sorted(case.wing.as_dict().items())), case.settings.mass_basis)
+    aircraft = None
+    if case.aircraft is not None:
+        from bioflex_jsb.sweep.aircraft_axis import aircraft_identity
+
+        aircraft = aircraft_identity(case.aircraft)["definition_sha256"]
+    return (repr(sorted(case.wing.as_dict().items())), case.settings.mass_basis, aircraft)
+
+
+def _build(case: Case):
+    """The case's wing: its variant's build (``build_wing``'s cache), or its aircraft's
+    (cached here per definition content and mass basis)."""
+    from bioflex_jsb.flight_dynamics.wing_model import build_wing
+
+    if case.aircraft is None:
+        return build_wing(case.wing, mass_basis=case.settings.mass_basis)
+    key = _wing_key(case)
+    if key not in _AIRCRAFT_BUILDS:
+        _AIRCRAFT_BUILDS[key] = case.aircraft.wing(case.settings.mass_basis)
+    return _AIRCRAFT_BUILDS[key]
 
 
 def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
-    from bioflex_jsb.flight_dynamics.wing_model import build_wing
-
-    row: dict[str, Any] = {name: None for name in result_columns(case.metrics,
-                                                                  case.settings.aero)}
+    row: dict[str, Any] = {name: None for name in case.columns()}
     row.update(case.inputs())
     row["status"] = "ok"
-    s = case.settings
-    build = build_wing(case.wing, mass_basis=s.mass_basis)
+    build = _build(case)
     if "coefficients" in case.metrics:
         row["c_eta1_q1"] = float(build.model.coefficients.c_eta_q[0, 0])
         row["c_eta1_q1_physical"] = _num(build.physical_c_eta1_q1)
@@ -199,7 +213,9 @@ def case_description(case: Case):
                           gust=parse_gust(case.gust).text(), models=(case.model,),
                           duration_s=s.duration_s, gust_start_s=s.gust_start_s,
                           dt_s=s.dt_s, mass_basis=s.mass_basis,
-                          extra={"case_id": case.case_id, "aero": s.aero})
+                          extra={"case_id": case.case_id, "aero": s.aero,
+                                 **({"aircraft": str(case.aircraft.definition.path)}
+                                    if case.aircraft is not None else {})})
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
