@@ -45,3 +45,13 @@ def test_the_command_takes_the_definitions_stations_unless_told(definition_file,
                      capsys) == ["root", "50% b/2"]
     assert _stations(["--aircraft", "bioflex_optimised"], capsys) == [
         "root", "25% b/2", "50% b/2", "75% b/2"]
+
+
+def test_the_tuned_gust_ships_the_aircraft_to_its_workers(definition_file, capsys):
+    """--tuned --aircraft: the workers build the definition's wing (the Aircraft is the
+    case's wing source) and the loads are at the definition's stations."""
+    assert main(["loads", "--tuned", "--aircraft", str(definition_file), "--gradients", "0.5",
+                 "--workers", "2", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["station_fractions"] == list(OTHER_STATIONS)
+    assert len(data["cases"]) == 2 and len(data["critical"]) == 2 * 3 * 2 * 2
