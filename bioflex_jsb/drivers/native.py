@@ -35,8 +35,10 @@ from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 # Glide trim (:func:`glide_trim_state`): Newton on (α, γ, elevator) until |u̇|, |ẇ| are below
 # GLIDE_TRIM_TOL_FPS2 [ft/s²] and |q̇| below GLIDE_TRIM_TOL_RAD_S2 [rad/s²]. Left over 2 s,
 # 1e-6 ft/s² moves the speed by 2e-6 ft/s and 1e-7 rad/s² the pitch rate by 2e-7 rad/s, 1e-5
-# of what a 0.3 m/s gust makes (measured on the SGS: converged to < 2e-9 ft/s² and
-# < 3e-11 rad/s² in 3 steps at 25 m/s). Finite differences of GLIDE_TRIM_STEP [rad, -]:
+# and 4e-5 of what a 0.3 m/s gust makes (vt 0.19 ft/s, q 4.7e-3 rad/s). Measured on the SGS:
+# 4 Newton steps to 3.6e-12 ft/s² and 2.3e-14 rad/s² at 25 m/s; 3-5 steps at 18-28 m/s; no
+# glide at 17 m/s (stall) nor at 32 m/s (C_L 0.39, under the CLwbh table's first 0.43). Finite
+# differences of GLIDE_TRIM_STEP [rad, -]:
 # JSBSim's tables are piecewise linear, so a small step sees the slope of the segment.
 GLIDE_TRIM_TOL_FPS2 = 1e-6
 GLIDE_TRIM_TOL_RAD_S2 = 1e-7
@@ -110,16 +112,18 @@ def glide_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimState:
             try:
                 x = x - np.linalg.solve(jac, f)
             except np.linalg.LinAlgError:
-                raise TrimError(f"aircraft {spec.aircraft_name!r} cannot be trimmed in a glide "
-                                f"at {spec.speed_m_s:g} m/s: the elevator does not move the "
-                                "pitch acceleration") from None
+                raise TrimError(f"aircraft {spec.aircraft_name!r}: no glide trim at "
+                                f"{spec.speed_m_s:g} m/s: u-dot, w-dot, q-dot do not change "
+                                "with alpha, gamma and the elevator there (a flat end of a "
+                                "table or a dead elevator); try another --speed") from None
         else:
             raise TrimError(f"aircraft {spec.aircraft_name!r}: no glide trim at "
                             f"{spec.speed_m_s:g} m/s (residual u-dot {f[0]:.3g} ft/s2, w-dot "
                             f"{f[1]:.3g} ft/s2, q-dot {f[2]:.3g} rad/s2 after "
-                            f"{GLIDE_TRIM_ITERATIONS} Newton steps; stall or a saturated "
-                            "elevator: try another --speed)")
-        f = _glide_state(af, v_fps, x)
+                            f"{GLIDE_TRIM_ITERATIONS} Newton steps: beyond the aircraft's "
+                            "tables (stall, their end in alpha) or its elevator; try another "
+                            "--speed)")
+        # the last evaluation was at x: af holds the trimmed state
         if not -1.0 <= x[2] <= 1.0:
             raise TrimError(f"aircraft {spec.aircraft_name!r}: the glide at "
                             f"{spec.speed_m_s:g} m/s needs elevator command {x[2]:.3g}, "
