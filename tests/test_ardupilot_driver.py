@@ -810,3 +810,76 @@ def test_unchanged_servo_outputs_are_not_written_again_and_fly_the_same(wing):
         assert ph.phase == ad.FLIGHT
         rows.append(out)
     assert rows[0] == rows[1]
+
+
+# ---------------------------------------------------------------------------------------
+# The aircraft in 3-D in the session's log (issue 26: "the aircraft in 3-D in every log")
+# ---------------------------------------------------------------------------------------
+
+def _cli_flight(argv: list[str], port: int) -> int:
+    """``bioflex-jsb ardupilot ARGV`` in a thread, flown by the stand-in holding ArduPlane's
+    idle throttle in TAKEOFF mode (the launcher fires after 0.5 s) until ``--duration`` ends
+    it; the exit status."""
+    from bioflex_jsb.cli import build_parser
+
+    args = build_parser().parse_args(["ardupilot", "--port", str(port), *argv])
+    result = {}
+    th = threading.Thread(target=lambda: result.update(rc=args.run(args)), daemon=True)
+    th.start()
+    ap = ArduPilotStandin(("127.0.0.1", port), timeout_s=0.5)
+    try:
+        for _ in range(5000):
+            if not th.is_alive():
+                break
+            ap.send_servos(ARMED_IDLE)
+            try:
+                ap.receive()
+            except TimeoutError:
+                continue
+    finally:
+        ap.close()
+    th.join(30.0)
+    return result.get("rc")
+
+
+def test_command_line_log_has_the_aircraft_in_3d(tmp_path):
+    """The session's log carries the scene as gust, compare and sitl logs do: one wing
+    message at the first step of each 1/60 s bin of the flight's steps (none on the
+    launcher: no coupled step there), the tip twisted by the mode shapes times the logged
+    η (exaggeration 1, cli.gust.SCENE_EXAGGERATION), the rigid airframe, the metadata."""
+    pytest.importorskip("google.protobuf")
+    pytest.importorskip("foxglove_schemas_protobuf")
+    from bioflex_jsb.cli.gust import SCENE_EXAGGERATION
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.sinks.mcap import scene
+    from tests.tools import decode_topic
+
+    out = tmp_path / "session.mcap"
+    assert _cli_flight(["--duration", "1.3", "--launch-height", "100", "--out", str(out)],
+                       _free_port()) == 0
+    modal = decode_topic(out, sink.topic("coupled", "modal"))
+    wing = decode_topic(out, sink.topic("coupled", "scene"))
+    assert len(modal) > 300  # 1.3 s less the launcher's 0.5 s hold and 0.375 s stroke
+    steps = np.array([ns for ns, _ in modal])
+    bins = np.floor(steps * 1e-9 * scene.SCENE_RATE_HZ + 1e-6)
+    first = steps[np.flatnonzero(np.diff(np.concatenate([[bins[0] - 1], bins])))]
+    assert [ns for ns, _ in wing] == first.tolist()
+    assert len(wing) >= 20
+    build = build_wing(VARIANTS["optimised"])
+    eta_at = {ns: np.array(m.eta_rad) for ns, m in modal}
+    moved = 0
+    for ns, msg in wing:
+        ent = msg.entities[0]
+        assert (ent.frame_id, ent.id) == ("coupled_body", scene.ENTITY_ID)
+        le, te = [(p.x, p.z) for p in ent.triangles[0].points][-2:]
+        twist = math.atan2(le[1] - te[1], le[0] - te[0])
+        expected = SCENE_EXAGGERATION * build.modes.twist_rad[:, -1] @ eta_at[ns]
+        # rounding only: a few double operations on numbers below 1 m (tests/test_scene.py)
+        assert twist == pytest.approx(expected, abs=1e-12)
+        moved += abs(expected) > 1e-9
+    assert moved  # the flight's wing is deformed: the check sees the η
+    air = decode_topic(out, sink.topic("coupled", "airframe"))
+    assert air and air[0][0] == wing[0][0]  # with the first sample of the flight
+    info = sink.summarise(out)["metadata"][sink.schemas.SCENE_METADATA]
+    assert float(info["exaggeration"]) == SCENE_EXAGGERATION
+    _doctor(out)

@@ -149,6 +149,9 @@ def test_reply_is_newline_compact_json_newline():
     ({"quaternion": None, "attitude_rad": None}, "quaternion or attitude"),
     ({"position_ned_m": (0.0, 0.0)}, "3 components"),
     ({"airspeed_m_s": -1.0}, ">= 0"),
+    ({"accel_body_m_s2": (0.0, 4e38, 0.0)}, "C float"),
+    ({"velocity_ned_m_s": (0.0, "x", 0.0)}, "could not convert"),
+    ({"gyro_rad_s": 3.0}, "sequence of 3"),
 ])
 def test_bad_states_raise_one_line_value_errors(change, text):
     good = LevelTurn().state()
@@ -578,30 +581,91 @@ def test_a_slow_step_of_ours_counts_as_connected_time():
 
 # ------------------------------------------------------------------ the fast reply, pacing
 def _states(n: int, seed: int = 1):
-    """Random states: every number class (zero, -0.0, subnormal, 1e±300, long mantissas),
-    each optional field present or not."""
+    """Random states: every number class (zero, -0.0, subnormals of double and single,
+    1e±300 in the doubles, up to ±3e38 in the C floats, long mantissas), each optional field
+    present or not."""
     rng = np.random.default_rng(seed)
-    picks = (lambda: rng.uniform(-1e3, 1e3), lambda: 0.0, lambda: -0.0, lambda: 5e-324,
-             lambda: rng.standard_normal() * 10.0 ** rng.integers(-300, 300),
-             lambda: 123456789.123456789, lambda: 1e16)
+
+    def picks(top: int):
+        return (lambda: rng.uniform(-1e3, 1e3), lambda: 0.0, lambda: -0.0, lambda: 5e-324,
+                lambda: 1e-40, lambda: rng.standard_normal() * 10.0 ** rng.integers(-300, top),
+                lambda: 123456789.123456789, lambda: 1e16)
+
+    doubles, singles = picks(300), picks(38)
+
+    def d() -> float:
+        return float(doubles[rng.integers(len(doubles))]())
 
     def f() -> float:
-        return float(picks[rng.integers(len(picks))]())
+        return float(singles[rng.integers(len(singles))]())
 
     for _ in range(n):
         q = rng.standard_normal(4)
         q = tuple(q / np.linalg.norm(q))
         has_q = rng.uniform() < 0.7
         yield aj.JsonState(
-            abs(f()), (f(), f(), f()), (f(), f(), f()), (f(), f(), f()), (f(), f(), f()),
+            abs(d()), (f(), f(), f()), (f(), f(), f()), (d(), d(), d()), (f(), f(), f()),
             quaternion=q if has_q else None,
             attitude_rad=(f(), f(), f()) if not has_q or rng.uniform() < 0.5 else None,
             airspeed_m_s=abs(f()) if rng.uniform() < 0.5 else None)
 
 
-def test_the_format_string_reply_is_json_dumps_byte_for_byte():
+def _single(x: float) -> float:
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def _same(a: float, b: float) -> bool:
+    """Equal, with the sign of a zero."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+
+
+DOUBLE_KEYS = ("timestamp", "position")  # doubles in ArduPilot (SIM_JSON.h); the rest floats
+
+
+def test_the_reply_is_json_dumps_document_in_arduPilots_precision():
+    """The fast reply (one %-format, floats rounded to single precision) is the document
+    ``json.dumps`` writes, key for key in the same order, each number the one ArduPilot
+    stores: the doubles (timestamp, position) exactly, every other field as the float
+    nearest the state's (what strtof of json.dumps's text gives: float32(x))."""
+    rounded = 0
     for state in _states(5000):
-        assert aj.encode_reply(state) == aj.encode_reply_json(state)
+        data = aj.encode_reply(state)
+        assert data.startswith(b"\n{") and data.endswith(b"}\n") and b" " not in data
+        mine = json.loads(data, parse_int=float)
+        ref = json.loads(aj.encode_reply_json(state), parse_int=float)
+        flat_mine = {**mine.pop("imu"), **mine}
+        flat_ref = {**ref.pop("imu"), **ref}
+        assert list(flat_mine) == list(flat_ref)
+        for key, ref_value in flat_ref.items():
+            a = flat_mine[key] if isinstance(flat_mine[key], list) else [flat_mine[key]]
+            b = ref_value if isinstance(ref_value, list) else [ref_value]
+            assert len(a) == len(b), key
+            for x, y in zip(a, b, strict=True):
+                if key in DOUBLE_KEYS:
+                    assert _same(x, y), (key, x, y)
+                else:
+                    assert _same(_single(x), _single(y)), (key, x, y)
+                    rounded += x != y
+    assert rounded > 1000  # the floats' text is not json's: the test compares numbers
+
+
+def test_the_floats_text_is_read_back_to_the_same_single_by_both_of_arduPilots_reads():
+    """``sscanf("%f")`` (vectors: strtof, straight to single) and ``atof`` then the cast
+    (airspeed: through a double) give the same float from the 9-digit text: the stand-in's
+    two readers on every float of 2000 replies."""
+    from tests.ardupilot_standin import c_atof
+
+    for state in _states(2000, seed=5):
+        line = aj.encode_reply(state).strip(b"\n")
+        parsed = parse_sensors(line).values
+        assert parsed["gyro"] == tuple(map(_single, state.gyro_rad_s))
+        assert parsed["velocity"] == tuple(map(_single, state.velocity_ned_m_s))
+        assert parsed["timestamp"] == state.timestamp_s
+        assert parsed["position"] == state.position_ned_m
+        if state.airspeed_m_s is not None:
+            at = line.index(b'"airspeed":') + len(b'"airspeed":')
+            assert _single(c_atof(line[at:])) == _single(state.airspeed_m_s)
+            assert parsed["airspeed"] == _single(state.airspeed_m_s)
 
 
 def test_the_standins_cheap_read_agrees_with_its_full_parse():

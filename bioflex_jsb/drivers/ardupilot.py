@@ -276,6 +276,7 @@ class ArduPilotPhysics:
         self._pending_events: list[tuple[float, str, str]] = []
         self.on_event: Callable[[float, str, str], None] | None = None
         self.records: list[tuple[float, ...]] = []
+        self._commands_of: tuple[tuple[int, ...] | None, tuple[float, ...]] = (None, ())
         self._log = None  # RunLog (log_to)
         self._autopilot_log = None
         self._step_row: tuple[float, ...] | None = None  # the last frame's flight row
@@ -318,6 +319,9 @@ class ArduPilotPhysics:
         speed = math.sqrt(sum(c * c for c in v_exit))
         self._exit_speed_m_s = speed
         self._exit_dir = tuple(c / speed for c in v_exit)
+        self.dt_s = core.dt_s
+        # where the stroke ends (NED from the launch point) [m]: the flight's position offset
+        self._stroke_ned_m = tuple(self.stroke_m * c for c in self._exit_dir)
         s2 = math.sin(self._lat0) ** 2
         r_meridian = WGS84_A_M * (1 - WGS84_E2) / (1 - WGS84_E2 * s2) ** 1.5
         r_normal = WGS84_A_M / math.sqrt(1 - WGS84_E2 * s2)
@@ -528,8 +532,7 @@ class ArduPilotPhysics:
         k = U.M_PER_FT / m
         phi, theta = get["phi"](), get["theta"]()
         psi = math.remainder(get["psi"](), 2.0 * math.pi)
-        stroke = self.stroke_m
-        s_n, s_e, s_d = (stroke * c for c in self._exit_dir)
+        s_n, s_e, s_d = self._stroke_ned_m
         north = (get["lat"]() - self._lat0) * self._m_per_rad_n + s_n
         east = math.remainder(get["lon"]() - self._lon0, 2.0 * math.pi) * self._m_per_rad_e + s_e
         down = self._h_launch_m - get["h"]() * U.M_PER_FT + s_d
@@ -551,9 +554,15 @@ class ArduPilotPhysics:
 
     def commands(self, pwm_us: tuple[int, ...]) -> tuple[float, ...]:
         """The four normalised commands (aileron, elevator, throttle, rudder) the channel map
-        gives for ``pwm_us`` [µs] (:data:`CHANNEL_MAP`)."""
-        return tuple(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0)
-                     for ch in CHANNEL_MAP)
+        gives for ``pwm_us`` [µs] (:data:`CHANNEL_MAP`); the last PWM's kept (ArduPlane's
+        outputs change at its loop rate, 50-400 Hz, against 960 frames a second)."""
+        last_pwm, last = self._commands_of
+        if pwm_us == last_pwm:
+            return last
+        out = tuple(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0)
+                    for ch in CHANNEL_MAP)
+        self._commands_of = (pwm_us, out)
+        return out
 
     def _log_frame(self, rec: FrameRecord) -> None:
         # the state the frame arrived at: before the step (step, reset), the one repeated
