@@ -121,8 +121,9 @@ def to_python_control(model):
     """A python-control ``StateSpace`` with named states, inputs and outputs.
 
     ``model``: a :class:`StateSpace`, the path of a file ``bioflex-jsb export`` wrote (.npz
-    or .mat), or the mapping ``numpy.load``/``scipy.io.loadmat`` returned for one. Needs the
-    optional dependency (``pip install "bioflex-jsb[control]"``).
+    or .mat), or the mapping ``numpy.load``/``scipy.io.loadmat`` returned for one: its
+    :meth:`~bioflex_jsb.state_space.StateSpace.to_control`. Needs the optional dependency
+    (``pip install "bioflex-jsb[control]"``; without it one line, exit 2 in the CLI).
     """
     if isinstance(model, str | Path):
         ss = read_state_space(model)
@@ -133,11 +134,4 @@ def to_python_control(model):
     else:
         raise InputError(f"to_python_control needs a StateSpace, a model file or its arrays, "
                          f"got {type(model).__name__}")
-    try:
-        import control
-    except ImportError:
-        raise ImportError(
-            "python-control is not installed; pip install 'bioflex-jsb[control]'"
-        ) from None
-    return control.ss(ss.a, ss.b, ss.c, ss.d, states=list(ss.states), inputs=list(ss.inputs),
-                      outputs=list(ss.outputs), name=f"bioflex_{ss.model}")
+    return ss.to_control()  # the one conversion (bioflex_jsb.state_space)
