@@ -200,4 +200,8 @@ def test_commands_take_the_aircraft_file(capsys):
     # yet moved to another airframe (export: the prototype's level-flight LTI export)
     # refuse it in one line, exit 2
     code, _, err = run_cli(capsys, "export", "--aircraft", path, "--out", "never.npz")
-    assert_one_line_error(code, err, "airframe.jsbsim = 'SGS'")
+    assert_one_line_error(code, err, "export takes the prototype's airframe only")
+    # sitl: the prototype's JSBSim autopilot holds altitude with the throttle; a glider has
+    # none (cli/aircraft_option.py sitl_refusal)
+    code, _, err = run_cli(capsys, "sitl", "--aircraft", path)
+    assert_one_line_error(code, err, "sitl flies the prototype's JSBSim autopilot")
