@@ -10,16 +10,12 @@ driver; the XML itself is :mod:`bioflex_jsb.generators.native_wing`'s).
 from __future__ import annotations
 
 import argparse
-import math
 import re
 import sys
 import tempfile
 from functools import lru_cache
 from pathlib import Path
 
-import numpy as np
-
-from bioflex_jsb import units as U
 from bioflex_jsb.definition.airframe import GENERATED
 from bioflex_jsb.definition.reader import DefinitionError
 from bioflex_jsb.generators import airframe as airframe_xml
@@ -32,18 +28,6 @@ from bioflex_jsb.runtime.fdm import TRIM_CONTROLS, Airframe
 from bioflex_jsb.runtime.results import TrimError
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
-# Glide trim (:func:`glide_trim_state`): Newton on (α, γ, elevator) until |u̇|, |ẇ| are below
-# GLIDE_TRIM_TOL_FPS2 [ft/s²] and |q̇| below GLIDE_TRIM_TOL_RAD_S2 [rad/s²]. Left over 2 s,
-# 1e-6 ft/s² moves the speed by 2e-6 ft/s and 1e-7 rad/s² the pitch rate by 2e-7 rad/s, 1e-5
-# and 4e-5 of what a 0.3 m/s gust makes (vt 0.19 ft/s, q 4.7e-3 rad/s). Measured on the SGS:
-# 4 Newton steps to 3.6e-12 ft/s² and 2.3e-14 rad/s² at 25 m/s; 3-5 steps at 18-28 m/s; no
-# glide at 17 m/s (stall) nor at 32 m/s (C_L 0.39, under the CLwbh table's first 0.43). Finite
-# differences of GLIDE_TRIM_STEP [rad, -]:
-# JSBSim's tables are piecewise linear, so a small step sees the slope of the segment.
-GLIDE_TRIM_TOL_FPS2 = 1e-6
-GLIDE_TRIM_TOL_RAD_S2 = 1e-7
-GLIDE_TRIM_STEP = 1e-6
-GLIDE_TRIM_ITERATIONS = 25
 # The exported flights start at ISA sea level (as the prototype's: TrimState): a definition's
 # air density must be that one's, to the rounding of a printed 1.225 (1e-9 relative).
 DENSITY_REL_TOL = 1e-9
@@ -70,67 +54,25 @@ def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
     return trim_state(P.SECTION5_AIRSPEED_M_S, dt_s)
 
 
-def _glide_state(af: Airframe, v_fps: float, x: np.ndarray) -> np.ndarray:
-    """(u̇ [ft/s²], ẇ [ft/s²], q̇ [rad/s²]) of ``af`` restarted at airspeed ``v_fps`` with
-    x = (α [rad], γ [rad], elevator command [-]), wings level (JSBSim's RunIC: dt = 0)."""
-    af["ic/vt-fps"] = v_fps
-    af["ic/gamma-rad"] = x[1]
-    af["ic/alpha-rad"] = x[0]
-    af["fcs/elevator-cmd-norm"] = x[2]
-    af.restart_from_initial_conditions()
-    return np.array([af["accelerations/udot-ft_sec2"], af["accelerations/wdot-ft_sec2"],
-                     af["accelerations/qdot-rad_sec2"]])
-
-
 def glide_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimState:
     """Glide trim of an exported glider (``files``: its aircraft and system, written to a
-    temporary root and loaded there; never into the user's): steady, straight, wings-level
-    flight at ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, the flight-path angle γ
-    (negative: descending), α and the elevator solved by Newton (constants above) from the
-    linear model's glide (C_L from the weight, γ = −atan(C_D/C_L)). JSBSim's own trim cannot
-    trim a glider (u̇ needs the throttle). The modal loads are zero: the wing is held at its
-    trim reference while JSBSim's step is 0. Raises TrimError (one line)."""
-    from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-
-    cond = level_flight_condition(spec.speed_m_s, spec.rho_ref, airframe=spec.wing.airframe)
-    x = np.array([cond.alpha_trim_rad, -math.atan(cond.cd_trim / cond.cl_trim), 0.0])
+    temporary root and loaded there, never into the user's): the steady, straight,
+    wings-level glide at ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, by
+    :meth:`Airframe.trim` (an aircraft without an engine: α, the flight-path angle γ and the
+    pitch trim by Newton in JSBSim's initial-condition run, runtime/other_airframe.py) with
+    the export's step and integrators, as :func:`trim_state` trims the prototype. The modal
+    loads are zero in it: the wing is held at its trim reference while JSBSim's step is 0.
+    Raises TrimError (one line)."""
     with tempfile.TemporaryDirectory(prefix="bioflex-glide-trim-") as tmp:
         write_export(files, Path(tmp))
         af = Airframe(tmp, spec.aircraft_name)
-        if af.engine_count:
+        if not af.glider:
             raise TrimError(f"aircraft {spec.aircraft_name!r} has {af.engine_count} engines: "
-                            "the glide trim is for an aircraft without one")
-        af.set_initial_conditions(spec.speed_m_s)
-        v_fps = spec.speed_m_s * U.FT_PER_M
-        scale = np.array([GLIDE_TRIM_TOL_FPS2, GLIDE_TRIM_TOL_FPS2, GLIDE_TRIM_TOL_RAD_S2])
-        for _ in range(GLIDE_TRIM_ITERATIONS):
-            f = _glide_state(af, v_fps, x)
-            if np.all(np.abs(f) <= scale):
-                break
-            jac = np.column_stack([(_glide_state(af, v_fps, x + GLIDE_TRIM_STEP * e) - f)
-                                   / GLIDE_TRIM_STEP for e in np.eye(3)])
-            try:
-                x = x - np.linalg.solve(jac, f)
-            except np.linalg.LinAlgError:
-                raise TrimError(f"aircraft {spec.aircraft_name!r}: no glide trim at "
-                                f"{spec.speed_m_s:g} m/s: u-dot, w-dot, q-dot do not change "
-                                "with alpha, gamma and the elevator there (a flat end of a "
-                                "table or a dead elevator); try another --speed") from None
-        else:
-            raise TrimError(f"aircraft {spec.aircraft_name!r}: no glide trim at "
-                            f"{spec.speed_m_s:g} m/s (residual u-dot {f[0]:.3g} ft/s2, w-dot "
-                            f"{f[1]:.3g} ft/s2, q-dot {f[2]:.3g} rad/s2 after "
-                            f"{GLIDE_TRIM_ITERATIONS} Newton steps: beyond the aircraft's "
-                            "tables (stall, their end in alpha) or its elevator; try another "
-                            "--speed)")
-        # the last evaluation was at x: af holds the trimmed state
-        if not -1.0 <= x[2] <= 1.0:
-            raise TrimError(f"aircraft {spec.aircraft_name!r}: the glide at "
-                            f"{spec.speed_m_s:g} m/s needs elevator command {x[2]:.3g}, "
-                            "beyond its travel (-1..1): try another --speed")
-        state = _state(af)
-        controls = {name: af[name] for name in TRIM_CONTROLS}
-    return NA.TrimState(state, controls, spec.speed_m_s, 0.0, 0.0, gamma_rad=float(x[1]))
+                            "an aircraft file's export is trimmed to a glide")
+        configure_airframe(af, spec.dt_s, modal_hooks=False)
+        trim = af.trim(spec.speed_m_s)
+        return NA.TrimState(_state(af), {name: af[name] for name in TRIM_CONTROLS},
+                            trim.speed_m_s, 0.0, 0.0, gamma_rad=trim.flight_path_rad)
 
 
 def _state(af: Airframe) -> dict[str, tuple[str, float]]:
