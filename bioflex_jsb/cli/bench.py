@@ -26,7 +26,8 @@ unsteady wing, whose first reference step costs tens of ms, at 4x those). The ru
 (the machine's own speed changes in states of ~10-50 ms on a shared host: a run that long
 mixes them) and many: per-step costs are the slope of a line through the least time of each
 run length (noise only adds time; the line's offset is the fixed cost per run), for all the
-repeats (the figure) and for 3 interleaved groups of them (its spread: median [min .. max]);
+repeats (the figure) and for 3 interleaved groups of them (its spread: median [min .. max]
+of the groups trusted, at least 2);
 an estimate the timings do not support is reported as not trusted, with the reason, instead
 of a figure (never negative). Timed on the process's CPU clock (a run preempted by other
 work is not charged for the wait; wall-clock figures beside them in --json). Ratios, the
