@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb.sinks import mcap as sink
-from bioflex_jsb.sinks.mcap import scene_view
+from bioflex_jsb.sinks.mcap import scene_loads, scene_view
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYOUT = ROOT / "docs" / "foxglove" / "layout.json"
@@ -61,8 +61,13 @@ def test_layout_names_only_what_a_log_holds(shot_log):
     assert three["followTf"] == sink.body_frame("coupled")
     assert three["followMode"] == "follow-pose"
     visible = [t for t, s in three["topics"].items() if s["visible"]]
-    assert sorted(visible) == ["/bioflex/coupled/airframe", "/bioflex/coupled/scene"]
-    assert {ours(t) for t in three["topics"]} <= have
+    assert sorted(visible) == ["/bioflex/coupled/airframe", "/bioflex/coupled/scene",
+                               "/bioflex/coupled/scene_loads"]
+    # the section-load markers are in a log with loads (tests/test_scene_loads.py; the
+    # screenshot's run has none): their topic is the markers' group of each model
+    markers = {t for t in three["topics"] if t.endswith("/" + scene_loads.GROUP)}
+    assert markers == {sink.topic(m, scene_loads.GROUP) for m in ("coupled", "rigid", "qsd")}
+    assert {ours(t) for t in three["topics"]} - {ours(t) for t in markers} <= have
     plotted = []
     for name, cfg in panels.items():
         if name.startswith("Plot!"):

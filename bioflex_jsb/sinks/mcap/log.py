@@ -378,7 +378,9 @@ class TableRecorder:
         ``meta["loads"]``), a chunk per block after the steps' (:mod:`.loads_topic`)."""
         from bioflex_jsb.sinks.mcap.loads_topic import LoadsTopic
 
-        return LoadsTopic(self._log, self._model, layout)
+        out = LoadsTopic(self._log, self._model, layout)
+        scene = self._log.scene  # with the scene: also drawn as markers (scene_loads.py)
+        return out if scene is None else scene.with_loads(out, self._model, layout)
 
 
 class AutopilotRecorder:

@@ -370,6 +370,9 @@ class _Channel:
         self.names: tuple = ()
         self.etas: list[int] = []
         self.cols: list[int] = []
+        # the η of the samples drawn, by log time [ns], kept for the section-load markers
+        # (scene_loads.py) until they draw them (None: the run has no loads, nothing kept)
+        self.drawn: dict[int, np.ndarray] | None = None
 
 
 class SceneLog:
@@ -402,13 +405,37 @@ class SceneLog:
         build = build_wing(variant, mass_basis=description.mass_basis)
         return cls(writer, AircraftMesh(wing_shape(build), airframe_outline(), exaggeration))
 
+    def schema_id(self) -> int:
+        """The id of the ``foxglove.SceneUpdate`` schema (added at the first call)."""
+        if self._schema_id is None:
+            name, data = SCENE_PROTO_SCHEMA
+            self._schema_id = self._writer.add_schema(name, "protobuf", data)
+        return self._schema_id
+
+    def with_loads(self, loads_topic, model: str, layout: dict):
+        """The run's loads topic (``loads_topic``, a :class:`~.loads_topic.LoadsTopic` of
+        ``layout``, the run's ``meta["loads"]``) drawing each block it writes as section-load
+        markers too (:class:`~.scene_loads.LoadMarkers`)."""
+        from bioflex_jsb.sinks.mcap.scene_loads import LoadMarkers
+
+        return LoadMarkers(self, loads_topic, model, layout)
+
+    def remember_eta(self, model: str) -> None:
+        """Keep the η of every sample drawn for ``model`` from now on (:meth:`drawn_eta`)."""
+        ch = self._channel(model)
+        if ch.drawn is None:
+            ch.drawn = {}
+
+    def drawn_eta(self, model: str) -> dict[int, np.ndarray]:
+        """The η [rad] of the samples drawn and not yet taken, by log time [ns] (the caller
+        pops what it uses)."""
+        return self._channel(model).drawn
+
     def _channel(self, model: str) -> _Channel:
         ch = self._channels.get(model)
         if ch is None:
             w = self._writer
-            if self._schema_id is None:
-                name, data = SCENE_PROTO_SCHEMA
-                self._schema_id = w.add_schema(name, "protobuf", data)
+            self.schema_id()
             frame = body_frame(model)
             cid = w.add_channel(topic(model, SCENE_GROUP), self._schema_id, {"model": model})
             aid = w.add_channel(topic(model, AIRFRAME_GROUP), self._schema_id,
@@ -463,6 +490,8 @@ class SceneLog:
         eta = v[:, ch.etas] if ch.etas else np.zeros((len(pick), self.mesh.shape.n_modes))
         floats = scene_floats(self.mesh, eta, *v[:, ch.cols].T)
         ns = np.rint(t[pick] * 1e9).astype(np.int64)
+        if ch.drawn is not None:
+            ch.drawn.update(zip(ns.tolist(), eta, strict=True))
         block, index = ch.records.build(ns, floats, ch.seq)
         ch.seq += len(pick)
         self.messages += len(pick)
