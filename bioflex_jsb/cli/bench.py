@@ -26,8 +26,8 @@ unsteady wing, whose first reference step costs tens of ms, at 4x those). The ru
 (the machine's own speed changes in states of ~10-50 ms on a shared host: a run that long
 mixes them) and many: per-step costs are the slope of a line through the least time of each
 run length (noise only adds time; the line's offset is the fixed cost per run), for all the
-repeats (the figure) and for 3 interleaved groups of them (its spread: median [min .. max]
-of the groups trusted, at least 2);
+repeats (the figure), and again without each of 3 interleaved groups of them in turn (its
+spread: median [min .. max] of the estimates trusted, at least 2);
 an estimate the timings do not support is reported as not trusted, with the reason, instead
 of a figure (never negative). Timed on the process's CPU clock (a run preempted by other
 work is not charged for the wait; wall-clock figures beside them in --json). Ratios, the
@@ -170,8 +170,9 @@ def _print(p: dict) -> None:
     us = p["us_per_step"]
     load = ", ".join(f"{x:.2f}" for x in p["load_average"])
     print(f"time step {p['dt_s']:.6f} s; runs of {', '.join(map(str, p['run_lengths']))} "
-          f"steps, {p['repeat']} interleaved repeats; CPU clock; figure [min .. max of its "
-          f"groups]; load average before {_load(p['load_average_before'])}, after {load}")
+          f"steps, {p['repeat']} interleaved repeats; CPU clock; figure [min .. max without "
+          f"a third of the repeats]; load average before {_load(p['load_average_before'])}, "
+          f"after {load}")
     rows = (("bare JSBSim", "bare", None), ("co-simulation", "cosim", "ratio"),
             ("  logged (gust log)", "logged", "logged_ratio"),
             ("  unsteady strips", "unsteady", "unsteady_ratio"),
