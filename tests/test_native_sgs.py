@@ -387,3 +387,18 @@ def test_cli_run_refuses_qsd_of_the_sgs_in_one_line(tmp_path):
         _run_with_aircraft(["--out", str(tmp_path / "r"), "--speed", "25", "--model", "qsd"])
     assert "coupled model" in _one_line(exc)
     assert not (tmp_path / "r").exists()
+
+
+def test_cli_run_takes_the_aircrafts_speeds(tmp_path, capsys):
+    """--speed not given: the definition's cruise_speed_m_s (25 m/s); a given one outside
+    its speed_range_m_s (20..28 m/s) is one line, nothing written."""
+    import json
+
+    from bioflex_jsb.cli.common import UsageError
+
+    assert _run_with_aircraft(["--out", str(tmp_path / "a"), "--gust", "none", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_m_s"] == 25.0
+    with pytest.raises(UsageError) as exc:
+        _run_with_aircraft(["--out", str(tmp_path / "b"), "--speed", "30"])
+    assert "outside aircraft 'sgs_elastic''s speeds 20..28 m/s" in _one_line(exc)
+    assert not (tmp_path / "b").exists()

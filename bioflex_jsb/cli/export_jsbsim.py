@@ -62,10 +62,13 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="JSBSim root to write into")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
                    help=f"JSBSim step the system is exported for [s] (default {DEFAULT_DT_S:.6g})")
-    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S,
-                   help=speed_help(extra="; it sets the script's level trim (the airframe trims at "
-                                         "about 9.4-32.7 m/s), the trim lift coefficient and "
-                                         "the reference flow of the system"))
+    p.add_argument("--speed", type=airspeed, default=None, metavar="V",
+                   help=speed_help(DEFAULT_SPEED_M_S,
+                                   extra="; it sets the script's level trim (the airframe trims "
+                                         "at about 9.4-32.7 m/s), the trim lift coefficient and "
+                                         "the reference flow of the system; with --aircraft: "
+                                         "within its airframe.speed_range_m_s, default its "
+                                         "cruise_speed_m_s (a glider's glide trim)"))
     p.add_argument("--gust", default=DEFAULT_GUST, metavar="sharp:A|none",
                    help="the script's vertical gust: sharp-edged, A [m/s] up, 0.5 s after the "
                         f"release, or none (default {DEFAULT_GUST}, the paper's Fig. 21)")
@@ -74,16 +77,14 @@ def register(sub) -> None:
     p.set_defaults(run=run)
 
 
-def _gust_up_m_s(text: str) -> float:
-    """The script's sharp-edged gust [m/s] (0: none); other gust kinds are refused."""
-    from bioflex_jsb.simulation.gusts import parse_gust
-
-    gust = parse_gust(text)  # GustSpecError: one line
+def _gust_up_m_s(gust) -> float:
+    """The script's sharp-edged gust [m/s] (0: none) of a parsed --gust (a GustSpec); other
+    gust kinds are refused."""
     if gust.kind == "none":
         return 0.0
     if gust.kind != "sharp":
-        raise UsageError(f"--gust {text!r}: the exported script flies a sharp-edged gust "
-                         "(sharp:A) or none")
+        raise UsageError(f"--gust {gust.text()!r}: the exported script flies a sharp-edged "
+                         "gust (sharp:A) or none")
     return float(gust.amplitude_m_s)
 
 
@@ -113,6 +114,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} is not a directory")
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    args.gust = parse_gust(args.gust)  # GustSpecError: one line
+    resolve_flight(args)  # --speed of the aircraft (default its cruise speed), one line
     gust_up = _gust_up_m_s(args.gust)
     aircraft = getattr(args, "aircraft_definition", None)
     try:
