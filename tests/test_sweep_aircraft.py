@@ -1,8 +1,9 @@
 """Sweeps of aircraft definitions (issue 23; sweep/aircraft_axis.py): ``axes.aircraft`` names
 shipped aircraft and definition files, a case's id hashes the definition file's content,
 the table gains an ``aircraft`` column (only then), the cases run with the definition's
-own wing (its airframe's, for the linear metrics), and a definition that cannot fly the
-gust runs is refused in one line naming the key."""
+own wing on its own airframe (JSBSim's SGS glider's gust runs as the gust command flies
+them), and a definition that cannot fly the gust runs is refused in one line naming the
+key."""
 
 from __future__ import annotations
 
@@ -90,7 +91,6 @@ def test_a_case_id_hashes_the_definition_files_content(folder):
 
 
 @pytest.mark.parametrize("entry, needle", [
-    ('"sgs_elastic"', "airframe.jsbsim = 'SGS'"),
     ('"goland"', "has no [airframe]"),
     ('"nowhere.toml"', "not found"),
     ('"nothing"', "unknown definition 'nothing'"),
@@ -144,14 +144,63 @@ def test_another_airframes_linear_metrics_sweep(folder, monkeypatch, capsys):
         rows["bioflex_original"]["short_period_re_rad_s"]
 
 
-def test_a_gust_campaign_on_another_airframe_exits_2_in_one_line(folder, monkeypatch,
-                                                                 capsys):
-    (folder / "sgs_gust.toml").write_text(SGS_LINEAR.replace(
-        '["eigenvalues", "coefficients"]', '["gust"]') + 'gusts = ["sharp:1"]\n',
-        encoding="utf-8")
-    code, out = _sweep([folder / "sgs_gust.toml", "--out", folder / "x.csv"], monkeypatch,
-                       capsys)
+SGS_GUST = """
+name = "sgs_gust"
+metrics = ["gust"]
+
+[run]
+duration_s = 2.0
+
+[axes]
+aircraft = ["sgs_elastic"]
+speeds_m_s = [15.0, 25.0]
+gusts = ["1cos:1:25"]
+"""
+GUST_COLUMNS = ("peak_du_m_s", "peak_dalpha_rad", "peak_dq_rad_s", "peak_dtheta_rad",
+                "peak_dn_z", "overshoot")
+
+
+def test_another_airframe_flies_its_gust_runs_as_the_gust_command(folder, monkeypatch,
+                                                                   capsys):
+    """JSBSim's SGS glider on its own airframe (runtime/other_airframe.py): the sweep's row
+    is the gust command's summary to the last bit (the same code path), and a speed outside
+    the aircraft's speed_range_m_s (20-28 m/s) is a failed row saying so."""
+    import json
+
+    (folder / "sgs_gust.toml").write_text(SGS_GUST, encoding="utf-8")
+    out = folder / "sgs_gust.csv"
+    code, _ = _sweep([folder / "sgs_gust.toml", "--out", out, "--workers", "1"], monkeypatch,
+                     capsys)
+    assert code == 0
+    rows = {float(r["speed_m_s"]): r for r in csv.DictReader(out.open(encoding="utf-8"))}
+    assert rows[15.0]["status"] == "failed" and "outside aircraft 'sgs_elastic'" in \
+        rows[15.0]["error"] and "20..28" in rows[15.0]["error"]
+    assert rows[25.0]["status"] == "ok"
+    assert cli.main(["gust", "--aircraft", "sgs_elastic", "--speed", "25", "--gust",
+                     "1cos:1:25", "--duration", "2", "--models", "coupled", "--json",
+                     "--no-log"]) == 0
+    summary = json.loads(capsys.readouterr().out)["summary"]["coupled"]
+    for col in GUST_COLUMNS:
+        assert float(rows[25.0][col]) == summary[col], col
+
+
+def test_an_aircraft_that_cannot_fly_is_refused_for_gust_runs(folder, monkeypatch, capsys):
+    """A copy of the SGS definition without its speeds cannot fly (flight_refusal's line);
+    with the linear metrics only it is swept."""
+    data = shipped_path("sgs_elastic").parent
+    text = (data / "sgs_elastic.toml").read_text(encoding="utf-8")
+    (folder / "sgs_elastic_modes.toml").write_text(
+        (data / "sgs_elastic_modes.toml").read_text(encoding="utf-8"), encoding="utf-8")
+    nospeed = text.replace("cruise_speed_m_s = 25.0\n", "").replace(
+        "speed_range_m_s = [20.0, 28.0]\n", "")
+    assert "cruise_speed_m_s" not in nospeed and "speed_range_m_s" not in nospeed
+    (folder / "nospeed.toml").write_text(nospeed, encoding="utf-8")
+    (folder / "c.toml").write_text(SGS_GUST.replace('["sgs_elastic"]', '["nospeed.toml"]'),
+                                   encoding="utf-8")
+    code, out = _sweep([folder / "c.toml", "--out", folder / "x.csv"], monkeypatch, capsys)
     assert code == 2
     err = out.err.strip().splitlines()
-    assert len(err) == 1 and "axes.aircraft[0]" in err[0] and "only the prototype" in err[0]
+    assert len(err) == 1 and "axes.aircraft[0]" in err[0] and "cruise_speed_m_s" in err[0]
     assert not (folder / "x.csv").exists()
+    linear = SGS_LINEAR.replace('["sgs_elastic", "bioflex_original"]', '["nospeed.toml"]')
+    assert _campaign(folder, linear).n_cases == 1

@@ -6,9 +6,12 @@ the wings of a sweep (pure: parsing, checks, identity).
 relative to the campaign file). Each is read and checked when the campaign is loaded, so a
 bad file is one line (exit 2) before any case runs:
 
-* with the ``gust`` metric, the aircraft must fly: the sweep's gust runs fly JSBSim's
-  generated prototype airframe (``sweep/evaluate.py``), so a definition on another airframe
-  is refused with the definition's own line (:meth:`Aircraft.flight_problem`);
+* with the ``gust`` metric, the aircraft must fly
+  (:func:`~bioflex_jsb.definition.flying.flight_refusal`, the line of ``gust --aircraft``):
+  the prototype's airframe with any wing, or another airframe on its own JSBSim aircraft
+  (``runtime.other_airframe.airframe_for``; a glider in its steady glide). A case whose
+  speed is outside the aircraft's ``speed_range_m_s`` is a failed row saying so (one
+  campaign may sweep aircraft of different speeds);
 * with the linear metrics only (``flutter``, ``eigenvalues``, ``coefficients``) any airframe
   the linear analyses take (:meth:`Aircraft.linear_problem`): its wing's model carries the
   airframe's mass, inertia and derivatives.
@@ -37,7 +40,7 @@ def aircraft_axis(values: list, base_dir: Path | None, metrics: tuple[str, ...])
     """The :class:`~bioflex_jsb.definition.aircraft.Aircraft` of ``values`` (the axis's
     list), each checked for the campaign's ``metrics`` (module docstring)."""
     from bioflex_jsb.definition.aircraft import load_aircraft
-    from bioflex_jsb.definition.airframe import GENERATED
+    from bioflex_jsb.definition.flying import flight_refusal
     from bioflex_jsb.errors import InputError
 
     out = []
@@ -58,10 +61,10 @@ def aircraft_axis(values: list, base_dir: Path | None, metrics: tuple[str, ...])
         except InputError as exc:  # the definition's one line, naming the field
             raise _fail(f"{key}: {exc}") from None
         if "gust" in metrics:
-            problem = aircraft.flight_problem()
-            if problem is None and aircraft.airframe.jsbsim != GENERATED:
-                problem = (f"aircraft {aircraft.name!r}: the sweep's gust runs fly the "
-                           f"generated prototype airframe {GENERATED!r}")
+            try:
+                problem = flight_refusal(aircraft)
+            except InputError as exc:  # its planform, in one line
+                problem = str(exc)
             if problem:
                 raise _fail(f"{key}: {problem}; with metrics from flutter, eigenvalues, "
                             "coefficients only (no gust runs) its linear analyses sweep")

@@ -70,11 +70,16 @@ def warm_worker() -> None:
     step_kernel.compile_now()
 
 
-def airframe():
-    """A freshly loaded JSBSim airframe (see the module docstring for why not reused)."""
-    from bioflex_jsb.runtime.fdm import Airframe
+def airframe(aircraft=None):
+    """A freshly loaded JSBSim airframe (see the module docstring for why not reused): the
+    prototype's, or the one ``aircraft`` (an Aircraft definition) flies on."""
+    if aircraft is None:
+        from bioflex_jsb.runtime.fdm import Airframe
 
-    return Airframe()
+        return Airframe()
+    from bioflex_jsb.runtime.other_airframe import airframe_for
+
+    return airframe_for(aircraft)
 
 
 def worker_name() -> str:
@@ -224,8 +229,18 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     from bioflex_jsb.simulation.results import gust_metrics
 
     s = case.settings
-    setup = RunSetup(case.speed_m_s, parse_gust(case.gust), s.duration_s, s.gust_start_s,
-                     dt_s=s.dt_s)
+    chord_m = build.model.airframe.reference.mean_chord_m  # the shortest gust: one chord
+    if case.aircraft is not None:
+        from bioflex_jsb.definition.flying import flight_speeds
+        from bioflex_jsb.errors import InputError
+
+        _cruise, (lo, hi) = flight_speeds(case.aircraft)
+        if not lo <= case.speed_m_s <= hi:  # a row: the campaign's speeds are shared
+            raise InputError(f"speed {case.speed_m_s:g} m/s is outside aircraft "
+                             f"{case.aircraft.name!r}'s flight speeds {lo:g}..{hi:g} m/s "
+                             "(airframe.speed_range_m_s)")
+    setup = RunSetup(case.speed_m_s, parse_gust(case.gust, chord_m), s.duration_s,
+                     s.gust_start_s, dt_s=s.dt_s)
     log = None
     recorder = None
     if log_dir:
@@ -240,7 +255,8 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     try:
         # the unsteady strips need the wing's build (its strips); the quasi-steady its model
         wing = build if s.aero == "unsteady" else build.model
-        run = run_gust(airframe(), wing, case.model, setup, recorder=recorder, aero=s.aero)
+        run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
+                       aero=s.aero)
     finally:
         if log is not None:
             log.close()
