@@ -102,6 +102,10 @@ def test_export_writes_a_copy_of_the_sgs_with_the_wing(exported):
                 "PITCH": "aero/moment/modal-pitch"}[axis]
         theirs = [f.get("name") for f in sgs.find(f"aerodynamics/axis[@name='{axis}']")]
         assert funcs == [mine, *theirs]
+    # JSBSim loads it without a warning (as it loads the package's SGS.xml)
+    from bioflex_jsb.runtime.fdm import Airframe
+
+    assert Airframe(root=root, aircraft=craft).warnings == []
     # no propeller column: the SGS has no engine
     assert all(not c.prop.startswith("propulsion/") for c in case.columns)
     # JSBSim's ci2vel chord is the file's 3.28 ft, the coefficients' c-bar the definition's
