@@ -406,3 +406,16 @@ def test_cli_run_takes_the_aircrafts_speeds(tmp_path, capsys):
         _run_with_aircraft(["--out", str(tmp_path / "b"), "--speed", "30"])
     assert "outside aircraft 'sgs_elastic''s speeds 20..28 m/s" in _one_line(exc)
     assert not (tmp_path / "b").exists()
+
+
+def test_the_generated_airframe_with_other_numbers_is_refused(tmp_path):
+    """A definition on the generated 'bioflex' airframe with another mass: the generated XML
+    holds the prototype's numbers, so its wing (the definition's) would not match it."""
+    text = (DATA / "bioflex_optimised.toml").read_text(encoding="utf-8")
+    assert "mass_kg = 2.5 " in text
+    path = tmp_path / "heavy.toml"
+    path.write_text(text.replace("mass_kg = 2.5 ", "mass_kg = 3.0 "), encoding="utf-8")
+    aircraft = load_aircraft(path)
+    with pytest.raises(DefinitionError) as exc:
+        N.aircraft_spec(aircraft, aircraft.wing())
+    assert "airframe.mass_kg = 3 differs from the prototype's 2.5" in _one_line(exc)

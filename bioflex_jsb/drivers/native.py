@@ -112,6 +112,9 @@ def aircraft_spec(aircraft, build, model: str = "coupled", dt_s: float = DEFAULT
                               f"{SEA_LEVEL_DENSITY_KG_M3:g} kg/m3")
     wing, variant = build.model, build.variant.name
     if a.jsbsim == GENERATED:
+        problem = aircraft.flight_problem()  # the generated XML holds the prototype's numbers
+        if problem:
+            raise DefinitionError(problem)
         return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho)
     craft = re.sub(r"[^A-Za-z0-9_-]+", "_", d.name)
     return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho, jsbsim_path=a.jsbsim_path,
