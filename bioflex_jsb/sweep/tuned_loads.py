@@ -86,8 +86,10 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
     executors' argument; the tuned gust writes no log."""
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.errors import InputError
+    from bioflex_jsb.flight_dynamics.wing_model import WingVariant
     from bioflex_jsb.loads import section_loads
-    from bioflex_jsb.runtime.fdm import Airframe, FdmError
+    from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.runtime.other_airframe import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
 
     row: dict[str, Any] = {"case_id": case.case_id, "index": case.index, "gust": case.gust}
@@ -97,8 +99,10 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
                          case.gust_start_s, 0.0, case.dt_s)
         elastic = case.trim == "elastic" and case.model != "rigid"
         # as api.fly_gust flies one model: the build for the elastic trim, else its model
-        run = run_gust(Airframe(), build if elastic else build.model, case.model, setup,
-                       trim_mode="elastic" if elastic else "rigid", loads=build)
+        aircraft = None if isinstance(case.wing, WingVariant) else case.wing
+        # the JSBSim airframe the wing's aircraft flies on (the prototype's for a variant)
+        run = run_gust(airframe_for(aircraft), build if elastic else build.model, case.model,
+                       setup, trim_mode="elastic" if elastic else "rigid", loads=build)
         loads = section_loads(build, run, case.stations, static=case.static)
     except (FdmError, InputError) as exc:  # the case's own problem, in one line
         return dict(row, status="failed", error=" ".join(str(exc).split()), loads=None)
