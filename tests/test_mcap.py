@@ -28,8 +28,9 @@ RUN_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", 
 # one message per step, a chunk of their own per block)
 LOG_GROUPS = RUN_GROUPS + ("loads",)
 # The 3-D scene (sinks/mcap/scene.py) in every gust log: the wing at SCENE_RATE_HZ, the rigid
-# parts once per chunk; not one message per step, so counted apart.
-SCENE_GROUPS = ("scene", "airframe")
+# parts once per chunk, the section-load markers at the wing's samples (scene_loads.py); not
+# one message per step, so counted apart.
+SCENE_GROUPS = ("scene", "airframe", "scene_loads")
 
 
 def per_step(counts: dict[str, int]) -> dict[str, int]:
@@ -96,8 +97,8 @@ def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
                                        gust="sharp:3", models=("coupled",), duration_s=1.0)
     assert "arguments" not in run and "argv" not in run
     # chunks close every CHUNK_SPAN_S of simulated time: what a SIGKILL can lose
-    # steps, then their scene, then their loads
-    assert info["chunks"] == 3 * math.ceil(1.0 / sink.CHUNK_SPAN_S)
+    # steps, then their scene, then their loads, then the loads' markers in the scene
+    assert info["chunks"] == 4 * math.ceil(1.0 / sink.CHUNK_SPAN_S)
 
 
 def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
@@ -227,7 +228,7 @@ def test_pymcap_cli_doctor(gust_log):
 def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     assert main(["info", str(gust_log), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["messages"] == step_messages(gust_log) + 60 + 2  # + the scene's
+    assert info["messages"] == step_messages(gust_log) + 60 + 2 + 60  # + the scene's, markers
     assert step_messages(gust_log) == STEPS_1S * len(LOG_GROUPS)
     png = tmp_path / "run.png"
     assert main(["plot", str(gust_log), "--out", str(png)]) == 0
