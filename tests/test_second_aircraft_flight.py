@@ -192,3 +192,20 @@ def test_a_glider_without_its_speeds_is_analysed_not_flown(tmp_path, capsys):
     definition.write_text(bad + "\n", encoding="utf-8")
     code, _, err = run_cli(capsys, "gust", "--aircraft", str(definition), "--no-log")
     assert_one_line_error(code, err, "airframe.speed_range_m_s: must be [low, high] m/s")
+
+
+def test_the_gliders_log_records_its_aircraft_without_the_prototypes_scene(tmp_path, capsys):
+    """``gust --out``: the log's run description names the definition (``extra.aircraft``);
+    the 3-D scene (the prototype's fuselage and planform, sinks/mcap/scene.py) is left out
+    rather than drawn with the prototype's wing."""
+    from bioflex_jsb.sinks import mcap as sink
+
+    out = tmp_path / "sgs.mcap"
+    code, _, _ = run_cli(capsys, "gust", "--aircraft", "sgs_elastic", "--gust", "1cos:1:25",
+                         "--duration", "1", "--out", str(out), "--json")
+    assert code == 0
+    summary = sink.summarise(out)
+    d = sink.description_from_metadata(summary["metadata"]["bioflex.run"])
+    assert d.speed_m_s == 25.0 and d.extra["aircraft"].endswith("sgs_elastic.toml")
+    topics = set(sink.messages_by_topic(out))
+    assert "/bioflex/coupled/scene" not in topics and any("coupled" in t for t in topics)

@@ -28,6 +28,19 @@ LINEAR_COMMANDS = ("modes", "flutter")
 FLIGHT_COMMANDS = ("gust", "compare")
 
 
+class CruiseSpeed(float):
+    """The ``--speed`` default of the flight commands [m/s]: the prototype's cruise speed
+    (Table 1, 15 m/s: cli/case.py DEFAULT_SPEED_M_S) marked as not given, so that an
+    ``--aircraft``'s own cruise speed replaces it (:func:`resolve_flight`)."""
+
+
+def cruise_speed_default() -> CruiseSpeed:
+    """The marked default of ``--speed`` (:class:`CruiseSpeed`)."""
+    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S
+
+    return CruiseSpeed(DEFAULT_SPEED_M_S)
+
+
 class _ShippedOrFile(tuple):
     """The option's choices: it lists the shipped aircraft (for help and for tools that
     enumerate choices) and admits any text, a definition file's path being checked when it
@@ -123,8 +136,9 @@ def wing_from_aircraft(args: argparse.Namespace):
 
 def resolve_flight(args: argparse.Namespace) -> None:
     """The trim speed and gust of a flight command from the aircraft (``--aircraft``, else
-    the prototype): ``--speed`` not given is the aircraft's cruise speed (the prototype's
-    15 m/s, Table 1), a given one must lie in its ``airframe.speed_range_m_s`` (the
+    the prototype): ``--speed`` not given (None or the marked :class:`CruiseSpeed`
+    default) is the aircraft's cruise speed (the prototype's 15 m/s, Table 1), a given one
+    must lie in its ``airframe.speed_range_m_s`` (the
     prototype's 5-40 m/s: the option's own check), and a 1-cos length or turbulence scale
     must be at least the aircraft's mean chord (simulation/gusts.py). One line (a
     UsageError, exit 2) otherwise."""
@@ -137,8 +151,8 @@ def resolve_flight(args: argparse.Namespace) -> None:
         cruise, speeds, chord = DEFAULT_SPEED_M_S, None, None
     else:
         (cruise, speeds), chord = flight_speeds(aircraft), aircraft.airframe.mean_chord_m
-    if args.speed is None:
-        args.speed = cruise
+    if args.speed is None or isinstance(args.speed, CruiseSpeed):
+        args.speed = float(cruise)
     elif speeds is not None and not speeds[0] <= args.speed <= speeds[1]:
         raise UsageError(f"--speed {args.speed:g} m/s is outside aircraft {aircraft.name!r}'s "
                          f"speeds {speeds[0]:g}..{speeds[1]:g} m/s (its airframe."

@@ -67,7 +67,9 @@ gust_type.plain_numbers = True  # type: ignore[attr-defined]  # parse_gust reads
 
 
 def add_run_arguments(p: argparse.ArgumentParser, default_gust: str = DEFAULT_GUST) -> None:
-    p.add_argument("--speed", type=airspeed, default=None, metavar="V",
+    from bioflex_jsb.cli.aircraft_option import cruise_speed_default
+
+    p.add_argument("--speed", type=airspeed, default=cruise_speed_default(), metavar="V",
                    help="trim " + speed_help(extra="; with --aircraft: within its airframe."
                                              "speed_range_m_s, default its cruise_speed_m_s"))
     p.add_argument("--gust", type=gust_type, default=gust_type(default_gust),
@@ -210,6 +212,9 @@ def run_description(args, kind: str, models):
         extra["structural_damping"] = args.structural_damping
     if getattr(args, "trim", "rigid") != "rigid":
         extra["trim"] = args.trim
+    aircraft = getattr(args, "aircraft_definition", None)
+    if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
+        extra["aircraft"] = str(aircraft.definition.path or aircraft.name)
     return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
                           gust=args.gust.text(), models=tuple(models),
                           duration_s=args.duration, gust_start_s=args.gust_start,
@@ -224,12 +229,17 @@ SCENE_EXAGGERATION = 1.0
 def open_log(path: str, description, build):
     """The MCAP log of the run ``description`` with the wing ``build`` (its variant and
     overrides as plain data); a file that cannot be written is a one-line UsageError."""
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
     from bioflex_jsb.sinks.mcap import LogWriteError, RunLog
 
+    # the 3-D scene's mesh is the prototype's (its fuselage and planform: sinks/mcap/scene.py
+    # builds the wing from the variant on the prototype's planform): another aircraft's log
+    # has no scene
+    scene = SCENE_EXAGGERATION if build.airframe is PROTOTYPE_AIRFRAME else None
     try:
         return RunLog.open(path, description, wing_variant=build.variant.as_dict(),
                            overrides=dict(build.model.coefficients.overrides),
-                           scene=SCENE_EXAGGERATION)
+                           scene=scene)
     except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 

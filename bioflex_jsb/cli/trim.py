@@ -67,7 +67,10 @@ def register(sub) -> None:
 
     p = sub.add_parser("trim", help="level-flight trim of the JSBSim airframe", description=HELP)
     add_flight_condition_arguments(p)
-    p.set_defaults(speed=None)  # DEFAULT_SPEED_M_S, or an aircraft definition's cruise speed
+    from bioflex_jsb.cli.aircraft_option import cruise_speed_default
+
+    # DEFAULT_SPEED_M_S, marked: an aircraft definition's cruise speed replaces it
+    p.set_defaults(speed=cruise_speed_default())
     p.add_argument("--wing", default=None, metavar="NAME|FILE.toml",
                    help=f"also the elastic trim of this wing: {', '.join(VARIANTS)}, or a "
                    "variant file (default: the rigid trim only)")
@@ -135,8 +138,7 @@ def run(args: argparse.Namespace) -> int:
     aircraft = _definition(args)
     if aircraft is None:
         airframe = load_airframe(args)
-        if args.speed is None:
-            args.speed = DEFAULT_SPEED_M_S
+        args.speed = float(args.speed)
     else:
         from bioflex_jsb.cli.aircraft_option import resolve_flight
         from bioflex_jsb.runtime.fdm import FdmError
