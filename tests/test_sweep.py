@@ -331,6 +331,16 @@ def test_lti_only_campaign_and_per_case_logs(tmp_path, monkeypatch, capsys):
     (row,) = read_results(tmp_path / "one.csv")
     log = logs / f"{row['case_id']}.mcap"
     assert log.is_file() and log.read_bytes()[:8] == b"\x89MCAP0\r\n"
+    # the case's log has the 3-D scene of a gust run, at the gust command's exaggeration
+    from mcap.reader import make_reader
+
+    from bioflex_jsb.cli.gust import SCENE_EXAGGERATION
+    from bioflex_jsb.sweep.evaluate import SCENE_EXAGGERATION as SWEEP_SCENE
+
+    assert SWEEP_SCENE == SCENE_EXAGGERATION
+    with open(log, "rb") as f:
+        topics = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    assert f"/bioflex/{row['model']}/scene" in topics, sorted(topics)
 
 
 # ------------------------------------------------------------------ unsteady strips, reuse

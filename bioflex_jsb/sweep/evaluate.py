@@ -52,6 +52,10 @@ _EIGEN_CACHE: dict[tuple, Any] = {}
 _AIRCRAFT_BUILDS: dict[tuple, Any] = {}  # an aircraft's wing (its own airframe's model)
 # What a case imports beyond the executors' preload (measured: a first case imported these
 # and numba, 1-2 s under load): imported, and the step kernel loaded, once per worker.
+# A case's log has the 3-D scene a gust run's has (sinks/mcap/scene.py), at the same
+# exaggeration as the gust command's (cli/gust.py SCENE_EXAGGERATION: true scale; a test
+# holds the two equal; the sweep does not import the CLI).
+SCENE_EXAGGERATION = 1.0
 WARM_MODULES = ("bioflex_jsb.flight_dynamics.eigen", "bioflex_jsb.flight_dynamics.flutter_engine",
                 "bioflex_jsb.flight_dynamics.wing_model", "bioflex_jsb.structures.wing_model",
                 "bioflex_jsb.simulation.results", "bioflex_jsb.drivers.gust")
@@ -249,7 +253,8 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         Path(log_dir).mkdir(parents=True, exist_ok=True)
         log = RunLog.open(Path(log_dir) / f"{case.case_id}.mcap", case_description(case),
                           wing_variant=build.variant.as_dict(),
-                          overrides=dict(build.model.coefficients.overrides))
+                          overrides=dict(build.model.coefficients.overrides),
+                          scene=SCENE_EXAGGERATION)
         recorder = log.recorder(case.model)
 
     try:
