@@ -141,16 +141,16 @@ def _figure(all_slope, group_slopes, reason=None):
 
 
 def test_ratio_is_of_the_slopes_group_by_group_and_refuses_untrusted_figures():
-    a = _figure(2.4e-5, (2e-5, 3e-5, 2.5e-5))
+    a = _figure(2.4e-5, (2.2e-5, 2.6e-5, 2.5e-5))
     b = _figure(1e-5, (1e-5, 1e-5, 1e-5))
     r = ratio(a, b)
     assert r["value"] == pytest.approx(2.4)
-    assert (r["min"], r["median"], r["max"]) == pytest.approx((2.0, 2.5, 3.0))
+    assert (r["min"], r["median"], r["max"]) == pytest.approx((2.2, 2.5, 2.6))
     fail = PerStep(None, -1e-6, 0.0, 0.0, "does not grow")
     one_bad = Figure(b.all, (b.groups[0], fail, b.groups[2]))
     r = ratio(a, one_bad)  # two groups of three trusted in both: the spread is theirs
     assert r["trusted"] and r["value"] == pytest.approx(2.4)
-    assert (r["min"], r["max"]) == pytest.approx((2.0, 2.5))
+    assert (r["min"], r["max"]) == pytest.approx((2.2, 2.5))
     assert one_bad.as_dict()["groups_trusted"] == 2
     other_bad = Figure(a.all, (fail, a.groups[1], a.groups[2]))
     r = ratio(other_bad, one_bad)  # only group 3 is trusted in both
@@ -159,6 +159,22 @@ def test_ratio_is_of_the_slopes_group_by_group_and_refuses_untrusted_figures():
     two_bad = Figure(b.all, (fail, fail, b.groups[2]))
     assert "1 of 3 groups trusted" in two_bad.reason and two_bad.as_dict()["value"] is None
     assert ratio(a, two_bad)["reason"] == two_bad.reason
+
+
+def test_a_figure_or_ratio_that_its_estimates_do_not_reproduce_is_refused():
+    """Without a third of the repeats the estimate may move by 20 % (MAX_SPREAD), no more;
+    and no ratio of bench is below 1 (the co-simulation is JSBSim's step and more)."""
+    wide = _figure(10e-6, (10e-6, 12.5e-6, 10.5e-6))
+    assert "not reproducible" in wide.reason and wide.as_dict()["value"] is None
+    assert _figure(10e-6, (10e-6, 11.9e-6, 10.5e-6)).reason is None
+    fast = _figure(8e-6, (8e-6, 8.2e-6, 8.1e-6))
+    slow = _figure(9e-6, (9e-6, 9.5e-6, 9.2e-6))
+    r = ratio(fast, slow)
+    assert r["value"] is None and "below 1" in r["reason"]
+    assert ratio(fast, slow, floor=None)["value"] == pytest.approx(8 / 9)
+    swing = ratio(_figure(14e-6, (14e-6, 16e-6, 14.5e-6)), _figure(10e-6, (10e-6, 8.5e-6,
+                                                                             10.2e-6)))
+    assert swing["value"] is None and "not reproducible" in swing["reason"]  # 16/8.5: +34 %
 
 
 def test_a_difference_within_the_groups_spread_is_not_resolved_never_negative():
@@ -200,9 +216,9 @@ def test_short_runs_find_the_fast_state_that_long_runs_mix():
     defaults (runs of 1200-4800 steps, 8-34 ms at 7 µs/step, 5 repeats; on the real
     machine, quiet, a residual of 11 %) mix the states in their long runs and come out
     biased high; the defaults now (300-1200 steps, 12 repeats) give the fast state's cost.
-    Measured over these 200 seeds: old 0 untrusted, bias 15 % at the 95th percentile
-    (worst 25 %); new 0 untrusted, bias 0 at the 95th percentile and worst (every least
-    time a fast run): the bounds below leave margin on both sides."""
+    Measured over these 200 seeds: old 20 untrusted, bias 16 % at the 95th percentile
+    (worst 25 %); new 6 untrusted (estimates 20 % apart), bias 0 at the 95th percentile
+    and worst (every least time a fast run): the bounds below leave margin on both sides."""
     old = [1200 * f for f in LENGTH_FACTORS]
     new = [DEFAULT_STEPS * f for f in LENGTH_FACTORS]
     untrusted = {"old": 0, "new": 0}
@@ -218,7 +234,7 @@ def test_short_runs_find_the_fast_state_that_long_runs_mix():
                 bias[name].append(abs(f.all.slope_s / 7e-6 - 1.0))
     p95 = {k: float(np.percentile(v, 95)) for k, v in bias.items()}
     assert p95["old"] > 0.08, (untrusted, p95)
-    assert untrusted["new"] <= 10 and p95["new"] < 0.03, (untrusted, p95)
+    assert untrusted["new"] <= 15 and p95["new"] < 0.03, (untrusted, p95)
 
 
 def test_each_figures_spread_is_the_estimate_without_each_interleaved_group():
@@ -228,17 +244,17 @@ def test_each_figures_spread_is_the_estimate_without_each_interleaved_group():
     rng = np.random.default_rng(3)
     times = synthetic(10e-6, 1e-3, 12, rng, jitter=0.002)
     fast = np.arange(12) % GROUPS == 0
-    times[~fast] *= 1.2
+    times[~fast] *= 1.15
     f = estimate_figure(LENGTHS, times)
     assert len(f.groups) == GROUPS and f.reason is None
     assert f.all.slope_s == pytest.approx(10e-6, rel=0.02)
     slopes = f.slopes()
-    assert slopes[0] == pytest.approx(12e-6, rel=0.02)  # without the fast group
+    assert slopes[0] == pytest.approx(11.5e-6, rel=0.02)  # without the fast group
     assert slopes[1] == pytest.approx(10e-6, rel=0.02) and slopes[2] == pytest.approx(
         10e-6, rel=0.02)
     d = f.as_dict()
     assert d["value"] == pytest.approx(10.0, rel=0.02)
-    assert (d["median"], d["max"]) == pytest.approx((10.0, 12.0), rel=0.02)
+    assert (d["median"], d["max"]) == pytest.approx((10.0, 11.5), rel=0.02)
     assert d["groups"] == GROUPS
     assert len(estimate_figure(LENGTHS, times[:2]).groups) == 2  # fewer repeats than groups
     one = estimate_figure(LENGTHS, times[:1])  # one repeat: its own estimate, once
