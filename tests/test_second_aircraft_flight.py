@@ -209,3 +209,19 @@ def test_the_gliders_log_records_its_aircraft_without_the_prototypes_scene(tmp_p
     assert d.speed_m_s == 25.0 and d.extra["aircraft"].endswith("sgs_elastic.toml")
     topics = set(sink.messages_by_topic(out))
     assert "/bioflex/coupled/scene" not in topics and any("coupled" in t for t in topics)
+
+
+def test_a_wing_is_flown_on_its_own_aircrafts_airframe_only(sgs):
+    """The SGS wing on the prototype's JSBSim airframe, or the prototype's wing on SGS.xml:
+    a caller's mix-up, one line (InputError), before anything flies."""
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.runtime.fdm import Airframe
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    setup = RunSetup(25.0, parse_gust("none"), 0.1)
+    with pytest.raises(InputError, match="built for aircraft 'sgs_elastic'"):
+        run_gust(Airframe(), sgs.wing().model, "coupled", setup)
+    proto = api.load_aircraft("bioflex_optimised").wing().model
+    with pytest.raises(InputError, match="the JSBSim airframe is 'sgs_elastic'"):
+        run_gust(airframe_for(sgs), proto, "coupled", setup)

@@ -229,6 +229,7 @@ class CoupledStep:
             nodes["throttle"] = _NO_THROTTLE
         # the aircraft's own data (S, c̄, derivatives): its wing model's AirframeData
         self.airframe_data = PROTOTYPE_AIRFRAME if wing is None else wing.airframe
+        _check_pair(airframe, self.airframe_data)
         self.alpha_range_rad = airframe.alpha_table_range_rad
         self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
         self._read = state_reader(self.get)
@@ -554,6 +555,19 @@ def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitu
                            tol_rad=ELASTIC_TRIM_TOL_RAD)
     jsbsim_trim(elastic.loads)  # leave the airframe trimmed with the final loads
     return state["trim"], elastic
+
+
+def _check_pair(airframe: Airframe, data) -> None:
+    """The JSBSim airframe and the wing's aircraft are one aircraft: the generated prototype
+    with the prototype's :class:`AirframeData`, a definition's JSBSim aircraft
+    (``airframe.definition_name``, runtime/other_airframe.py) with that definition's; else
+    InputError, one line (a wing's loads are in its aircraft's S, c̄)."""
+    mine = getattr(airframe, "definition_name", None)
+    if (mine is None) != (data is PROTOTYPE_AIRFRAME) or (mine is not None
+                                                          and mine != data.name):
+        raise InputError(f"the wing is built for aircraft {data.name!r}, the JSBSim airframe "
+                         f"is {mine or airframe.aircraft!r}: fly a wing on its own aircraft's "
+                         "airframe (runtime/other_airframe.py airframe_for)")
 
 
 class _ZeroNode:

@@ -177,15 +177,20 @@ def glide_trim(fdm, speed_m_s: float) -> int:
                     f"udot {r[0]:.1e} ft/s2, wdot {r[1]:.1e} ft/s2, qdot {r[2]:.1e} rad/s2)")
 
 
-def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airframe_class):
+def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airframe_class,
+                       definition_name: str | None = None):
     """An ``airframe_class`` (:class:`~bioflex_jsb.runtime.fdm.Airframe`) of another
     aircraft (``<dir>/<name>.xml``: a jsbsim package aircraft or a user's) with the modal
     wing's hooks at ``cg_m`` [m, structural frame], loaded from a copy
-    (:func:`derived_root`, kept while the airframe lives), its α range from its tables."""
+    (:func:`derived_root`, kept while the airframe lives), its α range from its tables;
+    ``definition_name``: the aircraft definition it flies (the name of the
+    :class:`~bioflex_jsb.parameters.airframe.AirframeData` its wing carries: the coupled
+    step checks the pair)."""
     work, name = derived_root(jsbsim_path, cg_m)
     airframe = airframe_class(work.name, name)
     airframe._workdir = work
     airframe.alpha_table_range_rad = alpha_table_range_rad(jsbsim_path)
+    airframe.definition_name = definition_name
     return airframe
 
 
@@ -199,7 +204,8 @@ def airframe_for(aircraft=None, root=None):
 
     if aircraft is None or not aircraft.airframe.jsbsim_path:
         return Airframe(root)
-    return airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m, Airframe)
+    return airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m, Airframe,
+                              aircraft.name)
 
 
 # Central-difference steps of the glider's A_RR (:func:`rigid_jacobian`): 0.01 m/s of
