@@ -107,3 +107,23 @@ def test_the_modes_layout_names_what_the_animation_holds(animated):
     assert three["followTf"] == sink.body_frame(scene_modes.MODEL)
     assert set(three["topics"]) <= have
     assert layout["configById"]["RosOut!bioflexmodesevents"]["topicToRender"] in have
+
+
+def test_a_bending_mode_is_scaled_on_its_tip_heave():
+    """A sailplane's first mode bends without twisting: scaled on its tip heave (up at phase
+    0, PEAK_TIP_HEAVE_FRAC of the semispan in the animation), not refused; the sheet's
+    shapes then equal the beam's mode per unit amplitude."""
+    build = api.load_aircraft("sgs_elastic").wing()
+    shapes = scene_modes.mode_shapes(build, 25.0)
+    first = shapes[0]
+    assert first.kind == "structural"
+    tip_heave_up_m = -complex(build.modes.bending_m[:, -1] @ first.eta)
+    semispan_m = float(build.modes.stations_m[-1])
+    # animated at PEAK_TIP_TWIST_RAD x eta: the tip rises by the heave fraction of the span
+    animated_m = scene_modes.PEAK_TIP_TWIST_RAD * tip_heave_up_m
+    assert animated_m.real == pytest.approx(scene_modes.PEAK_TIP_HEAVE_FRAC * semispan_m,
+                                            rel=1e-12)
+    assert abs(animated_m.imag) < 1e-12
+    # a twist mode keeps the unit tip twist
+    twisting = next(s for s in shapes[:3] if abs(build.modes.twist_rad[:, -1] @ s.eta) > 0.5)
+    assert complex(build.modes.twist_rad[:, -1] @ twisting.eta) == pytest.approx(1.0, abs=1e-12)

@@ -6,12 +6,15 @@ coordinate each) and the aeroelastic modes of the coupled model (the paper's Eq.
 speed (``aeroelastic_1`` …, labels tracked from 2 m/s by :func:`~bioflex_jsb.flight_dynamics.
 eigen.track`; their η part of the eigenvector, complex: the sections need not move in phase).
 Each shape is scaled so that the starboard tip twists by 1 rad per unit amplitude at phase 0
-(its largest tip twist when the others lag). In the animation every mode oscillates at
-:data:`DISPLAY_PERIOD_S` (the real 20-110 Hz cannot be watched) for :data:`CYCLES` cycles
-with a peak tip twist of :data:`PEAK_TIP_TWIST_RAD`, undamped; its label (a text in the
-scene and an event) gives the real frequency and damping ratio. The scene is
-:mod:`.scene`'s (model ``modes``: topics ``/bioflex/modes/scene`` and ``/airframe``, frame
-``modes_body``, a fixed ``pose`` at the world origin).
+(its largest tip twist when the others lag); a mode that would reach a tip heave of
+:data:`PEAK_TIP_HEAVE_FRAC` of the semispan first (a bending mode) is scaled on its tip heave
+instead, so that the animation shows it at that heave. In the animation every mode
+oscillates at :data:`DISPLAY_PERIOD_S` (the real 20-110 Hz cannot be watched) for
+:data:`CYCLES` cycles with a peak tip twist of :data:`PEAK_TIP_TWIST_RAD` (or tip heave, as
+above), undamped; its label (a text in the scene and an event) gives the real frequency and
+damping ratio. The scene is :mod:`.scene`'s (model ``modes``: topics
+``/bioflex/modes/scene`` and ``/airframe``, frame ``modes_body``, a fixed ``pose`` at the
+world origin).
 """
 
 from __future__ import annotations
@@ -59,6 +62,8 @@ DISPLAY_PERIOD_S = 1.0
 CYCLES = 3
 FRAME_RATE_HZ = 60.0
 PEAK_TIP_TWIST_RAD = math.radians(10.0)
+# a bending mode's peak tip heave in the animation [fraction of the semispan]
+PEAK_TIP_HEAVE_FRAC = 0.05
 
 
 @dataclass(frozen=True)
@@ -90,10 +95,20 @@ class ModeShape:
 
 
 def _unit_tip_twist(build, eta: np.ndarray) -> np.ndarray:
-    tip = complex(np.asarray(build.modes.twist_rad, dtype=float)[:, -1] @ eta)
-    if abs(tip) < 1e-12:
-        raise ValueError("a mode without tip twist cannot be scaled on it")
-    return eta / tip
+    """``eta`` scaled to its display amplitude: tip twist 1 rad at phase 0, or, for a mode
+    that reaches :data:`PEAK_TIP_HEAVE_FRAC` of the semispan in tip heave before
+    :data:`PEAK_TIP_TWIST_RAD` in tip twist (a bending mode: a sailplane's first), the tip
+    heave (up) of that fraction × 1 rad / PEAK_TIP_TWIST_RAD at phase 0; the animation then
+    multiplies by PEAK_TIP_TWIST_RAD."""
+    twist = complex(np.asarray(build.modes.twist_rad, dtype=float)[:, -1] @ eta)
+    heave = complex(np.asarray(build.modes.bending_m, dtype=float)[:, -1] @ eta)
+    heave_ref_m = PEAK_TIP_HEAVE_FRAC * float(build.modes.stations_m[-1])
+    if abs(twist) / PEAK_TIP_TWIST_RAD >= abs(heave) / heave_ref_m:
+        if abs(twist) < 1e-12:
+            raise ValueError("a mode without tip twist or tip heave cannot be scaled")
+        return eta / twist
+    # bending_m is positive down: the tip goes up at phase 0
+    return eta / (-heave * PEAK_TIP_TWIST_RAD / heave_ref_m)
 
 
 def mode_shapes(build, speed_m_s: float) -> list[ModeShape]:
@@ -115,7 +130,8 @@ def mode_shapes(build, speed_m_s: float) -> list[ModeShape]:
     grid = eigen.sweep_grid([speed_m_s])
     sweep = eigen.track("coupled", grid, build.model)
     k = int(np.flatnonzero(grid == speed_m_s)[0])
-    states = build_state_space("coupled", level_flight_condition(speed_m_s), build.model).states
+    condition = level_flight_condition(speed_m_s, airframe=build.model.airframe)
+    states = build_state_space("coupled", condition, build.model).states
     rows = [states.index(f"eta{i + 1}") for i in range(n)]
     for label in dict.fromkeys(lab for lab in sweep.labels if lab.startswith("aeroelastic")):
         cols = [j for j, lab in enumerate(sweep.labels) if lab == label]
@@ -151,7 +167,9 @@ def write_animation(path: str | Path, build, speed_m_s: float,
         try:
             meta = scene_metadata(mesh, FRAME_RATE_HZ)
             meta["display"] = (f"each mode for {CYCLES} cycles at {DISPLAY_PERIOD_S:g} s a "
-                               f"cycle, peak tip twist {math.degrees(PEAK_TIP_TWIST_RAD):g} deg")
+                               f"cycle, peak tip twist {math.degrees(PEAK_TIP_TWIST_RAD):g} "
+                               f"deg or tip heave {PEAK_TIP_HEAVE_FRAC:.0%} of the semispan, "
+                               "whichever comes first")
             w.add_metadata(SCENE_METADATA, meta)
             w.add_metadata(MODES_METADATA, {
                 "wing": build.variant.name, "speed_m_s": repr(float(speed_m_s)),
@@ -197,8 +215,9 @@ def write_animation(path: str | Path, build, speed_m_s: float,
 def draw_mode_sheet(path: str | Path, build, speed_m_s: float,
                     shapes: list[ModeShape] | None = None, software: str = "") -> Path:
     """A sheet of the shapes: per mode the section twist θ(y) and the elastic axis's
-    bending w(y) (up) along the half span per unit tip twist (real part solid, imaginary
-    part dotted: the share a quarter period behind), titled with frequency and damping."""
+    bending w(y) (up) along the half span per unit amplitude (tip twist 1 rad, or for a
+    bending mode the tip heave of the module docstring; real part solid, imaginary part
+    dotted: the share a quarter period behind), titled with frequency and damping."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -225,12 +244,12 @@ def draw_mode_sheet(path: str | Path, build, speed_m_s: float,
                 ax.plot(y, twist.imag, color="C0", lw=1.2, ls=":", label="twist θ (imag.)")
             ax.axhline(0.0, color="0.6", lw=0.6)
             ax.set_ylim(-1.15, 1.15)
-            ax.set_ylabel("twist per unit tip twist [rad/rad]" if c == 0 else "")
+            ax.set_ylabel("twist per unit amplitude [rad]" if c == 0 else "")
             bx = ax.twinx()
             bx.plot(y, heave_mm.real, color="C3", lw=1.5, ls="--", label="bending w, up")
             lim = max(1e-3, 1.15 * np.abs(heave_mm).max())
             bx.set_ylim(-lim, lim)
-            bx.set_ylabel("bending up [mm/rad of tip twist]" if c == cols - 1 else "",
+            bx.set_ylabel("bending up per unit amplitude [mm]" if c == cols - 1 else "",
                           color="C3")
             bx.tick_params(axis="y", colors="C3")
             title = s.label(speed_m_s).replace(": ", ":\n", 1)
