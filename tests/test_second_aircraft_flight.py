@@ -88,7 +88,7 @@ def test_the_nonlinear_glide_against_the_lti_model(sgs):
     drift added to the prediction: drivers/compare.py). A 0.05 m/s 1-cos gust over 25 m:
     NRMSE α 0.0070, q 0.0094, θ 0.0042, η1 0.0205, u 0.078 (measured); bars about 2.5 ×
     those: the trim's α 1.96° sits 0.04° below the 2° point of SGS.xml's CLwbh table, whose
-    slope falls there from 4.57 to 4.0 /rad, so the linear model is exact only below it.
+    slope falls there from 4.60 to 4.0 /rad, so the linear model is exact only below it.
     A 0.5 m/s gust crosses that point: α 0.044, q 0.17 (the tables', not the wing's, limit)."""
     result = api.compare(sgs, gust="1cos:0.05:25", model="coupled", duration_s=8.0)
     assert not result.diverged and result.linear.meta["drift"]
@@ -225,3 +225,37 @@ def test_a_wing_is_flown_on_its_own_aircrafts_airframe_only(sgs):
     proto = api.load_aircraft("bioflex_optimised").wing().model
     with pytest.raises(InputError, match="the JSBSim airframe is 'sgs_elastic'"):
         run_gust(airframe_for(sgs), proto, "coupled", setup)
+
+
+def test_the_glide_linearisation_against_sgs_xml_by_hand(sgs):
+    """The glider's A_RR (runtime/other_airframe.py rigid_jacobian; JSBSim's FGLinearization
+    needs an engine) entry by entry against SGS.xml's coefficients at the 25 m/s glide:
+    Z_α = −(C_Lα + C_D) Q S/(m V) with the table's local slopes (CLwbh 4.60, CDwbh 0.287
+    /rad between 1° and 2°); M_q + M_α̇ = (C_mq + C_mα̇) Q S c̄²/(2 V I_yy); M_α + M_α̇ Z_α
+    with M_α = (C_mα Q S c̄ − h ∂F_x/∂α)/I_yy, the body-x force's change with α acting at
+    the AERORP h = 12 in above the CG. Measured 1.4e-8, 1.3e-11, 1.0e-8 relative (the
+    central differences lie inside one table interval: exact but for rounding); bar 1e-6.
+    X_θ = −g cos γ: 4.1e-5 (JSBSim's gravity at 45°, 9.8062 m/s²); bar 1e-4."""
+    airframe = airframe_for(sgs)
+    lin = airframe.linearize(25.0)
+    a, trim = lin.a, lin.trim
+    rho = airframe["atmosphere/rho-slugs_ft3"] * 515.3788184  # slug/ft^3 -> kg/m^3
+    s, c = AREA_FT2 * 0.3048**2, 3.28 * 0.3048
+    m, iyy = WEIGHT_LB * 0.45359237, 672.0 * 1.3558179483314  # SGS.xml iyy 672 slug ft^2
+    q_s = 0.5 * rho * 25.0**2 * s
+    alpha = trim.alpha_rad
+    cla = (CL_ROWS[2] - CL_ROWS[1]) / (ALPHA_ROWS[2] - ALPHA_ROWS[1])
+    cda = (CD_ROWS[2] - CD_ROWS[1]) / (ALPHA_ROWS[2] - ALPHA_ROWS[1])
+    cl = CL_ROWS[1] + cla * (alpha - ALPHA_ROWS[1]) + CL_DE * trim.elevator_rad
+    cd = CD0 + CD_ROWS[1] + cda * (alpha - ALPHA_ROWS[1])
+    z_alpha = -(cla + cd) * q_s / (m * 25.0)
+    rate = q_s * c * c / (2.0 * 25.0 * iyy)
+    m_q, m_alphadot = -9.0 * rate, -5.2 * rate  # Cmq, Cmadot
+    dfx = q_s * (cl * math.cos(alpha) + cla * math.sin(alpha) - cda * math.cos(alpha)
+                 + cd * math.sin(alpha))
+    m_alpha = (-0.573 * q_s * c - 12 * 0.0254 * dfx) / iyy  # Cmalpha; AERORP z 12 in
+    assert a[1, 1] == pytest.approx(z_alpha, rel=1e-6)
+    assert a[2, 2] == pytest.approx(m_q + m_alphadot, rel=1e-6)
+    assert a[2, 1] == pytest.approx(m_alpha + m_alphadot * z_alpha, rel=1e-6)
+    assert a[0, 3] == pytest.approx(-9.80665 * math.cos(trim.flight_path_rad), rel=1e-4)
+    assert lin.residualised_states == () and lin.trim.flight_path_rad < 0.0
