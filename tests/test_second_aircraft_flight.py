@@ -194,10 +194,9 @@ def test_a_glider_without_its_speeds_is_analysed_not_flown(tmp_path, capsys):
     assert_one_line_error(code, err, "airframe.speed_range_m_s: must be [low, high] m/s")
 
 
-def test_the_gliders_log_records_its_aircraft_without_the_prototypes_scene(tmp_path, capsys):
-    """``gust --out``: the log's run description names the definition (``extra.aircraft``);
-    the 3-D scene (the prototype's fuselage and planform, sinks/mcap/scene.py) is left out
-    rather than drawn with the prototype's wing."""
+def test_the_gliders_log_records_its_aircraft(tmp_path, capsys):
+    """``gust --out``: the log's run description names the definition (``extra.aircraft``)
+    and every step of every model is in it (the 3-D scene is sinks/mcap/scene.py's)."""
     from bioflex_jsb.sinks import mcap as sink
 
     out = tmp_path / "sgs.mcap"
@@ -207,8 +206,10 @@ def test_the_gliders_log_records_its_aircraft_without_the_prototypes_scene(tmp_p
     summary = sink.summarise(out)
     d = sink.description_from_metadata(summary["metadata"]["bioflex.run"])
     assert d.speed_m_s == 25.0 and d.extra["aircraft"].endswith("sgs_elastic.toml")
-    topics = set(sink.messages_by_topic(out))
-    assert "/bioflex/coupled/scene" not in topics and any("coupled" in t for t in topics)
+    counts = {c["topic"]: c["messages"] for c in summary["channels"]}
+    steps = round(1.0 / DEFAULT_DT_S)
+    for model in ("rigid", "coupled", "qsd"):
+        assert counts[f"/bioflex/{model}/rigid_body"] == steps, counts
 
 
 def test_a_wing_is_flown_on_its_own_aircrafts_airframe_only(sgs):
