@@ -194,3 +194,30 @@ def test_protobufjs_reads_the_scene_as_foxglove_does(gust_log, tmp_path_factory)
             (p.x, p.y, p.z) for p in m.points]  # toObject leaves out zeros (defaults: false)
         assert t["indices"] == list(m.indices)
     assert theirs["arrows"][0].get("shaftLength", 0.0) == mine.arrows[0].shaft_length
+
+
+def test_another_aircraft_is_drawn_from_its_own_definition(tmp_path, capsys):
+    """A gust log of the SGS (a definition on JSBSim's sailplane) draws that wing: the
+    definition's semispan and chord and the outline scaled to its span;
+    before, its log had no scene (the mesh was the prototype's)."""
+    from bioflex_jsb import api, cli
+    from bioflex_jsb.sinks.mcap import scene_view
+
+    path = tmp_path / "sgs.mcap"
+    assert cli.main(["gust", "--aircraft", "sgs_elastic", "--duration", "0.6",
+                     "--gust-start", "0.1", "--models", "coupled", "--json",
+                     "--out", str(path)]) == 0
+    capsys.readouterr()
+    build = api.load_aircraft("sgs_elastic").wing()
+    shot = scene_view.scene_at(path, "coupled")
+    pts = np.concatenate([scene_view.triangles(t).reshape(-1, 3)
+                          for t in shot["wing"]["triangles"]])
+    semispan = float(build.aero.semispan_m)
+    assert semispan == pytest.approx(7.036)
+    assert np.abs(pts[:, 1]).max() == pytest.approx(semispan, rel=1e-9)
+    chord = pts[:, 0].max() - pts[:, 0].min()
+    assert chord == pytest.approx(1.0, abs=0.05)  # 1 m chord; the twist tilts it a little
+    air = np.concatenate([scene_view.triangles(t).reshape(-1, 3)
+                          for t in shot["airframe"]["triangles"]])
+    # the prototype's outline x 14.073/1.7: a fuselage several metres long, not 1 m
+    assert air[:, 0].max() - air[:, 0].min() > 4.0

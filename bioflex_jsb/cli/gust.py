@@ -229,17 +229,14 @@ SCENE_EXAGGERATION = 1.0
 def open_log(path: str, description, build):
     """The MCAP log of the run ``description`` with the wing ``build`` (its variant and
     overrides as plain data); a file that cannot be written is a one-line UsageError."""
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
     from bioflex_jsb.sinks.mcap import LogWriteError, RunLog
 
-    # the 3-D scene's mesh is the prototype's (its fuselage and planform: sinks/mcap/scene.py
-    # builds the wing from the variant on the prototype's planform): another aircraft's log
-    # has no scene
-    scene = SCENE_EXAGGERATION if build.airframe is PROTOTYPE_AIRFRAME else None
+    # the 3-D scene draws the run's own build: its planform (a definition's stations) and its
+    # airframe (sinks/mcap/scene.py: another aircraft's outline is the prototype's scaled)
     try:
         return RunLog.open(path, description, wing_variant=build.variant.as_dict(),
                            overrides=dict(build.model.coefficients.overrides),
-                           scene=scene)
+                           scene=SCENE_EXAGGERATION, build=build)
     except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 

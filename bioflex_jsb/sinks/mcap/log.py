@@ -89,12 +89,14 @@ class RunLog:
     def open(cls, path: str | Path, description: RunDescription,
              wing_variant: Mapping[str, Any] | None = None,
              overrides: Mapping[str, float] | None = None,
-             scene: float | None = None) -> RunLog:
+             scene: float | None = None, build=None) -> RunLog:
         """Create ``path`` and write the ``bioflex.run`` metadata of the run ``description``
         (:func:`~bioflex_jsb.sinks.mcap.metadata.run_metadata`; ``wing_variant``: the wing
         build's variant as a dict, ``overrides``: its coefficient overrides, plain data).
         ``scene``: also log the aircraft in 3-D (:mod:`.scene`, topics
-        ``/bioflex/<model>/scene``) with this exaggeration of the deformation [-]; None: not.
+        ``/bioflex/<model>/scene``) with this exaggeration of the deformation [-]; None: not;
+        ``build``: the run's ``WingBuild`` the scene draws (its planform and airframe; default
+        the wing built from ``wing_variant`` on the prototype's airframe).
         Served live (``--live``): :mod:`bioflex_jsb.sinks.live`, teed at the writer.
         A file that cannot be created is a :class:`LogWriteError` (one line)."""
         p = Path(path)
@@ -107,7 +109,8 @@ class RunLog:
         if scene is not None:
             from bioflex_jsb.sinks.mcap.scene import SceneLog
 
-            log.scene = SceneLog.for_run(log._writer, description, wing_variant, scene)
+            log.scene = SceneLog.for_run(log._writer, description, wing_variant, scene,
+                                         build=build)
         return log
 
     @classmethod

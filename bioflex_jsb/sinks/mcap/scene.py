@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import struct
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -99,13 +99,16 @@ class AirframeOutline:
     fin_tip_chord_m: float
 
 
-def airframe_outline() -> AirframeOutline:
-    """The prototype's outline from ``parameters/`` (the aircraft-as-data work replaces this
-    one function by the aircraft definition's)."""
-    from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY
+def airframe_outline(airframe=None) -> AirframeOutline:
+    """The outline of ``airframe`` (an ``AirframeData``; None: the prototype's), the
+    prototype's from ``parameters/``. A definition describes no fuselage or tail geometry:
+    another aircraft's outline is the prototype's scaled by the span ratio (an ESTIMATE for
+    the drawing only, nothing is computed with it; the wing is drawn from the definition's
+    own planform, :func:`wing_shape`)."""
+    from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY, PROTOTYPE_AIRFRAME
     from bioflex_jsb.parameters.airframe_consistent import FUSELAGE, TAIL
 
-    return AirframeOutline(
+    outline = AirframeOutline(
         fuselage_length_m=FUSELAGE.length_m,  # Table 1
         fuselage_max_diameter_m=FUSELAGE.max_diameter_m,  # ESTIMATE there (Fig. 1)
         nose_ahead_of_root_le_m=AIRFRAME_GEOMETRY.wing_root_leading_edge_x_m,
@@ -118,6 +121,10 @@ def airframe_outline() -> AirframeOutline:
         # arm" (airframe.py, C_nβ): as tall as the tail is half-wide, half its chord at the tip
         fin_height_m=0.5 * TAIL.semispan_m, fin_tip_chord_m=0.5 * TAIL.chord_m,
     )
+    if airframe is None or airframe.reference == PROTOTYPE_AIRFRAME.reference:
+        return outline
+    scale = airframe.reference.span_m / PROTOTYPE_AIRFRAME.reference.span_m
+    return AirframeOutline(*(scale * v for v in astuple(outline)))
 
 
 # -- the half wing at the mesh's stations ---------------------------------------------------
@@ -145,10 +152,10 @@ class WingShape:
 
 def wing_shape(build, planform=None) -> WingShape:
     """The mesh's half wing of the wing ``build`` (a ``WingBuild``: its modes and strips) on
-    ``planform`` (default: the prototype's, ``parameters.wing.DEFAULT_PLANFORM``, the one the
-    builds are made on)."""
+    ``planform`` (default: the build's own, the one its strips were made on: the prototype's
+    ``parameters.wing.DEFAULT_PLANFORM`` or a definition's stations)."""
     if planform is None:
-        from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM as planform
+        planform = build.planform
     modes, aero = build.modes, build.aero
     y = np.concatenate([[0.0], np.asarray(aero.stations_m, dtype=float), [aero.semispan_m]])
 
@@ -390,10 +397,14 @@ class SceneLog:
 
     @classmethod
     def for_run(cls, writer: McapFileWriter, description, wing_variant=None,
-                exaggeration: float = DEFAULT_EXAGGERATION) -> SceneLog:
-        """The scene of the run ``description``: its wing built as the run built it (the
-        variant ``wing_variant``, a ``WingVariant.as_dict()``, or else the description's
-        ``wing``; the build cache returns the run's own build)."""
+                exaggeration: float = DEFAULT_EXAGGERATION, build=None) -> SceneLog:
+        """The scene of the run ``description``: its wing ``build`` (a ``WingBuild``: its
+        planform, modes and airframe), or else built as the run built it (the variant
+        ``wing_variant``, a ``WingVariant.as_dict()``, or else the description's ``wing``, on
+        the prototype's airframe; the build cache returns the run's own build)."""
+        if build is not None:
+            return cls(writer, AircraftMesh(wing_shape(build), airframe_outline(build.airframe),
+                                            exaggeration))
         from bioflex_jsb.flight_dynamics.wing_model import (
             WingVariant,
             build_wing,

@@ -159,7 +159,7 @@ def write_animation(path: str | Path, build, speed_m_s: float,
     """Write the animation of ``shapes`` (default :func:`mode_shapes`) to ``path``; returns
     what was written (modes, their start times [s], frames)."""
     shapes = mode_shapes(build, speed_m_s) if shapes is None else shapes
-    mesh = AircraftMesh(wing_shape(build), airframe_outline(), 1.0)
+    mesh = AircraftMesh(wing_shape(build), airframe_outline(build.airframe), 1.0)
     frame = body_frame(MODEL)
     label_at = (mesh.nose_x_m, 0.0, mesh.z0_m + 0.25)
     with open(path, "wb") as stream:
