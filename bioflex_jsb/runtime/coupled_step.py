@@ -488,21 +488,28 @@ class CoupledStep:
         (g_u, g_v, g_w, g_q, g_p, g_r, g_theta, g_phi, g_psi, g_rho, g_nz, g_h, g_agl, g_lat,
          g_lon, g_vn, g_ve, g_vd, g_elevator, g_throttle) = self._getters
         kernel, needs_refresh, ok = self._kernel, K.NEEDS_REFRESH, K.OK
+        # the kernel's machine code without numba's type dispatch (0.67 µs a step,
+        # K.direct_entry) for a table it accepts, checked once per table; else the dispatcher
+        entry, accepts = K.direct_entry(kernel, params, x, cols)
+        checked, call = None, kernel
         set_wind, jsbsim_step, agl = self._set_wind, self.airframe.step_function(), self._agl_m
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
 
         def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+            nonlocal checked, call
+            if table is not checked:
+                checked, call = table, (entry if accepts(table) else kernel)
             wind_down_fps = -w_g_m_s * ft_per_m
             set_wind(wind_down_fps)
             reads = (g_u(), g_v(), g_w(), g_q(), g_p(), g_r(), g_theta(), g_phi(), g_psi(),
                      g_rho(), g_nz(), g_h(), g_agl(), g_lat(), g_lon(), g_vn(), g_ve(), g_vd(),
                      g_elevator(), g_throttle())
-            status = kernel(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
+            status = call(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
             if status == needs_refresh:
                 self._renew_reference()
-                status = kernel(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
+                status = call(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
             set_lift(reactions[0])
             set_drag(reactions[1])
             set_pitch(reactions[2])
