@@ -23,9 +23,10 @@ AIRCRAFT_PREFIX = "aircraft:"
 LINEAR_COMMANDS = ("modes", "flutter")
 # The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
 # flight_refusal: its own JSBSim aircraft, a glider in its steady glide; trim reads its own
-# --aircraft: cli/trim.py); the others (sitl, export, export-jsbsim, ardupilot, loads)
-# refuse an airframe other than the prototype's in one line.
-FLIGHT_COMMANDS = ("gust", "compare")
+# --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's copy with the wing:
+# docs/native.md); the others (sitl, export, ardupilot, loads) refuse an airframe other than
+# the prototype's in one line.
+FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim")
 
 
 class CruiseSpeed(float):
@@ -81,8 +82,8 @@ class _AircraftAction(argparse._StoreAction):
             elif aircraft.flight_problem() and aircraft.airframe.jsbsim_path:
                 problem = (f"aircraft {aircraft.name!r}: {command} takes the prototype's "
                            "airframe only in this version (airframe.jsbsim = "
-                           f"{aircraft.airframe.jsbsim!r}; gust, compare, trim, modes and "
-                           "flutter take this one: docs/aircraft.md)")
+                           f"{aircraft.airframe.jsbsim!r}; gust, compare, trim, export-jsbsim, "
+                           "modes and flutter take this one: docs/aircraft.md)")
             else:
                 problem = aircraft.flight_problem()
             variant = aircraft.variant()
