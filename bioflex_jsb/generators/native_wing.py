@@ -95,12 +95,13 @@ from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matr
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.generators.xml_writer import XmlWriter, collapse, num_12g, serialise
-from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import (
     AIRSPEED_RANGE_M_S,
+    CRUISE_SPEED_M_S,
     REFERENCE_GEOMETRY,
     ReferenceGeometry,
 )
+from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for the checks)
     GRID_SPEED_MAX_M_S,
     GRID_SPEED_STEP_M_S,
@@ -156,13 +157,13 @@ def system_name(variant: str, model: str = "coupled") -> str:
 # ======================================================================================
 
 
-def q_grid_pa(rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3) -> np.ndarray:
+def q_grid_pa(rho_ref: float = SEA_LEVEL_DENSITY_KG_M3) -> np.ndarray:
     """Dynamic pressures of the table rows [Pa] (uniform in V_ref)."""
     v = np.arange(0.0, GRID_SPEED_MAX_M_S + 0.5 * GRID_SPEED_STEP_M_S, GRID_SPEED_STEP_M_S)
     return 0.5 * rho_ref * v**2
 
 
-def qsd_schedule(nums: ModalMatrices, rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3):
+def qsd_schedule(nums: ModalMatrices, rho_ref: float = SEA_LEVEL_DENSITY_KG_M3):
     """(Q grid, K(Q)⁻¹ stack) of the QSD model's tables."""
     qs = q_grid_pa(rho_ref)
     inv = [np.linalg.inv(np.diag(nums.omega**2) - q * nums.k_aero) for q in qs]
@@ -200,8 +201,8 @@ class ExportSpec:
     variant: str
     model: str = "coupled"
     dt_s: float = DEFAULT_DT_S
-    speed_m_s: float = P.CRUISE_SPEED_M_S
-    rho_ref: float = P.SEA_LEVEL_DENSITY_KG_M3
+    speed_m_s: float = CRUISE_SPEED_M_S
+    rho_ref: float = SEA_LEVEL_DENSITY_KG_M3
     jsbsim_path: str = ""
     aircraft: str = ""
     jsbsim_chord_m: float = 0.0
