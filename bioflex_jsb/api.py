@@ -385,8 +385,9 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
 
     Free aircraft (``wing`` a :class:`WingBuild`): Eq. (4) on ``aero`` strips (default
     ``quasi-steady``, the paper's; ``unsteady``: Jones lag states), ``method``
-    ``state-space``; range default 5-40 m/s; ``structural_damping`` ζ [-] replaces the
-    wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML
+    ``state-space``; range default 5-40 m/s for the prototype, derived from the wing for
+    another aircraft (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-] replaces
+    the wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML
     file): ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and ρ
     default to the definition's; the range to the one derived from the wing
     (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`)."""
@@ -409,13 +410,39 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if lift_slope is not None:
         raise InputError("lift_slope is for clamped wings; the free aircraft takes the "
                          "vortex lattice's span loading (Table B1)")
-    rng = (5.0, 40.0) if range_m_s is None else range_m_s
+    rng = free_speed_range_m_s(wing, air.get("density_kg_m3")) if range_m_s is None \
+        else range_m_s
     if aero == "unsteady":
         return free_flutter(wing, aero="unsteady", structural_damping=structural_damping,
                             range_m_s=rng, **air)
     model = wing.model if structural_damping is None else with_damping(wing,
                                                                        structural_damping)
     return find_flutter(model, rng, **air)
+
+
+PAPER_FLUTTER_RANGE_M_S = (5.0, 40.0)  # the paper's scans of the prototype (Figs. 11-13)
+
+
+def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:
+    """The default speed range [m/s] of a free aircraft's flutter search: the paper's
+    5-40 m/s for the prototype's airframe; another aircraft's derived from its wing as a
+    clamped wing's is (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`):
+    150 % of the wing's static divergence speed in the aircraft (A_EE singular, the body
+    held: :func:`bioflex_jsb.flight_dynamics.eigen.wing_divergence_speed_m_s`) down to 5 %
+    of that, the search's top at most 400 m/s (the strips are incompressible). A fixed
+    5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s."""
+    from bioflex_jsb.definition.clamped import BOTTOM_FRACTION, TOP_OVER_DIVERGENCE
+    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
+    from bioflex_jsb.flight_dynamics.eigen import wing_divergence_speed_m_s
+    from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
+
+    if build.model.airframe.reference == PROTOTYPE_AIRFRAME.reference:
+        return PAPER_FLUTTER_RANGE_M_S
+    rho = SEA_LEVEL_DENSITY_KG_M3 if density_kg_m3 is None else density_kg_m3
+    v_div = wing_divergence_speed_m_s(build.model, rho,
+                                      (2.0, SPEED_LIMIT_M_S / TOP_OVER_DIVERGENCE))
+    top = SPEED_LIMIT_M_S if v_div is None else TOP_OVER_DIVERGENCE * v_div
+    return BOTTOM_FRACTION * top, top
 
 
 def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope):

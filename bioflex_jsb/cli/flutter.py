@@ -131,8 +131,9 @@ def register(sub) -> None:
     p.add_argument("--range", type=speed_range, default=None, metavar="LOW:HIGH",
                    help=f"airspeed range to search [m/s], 0 < LOW < HIGH <= "
                    f"{MAX_SPEED_M_S:g}; default {PAPER_DEFAULT_RANGE_M_S[0]:g}:"
-                   f"{PAPER_DEFAULT_RANGE_M_S[1]:g} for paper wings, derived from the wing "
-                   "for --clamped")
+                   f"{PAPER_DEFAULT_RANGE_M_S[1]:g} for the prototype's wings, derived from "
+                   "the wing for another aircraft and for --clamped (5 %% to 150 %% of its "
+                   "static divergence speed, at most 400)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -244,7 +245,7 @@ def paper_payload(args: argparse.Namespace) -> dict:
     build = wing_from_args(args)
     model = build.model if args.structural_damping is None else with_damping(
         build, args.structural_damping)
-    res = api.flutter(build, args.range or PAPER_DEFAULT_RANGE_M_S,
+    res = api.flutter(build, args.range,
                       aero=args.aero or "quasi-steady", method=args.method,
                       structural_damping=args.structural_damping, density_kg_m3=args.density)
     d = _formatted(res, 1)
