@@ -42,7 +42,8 @@ rad/s; damping ratio dimensionless. One entry per conjugate pair (im >= 0); real
 listed with im = 0. Valid range: --speed {SPEED_RANGE_TEXT}; the linear models are defined
 below the speed at which the aircraft can trim (the phugoid of the linear model goes unstable
 there). Default: the {DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s (the paper's Fig. 21
-case). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization of the
+case); with --aircraft its [airframe] cruise speed (the plot to 1.5 x its top flight
+speed). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization of the
 airframe), which includes the thrust's change with airspeed; see its --help."""
 
 
@@ -52,7 +53,7 @@ def register(sub) -> None:
     p.add_argument(
         "--speed", type=airspeed, action="append", metavar="V",
         help=f"airspeed [m/s], {SPEED_MIN_M_S:g}..{SPEED_MAX_M_S:g}; repeat for several "
-        f"speeds (default {DEFAULT_SPEED_M_S:g})",
+        f"speeds (default {DEFAULT_SPEED_M_S:g}; an --aircraft's own cruise speed)",
     )
     p.add_argument(
         "--models", type=models_list, default=("rigid", "coupled", "qsd"),
@@ -109,8 +110,19 @@ def _check_shape_outputs(args, speeds) -> None:
                              f"{str(Path(args.animate).parent)!r} does not exist")
 
 
+def _aircraft_speeds(args) -> tuple[float, float | None]:
+    """(default speed, top of its flight speeds or None) [m/s]: an ``--aircraft`` with
+    ``[airframe]`` speeds gives its cruise speed and the top of its speed range (the SGS:
+    25, 28 m/s; a default of 15 m/s is below its stall), else the prototype's 15 m/s."""
+    aircraft = getattr(args, "aircraft_definition", None)
+    if aircraft is not None and aircraft.airframe.cruise_speed_m_s is not None:
+        return aircraft.airframe.cruise_speed_m_s, aircraft.airframe.speed_range_m_s[1]
+    return DEFAULT_SPEED_M_S, None
+
+
 def run(args: argparse.Namespace) -> int:
-    speeds = args.speed or [DEFAULT_SPEED_M_S]
+    default_speed, flight_top = _aircraft_speeds(args)
+    speeds = args.speed or [default_speed]
     check_plot_path(args.plot, args.force)
     _check_shape_outputs(args, speeds)
     build = wing_for_run(wing_from_args(args), args)
@@ -131,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
         "plot": args.plot,
     }
     if args.plot:
-        _plot(args, build, speeds)
+        _plot(args, build, speeds, flight_top)
     if args.animate or args.mode_sheet:
         payload.update(_shapes(args, build, speeds[0]))
     if args.json:
@@ -181,10 +193,12 @@ def _shapes(args, build, speed_m_s: float) -> dict:
     return out
 
 
-def _plot(args, build, speeds) -> None:
+def _plot(args, build, speeds, flight_top_m_s: float | None = None) -> None:
     from bioflex_jsb.sinks import plotting
 
-    top = max(PLOT_TOP_M_S, max(speeds))
+    # to 1.5 x the top of another aircraft's flight speeds (the SGS: 42 m/s), as the
+    # prototype's 25 m/s is 1.7 x its 15 m/s cruise
+    top = max(PLOT_TOP_M_S, max(speeds), 1.5 * (flight_top_m_s or 0.0))
     grid = np.arange(SPEED_MIN_M_S, top + 1e-9, 0.5)
     sweeps = []
     for model in args.models:
