@@ -16,13 +16,16 @@ flight condition built for it, and the wing's planform (:meth:`Aircraft.planform
 by the :class:`WingBuild`; :meth:`Aircraft.linear_problem` says what they cannot take (a
 beam structure, derivatives from JSBSim, the prototype's membrane on another airframe).
 
-What flies (:meth:`Aircraft.flight_problem`): the nonlinear co-simulation (the JSBSim runs
-of ``gust``, ``compare``, ``sitl``, ``trim``) still takes the prototype's airframe and
-planform from the parameter modules (tests/test_prototype_imports.py lists the modules
-left), so an aircraft flies when its airframe and planform are the prototype's (each field
-equal to 1e-9 relative: the rounding of a printed value); its wing (axes, ribs, damping, a
-modal file, the C_η1^Q1 pin) is free. Any other airframe is refused for flight in one line
-naming the first field that differs, never flown with the prototype's numbers in its place.
+What flies: the nonlinear co-simulation (the JSBSim runs of ``gust``, ``compare``,
+``trim``, ``export-jsbsim``) flies the generated prototype airframe with any wing (axes,
+ribs, damping, a modal file, the C_η1^Q1 pin) when the file's airframe is the prototype's
+(:meth:`Aircraft.flight_problem` is None: each field equal to 1e-9 relative, the rounding of
+a printed value), and another aircraft on its own JSBSim aircraft (``airframe.jsbsim``: a
+package aircraft such as the SGS, or a directory; a glider in its steady glide) when the
+linear analyses take it and it gives its flight speeds
+(:func:`bioflex_jsb.definition.flying.flight_refusal`). The generated ``bioflex`` airframe
+with other numbers is refused in one line naming the first field that differs (its JSBSim
+model holds the prototype's numbers), never flown with them in its place.
 """
 
 from __future__ import annotations
@@ -189,12 +192,14 @@ class Aircraft:
         return None
 
     def flight_problem(self) -> str | None:
-        """Why this aircraft cannot fly in this version (module docstring), or ``None``."""
+        """Why this aircraft does not fly on the generated prototype airframe (module
+        docstring), or ``None``; :func:`~bioflex_jsb.definition.flying.flight_refusal` says
+        whether it flies on its own JSBSim aircraft instead."""
         a, d = self.airframe, self.definition
         head = f"aircraft {d.name!r}: "
-        tail = (" (the nonlinear co-simulation still reads the prototype's airframe from "
-                "parameters/; only the prototype's airframe flies in this version, with any "
-                "wing; the linear analyses modes, flutter and linear_model take this one: "
+        tail = (" (the generated airframe's JSBSim model holds the prototype's numbers; "
+                "another airframe flies on its own JSBSim aircraft, airframe.jsbsim; the "
+                "linear analyses modes, flutter and linear_model take this one: "
                 "docs/aircraft.md)")
         if not isinstance(d.structure, MembraneStructure | ModalStructure):
             return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
