@@ -1,11 +1,31 @@
 """Test-session settings: the MCAP logs that runs write by default go to a temporary
-directory, not into the working tree."""
+directory, not into the working tree; under pytest-xdist (``-n``, on by default in
+pyproject.toml's addopts) every worker's BLAS runs on one thread."""
 
 from __future__ import annotations
+
+import os
 
 import pytest
 
 from bioflex_jsb.cli.common import LOG_DIR_ENV_VAR
+
+# One BLAS/OpenMP thread per xdist worker (and per child process a test starts): OpenBLAS
+# starts one thread per core by default (2 here), so two workers would run 4 busy-waiting
+# BLAS threads on 2 cores. Measured on this 2-core machine under the other engineers' load:
+# tests/test_consistent_aircraft.py::test_script_json took 15.6 s serial and 240 s under
+# -n 2 with the default threads. The variables are set in the controller before it starts
+# the workers, so each worker's numpy reads them at its first import; a run without -n
+# keeps the library defaults. The thread count only changes how BLAS splits the work, within
+# the cross-processor spread the golden tolerances already allow (docs/validation.md).
+THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def pytest_configure(config):
+    workers = config.getoption("numprocesses", None)  # None: pytest-xdist not loaded
+    if workers and not os.environ.get("PYTEST_XDIST_WORKER"):
+        for name in THREAD_VARIABLES:
+            os.environ.setdefault(name, "1")
 
 
 @pytest.fixture(autouse=True, scope="session")
