@@ -554,6 +554,7 @@ def _must_be_refused(command, parts) -> bool:
     return False
 
 
+@pytest.mark.slow  # 1500 parses: ~16 s of the fast subset (measured 15.7 s); full suite only
 def test_fuzzed_command_lines_parse_into_valid_values_or_one_line_exit_2():
     """Any argv of gust, compare, modes, trim, flutter and export-jsbsim either parses into
     values the command can use, or ends with SystemExit(2) and one line; never another

@@ -145,6 +145,7 @@ def test_exchanged_unsteady_system(set_name):
     np.testing.assert_allclose(steady, -np.linalg.solve(qs.a, qs.b), rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.slow  # the whole script in a child process: 15.6 s measured; full suite only
 def test_script_json():
     out = subprocess.run([sys.executable, str(ROOT / "scripts" / "consistent_aircraft.py"),
                           "--json"], capture_output=True, text=True, check=True, cwd=ROOT)

@@ -101,6 +101,7 @@ def test_paper_wing_reports_mechanism_and_damping(capsys):
     assert d0["flutter_speed_m_s"] < d["flutter_speed_m_s"]
 
 
+@pytest.mark.slow  # two unsteady flutter scans: 13.6 s measured; full suite only
 def test_paper_wing_unsteady_reports_body_freedom_flutter(capsys):
     # Unsteady strips (aeroelasticity/free_aircraft.py): the backward-axis wings' flutter is
     # set by the aerodynamics, not the assumed damping (issue 15: < 10 % between ζ = 0 and

@@ -292,6 +292,7 @@ def test_fig22_forward_axes_alleviate_the_gust(section5):
     assert claim["change_si"]["peak_dq_rad_s"] == pytest.approx(-0.25, abs=0.03)
 
 
+@pytest.mark.slow  # the Section 5 script once more, in text form: 7.9 s; full suite only
 def test_section5_text_has_no_raw_none():
     out = subprocess.run([sys.executable, str(ROOT / "scripts" / "section5_gust.py"),
                           "--no-plot"], capture_output=True, text=True, check=True,

@@ -468,6 +468,7 @@ def _strategies(hypothesis, gcs):
     return st.lists(messages(), min_size=1, max_size=6)
 
 
+@pytest.mark.slow  # a randomised command session: 16.5 s measured; full suite only
 def test_random_commands_params_and_items_never_crash_and_keep_the_state_finite(build):  # noqa: F811,E501
     """Random COMMAND_LONG / COMMAND_INT (any command, NaN, inf, huge), PARAM_SET,
     MISSION_COUNT / MISSION_ITEM_INT and RC overrides: no exception, exactly one ack per
