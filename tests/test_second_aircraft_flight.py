@@ -282,3 +282,21 @@ def test_the_compiled_step_is_the_python_step_on_the_glider(sgs):
     assert stops[0].stopped == stops[1].stopped
     assert "left the aerodynamic model (-1..90 deg" in stops[0].stopped
     assert len(stops[0].time_s) == len(stops[1].time_s) == 481  # the step after 0.5 s
+
+
+def test_rerun_flies_the_gliders_log_from_its_definition(tmp_path, capsys):
+    """``rerun`` repeats a logged run of a definition from the definition the log names
+    (``extra.aircraft``), not from ``--wing`` (which has no variant of that name), and the
+    new log agrees with the old message for message."""
+    old, new = tmp_path / "old.mcap", tmp_path / "new.mcap"
+    code, _, err = run_cli(capsys, "gust", "--aircraft", "sgs_elastic", "--duration", "0.4",
+                           "--gust-start", "0.1", "--models", "coupled", "--out", str(old),
+                           "--json")
+    assert code == 0, err
+    code, out, err = run_cli(capsys, "rerun", str(old), "--out", str(new), "--json")
+    assert code == 0, err
+    report = json.loads(out)
+    argv = report["command"]
+    assert argv[1:3] == ["gust", "--aircraft"] and argv[3].endswith("sgs_elastic.toml")
+    assert "--wing" not in argv
+    assert report["equal"] is True and report["messages"] > 0

@@ -45,7 +45,11 @@ def argv_for(description) -> list[str]:
     if d.altitude_m != 0.0:
         raise UsageError(f"the logged run flew at {d.altitude_m:g} m; gust and compare fly "
                          "at sea level only")
-    common = ["--wing", d.wing, "--mass-basis", d.mass_basis,
+    # a run of an --aircraft definition (extra.aircraft: the shipped name or the file it was
+    # read from) is flown from that definition again; its wing is the definition's
+    wing = (["--aircraft", str(d.extra["aircraft"])] if d.extra.get("aircraft")
+            else ["--wing", d.wing])
+    common = [*wing, "--mass-basis", d.mass_basis,
               "--speed", repr(float(d.speed_m_s)), "--gust", d.gust,
               "--duration", repr(float(d.duration_s)),
               "--gust-start", repr(float(d.gust_start_s)), "--dt", repr(float(d.dt_s))]
