@@ -214,8 +214,10 @@ def _print_elastic(e: dict) -> None:
     print(f"  {'elevator':<10} {deg(e['elevator_rigid_rad']):10.2f} -> "
           f"{deg(e['elevator_rad']):.2f}  deg (rigid -> elastic)")
     loads = e["wing_loads"]
-    print(f"  {'wing lift':<10} {loads['lift_n']:10.3f}  N;  pitching moment "
-          f"{loads['pitch_moment_n_m']:.4f} N*m")
+    # the modal wing's loads are the deformation's increments over the rigid aircraft's
+    # (JSBSim's aerodynamics carry the rigid wing: docs/aircraft.md), not the wing's lift
+    print(f"  {'d lift':<10} {loads['lift_n']:10.3f}  N (the deformation's);  pitching "
+          f"moment {loads['pitch_moment_n_m']:.4f} N*m")
     div = e["divergence_speed_m_s"]
     print(f"  {'divergence':<10} {'none' if div is None else f'{div:.2f} m/s':>10}  "
           "(static, body held)")
