@@ -235,8 +235,8 @@ TIME_PANELS = (
 # η₁ is the first wing mode's coordinate; each mode is scaled so that its largest section
 # twist is 1 rad/rad (docs/conventions.md), so η₁ reads as the twist of that section (the tip).
 ETA1_NOTE = ("η₁: first wing mode (the prototype's: twist-dominated, scaled to equal its "
-             "tip twist, leading edge up positive; another wing's as its modes are scaled). "
-             "Shaded: running min/max over 0.1 s")
+             "largest section twist, at the tip, leading edge up positive; another wing's as "
+             "its modes are scaled). Shaded: running min/max over 0.1 s")
 # Runs that share a model's style (e.g. two wings flown with the same model) get these
 # colours instead, in order, so that every line in a figure can be told apart.
 EXTRA_COLOURS = ("tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
