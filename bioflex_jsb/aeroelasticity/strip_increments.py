@@ -72,12 +72,15 @@ def lag_state_names(n_strips: int, gust: bool) -> tuple[str, ...]:
     return names
 
 
-def strip_increments(g, n_modes: int, speed_m_s: float, density_kg_m3: float, *,
-                     gust: bool = False) -> StripIncrements:
-    """The :class:`StripIncrements` of the strips ``g`` (a
-    :class:`~bioflex_jsb.aeroelasticity.free_aircraft.StripGeometry`) with ``n_modes`` modes
-    at ``speed_m_s`` [m/s] and ``density_kg_m3`` [kg/m³]; ``gust``: with the Küssner states
-    (the wing's gust lift through Küssner's function instead of at once)."""
+def _strip_rows(g, n_modes: int, speed_m_s: float, density_kg_m3: float,
+                gust: bool) -> dict:
+    """The increments per strip and unit span, on the full state x (module docstring), and
+    the lag states' rates: ``dl_circ`` circulatory lift [N/m] on x, ``l_nc_x``, ``l_nc_xd``
+    apparent-mass lift [N/m] on x and ẋ, ``m_nc_x``, ``m_nc_xd`` apparent-mass moment about
+    the elastic axis [N·m/m] on x and ẋ, with ``gust`` ``dl_g`` the Küssner lift on x and
+    ``dl_w`` (K, 1) per unit gust; ``lag_a``, ``lag_b``; sizes ``n_all``, ``n0``.
+    :func:`strip_increments` sums them over the span, :func:`strip_load_rows` hands them
+    out per strip."""
     n, k_strips = int(n_modes), g.chord_m.size
     n0 = 4 + 2 * n
     n_all = n0 + (4 if gust else 2) * k_strips
@@ -120,22 +123,10 @@ def strip_increments(g, n_modes: int, speed_m_s: float, density_kg_m3: float, *,
     add_xd = ad_x.copy()  # α̇_s in x; α̈_s = the same row on ẋ
     pb2 = (math.pi * rho * b**2)[:, None]
     ba = (b * g.a)[:, None]
-    l_nc_x = pb2 * (hdd_x + v * ad_x)
-    l_nc_xd = pb2 * (hdd_xd - ba * add_xd)
-    m_nc_x = pb2 * (ba * hdd_x - v * (b * (0.5 - g.a))[:, None] * ad_x)
-    m_nc_xd = pb2 * (ba * hdd_xd - (b**2 * (0.125 + g.a**2))[:, None] * add_xd)
-    w = g.weights_m
-
-    def loads(dl_c, l_nc, m_nc):
-        """Z [N], M about CG [N·m], Q_i [N·m] of the strip increments (rows on x or ẋ)."""
-        z = -(w @ (dl_c + l_nc))
-        m = (w * g.d_m) @ dl_c + w @ (m_nc + g.d_e_m[:, None] * l_nc)
-        q = ((g.e_m * g.theta - g.phi) * w) @ dl_c + (-(g.phi * w) @ l_nc
-                                                      + (g.theta * w) @ m_nc)
-        return z, m, q
-
-    z_x, m_x, q_x = loads(dl_circ, l_nc_x, m_nc_x)
-    z_xd, m_xd, q_xd = loads(np.zeros_like(dl_circ), l_nc_xd, m_nc_xd)
+    out = {"n_all": n_all, "n0": n0, "dl_circ": dl_circ,
+           "l_nc_x": pb2 * (hdd_x + v * ad_x), "l_nc_xd": pb2 * (hdd_xd - ba * add_xd),
+           "m_nc_x": pb2 * (ba * hdd_x - v * (b * (0.5 - g.a))[:, None] * ad_x),
+           "m_nc_xd": pb2 * (ba * hdd_xd - (b**2 * (0.125 + g.a**2))[:, None] * add_xd)}
     n_lag = n_all - n0
     lag_a = np.zeros((n_lag, n_all))
     lag_b = np.zeros(n_lag)
@@ -144,7 +135,6 @@ def strip_increments(g, n_modes: int, speed_m_s: float, density_kg_m3: float, *,
         rj = slice(j * k_strips, (j + 1) * k_strips)
         lag_a[rj, lag[j]] -= np.diag(rate)
         lag_a[rj] += amp[j] * rate[:, None] * w34
-    z_w, m_w, q_w = 0.0, 0.0, np.zeros(n)
     if gust:
         # wing's gust lift: ½ρV C_lα c Σ x_g (Küssner) instead of ½ρV C_lα c w_g (paper),
         # on the paper's arms; Sears & Sparks: Σ A_j = 1, no direct term
@@ -156,13 +146,75 @@ def strip_increments(g, n_modes: int, speed_m_s: float, density_kg_m3: float, *,
             rj = slice((2 + j) * k_strips, (3 + j) * k_strips)
             lag_a[rj, lag[2 + j]] -= np.diag(rate)
             lag_b[rj] += kamp[j] * rate
+        out["dl_g"] = dl_g
+        out["dl_w"] = -half  # (K, 1): minus the paper's instantaneous gust lift per m/s
+    out["lag_a"], out["lag_b"] = lag_a, lag_b
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class StripLoadRows:
+    """The unsteady increments' loads **per strip and unit span** (the force summation of
+    the unsteady wing, :mod:`bioflex_jsb.loads.unsteady`): ``lift_x`` (K, n_states) [N/m per
+    unit of the state, up] on the full state x (module docstring), ``lift_xd`` on its rate
+    ẋ (apparent mass: the α̇, q̇ and η̈ columns), ``lift_w`` (K,) per unit gust w_g [N/m per
+    m/s]; ``torque_*`` the same for the section torque about the elastic axis [N·m/m,
+    leading edge up]: the circulatory and Küssner lift at the offset e of the aerodynamic
+    centre ahead of the elastic axis (the arms the generalised forces of
+    :func:`strip_increments` take) plus the apparent mass's moment."""
+
+    lift_x: np.ndarray
+    lift_xd: np.ndarray
+    lift_w: np.ndarray
+    torque_x: np.ndarray
+    torque_xd: np.ndarray
+    torque_w: np.ndarray
+
+
+def strip_load_rows(g, n_modes: int, speed_m_s: float, density_kg_m3: float
+                    ) -> StripLoadRows:
+    """The :class:`StripLoadRows` of the strips ``g`` with the Küssner states (the
+    co-simulation's unsteady wing) at ``speed_m_s`` [m/s], ``density_kg_m3`` [kg/m³]."""
+    r = _strip_rows(g, n_modes, speed_m_s, density_kg_m3, True)
+    e = g.e_m[:, None]
+    circ = r["dl_circ"] + r["dl_g"]
+    return StripLoadRows(
+        lift_x=circ + r["l_nc_x"], lift_xd=r["l_nc_xd"].copy(), lift_w=r["dl_w"][:, 0].copy(),
+        torque_x=e * circ + r["m_nc_x"], torque_xd=r["m_nc_xd"].copy(),
+        torque_w=(e * r["dl_w"])[:, 0])
+
+
+def strip_increments(g, n_modes: int, speed_m_s: float, density_kg_m3: float, *,
+                     gust: bool = False) -> StripIncrements:
+    """The :class:`StripIncrements` of the strips ``g`` (a
+    :class:`~bioflex_jsb.aeroelasticity.free_aircraft.StripGeometry`) with ``n_modes`` modes
+    at ``speed_m_s`` [m/s] and ``density_kg_m3`` [kg/m³]; ``gust``: with the Küssner states
+    (the wing's gust lift through Küssner's function instead of at once)."""
+    n, k_strips = int(n_modes), g.chord_m.size
+    r = _strip_rows(g, n_modes, speed_m_s, density_kg_m3, gust)
+    n_all, n0, dl_circ = r["n_all"], r["n0"], r["dl_circ"]
+    w = g.weights_m
+
+    def loads(dl_c, l_nc, m_nc):
+        """Z [N], M about CG [N·m], Q_i [N·m] of the strip increments (rows on x or ẋ)."""
+        z = -(w @ (dl_c + l_nc))
+        m = (w * g.d_m) @ dl_c + w @ (m_nc + g.d_e_m[:, None] * l_nc)
+        q = ((g.e_m * g.theta - g.phi) * w) @ dl_c + (-(g.phi * w) @ l_nc
+                                                      + (g.theta * w) @ m_nc)
+        return z, m, q
+
+    z_x, m_x, q_x = loads(dl_circ, r["l_nc_x"], r["m_nc_x"])
+    z_xd, m_xd, q_xd = loads(np.zeros_like(dl_circ), r["l_nc_xd"], r["m_nc_xd"])
+    z_w, m_w, q_w = 0.0, 0.0, np.zeros(n)
+    if gust:
+        dl_g = r["dl_g"]
         zero = np.zeros_like(dl_g)
         zg, mg, qg = loads(dl_g, zero, zero)
         z_x, m_x, q_x = z_x + zg, m_x + mg, q_x + qg
-        dl_w = -half  # (K, 1): minus the paper's instantaneous gust lift per m/s
+        dl_w = r["dl_w"]
         zw, mw, qw = loads(dl_w, np.zeros_like(dl_w), np.zeros_like(dl_w))
         z_w, m_w, q_w = float(zw[0]), float(mw[0]), qw[:, 0]
     names = RIGID_STATES + tuple(f"eta{i + 1}" for i in range(n)) + tuple(
         f"eta{i + 1}_dot" for i in range(n)) + lag_state_names(k_strips, gust)
     return StripIncrements(names, n, k_strips, z_x, m_x, q_x, z_xd, m_xd, q_xd, z_w, m_w, q_w,
-                           lag_a, lag_b, slice(n0, n_all))
+                           r["lag_a"], r["lag_b"], slice(n0, n_all))
