@@ -157,16 +157,16 @@ def test_a_diverged_run_and_a_run_without_loads(wing, coupled_run):
     assert "loads" not in plain.meta and not any(c.startswith("loads") for c in plain.channels)
 
 
-def test_unsteady_wing_reports_mode_displacement_only(wing):
-    """The unsteady strips carry lag states the force summation's quasi-steady strips do
-    not: mode displacement only (K_md on the run's own η)."""
+def test_unsteady_wing_reports_both_methods(wing):
+    """The unsteady wing: force summation (its lag states recovered from the rows:
+    tests/test_loads_unsteady.py) and mode displacement (K_md on the run's own η)."""
     run = _fly(wing, aero="unsteady", duration_s=0.8)
-    assert run.meta["loads"]["methods"] == ["mode_displacement"]
+    assert run.meta["loads"]["methods"] == ["force_summation", "mode_displacement"]
     lm = build_loads_model(wing, 15.0, density_kg_m3=run.meta["loads"]["density_kg_m3"])
     eta = lm.static_eta_rad + np.column_stack([run[f"eta{i + 1}"] for i in range(3)])
     np.testing.assert_allclose(run["loads_md_torque_n_m_s0"], eta @ lm.md_matrix[8],
                                rtol=1e-13, atol=1e-15)
-    assert not any(c.startswith("loads_fs") for c in run.channels)
+    assert all(np.all(np.isfinite(run[c])) for c in run.channels if c.startswith("loads_fs"))
 
 
 def test_a_wing_without_section_loads_says_why(wing):

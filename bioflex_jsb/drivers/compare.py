@@ -42,6 +42,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.loads.lti import with_load_outputs
 from bioflex_jsb.loads.model import QUANTITIES, LoadsModel, build_loads_model
+from bioflex_jsb.loads.stream import layout_for_methods
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.lti_response import simulate
 from bioflex_jsb.simulation.results import TimeHistory, nrmse
@@ -168,7 +169,10 @@ def _loads_model(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s
 def _add_linear_loads(linear: TimeHistory, lm, layout: dict) -> None:
     """The LTI loads as the run's channels (totals: the run's 1 g values plus the LTI's
     perturbations), for the run's methods; mode displacement of an LTI model without load
-    outputs (the unsteady one) from its η outputs."""
+    outputs (the unsteady one) from its η outputs, and its run's force summation left out
+    (it has none)."""
+    if not any(c.startswith("fs_") for c in linear.channels):  # the unsteady LTI model
+        layout = layout_for_methods(layout, ("mode_displacement",))
     static = layout["static_1g"]
     s = lm.n_stations
     for name in layout["names"]:

@@ -162,7 +162,7 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
     values = {"force_summation": lm.force_summation(z).reshape(shape)}
     static_all = lm.static_loads()
     static = {"force_summation": static_all["force_summation"]}
-    if run.model in ("coupled", "qsd"):
+    if run.model in ("coupled", "qsd") and lm.md_matrix is not None:
         n = lm.n_modes
         eta = lm.static_eta_rad[None, :] + np.column_stack(
             [run[f"eta{i + 1}"] for i in range(n)])
@@ -172,7 +172,9 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
             "gust": run.meta.get("gust"), "density_kg_m3": lm.density_kg_m3,
             "accelerations": "n_z: run channel; q_dot: central differences of q; "
                              "eta_ddot: the modal equation (loads/history.py)",
-            "stopped": run.stopped}
+            "stopped": run.stopped, "mass": lm.mass_source}
+    if lm.md_matrix is None:
+        meta["mode_displacement_unavailable"] = lm.md_unavailable
     return SectionLoads(lm.wing, run.model, np.asarray(run.time_s, dtype=float), lm.stations_m,
                         lm.station_fractions, values, static,
                         lm.force_summation(z, "aero").reshape(shape),

@@ -87,7 +87,8 @@ def _signal_rows(ss: StateSpace, lm: LoadsModel) -> tuple[np.ndarray, ...]:
 
 def load_outputs(ss: StateSpace, lm: LoadsModel) -> LoadOutputs:
     """C_loads, D_loads of ``ss`` (rigid, coupled or qsd) for ``lm``'s stations: force
-    summation rows first, then mode displacement (not for ``rigid``)."""
+    summation rows first, then mode displacement (not for ``rigid``, nor for a wing without
+    EI, GJ: ``lm.md_matrix`` None)."""
     zx, zw, eta_x, eta_w = _signal_rows(ss, lm)
     ig = ss.inputs.index("w_g")
     s = lm.n_stations
@@ -96,7 +97,7 @@ def load_outputs(ss: StateSpace, lm: LoadsModel) -> LoadOutputs:
     c = [lm.fs_matrix @ zx]
     dw = [lm.fs_matrix @ zw]
     static = [static_all["force_summation"].reshape(-1)]
-    if ss.model != "rigid":
+    if ss.model != "rigid" and lm.md_matrix is not None:
         names += [f"md_{q}_s{j}" for q in QUANTITIES for j in range(s)]
         c.append(lm.md_matrix @ eta_x)
         dw.append(lm.md_matrix @ eta_w)

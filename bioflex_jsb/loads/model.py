@@ -54,7 +54,6 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geo
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
 DEFAULT_STATION_FRACTIONS = (0.0, 0.25, 0.5, 0.75)  # root, 25, 50, 75 % semispan (issue 24)
 QUANTITIES = ("shear_n", "bending_n_m", "torque_n_m")
@@ -87,7 +86,10 @@ class LoadsModel:
     stations_m (s,) [m]; fs_matrix (3 s, len(z)): rows shear, bending, torque of every
     station (quantity-major: row q·s + j), columns the signals z (:func:`signal_names`);
     fs_aero_columns: which columns are aerodynamic (the rest inertial); md_matrix (3 s, n):
-    the same rows per unit total deflection η [rad]; static_eta_rad (n,) η₀ and
+    the same rows per unit total deflection η [rad], or None for a wing without EI, GJ (a
+    modes file: ``md_unavailable`` says why); ``mass_source``: where the inertia per span
+    comes from (the beam, or the fit to a modes file's generalised masses:
+    :func:`modal_mass_sections`); static_eta_rad (n,) η₀ and
     static_alpha_rad Δα_trim of the static part; alpha_wing_rad α_w; dynamic_pressure_pa,
     speed_m_s, density_kg_m3 of the trim; matrices: the modal wing's per-unit matrices (the
     modal accelerations by the model); static_note says where the static part comes from.
@@ -105,15 +107,19 @@ class LoadsModel:
     static_alpha_rad: float
     fs_matrix: np.ndarray
     fs_aero_columns: np.ndarray
-    md_matrix: np.ndarray
+    md_matrix: np.ndarray | None
     matrices: ModalMatrices
     n_modes: int
     static_note: str
     half_wing_mass_kg: float
+    mass_source: str
+    md_unavailable: str | None
     cells_m: np.ndarray = field(repr=False)
     cell_widths_m: np.ndarray = field(repr=False)
     cell_coefficients: tuple[np.ndarray, np.ndarray] = field(repr=False)
     cell_shapes: tuple[np.ndarray, np.ndarray] = field(repr=False)  # (φ, θ) at the cells
+    cell_strips: np.ndarray = field(repr=False)  # the lattice strip of each cell
+    build: object = field(repr=False)  # the WingBuild (the unsteady wing's strips)
 
     @property
     def n_stations(self) -> int:
@@ -145,14 +151,25 @@ class LoadsModel:
 
     def mode_displacement(self, eta_total_rad: np.ndarray) -> np.ndarray:
         """MD loads (3 s,) or (samples, 3 s) of the total deflection η [rad]."""
+        if self.md_matrix is None:
+            raise InputError(f"wing {self.wing!r}: {self.md_unavailable}")
         return np.asarray(eta_total_rad) @ self.md_matrix.T
 
+    @property
+    def methods(self) -> tuple[str, ...]:
+        """The methods this model gives (:data:`METHODS` order): no mode displacement
+        without the beam's EI, GJ."""
+        return METHODS if self.md_matrix is not None else ("force_summation",)
+
     def static_loads(self) -> dict[str, np.ndarray]:
-        """The 1 g trim's loads {method: (3, s)} (quantity rows, station columns)."""
+        """The 1 g trim's loads {method: (3, s)} (quantity rows, station columns), for
+        :attr:`methods`."""
         z = self.static_signals()
         s = self.n_stations
-        return {"force_summation": self.force_summation(z).reshape(3, s),
-                "mode_displacement": self.mode_displacement(self.static_eta_rad).reshape(3, s)}
+        out = {"force_summation": self.force_summation(z).reshape(3, s)}
+        if self.md_matrix is not None:
+            out["mode_displacement"] = self.mode_displacement(self.static_eta_rad).reshape(3, s)
+        return out
 
     def generalised_aero_force(self, z: np.ndarray) -> np.ndarray:
         """Generalised force of the FS **aerodynamic** loads of the half wing on each mode,
@@ -178,6 +195,98 @@ def _sections(variant):
     return wing_sections(RIBBED_WING if variant.ribs else UNRIBBED_WING,
                          x_inertial_frac=variant.x_inertial_frac,
                          x_elastic_frac=variant.x_elastic_frac)
+
+
+# ESTIMATE: how closely the uniform m', I' of a modes-file wing must give back each mode's
+# generalised mass (:func:`modal_mass_sections`). The fit integrates the file's shapes
+# linearly between its stations where the beam's finite elements are Hermite cubics: for
+# the SGS wing's 40-element modes that alone leaves 7.4e-4 (modes 1 and 3, measured; mode 2
+# to round-off), and m' comes out 7.0045 kg/m against its beam's 7.0 (sgs_wing.toml). A wing
+# whose mass is not near uniform misses by far more than 1 % and gets no force summation.
+MODAL_MASS_FIT_TOLERANCE = 0.01
+
+
+@dataclass(frozen=True, eq=False)
+class MassSections:
+    """The wing's inertia per span for the force summation, at ``stations_m`` [m] (linear
+    in between): m' ``mass_per_length_kg_m`` [kg/m], I' ``torsional_inertia_kg_m`` [kg·m]
+    about the elastic axis, S' ``static_moment_kg`` = m' (x_I − x_E) c [kg] (positive for
+    the centre of mass aft of the elastic axis); the axes as chord fractions aft of the
+    leading edge; ``source`` says where the numbers come from. The interface of
+    :class:`~bioflex_jsb.structures.beam.BeamSections` that the force summation reads."""
+
+    stations_m: np.ndarray
+    mass_per_length_kg_m: np.ndarray
+    torsional_inertia_kg_m: np.ndarray
+    static_moment_kg: np.ndarray
+    x_elastic_frac: np.ndarray
+    x_inertial_frac: np.ndarray
+    source: str
+
+    @property
+    def half_wing_mass_kg(self) -> float:
+        """∫ m' dy over the half wing [kg] (trapezoid rule: exact for linear m')."""
+        return float(np.trapezoid(self.mass_per_length_kg_m, self.stations_m))
+
+    def at(self, y_m: np.ndarray) -> dict[str, np.ndarray]:
+        """m', I', S' linearly interpolated at ``y_m`` (the keys of ``BeamSections.at``)."""
+        y = np.asarray(y_m, dtype=float)
+        return {"m": np.interp(y, self.stations_m, self.mass_per_length_kg_m),
+                "I": np.interp(y, self.stations_m, self.torsional_inertia_kg_m),
+                "S": np.interp(y, self.stations_m, self.static_moment_kg)}
+
+
+def modal_mass_sections(build) -> MassSections:
+    """The inertia per span of a modes-file wing (``build.variant.modes_file``).
+
+    A modes file (docs/structures.md) carries the shapes φ_i, θ_i, the frequencies, the
+    generalised masses m_i and the axes x_E, x_I, but no mass distribution, no EI and no GJ.
+    The force summation takes the **spanwise-uniform** m' and I' (about the elastic axis)
+    whose generalised masses m_i = ∫ (m' φ_i² + 2 S' φ_i θ_i + I' θ_i²) dy, S' = m'(x_I −
+    x_E) c on the wing's planform, best match the file's (least squares over the modes),
+    and refuses the wing (InputError, said why) if a mode's generalised mass is then off by
+    more than :data:`MODAL_MASS_FIT_TOLERANCE`, if the modes cannot separate m' from I' (no
+    twist, or no bending, in any mode) or if the fit is not physical (m' ≤ 0, I' < m' d²)."""
+    modes, planform = build.modes, build.planform
+    name = build.variant.name
+    y = np.linspace(0.0, float(modes.stations_m[-1]), 4001)  # 1.8 mm on the SGS's 7.04 m
+    chord = planform.chord_at(y)
+    offset = np.interp(y, modes.stations_m, modes.x_inertial_frac - modes.x_elastic_frac) * chord
+    rows = []
+    for phi_i, theta_i in zip(modes.bending_m, modes.twist_rad, strict=True):
+        phi = np.interp(y, modes.stations_m, phi_i)
+        theta = np.interp(y, modes.stations_m, theta_i)
+        rows.append([np.trapezoid(phi * phi + 2.0 * offset * phi * theta, y),
+                     np.trapezoid(theta * theta, y)])
+    a = np.array(rows)
+    masses = np.asarray(modes.generalised_masses_kg_m2, dtype=float)
+    head = f"wing {name!r} (a modes file: no mass distribution, EI or GJ)"
+    if np.linalg.matrix_rank(a, tol=1e-9 * np.max(np.abs(a))) < 2:
+        raise InputError(f"{head}: its modes do not give m' and I' apart (they need bending "
+                         "and twist); force summation needs them: use a beam-model wing")
+    (m_per_length, inertia), *_ = np.linalg.lstsq(a, masses, rcond=None)
+    miss = np.abs(a @ np.array([m_per_length, inertia]) / masses - 1.0)
+    if m_per_length <= 0.0 or inertia < m_per_length * np.max(offset**2):
+        raise InputError(f"{head}: its generalised masses give no physical uniform mass "
+                         f"(m' = {m_per_length:.4g} kg/m, I' = {inertia:.4g} kg*m)")
+    if np.max(miss) > MODAL_MASS_FIT_TOLERANCE:
+        raise InputError(
+            f"{head}: a uniform m', I' misses mode {int(np.argmax(miss)) + 1}'s generalised "
+            f"mass by {100 * np.max(miss):.1f} % (accepted {100 * MODAL_MASS_FIT_TOLERANCE:g} "
+            "%): its mass is not uniform; force summation needs a beam-model wing")
+    ys = np.asarray(modes.stations_m, dtype=float)
+    d = (modes.x_inertial_frac - modes.x_elastic_frac) * planform.chord_at(ys)
+    return MassSections(
+        stations_m=ys, mass_per_length_kg_m=np.full(ys.size, m_per_length),
+        torsional_inertia_kg_m=np.full(ys.size, inertia),
+        static_moment_kg=m_per_length * d, x_elastic_frac=np.asarray(modes.x_elastic_frac),
+        x_inertial_frac=np.asarray(modes.x_inertial_frac),
+        source=(f"uniform m' = {m_per_length:.5g} kg/m, I' = {inertia:.5g} kg*m fitted to the "
+                f"modes file's generalised masses (worst mode {100 * np.max(miss):.2g} % off)"))
+
+
+MD_UNAVAILABLE_MODES_FILE = ("mode displacement needs the beam's EI and GJ (a modes file "
+                             "gives neither): force summation only")
 
 
 def station_positions_m(fractions, semispan_m: float) -> np.ndarray:
@@ -288,7 +397,11 @@ def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTION
                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
                       static: str = "elastic") -> LoadsModel:
     """The :class:`LoadsModel` of ``build`` (a :class:`~bioflex_jsb.flight_dynamics.
-    wing_model.WingBuild` of a beam-model wing) at the level-flight trim ``speed_m_s``.
+    wing_model.WingBuild`: the prototype's or a definition's wing, on its own planform,
+    lattice strips and airframe) at the level-flight trim ``speed_m_s``. A beam-model wing
+    gets both methods; a modes-file wing force summation only, with the uniform inertia
+    fitted to its generalised masses (:func:`modal_mass_sections`; InputError if that fit
+    fails).
 
     ``stations``: fractions of the semispan. ``static``: the 1 g static part,
     ``elastic`` (the elastic trim's η₀ and Δα, :mod:`bioflex_jsb.flight_dynamics.
@@ -298,13 +411,22 @@ def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTION
     if static not in ("elastic", "rigid"):
         raise InputError(f"unknown static part {static!r}; accepted: elastic, rigid")
     variant, modes, aero = build.variant, build.modes, build.aero
-    planform = DEFAULT_PLANFORM
-    if abs(aero.semispan_m - planform.semispan_m) > 1e-12:
-        raise InputError("section loads are built for the default planform's lattice")
-    sections = _sections(variant)
+    planform = build.planform
+    if abs(aero.semispan_m - planform.semispan_m) > 1e-9 * planform.semispan_m:
+        raise RuntimeError(f"the wing's lattice spans {aero.semispan_m:g} m, its planform "
+                           f"{planform.semispan_m:g} m")
+    if variant.modes_file:
+        sections = modal_mass_sections(build)
+        md_unavailable = MD_UNAVAILABLE_MODES_FILE
+        mass_source = sections.source
+    else:
+        sections = _sections(variant)
+        md_unavailable = None
+        mass_source = "the beam's sections (structures/wing_model.py)"
     half = planform.semispan_m
     ys = station_positions_m(stations, half)
-    condition = level_flight_condition(float(speed_m_s), density_kg_m3)
+    condition = level_flight_condition(float(speed_m_s), density_kg_m3,
+                                       airframe=build.airframe)
     q0 = condition.dynamic_pressure_pa
     n = modes.n_modes
     strips = shifted(spanwise_geometry(aero, planform, modes.x_elastic_frac, modes.stations_m),
@@ -359,8 +481,10 @@ def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTION
         cl_trim=condition.cl_trim,
         alpha_wing_rad=condition.cl_trim / build.model.wing_lift_slope_per_rad,
         static_eta_rad=eta0, static_alpha_rad=float(dalpha0), fs_matrix=fs,
-        fs_aero_columns=aero_cols, md_matrix=_md_matrix_cached(sections, modes, ys),
+        fs_aero_columns=aero_cols,
+        md_matrix=None if md_unavailable else _md_matrix_cached(sections, modes, ys),
         matrices=modal_matrices(build.model, condition.cl_trim), n_modes=n,
         static_note=note, half_wing_mass_kg=sections.half_wing_mass_kg,
+        mass_source=mass_source, md_unavailable=md_unavailable,
         cells_m=yc, cell_widths_m=wc, cell_coefficients=(f_coef, t_coef),
-        cell_shapes=(phi_c, theta_c))
+        cell_shapes=(phi_c, theta_c), cell_strips=strip, build=build)

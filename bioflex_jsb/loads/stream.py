@@ -46,8 +46,8 @@ def run_methods(model: str, aero: str = "quasi-steady") -> tuple[str, ...]:
     if model not in ("coupled", "qsd"):
         raise InputError(f"section loads are for the rigid, coupled and qsd wings, not "
                          f"{model!r}")
-    if aero == "unsteady":
-        return ("mode_displacement",)
+    if aero not in ("quasi-steady", "unsteady"):
+        raise InputError(f"unknown strips {aero!r}; accepted: quasi-steady, unsteady")
     return METHODS
 
 
@@ -64,7 +64,10 @@ class LoadStream:
                  static_eta_rad=None, aero: str = "quasi-steady") -> None:
         self.lm = lm
         self.model = model
-        self.methods = run_methods(model, aero)
+        self.methods = tuple(m for m in run_methods(model, aero) if m in lm.methods)
+        if not self.methods:
+            raise InputError(f"wing {lm.wing!r}: {lm.md_unavailable}; and the run of model "
+                             f"{model!r} with {aero} strips has no force summation")
         n = lm.n_modes
         col = {c: i for i, c in enumerate(names)}
         need = ["alpha", "q", "n_z", "airspeed_m_s"]
@@ -97,6 +100,12 @@ class LoadStream:
         # the product of each method: FS on z, MD on the total η
         self._fs = lm.fs_matrix.T if "force_summation" in self.methods else None
         self._md = lm.md_matrix.T if "mode_displacement" in self.methods else None
+        # the unsteady wing's increments and η̈, replayed from the rows (loads/unsteady.py)
+        self._unsteady = None
+        if aero == "unsteady" and self._fs is not None:
+            from bioflex_jsb.loads.unsteady import UnsteadyStripLoads
+
+            self._unsteady = UnsteadyStripLoads(lm, names, dt_s)
         self._held_t: float | None = None  # the last row handed in, its loads not yet out
         self._held: np.ndarray | None = None
         self._q_before = None  # q of the row before the held one (None: the run's first)
@@ -192,12 +201,17 @@ class LoadStream:
             z[:, 2 + 2 * n] = q_pa
             z[:, 3 + 2 * n] = G * rows[:, self._i_nz]
             z[:, 4 + 2 * n] = q_dot
-            if self.model == "coupled":
+            if self._unsteady is not None:
+                extra, eta_ddot = self._unsteady.block(rows, d_eta)
+                z[:, 5 + 2 * n:] = eta_ddot
+                parts.append(z @ self._fs + extra)
+            elif self.model == "coupled":
                 z[:, 5 + 2 * n:] = self._modal_accelerations(q_pa, v, d_alpha, q, d_eta,
                                                              d_eta_dot)
+                parts.append(z @ self._fs)
             else:
                 z[:, 5 + 2 * n:] = 0.0
-            parts.append(z @ self._fs)
+                parts.append(z @ self._fs)
         if self._md is not None:
             parts.append(eta @ self._md)
         return parts[0] if len(parts) == 1 else np.hstack(parts)
@@ -210,3 +224,15 @@ class LoadStream:
                 - d_eta_dot * (2.0 * mm.zeta * mm.omega) + qv[:, None] * (d_eta_dot @ mm.d_aero.T)
                 + np.outer(q_pa * d_alpha, mm.b_alpha) + np.outer(qv * q, mm.b_q)
                 + np.outer(q_pa - self.lm.dynamic_pressure_pa, self._b0))
+
+
+def layout_for_methods(layout: dict, methods) -> dict:
+    """A run's loads layout (``meta["loads"]``) cut to ``methods`` (its names, units,
+    methods and 1 g values; the stations, density and notes kept): for a prediction that
+    has some of the run's methods only (the unsteady LTI model: mode displacement)."""
+    keep = [m for m in METHODS if m in layout["methods"] and m in tuple(methods)]
+    prefixes = tuple(f"loads_{TAGS[m]}_" for m in keep)
+    names = [c for c in layout["names"] if c.startswith(prefixes)] if keep else []
+    return {**layout, "methods": keep, "names": names,
+            "units": {c: layout["units"][c] for c in names},
+            "static_1g": {c: layout["static_1g"][c] for c in names}}

@@ -25,7 +25,7 @@ def root_loads_lines(summary: Mapping[str, Mapping[str, object]]) -> list[str]:
     """Lines of the root bending moment and torque peaks of each model's metrics (as
     JSON: ``summary[model]["loads"]``), both methods; a run without loads says why (a
     diverged run is left out: it has no response metrics)."""
-    rows, notes = [], []
+    rows, notes, no_md = [], [], []
     for model, m in summary.items():
         loads = m.get("loads")
         if not loads:
@@ -35,6 +35,8 @@ def root_loads_lines(summary: Mapping[str, Mapping[str, object]]) -> list[str]:
             continue
         if not loads["station_fractions"] or loads["station_fractions"][ROOT] != 0.0:
             continue
+        if model != "rigid" and "mode_displacement" not in loads["methods"]:
+            no_md.append(model)
         for method, per_q in loads["methods"].items():
             b = _peak(per_q["bending_n_m"][ROOT])
             t = _peak(per_q["torque_n_m"][ROOT])
@@ -45,7 +47,15 @@ def root_loads_lines(summary: Mapping[str, Mapping[str, object]]) -> list[str]:
     head = [f"{'root loads':<15} {'bending moment M [N*m]':^31} {'torque T [N*m]':^31}",
             f"{'model':<8} {'method':<6} {'peak':>9} {'vs 1 g':>11} {'at t [s]':>9}"
             f" {'peak':>9} {'vs 1 g':>11} {'at t [s]':>9}"]
-    foot = ["root loads: FS force summation, MD mode displacement (docs/loads.md; MD sees "
-            "little bending: the wing's three modes are twist-dominated); peak: the extreme "
-            "farther from the 1 g value after the gust start"]
+    if any(f" {LABELS['mode_displacement']} " in r for r in rows):
+        foot = ["root loads: FS force summation, MD mode displacement (docs/loads.md; MD "
+                "sees what the wing's modes carry: the prototype's three are "
+                "twist-dominated); peak: the extreme farther from the 1 g value after the "
+                "gust start"]
+    else:
+        foot = ["root loads: FS force summation (docs/loads.md); peak: the extreme farther "
+                "from the 1 g value after the gust start"]
+    if no_md:
+        notes.append(f"section loads: {', '.join(no_md)}: no mode displacement (it needs the "
+                     "beam's EI and GJ, which the wing's modes file does not give)")
     return head + rows + foot + notes
