@@ -14,9 +14,10 @@ blocks.
 Methods per run (``docs/loads.md``, "In every gust run"): force summation and mode
 displacement for the quasi-steady coupled and qsd wings; force summation only for the rigid
 model (no wing modes: the mode-displacement loads are zero by construction and are not
-reported); mode displacement only for the unsteady wing (its strips carry lag states and
-apparent mass that the force summation's quasi-steady strips do not, and its η̈ is not the
-quasi-steady modal equation's).
+reported); both for the unsteady wing, whose force summation adds its strips' lag, apparent
+mass and Küssner increments and takes η̈ of its own modal equation, the lag states
+recomputed from the rows (:mod:`bioflex_jsb.loads.unsteady`); force summation only for a
+wing without EI, GJ (a modes file: ``LoadsModel.methods``).
 """
 
 from __future__ import annotations
