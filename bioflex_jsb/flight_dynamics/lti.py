@@ -55,10 +55,11 @@ class ElasticWingModel:
 
     frequencies_rad_s, damping_ratios, generalised_masses_kg_m2: the m_i of Table B2 as used
     in H_i (see :mod:`bioflex_jsb.flight_dynamics.wing_model` for the convention);
-    coefficients: Table B1; wing_lift_slope_per_rad: C_Lα of the wing alone (lifting line),
-    used for the trim lift distribution in C_0^Q; cm_ac: section moment coefficient about the
-    aerodynamic centre [-]; airframe: the aircraft the wing was built for (its S and c̄
-    non-dimensionalise ``coefficients``; the flight condition must carry the same).
+    coefficients: Table B1; wing_lift_slope_per_rad: C_Lα of the wing alone (lifting line) on
+    the airframe's reference area S [1/rad], used for the trim lift distribution in C_0^Q;
+    cm_ac: section moment coefficient about the aerodynamic centre [-]; airframe: the
+    aircraft the wing was built for (its S and c̄ non-dimensionalise ``coefficients``; the
+    flight condition must carry the same).
     """
 
     name: str

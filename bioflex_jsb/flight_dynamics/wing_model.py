@@ -518,7 +518,12 @@ def _build(variant: WingVariant, n_modes: int, mass_basis: str, planform: Planfo
         damping_ratios=damping,
         generalised_masses_kg_m2=masses,
         coefficients=coeffs,
-        wing_lift_slope_per_rad=float(aero.wing_lift_slope_per_rad),
+        # on the airframe's reference area S, as C_L and Table B1 are: the lattice's slope
+        # is on the planform's own area (the SGS: 14.072 m² of a 1 m chord against SGS.xml's
+        # S = 13.073 m²; α_w = C_L / C_Lα,w then left the wing carrying 1.076 × W at 1 g);
+        # the prototype's two areas are equal (0.3111 m², to 1 ulp)
+        wing_lift_slope_per_rad=float(aero.wing_lift_slope_per_rad * aero.reference_area_m2
+                                      / airframe.reference.area_m2),
         cm_ac=CM_AC_SECTION,
         tip_twist_per_eta=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
         airframe=airframe,
