@@ -286,7 +286,9 @@ class Airframe:
         self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
         self.glider = self.engine_count == 0  # trimmed to a glide (runtime/other_airframe.py)
         self._workdir = None  # the temporary root of an aircraft from a file (other_airframe.py)
-
+        # every trim starts from the loaded controls, not the last trim's (its starting point)
+        self._trim_start = {n: self._trim_fdm[n] for n in TRIM_CONTROLS + tuple(
+            f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engine_count))}
 
     # ---- JSBSim messages ----------------------------------------------------------
     @property
@@ -402,6 +404,8 @@ class Airframe:
             for name in _WIND_PROPERTIES:
                 fdm[name] = 0.0
         tfdm = self._trim_fdm
+        for name, value in self._trim_start.items():
+            tfdm[name] = value
         self._set_level_ic(tfdm, v, h)
         if self.glider:  # no engine: the steady glide at v (runtime/other_airframe.py)
             from bioflex_jsb.runtime.other_airframe import glide_trim
@@ -670,9 +674,8 @@ class Airframe:
 # ======================================================================================
 
 
-def load_airframe(
-    root: str | os.PathLike | None = None, aircraft: str = DEFAULT_AIRCRAFT
-) -> Airframe:
+def load_airframe(root: str | os.PathLike | None = None,
+                  aircraft: str = DEFAULT_AIRCRAFT) -> Airframe:
     """Load the airframe (JSBSim console output captured; see :attr:`Airframe.warnings`)."""
     return Airframe(root, aircraft)
 
