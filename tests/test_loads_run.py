@@ -234,6 +234,7 @@ def test_the_log_topic_is_the_runs_load_channels(logged, model):
                                      for j in range(4)]
 
 
+@pytest.mark.slow  # the strict pymcap-cli doctor: 13-32 s
 def test_info_lists_the_topic_and_doctor_passes(logged, capsys):
     path, _ = logged
     assert cli.main(["info", str(path)]) == 0

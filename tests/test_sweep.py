@@ -158,6 +158,7 @@ def test_bad_arguments_exit_2_one_line(small, tmp_path, monkeypatch, capsys, arg
 # ---------------------------------------------------------------------------------------
 # Runs
 # ---------------------------------------------------------------------------------------
+@pytest.mark.slow  # process pools and a Dask cluster: 6-12 s
 def test_local_processes_and_dask_localcluster_give_identical_tables(small, tmp_path,
                                                                      monkeypatch, capsys):
     local, dask = tmp_path / "local.csv", tmp_path / "dask.parquet"
@@ -283,6 +284,7 @@ def test_local_worker_death_is_retried_once_then_recorded_failed(small, tmp_path
     assert all(_attempts(marks, c.case_id) <= 2 for c in others)
 
 
+@pytest.mark.slow  # a Dask cluster: 16 s
 def test_dask_worker_death_is_retried_once_then_recorded_failed(small, tmp_path):
     from bioflex_jsb.sweep.dask_cluster import DaskExecutor
 

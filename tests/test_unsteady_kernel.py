@@ -153,6 +153,7 @@ COMPILE = ("from bioflex_jsb.simulation import step_kernel as K, unsteady_kernel
            "UK.compile_now(); print(len(K.cache_files(UK.unsteady_kernel)))")
 
 
+@pytest.mark.slow  # recompiles the kernel: 13-20 s
 def test_a_damaged_kernel_cache_is_discarded_recompiled_and_said_once(tmp_path):
     """The unsteady kernel's cache heals as the quasi-steady kernel's (step_kernel.guard_cache;
     tests/test_faults.py holds the kinds of damage): an emptied index is discarded with one
