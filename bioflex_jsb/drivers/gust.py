@@ -197,9 +197,11 @@ def run_gust(
     run's speed. The history then has the channels ``loads_<fs|md>_<quantity>_s<j>`` [N,
     N·m] and ``meta["loads"]`` (stations, methods, 1 g values); a wing without section loads
     (a modes file, no static equilibrium at this speed) or the native model has
-    ``meta["loads_unavailable"]`` (why) instead. Methods: both for the quasi-steady coupled
-    and qsd wings, force summation for the rigid model, mode displacement for the unsteady
-    wing (:mod:`bioflex_jsb.loads.stream`).
+    ``meta["loads_unavailable"]`` (why) instead. Methods: both for the coupled and qsd
+    wings (the unsteady wing's force summation with its strips' lag, apparent-mass and
+    Küssner increments recovered after the steps: :mod:`bioflex_jsb.loads.unsteady`), force
+    summation for the rigid model; a modes-file wing without EI, GJ has force summation only
+    (:mod:`bioflex_jsb.loads.stream`).
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
