@@ -58,6 +58,17 @@ airspeed.__name__ = "speed"
 airspeed.plain_numbers = True  # type: ignore[attr-defined]  # checks its own text
 
 
+def aircraft_speeds(args: argparse.Namespace) -> tuple[float, float | None]:
+    """(default speed, top of the flight speeds or None) [m/s] of a linear command: an
+    ``--aircraft`` with ``[airframe]`` speeds gives its cruise speed and the top of its speed
+    range (the SGS: 25, 28 m/s; the prototype's 15 m/s is below its stall), else the
+    prototype's :data:`DEFAULT_SPEED_M_S`."""
+    aircraft = getattr(args, "aircraft_definition", None)
+    if aircraft is not None and aircraft.airframe.cruise_speed_m_s is not None:
+        return aircraft.airframe.cruise_speed_m_s, aircraft.airframe.speed_range_m_s[1]
+    return DEFAULT_SPEED_M_S, None
+
+
 def speed_help(default: float | None = DEFAULT_SPEED_M_S, extra: str = "") -> str:
     """The --speed help line: unit, valid range, default."""
     tail = f"; default {default:g}" if default is not None else ""

@@ -9,6 +9,7 @@ from bioflex_jsb.cli.case import (
     DEFAULT_WING,
     SPEED_RANGE_TEXT,
     add_force_argument,
+    aircraft_speeds,
     airspeed,
     speed_help,
 )
@@ -38,8 +39,8 @@ it is a model file bioflex-jsb wrote, else give --force."""
 def register(sub) -> None:
     p = sub.add_parser("export", help="write the LTI model to .npz or .mat", description=HELP)
     add_wing_arguments(p, default=DEFAULT_WING)
-    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
-                   help="trim " + speed_help())
+    p.add_argument("--speed", type=airspeed, default=None, metavar="V",
+                   help="trim " + speed_help(extra="; an --aircraft's own cruise speed"))
     p.add_argument("--model", choices=("rigid", "coupled", "qsd"), default="coupled",
                    help="which linear model (default coupled)")
     p.add_argument("--out", required=True, metavar="FILE.npz|FILE.mat",
@@ -70,8 +71,11 @@ def run(args: argparse.Namespace) -> int:
                          f"{', '.join(FORMATS)}")
     check_output(args.out, args.force, "model file", ours=_is_our_model)
     build = wing_from_args(args)
-    ss = build_state_space(args.model, level_flight_condition(args.speed), build.model,
-                           controls=True)
+    if args.speed is None:
+        args.speed = aircraft_speeds(args)[0]
+    # the flight condition of the wing's own aircraft (its S, mass, derivatives)
+    condition = level_flight_condition(args.speed, airframe=build.model.airframe)
+    ss = build_state_space(args.model, condition, build.model, controls=True)
     metadata = {"software": f"bioflex-jsb {__version__}", "wing": build.variant.name,
                 "wing_variant": build.variant.as_dict(), "speed_m_s": args.speed,
                 "mass_basis": build.mass_basis, "model": args.model,

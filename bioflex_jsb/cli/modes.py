@@ -14,6 +14,7 @@ from bioflex_jsb.cli.case import (
     SPEED_MIN_M_S,
     SPEED_RANGE_TEXT,
     add_force_argument,
+    aircraft_speeds,
     airspeed,
     check_plot_path,
 )
@@ -110,18 +111,8 @@ def _check_shape_outputs(args, speeds) -> None:
                              f"{str(Path(args.animate).parent)!r} does not exist")
 
 
-def _aircraft_speeds(args) -> tuple[float, float | None]:
-    """(default speed, top of its flight speeds or None) [m/s]: an ``--aircraft`` with
-    ``[airframe]`` speeds gives its cruise speed and the top of its speed range (the SGS:
-    25, 28 m/s; a default of 15 m/s is below its stall), else the prototype's 15 m/s."""
-    aircraft = getattr(args, "aircraft_definition", None)
-    if aircraft is not None and aircraft.airframe.cruise_speed_m_s is not None:
-        return aircraft.airframe.cruise_speed_m_s, aircraft.airframe.speed_range_m_s[1]
-    return DEFAULT_SPEED_M_S, None
-
-
 def run(args: argparse.Namespace) -> int:
-    default_speed, flight_top = _aircraft_speeds(args)
+    default_speed, flight_top = aircraft_speeds(args)
     speeds = args.speed or [default_speed]
     check_plot_path(args.plot, args.force)
     _check_shape_outputs(args, speeds)
