@@ -58,8 +58,11 @@ def register(sub) -> None:
     p = sub.add_parser("sitl", help="real-time MAVLink vehicle (QGC, MAVProxy, MAVSDK)",
                        description=HELP)
     add_wing_arguments(p, default="optimised")
-    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
-                   help="trim airspeed [m/s] (default 15)")
+    from bioflex_jsb.cli.aircraft_option import cruise_speed_default
+
+    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=cruise_speed_default(),
+                   help="trim airspeed [m/s] (default 15; with --aircraft: its "
+                   "cruise_speed_m_s, within its speed_range_m_s)")
     p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
                    help="the trim the session starts from (and resets to): rigid (the paper's "
                    "reading, default) or elastic (the static aeroelastic equilibrium: the "
@@ -125,6 +128,10 @@ def run(args: argparse.Namespace) -> int:
         key = None if args.signing_key is None else read_signing_key(args.signing_key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
+
+    resolve_flight(args)  # --speed of the aircraft (its cruise speed by default)
+    args.speed = float(args.speed)
     home = _parse_home(args.home, DEFAULT_HOME)
     if args.aero == "unsteady" and (args.model != "coupled" or args.trim != "rigid"):
         raise UsageError(f"--aero unsteady is for --model coupled from --trim rigid, not "
@@ -132,10 +139,12 @@ def run(args: argparse.Namespace) -> int:
                          "linearised about the rigid trim; the rigid wing is quasi-steady)")
     build = wing_from_args(args)
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
+    airframe, speeds = _airframe(args)
     try:
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
-                      trim_mode=args.trim, aero=args.aero)
+                      trim_mode=args.trim, aero=args.aero, airframe=airframe,
+                      **({} if speeds is None else {"airspeed_range_m_s": speeds}))
     except (FdmError, InputError) as exc:  # the airframe cannot trim, a home out of range
         raise UsageError(str(exc)) from None
     try:
@@ -162,7 +171,8 @@ def run(args: argparse.Namespace) -> int:
             extra={"until_stopped": args.duration is None, "speedup": args.speedup,
                    "mavlink": endpoint.text(), "signed": key is not None,
                    "trim": args.trim, "aero": args.aero,
-                   "preflight_stable": check["stable"]})
+                   "preflight_stable": check["stable"], "glider": sim.glider,
+                   **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
         try:
             log = SplitLog(args.out, description, build, args.log_max_mb,
                            live_opener(args, open_log))
@@ -176,7 +186,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print(f"bioflex-jsb sitl: MAVLink 2 on {endpoint.text()} (local {host}:{port}"
               f"{', signed' if key else ''}), {args.speedup:g}x real time, {args.aero} "
-              f"{args.model} wing; Ctrl-C stops", file=sys.stderr)
+              f"{args.model} wing{'; a glider: speed held with pitch' if sim.glider else ''}"
+              "; Ctrl-C stops", file=sys.stderr)
     if not check["stable"]:
         print(f"bioflex-jsb sitl: warning: flying a model unstable at the trim speed "
               f"(--allow-unstable): largest growth {check['max_growth_1_s']:+.3g} 1/s",
@@ -195,6 +206,7 @@ def run(args: argparse.Namespace) -> int:
     summary = {
         "resets": sim.resets,
         "crashes": sim.crashes,
+        "landings": sim.landings,
         "last_reset": sim.last_reset,
         "refusals": sim.vehicle.refusals,
         "log_files": log.paths if log is not None else [],
@@ -227,6 +239,32 @@ def run(args: argparse.Namespace) -> int:
                                                 if args.out else ""), file=sys.stderr)
         return 130
     return 0
+
+
+def _airframe(args: argparse.Namespace):
+    """(the JSBSim airframe, the accepted speed targets [m/s]) of ``--aircraft`` when it
+    is another JSBSim aircraft than the prototype's: an aircraft without an engine with the
+    glider's autopilot (drivers/sitl.py glider_airframe; its speeds: its definition's
+    speed_range_m_s); (None, None): the prototype's SITL aircraft. An aircraft with an
+    engine is refused in one line (the SITL autopilot of an engine is the prototype's)."""
+    from bioflex_jsb.definition.flying import flight_speeds
+    from bioflex_jsb.drivers.sitl import glider_airframe
+
+    aircraft = getattr(args, "aircraft_definition", None)
+    if aircraft is None or aircraft.flight_problem() is None:
+        return None, None
+    airframe = glider_airframe(aircraft)
+    if not airframe.glider:
+        raise UsageError(f"--aircraft {aircraft.name}: sitl flies another JSBSim aircraft as "
+                         f"a glider (no engine); airframe.jsbsim = {aircraft.airframe.jsbsim!r}"
+                         f" has {airframe.engine_count} engine(s), whose autopilot is the "
+                         "prototype's only (docs/sitl.md)")
+    return airframe, tuple(flight_speeds(aircraft)[1])
+
+
+def _aircraft_source(args: argparse.Namespace) -> str:
+    aircraft = args.aircraft_definition
+    return str(aircraft.definition.path or aircraft.name)
 
 
 def _parse_home(text: str | None, default: tuple[float, float, float]):

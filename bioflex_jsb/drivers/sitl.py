@@ -3,7 +3,9 @@
 The one coupled step (:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`), on the
 ``bioflex_sitl`` aircraft, whose autopilot (``systems/bioflex_autopilot.xml`` and
 ``systems/bioflex_autothrottle.xml``, see :mod:`bioflex_jsb.generators.autopilot`) flies the
-modes of :mod:`bioflex_jsb.drivers.sitl_vehicle`, for as long as asked (or until stopped).
+modes of :mod:`bioflex_jsb.drivers.sitl_vehicle`, for as long as asked (or until stopped);
+or on another aircraft without an engine (a glider: :func:`glider_airframe`, its speed held
+with pitch by the glider's autopilot), whose arrival at the ground is a landing.
 
 Where it flies: home is a point on the ground (latitude, longitude, ground altitude AMSL;
 default :data:`DEFAULT_HOME`, the Canberra model aircraft field ArduPilot's SITL also
@@ -35,7 +37,8 @@ AP_HDG_RAD      heading held in CRUISE [rad, from north, clockwise]; sets CRUISE
 WP_RADIUS_M     default waypoint acceptance radius [m], 5..500
 LOIT_RAD_M      loiter radius [m], 20..1000
 RTL_ALT_M       return altitude [m above home], 20..1000
-AIRSPEED_MS     airspeed held by the autothrottle [m/s], 12..22 (MAV_CMD_DO_CHANGE_SPEED)
+AIRSPEED_MS     airspeed held by the autothrottle [m/s], 12..22 (MAV_CMD_DO_CHANGE_SPEED);
+                a glider's: held with pitch, within its definition's speed range
 GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up], ±5
 GUST_LEN_M      length of that gust [m], 1..500
 GUST_TRIG       write 1: the gust starts now; reads 1 while it blows, then 0
@@ -62,7 +65,11 @@ from bioflex_jsb.drivers.sitl_vehicle import (
     SitlVehicle,
 )
 from bioflex_jsb.errors import InputError
-from bioflex_jsb.generators.autopilot import SITL_AIRCRAFT
+from bioflex_jsb.generators.autopilot import (
+    GLIDER_SYSTEM_FILE,
+    SITL_AIRCRAFT,
+    render_glider_autopilot,
+)
 from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink import VehicleState
 from bioflex_jsb.runtime.coupled_step import CoupledStep
@@ -81,6 +88,23 @@ DEFAULT_START_HEIGHT_M = 100.0
 START_HEIGHT_RANGE_M = (20.0, 3000.0)
 ALT_HOLD_RANGE_ABOVE_HOME_M = (20.0, 1500.0)
 MAX_RESETS_PER_MINUTE = 30  # a run that keeps diverging: each reset still costs a trim
+# A glider's guidance (SitlSim with an airframe without an engine; docs/sitl.md "A glider"):
+# LOIT_RAD_M's default is a circle it flies within the guidance's ±30° bank at 25 m/s, the
+# SGS's cruise (V²/(g tan 30°) = 110 m; 150 m needs 23°), and the L1 period is longer than
+# the prototype's 17 s (L1 = ζPV/π = 149 m at 25 m/s): with 17 s (L1 101 m) the SGS's slow
+# roll (≈ 0.5 rad/s per unit aileron) made its 150 m loiter wander between 94 and 319 m from
+# the centre; with 25 s it holds 144-146 m (tests/test_glider_sitl.py).
+GLIDER_LOITER_RADIUS_M = 150.0
+GLIDER_L1_PERIOD_S = 25.0
+
+
+def glider_airframe(aircraft) -> Airframe:
+    """The JSBSim airframe of an aircraft definition (``--aircraft``: its own JSBSim
+    aircraft, runtime/other_airframe.py) with the glider's autopilot system added
+    (:func:`~bioflex_jsb.generators.autopilot.render_glider_autopilot`)."""
+    from bioflex_jsb.runtime.other_airframe import airframe_for
+
+    return airframe_for(aircraft, systems={GLIDER_SYSTEM_FILE: render_glider_autopilot()})
 
 
 class PacingStats:
@@ -196,7 +220,7 @@ class SitlParameters:
             self._range(name, value, 20.0, 1000.0, " m")
             st.rtl_altitude_m = value
         elif name == "AIRSPEED_MS":
-            self._range(name, value, *AIRSPEED_RANGE_M_S, " m/s")
+            self._range(name, value, *s.airspeed_range_m_s, " m/s")
             v.change_speed(value)
         elif name == "GUST_AMP_MS":
             self._range(name, value, -5.0, 5.0, " m/s")
@@ -243,18 +267,25 @@ class SitlSim:
                  home: tuple[float, float, float] = DEFAULT_HOME,
                  start_height_m: float = DEFAULT_START_HEIGHT_M, dt_s: float = DEFAULT_DT_S,
                  speedup: float = 1.0, airframe: Airframe | None = None,
-                 trim_mode: str = "rigid", aero: str = "quasi-steady") -> None:
+                 trim_mode: str = "rigid", aero: str = "quasi-steady",
+                 airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S) -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
         :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
         ``aero="unsteady"``). ``aero``: the coupled wing's strips, ``quasi-steady`` or
         ``unsteady`` (Jones lag states, apparent mass, Küssner gust), handed to the coupled
         step as they are (an unsupported combination is refused there in one line,
-        InputError; both strips run on the compiled step)."""
+        InputError; both strips run on the compiled step). ``airframe``: the prototype's
+        SITL aircraft by default, or an aircraft without an engine with the glider's
+        autopilot (:func:`glider_airframe`): the vehicle then flies as a glider (its speed
+        held with pitch, no altitude hold; ``glider``). ``airspeed_range_m_s``: the
+        speed targets accepted [m/s] (AIRSPEED_MS, DO_CHANGE_SPEED)."""
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
         self.aero = aero
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
+        self.glider = bool(self.airframe.glider)
+        self.airspeed_range_m_s = tuple(float(v) for v in airspeed_range_m_s)
         self._wing_model, self._model0 = wing_model, model
         self.home_deg = tuple(float(x) for x in home)
         self.start_height_m = float(start_height_m)
@@ -264,6 +295,7 @@ class SitlSim:
         self.resync = False
         self.resets = 0
         self.crashes = 0  # resets after ground contact (the others: the model diverged)
+        self.landings = 0  # a glider's arrivals at the ground (reset, not crashes)
         self.last_reset: str | None = None
         self.on_reset: Callable[[str], None] | None = None
         self._k_base = 0  # steps flown by the cores before the present one
@@ -274,7 +306,10 @@ class SitlSim:
         self.n_modes = self.core.n_modes
         twist = np.asarray(modes.twist_rad, dtype=float)
         tip = int(np.argmax(np.abs(np.asarray(modes.stations_m, dtype=float))))
-        self._tip_twist_per_mode = np.abs(twist[:, tip]) / np.max(np.abs(twist), axis=1)
+        # a mode without twist (a pure bending mode of another wing) adds no tip twist
+        peak = np.max(np.abs(twist), axis=1)
+        self._tip_twist_per_mode = np.divide(np.abs(twist[:, tip]), peak,
+                                             out=np.zeros_like(peak), where=peak > 0.0)
         self.h0_m = self.start_altitude_m
         ground = self.home_deg[2]
         self.altitude_hold_range_m = (ground + ALT_HOLD_RANGE_ABOVE_HOME_M[0],
@@ -292,6 +327,9 @@ class SitlSim:
         home_rad = (math.radians(self.home_deg[0]), math.radians(self.home_deg[1]),
                     self.home_deg[2])
         self.vehicle = SitlVehicle(self, home_rad)
+        if self.glider:
+            self.vehicle.settings.loiter_radius_m = GLIDER_LOITER_RADIUS_M
+            self.vehicle.settings.l1_period_s = GLIDER_L1_PERIOD_S
         self._guide_every = max(1, int(round(GUIDANCE_PERIOD_S / self.dt_s)))
 
     def _new_core(self, model: str) -> None:
@@ -409,7 +447,11 @@ class SitlSim:
         "Diverged: ``reason``"); put the aircraft back in trim at the start point over
         home. ``stopped`` and ``last_reset`` say which."""
         impact = self.ground_contact()
-        if impact is not None:  # the ground, not the model, ended the flight
+        if impact is not None and self.glider:  # its glide's end: where a glider lands
+            self.landings += 1
+            reason = f"ground reached at t = {self.t_s:.3f} s: {impact}"
+            self.vehicle.status(5, "Landed: " + reason)
+        elif impact is not None:  # the ground, not the model, ended the flight
             self.crashes += 1
             reason = f"ground contact at t = {self.t_s:.3f} s: {impact}"
             self.vehicle.status(2, "Crashed: " + reason)

@@ -21,6 +21,13 @@ Lateral guidance: L1 (:mod:`bioflex_jsb.simulation.guidance`), bank commanded th
 ``ap/roll-mode`` 1. Waypoints are reached within their acceptance radius (item param2, else
 WP_RADIUS_M) — not by passing abeam: an aircraft that misses one turns back for it.
 The altitude of a waypoint is commanded from the start of its leg (no slope).
+
+A glider (``sim.glider``: an aircraft without an engine flying the glider's autopilot,
+:func:`bioflex_jsb.generators.autopilot.render_glider_autopilot`) flies the same modes with
+its airspeed held by the pitch loop and no altitude hold: it descends along its glide.
+Commands that set only an altitude (DO_CHANGE_ALTITUDE, AP_ALT_M, a guided item with
+current = 3) are refused with the reason; the altitudes of positions (waypoints,
+DO_REPOSITION, RTL_ALT_M) are not flown, which the mode's STATUSTEXT says once.
 """
 
 from __future__ import annotations
@@ -191,7 +198,9 @@ class SitlVehicle:
         else:  # stick modes
             self._nav = ("stick",)
         if not quiet:
-            self.status(6, f"Mode {MODES.mode_name(number)}")
+            note = (" (glider: altitude not held)" if self.sim.glider and number not in
+                    (MODES.MANUAL, MODES.STABILIZE, MODES.FLY_BY_WIRE_A) else "")
+            self.status(6, f"Mode {MODES.mode_name(number)}{note}")
         self._apply_mode_flags()
         return None
 
@@ -218,7 +227,8 @@ class SitlVehicle:
             return "disarm in flight refused (force with param2 = 21196)"
         self.armed = armed
         self.sim.airframe["ap/armed"] = 1.0 if armed else 0.0
-        self.status(4 if not armed else 6, "Disarmed: motor stopped" if not armed else "Armed")
+        motor = "no motor (glider)" if self.sim.glider else "motor stopped"
+        self.status(4 if not armed else 6, f"Disarmed: {motor}" if not armed else "Armed")
         return None
 
     def manual(self, pitch: float | None, roll: float | None) -> bool:
@@ -240,7 +250,7 @@ class SitlVehicle:
 
     # -- commands -------------------------------------------------------------------------
     def change_speed(self, speed_m_s: float) -> str | None:
-        lo, hi = AIRSPEED_RANGE_M_S
+        lo, hi = self.sim.airspeed_range_m_s
         if not lo <= speed_m_s <= hi:
             return f"airspeed must be in {lo:g}..{hi:g} m/s"
         self.speed_target_m_s = float(speed_m_s)
@@ -249,6 +259,9 @@ class SitlVehicle:
         return None
 
     def change_altitude(self, alt_amsl_m: float) -> str | None:
+        if self.sim.glider:
+            return ("a glider cannot hold an altitude (no engine): it glides at the airspeed "
+                    "target (AIRSPEED_MS)")
         lo, hi = self.sim.altitude_hold_range_m
         if not lo <= alt_amsl_m <= hi:
             return f"altitude must be in {lo:.0f}..{hi:.0f} m AMSL"
@@ -272,7 +285,7 @@ class SitlVehicle:
         if radius_m and not LOITER_RADIUS_RANGE_M[0] <= radius_m <= LOITER_RADIUS_RANGE_M[1]:
             return f"loiter radius must be in {LOITER_RADIUS_RANGE_M[0]:g}.." \
                    f"{LOITER_RADIUS_RANGE_M[1]:g} m"
-        if alt_amsl_m is not None:
+        if alt_amsl_m is not None and not self.sim.glider:  # a glider flies to it gliding
             reason = self.change_altitude(alt_amsl_m)
             if reason:
                 return reason
@@ -369,7 +382,7 @@ class SitlVehicle:
         if cmd == NAV_LOITER_TIME:
             checks.append((1, "time [s]", item.param1, (0.0, LOITER_TIME_MAX_S), None))
         if cmd == DO_CHANGE_SPEED:
-            checks.append((2, "speed [m/s]", item.param2, AIRSPEED_RANGE_M_S, False))
+            checks.append((2, "speed [m/s]", item.param2, self.sim.airspeed_range_m_s, False))
         for k, label, value, (lo, hi), signed in checks:
             if signed is None:  # a count or a time: required, within lo..hi
                 ok = math.isfinite(value) and lo <= value <= hi

@@ -56,12 +56,18 @@ GAMMA_LIMIT_RAD = math.radians(45.0)
 PITCH_TRIM = "fcs/pitch-trim-cmd-norm"  # the control JSBSim's full trim moves for q̇
 
 
-def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float]
+def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float],
+                 systems: dict[str, str] | None = None
                  ) -> tuple[tempfile.TemporaryDirectory, str]:
     """A temporary JSBSim root holding a copy of the aircraft ``jsbsim_path``
     (``<dir>/<name>.xml``) with the modal-wing reactions at ``cg_m`` [m, structural frame]:
-    (the directory, the aircraft's name). Raises :class:`AircraftLoadError` (one line) for
-    a file JSBSim could not read either or one that has the reactions already."""
+    (the directory, the aircraft's name). ``systems``: system files to add (file name
+    without ``.xml`` → its text; the SITL glider's autopilot,
+    :func:`bioflex_jsb.generators.autopilot.render_glider_autopilot`), written to the copy's
+    ``Systems/`` (JSBSim looks there first) and included ahead of its flight controls, in
+    order (JSBSim cannot add a system to a loaded model). Raises :class:`AircraftLoadError`
+    (one line) for a file JSBSim could not read either or one that has the reactions
+    already."""
     src = Path(jsbsim_path)
     name = src.stem
     try:
@@ -87,6 +93,11 @@ def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float]
     for name_, (direction, _text) in airframe_xml.EXTERNAL_MOMENTS.items():
         _direction(ET.SubElement(ext, "moment", name=name_, frame="BODY", unit="LBSFT"),
                    direction)
+    if systems:
+        fcs = root.find("flight_control")
+        at = list(root).index(fcs) if fcs is not None else len(root)
+        for i, file in enumerate(systems):
+            root.insert(at + i, ET.Element("system", file=file))
     for key in [k for k in root.attrib if k.startswith("{")]:  # the schema's location
         del root.attrib[key]
     work = tempfile.TemporaryDirectory(prefix="bioflex-jsb-aircraft-")
@@ -94,6 +105,10 @@ def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float]
     shutil.copytree(src.parent, base / "aircraft" / name)
     tree.write(base / "aircraft" / name / f"{name}.xml", encoding="utf-8",
                xml_declaration=True)
+    for file, text in (systems or {}).items():
+        target = base / "aircraft" / name / "Systems" / f"{file}.xml"
+        target.parent.mkdir(exist_ok=True)
+        target.write_text(text, encoding="utf-8")
     package = Path(jsbsim.get_default_root_dir())
     for sub in ("engine", "systems"):
         if (package / sub).is_dir():
@@ -178,15 +193,16 @@ def glide_trim(fdm, speed_m_s: float) -> int:
 
 
 def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airframe_class,
-                       definition_name: str | None = None):
+                       definition_name: str | None = None,
+                       systems: dict[str, str] | None = None):
     """An ``airframe_class`` (:class:`~bioflex_jsb.runtime.fdm.Airframe`) of another
     aircraft (``<dir>/<name>.xml``: a jsbsim package aircraft or a user's) with the modal
     wing's hooks at ``cg_m`` [m, structural frame], loaded from a copy
     (:func:`derived_root`, kept while the airframe lives), its α range from its tables;
     ``definition_name``: the aircraft definition it flies (the name of the
     :class:`~bioflex_jsb.parameters.airframe.AirframeData` its wing carries: the coupled
-    step checks the pair)."""
-    work, name = derived_root(jsbsim_path, cg_m)
+    step checks the pair); ``systems``: system files added to the copy (:func:`derived_root`)."""
+    work, name = derived_root(jsbsim_path, cg_m, systems)
     airframe = airframe_class(work.name, name)
     airframe._workdir = work
     airframe.alpha_table_range_rad = alpha_table_range_rad(jsbsim_path)
@@ -194,18 +210,19 @@ def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airfr
     return airframe
 
 
-def airframe_for(aircraft=None, root=None):
+def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None):
     """The JSBSim airframe (:class:`~bioflex_jsb.runtime.fdm.Airframe`) an aircraft
     definition flies (an :class:`~bioflex_jsb.definition.aircraft.Aircraft`; None: the
     generated prototype): the prototype's generated ``bioflex`` (under ``root``, the default
     search without it) for the prototype's airframe, else its ``airframe.jsbsim`` aircraft
-    with the modal wing's hooks (:func:`airframe_from_file`)."""
+    with the modal wing's hooks (:func:`airframe_from_file`) and ``systems`` added (the SITL
+    glider's autopilot; the prototype's SITL aircraft has its own: generators/autopilot.py)."""
     from bioflex_jsb.runtime.fdm import Airframe
 
     if aircraft is None or not aircraft.airframe.jsbsim_path:
         return Airframe(root)
     return airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m, Airframe,
-                              aircraft.name)
+                              aircraft.name, systems)
 
 
 # Central-difference steps of the glider's A_RR (:func:`rigid_jacobian`): 0.01 m/s of
