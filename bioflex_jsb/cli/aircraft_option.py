@@ -24,9 +24,9 @@ LINEAR_COMMANDS = ("modes", "flutter")
 # The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
 # flight_refusal: its own JSBSim aircraft, a glider in its steady glide; trim reads its own
 # --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's copy with the wing:
-# docs/native.md); the others (sitl, export, ardupilot, loads) refuse an airframe other than
-# the prototype's in one line.
-FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim")
+# docs/native.md; sitl flies a glider with the glider's autopilot: cli/sitl.py); the others
+# (export, ardupilot, loads) refuse an airframe other than the prototype's in one line.
+FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl")
 
 
 class CruiseSpeed(float):
@@ -77,13 +77,11 @@ class _AircraftAction(argparse._StoreAction):
                 problem = aircraft.linear_problem()
             elif command in FLIGHT_COMMANDS:
                 problem = flight_refusal(aircraft)
-            elif command == "sitl" and aircraft.flight_problem():
-                problem = flight_refusal(aircraft) or sitl_refusal(aircraft)
             elif aircraft.flight_problem() and aircraft.airframe.jsbsim_path:
                 problem = (f"aircraft {aircraft.name!r}: {command} takes the prototype's "
                            "airframe only in this version (airframe.jsbsim = "
                            f"{aircraft.airframe.jsbsim!r}; gust, compare, trim, export-jsbsim, "
-                           "modes and flutter take this one: docs/aircraft.md)")
+                           "sitl, modes and flutter take this one: docs/aircraft.md)")
             else:
                 problem = aircraft.flight_problem()
             variant = aircraft.variant()
@@ -95,20 +93,6 @@ class _AircraftAction(argparse._StoreAction):
         namespace.wing = variant.name if named == variant else AIRCRAFT_PREFIX + aircraft.name
         namespace.aircraft = values
         namespace.aircraft_definition = aircraft
-
-
-def sitl_refusal(aircraft) -> str:
-    """Why ``sitl`` does not fly an aircraft other than the prototype (one line): the SITL
-    vehicle is the prototype's JSBSim autopilot (the generated ``bioflex_sitl``: altitude
-    and airspeed held with the throttle, systems/bioflex_autopilot.xml and
-    bioflex_autothrottle.xml); another JSBSim aircraft has no such autopilot, and a glider
-    (SGS: no engine) no throttle to hold its altitude with, so its modes (CRUISE, LOITER,
-    RTL at a held altitude) cannot be flown as they are."""
-    return (f"aircraft {aircraft.name!r}: sitl flies the prototype's JSBSim autopilot "
-            "(bioflex_sitl: altitude and airspeed held with the throttle); "
-            f"airframe.jsbsim = {aircraft.airframe.jsbsim!r} has no such autopilot (a glider "
-            "has no throttle to hold an altitude with); fly it with gust or compare "
-            "(docs/aircraft.md)")
 
 
 def add_aircraft_argument(parser: argparse.ArgumentParser, wing_default: str | None) -> None:
