@@ -35,7 +35,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.structures.beam import beam_modes
 from bioflex_jsb.structures.modal_file import read_modal_file
-from tests.cli_helpers import assert_one_line_error, run_cli
+from tests.cli_helpers import run_cli
 
 G = 9.80665
 RHO = 1.225
@@ -190,7 +190,7 @@ def test_free_aircraft_flutter_both_aerodynamic_models(sgs):
     assert not un.present_at_lower_end
 
 
-def test_commands_take_the_aircraft_file(capsys):
+def test_commands_take_the_aircraft_file(capsys, tmp_path):
     path = "bioflex_jsb/data/aircraft/sgs_elastic.toml"
     code, out, _ = run_cli(capsys, "modes", "--aircraft", path, "--speed", "25", "--json")
     assert code == 0
@@ -202,12 +202,21 @@ def test_commands_take_the_aircraft_file(capsys):
     assert sp and sp[0]["frequency_rad_s"] == pytest.approx(2.466, abs=1e-3)
     code, out, _ = run_cli(capsys, "flutter", "--aircraft", path, "--range", "5:150")
     assert code == 0 and "59.1" in out
-    # the flight commands fly it (tests/test_second_aircraft_flight.py); the commands not
-    # yet moved to another airframe (export: the prototype's level-flight LTI export)
-    # refuse it in one line, exit 2
-    code, _, err = run_cli(capsys, "export", "--aircraft", path, "--out", "never.npz")
-    assert_one_line_error(code, err, "export takes the prototype's airframe only")
-    # sitl: the prototype's JSBSim autopilot holds altitude with the throttle; a glider has
-    # none (cli/aircraft_option.py sitl_refusal)
-    code, _, err = run_cli(capsys, "sitl", "--aircraft", path)
-    assert_one_line_error(code, err, "sitl flies the prototype's JSBSim autopilot")
+    # the flight commands fly it (tests/test_second_aircraft_flight.py; sitl:
+    # tests/test_glider_sitl.py); export writes the LTI model of its own glide condition at
+    # its cruise speed (the throttle column zero: no engine)
+    out_file = tmp_path / "sgs.npz"
+    code, out, err = run_cli(capsys, "export", "--aircraft", path, "--out", str(out_file),
+                             "--json")
+    assert code == 0, err
+    info = json.loads(out)
+    assert info["speed_m_s"] == 25.0 and info["wing"] == "sgs"
+    from bioflex_jsb.sinks.model_export import read_state_space
+
+    ss = read_state_space(out_file)
+    assert ss.a.shape[0] == 10
+    throttle = list(ss.inputs).index("throttle")
+    assert not ss.b[:, throttle].any()
+    mine = api.linear_model(sgs_wing := api.load_aircraft("sgs_elastic").wing(), 25.0,
+                            "coupled")
+    assert ss.a == pytest.approx(mine.a, rel=1e-12, abs=1e-12), sgs_wing.variant.name

@@ -20,12 +20,12 @@ AIRCRAFT_PREFIX = "aircraft:"
 # The commands whose analyses are linear and take the aircraft's own airframe
 # (definition/aircraft.py: Aircraft.linear_problem); the others fly JSBSim's prototype
 # airframe and refuse another one (Aircraft.flight_problem).
-LINEAR_COMMANDS = ("modes", "flutter")
+LINEAR_COMMANDS = ("modes", "flutter", "export")
 # The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
 # flight_refusal: its own JSBSim aircraft, a glider in its steady glide; trim reads its own
 # --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's copy with the wing:
 # docs/native.md; sitl flies a glider with the glider's autopilot: cli/sitl.py); the others
-# (export, ardupilot, loads) refuse an airframe other than the prototype's in one line.
+# (ardupilot, loads) refuse an airframe other than the prototype's in one line.
 FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl")
 
 
@@ -81,7 +81,7 @@ class _AircraftAction(argparse._StoreAction):
                 problem = (f"aircraft {aircraft.name!r}: {command} takes the prototype's "
                            "airframe only in this version (airframe.jsbsim = "
                            f"{aircraft.airframe.jsbsim!r}; gust, compare, trim, export-jsbsim, "
-                           "sitl, modes and flutter take this one: docs/aircraft.md)")
+                           "sitl, modes, flutter and export take this one: docs/aircraft.md)")
             else:
                 problem = aircraft.flight_problem()
             variant = aircraft.variant()
