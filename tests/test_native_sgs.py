@@ -66,7 +66,6 @@ def _fly(root: Path, case, seconds: float = FLY_S) -> dict[str, np.ndarray]:
     """The exported script in JSBSim (python module, ``root`` as its root) for ``seconds``:
     property → samples, one per step."""
     fdm = jsbsim.FGFDMExec(str(root))
-    fdm.set_debug_level(0)
     assert fdm.load_script(case.script)
     assert fdm.get_delta_t() == pytest.approx(case.dt_s, rel=1e-12)
     fdm.run_ic()
@@ -222,7 +221,6 @@ def test_exported_frequencies_are_the_definitions_modes(exported):
     np.testing.assert_allclose(written, omega_sq, rtol=OMEGA_RTOL, atol=0.0)
     # JSBSim reads the same numbers
     fdm = jsbsim.FGFDMExec(str(root))
-    fdm.set_debug_level(0)
     assert fdm.load_model("sgs_elastic")
     np.testing.assert_allclose([fdm[f"bioflex/modal/omega{i}-sq-rad2_s2"] for i in (1, 2, 3)],
                                omega_sq, rtol=OMEGA_RTOL, atol=0.0)

@@ -344,3 +344,21 @@ def test_trim_failure_diagnosis_from_jsbsim_report(airframe, records, expected):
     message = airframe._diagnose_trim_failure(15.0)
     assert expected in message and "\n" not in message
     airframe._log.records.clear()
+
+
+def test_the_diagnosis_does_not_depend_on_jsbsims_process_wide_debug_level(airframe):
+    """JSBSim's debug level is the process's: another FGFDMExec silenced (level 0, as a test
+    of the exported aircraft did) removed the trim's axis report the diagnosis reads, and
+    60 m/s read "accelerates even at zero throttle" (CI under pytest-xdist, twice)."""
+    import jsbsim
+
+    other = jsbsim.FGFDMExec(None)
+    level = other.get_debug_level()
+    other.set_debug_level(0)
+    try:
+        with pytest.raises(jsbsim_fdm.TrimError) as err:
+            airframe.trim(60.0)
+        assert "more thrust than the motor gives" in str(err.value)
+        assert other.get_debug_level() == 0  # the caller's level is left as it was
+    finally:
+        other.set_debug_level(level)

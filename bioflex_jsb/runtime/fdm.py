@@ -94,7 +94,7 @@ from bioflex_jsb.runtime.roots import (  # noqa: F401  (where the JSBSim files a
     candidate_roots,
     locate_root,
 )
-from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure
+from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure, trim_report
 from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD
 
 DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
@@ -286,9 +286,6 @@ class Airframe:
         self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
         self.glider = self.engine_count == 0  # trimmed to a glide (runtime/other_airframe.py)
         self._workdir = None  # the temporary root of an aircraft from a file (other_airframe.py)
-        # every trim starts from the loaded controls, not the last trim's (its starting point)
-        self._trim_start = {n: self._trim_fdm[n] for n in TRIM_CONTROLS + tuple(
-            f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engine_count))}
 
     # ---- JSBSim messages ----------------------------------------------------------
     @property
@@ -404,8 +401,6 @@ class Airframe:
             for name in _WIND_PROPERTIES:
                 fdm[name] = 0.0
         tfdm = self._trim_fdm
-        for name, value in self._trim_start.items():
-            tfdm[name] = value
         self._set_level_ic(tfdm, v, h)
         if self.glider:  # no engine: the steady glide at v (runtime/other_airframe.py)
             from bioflex_jsb.runtime.other_airframe import glide_trim
@@ -417,7 +412,7 @@ class Airframe:
             return result
         self._spin_up_propeller(tfdm, v)
         self._log.records.clear()
-        with _captured(self._log):
+        with _captured(self._log), trim_report(tfdm):
             try:
                 tfdm.do_trim(TRIM_MODE_FULL)
                 failed = False

@@ -4,6 +4,7 @@ report). Pure text processing: no JSBSim import."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 
@@ -74,3 +75,18 @@ def diagnose_trim_failure(text: str, v: float, alpha_limits_rad: tuple[float, fl
         )
     reason = first_warning
     return f"cannot trim {where}: JSBSim's trim failed" + (f" ({reason})" if reason else "")
+
+
+@contextlib.contextmanager
+def trim_report(fdm):
+    """JSBSim prints its trim's axis report, which :func:`diagnose_trim_failure` reads, only
+    at a debug level of 1 or more, and that level is the process's (``FGJSBBase::debug_lvl``:
+    any ``FGFDMExec.set_debug_level`` changes it for every instance; a test that silenced its
+    own JSBSim made a later 60 m/s trim read "accelerates even at zero throttle"): at least 1
+    during the trim, the level found restored after."""
+    level = fdm.get_debug_level()
+    fdm.set_debug_level(max(1, level))
+    try:
+        yield
+    finally:
+        fdm.set_debug_level(level)
