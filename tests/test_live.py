@@ -226,6 +226,16 @@ def _resubscribe(client: WsClient, message: dict) -> bool:
     return True
 
 
+def _on_text(client: WsClient, payload: str, channels: dict) -> None:
+    """A text message of the server: subscribe to what it advertises, or again to what it
+    refused a moment after advertising it (:func:`_resubscribe`)."""
+    message = json.loads(payload)
+    if message["op"] == "advertise":
+        _subscribe_new(client, message, channels)
+    else:
+        _resubscribe(client, message)
+
+
 def _file_messages(path) -> tuple[dict, dict]:
     """The file's messages {(topic, log time): bytes} and schemas {topic: (name, data)}."""
     from mcap.reader import make_reader
@@ -368,11 +378,7 @@ def test_a_client_that_stops_reading_never_stalls_a_sitl_session(tmp_path):
             assert time.monotonic() < end, "the session's channels were not advertised"
             kind, payload = client.recv()
             if kind == "text":
-                message = json.loads(payload)
-                if message["op"] == "advertise":
-                    _subscribe_new(client, message, channels)
-                else:
-                    _resubscribe(client, message)
+                _on_text(client, payload, channels)
             elif payload[0] == 0x01:
                 received.add(struct.unpack_from("<I", payload, 1)[0])
         t0 = time.monotonic()
@@ -454,11 +460,7 @@ def test_one_server_serves_a_sitl_session_across_its_log_files(tmp_path):
             if kind == "close":
                 break
             if kind == "text":
-                message = json.loads(payload)
-                if message["op"] == "advertise":
-                    _subscribe_new(client, message, channels)
-                else:
-                    _resubscribe(client, message)
+                _on_text(client, payload, channels)
             elif payload[0] == 0x01 and channels[struct.unpack_from("<I", payload, 1)[0]][
                     "topic"] == "/bioflex/coupled/modal":
                 times.append(struct.unpack_from("<Q", payload, 5)[0])
@@ -515,11 +517,7 @@ def test_an_ardupilot_session_is_served_live(tmp_path):
             except ConnectionError:
                 return
             if kind == "text":
-                message = json.loads(payload)
-                if message["op"] == "advertise":
-                    _subscribe_new(client, message, channels)
-                else:
-                    _resubscribe(client, message)
+                _on_text(client, payload, channels)
             elif kind == "binary" and channels[struct.unpack_from(
                     "<I", payload, 1)[0]]["topic"] == autopilot:
                 got.append((struct.unpack_from("<Q", payload, 5)[0], payload[13:]))
