@@ -64,6 +64,7 @@ from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks.mcap import RunLog
+from bioflex_jsb.sinks.mcap.scene import DEFAULT_EXAGGERATION
 
 LENGTH_FACTORS = (1, 2, 4)  # run lengths, × ``steps``
 DEFAULT_STEPS = 300  # the shortest run (module docstring: shorter than the speed states)
@@ -99,9 +100,9 @@ RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
-# The 3-D scene of a gust log at true scale: cli.gust.SCENE_EXAGGERATION (the CLI is above
-# this layer; tests/test_bench.py holds the two equal).
-GUST_SCENE_EXAGGERATION = 1.0
+# The 3-D scene of a gust log: the scene's default, true scale, as cli.gust.SCENE_EXAGGERATION
+# (the CLI is above this layer; tests/test_bench.py holds the two equal).
+GUST_SCENE_EXAGGERATION = DEFAULT_EXAGGERATION
 
 
 @dataclass(frozen=True)

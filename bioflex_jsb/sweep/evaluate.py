@@ -40,6 +40,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bioflex_jsb.sinks.mcap.scene import DEFAULT_EXAGGERATION
 from bioflex_jsb.sweep.campaign import (
     EIGEN_MODES,
     Case,
@@ -52,10 +53,9 @@ _EIGEN_CACHE: dict[tuple, Any] = {}
 _AIRCRAFT_BUILDS: dict[tuple, Any] = {}  # an aircraft's wing (its own airframe's model)
 # What a case imports beyond the executors' preload (measured: a first case imported these
 # and numba, 1-2 s under load): imported, and the step kernel loaded, once per worker.
-# A case's log has the 3-D scene a gust run's has (sinks/mcap/scene.py), at the same
-# exaggeration as the gust command's (cli/gust.py SCENE_EXAGGERATION: true scale; a test
-# holds the two equal; the sweep does not import the CLI).
-SCENE_EXAGGERATION = 1.0
+# A case's log has the 3-D scene a gust run's has, at the scene's default exaggeration (true
+# scale), as the gust command's (cli/gust.py SCENE_EXAGGERATION; a test holds them equal).
+SCENE_EXAGGERATION = DEFAULT_EXAGGERATION
 WARM_MODULES = ("bioflex_jsb.flight_dynamics.eigen", "bioflex_jsb.flight_dynamics.flutter_engine",
                 "bioflex_jsb.flight_dynamics.wing_model", "bioflex_jsb.structures.wing_model",
                 "bioflex_jsb.simulation.results", "bioflex_jsb.drivers.gust")
