@@ -139,6 +139,13 @@ def test_dense_rows_sees_only_exact_diagonal_rows():
     assert UK.dense_rows(phi, dphi) == 2
     dphi[3, 0] = -2.0
     assert UK.dense_rows(phi, dphi) == 4
+    # a diagonal row driven by the gust alone stays out; by any other input it is dense
+    psi = np.zeros((5, UK.N_INPUTS))
+    psi[4, UK.GUST] = 0.5
+    assert UK.dense_rows(phi, dphi, (psi, psi, psi)) == 4
+    psi2 = np.zeros((5, UK.N_INPUTS))
+    psi2[4, 0] = 1e-300
+    assert UK.dense_rows(phi, dphi, (psi, psi, psi2)) == 5
 
 
 def test_layout_header_points_at_every_block():
