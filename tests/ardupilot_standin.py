@@ -191,16 +191,20 @@ class ArduPilotStandin:
     """ArduPilot SITL's JSON backend, network side: send servos, read and parse replies.
 
     ``target``: (host, port) of the physics server. ``channels``: 16 or 32 (SERVO_32_ENABLE).
-    ``rate_hz``: the frame_rate field (SIM_RATE_HZ; ArduPilot's default 1200).
+    ``rate_hz``: the frame_rate field sent [Hz] (default 1200, ArduPilot's SIM_RATE_HZ
+    default), fixed; or, with ``sim_rate_hz`` [Hz] set, ArduPilot's own ``rate_hz``: 1200
+    at the start, after every accepted reply 1/Δtimestamp moved by at most 1 Hz towards
+    ``sim_rate_hz`` and truncated to an integer (``JSON::recv_fdm``, ``JSON::update``).
     """
 
     def __init__(self, target: tuple[str, int], channels: int = 16, rate_hz: int = 1200,
-                 timeout_s: float = DEFAULT_TIMEOUT_S) -> None:
+                 timeout_s: float = DEFAULT_TIMEOUT_S, sim_rate_hz: int | None = None) -> None:
         if channels not in (16, 32):
             raise ValueError(f"channels must be 16 or 32, got {channels}")
         self.target = target
         self.channels = channels
         self.rate_hz = rate_hz
+        self.sim_rate_hz = sim_rate_hz
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(timeout_s)
@@ -218,6 +222,8 @@ class ArduPilotStandin:
             self.sock.bind(("127.0.0.1", 0))
             self.sock.settimeout(timeout)
         self.frame_counter = 0
+        if self.sim_rate_hz is not None:
+            self.rate_hz = ARDUPILOT_START_RATE_HZ
         self.last_timestamp_s = 0.0
         self.time_now_us = 0.0
         self.physics_resets_seen = 0
@@ -296,8 +302,20 @@ class ArduPilotStandin:
         self.time_now_us += dt_s * 1e6
         self.last_timestamp_s = timestamp_s
         self.frame_counter += 1
+        self.follow_rate(dt_s)
         self.last_parsed = parsed
         return parsed
+
+    def follow_rate(self, dt_s: float) -> None:
+        """With ``sim_rate_hz``: ArduPilot's rate_hz after a reply that advanced ``dt_s``
+        [s] (it adopts 1/Δt for 0 < Δt < 0.1 s, then moves 1 Hz at most towards
+        SIM_RATE_HZ); the frame_rate field is its integer part (a C cast to uint16)."""
+        if self.sim_rate_hz is None:
+            return
+        rate = float(self.rate_hz)
+        if 0.0 < dt_s < 0.1:
+            rate = _single(1.0 / dt_s)
+        self.rate_hz = int(min(max(float(self.sim_rate_hz), rate - 1.0), rate + 1.0))
 
 
 # ------------------------------------------------------------------ flying at a speed-up
@@ -309,6 +327,7 @@ class ArduPilotStandin:
 SLEEP_DEBT_FLOOR_S = -0.1
 MIN_SLEEP_S = 0.005
 LAUNCH_SWITCH_US = 1900  # servo 5 in the backend's launch window (1880..1920 us)
+ARDUPILOT_START_RATE_HZ = 1200  # SIM_Aircraft.h: rate_hz's initial value
 RESEND_S = 1.0  # JSON::recv_fdm sends the frame again after 1 s without a reply
 PATIENCE = 60  # re-sends before the stand-in gives up (a backend still starting up)
 
@@ -395,8 +414,10 @@ class PacedStandin(ArduPilotStandin):
                 parsed.values.get("airspeed", 0.0))
         ts, airspeed = reply_timestamp(data)
         self.frame_counter += 1
-        self.time_now_us += max(0.0, ts - self.last_timestamp_s) * 1e6
+        step = max(0.0, ts - self.last_timestamp_s)
+        self.time_now_us += step * 1e6
         self.last_timestamp_s = ts
+        self.follow_rate(step)
         return wait, ts, airspeed
 
     def fly(self, frames: int, speedup: float | None = None) -> FlightStats:
@@ -430,10 +451,16 @@ class PacedStandin(ArduPilotStandin):
 
 def main(argv: list[str] | None = None) -> int:
     """``python tests/ardupilot_standin.py --target HOST:PORT [--warmup N] [--frames N]
-    [--speedups S,S,...] [--repeat N] [--throttle-us US]``: fly the backend (the launch
+    [--speedups S,S,...] [--repeat N] [--throttle-us US] [--frame-rate HZ | --sim-rate-hz
+    HZ]``: fly the backend (the launch
     switch held, the surfaces at trim), ``--warmup`` frames first (launch and settle), then
     ``--repeat`` rounds of a free run and a run at each speed-up, ``--frames`` each; one JSON
-    document on stdout (the runs in order, :meth:`FlightStats.as_dict`)."""
+    document on stdout (the runs in order, :meth:`FlightStats.as_dict`). ``--frame-rate``:
+    the frame_rate field sent (default 1200, ArduPilot's SIM_RATE_HZ default); with
+    ``--sim-rate-hz`` the field is ArduPilot's rate_hz following the replies' timestamps
+    towards that SIM_RATE_HZ, as ArduPlane's (:class:`ArduPilotStandin`). The pacing follows
+    the timestamps' step per frame (1/frame rate once the backend honours it), as
+    ArduPilot's does."""
     import argparse
     import json
 
@@ -444,10 +471,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--speedups", default="")
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--throttle-us", type=int, default=1500)
+    p.add_argument("--frame-rate", type=int, default=ARDUPILOT_START_RATE_HZ)
+    p.add_argument("--sim-rate-hz", type=int, default=None)
     args = p.parse_args(argv)
+    for name, value in (("--frame-rate", args.frame_rate), ("--sim-rate-hz", args.sim_rate_hz)):
+        if value is not None and not 0 <= value <= 65535:
+            p.error(f"{name} {value} is outside 0..65535 Hz (a uint16 field)")
     host, port = args.target.rsplit(":", 1)
     speedups = [float(s) for s in args.speedups.split(",") if s]
-    ap = PacedStandin((host, int(port)), throttle_us=args.throttle_us)
+    ap = PacedStandin((host, int(port)), throttle_us=args.throttle_us,
+                      rate_hz=args.frame_rate, sim_rate_hz=args.sim_rate_hz)
     runs = []
     try:
         warm = ap.fly(args.warmup)

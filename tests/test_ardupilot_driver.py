@@ -305,6 +305,15 @@ def _servos(n: int, base: tuple[int, ...]) -> tuple[int, ...]:
     return base + tail
 
 
+def open_log(ph, path):
+    """``ph`` logging its frames into a new MCAP file at ``path`` (the caller closes it)."""
+    desc = RunDescription(kind="ardupilot", wing="optimised", speed_m_s=15.0, gust="none",
+                          models=("coupled",), dt_s=ph.dt_s, extra={"autopilot": "ardupilot"})
+    log = sink.RunLog.open(path, desc)
+    ph.log_to(log)
+    return log
+
+
 @pytest.fixture(scope="module")
 def session_log(wing, tmp_path_factory):
     """A stand-in session logged to MCAP: rest, a resend, launch, flight with a resend,
@@ -662,10 +671,7 @@ def test_real_time_factor_at_a_known_pace_across_a_kill_and_restart(wing):
 def test_session_events_are_in_the_log(wing, tmp_path):
     path = tmp_path / "events.mcap"
     ph = _physics(wing)
-    desc = RunDescription(kind="ardupilot", wing="optimised", speed_m_s=15.0, gust="none",
-                          models=("coupled",), dt_s=ph.dt_s, extra={"autopilot": "ardupilot"})
-    log = sink.RunLog.open(path, desc)
-    ph.log_to(log)
+    log = open_log(ph, path)
     lk = Link(ph)
     stray = ArduPilotStandin(lk.server.address)
     try:

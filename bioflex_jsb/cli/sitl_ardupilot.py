@@ -55,7 +55,8 @@ namespace (scripts/ardupilot_sitl.py fly)."""
 
 AERO_CHOICES = ("quasi-steady", "unsteady")
 RTF_DEFINITION = (
-    "session_s / connected_wall_s: the physics time advanced (every frame stepped, across "
+    "session_s / connected_wall_s: the physics time advanced (every frame stepped, k steps "
+    "of dt_s each at ArduPilot's frame rate, across "
     "ArduPilot restarts) over the wall time while an ArduPilot peer was connected (gaps "
     "between its frames shorter than 3 s; waiting for a peer and a killed ArduPilot's "
     "silence are left out)")
@@ -222,7 +223,8 @@ def _text_report(s: dict) -> str:
     lines = [f"flew {s['session_s']:.2f} s of physics ({s['flown_s']:.2f} s in flight), "
              f"{s['frames']['steps']} frames, {s['restarts']} ArduPilot restarts, "
              f"{s['launches']} launches ({s['relaunches']} re-launches), {s['stop_count']} "
-             f"valid-range stops; {s['step']} step, {s['aero']} wing",
+             f"valid-range stops; {s['step']} step, {s['aero']} wing; last "
+             f"{s['frame_steps']} step(s) a frame ({s['frame_rate_hz']:.4g} Hz)",
              "real-time factor " + ("n/a" if rtf is None else f"{rtf:.3f}")
              + " (physics time over wall time while ArduPilot was connected)"]
     if sc["foreign_packets"] or sc["stale_packets"]:

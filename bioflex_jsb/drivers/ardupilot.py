@@ -1,10 +1,21 @@
 """ArduPlane flies the co-simulation: the one coupled step as ArduPilot's JSON SITL physics.
 
 :class:`ArduPilotPhysics` is the :class:`~bioflex_jsb.links.ardupilot_json.JsonPhysics` a
-:class:`~bioflex_jsb.links.ardupilot_json.LockstepServer` drives: one
-:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep` step per ArduPilot frame, the servo
-outputs mapped to JSBSim's controls before it and the state converted to ArduPilot's units
-and frames after it (once, here; ``docs/ardupilot.md``).
+:class:`~bioflex_jsb.links.ardupilot_json.LockstepServer` drives: k
+:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep` steps of ``dt_s`` (1/960 s) per
+ArduPilot frame, the servo outputs mapped to JSBSim's controls before them and the state
+converted to ArduPilot's units and frames after them (once, here; ``docs/ardupilot.md``).
+
+Frame rate: k follows the frame rate ArduPilot reports (its SIM_RATE_HZ, reached through
+its ``rate_hz``: :class:`~bioflex_jsb.links.ardupilot_rate.FrameRate`; k = 1 at the
+default 1200 Hz, 4 at 240 Hz; each change an INFO event, a rate out of range a WARNING).
+The servo outputs are held over the k steps (a servo updated at ArduPilot's rate) and the
+reply's timestamp advances k·dt, so ArduPilot's clock, and its IMU, GPS and airspeed
+samples, run at 1/(k·dt); the co-simulation still steps at 1/dt, each step as it would be
+with one frame per step and the same outputs. Everything per step (the launcher's hold and
+stroke, the gust, the range checks, the log's run topics) counts steps, not frames; a
+valid-range stop inside a frame is taken at its own step (its time in :attr:`stops`), and
+the frame's remaining steps pass at rest on the launcher.
 
 Channel map (ArduPilot's convention: PWM above trim = roll right, nose up, nose right, more
 thrust; bioflex's JSBSim controls: + elevator = nose down, + rudder = nose left; see
@@ -91,12 +102,13 @@ The MCAP log (:meth:`ArduPilotPhysics.log_to`, a :class:`~bioflex_jsb.sinks.mcap
 ``docs/logging.md``), every frame the server answers:
 
 * ``/bioflex/<model>/autopilot``: one message per frame (steps, resends and resets, in the
-  order they arrived): ArduPilot's frame count and rate [Hz], all 16 (or 32) PWM values
-  [µs], the four commands the channel map gives for them (applied in flight only), the
-  server's action, the phase after the frame and the reply's timestamp [s];
-* the run topics (``rigid_body`` … ``location``) of every coupled step in flight: the step's
-  row, the snapshot at the step's start, as every run logs it (none at rest and on the
-  launcher: there is no coupled step there).
+  order they arrived; at the frame's first step): ArduPilot's frame count and rate [Hz],
+  all 16 (or 32) PWM values [µs], the four commands the channel map gives for them (applied
+  in flight only), the server's action, the phase after the frame and the reply's
+  timestamp [s];
+* the run topics (``rigid_body`` … ``location``) of every coupled step in flight (all k of a
+  frame): the step's row, the snapshot at the step's start, as every run logs it (none at
+  rest and on the launcher: there is no coupled step there).
 
 Log time is the *session* time: the physics time, continued across ArduPilot restarts
 (which send the reply's timestamp back to 0), so the file's time never goes back. A step's
@@ -117,6 +129,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.links.ardupilot_json import RESEND, RESET, FrameRecord, JsonState
+from bioflex_jsb.links.ardupilot_rate import FrameRate
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
@@ -279,7 +292,8 @@ class ArduPilotPhysics:
         self._commands_of: tuple[tuple[int, ...] | None, tuple[float, ...]] = (None, ())
         self._log = None  # RunLog (log_to)
         self._autopilot_log = None
-        self._step_row: tuple[float, ...] | None = None  # the last frame's flight row
+        # the last frame's flight rows: (step index since the start or restart, row)
+        self._step_rows: list[tuple[int, tuple[float, ...]]] = []
         self._t_offset_s = 0.0  # session time at ArduPilot's last restart [s]
         self._frames_seen = 0
         self._flown_before_s = 0.0  # flight time of the flights before this one [s]
@@ -291,7 +305,9 @@ class ArduPilotPhysics:
         self._last_row: tuple[float, ...] = self._nan_row
         self._last_w_g = 0.0
         self.pwm_us: tuple[int, ...] = ()
-        self.frame_k = 0  # physics frames since the start (or ArduPilot's last restart)
+        self.frame_k = 0  # co-simulation steps since the start (or ArduPilot's last restart)
+        self.frame_steps = 1  # steps the last frame advanced (k: links/ardupilot_rate.py)
+        self.frame_rate = FrameRate(self.dt_s)
         self.gust_report: dict[str, float] = {}
         self._to_rest()
 
@@ -397,7 +413,7 @@ class ArduPilotPhysics:
 
     @property
     def launch_hold_steps(self) -> int:
-        """Frames of the launch signal (throttle or switch) that fire the launcher."""
+        """Steps of the launch signal (throttle or switch) that fire the launcher."""
         return max(1, math.ceil(LAUNCH_HOLD_S / self.dt_s - 1e-9))
 
     @property
@@ -424,12 +440,24 @@ class ArduPilotPhysics:
         self._to_rest()
         self._t_offset_s += self.frame_k * self.dt_s
         self.frame_k = 0
+        self.frame_rate.reset()
 
     def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
-        """One frame of ``dt_s`` with these servo outputs [µs, servo 1 first]."""
+        """One ArduPilot frame: k steps of ``dt_s`` with these servo outputs [µs, servo 1
+        first] held over them, k from ArduPilot's ``frame_rate_hz`` [Hz]
+        (:class:`~bioflex_jsb.links.ardupilot_rate.FrameRate`; a change of k is an event)."""
+        k, note = self.frame_rate.steps(frame_rate_hz)
+        if note is not None:
+            self.event(*note)
         self.pwm_us = pwm_us
+        self.frame_steps = k
+        self._step_rows = []
+        for _ in range(k):
+            self._step(pwm_us)
+
+    def _step(self, pwm_us: tuple[int, ...]) -> None:
+        """One co-simulation step of ``dt_s`` (at rest, on the launcher or in flight)."""
         self.frame_k += 1
-        self._step_row = None
         if self.phase == REST:
             thr = pwm_us[THROTTLE_CHANNEL] if len(pwm_us) > THROTTLE_CHANNEL else 0
             switch = pwm_us[LAUNCH_SWITCH_CHANNEL] if len(pwm_us) > LAUNCH_SWITCH_CHANNEL else 0
@@ -458,7 +486,9 @@ class ArduPilotPhysics:
             self._written_pwm = pwm_us
         k = core.k
         w_g = self.gust.at_step(k) if self.gust is not None else 0.0
-        self._last_row = self._step_row = core.advance(w_g)
+        self._last_row = row = core.advance(w_g)
+        if self._log is not None:
+            self._step_rows.append((self.frame_k - 1, row))
         self._last_w_g = w_g
         k0, k1 = self._gust_steps
         if k0 <= k <= k1:
@@ -565,15 +595,23 @@ class ArduPilotPhysics:
         return out
 
     def _log_frame(self, rec: FrameRecord) -> None:
-        # the state the frame arrived at: before the step (step, reset), the one repeated
-        k = self.frame_k if rec.action == RESEND else self.frame_k - 1
+        # the state the frame arrived at: before its steps (step, reset), the one repeated
+        k = self.frame_k if rec.action == RESEND else self.frame_k - self.frame_steps
         t = self._t_offset_s + k * self.dt_s
-        row, self._step_row = self._step_row, None
-        if row is not None and rec.action != RESEND:
-            self._log.sample(self.model, t, dict(zip(self.core.names, row, strict=True)))
+        rows, self._step_rows = self._step_rows, []
+        if rec.action == RESEND:
+            rows = []
+        names, sample = self.core.names, self._log.sample
+        first = 0
+        if rows and rows[0][0] == k:  # the frame's first step: its row, then the frame
+            sample(self.model, t, dict(zip(names, rows[0][1], strict=True)))
+            first = 1
         self._autopilot_log.frame(
             t, rec.frame_count, rec.frame_rate_hz, rec.pwm_us, self.commands(rec.pwm_us),
             ACTIONS.index(rec.action), PHASES.index(self.phase), rec.timestamp_s)
+        for i, row in rows[first:]:  # the frame's further steps, each at its own start
+            sample(self.model, self._t_offset_s + i * self.dt_s,
+                   dict(zip(names, row, strict=True)))
 
     def on_frame(self, rec: FrameRecord) -> None:
         """The server's callback: log the frame (:meth:`log_to`); keep every
@@ -602,6 +640,7 @@ class ArduPilotPhysics:
             "model": self.model, "aero": self.aero, "step": self.step_kind,
             "speed_m_s": self.speed_m_s, "altitude_m": self.altitude_m,
             "dt_s": self.dt_s, "time_s": self.t_s, "session_s": self.session_t_s,
+            "frame_steps": self.frame_steps, "frame_rate_hz": self.frame_rate.rate_hz,
             "phase": self.phase, "grounded": self.grounded,
             "flight_s": self.core.k * self.dt_s if self.phase == FLIGHT else 0.0,
             "flown_s": self._flown_before_s + self.core.k * self.dt_s,

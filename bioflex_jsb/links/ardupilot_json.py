@@ -4,7 +4,7 @@ ArduPilot SITL started with ``--model JSON:127.0.0.1`` flies a physics model it 
 UDP (``libraries/SITL/SIM_JSON.cpp`` and ``SIM_JSON.h`` of ArduPilot master 90700977c553;
 ``libraries/SITL/examples/JSON/readme.md``). This module is the physics side of that link,
 without the physics: it imports neither JSBSim nor the co-simulation. A physics object that
-satisfies :class:`JsonPhysics` is driven one step per servo frame.
+satisfies :class:`JsonPhysics` is driven one ``step`` call per servo frame.
 
 ArduPilot → simulator (:func:`parse_servo_packet`): one datagram per SITL frame, little
 endian, to ``127.0.0.1:9002 + 10·instance`` (:func:`instance_port`):
@@ -45,8 +45,9 @@ Lock-step rules (:meth:`LockstepServer.handle`), from ``JSON::recv_fdm``: ArduPi
 frame n, waits for the reply and only then sends frame n+1 (its ``frame_counter`` advances
 only on a reply it could parse); without a reply for 1 s it sends frame n again.
 
-* a frame_count greater than the last one: one physics step with the packet's PWM, one
-  reply with the new state (a jump of more than one is counted in ``frames_skipped``);
+* a frame_count greater than the last one: one ``physics.step`` with the packet's PWM and
+  frame rate, one reply with the new state (a jump of more than one is counted in
+  ``frames_skipped``);
 * the same frame_count again: the same reply again, no step (ArduPilot's timestamp then
   does not change, so its clock does not advance either);
 * frame_count 0 after a larger one: ArduPilot SITL restarted, so the physics is reset, then
@@ -73,7 +74,9 @@ ArduPilot until its restart, are not in it. The silence of the re-binding rule i
 the same way: from our last reply to the peer.
 
 ArduPilot adopts 1/Δtimestamp as its frame rate for 0 < Δt < 0.1 s, so the physics may
-step by its own time step; ``frame_rate_hz`` is passed to it for information. frame_count
+advance a frame by its own time; ``frame_rate_hz`` is passed to it, which may advance
+several of its steps per frame at a low rate (the co-simulation's:
+:mod:`bioflex_jsb.links.ardupilot_rate`). frame_count
 is ArduPilot's uint32 and would wrap after 2³² frames (41 days at 1200 Hz); a wrap would be
 taken for a restart.
 """
@@ -385,13 +388,15 @@ def encode_reply_json(state: JsonState) -> bytes:
 
 
 class JsonPhysics(Protocol):
-    """What the lock-step server drives: one step per new ArduPilot frame."""
+    """What the lock-step server drives: one :meth:`step` per new ArduPilot frame."""
 
     def reset(self) -> None:
         """Back to the initial state (ArduPilot SITL restarted); timestamp back to its start."""
 
     def step(self, pwm_us: tuple[int, ...], frame_rate_hz: int) -> None:
-        """Advance one step with these servo outputs [µs, channel 1 first]."""
+        """Advance one frame with these servo outputs [µs, channel 1 first] at ArduPilot's
+        frame rate ``frame_rate_hz`` [Hz] (the physics decides how far: the reply's
+        timestamp says it)."""
 
     def state(self) -> JsonState:
         """The state after the last step (or reset)."""
@@ -424,7 +429,7 @@ class FrameRecord(NamedTuple):
 class ServerStats:
     """Counters of the lock-step server."""
 
-    steps: int = 0  # physics steps (new frames, including those after a reset)
+    steps: int = 0  # frames stepped (physics.step calls: new frames, also after a reset)
     resends: int = 0  # repeated frame_count answered again without a step
     resets: int = 0  # the peer restarted (frame 0 again, or re-bound): physics reset
     frames_skipped: int = 0  # frame numbers jumped over (never stepped)
