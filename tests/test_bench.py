@@ -13,7 +13,6 @@ import pytest
 from bioflex_jsb.cli import main
 from bioflex_jsb.drivers import bench
 from bioflex_jsb.drivers.bench import (
-    ARDUPILOT_SPEEDUPS,
     BARS,
     DEFAULT_REPEAT,
     DEFAULT_STEPS,
@@ -21,15 +20,20 @@ from bioflex_jsb.drivers.bench import (
     LENGTH_FACTORS,
     MAX_DISAGREEMENT,
     MAX_RESIDUAL,
-    SITL_SPEEDUPS,
     Figure,
     PerStep,
     difference,
     estimate_figure,
     estimate_per_step,
+    ratio,
+)
+from bioflex_jsb.drivers.bench_speedup import (
+    ARDUPILOT_SIM_RATES_HZ,
+    ARDUPILOT_SPEEDUPS,
+    SITL_SPEEDUPS,
     held,
     max_held,
-    ratio,
+    rate_figures,
 )
 
 LENGTHS = (1200, 2400, 4800)
@@ -315,9 +319,14 @@ def test_bench_json_has_every_figure(capsys):
     assert len(data["load_average_before"]) == 3
     a = data["ardupilot"]  # the backend against the stand-in: shape, not values
     assert a["available"] and a["logged"] and a["trusted"], a.get("reason")
-    assert a["answered_per_s"]["median"] > 0.0 and a["physics_rate_hz"] == 960.0
-    assert set(a["real_time_factor_by_speedup"]) == {f"{x:g}" for x in ARDUPILOT_SPEEDUPS}
-    assert a["max_speedup_held"]["median"] in (0.0, *ARDUPILOT_SPEEDUPS)
+    assert a["physics_rate_hz"] == 960.0
+    assert a["sim_rates_hz"] == list(ARDUPILOT_SIM_RATES_HZ) == [1200, 240]
+    for rate, k in (("1200", 1.0), ("240", 4.0)):  # the steps a frame the backend chose
+        b = a["by_sim_rate"][rate]
+        assert b["steps_per_frame"]["median"] == pytest.approx(k, rel=1e-9), rate
+        assert b["answered_per_s"]["median"] > 0.0
+        assert set(b["real_time_factor_by_speedup"]) == {f"{x:g}" for x in ARDUPILOT_SPEEDUPS}
+        assert b["max_speedup_held"]["median"] in (0.0, *ARDUPILOT_SPEEDUPS)
     assert len(a["load_average"]) == 3
     s = data["sitl_speedup"]
     assert [r["speedup"] for r in s["runs"]] == list(SITL_SPEEDUPS)
@@ -340,13 +349,35 @@ def test_max_speedup_held_is_the_top_of_an_unbroken_run_of_held_speedups():
     assert m["real_time_factor_by_speedup"]["10"] == {"median": 9.9, "min": 9.0, "max": 10.0}
 
 
+def test_rate_figures_take_the_free_runs_and_the_steps_a_frame():
+    """The free runs give the frames per second and the steps a frame (physics time over
+    frames × dt: the backend's k), the paced ones the speed-ups held."""
+    dt = 1 / 960
+    rows = []
+    for repeat in (0, 1):
+        rows.append({"speedup": None, "frames": 100, "physics_s": 100 * 4 * dt,
+                     "answered_per_s": 1000.0 + repeat, "frames_per_s": 900.0,
+                     "real_time_factor": 4.0, "grounded": 0, "repeat": repeat})
+        rows += [{"speedup": s, "frames": 100, "physics_s": 1.0, "answered_per_s": 0.0,
+                  "frames_per_s": 0.0, "real_time_factor": r, "grounded": repeat, "repeat": repeat}
+                 for s, r in ((1.0, 1.0), (2.0, 2.0), (5.0, 4.0))]
+    f = rate_figures(rows, dt)
+    assert f["steps_per_frame"]["median"] == pytest.approx(4.0, rel=1e-12)
+    assert f["answered_per_s"] == {"median": 1000.5, "min": 1000.0, "max": 1001.0}
+    assert f["per_repeat"] == [2.0, 2.0] and f["grounded_frames"] == 3
+
+
 def test_bench_bad_input_is_one_line_and_exit_2(capsys):
     for argv, word in ((["bench", "--steps", "5"], "--steps"),
                        (["bench", "--speed", "1000"], "--speed"),
                        (["bench", "--steps", "1e8"], "--steps"),
                        (["bench", "--sitl-seconds", "-1"], "--sitl-seconds"),
                        (["bench", "--sitl-speedups-seconds", "99"], "--sitl-speedups-seconds"),
-                       (["bench", "--ardupilot-frames", "-3"], "--ardupilot-frames")):
+                       (["bench", "--ardupilot-frames", "-3"], "--ardupilot-frames"),
+                       (["bench", "--ardupilot-sim-rates", "1200,20"], "--ardupilot-sim-rates"),
+                       (["bench", "--ardupilot-sim-rates", "fast"], "--ardupilot-sim-rates"),
+                       (["bench", "--only", "ardupilot", "--ardupilot-frames", "0"],
+                        "--ardupilot-frames")):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert word in err and err.count("\n") == 1, (argv, err)

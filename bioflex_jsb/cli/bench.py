@@ -42,12 +42,29 @@ SITL pacing error (step start against the wall clock, p50/p99 [ms] and resyncs) 
 --sitl-seconds of simulated time at --sitl-speedup. Autopilots faster than real time
 (--ardupilot-frames, 0 skips): the ardupilot backend (its log written, as a session logs)
 lock-stepped with the stand-in of ArduPilot's side (tests/ardupilot_standin.py, in its own
-process as ArduPlane is): frames per second it answers, and the highest --speedup at which
+process as ArduPlane is) at each ArduPilot physics rate of --ardupilot-sim-rates (its
+SIM_RATE_HZ; default 1200,240: the backend advances 1 and 4 steps of 1/960 s a frame):
+frames per second it answers, the free real-time factor, and the highest --speedup at which
 its real-time factor stays within 5 % of the speed-up asked for (ArduPilot's own pacing:
 sleep debt), each over --ardupilot-repeat rounds (median [min .. max]); and the sitl
 vehicle's pacing error at speed-ups 1..30 (--sitl-speedups-seconds of wall time each, 0
-skips): the highest with p99 <= 5 ms. Each with the load average. Machines are shared and
-noisy: compare the ratios, not the absolute times."""
+skips): the highest with p99 <= 5 ms. Each with the load average. --only ardupilot (or
+speedups: with the sitl vehicle's) measures those alone, without the step timings. Machines
+are shared and noisy: compare the ratios, not the absolute times."""
+
+
+def _rates(text: str) -> tuple[int, ...]:
+    """--ardupilot-sim-rates: comma-separated whole numbers of Hz, each 50..10000 (ArduPlane's
+    loop rate up to the backend's absurd bound, links/ardupilot_rate.py)."""
+    try:
+        rates = tuple(int(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        rates = ()
+    if not rates or not all(50 <= r <= 10_000 for r in rates):
+        raise argparse.ArgumentTypeError(
+            f"--ardupilot-sim-rates must be comma-separated whole numbers of Hz in 50..10000 "
+            f"(e.g. 1200,240), got {text!r}")
+    return rates
 
 
 def _int_in(label: str, lo: int, hi: int):
@@ -84,6 +101,12 @@ def register(sub) -> None:
                    "0..100000 (0: skip; default 3000)")
     p.add_argument("--ardupilot-repeat", type=_int_in("--ardupilot-repeat", 1, 20), default=3,
                    help="rounds of the ArduPilot speed-up runs, 1..20 (default 3)")
+    p.add_argument("--ardupilot-sim-rates", type=_rates, default=(1200, 240),
+                   help="ArduPilot's SIM_RATE_HZ of the ArduPilot runs, comma-separated Hz "
+                   "in 50..10000 (default 1200,240)")
+    p.add_argument("--only", choices=("ardupilot", "speedups"), default=None,
+                   help="measure only the ArduPilot backend (ardupilot), or it and the sitl "
+                   "vehicle's speed-ups (speedups); default everything")
     p.add_argument("--sitl-speedups-seconds", type=float, default=1.0,
                    help="wall seconds of each sitl speed-up run, 0..60 (0: skip; default 1)")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -105,6 +128,16 @@ def run(args: argparse.Namespace) -> int:
     if not 0.0 <= args.sitl_speedups_seconds <= 60.0:
         raise UsageError(f"--sitl-speedups-seconds {args.sitl_speedups_seconds:g} is outside "
                          "0..60 s")
+    if args.only is not None:
+        if args.ardupilot_frames == 0:
+            raise UsageError(f"--only {args.only} with --ardupilot-frames 0 measures nothing "
+                             "of the ArduPilot backend; give --ardupilot-frames 1..100000")
+        payload = _speedups(args, sitl=args.only == "speedups")
+        if args.json:
+            print_json(payload)
+        else:
+            _print_speedups(payload)
+        return 0
     build = build_wing(VARIANTS["optimised"])
     compile_s = bench.compile_cost_s()
     sb = bench.StepBench(build, args.speed, args.steps)
@@ -128,16 +161,27 @@ def run(args: argparse.Namespace) -> int:
             payload["sitl"] = measure_pacing(duration_s=args.sitl_seconds,
                                              speedup=args.sitl_speedup,
                                              log_path=str(Path(tmp) / "sitl.mcap"))
-    if args.ardupilot_frames:
-        payload["ardupilot"] = bench.ardupilot_speedup(args.ardupilot_frames,
-                                                       args.ardupilot_repeat)
-    if args.sitl_speedups_seconds > 0.0:
-        payload["sitl_speedup"] = bench.sitl_speedup(args.sitl_speedups_seconds)
+    payload.update(_speedups(args, sitl=True))
     if args.json:
         print_json(payload)
     else:
         _print(payload)
     return 0
+
+
+def _speedups(args: argparse.Namespace, sitl: bool) -> dict:
+    """The autopilots' speed-up figures asked for: the ArduPilot backend's (unless
+    --ardupilot-frames 0) and, with ``sitl``, the sitl vehicle's (unless
+    --sitl-speedups-seconds 0)."""
+    from bioflex_jsb.drivers import bench_speedup
+
+    out = {}
+    if args.ardupilot_frames:
+        out["ardupilot"] = bench_speedup.ardupilot_speedup(
+            args.ardupilot_frames, args.ardupilot_repeat, sim_rates_hz=args.ardupilot_sim_rates)
+    if sitl and args.sitl_speedups_seconds > 0.0:
+        out["sitl_speedup"] = bench_speedup.sitl_speedup(args.sitl_speedups_seconds)
+    return out
 
 
 def _progress(args):
@@ -215,21 +259,23 @@ def _print_speedups(p: dict) -> None:
     if a is not None and not a["available"]:
         print(f"ArduPilot backend: not measured ({a['reason']})")
     elif a is not None:
-        n = a["answered_per_s"]
-        m = a["max_speedup_held"]
+        trust = "" if a["trusted"] else f"  NOT TRUSTED: {a['reason']}"
         print(f"ArduPilot backend ({'logged' if a['logged'] else 'no log'}, "
               f"{a['physics_rate_hz']:.0f} Hz physics, {a['repeat']} rounds of "
               f"{a['frames_per_run']} frames; load average {_load(a['load_average_before'])} "
-              f"-> {_load(a['load_average'])}):")
-        print(f"  frames answered per second {n['median']:8.0f}  [{n['min']:.0f} .. "
-              f"{n['max']:.0f}]  (free run, real-time factor "
-              f"{a['free_real_time_factor']['median']:.2f})")
-        trust = "" if a["trusted"] else f"  NOT TRUSTED: {a['reason']}"
-        print(f"  highest --speedup held within {100 * a['tolerance']:.0f} %: "
-              f"{m['median']:g}  [{m['min']:g} .. {m['max']:g}]{trust}")
-        for s_, r in a["real_time_factor_by_speedup"].items():
-            print(f"    {s_:>4s}x: real-time factor {r['median']:6.2f}  [{r['min']:.2f} .. "
-                  f"{r['max']:.2f}]")
+              f"-> {_load(a['load_average'])}){trust}:")
+        for rate, b in a["by_sim_rate"].items():
+            n, m, f = b["answered_per_s"], b["max_speedup_held"], b["free_real_time_factor"]
+            print(f"  SIM_RATE_HZ {rate} ({b['steps_per_frame']['median']:.2f} steps a frame):"
+                  f" frames answered per second {n['median']:.0f}  [{n['min']:.0f} .. "
+                  f"{n['max']:.0f}], free real-time factor {f['median']:.2f}  [{f['min']:.2f}"
+                  f" .. {f['max']:.2f}]")
+            print(f"    highest --speedup held within {100 * a['tolerance']:.0f} %: "
+                  f"{m['median']:g}  [{m['min']:g} .. {m['max']:g}] (per round "
+                  f"{', '.join(f'{x:g}' for x in b['per_repeat'])})")
+            for s_, r in b["real_time_factor_by_speedup"].items():
+                print(f"      {s_:>4s}x: real-time factor {r['median']:6.2f}  [{r['min']:.2f} "
+                      f".. {r['max']:.2f}]")
     s = p.get("sitl_speedup")
     if s is not None:
         m = s["max_speedup_p99_within_bar"]
