@@ -405,14 +405,14 @@ class JsonPhysics(Protocol):
 # What the server did with a frame (FrameRecord.action).
 STEP = "step"
 RESEND = "resend"
-RESET = "reset"  # physics reset, then one step
+RESET = "reset"  # physics reset, then the frame stepped
 
 
 class FrameRecord(NamedTuple):
     """One answered servo frame, for logs (the ``on_frame`` callback; a named tuple, built
     once per frame).
 
-    action: STEP, RESEND (same reply again, no step) or RESET (reset, then one step).
+    action: STEP, RESEND (same reply again, no step) or RESET (reset, then the frame stepped).
     timestamp_s: physics time of the state sent [s].
     source: (host, port) the packet came from and the reply went to.
     """
@@ -445,7 +445,7 @@ class ServerStats:
 
 
 class LockstepServer:
-    """ArduPilot's JSON physics peer over one UDP socket: one step and one reply per frame.
+    """ArduPilot's JSON physics peer over one UDP socket: one physics.step and one reply per frame.
 
     Binds ``host:port`` (default 127.0.0.1 and :func:`instance_port` of ``instance``; port 0
     picks a free port, see :attr:`address`) and replies to the peer (module docstring: the
