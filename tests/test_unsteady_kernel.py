@@ -131,6 +131,36 @@ def test_unsteady_from_the_elastic_trim_is_refused_in_one_line():
     assert "\n" not in str(err.value)
 
 
+def test_kernel_follows_the_python_step_with_the_states_of_a_group_apart():
+    """The Küssner states of equal strips start equal and the kernel steps them as one
+    (unsteady_kernel.state_groups); one of them set apart takes the whole-state product,
+    which still follows the Python step (same tolerance as the golden case's)."""
+    build = build_wing(VARIANTS["optimised"])
+    steps = []
+    for compiled in (True, False):
+        step = CoupledStep(Airframe(), build, "coupled", 15.0, aero="unsteady",
+                           compiled=compiled)
+        step.prepare()
+        k1 = step.wing.state_names.index("kussner1[5]")
+        step.wing._x[k1] = 0.05  # [m/s]: the others are at rest
+        steps.append(step)
+    rows = np.array([[s.advance(0.3 if k >= 50 else 0.0) for k in range(400)]
+                     for s in steps])
+    fast_x, slow_x = steps[0].wing._x, steps[1].wing._x
+    assert fast_x[k1] != fast_x[k1 + 1]  # still apart: the whole-state path ran throughout
+    span = np.ptp(rows[1], axis=0)
+    moving = span > 0.0
+    worst = np.max(np.abs(rows[0] - rows[1])[:, moving] / span[moving])
+    assert worst < KERNEL_RTOL_OF_RANGE, worst
+    assert np.max(np.abs(fast_x - slow_x)) <= KERNEL_RTOL_OF_RANGE * np.max(np.abs(slow_x))
+
+
+def test_state_groups_are_rows_of_equal_entries():
+    diag = np.array([[0.9, 0.8, 0.9, 0.9], [1.0, 1.0, 1.0, 2.0], [0.0] * 4, [0.0] * 4,
+                     [3.0, 3.0, 3.0, 3.0]])
+    assert UK.state_groups(diag).tolist() == [0, 1, 0, 2]
+
+
 def test_dense_rows_sees_only_exact_diagonal_rows():
     phi = np.diag(np.arange(1.0, 6.0))
     dphi = np.zeros((5, 5))
