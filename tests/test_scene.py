@@ -102,7 +102,7 @@ def test_the_tip_moves_by_the_mode_shapes_times_eta(gust_log, build):
     assert abs(eta[0]) > 0.05  # the gust has deformed the wing
     tris = msg.entities[0].triangles
     assert len(tris) == len(scene.WING_PARTS)
-    k = len(build.aero.stations_m) + 2  # root, every strip's station, tip
+    k = min(len(build.aero.stations_m), scene.SCENE_MESH_STATIONS - 2) + 2  # root, strips, tip
     for half, sign in ((tris[0], -1.0), (tris[1], 1.0)):
         pts = np.array([(p.x, p.y, p.z) for p in half.points])
         assert pts.shape == (2 * k, 3)

@@ -89,7 +89,8 @@ def test_colour_and_size_follow_the_load_over_its_1g_value(gust_log, build):
     s = len(stations)
     markers = decode_topic(gust_log, "/bioflex/coupled/scene_loads")
     peak = 0.0
-    mesh = scene.AircraftMesh(scene.wing_shape(build), scene.airframe_outline(), EXAGGERATION)
+    mesh = scene.AircraftMesh(scene.wing_shape(build, max_stations=scene.SCENE_MESH_STATIONS),
+                              scene.airframe_outline(), EXAGGERATION)  # the log's mesh
     for ns, msg in markers:
         sp = _spheres(msg)
         assert sp.shape == (2 * 2 * s, 7)  # starboard then port; bending then torque

@@ -20,10 +20,11 @@ from tests.test_sitl_commands import Bench
 # docs/sitl.md: the log grows ≈ 37 MB per simulated minute: 645 bytes a step at 960 steps/s.
 # Of them 452 are the 7 run topics' messages (each with a 31-byte record header and a 16-byte
 # index entry; chunks of 24 steps, the session's chunks when the loop has slack; measured 452
-# B/step with 24-step chunks, 434 with 96, 429 with one chunk per 0.9 s), ~190 the 3-D scene
-# (sinks/mcap/scene.py: the wing's mesh at 60 Hz and the airframe's at most every 0.5 s;
-# measured 645 B/step in all with 24-step chunks). The band holds it with ±7 %.
-BYTES_PER_STEP = (600.0, 690.0)
+# B/step with 24-step chunks, 434 with 96, 429 with one chunk per 0.9 s), ~110 the 3-D scene
+# (sinks/mcap/scene.py: the wing's mesh of 17 stations a half at 60 Hz and the airframe's at
+# most every 0.5 s; measured 564 B/step in all with 24-step chunks, 2026-12-02; 645 with
+# the 42-station mesh before). The band holds it with ±7 %.
+BYTES_PER_STEP = (525.0, 605.0)
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +86,7 @@ def test_log_growth_per_simulated_minute_is_what_the_docs_say(steps, build, tmp_
     per_step = (os.path.getsize(path) - os.path.getsize(empty)) / len(rows)
     lo, hi = BYTES_PER_STEP
     assert lo <= per_step <= hi, per_step
-    assert 34.5 <= per_step * 960 * 60 / 1e6 <= 39.8  # MB per simulated minute
+    assert 30.2 <= per_step * 960 * 60 / 1e6 <= 34.8  # MB per simulated minute
 
 
 def test_refusals_are_events_of_the_session_log(build, tmp_path):  # noqa: F811

@@ -220,8 +220,12 @@ class RunLog:
         the ones to come at the most bytes a step has taken, ``_row_bytes``). For a log of
         :meth:`sample` steps (and events); autopilot frames are not counted."""
         scene = sum(len(block) for block, _ in self._scene_blocks)  # not yet in the writer
+        # the scene's samples go in a chunk of their own (flush): its overhead too (with the
+        # 3.0 kB wing messages of 17 stations a file came out 188 bytes over its limit
+        # without it; the 7.2 kB ones had hidden it in the per-step margin)
+        own_chunk = self._writer.chunk_overhead_bound() if self.scene is not None else 0
         return self._writer.size_bound((len(self._rows) + more_steps) * self._row_bytes
-                                       + scene)
+                                       + scene) + own_chunk
 
     def event(self, t_s: float, level: int | str, text: str, name: str = "bioflex-jsb") -> None:
         """An event at the log time ``t_s`` [s]: a ``foxglove.Log`` message on

@@ -10,10 +10,11 @@ upward gust, its length proportional to w_g); ``/bioflex/<model>/airframe`` once
 rigid parts are two thirds of the bytes of a whole aircraft; apart, they cost nothing per
 step, and a viewer that seeks gets them from the topic's last message.
 
-The wing's mesh has a leading-edge and a trailing-edge vertex at the root, at every strip's
-station of the lifting line (``WingBuild.aero.stations_m``: where the loads act) and at the
-tip. Each section is moved as the modes move it (``docs/conventions.md``): its elastic axis
-(at ``x_elastic_frac`` of the chord) rises by −Σ φ_i(y) η_i (``bending_m``, positive down)
+The wing's mesh has a leading-edge and a trailing-edge vertex at the root, at strips'
+stations of the lifting line (``WingBuild.aero.stations_m``: where the loads act; in a run's
+log :data:`SCENE_MESH_STATIONS` of them in all, :func:`mesh_stations_m`) and at the tip.
+Each section is moved as the modes move it (``docs/conventions.md``): its elastic axis (at
+``x_elastic_frac`` of the chord) rises by −Σ φ_i(y) η_i (``bending_m``, positive down)
 and the chord turns about it, leading edge up, by Σ θ_i(y) η_i (``twist_rad``), the shapes
 interpolated at the stations as the modal coefficients of the loads and the LTI model
 interpolate them (``flight_dynamics.modal_coefficients``); both multiplied by the
@@ -61,6 +62,13 @@ _ARROW_HEAD_FRACTION = 0.3
 _ARROW_SHAFT_DIAMETER_M = 0.015
 _ARROW_HEAD_DIAMETER_M = 0.04
 _ARROW_AHEAD_OF_NOSE_M = 0.1
+# DECISION (drawing only): the logged scene's wing is drawn at 17 stations a half (root, tip
+# and 15 of the prototype's 40 strips' stations, evenly picked by index: mesh_stations_m, so
+# the tip, where the cosine-spaced strips crowd and the shapes turn, keeps its density), not
+# at all 42: the shapes drawn linearly between them are within 0.7, 1.9 and 4.2 % of each
+# mode's peak (modes 1-3) of the 42-station mesh, and a scene message is 3.0 kB instead of
+# 7.2 kB (measured 2026-12-02). The mode sheet and the mode animation draw every station.
+SCENE_MESH_STATIONS = 17
 # NUMERICAL (drawing only): the fuselage's spheroid in rings along x and sides around
 _FUSELAGE_RINGS, _FUSELAGE_SIDES = 16, 12
 COLOURS = {  # r, g, b, a [0-1]
@@ -150,14 +158,16 @@ class WingShape:
         return int(self.bending_m.shape[0])
 
 
-def wing_shape(build, planform=None) -> WingShape:
+def wing_shape(build, planform=None, max_stations: int | None = None) -> WingShape:
     """The mesh's half wing of the wing ``build`` (a ``WingBuild``: its modes and strips) on
     ``planform`` (default: the build's own, the one its strips were made on: the prototype's
-    ``parameters.wing.DEFAULT_PLANFORM`` or a definition's stations)."""
+    ``parameters.wing.DEFAULT_PLANFORM`` or a definition's stations): root, the strips'
+    stations and tip, or at most ``max_stations`` of them (root, tip and strips' stations
+    evenly picked by index: :func:`mesh_stations_m`)."""
     if planform is None:
         planform = build.planform
     modes, aero = build.modes, build.aero
-    y = np.concatenate([[0.0], np.asarray(aero.stations_m, dtype=float), [aero.semispan_m]])
+    y = mesh_stations_m(aero.stations_m, aero.semispan_m, max_stations)
 
     def at(rows) -> np.ndarray:
         return np.array([np.interp(y, modes.stations_m, r) for r in np.atleast_2d(rows)])
@@ -168,6 +178,21 @@ def wing_shape(build, planform=None) -> WingShape:
         x_elastic_frac=at(np.broadcast_to(modes.x_elastic_frac, modes.stations_m.shape))[0],
         bending_m=at(modes.bending_m), twist_rad=at(modes.twist_rad),
         x_cg_m=float(planform.x_cg_m), source=f"wing {build.variant.name}: {modes.source}")
+
+
+def mesh_stations_m(strip_stations_m, semispan_m: float, max_stations: int | None = None
+                    ) -> np.ndarray:
+    """The mesh's stations [m]: the root (0), the strips' stations and the tip
+    (``semispan_m``); with ``max_stations`` (≥ 3), the strips' stations thinned to
+    ``max_stations`` − 2 picked evenly by index (the first and last strips kept)."""
+    strips = np.asarray(strip_stations_m, dtype=float)
+    if max_stations is not None:
+        if max_stations < 3:
+            raise ValueError(f"a mesh needs at least 3 stations, not {max_stations}")
+        if len(strips) > max_stations - 2:
+            strips = strips[np.unique(np.round(np.linspace(0, len(strips) - 1,
+                                                           max_stations - 2)).astype(int))]
+    return np.concatenate([[0.0], strips, [float(semispan_m)]])
 
 
 # -- the mesh in the body frame ------------------------------------------------------------
@@ -403,8 +428,8 @@ class SceneLog:
         ``wing_variant``, a ``WingVariant.as_dict()``, or else the description's ``wing``, on
         the prototype's airframe; the build cache returns the run's own build)."""
         if build is not None:
-            return cls(writer, AircraftMesh(wing_shape(build), airframe_outline(build.airframe),
-                                            exaggeration))
+            return cls(writer, AircraftMesh(wing_shape(build, max_stations=SCENE_MESH_STATIONS),
+                                            airframe_outline(build.airframe), exaggeration))
         from bioflex_jsb.flight_dynamics.wing_model import (
             WingVariant,
             build_wing,
@@ -414,7 +439,8 @@ class SceneLog:
         variant = (WingVariant(**dict(wing_variant)) if wing_variant is not None
                    else resolve_variant(description.wing))
         build = build_wing(variant, mass_basis=description.mass_basis)
-        return cls(writer, AircraftMesh(wing_shape(build), airframe_outline(), exaggeration))
+        return cls(writer, AircraftMesh(wing_shape(build, max_stations=SCENE_MESH_STATIONS),
+                                        airframe_outline(), exaggeration))
 
     def schema_id(self) -> int:
         """The id of the ``foxglove.SceneUpdate`` schema (added at the first call)."""

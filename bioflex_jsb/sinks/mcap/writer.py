@@ -244,6 +244,14 @@ class McapFileWriter:
                    + sum(25 + len(m.name) for m in self._metadata_indexes))
         return self._offset + chunk + summary
 
+    def chunk_overhead_bound(self) -> int:
+        """An upper bound [bytes] of what one more chunk costs besides its records: its
+        header, zstd's fixed margin, a message index per channel and its chunk index (for a
+        caller that writes part of its records as a chunk of their own)."""
+        channels = len(self._channels)
+        return (_CHUNK_HEADER_BYTES + 64 + _INDEX_PER_CHANNEL * channels
+                + 2 * (_CHUNK_INDEX_BYTES + _PER_CHANNEL_BYTES * channels))
+
     def close_chunk(self) -> None:
         """Compress and write the chunk in progress with its message indexes; flush."""
         with _signals_deferred():
