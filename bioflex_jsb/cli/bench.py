@@ -101,7 +101,7 @@ def register(sub) -> None:
                    "0..100000 (0: skip; default 3000)")
     p.add_argument("--ardupilot-repeat", type=_int_in("--ardupilot-repeat", 1, 20), default=3,
                    help="rounds of the ArduPilot speed-up runs, 1..20 (default 3)")
-    p.add_argument("--ardupilot-sim-rates", type=_rates, default=(1200, 240),
+    p.add_argument("--ardupilot-sim-rates", type=_rates, default="1200,240",
                    help="ArduPilot's SIM_RATE_HZ of the ArduPilot runs, comma-separated Hz "
                    "in 50..10000 (default 1200,240)")
     p.add_argument("--only", choices=("ardupilot", "speedups"), default=None,
