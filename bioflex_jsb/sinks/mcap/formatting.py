@@ -74,15 +74,6 @@ def varint_lengths(v: np.ndarray) -> np.ndarray:
     return n
 
 
-def varint_bytes(v: np.ndarray, width: int) -> np.ndarray:
-    """(len(v), width) canonical varints of ``v`` whose lengths are all ``width``."""
-    out = np.empty((len(v), width), dtype=np.uint8)
-    for i in range(width):
-        byte = (v >> (7 * i)) & 0x7F
-        out[:, i] = byte | 0x80 if i < width - 1 else byte
-    return out
-
-
 class _Layout:
     """The bytes of one step (records back to back) for given timestamp varint lengths: a
     template and where the doubles, record headers and varints go."""
@@ -108,7 +99,6 @@ class _Layout:
                     template += p
         self.template = np.frombuffer(bytes(template), dtype=np.uint8)
         self.size = len(template)
-        self.n_floats = len(float_at)
         self.record_offsets = np.array(self.record_offsets, dtype=np.int64)
         self.float_at = np.array(float_at, dtype=np.int64)
         self.head_at = np.array(head_at, dtype=np.int64)

@@ -236,9 +236,8 @@ class McapFileWriter:
         per_index = _CHUNK_INDEX_BYTES + _PER_CHANNEL_BYTES * channels
         chunk = 0
         if n:
-            chunk = (_CHUNK_HEADER_BYTES + n + n // 256 + 64
-                     + (n // _MSG_MIN_BYTES) * _INDEX_ENTRY_BYTES
-                     + _INDEX_PER_CHANNEL * channels + per_index)
+            chunk = (n + n // 256 + (n // _MSG_MIN_BYTES) * _INDEX_ENTRY_BYTES
+                     + self.chunk_overhead_bound())
         summary = (self._records_bytes + _FINISH_FIXED_BYTES + _PER_CHANNEL_BYTES * channels
                    + per_index * len(self._chunk_indexes)
                    + sum(25 + len(m.name) for m in self._metadata_indexes))
@@ -250,7 +249,7 @@ class McapFileWriter:
         caller that writes part of its records as a chunk of their own)."""
         channels = len(self._channels)
         return (_CHUNK_HEADER_BYTES + 64 + _INDEX_PER_CHANNEL * channels
-                + 2 * (_CHUNK_INDEX_BYTES + _PER_CHANNEL_BYTES * channels))
+                + _CHUNK_INDEX_BYTES + _PER_CHANNEL_BYTES * channels)
 
     def close_chunk(self) -> None:
         """Compress and write the chunk in progress with its message indexes; flush."""
