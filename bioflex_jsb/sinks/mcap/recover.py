@@ -1,8 +1,12 @@
 """Recovery of a log whose writer was killed or whose file was damaged, and a check of every
-chunk's CRC.
+chunk.
 
-Both read the file sequentially, record by record (``opcode``, ``length``, body), without
-its summary: a chunk whose CRC, compression or records do not check is *skipped* and the
+A chunk checks when it decompresses to its stated size (a zstd frame with its content
+checksum, XXH64, as :class:`~.writer.McapFileWriter` writes them, fails to decompress when
+damaged), its CRC-32 matches where one is written (uncompressed chunks, and the logs of
+earlier versions, which wrote one for every chunk; 0 means none, as the MCAP specification
+says) and its records fit. Both read the file sequentially, record by record (``opcode``, ``length``, body), without
+its summary: a chunk whose checksum, CRC, compression or records do not check is *skipped* and the
 scan goes on with the next record (or, where the damage hit a record's length, with the next
 place that holds a whole, valid chunk), so every intact chunk after a damaged one is kept.
 The recovered file is written by our own :class:`~.writer.McapFileWriter`: finished and
@@ -41,7 +45,8 @@ def _open_data(p: Path):
 
 
 def _chunk_records(body) -> tuple[int, list[tuple[int, bytes]]]:
-    """(uncompressed CRC, the records) of a Chunk body, decompressed and CRC-checked;
+    """(uncompressed CRC, the records) of a Chunk body, decompressed (a zstd frame's checksum
+    checked by the decoder) and CRC-checked where it has a CRC;
     ValueError (or a zstd/lz4 error) if anything does not check."""
     if len(body) < 36:
         raise ValueError("chunk record too short")
@@ -202,7 +207,7 @@ class _Copier:
 
 def recover(path: str | Path, out: str | Path) -> dict:
     """Copy every intact record of a (killed or damaged) log into a finished, indexed file
-    ``out``: every chunk whose CRC checks, also those after a damaged one (each skipped
+    ``out``: every chunk that checks (module docstring), also those after a damaged one (each skipped
     chunk is listed in ``skipped``: its byte offset and why). Returns counts, the last log
     time kept [s] and where and why the read stopped."""
     p = Path(path)
@@ -262,8 +267,8 @@ _FOOTER_BYTES = 9 + 20  # opcode, length, summary start, summary offset start, s
 
 
 def check_chunks(path: str | Path) -> dict:
-    """Every byte of a log checked against its CRCs: each chunk decompressed and its CRC
-    checked, the data section's CRC (header, schemas, channels, chunks, metadata: every
+    """Every byte of a log checked against its checksums: each chunk decompressed and checked
+    (module docstring), the data section's CRC (header, schemas, channels, chunks, metadata: every
     byte before Data End), the summary's CRC (summary, summary offsets and the footer's
     fields) and the footer's place and magic. Returns ``chunks``, ``bad`` (byte offset and
     why, per chunk that fails), ``data_crc`` and ``summary_crc`` (``ok``, ``bad``,
