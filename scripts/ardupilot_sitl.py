@@ -3,6 +3,7 @@
 
     python scripts/ardupilot_sitl.py build /path/to/ardupilot [--jobs 1] [--venv DIR]
     python scripts/ardupilot_sitl.py fly /path/to/ardupilot [--timeout-s 900] [--out DIR]
+        [--speedup 1] [--rate HZ]
 
 ``build`` runs ``./waf configure --board sitl --no-submodule-update`` and ``./waf plane`` at
 ``nice 19`` (the checkout must have its submodules: waf, mavlink + pymavlink, DroneCAN
@@ -10,17 +11,24 @@ DSDL / dronecan_dsdlc / libcanard / pydronecan, littlefs, lwip; ``--disable-netw
 builds without lwip). ``--venv`` is a virtual environment with the build's Python
 packages (empy==3.3.4, pexpect, future, dronecan, pymavlink); its ``bin`` goes first on PATH.
 
-``fly`` always runs inside a new network namespace with loopback only (ArduPilot's TCP
-ports 5760, 5762, 5763 listen on all interfaces): it re-executes itself under
-``unshare -n`` (as root) or ``unshare -rn`` (as a user), brings ``lo`` up, starts the physics
+``fly`` always runs inside a new network namespace with loopback only (ArduPilot's TCP ports
+5760, 5762, 5763 listen on all interfaces): it re-executes itself under ``unshare -n`` (as
+root) or ``unshare -rn`` (as a user), brings ``lo`` up, starts the physics
 (``--physics-cmd``, default the bioflex JSON backend on UDP 9002), starts ArduPlane with
 ``bioflex_jsb/data/ardupilot/bioflex_plane.parm``, and flies a takeoff + 4-waypoint + RTL
-mission over MAVLink (pymavlink, TCP 5760). It prints one JSON summary: waypoints reached,
-the cross-track error [m] twice (``xtrack_from_8s_into_leg_m``: from 8 s after each waypoint
-switch, the line being flown; ``xtrack_including_turns_m``: every sample, the turn at each
-waypoint included, where the error jumps to the next leg's ~30 m at the switch), ArduPilot's
-STATUSTEXT messages, simulated and wall time [s] and two real-time factors, each named with
-its definition (``real_time_factors``).
+mission over MAVLink (pymavlink, TCP 5760). ``--speedup N`` is ArduPlane's ``--speedup`` (it
+paces its frames to N times real time; lock-stepped, the backend sets the pace it reaches)
+and ``--rate HZ`` its ``--rate`` (``SIM_RATE_HZ``, ArduPilot's default 1200 when not given);
+the script's own waits in wall time (the arming retry, the launch switch) are divided by N
+so that they last as long in ArduPlane's time. It prints one JSON summary: waypoints
+reached, the cross-track error [m] twice (``xtrack_from_8s_into_leg_m``: from 8 s after each
+waypoint switch, the line being flown; ``xtrack_including_turns_m``: every sample, the turn
+at each waypoint included, where the error jumps to the next leg's ~30 m at the switch),
+ArduPilot's STATUSTEXT messages, simulated and wall time [s], three real-time factors (the
+backend's, ArduPlane's from boot and ArduPlane's in flight), each named with its definition
+(``real_time_factors``), whether the backend's held the requested speed-up within 5 %
+(``speedup_held``), the load average before and after and the CPU time [s] of the script,
+the physics and ArduPlane (``cpu_s``).
 
 Exit status: 0 the mission was completed (every waypoint of the square reached, then home
 in RTL); 1 the mission was not completed (timeout, a process exited, waypoints missed: the
@@ -32,6 +40,7 @@ Nothing here is ArduPilot's code; the checkout is only built and run.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -60,7 +69,21 @@ MISSION_ALT_M = 60.0
 SQUARE_M = ((300.0, 0.0), (300.0, 300.0), (0.0, 300.0), (0.0, 0.0))
 LAUNCH_SWITCH_PWM_US = 1900  # RC 5 "fire" (the physics fires at 1880..1920 us held 0.5 s)
 RTL_WATCH_S = 30.0  # the flight ends after this long [s] in RTL near home
-LAUNCH_SWITCH_S = 2.0  # how long the switch is held [s of wall time]
+LAUNCH_SWITCH_S = 2.0  # how long the switch is held [s of wall time at --speedup 1]
+LAUNCH_RESEND_S = 0.2  # RC override re-sent this often [s of wall time at --speedup 1]
+ARM_RETRY_S = 5.0  # arming re-sent this often while refused [s of wall time at --speedup 1]
+# MAVLink streams asked for, at STREAM_RATE_HZ of ArduPlane's time: only those holding the
+# messages read here (EXTENDED_STATUS: MISSION_CURRENT, GPS_RAW_INT, NAV_CONTROLLER_OUTPUT;
+# POSITION: GLOBAL_POSITION_INT; EXTRA3: SYSTEM_TIME; libraries/GCS_MAVLink/
+# GCS_MAVLink_Parameters.cpp). MAV_DATA_STREAM_ALL covers up to 55 kinds of message there,
+# up to 550 a simulated second at 10 Hz for Python to parse: 11 000 a wall second at
+# --speedup 20, processor time taken from the two lock-stepped processes.
+STREAMS = ("MAV_DATA_STREAM_EXTENDED_STATUS", "MAV_DATA_STREAM_POSITION",
+           "MAV_DATA_STREAM_EXTRA3")
+STREAM_RATE_HZ = 10
+# DEFINITION (issue 28): a speed-up is held when the backend's real-time factor is within
+# this fraction of it (docs/ardupilot.md, "Faster than real time").
+HELD_TOLERANCE = 0.05
 PLANE_MODE_RTL = 11  # ArduPlane custom_mode of RTL
 NO_OVERRIDE = 65535  # RC_CHANNELS_OVERRIDE: leave this channel alone
 EARTH_RADIUS_M = 6378137.0  # WGS-84 equatorial radius: metres → degrees near home
@@ -142,7 +165,8 @@ def _mission(mav, home_lat: float, home_lon: float):
         mav.mav.send(messages[req.seq])
 
 
-def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
+def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float = 1.0,
+        rate_hz: int | None = None) -> dict:
     if os.environ.get(NETNS_ENV) != "1":
         _in_private_netns()
     from pymavlink import mavutil
@@ -152,7 +176,15 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
         raise ScriptError(f"{binary} not built: run the build step first")
     out.mkdir(parents=True, exist_ok=True)
     procs = []
-    summary: dict = {"statustext": [], "reached": [], "xtrack_m": []}
+    summary: dict = {"speedup": speedup, "sim_rate_hz": rate_hz,
+                     "loadavg_start": list(os.getloadavg()),
+                     "statustext": [], "reached": [], "xtrack_m": []}
+    ap_cmd = [str(binary), "--model", "JSON:127.0.0.1", "--speedup", f"{speedup:g}",
+              "--slave", "0", "--defaults", str(PARAM_FILE), "-I0", "--wipe"]
+    if rate_hz is not None:
+        ap_cmd += ["--rate", str(rate_hz)]
+    summary["arduplane_cmd"] = shlex.join(ap_cmd)
+    cpu0 = os.times()
     wall0 = time.monotonic()
     try:
         with open(out / "physics.log", "w") as plog, open(out / "arduplane.log", "w") as alog:
@@ -161,12 +193,10 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
                 p for p in (str(REPO), env.get("PYTHONPATH", "")) if p)
             procs.append(subprocess.Popen(shlex.split(physics_cmd), cwd=out, stdout=plog,
                                           stderr=subprocess.STDOUT, env=env))
-            procs.append(subprocess.Popen(
-                [str(binary), "--model", "JSON:127.0.0.1", "--speedup", "1", "--slave", "0",
-                 "--defaults", str(PARAM_FILE), "-I0", "--wipe"],
-                cwd=out, stdout=alog, stderr=subprocess.STDOUT))
+            procs.append(subprocess.Popen(ap_cmd, cwd=out, stdout=alog,
+                                          stderr=subprocess.STDOUT))
             mav = _connect(mavutil, procs)
-            _run_mission(mav, procs, timeout_s, summary)
+            _run_mission(mav, procs, timeout_s, summary, speedup)
     finally:
         for p in reversed(procs):
             if p.poll() is None:
@@ -176,6 +206,12 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
                 except subprocess.TimeoutExpired:
                     p.kill()
     summary["wall_s"] = time.monotonic() - wall0
+    summary["loadavg_end"] = list(os.getloadavg())
+    cpu1 = os.times()
+    summary["cpu_s"] = {  # processor time (user + system) [s] over the flight
+        "script": (cpu1.user + cpu1.system) - (cpu0.user + cpu0.system),
+        "physics_and_arduplane": ((cpu1.children_user + cpu1.children_system)
+                                  - (cpu0.children_user + cpu0.children_system))}
     physics_summary = out / "physics.json"  # written by bioflex-jsb ardupilot when stopped
     if physics_summary.is_file():
         try:
@@ -183,15 +219,21 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path) -> dict:
         except ValueError as exc:
             summary["physics"] = f"unreadable {physics_summary}: {exc}"
     summary["real_time_factors"] = real_time_factors(summary)
+    summary["speedup_held"] = speedup_held(summary["real_time_factors"]["physics"], speedup)
     summary.update(cross_track_report(summary.pop("xtrack_m")))
     summary["incomplete"] = incomplete(summary)
     return summary
 
 
 def real_time_factors(summary: dict) -> dict:
-    """The two real-time factors of a flight, each with what it divides."""
+    """The three real-time factors of a flight, each with what it divides."""
     physics = summary.get("physics")
     rtf = physics.get("real_time_factor") if isinstance(physics, dict) else None
+    in_flight = None
+    if "launch_sent_wall_s" in summary and summary.get("end_wall_s"):
+        wall = summary["end_wall_s"] - summary["launch_sent_wall_s"]
+        if wall > 0:
+            in_flight = (summary["sim_s"] - summary["launch_sent_at_s"]) / wall
     return {
         "physics": rtf,
         "physics_definition": (physics.get("real_time_factor_definition")
@@ -201,7 +243,19 @@ def real_time_factors(summary: dict) -> dict:
         "arduplane_boot_to_end_definition": (
             "ArduPlane's SYSTEM_TIME time_boot_ms at the end over this script's wall time, "
             "ArduPlane's boot, EKF alignment and the waits for the physics included"),
+        "arduplane_launch_to_end": in_flight,
+        "arduplane_launch_to_end_definition": (
+            "the change of ArduPlane's SYSTEM_TIME time_boot_ms from the launch switch to the "
+            "end over the script's wall time between them: the flight only"),
     }
+
+
+def speedup_held(real_time_factor: float | None, speedup: float) -> bool | None:
+    """Whether the backend's real-time factor is within :data:`HELD_TOLERANCE` of the
+    speed-up asked for (None without a factor)."""
+    if real_time_factor is None:
+        return None
+    return abs(real_time_factor - speedup) <= HELD_TOLERANCE * speedup
 
 
 def _percentile(values: list[float], q: float) -> float:
@@ -256,7 +310,10 @@ def _connect(mavutil, procs, timeout_s: float = 60.0):
         if any(p.poll() is not None for p in procs):
             raise ScriptError("the physics or ArduPlane exited at start (see their logs)")
         try:
-            mav = mavutil.mavlink_connection(MAVLINK_URL, source_system=255)
+            # pymavlink prints "[Errno 111] Connection refused sleeping" on stdout while
+            # ArduPlane boots: stdout is the JSON summary's, so that goes to stderr
+            with contextlib.redirect_stdout(sys.stderr):
+                mav = mavutil.mavlink_connection(MAVLINK_URL, source_system=255)
         except OSError:
             time.sleep(1.0)
             continue
@@ -265,13 +322,17 @@ def _connect(mavutil, procs, timeout_s: float = 60.0):
     raise ScriptError(f"no HEARTBEAT on {MAVLINK_URL} within {timeout_s:.0f} s")
 
 
-def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
-    """Wait for a GPS fix and home, upload the mission, AUTO + arm, watch until home."""
+def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1.0) -> None:
+    """Wait for a GPS fix and home, upload the mission, AUTO + arm, watch until home.
+    The waits in wall time are divided by ``speedup``: as long in ArduPlane's time."""
     from pymavlink import mavutil
 
     m = mavutil.mavlink
-    mav.mav.request_data_stream_send(mav.target_system, mav.target_component,
-                                     m.MAV_DATA_STREAM_ALL, 10, 1)
+    for stream in STREAMS:
+        mav.mav.request_data_stream_send(mav.target_system, mav.target_component,
+                                         getattr(m, stream), STREAM_RATE_HZ, 1)
+    arm_retry_s, launch_hold_s, launch_resend_s = (
+        ARM_RETRY_S / speedup, LAUNCH_SWITCH_S / speedup, LAUNCH_RESEND_S / speedup)
     deadline = time.monotonic() + timeout_s
     state = "wait_gps"
     home = None
@@ -337,14 +398,15 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
             mav.arducopter_arm()
             arm_sent_s = time.monotonic()
             state = "auto"
-        if state == "auto" and not armed and time.monotonic() - arm_sent_s > 5.0:
+        if state == "auto" and not armed and time.monotonic() - arm_sent_s > arm_retry_s:
             mav.arducopter_arm()  # pre-arm checks (EKF, GPS) may refuse at first: again
             arm_sent_s = time.monotonic()
         if state == "auto" and armed and "launch_sent_at_s" not in summary:
             summary["launch_sent_at_s"] = sim_s
-            launch_until = time.monotonic() + LAUNCH_SWITCH_S
+            summary["launch_sent_wall_s"] = time.monotonic()
+            launch_until = time.monotonic() + launch_hold_s
         if state == "auto" and armed and time.monotonic() < launch_until \
-                and time.monotonic() - launch_sent_s > 0.2:
+                and time.monotonic() - launch_sent_s > launch_resend_s:
             # the launch switch: RC 5 high (SERVO5_FUNCTION 55 passes it to the physics)
             launch_sent_s = time.monotonic()
             mav.mav.rc_channels_override_send(
@@ -364,6 +426,7 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict) -> None:
                 summary["ended"] = "home reached in RTL"
                 break
     summary["sim_s"] = sim_s
+    summary["end_wall_s"] = time.monotonic()
     summary["mission_items"] = n_items
     summary["track"] = track[::10]  # ≈ 1 s apart at the 10 Hz stream
 
@@ -388,6 +451,10 @@ def main(argv: list[str] | None = None) -> int:
     f.add_argument("--physics-cmd", default=DEFAULT_PHYSICS_CMD)
     f.add_argument("--timeout-s", type=float, default=900.0)
     f.add_argument("--out", type=Path, default=Path("ardupilot_run"))
+    f.add_argument("--speedup", type=float, default=1.0,
+                   help="ArduPlane's --speedup (default 1)")
+    f.add_argument("--rate", type=int, default=None,
+                   help="ArduPlane's --rate: SIM_RATE_HZ [Hz] (default ArduPilot's, 1200)")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -395,8 +462,12 @@ def main(argv: list[str] | None = None) -> int:
                 raise ScriptError(f"--jobs must be >= 1, got {args.jobs}")
             build(args.ardupilot.resolve(), args.jobs, args.venv, args.disable_networking)
         else:
+            if not (math.isfinite(args.speedup) and args.speedup > 0):
+                raise ScriptError(f"--speedup must be > 0, got {args.speedup:g}")
+            if args.rate is not None and args.rate < 1:
+                raise ScriptError(f"--rate must be >= 1 Hz, got {args.rate}")
             summary = fly(args.ardupilot.resolve(), args.physics_cmd, args.timeout_s,
-                          args.out.resolve())
+                          args.out.resolve(), args.speedup, args.rate)
             print(json.dumps(summary, indent=1))
             if summary["incomplete"]:
                 print(f"ardupilot_sitl: mission not completed: {'; '.join(summary['incomplete'])}",

@@ -79,3 +79,36 @@ def test_real_time_factors_are_named(script):
     assert rtf["physics"] == 0.97 and rtf["physics_definition"].startswith("session_s")
     assert rtf["arduplane_boot_to_end"] == pytest.approx(0.643)
     assert "boot" in rtf["arduplane_boot_to_end_definition"]
+    assert rtf["arduplane_launch_to_end"] is None  # never launched
+    flown = {"sim_s": 250.0, "wall_s": 30.0, "launch_sent_at_s": 50.0,
+             "launch_sent_wall_s": 1000.0, "end_wall_s": 1020.0}
+    rtf = script.real_time_factors(flown)
+    assert rtf["arduplane_launch_to_end"] == pytest.approx(10.0)  # 200 s in 20 s
+    assert "flight only" in rtf["arduplane_launch_to_end_definition"]
+
+
+def test_speedup_held_within_5_percent(script):
+    assert script.HELD_TOLERANCE == 0.05
+    assert script.speedup_held(9.6, 10.0) and script.speedup_held(10.4, 10.0)
+    assert not script.speedup_held(9.4, 10.0)
+    assert not script.speedup_held(1.06, 1.0)
+    assert script.speedup_held(None, 10.0) is None
+
+
+def test_speedup_and_rate_reach_fly(script, monkeypatch, tmp_path):
+    seen = []
+    monkeypatch.setattr(script, "fly", lambda *a: seen.append(a) or {"incomplete": []})
+    assert script.main(["fly", str(tmp_path), "--speedup", "12", "--rate", "240"]) == 0
+    assert seen[-1][4:] == (12.0, 240)
+    assert script.main(["fly", str(tmp_path)]) == 0
+    assert seen[-1][4:] == (1.0, None)  # ArduPilot's own SIM_RATE_HZ
+
+
+@pytest.mark.parametrize("bad", [["--speedup", "0"], ["--speedup", "-2"],
+                                 ["--speedup", "nan"], ["--speedup", "inf"],
+                                 ["--rate", "0"]])
+def test_bad_speedup_or_rate_is_exit_2(script, monkeypatch, capsys, tmp_path, bad):
+    monkeypatch.setattr(script, "fly", lambda *a: pytest.fail("flown with bad input"))
+    assert script.main(["fly", str(tmp_path), *bad]) == script.EXIT_ERROR == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "must be" in err
