@@ -33,6 +33,7 @@ from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
+from bioflex_jsb.sinks.mcap.scene import SCENE_RATE_HZ
 from tests.ardupilot_standin import ArduPilotStandin, dcm_of
 
 G = ad.G0_M_S2
@@ -410,9 +411,20 @@ def test_log_run_topics_are_the_state_sent(session_log):
     msgs = sink.messages_by_topic(path)
     rigid = msgs[sink.topic("coupled", "rigid_body")]
     flight_steps = 200  # 150 + 50 frames after the stroke, the resend not a step
-    for group in ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose",
-                  "location"):
+    for group in ("rigid_body", "modal", "modal_loads", "gust", "controls"):
         assert len(msgs[sink.topic("coupled", group)]) == flight_steps, group
+    # pose and location at the 3-D scene's samples: the first step in each 1/60 s of log time
+    # (SCENE_RATE_HZ; floor(t·60 + 1e-6), scene.py's bins, the scene's instants), in this
+    # log without a scene too
+    assert sink.topic("coupled", "scene") not in msgs
+    bins = [math.floor(ns * 1e-9 * SCENE_RATE_HZ + 1e-6) for ns, _ in rigid]
+    samples = [ns for k, (ns, _) in enumerate(rigid) if k == 0 or bins[k] != bins[k - 1]]
+    assert 10 <= len(samples) < flight_steps
+    for group in ("pose", "location"):
+        assert [ns for ns, _ in msgs[sink.topic("coupled", group)]] == samples, group
+    at = dict(rigid)
+    for ns, fix in msgs[sink.topic("coupled", "location")]:
+        assert fix["altitude"] == at[ns]["altitude_m"]
     # the snapshot logged at t is the state the reply at t sent (float32 in ArduPilot)
     sent_at = {round(t * 1e9): p for t, phase, p in replies}
     for ns, m in rigid:

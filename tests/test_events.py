@@ -142,7 +142,14 @@ def test_a_crash_and_the_reset_are_events_on_either_side_of_the_split(crash_sess
     for order in (file_order(paths[1]), time_order(paths[1])):
         assert order[0] == (EVENTS, t_reset_ns)
         assert min(ns for top, ns in order if top != EVENTS) == t_reset_ns  # trim at home
-        assert len(order) > 7 * 400  # the session went on (0.5 s of steps)
+        # the session went on (0.5 s of steps): > 400 steps on the every-step topics
+        assert sum(top.endswith("/rigid_body") for top, _ in order) > 400
+    for path in paths:  # pose at the scene's 60 Hz instants in each file, from its first step
+        order = time_order(path)
+        pose = [ns for top, ns in order if top.endswith("/pose")]
+        assert len(pose) >= 2 and pose == [ns for top, ns in order if top.endswith("/scene")]
+        assert pose == [ns for top, ns in order if top.endswith("/location")]
+        assert pose[0] == min(ns for top, ns in order if top.endswith("/rigid_body"))
     meta = sink.summarise(paths[1])["metadata"][sink.RUN_METADATA]
     assert "after_reset" in meta["description"]
     for p in paths:

@@ -567,16 +567,27 @@ class _Clock:
 
 
 class _TeeStub:
-    """A writer's ``on_chunk`` recording the steps of each chunk it is handed."""
+    """A writer's ``on_chunk`` recording the messages of each chunk it is handed."""
 
     def __init__(self, subscribed: bool) -> None:
         self.subscribed = subscribed
         self.chunks: list[int] = []  # messages per chunk
+        self.topics: list[dict[str, int]] = []  # messages per topic, per chunk
 
     def __call__(self, data, channels, schemas) -> None:
+        import struct
+
         from bioflex_jsb.sinks.live import _count
 
         self.chunks.append(_count(data))
+        topic = {c.id: c.topic for c in channels}
+        counts: dict[str, int] = {}
+        pos = 0
+        while pos < len(data):  # Message records: opcode, length, channel id, ...
+            name = topic[struct.unpack_from("<H", data, pos + 9)[0]]
+            counts[name] = counts.get(name, 0) + 1
+            pos += 9 + struct.unpack_from("<Q", data, pos + 1)[0]
+        self.topics.append(counts)
 
 
 @pytest.mark.parametrize("subscribed", [False, True])
@@ -608,9 +619,18 @@ def test_chunks_close_within_the_live_span_only_while_a_client_listens(
         log.sample("coupled", k * dt, row)
         clock.t += dt
     log.close()
-    per_step = 7  # the run topics of a step (rigid_body ... location)
-    steps = [n // per_step for n in tee.chunks]
+    # every step on rigid_body (and four more topics); pose and location at the steps that
+    # begin a 1/60 s (every 16th from the first; SCENE_RATE_HZ), in the chunk of their step
+    steps = [c[sink.topic("coupled", "rigid_body")] for c in tee.topics]
     assert sum(steps) == 1920
+    first = [sum(steps[:i]) for i in range(len(steps))]  # each chunk's first step
+    for c, k0, n in zip(tee.topics, first, steps, strict=True):
+        samples = len([k for k in range(k0, k0 + n) if k % 16 == 0])
+        assert c == {**{sink.topic("coupled", g): n for g in
+                        ("rigid_body", "modal", "modal_loads", "gust", "controls")},
+                     **({sink.topic("coupled", g): samples for g in ("pose", "location")}
+                        if samples else {})}
+    assert tee.chunks == [sum(c.values()) for c in tee.topics]
     if subscribed:
         assert steps[:-1] == [math.ceil(LIVE_CHUNK_WALL_S / dt - 1e-9)] * (len(steps) - 1)
     else:

@@ -19,11 +19,17 @@ from bioflex_jsb import cli
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.run import RunDescription
 from bioflex_jsb.sinks import mcap as sink
+from bioflex_jsb.sinks.mcap.scene import SCENE_RATE_HZ
 from tests.tools import env_program
 
 ROOT = Path(__file__).resolve().parents[1]
 JS_CHECK = ROOT / "tests" / "js" / "check_mcap.cjs"
 RUN_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
+# pose and location (the 3-D panel's body pose, the map's fix) at the 3-D scene's samples only
+# (SCENE_RATE_HZ: the first step of each 1/60 s, a run's first step too), with or without a
+# scene in the log; the other run topics at every step
+SAMPLED_GROUPS = ("pose", "location")
+EVERY_STEP_GROUPS = tuple(g for g in RUN_GROUPS if g not in SAMPLED_GROUPS)
 # a gust run's log: the steps' topics and the wing's section loads (sinks/mcap/loads_topic.py,
 # one message per step, a chunk of their own per block)
 LOG_GROUPS = RUN_GROUPS + ("loads",)
@@ -31,15 +37,36 @@ LOG_GROUPS = RUN_GROUPS + ("loads",)
 # parts once per chunk, the section-load markers at the wing's samples (scene_loads.py); not
 # one message per step, so counted apart.
 SCENE_GROUPS = ("scene", "airframe", "scene_loads")
+# 960 steps a second, 60 samples: a run from t = 0 has a sample every 16th step, from its first
+STEPS_PER_SAMPLE = 16
+assert STEPS_PER_SAMPLE * DEFAULT_DT_S * SCENE_RATE_HZ == pytest.approx(1.0, abs=1e-12)
+
+
+def samples(n_steps: int) -> int:
+    """Pose and location messages of a run of ``n_steps`` steps from t = 0."""
+    return -(-n_steps // STEPS_PER_SAMPLE)
 
 
 def per_step(counts: dict[str, int]) -> dict[str, int]:
-    """The topics' message counts without the scene's (which are not one per step)."""
-    return {t: n for t, n in counts.items() if t.rsplit("/", 1)[-1] not in SCENE_GROUPS}
+    """The topics' message counts without the scene's and pose and location (which are not
+    one per step)."""
+    return {t: n for t, n in counts.items()
+            if t.rsplit("/", 1)[-1] not in SCENE_GROUPS + SAMPLED_GROUPS}
+
+
+def sampled_counts(counts: dict[str, int]) -> dict[str, int]:
+    """The message counts of pose and location."""
+    return {t: n for t, n in counts.items() if t.rsplit("/", 1)[-1] in SAMPLED_GROUPS}
+
+
+def expected_counts(model: str, n_steps: int, groups=LOG_GROUPS) -> dict[str, int]:
+    """The per-step and pose/location counts of ``n_steps`` steps of ``model`` from t = 0."""
+    return {sink.topic(model, g): samples(n_steps) if g in SAMPLED_GROUPS else n_steps
+            for g in groups}
 
 
 def step_messages(path) -> int:
-    """Messages of a log on its per-step topics (the scene's left out)."""
+    """Messages of a log on its per-step topics (the scene's, pose and location left out)."""
     info = sink.summarise(path)
     return sum(per_step({c["topic"]: c["messages"] for c in info["channels"]}).values())
 NEW_COMMANDS = ("info", "plot", "rerun")
@@ -78,9 +105,12 @@ def read_all(path: Path) -> dict[str, list[tuple[int, dict]]]:
 def test_every_step_on_every_topic_with_schemas_and_metadata(gust_log):
     info = sink.summarise(gust_log)
     counts = {c["topic"]: c["messages"] for c in info["channels"]}
-    assert per_step(counts) == {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
-    # the scene: 60 samples over the second flown, the rigid parts once per chunk of steps
-    assert counts[sink.topic("coupled", "scene")] == 60
+    assert per_step(counts) == {sink.topic("coupled", g): STEPS_1S
+                                for g in LOG_GROUPS if g not in SAMPLED_GROUPS}
+    # the scene: 60 samples over the second flown, the rigid parts once per chunk of steps;
+    # pose and location at the same 60 samples
+    assert counts[sink.topic("coupled", "scene")] == 60 == samples(STEPS_1S)
+    assert sampled_counts(counts) == {sink.topic("coupled", g): 60 for g in SAMPLED_GROUPS}
     assert counts[sink.topic("coupled", "airframe")] == math.ceil(1.0 / sink.CHUNK_SPAN_S)
     schemas = {c["topic"]: c["schema"] for c in info["channels"]}
     assert schemas[sink.topic("coupled", "scene")] == "foxglove.SceneUpdate"
@@ -140,6 +170,42 @@ def test_messages_follow_the_schemas_and_foxglove_field_names(gust_log):
     assert max(gust) == pytest.approx(3.0)
 
 
+def test_pose_and_location_at_the_scene_samples_with_rigid_body_values(gust_log):
+    """Pose and location at the scene's 60 Hz instants (its rule and rate, so the body pose
+    and the wing drawn agree), their values those of rigid_body at those steps, their
+    sequence numbers counting their own messages, the rate in their channel metadata."""
+    from mcap.reader import make_reader
+
+    msgs = read_all(gust_log)
+    rigid = msgs[sink.topic("coupled", "rigid_body")]
+    scene_ns = [ns for ns, _ in msgs[sink.topic("coupled", "scene")]]
+    assert len(rigid) == STEPS_1S and len(scene_ns) == samples(STEPS_1S)
+    at = {ns: m for ns, m in rigid}
+    pose, fix = msgs[sink.topic("coupled", "pose")], msgs[sink.topic("coupled", "location")]
+    assert [ns for ns, _ in pose] == [ns for ns, _ in fix] == scene_ns
+    assert scene_ns == [ns for ns, _ in rigid[::STEPS_PER_SAMPLE]]
+    h0 = rigid[0][1]["altitude_m"]
+    for (ns, p), (_, f) in zip(pose, fix, strict=True):
+        r = at[ns]
+        assert p["timestamp"] == f["timestamp"] == {"sec": ns // 10**9, "nsec": ns % 10**9}
+        assert p["translation"]["z"] == r["altitude_m"] - h0  # the same double, offset
+        assert f["altitude"] == r["altitude_m"]
+        q = sink.enu_quaternion(r["roll_rad"], r["pitch_rad"], r["yaw_rad"])
+        assert [p["rotation"][k] for k in "xyzw"] == pytest.approx(q, abs=1e-15)
+    with open(gust_log, "rb") as f:
+        reader = make_reader(f)
+        channels = reader.get_summary().channels
+        seqs: dict[str, list[int]] = {}
+        for _schema, channel, message in reader.iter_messages(log_time_order=False):
+            seqs.setdefault(channel.topic, []).append(message.sequence)
+    meta = {c.topic.rsplit("/", 1)[-1]: dict(c.metadata) for c in channels.values()}
+    for g in RUN_GROUPS:
+        n = samples(STEPS_1S) if g in SAMPLED_GROUPS else STEPS_1S
+        assert seqs[sink.topic("coupled", g)] == list(range(n)), g
+        assert meta[g].get("rate_hz") == (repr(SCENE_RATE_HZ) if g in SAMPLED_GROUPS
+                                          else None), g
+
+
 def test_enu_quaternion_matches_the_rotation_matrix():
     rng = np.random.default_rng(1)
     for phi, theta, psi in rng.uniform(-1.2, 1.2, size=(20, 3)):
@@ -190,9 +256,10 @@ def node_check(tmp_path_factory):
 
 def test_mcap_core_indexed_reader_with_crcs(gust_log, node_check):
     result = node_check(gust_log)
-    expected = {sink.topic("coupled", g): STEPS_1S for g in LOG_GROUPS}
-    assert per_step(result["counts"]) == expected  # through the chunk indexes, CRCs checked
-    assert per_step(result["statistics"]) == expected
+    expected = expected_counts("coupled", STEPS_1S)
+    # through the chunk indexes, CRCs checked
+    assert {**per_step(result["counts"]), **sampled_counts(result["counts"])} == expected
+    assert {**per_step(result["statistics"]), **sampled_counts(result["statistics"])} == expected
     assert result["dataCrcOk"] is True and result["ordered"] is True
     assert result["schemas"]["/bioflex/coupled/location"] == "foxglove.LocationFix"
     assert set(result["encodings"].values()) == {"protobuf"}
@@ -228,8 +295,9 @@ def test_pymcap_cli_doctor(gust_log):
 def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     assert main(["info", str(gust_log), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["messages"] == step_messages(gust_log) + 60 + 2 + 60  # + the scene's, markers
-    assert step_messages(gust_log) == STEPS_1S * len(LOG_GROUPS)
+    # + pose and location, the scene's and the markers
+    assert info["messages"] == step_messages(gust_log) + 2 * 60 + 60 + 2 + 60
+    assert step_messages(gust_log) == STEPS_1S * (len(LOG_GROUPS) - len(SAMPLED_GROUPS))
     png = tmp_path / "run.png"
     assert main(["plot", str(gust_log), "--out", str(png)]) == 0
     assert png.stat().st_size > 10_000
@@ -239,7 +307,7 @@ def test_info_plot_and_rerun(gust_log, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["equal"] is True and result["first_difference"] is None
     assert result["command"][1:3] == ["gust", "--wing"]
-    assert step_messages(again) == STEPS_1S * len(LOG_GROUPS)
+    assert step_messages(again) == STEPS_1S * (len(LOG_GROUPS) - len(SAMPLED_GROUPS))
 
 
 def test_rerun_reports_a_difference(gust_log, tmp_path, capsys):
@@ -287,7 +355,9 @@ def test_runs_log_by_default_unless_told_not_to(tmp_path, monkeypatch, capsys):
     second = json.loads(capsys.readouterr().out)["out"]
     logs = sorted(folder.glob("gust-optimised-*.mcap"))
     assert {str(p) for p in logs} == {first, second} and first != second
-    assert step_messages(first) == round(0.2 / DEFAULT_DT_S) * len(LOG_GROUPS)
+    counts = {c["topic"]: c["messages"] for c in sink.summarise(first)["channels"]}
+    assert {**per_step(counts), **sampled_counts(counts)} == expected_counts(
+        "rigid", round(0.2 / DEFAULT_DT_S))  # pose and location at 60 Hz
     assert main([*args, "--no-log"]) == 0
     assert json.loads(capsys.readouterr().out)["out"] is None
     assert len(list(folder.iterdir())) == 2
@@ -423,9 +493,10 @@ def test_sigint_leaves_a_finished_file_with_every_step(tmp_path, node_check):
         # the signal lands between two statements of the instrumented loop: the last step
         # printed and the last step logged can be one step apart (either way), no more
         assert abs(rigid[-1][0] * 1e-9 - flown[-1]) <= DEFAULT_DT_S + 1e-9
-    counts = per_step(node_check(path)["counts"])
-    # the loads too: the run hands on its last row's loads when it is stopped
-    assert counts == {sink.topic("coupled", g): n for g in LOG_GROUPS}
+    counts = node_check(path)["counts"]
+    # the loads too: the run hands on its last row's loads when it is stopped; pose and
+    # location at the 60 Hz samples of the steps logged
+    assert {**per_step(counts), **sampled_counts(counts)} == expected_counts("coupled", n)
     assert "interrupted" in err and "holds every step" in err
 
 
@@ -440,11 +511,16 @@ def _is_number(text: str) -> bool:
 def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, capsys):
     path = tmp_path / "killed.mcap"
     # killed just before a chunk closes (chunks span [k, k+1) × CHUNK_SPAN_S): the worst case
-    proc, _ = _start_run(path, until_s=7.9 * sink.CHUNK_SPAN_S)
+    proc, last = _start_run(path, until_s=7.9 * sink.CHUNK_SPAN_S)
     proc.kill()
-    rest, _err = proc.communicate(timeout=60)
-    sampled = [float(x) for x in rest.split() if _is_number(x)]
-    last_flown_s = sampled[-1] if sampled else 7.9 * sink.CHUNK_SPAN_S
+    # the steps printed before the kill: through the text stream, whose buffer may already
+    # hold lines the loop above has not read (communicate() reads only the pipe: the run was
+    # then taken as stopped at until_s while a later chunk was on disk, "lost" < 0, a flake
+    # under load); a line cut by the kill is not a step's time
+    rest = proc.stdout.read()
+    proc.communicate(timeout=60)
+    sampled = [float(x) for x in rest.split("\n")[:-1] if _is_number(x)]
+    last_flown_s = sampled[-1] if sampled else last
     # the killed log has no summary: info says how to recover it
     assert main(["info", str(path)]) == 2
     assert "--recover" in capsys.readouterr().err
@@ -455,10 +531,11 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
     print(f"SIGKILL at t = {last_flown_s:.3f} s simulated: recovered up to "
           f"{report['last_time_s']:.3f} s, lost {lost_s:.3f} s")
     assert 0.0 <= lost_s <= sink.CHUNK_SPAN_S + 2 * DEFAULT_DT_S <= 1.0
-    counts = per_step(node_check(fixed)["counts"])
+    counts = node_check(fixed)["counts"]
+    counts = {**per_step(counts), **sampled_counts(counts)}
     n = round(report["last_time_s"] / DEFAULT_DT_S) + 1
     loads = counts.pop(sink.topic("coupled", "loads"))
-    assert counts == {sink.topic("coupled", g): n for g in RUN_GROUPS}
+    assert counts == expected_counts("coupled", n, RUN_GROUPS)
     # the loads' chunk follows its steps' one step behind: killed between the two writes, a
     # block (864 steps) more is lost
     assert n - 1 - 864 <= loads <= n - 1
@@ -470,14 +547,63 @@ def test_varints_are_canonical_protobuf():
 
     v = np.array([0, 1, 127, 128, 16383, 16384, 2**21 - 1, 2**21, 2**28 - 1, 2**28,
                   999_999_999], dtype=np.int64)
-    lengths = formatting.varint_lengths(v)
-    assert lengths.tolist() == [len(protobuf.varint(int(x))) for x in v]
-    for x, n in zip(v.tolist(), lengths.tolist(), strict=True):
+    lengths = [formatting._varint_length(x) for x in v.tolist()]  # the records' lengths
+    assert lengths == [len(protobuf.varint(int(x))) for x in v]
+    for x, n in zip(v.tolist(), lengths, strict=True):
         row = np.zeros(n + 2, dtype=np.uint8)
         formatting._write_varint(row, 1, x, n)  # the records' writer, one byte in
         assert row[0] == 0 and row[-1] == 0  # nothing outside its n bytes
         got = row[1:1 + n].tobytes()
         assert got == protobuf.varint(x) and protobuf.read_varint(got, 0) == (x, n)
+
+
+def test_records_write_the_sampled_records_at_their_steps_only():
+    """Records with ``every``: each step's every-step record, the others only at the sampled
+    steps, in step order across a change of the timestamp's varint lengths (one compiled
+    pass, several layouts); each channel's sequence numbers count its own messages and its
+    index entries point at its records."""
+    import struct
+
+    from bioflex_jsb.sinks.mcap import formatting, protobuf
+
+    def pieces(ls, ln):
+        return [formatting._doubles((1,)),
+                formatting._timestamp(1, ls, ln) + formatting._doubles((2,))]
+
+    records = formatting.Records([7, 9], pieces, timestamped=True, every=1)
+    ns = np.array([127_999_999_000, 127_999_999_500, 128_000_000_000, 128_000_000_250,
+                   128_000_001_000, 128_000_002_000], dtype=np.int64)  # 1 → 2-byte seconds
+    floats = np.column_stack([np.arange(6.0), 100.0 + np.arange(6.0)])
+    sampled = np.array([0, 2, 3, 5])
+    block, index = records.build(ns, floats, 40, sampled, 11)
+    data, pos, got = bytes(block), 0, []
+    while pos < len(data):
+        op, length, cid, seq, log_ns, pub_ns = struct.unpack_from("<BQHIQQ", data, pos)
+        assert op == 0x05 and log_ns == pub_ns
+        got.append((pos, cid, seq, log_ns, data[pos + 31:pos + 9 + length]))
+        pos += 9 + length
+    assert pos == len(data)
+    expect = []
+    for r in range(6):
+        expect.append((7, 40 + r, int(ns[r])))
+        if r in sampled:
+            expect.append((9, 11 + sampled.tolist().index(r), int(ns[r])))
+    assert [(c, q, t) for _, c, q, t, _ in got] == expect
+    for cid in (7, 9):
+        mine = [(t, at) for at, c, _, t, _ in got if c == cid]
+        assert index[cid].tolist() == [list(e) for e in mine]
+    read = protobuf.read_varint
+    for _, cid, _, t, body in got:
+        if cid == 9:  # the timestamp and the sampled row's own double
+            assert body[0] == 0x0A
+            stamp = body[2:2 + body[1]]
+            sec, k = read(stamp, 1)
+            nsec, _ = read(stamp, k + 1)
+            assert sec * 10**9 + nsec == t
+            step = ns.tolist().index(t)
+            assert struct.unpack_from("<d", body, len(body) - 8)[0] == 100.0 + step
+        else:
+            assert struct.unpack_from("<d", body, 1)[0] == ns.tolist().index(t)
 
 
 def _chunks_of(recorder, time_s, table, dt_s=1 / 960):
@@ -531,7 +657,9 @@ def test_recorder_writes_each_block_at_once_and_once(tmp_path):
     rec = log.recorder("coupled")
     block = rec.start(names, 1 / 960)
     rec.rows(time_s[:block], table[:block])
-    assert log._writer._n_messages == block * 7  # written when handed over, before stop
+    # written when handed over, before stop: five topics at every step, pose and location
+    # at its 60 Hz samples (127.5 s is the start of a 1/60 s bin: every 16th step from the first)
+    assert log._writer._n_messages == block * 5 + 2 * samples(block)
     rec.rows(time_s[block:900], table[block:900])  # the loop failed after row 899
     rec.stop(900)
     rec.stop(900)
@@ -539,8 +667,11 @@ def test_recorder_writes_each_block_at_once_and_once(tmp_path):
     msgs = read_all(tmp_path / "r.mcap")
     assert [m["du_m_s"] for _, m in msgs["/bioflex/coupled/rigid_body"]] == list(range(900))
     pose = msgs["/bioflex/coupled/pose"]
-    assert [ns for ns, _ in pose] == [round(t * 1e9) for t in time_s[:900]]
+    # the sample at step 480 (t = 128 s) is the first with 2-byte seconds varints
+    assert [ns for ns, _ in pose] == [round(t * 1e9) for t in time_s[:900:STEPS_PER_SAMPLE]]
+    assert round(128.0 * 1e9) in [ns for ns, _ in pose]
     assert all(m["timestamp"] == {"sec": ns // 10**9, "nsec": ns % 10**9} for ns, m in pose)
+    assert [ns for ns, _ in msgs["/bioflex/coupled/location"]] == [ns for ns, _ in pose]
 
 
 # --------------------------------------------------------------- run descriptions and errors

@@ -12,8 +12,10 @@ descriptions; the full table is in ``docs/logging.md``):
 * ``/bioflex/<model>/modal_loads`` (``bioflex.ModalLoads``): the elastic wing's loads applied;
 * ``/bioflex/<model>/gust`` (``bioflex.Gust``): the vertical gust w_g [m/s, up];
 * ``/bioflex/<model>/controls`` (``bioflex.Controls``): elevator [rad], throttle [-];
-* ``/bioflex/<model>/pose`` (``foxglove.FrameTransform``): ``world`` → ``<model>_body``;
-* ``/bioflex/<model>/location`` (``foxglove.LocationFix``): latitude, longitude [deg], altitude;
+* ``/bioflex/<model>/pose`` (``foxglove.FrameTransform``): ``world`` → ``<model>_body``, at
+  60 Hz;
+* ``/bioflex/<model>/location`` (``foxglove.LocationFix``): latitude, longitude [deg], altitude,
+  at 60 Hz;
 * ``/bioflex/<model>/lti_prediction`` (``bioflex.LtiPrediction``): the linear model's response
   to the same gust, where one ran alongside (:meth:`RunLog.prediction`);
 * ``/bioflex/<model>/autopilot`` (``bioflex.Autopilot``): an ArduPilot SITL session's servo
@@ -21,6 +23,12 @@ descriptions; the full table is in ``docs/logging.md``):
   the lock-step action and the launcher phase (:meth:`RunLog.autopilot`);
 * ``/bioflex/events`` (``foxglove.Log``, one per file): what happened (a run that stopped, a
   SITL vehicle's STATUSTEXT): time, level, text, reporter (:meth:`RunLog.event`).
+
+The run topics carry every step but ``pose`` and ``location`` (for Foxglove's 3D and Map
+panels; ``rigid_body`` holds the same position and attitude at every step), which carry the
+steps the 3-D scene samples: at :data:`.scene.SCENE_RATE_HZ` (60 Hz), the first step of each
+1/60 s of log time (a run's first step too), the scene's own instants whether or not the log
+has a scene (channel metadata ``rate_hz``; their sequence numbers count their own messages).
 
 Frames: ``world`` is a local East-North-Up frame [m] whose origin is the aircraft's position
 at the first sample of the file (flat-Earth tangent plane on the WGS-84 ellipsoid);
@@ -39,12 +47,13 @@ hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an 
 file from the intact chunks of such a log (skipping damaged ones) and :func:`check_chunks`
 verifies every chunk's CRC. A gust run hands the log a chunk of rows at a time
 (:meth:`RunLog.recorder`, nothing per step) and a chunk's protobuf records are built at once
-with numpy (:mod:`.formatting`, ``docs/logging.md``, Encoding and Overhead).
+by one compiled pass (:mod:`.formatting`, ``docs/logging.md``, Encoding and Overhead).
 
 The writer is our own (the ``mcap`` package's ``Writer`` costs ~6.5 µs per message, more than
-the 20 % overhead budget allows at seven messages per step); every record other than the
-messages in a chunk is serialised with the ``mcap`` package's record classes, and the files are
-checked by independent readers in the tests (``@mcap/core``, ``pymcap-cli doctor``).
+the 20 % overhead budget allows at five messages per step and two at 60 Hz); every record
+other than the messages in a chunk is serialised with the ``mcap`` package's record classes,
+and the files are checked by independent readers in the tests (``@mcap/core``,
+``pymcap-cli doctor``).
 
 Modules: :mod:`.schemas` (topics, frames, fields, protobuf schemas), :mod:`.protobuf` (the
 wire format, schemas and a decoder), :mod:`.foxglove_descriptors` (Foxglove's published

@@ -1,12 +1,14 @@
-"""A chunk's steps as protobuf message records, built at once with numpy.
+"""A chunk's steps as protobuf message records, built at once by one compiled pass.
 
 Every message of a step has a fixed protobuf layout: each double is a one- or two-byte tag
 and 8 bytes, strings (frame ids) and the covariance are constant, and the only varints that
 change, a ``google.protobuf.Timestamp``'s seconds and nanoseconds, have lengths that change
-only a few times a second. The steps of a chunk are therefore split into runs of consecutive
-steps whose varint lengths agree; within a run every step is the same byte layout (a
-template, compiled once per pair of lengths) with the doubles, the record headers and the
-varints written into their columns by one structured copy each. The protobuf written is
+only a few times a second. A step is therefore one of a few byte layouts (templates,
+compiled once per pair of varint lengths and per kind of step: with every record, or with
+the every-step ones only, :class:`Records` ``every``), and one compiled pass per chunk
+(:func:`_fill_steps`) writes each step's template, doubles, record headers, varints and
+index entries in turn. A wing model's step is seven records, pose and location only at the
+steps sampled at the rate log.py gives (:class:`_ModelChannels`). The protobuf written is
 canonical (shortest varints, fields in order); NaN and infinities are just doubles.
 """
 
@@ -66,14 +68,6 @@ def _timestamp(number: int, ls: int, ln: int) -> list:
     return [tag(number, LEN) + varint(2 + ls + ln) + b"\x08", (SEC, ls), b"\x10", (NSEC, ln)]
 
 
-def varint_lengths(v: np.ndarray) -> np.ndarray:
-    """Canonical varint lengths of non-negative integers < 2^35 (1 … 5 bytes)."""
-    n = np.ones(len(v), dtype=np.int64)
-    for k in (7, 14, 21, 28):
-        n += v >= (1 << k)
-    return n
-
-
 class _Layout:
     """The bytes of one step (records back to back) for given timestamp varint lengths: a
     template and where the doubles, record headers and varints go."""
@@ -116,27 +110,71 @@ def _write_varint(row, p, v, width):
 
 
 @numba.njit(cache=True, nogil=True)
-def _fill_steps(flat, at, template, float_at, head_at, sec_at, nsec_at, record_at,
-                float_bytes, ns, seq0, a, b, ls, ln, offsets):
-    """Steps ``a`` … ``b`` − 1 of a chunk (one layout: timestamp varints of ``ls``, ``ln``
-    bytes) into ``flat`` from byte ``at``, one step after the other: the template; each
-    record's header (sequence seq0 + step, log and publish time ``ns``, little-endian) at
-    ``head_at``; each double's 8 bytes (``float_bytes``: the chunk's doubles as bytes, a row a
-    step) at ``float_at``; the timestamp's seconds and nanoseconds varints; and each record's
-    offset into ``offsets`` (records × steps). One pass over each step's bytes in memory
-    order: the structured numpy copies this replaces wrote one field across the whole chunk
-    at a time (a pass over ~0.6 MB per field) and cost 1.5-2× as much inside a run as alone,
-    the run's own data evicted (measured 2026-12-02)."""
-    size = template.shape[0]
-    nf = float_at.shape[0]
-    for r in range(a, b):
-        base = at + (r - a) * size
+def _varint_length(v):
+    """The canonical (shortest) varint length of ``v`` ≥ 0 [bytes]."""
+    n = 1
+    while v >= 128:
+        v >>= 7
+        n += 1
+    return n
+
+
+# A step's layout code: (ls · 8 + ln) · 2 + (1 if the step carries every record, 0 if only
+# the every-step ones), ls and ln its timestamp's varint lengths (0 without a timestamp);
+# varints of times < 2^35 s are at most 5 bytes, so codes stay below this
+_N_CODES = (5 * 8 + 5 + 1) * 2
+
+
+@numba.njit(cache=True, nogil=True)
+def _step_codes(ns, full, timestamped, code, hist):
+    """Each step's layout code into ``code`` (its log time ``ns[r]`` [ns], ``full[r]`` 1 if
+    it carries every record) and how many steps have each code into ``hist``."""
+    for r in range(ns.shape[0]):
+        c = full[r]
+        if timestamped:
+            t = ns[r]
+            c += 2 * (8 * _varint_length(t // 1_000_000_000) + _varint_length(t % 1_000_000_000))
+        code[r] = c
+        hist[c] += 1
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_steps(flat, code, lut, templates, tpl_at, float_at, fa_at, head_at, record_at,
+                ha_at, sec_at, sa_at, nsec_at, na_at, counter, float_bytes, ns, seq0, seq1,
+                entries, counts):
+    """Every step of a chunk into ``flat``, one after the other, step r in the layout
+    ``lut[code[r]]`` (:func:`_step_codes`). The layouts are packed back to back: layout L's
+    template is ``templates[tpl_at[L]:tpl_at[L + 1]]``, its doubles go at ``float_at``
+    (entries ``fa_at[L]`` … ``fa_at[L + 1]`` − 1, offsets in the step), its record headers at
+    ``head_at`` and its records start at ``record_at`` (entries ``ha_at[L]`` …), its seconds
+    and nanoseconds varints at ``sec_at`` / ``nsec_at`` (``sa_at``, ``na_at``). A step gets
+    its template; each record's header (log and publish time ``ns[r]``, little-endian;
+    sequence: record j with ``counter[j]`` 0 counts the steps from ``seq0``, with 1 the
+    steps that carry every record from ``seq1``); its doubles (``float_bytes``: the chunk's
+    doubles as bytes, a row a step, the first ones for a layout of fewer records); the
+    timestamp's varints; and each record's index entry (log time, offset in ``flat``) as
+    entry ``counts[j]`` of ``entries[j]`` (records × steps × 2), counted. One pass over each
+    step's bytes in memory order: the structured numpy copies this replaces wrote one field
+    across the whole chunk at a time (a pass over ~0.6 MB per field) and cost 1.5-2× as much
+    inside a run as alone, the run's own data evicted (measured 2026-12-02); and one call per
+    chunk, whatever its layouts. The template and the step's doubles are read through views
+    of their own (``tpl``, ``fb``): indexed ``templates[t0 + i]`` instead, the kernel took
+    0.27-0.28 µs a step of the gust log's chunks against 0.14 (measured 2026-12-02)."""
+    base = 0
+    for r in range(code.shape[0]):
+        c = code[r]
+        lay = lut[c]
+        t0 = tpl_at[lay]
+        size = tpl_at[lay + 1] - t0
         row = flat[base:base + size]
+        tpl = templates[t0:t0 + size]
         for i in range(size):
-            row[i] = template[i]
-        seq = (seq0 + r) & 0xFFFFFFFF
+            row[i] = tpl[i]
         t = ns[r]
-        for h in range(head_at.shape[0]):
+        h0 = ha_at[lay]
+        for h in range(h0, ha_at[lay + 1]):
+            j = h - h0
+            seq = (seq1 if counter[j] else seq0) & 0xFFFFFFFF
             p = head_at[h]
             for k in range(4):
                 row[p + k] = (seq >> (8 * k)) & 0xFF
@@ -144,93 +182,174 @@ def _fill_steps(flat, at, template, float_at, head_at, sec_at, nsec_at, record_a
                 byte = (t >> (8 * k)) & 0xFF
                 row[p + 4 + k] = byte
                 row[p + 12 + k] = byte
-        for j in range(nf):
-            p, q = float_at[j], 8 * j
+            e = counts[j]
+            entries[j, e, 0] = t
+            entries[j, e, 1] = base + record_at[h]
+            counts[j] = e + 1
+        f0 = fa_at[lay]
+        fb = float_bytes[r]
+        for j in range(f0, fa_at[lay + 1]):
+            p, q = float_at[j], 8 * (j - f0)
             for k in range(8):
-                row[p + k] = float_bytes[r, q + k]
+                row[p + k] = fb[q + k]
+        ls, ln = c >> 4, (c >> 1) & 7
         if ls > 0:
             sec, nsec = t // 1_000_000_000, t % 1_000_000_000
-            for p in sec_at:
-                _write_varint(row, p, sec, ls)
-            for p in nsec_at:
-                _write_varint(row, p, nsec, ln)
-        for j in range(record_at.shape[0]):
-            offsets[j, r] = base + record_at[j]
+            for i in range(sa_at[lay], sa_at[lay + 1]):
+                _write_varint(row, sec_at[i], sec, ls)
+            for i in range(na_at[lay], na_at[lay + 1]):
+                _write_varint(row, nsec_at[i], nsec, ln)
+        base += size
+        seq0 += 1
+        seq1 += c & 1
 
 
 guard_cache(_write_varint)
+guard_cache(_varint_length)
+guard_cache(_step_codes)
 guard_cache(_fill_steps)
+
+
+def _packed_layouts(layouts: list[_Layout]) -> tuple[np.ndarray, ...]:
+    """The arrays of ``layouts`` back to back, as :func:`_fill_steps` reads them."""
+    def pack(arrays):
+        at = np.zeros(len(arrays) + 1, dtype=np.int64)
+        at[1:] = np.cumsum([len(a) for a in arrays])
+        return np.concatenate(arrays).astype(np.int64), at
+
+    float_at, fa_at = pack([lay.float_at for lay in layouts])
+    head_at, ha_at = pack([lay.head_at for lay in layouts])
+    record_at, _ = pack([lay.record_offsets for lay in layouts])
+    sec_at, sa_at = pack([lay.sec_at for lay in layouts])
+    nsec_at, na_at = pack([lay.nsec_at for lay in layouts])
+    templates = np.concatenate([lay.template for lay in layouts])
+    tpl_at = np.zeros(len(layouts) + 1, dtype=np.int64)
+    tpl_at[1:] = np.cumsum([lay.size for lay in layouts])
+    return (templates, tpl_at, float_at, fa_at, head_at, record_at, ha_at, sec_at, sa_at,
+            nsec_at, na_at)
 
 
 class Records:
     """A kind of step (one or more message records, each on its channel) whose records are
     built a chunk at a time: ``pieces(ls, ln)`` gives each record's pieces for timestamp
-    varints of ``ls`` and ``ln`` bytes (ignored by records without a timestamp)."""
+    varints of ``ls`` and ``ln`` bytes (ignored by records without a timestamp).
 
-    def __init__(self, channel_ids: list[int], pieces, timestamped: bool) -> None:
+    ``every``: how many of the records (the first ones) are written at every step; the
+    others only at the steps that :meth:`build` is told are sampled (None: all at every
+    step). The doubles of the every-step records come first in each row."""
+
+    def __init__(self, channel_ids: list[int], pieces, timestamped: bool,
+                 every: int | None = None) -> None:
         self.ids = channel_ids
         self._pieces = pieces
         self.timestamped = timestamped
-        self._layouts: dict[tuple[int, int], _Layout] = {}
+        self.every = len(channel_ids) if every is None else every
+        if not 0 < self.every <= len(channel_ids):
+            raise ValueError(f"every = {every}: 1 … {len(channel_ids)} records")
+        self._layouts: dict[tuple[int, int, bool], _Layout] = {}
+        self._packs: dict[tuple[int, ...], tuple[np.ndarray, ...]] = {}
+        # the sequence number's counter of each record: 0 the steps, 1 the sampled steps
+        self._counter = (np.arange(len(channel_ids)) >= self.every).astype(np.int64)
 
-    def layout(self, ls: int, ln: int) -> _Layout:
-        key = (ls, ln) if self.timestamped else (0, 0)
+    def layout(self, ls: int, ln: int, full: bool = True) -> _Layout:
+        """The layout of a step with timestamp varints of ``ls``, ``ln`` bytes, with every
+        record (``full``) or only the every-step ones."""
+        key = (ls, ln, full) if self.timestamped else (0, 0, full)
         lay = self._layouts.get(key)
         if lay is None:
-            lay = self._layouts[key] = _Layout(list(zip(self.ids, self._pieces(ls, ln),
-                                                        strict=True)))
+            records = list(zip(self.ids, self._pieces(*key[:2]), strict=True))
+            lay = self._layouts[key] = _Layout(records if full else records[:self.every])
         return lay
 
-    def build(self, ns: np.ndarray, floats: np.ndarray, seq0: int
+    def _pack(self, codes: np.ndarray) -> tuple[np.ndarray, ...]:
+        key = tuple(codes.tolist())
+        got = self._packs.get(key)
+        if got is None:
+            got = self._packs[key] = _packed_layouts(
+                [self.layout(c >> 4, (c >> 1) & 7, bool(c & 1)) for c in key])
+        return got
+
+    def build(self, ns: np.ndarray, floats: np.ndarray, seq0: int,
+              sampled: np.ndarray | None = None, sampled_seq0: int = 0
               ) -> tuple[memoryview, dict[int, np.ndarray]]:
         """The records of the steps at log times ``ns`` [ns] whose doubles are the rows of
         ``floats`` (in piece order), sequence numbers from ``seq0``; and their index entries
-        ((log time, offset) per channel)."""
+        ((log time, offset) per channel). ``sampled``: the indices (increasing) of the steps
+        that also carry the records after the first ``every`` (None: all steps), whose
+        sequence numbers count those steps from ``sampled_seq0``; the rows of the other
+        steps need no doubles for them."""
         n = len(ns)
+        if not n:
+            return memoryview(b""), {cid: np.empty((0, 2), dtype=np.int64) for cid in self.ids}
         ns = np.ascontiguousarray(ns, dtype=np.int64)
         float_bytes = np.ascontiguousarray(floats, dtype="<f8").view(np.uint8)  # (n, 8 nf)
-        if self.timestamped:
-            sec, nsec = np.divmod(ns, 1_000_000_000)
-            ls, ln = varint_lengths(sec), varint_lengths(nsec)
-            cls = ls * 8 + ln
-            cuts = np.flatnonzero(cls[1:] != cls[:-1]) + 1
-            bounds = [0, *cuts.tolist(), n]
+        if sampled is None:
+            full = np.ones(n, dtype=np.int64)
         else:
-            ls = ln = None
-            bounds = [0, n]
-        runs = []
-        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-            if b > a:
-                lay = self.layout(int(ls[a]), int(ln[a])) if self.timestamped else \
-                    self.layout(0, 0)
-                runs.append((a, b, lay, int(ls[a]) if self.timestamped else 0,
-                             int(ln[a]) if self.timestamped else 0))
-        flat = np.empty(sum((b - a) * lay.size for a, b, lay, _, _ in runs), dtype=np.uint8)
-        offsets = np.empty((len(self.ids), n), dtype=np.int64)
-        at = 0
-        for a, b, lay, w_sec, w_nsec in runs:
-            _fill_steps(flat, at, lay.template, lay.float_at, lay.head_at, lay.sec_at,
-                        lay.nsec_at, lay.record_offsets, float_bytes, ns, seq0, a, b, w_sec,
-                        w_nsec, offsets)
-            at += (b - a) * lay.size
-        index = {}
-        for cid, offs in zip(self.ids, offsets, strict=True):
-            entries = np.empty((n, 2), dtype=np.int64)
-            entries[:, 0], entries[:, 1] = ns, offs
-            index[cid] = entries
-        return memoryview(flat), index
+            if self.every == len(self.ids) and len(sampled) != n:
+                raise ValueError("these records have no sampled ones")
+            full = np.zeros(n, dtype=np.int64)
+            full[sampled] = 1
+        code = np.empty(n, dtype=np.int64)
+        hist = np.zeros(_N_CODES, dtype=np.int64)
+        _step_codes(ns, full, self.timestamped, code, hist)
+        codes = np.flatnonzero(hist)
+        pack = self._pack(codes)
+        lut = np.zeros(_N_CODES, dtype=np.int64)
+        lut[codes] = np.arange(len(codes))
+        flat = np.empty(int(hist[codes] @ np.diff(pack[1])), dtype=np.uint8)
+        entries = np.empty((len(self.ids), n, 2), dtype=np.int64)
+        counts = np.zeros(len(self.ids), dtype=np.int64)
+        _fill_steps(flat, code, lut, *pack, self._counter, float_bytes, ns, seq0, sampled_seq0,
+                    entries, counts)
+        return memoryview(flat), {cid: entries[j, :counts[j]]
+                                  for j, cid in enumerate(self.ids)}
+
+
+# the topics of a step written at every step; the others (SAMPLED_GROUPS: the 3-D panel's
+# body pose and the map's fix, whose values rigid_body holds at every step) only at the
+# steps sampled at the rate given to _ModelChannels
+EVERY_STEP_GROUPS = STEP_GROUPS[:5]
+SAMPLED_GROUPS = STEP_GROUPS[5:]
+
+
+def sample_steps(t_s: np.ndarray, rate_hz: float, bin_eps: float, last_bin: int | None
+                 ) -> tuple[np.ndarray, int | None]:
+    """The indices of the steps at times ``t_s`` [s] that are samples at ``rate_hz`` [Hz]:
+    those whose time enters a new 1/rate bin, ``floor(t · rate + bin_eps)``, the first step
+    too when ``last_bin`` (the bin of the step before, None: none) is None; and the bin of
+    the last step (``last_bin`` when there are no steps)."""
+    t = np.asarray(t_s, dtype=float)
+    if not len(t):
+        return np.empty(0, dtype=np.intp), last_bin
+    bins = np.floor(t * rate_hz + bin_eps).astype(np.int64)
+    prev = np.empty_like(bins)
+    prev[0] = bins[0] - 1 if last_bin is None else last_bin
+    prev[1:] = bins[:-1]
+    return np.flatnonzero(bins != prev), int(bins[-1])
 
 
 class _ModelChannels:
     """Channel ids and the protobuf records of one step of one wing model: seven messages
-    (rigid_body … location); :meth:`format` builds a chunk of steps at once."""
+    (rigid_body … location), the last two (:data:`SAMPLED_GROUPS`) only at the steps
+    sampled at ``rate_hz`` [Hz] (:func:`sample_steps` with ``bin_eps``; the rule and rate
+    are the caller's, log.py's: the 3-D scene's, so the body pose and the wing drawn agree);
+    :meth:`format` builds a chunk of steps at once."""
 
-    def __init__(self, log: RunLog, model: str, names) -> None:
+    def __init__(self, log: RunLog, model: str, names, rate_hz: float, bin_eps: float
+                 ) -> None:
         self.names = tuple(names)
+        self.rate_hz, self.bin_eps = float(rate_hz), float(bin_eps)
         col = {name: i for i, name in enumerate(self.names)}
         n = sum(1 for k in self.names if k.startswith("eta") and not k.endswith("_dot"))
-        self.ids = {g: log._channel_id(model, g) for g in STEP_GROUPS}
-        self.seq = 0
+        rate = {"rate_hz": repr(self.rate_hz),
+                "sampling": "the first step of each 1/rate_hz of log time (the run's first "
+                            "step too); every step: rigid_body"}
+        self.ids = {g: log._channel_id(model, g, rate if g in SAMPLED_GROUPS else None)
+                    for g in STEP_GROUPS}
+        self.seq = 0  # messages on each every-step topic so far (their sequence numbers)
+        self.sampled_seq = 0  # messages on each sampled topic so far
+        self.last_bin: int | None = None  # the sample bin of the last step formatted
         optional = [f for f, _ in _RIGID_OPTIONAL if f in col]
         rigid_keys = [k for _, k, _ in _RIGID_FIELDS] + optional
         modal_keys = [f"eta{i + 1}" for i in range(n)] + [f"eta{i + 1}_dot" for i in range(n)]
@@ -260,23 +379,37 @@ class _ModelChannels:
                 ts_loc + [string_field(7, frame)] + _doubles((1, 2, 3)) + [covariance],
             ]
 
-        self.records = Records([self.ids[g] for g in STEP_GROUPS], pieces, timestamped=True)
+        self.records = Records([self.ids[g] for g in STEP_GROUPS], pieces, timestamped=True,
+                               every=len(EVERY_STEP_GROUPS))
 
-    def floats(self, v: np.ndarray, origin) -> np.ndarray:
-        """The doubles of each step (rows of the raw values ``v``), in record order."""
+    def floats(self, v: np.ndarray, origin, sampled: np.ndarray | None = None) -> np.ndarray:
+        """The doubles of each step (rows of the raw values ``v``), in record order; those of
+        pose and location only in the rows ``sampled`` (None: all; the others unset)."""
         lat0, lon0, h0, r_north, r_east = origin
-        lat, lon, h = v[:, self.i_lat], v[:, self.i_lon], v[:, self.i_alt]
-        qx, qy, qz, qw = enu_quaternion(*(v[:, i] for i in self.i_att))
-        return np.column_stack([
-            v[:, self.copy_cols], (lon - lon0) * r_east, (lat - lat0) * r_north, h - h0,
+        n, k = len(v), len(self.copy_cols)
+        out = np.empty((n, k + 10))
+        out[:, :k] = v[:, self.copy_cols]
+        s = v if sampled is None else v[sampled]
+        lat, lon, h = s[:, self.i_lat], s[:, self.i_lon], s[:, self.i_alt]
+        qx, qy, qz, qw = enu_quaternion(*(s[:, i] for i in self.i_att))
+        out[slice(None) if sampled is None else sampled, k:] = np.column_stack([
+            (lon - lon0) * r_east, (lat - lat0) * r_north, h - h0,
             qx, qy, qz, qw, np.degrees(lat), np.degrees(lon), h])
+        return out
 
-    def format(self, t_s, v: np.ndarray, seq0: int, origin) -> tuple[memoryview,
-                                                                    dict[int, np.ndarray]]:
+    def format(self, t_s, v: np.ndarray, origin) -> tuple[memoryview, dict[int, np.ndarray]]:
         """The message records of the steps ``v`` (steps × channels in :attr:`names` order)
-        at times ``t_s`` [s] and their index entries ((log time, offset) per channel)."""
-        ns = np.rint(np.asarray(t_s, dtype=float) * 1e9).astype(np.int64)
-        return self.records.build(ns, self.floats(v, origin), seq0)
+        at times ``t_s`` [s], the next steps of the model (its sequence numbers and sample
+        bin carried on), and their index entries ((log time, offset) per channel)."""
+        t = np.asarray(t_s, dtype=float)
+        sampled, last_bin = sample_steps(t, self.rate_hz, self.bin_eps, self.last_bin)
+        ns = np.rint(t * 1e9).astype(np.int64)
+        out = self.records.build(ns, self.floats(v, origin, sampled), self.seq, sampled,
+                                 self.sampled_seq)
+        self.last_bin = last_bin
+        self.seq += len(t)
+        self.sampled_seq += len(sampled)
+        return out
 
 
 def lti_records(channel_id: int, n_eta: int, loads: tuple[tuple[str, int], ...] = ()

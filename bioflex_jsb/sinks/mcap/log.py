@@ -31,6 +31,7 @@ from bioflex_jsb.sinks.mcap.formatting import (
     lti_records,
 )
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
+from bioflex_jsb.sinks.mcap.scene import _BIN_EPS, SCENE_RATE_HZ
 from bioflex_jsb.sinks.mcap.schemas import (
     EVENT_LEVELS,
     EVENTS_PROTO_SCHEMA,
@@ -133,7 +134,10 @@ class RunLog:
     def _model(self, model: str, names) -> _ModelChannels:
         ch = self._models.get(model)
         if ch is None:
-            ch = self._models[model] = _ModelChannels(self, model, names)
+            # pose and location at the 3-D scene's samples (the scene's rate and rule, so
+            # the body pose and the wing drawn agree), with or without a scene in the log
+            rate = SCENE_RATE_HZ if self.scene is None else self.scene.rate_hz
+            ch = self._models[model] = _ModelChannels(self, model, names, rate, _BIN_EPS)
         elif ch.names != tuple(names):
             raise ValueError(f"the {model} samples changed their channels")
         return ch
@@ -153,8 +157,9 @@ class RunLog:
     # -- writing --------------------------------------------------------------------------
     def recorder(self, model: str) -> TableRecorder:
         """A recorder of the run of ``model`` for ``run_gust(..., recorder=)``: it logs every
-        step (seven messages, one per run topic), handed a chunk of rows at a time, so a
-        step costs the run nothing beyond its share of one call per chunk."""
+        step (a message on each run topic; pose and location at the 3-D scene's samples,
+        :class:`~.formatting._ModelChannels`), handed a chunk of rows at a time, so a step
+        costs the run nothing beyond its share of one call per chunk."""
         return TableRecorder(self, model)
 
     def sample(self, model: str, t_s: float, row: dict[str, float]) -> None:
@@ -199,7 +204,7 @@ class RunLog:
             first = rows[0]
             self._set_origin(first[ch.i_lat], first[ch.i_lon], first[ch.i_alt])
         v = np.fromiter(chain.from_iterable(rows), dtype=float, count=n * len(ch.names))
-        block, index = ch.format(ts[:n], v.reshape(n, len(ch.names)), ch.seq, self._origin)
+        block, index = ch.format(ts[:n], v.reshape(n, len(ch.names)), self._origin)
         scene = None if self.scene is None else self.scene.build(
             next(m for m, c in self._models.items() if c is ch), ch.names, ts[:n],
             v.reshape(n, len(ch.names)))  # the 3-D scene's samples of these steps
@@ -207,7 +212,6 @@ class RunLog:
         if not self._row_bytes_measured or size > n * self._row_bytes:
             self._row_bytes = -(-size // n)  # the first measure, then the largest
             self._row_bytes_measured = True
-        ch.seq += n
         rows.clear()
         ts.clear()
         self._writer.append_block(block, index)
@@ -366,8 +370,7 @@ class TableRecorder:
         with _signals_deferred():
             if log._origin is None:
                 log._set_origin(*rows[0, [ch.i_lat, ch.i_lon, ch.i_alt]].tolist())
-            block, index = ch.format(time_s, rows, ch.seq, log._origin)
-            ch.seq += len(rows)
+            block, index = ch.format(time_s, rows, log._origin)
             log._writer.append_block(block, index)
             log._writer.close_chunk()
             if log.scene is not None:  # its samples in a chunk of their own, after the
