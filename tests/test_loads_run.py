@@ -107,6 +107,69 @@ def test_the_blocks_do_not_change_the_loads(wing, coupled_run, block):
         stream.finish()
 
 
+@pytest.mark.parametrize("model, aero", [("coupled", "quasi-steady"), ("qsd", "quasi-steady"),
+                                         ("rigid", "quasi-steady"), ("coupled", "unsteady")])
+def test_the_compiled_loads_are_the_numpy_ones(wing, coupled_run, model, aero):
+    """A block's loads by the compiled pass (LoadStream._loads) are the readable numpy's
+    (_loads_numpy) to the last bit: the same element-wise operations in the same order and
+    the same matrix products (numpy's), on every row of a run and on NaN rows."""
+    run = coupled_run if (model, aero) == ("coupled", "quasi-steady") else _fly(
+        wing, model, duration_s=0.6, aero=aero)
+    names = tuple(c for c in run.channels if not c.startswith("loads_"))
+    rows = np.column_stack([run[c] for c in names])
+    rows[5] = np.nan  # a diverged row stays NaN in both
+    lm = build_loads_model(wing, 15.0, density_kg_m3=run.meta["loads"]["density_kg_m3"])
+    # a stream each: the unsteady wing's strip states are replayed from the rows
+    stream, again = (LoadStream(lm, names, run.meta["dt_s"], model, aero=aero)
+                     for _ in range(2))
+    q_dot = np.gradient(run["q"], run.time_s)
+    got = stream._loads(rows, q_dot)
+    assert got.shape == (len(rows), stream.n_channels)
+    np.testing.assert_array_equal(got, again._loads_numpy(rows, q_dot))
+    assert np.isnan(got[5]).all()
+    # the quasi-steady loads are a row's own; the unsteady strips' lag carries the NaN on
+    assert np.isfinite(got[6:]).all() == (aero == "quasi-steady")
+
+
+def test_a_stop_signal_in_the_compiled_pass_is_a_keyboard_interrupt(wing, coupled_run):
+    """A stop signal (the CLI raises KeyboardInterrupt from it) landing while a block's loads
+    are computed ends as KeyboardInterrupt, never as numba's ``SystemError: … returned a
+    result with an exception set`` (which a kernel returning a tuple gave for 9 in 10 such
+    signals, measured; tests/test_signal_faults.py met it once in a run)."""
+    import random
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signal handlers are the main thread's")
+    names = tuple(c for c in coupled_run.channels if not c.startswith("loads_"))
+    rows = np.column_stack([coupled_run[c] for c in names])[:864]
+    lm = build_loads_model(wing, 15.0)
+    stream = LoadStream(lm, names, coupled_run.meta["dt_s"], "coupled")
+    q_dot = np.zeros(len(rows))
+    stream._loads(rows, q_dot)
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    rng = random.Random(5)
+    old = signal.signal(signal.SIGALRM, stop)
+    got = []
+    try:
+        for _ in range(100):
+            try:
+                signal.setitimer(signal.ITIMER_REAL, rng.uniform(1e-5, 3e-4))
+                while True:
+                    stream._loads(rows, q_dot)
+            except BaseException as exc:  # noqa: BLE001 - which one is the test
+                got.append(type(exc).__name__)
+            finally:
+                signal.setitimer(signal.ITIMER_REAL, 0.0)
+    finally:
+        signal.signal(signal.SIGALRM, old)
+    assert got == ["KeyboardInterrupt"] * 100
+
+
 def test_an_envelope_keeps_every_load_peak(wing):
     """keep="envelope" (a long run's bounded history) gives the metrics of every step: each
     load's extremes and each FS − MD difference's are among the rows it keeps."""

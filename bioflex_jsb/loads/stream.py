@@ -18,15 +18,21 @@ reported); both for the unsteady wing, whose force summation adds its strips' la
 mass and Küssner increments and takes η̈ of its own modal equation, the lag states
 recomputed from the rows (:mod:`bioflex_jsb.loads.unsteady`); force summation only for a
 wing without EI, GJ (a modes file: ``LoadsModel.methods``).
+
+A block's signals z (and the modal accelerations of the coupled wing) are one compiled pass
+over its rows (:func:`_signals`), the matrix products numpy's as before: the same doubles as
+the readable numpy it replaces (:meth:`LoadStream._loads_numpy`, tests/test_loads_run.py).
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.loads.model import METHODS, QUANTITIES, QUANTITY_UNITS, LoadsModel
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.simulation.step_kernel import guard_cache
 
 G = P.STANDARD_GRAVITY_M_S2
 TAGS = {"force_summation": "fs", "mode_displacement": "md"}
@@ -50,6 +56,46 @@ def run_methods(model: str, aero: str = "quasi-steady") -> tuple[str, ...]:
     if aero not in ("quasi-steady", "unsteady"):
         raise InputError(f"unknown strips {aero!r}; accepted: quasi-steady, unsteady")
     return METHODS
+
+
+@numba.njit(cache=True, nogil=True)
+def _signals(rows, cols, q_dot, d_eta, d_eta_dot, ke, de, eta, half_rho, alpha0, static_eta,
+             g, omega2, damping, b_alpha, b_q, b_0, q_trim, modal):
+    """The signals z (m, 5 + 3 n) of the rows ``rows`` (``cols``: the columns of the
+    airspeed, α, q and n_z), their total η written into ``eta`` (m, n), operation for
+    operation as :meth:`LoadStream._loads_numpy` (the same doubles): Q = (½ρ V) V, z's η̈
+    columns zero unless ``modal`` (the coupled wing's modal equation, its products ``ke`` =
+    Δη K_aᵀ and ``de`` = Δη̇ D_aᵀ by numpy's matmul, as there). One array returned: numba's
+    boxing of a returned tuple lets a stop signal that lands in it end as ``SystemError``
+    instead of ``KeyboardInterrupt`` (tests/test_signal_faults.py met it)."""
+    m, n = d_eta.shape
+    z = np.zeros((m, 5 + 3 * n))
+    i_v, i_alpha, i_q, i_nz = cols[0], cols[1], cols[2], cols[3]
+    for r in range(m):
+        v = rows[r, i_v]
+        q_pa = half_rho * v * v
+        d_alpha, q = rows[r, i_alpha], rows[r, i_q]
+        qv = q_pa / v
+        z[r, 0] = q_pa * (alpha0 + d_alpha)
+        z[r, 1] = q_pa * q / v
+        for i in range(n):
+            e = static_eta[i] + d_eta[r, i]
+            eta[r, i] = e
+            z[r, 2 + i] = q_pa * e
+            z[r, 2 + n + i] = qv * d_eta_dot[r, i]
+        z[r, 2 + 2 * n] = q_pa
+        z[r, 3 + 2 * n] = g * rows[r, i_nz]
+        z[r, 4 + 2 * n] = q_dot[r]
+        if modal:
+            for i in range(n):
+                z[r, 5 + 2 * n + i] = (-(d_eta[r, i] * omega2[i]) + q_pa * ke[r, i]
+                                       - d_eta_dot[r, i] * damping[i] + qv * de[r, i]
+                                       + (q_pa * d_alpha) * b_alpha[i] + (qv * q) * b_q[i]
+                                       + (q_pa - q_trim) * b_0[i])
+    return z
+
+
+guard_cache(_signals)
 
 
 class LoadStream:
@@ -107,6 +153,12 @@ class LoadStream:
             from bioflex_jsb.loads.unsteady import UnsteadyStripLoads
 
             self._unsteady = UnsteadyStripLoads(lm, names, dt_s)
+        # the compiled pass's constants (_signals), each as _loads_numpy computes it
+        self._cols = np.array([self._i_v, self._i_alpha, self._i_q, self._i_nz], dtype=np.intp)
+        self._consts = (0.5 * lm.density_kg_m3, lm.alpha_wing_rad + lm.static_alpha_rad,
+                        np.ascontiguousarray(lm.static_eta_rad, dtype=float), G,
+                        mm.omega**2, 2.0 * mm.zeta * mm.omega, mm.b_alpha, mm.b_q,
+                        np.asarray(self._b0, dtype=float), lm.dynamic_pressure_pa)
         self._held_t: float | None = None  # the last row handed in, its loads not yet out
         self._held: np.ndarray | None = None
         self._q_before = None  # q of the row before the held one (None: the run's first)
@@ -134,7 +186,7 @@ class LoadStream:
             return time_s[:0], rows[:0], np.empty((0, self.n_channels))
         if self._held is None:
             t_all, r_all = time_s, rows
-        else:
+        else:  # a new array: its rows are the caller's to keep, no copy
             t_all = np.concatenate([[self._held_t], time_s])
             r_all = np.concatenate([self._held[None, :], rows])
         q = r_all[:, self._i_q]
@@ -155,7 +207,7 @@ class LoadStream:
         self._held_t = float(t_all[-1])
         self._held = r_all[-1].copy()
         self.rows_out += len(out_t)
-        return out_t, out_rows.copy(), loads
+        return out_t, out_rows.copy() if r_all is rows else out_rows, loads
 
     def finish(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The run is over: the held last row with its loads (q̇ by the backward difference,
@@ -178,7 +230,38 @@ class LoadStream:
 
     def _loads(self, rows: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
         """The loads (rows × :attr:`names`) of ``rows`` with their pitch accelerations
-        ``q_dot`` [rad/s²] (the signals of ``loads.history.run_signals``)."""
+        ``q_dot`` [rad/s²] (the signals of ``loads.history.run_signals``): the compiled pass
+        of :meth:`_loads_numpy`."""
+        n = self.lm.n_modes
+        m = len(rows)
+        if self._wing:
+            d_eta = rows[:, self._i_eta]
+            d_eta_dot = rows[:, self._i_etad]
+        else:
+            d_eta = d_eta_dot = np.zeros((m, n))
+        modal = self._fs is not None and self._unsteady is None and self.model == "coupled"
+        mm = self.lm.matrices
+        if modal:
+            ke, de = d_eta @ mm.k_aero.T, d_eta_dot @ mm.d_aero.T
+        else:
+            ke = de = d_eta
+        eta = np.empty((m, n))
+        z = _signals(rows, self._cols, np.asarray(q_dot, dtype=float), d_eta, d_eta_dot, ke, de,
+                     eta, *self._consts, modal)
+        parts = []
+        if self._fs is not None:
+            if self._unsteady is not None:
+                extra, eta_ddot = self._unsteady.block(rows, d_eta)
+                z[:, 5 + 2 * n:] = eta_ddot
+                parts.append(z @ self._fs + extra)
+            else:
+                parts.append(z @ self._fs)
+        if self._md is not None:
+            parts.append(eta @ self._md)
+        return parts[0] if len(parts) == 1 else np.hstack(parts)
+
+    def _loads_numpy(self, rows: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+        """:meth:`_loads` in numpy, the readable reference of the compiled pass."""
         lm = self.lm
         n = lm.n_modes
         m = len(rows)

@@ -20,8 +20,10 @@ interpolated at the stations as the modal coefficients of the loads and the LTI 
 interpolate them (``flight_dynamics.modal_coefficients``); both multiplied by the
 exaggeration stored in the ``bioflex.scene`` metadata (1: true scale). η are the logged
 modal coordinates, perturbations from the trim; the two halves deform alike (the modes are
-symmetric). The messages are built a chunk at a time with numpy (:class:`Records` of
-:mod:`.formatting`: the byte layout is fixed, only the doubles and the timestamp move).
+symmetric). The messages are built a chunk at a time (:class:`Records` of :mod:`.formatting`:
+the byte layout is fixed, only the doubles and the timestamp move); in a run log the doubles
+of a chunk's samples come from one compiled pass (:func:`_sample_floats`, the arithmetic of
+:func:`scene_floats`, which the mode sheet and the tests use, operation for operation).
 """
 
 from __future__ import annotations
@@ -31,8 +33,10 @@ import struct
 from dataclasses import astuple, dataclass
 from typing import TYPE_CHECKING
 
+import numba
 import numpy as np
 
+from bioflex_jsb.simulation.step_kernel import guard_cache
 from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp
 from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
 from bioflex_jsb.sinks.mcap.schemas import (
@@ -262,21 +266,33 @@ class AircraftMesh:
         """Vertices of one wing half (two per station)."""
         return 2 * len(self.y_m)
 
-    def wing_xz(self, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(x, z) [m] of one half's vertices, (m, K, 2) each (station, then leading/trailing
-        edge), for the modal coordinates ``eta`` (m, n) [rad]; y is ∓``y_m`` (starboard is
-        −y in the body frame)."""
+    def twist_heave(self, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The twist [rad, leading edge up] and heave [m, up] (m, K) of the stations, the
+        exaggeration included, for the modal coordinates ``eta`` (m, n) [rad]."""
         eta = np.asarray(eta, dtype=float).reshape(len(eta), -1)
         if eta.shape[1] != self.shape.n_modes:
             raise ValueError(f"the scene's wing has {self.shape.n_modes} modes, the samples "
                              f"{eta.shape[1]}")
         e = self.exaggeration
-        twist = e * eta @ self.shape.twist_rad  # (m, K), leading edge up
-        heave = -e * eta @ self.shape.bending_m  # (m, K), up
+        return e * eta @ self.shape.twist_rad, -e * eta @ self.shape.bending_m
+
+    def wing_xz(self, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(x, z) [m] of one half's vertices, (m, K, 2) each (station, then leading/trailing
+        edge), for the modal coordinates ``eta`` (m, n) [rad]; y is ∓``y_m`` (starboard is
+        −y in the body frame)."""
+        twist, heave = self.twist_heave(eta)
         d = self.chord_fwd_m.T[None]  # (1, K, 2)
         x = self.ea_x_m[None, :, None] + d * np.cos(twist)[:, :, None]
         z = self.z0_m + heave[:, :, None] + d * np.sin(twist)[:, :, None]
         return x, z
+
+    def sample_floats(self, v: np.ndarray, cols: np.ndarray, eta: np.ndarray) -> np.ndarray:
+        """:func:`scene_floats` of the samples' rows ``v`` (m, channels; ``cols`` the columns
+        of w_g, φ, θ, an ``intp`` array) and their modal coordinates ``eta`` (m, n): the
+        compiled pass (:func:`_sample_floats`)."""
+        return _sample_floats(v, cols, *self.twist_heave(eta), self.ea_x_m, self.chord_fwd_m,
+                              self.z0_m, self.arrow_head_m, GUST_ARROW_M_PER_M_S,
+                              1 - _ARROW_HEAD_FRACTION, _ARROW_HEAD_FRACTION)
 
     def gust_arrow(self, w_g_m_s, roll_rad, pitch_rad) -> np.ndarray:
         """(m, 9): the arrow's tail position (x, y, z) [m], its orientation (x, y, z, w) (its
@@ -390,6 +406,66 @@ def scene_floats(mesh: AircraftMesh, eta, w_g_m_s, roll_rad, pitch_rad) -> np.nd
     return np.column_stack([mesh.gust_arrow(w_g_m_s, roll_rad, pitch_rad), half, half])
 
 
+@numba.njit(cache=True, nogil=True)
+def _sample_floats(v, cols, twist, heave, ea_x, chord_fwd, z0, arrow_head, m_per_m_s,
+                   shaft_frac, head_frac):
+    """The doubles of :func:`scene_floats` for the samples' rows ``v`` (m, channels; ``cols``
+    the columns of w_g, φ, θ) and their stations' ``twist`` and ``heave`` (m, K:
+    :meth:`AircraftMesh.twist_heave`), in one pass, operation for operation as
+    :meth:`AircraftMesh.gust_arrow` and :meth:`AircraftMesh.wing_xz` (the same doubles,
+    tests/test_scene.py). Their ~50 small numpy operations on a chunk's 54 samples took
+    ~0.2 ms in a run, its caches cold, this (with :meth:`AircraftMesh.twist_heave`) ~0.08 ms
+    (measured 2026-12-02)."""
+    m, k_n = twist.shape
+    out = np.empty((m, 9 + 8 * k_n))
+    for i in range(m):
+        w, ph, th = v[i, cols[0]], v[i, cols[1]], v[i, cols[2]]
+        # the arrow: +x along the gust (world up for w_g > 0), its tail behind the head
+        ct = np.cos(th)
+        u0, u1, u2 = np.sin(th), np.sin(ph) * ct, np.cos(ph) * ct
+        if w < 0.0:
+            u0, u1, u2 = -u0, -u1, -u2
+        length = m_per_m_s * np.abs(w)
+        out[i, 0] = arrow_head[0] - length * u0
+        out[i, 1] = arrow_head[1] - length * u1
+        out[i, 2] = arrow_head[2] - length * u2
+        q1, q2, q3 = -u2, u1, 1.0 + u0  # its x is 0
+        norm = np.sqrt((0.0 * 0.0 + q1 * q1 + q2 * q2) + q3 * q3)  # numpy's sum, in order
+        out[i, 3], out[i, 4], out[i, 5], out[i, 6] = 0.0 / norm, q1 / norm, q2 / norm, q3 / norm
+        out[i, 7], out[i, 8] = shaft_frac * length, head_frac * length
+        # the wing: each station's leading and trailing edge (x, z), starboard then port
+        for k in range(k_n):
+            c, s = np.cos(twist[i, k]), np.sin(twist[i, k])
+            zk = z0 + heave[i, k]
+            for j in range(2):
+                d = chord_fwd[j, k]
+                x, z = ea_x[k] + d * c, zk + d * s
+                at = 9 + 4 * k + 2 * j
+                out[i, at], out[i, at + 1] = x, z
+                out[i, at + 4 * k_n], out[i, at + 4 * k_n + 1] = x, z
+    return out
+
+
+guard_cache(_sample_floats)
+
+
+@numba.njit(cache=True, nogil=True)
+def _positions(ns, wanted):
+    """The position in ``ns`` (increasing) of each of ``wanted`` (increasing), −1 where
+    absent."""
+    at = np.full(len(wanted), -1, dtype=np.int64)
+    j = 0
+    for i in range(len(wanted)):
+        while j < len(ns) and ns[j] < wanted[i]:
+            j += 1
+        if j < len(ns) and ns[j] == wanted[i]:
+            at[i] = j
+    return at
+
+
+guard_cache(_positions)
+
+
 # -- in a run log ---------------------------------------------------------------------------
 class _Channel:
     def __init__(self, cid: int, records: Records, airframe_id: int, airframe: Records
@@ -401,10 +477,11 @@ class _Channel:
         self.last_airframe_ns: int | None = None  # log time of the last airframe message
         self.names: tuple = ()
         self.etas: list[int] = []
-        self.cols: list[int] = []
-        # the η of the samples drawn, by log time [ns], kept for the section-load markers
-        # (scene_loads.py) until they draw them (None: the run has no loads, nothing kept)
-        self.drawn: dict[int, np.ndarray] | None = None
+        self.cols = np.zeros(3, dtype=np.intp)  # the columns of w_g, φ, θ
+        # the log times [ns] and η [rad] of the samples drawn, in time order, kept for the
+        # section-load markers (scene_loads.py) until they draw them (None: the run has no
+        # loads, nothing kept)
+        self.drawn: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class SceneLog:
@@ -458,15 +535,24 @@ class SceneLog:
         return LoadMarkers(self, loads_topic, model, layout)
 
     def remember_eta(self, model: str) -> None:
-        """Keep the η of every sample drawn for ``model`` from now on (:meth:`drawn_eta`)."""
+        """Keep the η of every sample drawn for ``model`` from now on (:meth:`take_drawn`)."""
         ch = self._channel(model)
         if ch.drawn is None:
-            ch.drawn = {}
+            ch.drawn = (np.empty(0, dtype=np.int64), np.empty((0, self.mesh.shape.n_modes)))
 
-    def drawn_eta(self, model: str) -> dict[int, np.ndarray]:
-        """The η [rad] of the samples drawn and not yet taken, by log time [ns] (the caller
-        pops what it uses)."""
-        return self._channel(model).drawn
+    def take_drawn(self, model: str, ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Of the log times ``ns`` [ns] (increasing), the positions of those the scene drew
+        for ``model`` and the η [rad] (rows) it drew them with; these are forgotten, the
+        samples drawn at other times kept."""
+        ch = self._channel(model)
+        kept_ns, kept_eta = ch.drawn
+        at = _positions(np.ascontiguousarray(ns, dtype=np.int64), kept_ns)
+        hit = at >= 0
+        if hit.all():  # the usual block: every sample kept is among its steps
+            ch.drawn = (kept_ns[:0], kept_eta[:0])
+            return at, kept_eta
+        ch.drawn = (kept_ns[~hit], kept_eta[~hit])
+        return at[hit], kept_eta[hit]
 
     def _channel(self, model: str) -> _Channel:
         ch = self._channels.get(model)
@@ -485,17 +571,27 @@ class SceneLog:
     def rows(self, model: str, names, time_s, rows: np.ndarray) -> None:
         """Log the samples among the steps ``rows`` (steps × channels) at ``time_s`` [s]
         (:meth:`build`) into the chunk in progress."""
-        got = self.build(model, names, time_s, rows)
-        if got:
-            self._writer.append_block(*got)
+        for block, index in self._build(model, names, time_s, rows):  # no copy joins them
+            self._writer.append_block(block, index)
 
     def build(self, model: str, names, time_s, rows: np.ndarray):
         """The records (and index entries) of the airframe at the first of the steps
         ``rows`` (at ``time_s`` [s]) and of the wing at each step whose time enters a new
         1/rate bin (a run's first step too); None if there are no steps."""
+        parts = self._build(model, names, time_s, rows)
+        if len(parts) < 2:
+            return parts[0] if parts else None
+        (air, air_index), (block, index) = parts
+        for entries in index.values():
+            entries[:, 1] += len(air)
+        return b"".join((air, block)), {**air_index, **index}
+
+    def _build(self, model: str, names, time_s, rows: np.ndarray) -> list[tuple]:
+        """:meth:`build`'s records apart: (records, index) of the airframe's message, if
+        one is due, then of the wing's, if any sample."""
         t = np.asarray(time_s, dtype=float)
         if not len(t):
-            return None
+            return []
         ch = self._channel(model)
         bins = np.floor(t * self.rate_hz + _BIN_EPS).astype(np.int64)
         prev = np.concatenate([[bins[0] - 1 if ch.last_bin is None else ch.last_bin],
@@ -503,15 +599,13 @@ class SceneLog:
         ch.last_bin = int(bins[-1])
         pick = np.flatnonzero(bins != prev)
         t0 = np.rint(t[:1] * 1e9).astype(np.int64)
-        air, air_index = b"", {}
+        parts = []
         if ch.last_airframe_ns is None or t0[0] - ch.last_airframe_ns >= AIRFRAME_PERIOD_NS:
-            air, air_index = ch.airframe.build(t0, np.empty((1, 0)), ch.airframe_seq)
+            parts.append(ch.airframe.build(t0, np.empty((1, 0)), ch.airframe_seq))
             ch.airframe_seq += 1
             ch.last_airframe_ns = int(t0[0])
         if not len(pick):
-            if not air:
-                return None
-            return air, air_index
+            return parts
         names = tuple(names)
         if ch.names != names:  # the columns read: η (none for a wing without modes), w_g, φ, θ
             col = {n: i for i, n in enumerate(names)}
@@ -521,19 +615,20 @@ class SceneLog:
                                  f"scene's wing {self.mesh.shape.n_modes} modes")
             ch.etas = [col[f"eta{i + 1}"] for i in range(self.mesh.shape.n_modes)
                        if f"eta{i + 1}" in col]
-            ch.cols = [col["w_g"], col["phi_rad"], col["theta_rad"]]
+            ch.cols = np.array([col["w_g"], col["phi_rad"], col["theta_rad"]], dtype=np.intp)
             ch.names = names
-        v = np.asarray(rows)[pick]
+        v = np.asarray(rows, dtype=float)[pick]
         eta = v[:, ch.etas] if ch.etas else np.zeros((len(pick), self.mesh.shape.n_modes))
-        floats = scene_floats(self.mesh, eta, *v[:, ch.cols].T)
+        floats = self.mesh.sample_floats(v, ch.cols, eta)
         ns = np.rint(t[pick] * 1e9).astype(np.int64)
         if ch.drawn is not None:
-            ch.drawn.update(zip(ns.tolist(), eta, strict=True))
-        block, index = ch.records.build(ns, floats, ch.seq)
+            kept_ns, kept_eta = ch.drawn
+            ch.drawn = ((ns, eta) if not len(kept_ns) else
+                        (np.concatenate([kept_ns, ns]), np.concatenate([kept_eta, eta])))
+        parts.append(ch.records.build(ns, floats, ch.seq))
         ch.seq += len(pick)
         self.messages += len(pick)
-        index[ch.id] = index[ch.id] + np.array([0, len(air)], dtype=np.int64)
-        return b"".join((air, block)), {**air_index, **index}
+        return parts
 
 
 def scene_metadata(mesh: AircraftMesh, rate_hz: float) -> dict[str, str]:
