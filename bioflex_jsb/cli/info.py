@@ -16,12 +16,13 @@ mcap package's indexed reader. A log whose writer was killed (SIGKILL, power los
 summary; --recover FIXED.mcap copies every complete chunk of it into a new, finished file
 (at most the last chunk, 0.9 s of simulated time, is lost); a damaged chunk is skipped,
 every intact chunk after it kept, and the skipped ones are named. --check decompresses
-every chunk and verifies its CRC, the data section's and the summary's, and that the file
-is finished (Data End, summary, footer): exit status 1 and one line saying what is wrong if
-not. Without --check, info verifies the same and refuses (exit 2, one line) a damaged or
-unfinished file; an unfinished one is told apart: still being written (a process has it
-open for writing, or it changed in the last 10 s) or cut off (its writer was killed). Logs
-in protobuf (this version) and JSON (older versions) are read alike."""
+every chunk and verifies it (its zstd checksum or CRC), the data section's CRC and the
+summary's, and that the file is finished (Data End, summary, footer): exit status 1 and
+one line saying what is wrong if not. Without --check, info verifies the same and refuses
+(exit 2, one line) a damaged or unfinished file; an unfinished one is told apart: still
+being written (a process has it open for writing, or it changed in the last 10 s) or cut
+off (its writer was killed). Logs in protobuf (this version) and JSON (older versions) are
+read alike."""
 
 
 def register(sub) -> None:
@@ -31,7 +32,8 @@ def register(sub) -> None:
     p.add_argument("--recover", metavar="FIXED.mcap",
                    help="write the complete records of a truncated FILE.mcap to FIXED.mcap")
     p.add_argument("--check", action="store_true",
-                   help="verify every CRC and that the file is finished (exit 1 if not)")
+                   help="verify every chunk's checksum or CRC, the data section's and the "
+                        "summary's CRCs and that the file is finished (exit 1 if not)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -63,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
               + (f"; skipped {len(skipped)} damaged: {'; '.join(skipped)}" if skipped else ""))
     elif args.check:
         print(f"{result['file']}: {_check_status(result)}: {result['chunks']} chunks, "
-              f"{len(result['bad'])} with a bad CRC or record, data section CRC "
+              f"{len(result['bad'])} with a bad checksum, CRC or record, data section CRC "
               f"{result['data_crc']}, summary CRC {result['summary_crc']}"
               + (f" ({'; '.join(result['bad'])})" if result["bad"] else ""))
     else:

@@ -45,7 +45,7 @@ Chunks are closed every :data:`CHUNK_SPAN_S` of simulated time (or :data:`CHUNK_
 wall time, or 4096 steps) and written to the operating system at once, so a process killed
 hard (SIGKILL) loses at most the chunk in progress; :func:`recover` rebuilds an indexed
 file from the intact chunks of such a log (skipping damaged ones) and :func:`check_chunks`
-verifies every chunk's CRC. A gust run hands the log a chunk of rows at a time
+verifies every chunk (zstd checksum or CRC). A gust run hands the log a chunk of rows at a time
 (:meth:`RunLog.recorder`, nothing per step) and a chunk's protobuf records are built at once
 by one compiled pass (:mod:`.formatting`, ``docs/logging.md``, Encoding and Overhead).
 

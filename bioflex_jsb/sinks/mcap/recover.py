@@ -5,10 +5,11 @@ A chunk checks when it decompresses to its stated size (a zstd frame with its co
 checksum, XXH64, as :class:`~.writer.McapFileWriter` writes them, fails to decompress when
 damaged), its CRC-32 matches where one is written (uncompressed chunks, and the logs of
 earlier versions, which wrote one for every chunk; 0 means none, as the MCAP specification
-says) and its records fit. Both read the file sequentially, record by record (``opcode``, ``length``, body), without
-its summary: a chunk whose checksum, CRC, compression or records do not check is *skipped* and the
-scan goes on with the next record (or, where the damage hit a record's length, with the next
-place that holds a whole, valid chunk), so every intact chunk after a damaged one is kept.
+says) and its records fit. Both read the file sequentially, record by record
+(``opcode``, ``length``, body), without its summary: a chunk whose checksum, CRC,
+compression or records do not check is *skipped* and the scan goes on with the next
+record (or, where the damage hit a record's length, with the next place that holds a
+whole, valid chunk), so every intact chunk after a damaged one is kept.
 The recovered file is written by our own :class:`~.writer.McapFileWriter`: finished and
 indexed like any log (the tests run ``pymcap-cli doctor`` on it).
 """
@@ -207,9 +208,9 @@ class _Copier:
 
 def recover(path: str | Path, out: str | Path) -> dict:
     """Copy every intact record of a (killed or damaged) log into a finished, indexed file
-    ``out``: every chunk that checks (module docstring), also those after a damaged one (each skipped
-    chunk is listed in ``skipped``: its byte offset and why). Returns counts, the last log
-    time kept [s] and where and why the read stopped."""
+    ``out``: every chunk that checks (module docstring), also those after a damaged one
+    (each skipped chunk is listed in ``skipped``: its byte offset and why). Returns counts,
+    the last log time kept [s] and where and why the read stopped."""
     p = Path(path)
     if not p.exists():
         raise LogError(f"{str(p)!r}: no such file")
