@@ -37,7 +37,7 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp
+from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp, sample_steps
 from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
 from bioflex_jsb.sinks.mcap.schemas import (
     AIRFRAME_GROUP,
@@ -593,11 +593,8 @@ class SceneLog:
         if not len(t):
             return []
         ch = self._channel(model)
-        bins = np.floor(t * self.rate_hz + _BIN_EPS).astype(np.int64)
-        prev = np.concatenate([[bins[0] - 1 if ch.last_bin is None else ch.last_bin],
-                               bins[:-1]])
-        ch.last_bin = int(bins[-1])
-        pick = np.flatnonzero(bins != prev)
+        # the samples: the steps entering a new 1/rate bin (the rule pose and location use)
+        pick, ch.last_bin = sample_steps(t, self.rate_hz, _BIN_EPS, ch.last_bin)
         t0 = np.rint(t[:1] * 1e9).astype(np.int64)
         parts = []
         if ch.last_airframe_ns is None or t0[0] - ch.last_airframe_ns >= AIRFRAME_PERIOD_NS:
