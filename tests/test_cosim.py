@@ -63,6 +63,21 @@ def test_rigid_run_has_no_modal_loads_and_coupled_run_has(airframe):
     assert np.min(coupled["eta1"]) < 0.0
 
 
+def test_progress_is_reported_once_a_block_up_to_every_step(airframe):
+    """``progress`` (a progress bar's hook, drivers/gust.py) sees the steps flown after each
+    block of WINDOW_S: increasing, the last the whole run, and nothing per step."""
+    from bioflex_jsb.drivers.gust import WINDOW_S
+
+    wing = build_wing(VARIANTS["original"]).model
+    setup = RunSetup(15.0, parse_gust("sharp:0.5"), duration_s=2.0)
+    seen: list[int] = []
+    run = run_gust(airframe, wing, "coupled", setup, progress=seen.append)
+    n = len(run.time_s)
+    block = int(round(WINDOW_S / DEFAULT_DT_S))
+    assert n == int(round(2.0 / DEFAULT_DT_S)) and run.stopped is None
+    assert seen == [min(n, (i + 1) * block) for i in range(-(-n // block))]
+
+
 def test_before_the_gust_the_trimmed_aircraft_stays_put(airframe):
     wing = build_wing(VARIANTS["original"]).model
     run = run_gust(airframe, wing, "coupled", RunSetup(15.0, parse_gust("sharp:1"), 1.0,
