@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb.cli import main
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import WINDOW_S, RunSetup, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -66,8 +66,6 @@ def test_rigid_run_has_no_modal_loads_and_coupled_run_has(airframe):
 def test_progress_is_reported_once_a_block_up_to_every_step(airframe):
     """``progress`` (a progress bar's hook, drivers/gust.py) sees the steps flown after each
     block of WINDOW_S: increasing, the last the whole run, and nothing per step."""
-    from bioflex_jsb.drivers.gust import WINDOW_S
-
     wing = build_wing(VARIANTS["original"]).model
     setup = RunSetup(15.0, parse_gust("sharp:0.5"), duration_s=2.0)
     seen: list[int] = []

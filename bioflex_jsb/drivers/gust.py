@@ -181,8 +181,9 @@ def run_gust(
     order; read it, do not keep it): it costs 0.28 µs a step of ~6.7 (a progress bar's
     callback, measured 2026-12-02), so a progress bar takes ``progress(steps)`` instead,
     called after every block with the steps flown so far; ``recorder`` (a log) is handed
-    the rows a block at a time (:class:`StepRecorder`). A run that leaves the valid range stops: the
-    returned history holds the steps up to then and its ``stopped`` field says why.
+    the rows a block at a time (:class:`StepRecorder`). A run that leaves the valid range
+    stops: the returned history holds the steps up to then and its ``stopped`` field says
+    why.
     ``trim``: the airframe was just trimmed to this (skip it). ``compiled``: the compiled
     step kernel, or (False) the readable Python step it is tested against.
 
