@@ -362,3 +362,34 @@ def test_per_step_loop_helpers_match_the_public_ones(airframe):
             airframe.step()
     assert airframe["simulation/sim-time-sec"] == pytest.approx(t0 + 3 * airframe.dt_s)
     airframe.set_external_reactions()
+
+
+def test_the_capturing_logger_keeps_each_message_whole_with_its_level_and_nothing_else():
+    """JSBSim's per-step set_level/flush pairs with nothing said in between keep nothing;
+    a message keeps its level (an int), its location and its text, and none of it leaks into
+    the next (the logger's cheap path for silent steps, runtime/jsbsim_log.py)."""
+    import jsbsim
+
+    from bioflex_jsb.runtime.jsbsim_log import _CapturingLogger
+
+    log = _CapturingLogger()
+    for _ in range(3):  # silent steps
+        log.set_level(jsbsim.LogLevel.INFO)
+        log.flush()
+    assert log.records == []
+    log.set_level(jsbsim.LogLevel.WARN)
+    log.file_location("FGTrim.cpp", 12)
+    log.message("trim failed")
+    log.flush()
+    log.set_level(jsbsim.LogLevel.INFO)
+    log.message("   ")  # whitespace only: not kept
+    log.flush()
+    log.set_level(jsbsim.LogLevel.ERROR)
+    log.message("second")
+    log.set_level(jsbsim.LogLevel.INFO)  # a new message before the flush drops the old parts
+    log.message("third")
+    log.flush()
+    assert [(r.level, r.text) for r in log.records] == [
+        (int(jsbsim.LogLevel.WARN), "FGTrim.cpp:12: trim failed"),
+        (int(jsbsim.LogLevel.INFO), "third")]
+    assert all(type(r.level) is int for r in log.records)
