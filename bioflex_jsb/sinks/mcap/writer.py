@@ -286,7 +286,11 @@ class McapFileWriter:
         entries = parts[0] if len(parts) == 1 else np.concatenate(parts)
         if len(parts) > 1:
             entries = entries[np.argsort(entries[:, 1], kind="stable")]
-        entries = entries[entries[:, 1] < n]
+        # in offset order (a block's entries are, and so are single messages'): the ones
+        # within the chunk's bytes are a prefix; a mask over every entry instead cost ~10 µs
+        # a channel a chunk (0.08 µs a step of a gust log's steps' chunk, 2026-12-03)
+        if len(entries) and entries[-1, 1] >= n:
+            entries = entries[:int(np.searchsorted(entries[:, 1], n))]
         return entries if len(entries) else None
 
     def _close_chunk(self) -> None:
