@@ -450,3 +450,37 @@ def test_unsteady_sitl_wing_flies_and_cannot_be_switched():
     for _ in range(240):
         sim.step()
     assert sim.resets == 0 and abs(float(sim.core.eta[0])) > 0.0
+
+
+def test_the_paced_loop_keeps_the_start_ups_objects_out_of_the_collector_while_it_runs():
+    """A full collection in flight would scan every object alive at the start (a 25-80 ms
+    stall, drivers/sitl.py run_paced): they are frozen while the loop runs and thawed after
+    it, unless the caller had frozen some itself."""
+    import contextlib
+    import gc
+    from types import SimpleNamespace
+
+    seen = []
+
+    class Fake:
+        dt_s, k, speedup, resync, t_s = 1e-3, 0, 1000.0, False, 0.0
+        wing = SimpleNamespace(model="coupled")
+        airframe = SimpleNamespace(capturing=contextlib.nullcontext)
+
+        def step(self):
+            seen.append(gc.get_freeze_count())
+            self.k += 1
+            return ()
+
+    gc.unfreeze()  # as a session starts (an in-process `ardupilot` test may have frozen)
+    run_paced(Fake(), 0.005)
+    assert len(seen) == 5 and min(seen) > 1000  # the test process's objects, frozen
+    assert gc.get_freeze_count() == 0  # and given back
+    seen.clear()
+    gc.freeze()  # a caller's own freeze (bioflex-jsb ardupilot's) stands after the loop
+    try:
+        before = gc.get_freeze_count()
+        run_paced(Fake(), 0.003)
+        assert min(seen) >= before and gc.get_freeze_count() >= before
+    finally:
+        gc.unfreeze()
