@@ -40,11 +40,13 @@ def test_freed_buffers_stay_in_the_process_once_told_to():
     took, kept = _faults("keep")
     _, default = _faults("default")
     assert took == "True"
-    # glibc's default hands most of the 3 MB back every round (3643 faults in seven rounds,
-    # 2026-12-03; bound: at least one buffer's 256 pages a round); kept: none came back fresh
-    # (0 measured; bound: a few for the interpreter's own growth)
-    assert default > 7 * 256
+    # kept: no page came back fresh (0 measured; bound: a few for the interpreter's own
+    # growth). glibc's default hands most of the 3 MB back every round: 3643 faults in
+    # seven rounds here (2026-12-03, transparent huge pages on madvise); where the kernel
+    # backs the heap with huge pages ("always") a fault maps 2 MB and the count is far
+    # smaller, so the default's count is only compared, not bounded
     assert kept < 100
+    assert default > kept
 
 
 def test_another_c_library_is_left_as_it_is(monkeypatch):
