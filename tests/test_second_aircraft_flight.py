@@ -175,6 +175,34 @@ def test_compare_takes_a_definition_on_a_users_jsbsim_directory(tmp_path, capsys
     assert not root.exists()
 
 
+@pytest.mark.parametrize("line, field", [
+    ("mass_kg = 354.26", "airframe.mass_kg = 354.26 kg but"),  # +10 %: the XML's 710 lb
+    ("span_m = 14.3", "airframe.span_m = 14.3 m but"),  # +1.6 %
+    ("cg_m = [0.02, 0.0, 0.0]", "airframe.cg_m (x) = 0.02 m but"),  # 2 % of the chord aft
+    ("inertia_kg_m2 = { ixx = 1376.2, iyy = 911.11, izz = 2254.7, ixz = 73.892 }",
+     "airframe.inertia_kg_m2.ixz = 73.892"),  # the sign flipped
+])
+def test_a_file_that_is_not_its_jsbsim_aircraft_is_refused(tmp_path, capsys, line, field):
+    """The definition's airframe numbers must be its JSBSim aircraft's
+    (other_airframe.definition_mismatch, 1 %): JSBSim flies the XML's mass and geometry
+    while the wing's trim and loads take the file's. A file 10 % heavier than SGS.xml was
+    flown at the XML's 322 kg with the loads of 354 kg; now every flight command refuses it
+    in one line naming the field."""
+    shutil.copy(DATA / "sgs_elastic_modes.toml", tmp_path / "sgs_elastic_modes.toml")
+    text = (DATA / "sgs_elastic.toml").read_text(encoding="utf-8")
+    key = line.split(" =")[0]
+    lines = [line if ln.startswith(key + " ") else ln for ln in text.splitlines()]
+    assert lines != text.splitlines()
+    definition = tmp_path / "glider.toml"
+    definition.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    for command in (("gust", "--no-log"), ("trim",)):
+        code, _, err = run_cli(capsys, *command, "--aircraft", str(definition))
+        assert_one_line_error(code, err, field)
+    # the analyses without JSBSim still take the file (they use its numbers only)
+    code, _, _ = run_cli(capsys, "modes", "--aircraft", str(definition), "--speed", "25")
+    assert code == 0
+
+
 def test_a_glider_without_its_speeds_is_analysed_not_flown(tmp_path, capsys):
     """Without airframe.cruise_speed_m_s and speed_range_m_s the linear analyses take the
     file, the flight commands refuse it in one line naming the fields."""

@@ -210,6 +210,75 @@ def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airfr
     return airframe
 
 
+# DECISION: the definition's [airframe] numbers and the JSBSim aircraft they describe must
+# agree: JSBSim flies its XML's mass, inertia and geometry while the modal wing, the elastic
+# trim and the section loads take the file's, so a mismatch would make the run and the linear
+# analyses two different aircraft (a user's 10 % heavier file with SGS.xml's 710 lb: the
+# loads carried ΔW/2 = 158 N of lift that was never flown). Relative tolerance 1 %: a
+# value rounded to 3 significant digits is off by at most 0.5 % (the shipped sgs_elastic
+# file, 5 digits: largest 2.5e-5, S); the CG within 1 % of the mean chord (a 1 % static
+# margin; an inch rounded in metres is 1.3 mm, 0.13 % of SGS's chord).
+CONSISTENCY_REL = 0.01
+CONSISTENCY_CG_CHORDS = 0.01
+_LB_KG = 0.45359237  # exact
+_FT_M = 0.3048  # exact
+_SLUG_FT2_KG_M2 = 14.59390294 * _FT_M ** 2  # slug = lbf s²/ft; 1.35581795 kg·m² a slug ft²
+
+
+def definition_mismatch(fdm, airframe) -> str | None:
+    """The first of the definition's ``[airframe]`` numbers (``airframe``: its
+    :class:`~bioflex_jsb.definition.model.AirframeDefinition`) that the loaded JSBSim
+    aircraft ``fdm`` (a ``jsbsim.FGFDMExec`` or an Airframe) disagrees with beyond
+    :data:`CONSISTENCY_REL` (:data:`CONSISTENCY_CG_CHORDS` of the mean chord for the CG),
+    as one line; None when they agree. Compared: mass (JSBSim's weight with its point
+    masses and fuel), S, b, c̄, Ixx, Iyy, Izz, Ixz (against the largest moment: a product of
+    inertia is small and its sign JSBSim's) and the CG (structural frame)."""
+    inertia = airframe.inertia
+    rows = [
+        ("mass_kg", airframe.mass_kg, fdm["inertia/weight-lbs"] * _LB_KG, "kg"),
+        ("reference_area_m2", airframe.reference_area_m2,
+         fdm["metrics/Sw-sqft"] * _FT_M ** 2, "m²"),
+        ("span_m", airframe.span_m, fdm["metrics/bw-ft"] * _FT_M, "m"),
+        ("mean_chord_m", airframe.mean_chord_m, fdm["metrics/cbarw-ft"] * _FT_M, "m"),
+    ]
+    jsb_i = {k: fdm[f"inertia/{k}-slugs_ft2"] * _SLUG_FT2_KG_M2
+             for k in ("ixx", "iyy", "izz", "ixz")}
+    rows += [(f"inertia_kg_m2.{k}", getattr(inertia, f"{k}_kg_m2"), jsb_i[k], "kg·m²")
+             for k in ("ixx", "iyy", "izz")]
+    where = "the JSBSim aircraft's XML"
+    for field, mine, theirs, unit in rows:
+        if not abs(mine - theirs) <= CONSISTENCY_REL * max(abs(mine), abs(theirs)):
+            return (f"airframe.{field} = {mine:.6g} {unit} but {where} has {theirs:.6g} {unit} "
+                    f"(more than {CONSISTENCY_REL:.0%} apart): JSBSim would fly the XML's "
+                    "and the wing's analyses the file's; make them the same aircraft")
+    largest = max(jsb_i["ixx"], jsb_i["iyy"], jsb_i["izz"])
+    if not abs(inertia.ixz_kg_m2 - jsb_i["ixz"]) <= CONSISTENCY_REL * largest:
+        return (f"airframe.inertia_kg_m2.ixz = {inertia.ixz_kg_m2:.6g} kg·m² but {where} has "
+                f"{jsb_i['ixz']:.6g} kg·m² (JSBSim's inertia/ixz-slugs_ft2, its sign; more than "
+                f"{CONSISTENCY_REL:.0%} of the largest moment apart)")
+    cg = [fdm[f"inertia/cg-{a}-in"] / INCH_PER_M for a in "xyz"]
+    limit = CONSISTENCY_CG_CHORDS * airframe.mean_chord_m
+    for axis, mine, theirs in zip("xyz", airframe.cg_m, cg, strict=True):
+        if not abs(mine - theirs) <= limit:
+            return (f"airframe.cg_m ({axis}) = {mine:.6g} m but {where} puts the CG at "
+                    f"{theirs:.6g} m (structural frame; more than {limit:.3g} m, "
+                    f"{CONSISTENCY_CG_CHORDS:.0%} of the mean chord, apart)")
+    return None
+
+
+def _mass_balance_probe(airframe) -> jsbsim.FGFDMExec:
+    """A throwaway JSBSim instance of ``airframe``'s aircraft with its initial conditions
+    run once: JSBSim computes the mass balance (inertia, CG) only when its models run, and
+    the flying instance is left as it was loaded."""
+    from bioflex_jsb.runtime.fdm import _captured, _CapturingLogger, _load_fdm
+
+    log = _CapturingLogger()
+    probe = _load_fdm(Path(airframe.root), airframe.aircraft, Path(airframe.aircraft_path), log)
+    with _captured(log):
+        probe.run_ic()
+    return probe
+
+
 def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None):
     """The JSBSim airframe (:class:`~bioflex_jsb.runtime.fdm.Airframe`) an aircraft
     definition flies (an :class:`~bioflex_jsb.definition.aircraft.Aircraft`; None: the
@@ -221,8 +290,12 @@ def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None
 
     if aircraft is None or not aircraft.airframe.jsbsim_path:
         return Airframe(root)
-    return airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m, Airframe,
-                              aircraft.name, systems)
+    airframe = airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m,
+                                  Airframe, aircraft.name, systems)
+    problem = definition_mismatch(_mass_balance_probe(airframe), aircraft.airframe)
+    if problem is not None:
+        raise AircraftLoadError(f"aircraft {aircraft.name!r}: {problem}")
+    return airframe
 
 
 # Central-difference steps of the glider's A_RR (:func:`rigid_jacobian`): 0.01 m/s of
