@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from bioflex_jsb import cli
@@ -146,3 +147,46 @@ def test_root_from_environment_is_not_skipped_when_wrong(capsys, tmp_path, monke
     code, out, err = _run(capsys, ["trim", "--speed", "15"])
     line = _assert_usage_error(code, out, err)
     assert jsbsim_fdm.ROOT_ENV_VAR in line and "not a directory" in line
+
+
+def test_linearize_takes_an_aircraft_definition(capsys):
+    """``linearize --aircraft sgs_elastic``: the glider's own JSBSim aircraft at its cruise
+    speed (25 m/s), the analytic columns from its file (C_Lδe 0.342, C_mδe −1.0088; no
+    engine: a zero throttle column and no thrust term), not the prototype's. Before, the
+    name was refused and ``--aircraft SGS`` printed the prototype's B and phugoid."""
+    from bioflex_jsb import api
+    from bioflex_jsb.flight_dynamics.lti import control_columns
+    from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+    from bioflex_jsb.runtime.other_airframe import airframe_for
+
+    code, out, err = _run(capsys, ["linearize", "--aircraft", "sgs_elastic", "--json"])
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    assert data["speed_m_s"] == 25.0 and data["inputs"] == ["w_g", "elevator", "throttle"]
+    sgs = api.load_aircraft("sgs_elastic")
+    lin = airframe_for(sgs).linearize(25.0)
+    assert data["A"] == [[float(x) for x in row] for row in lin.a]  # the glider's, to the bit
+    expected = control_columns(level_flight_condition(25.0, airframe=sgs.airframe_data()))
+    b = [row[1:] for row in data["B"]]
+    np.testing.assert_allclose(b, expected, rtol=1e-12, atol=1e-15)
+    assert all(row[2] == 0.0 for row in data["B"])  # no engine
+    assert data["phugoid_comparison"]["thrust_term_1_s"] == 0.0
+    proto = json.loads(_run(capsys, ["linearize", "--speed", "25", "--json"])[1])
+    assert b != [row[1:] for row in proto["B"]]
+
+
+def test_linearize_of_a_bare_jsbsim_aircraft_prints_only_what_it_knows(capsys):
+    """A JSBSim aircraft by name from another root (no definition): JSBSim's A and the gust
+    column; no analytic columns or phugoid borrowed from the prototype."""
+    import jsbsim
+
+    code, out, err = _run(capsys, ["linearize", "--jsbsim-root", jsbsim.get_default_root_dir(),
+                                   "--aircraft", "SGS", "--speed", "25", "--json"])
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    assert data["inputs"] == ["w_g"] and all(len(row) == 1 for row in data["B"])
+    assert data["phugoid_comparison"] is None
+    code, out, _ = _run(capsys, ["linearize", "--jsbsim-root", jsbsim.get_default_root_dir(),
+                                 "--aircraft", "SGS", "--speed", "25"])
+    assert code == 0 and "need the aircraft's analytic model" in out
+    assert "Table B2" not in out and "propeller" not in out

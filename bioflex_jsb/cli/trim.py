@@ -47,8 +47,8 @@ def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--aircraft", metavar="NAME", default=None,
-        help="aircraft name under aircraft/ (default: bioflex); trim: also an aircraft "
-        "definition, NAME|FILE.toml (docs/aircraft.md)",
+        help="aircraft name under aircraft/ (default: bioflex), or an aircraft definition, "
+        "NAME|FILE.toml (docs/aircraft.md: its JSBSim aircraft, speeds and airframe numbers)",
     )  # fmt: skip
 
 
@@ -99,7 +99,7 @@ def trim_payload(result) -> dict:
     }
 
 
-def _definition(args: argparse.Namespace):
+def aircraft_definition(args: argparse.Namespace):
     """The aircraft definition ``--aircraft`` names (``None``: a JSBSim aircraft name or no
     option): a ``.toml`` file, or a shipped definition that is no JSBSim aircraft of the
     root (``bioflex_optimised`` is both: the native aircraft, as before). Read and checked
@@ -128,14 +128,14 @@ def _definition(args: argparse.Namespace):
     problem = flight_refusal(aircraft)
     if problem:
         raise UsageError(f"--aircraft: {problem}")
-    if args.wing is not None:
+    if getattr(args, "wing", None) is not None:
         raise UsageError(f"--aircraft {name} and --wing {args.wing}: give one of them (the "
                          "aircraft's definition holds its wing)")
     return aircraft
 
 
 def run(args: argparse.Namespace) -> int:
-    aircraft = _definition(args)
+    aircraft = aircraft_definition(args)
     if aircraft is None:
         airframe = load_airframe(args)
         args.speed = float(args.speed)
