@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from bioflex_jsb.cli.common import UsageError, print_json
+from bioflex_jsb.cli.common import print_json
 from bioflex_jsb.cli.trim import add_flight_condition_arguments, load_airframe
 
 HELP = """Trim the rigid JSBSim airframe at --speed, linearize it with JSBSim's
@@ -122,7 +122,7 @@ def _airframe(args: argparse.Namespace):
     and its airframe numbers), else a JSBSim aircraft of the root (the prototype's
     numbers for the generated ``bioflex`` aircraft and its native variants; None for any
     other: its analytic model is not known here)."""
-    from bioflex_jsb.cli.trim import aircraft_definition
+    from bioflex_jsb.cli.trim import aircraft_definition, definition_airframe
 
     aircraft = aircraft_definition(args)
     if aircraft is None:
@@ -134,16 +134,7 @@ def _airframe(args: argparse.Namespace):
         name = airframe.aircraft
         prototype = name == DEFAULT_AIRCRAFT or name.startswith(DEFAULT_AIRCRAFT + "_")
         return airframe, PROTOTYPE_AIRFRAME if prototype else None
-    from bioflex_jsb.cli.aircraft_option import resolve_flight
-    from bioflex_jsb.runtime.fdm import FdmError
-    from bioflex_jsb.runtime.other_airframe import airframe_for
-
-    args.aircraft_definition = aircraft
-    resolve_flight(args)
-    try:
-        airframe = airframe_for(aircraft, args.jsbsim_root)
-    except FdmError as exc:
-        raise UsageError(str(exc)) from None
+    airframe = definition_airframe(args, aircraft)
     return airframe, (None if aircraft.linear_problem() else aircraft.airframe_data())
 
 

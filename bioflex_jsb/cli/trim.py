@@ -134,22 +134,28 @@ def aircraft_definition(args: argparse.Namespace):
     return aircraft
 
 
+def definition_airframe(args: argparse.Namespace, aircraft):
+    """The JSBSim airframe of the aircraft definition ``aircraft`` (``--speed`` resolved
+    against its speeds first); its errors one line (UsageError)."""
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
+    from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.runtime.other_airframe import airframe_for
+
+    args.aircraft_definition = aircraft
+    resolve_flight(args)
+    try:
+        return airframe_for(aircraft, args.jsbsim_root)
+    except FdmError as exc:
+        raise UsageError(str(exc)) from None
+
+
 def run(args: argparse.Namespace) -> int:
     aircraft = aircraft_definition(args)
     if aircraft is None:
         airframe = load_airframe(args)
         args.speed = float(args.speed)
     else:
-        from bioflex_jsb.cli.aircraft_option import resolve_flight
-        from bioflex_jsb.runtime.fdm import FdmError
-        from bioflex_jsb.runtime.other_airframe import airframe_for
-
-        args.aircraft_definition = aircraft
-        resolve_flight(args)
-        try:
-            airframe = airframe_for(aircraft, args.jsbsim_root)
-        except FdmError as exc:
-            raise UsageError(str(exc)) from None
+        airframe = definition_airframe(args, aircraft)
     result = airframe.trim(args.speed, args.altitude)
     if aircraft is not None:
         elastic = _elastic_trim(args, airframe, aircraft.wing(args.mass_basis))
