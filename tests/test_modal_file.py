@@ -203,3 +203,16 @@ def test_unreadable_file(tmp_path):
 def test_writer_rejects_unknown_unit():
     with pytest.raises(ModalFileError, match="units.length"):
         format_modal_text(example_modes(), length="ft")
+
+
+def test_generalised_mass_range_takes_a_sailplane_wing():
+    """A twist-normalised mode of a large wing has a large m_i (a 7 kg/m SGS-size beam with
+    its axes 0.05 c apart: 1.1e5 kg·m²): accepted (the range ended at 1e3 and refused the
+    package's own modes of such a wing); 1e13 is past the 1e12 bound and refused in one line."""
+    scale = math.radians(5.0) ** 2  # mode 2: max twist 5° → m_i / (5° in rad)²
+    text = GOOD.replace("generalised_mass = 2.0e-5", f"generalised_mass = {1.1e5 * scale!r}")
+    modes = parse_modal_text(text)
+    assert modes.generalised_masses_kg_m2[1] == pytest.approx(1.1e5, rel=1e-12)
+    text = GOOD.replace("generalised_mass = 2.0e-5", f"generalised_mass = {1e13 * scale!r}")
+    with pytest.raises(ModalFileError, match=r"mode\[2\]\.generalised_mass.*1e-12\.\.1e\+12"):
+        parse_modal_text(text)
