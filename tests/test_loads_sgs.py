@@ -185,3 +185,38 @@ def test_a_gust_runs_loads_are_in_its_log(tmp_path, capsys):
                                    lm.static_loads()["force_summation"][IM], rtol=1e-12)
         # the 2 m/s upward gust raises the root bending moment by a tenth at least
         assert root["increment_up"] > 0.1 * root["static_1g"]
+
+
+def _sgs_with_stations(tmp_path, stations: str):
+    """A copy of the shipped SGS definition with ``[loads] stations = <stations>``."""
+    import shutil
+    from pathlib import Path
+
+    data = Path(api.__file__).resolve().parent / "data" / "aircraft"
+    shutil.copy(data / "sgs_elastic_modes.toml", tmp_path / "sgs_elastic_modes.toml")
+    text = (data / "sgs_elastic.toml").read_text(encoding="utf-8")
+    path = tmp_path / "sgs_stations.toml"
+    path.write_text(text + f"\n[loads]\nstations = {stations}\n", encoding="utf-8")
+    return path
+
+
+def test_the_definitions_stations_reach_every_run(tmp_path, capsys):
+    """``[loads] stations`` of a definition on its own JSBSim aircraft: the gust run's loads
+    (api.fly_gust, ``gust``) and ``loads`` are at those stations. Before, runs of another
+    airframe reported the default root/25/50/75 % silently, and ``loads --aircraft``
+    refused every airframe but the prototype's."""
+    path = _sgs_with_stations(tmp_path, "[0.0, 0.1, 0.2]")
+    aircraft = api.load_aircraft(path)
+    assert aircraft.wing().monitoring_stations == (0.0, 0.1, 0.2)
+    run = api.fly_gust(aircraft, gust="1cos:1:25", models=("rigid",), duration_s=0.5,
+                       gust_start_s=0.1)["rigid"]
+    assert run.meta["loads"]["station_fractions"] == [0.0, 0.1, 0.2]
+    assert run.meta["loads"]["stations_m"] == pytest.approx([0.0, 0.7036, 1.4072], rel=1e-12)
+    code, out, _ = run_cli(capsys, "loads", "--aircraft", str(path), "--gust", "1cos:1:25",
+                           "--duration", "1", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["speed_m_s"] == SPEED_M_S  # the aircraft's cruise speed, not 15 m/s
+    assert data["loads"]["station_fractions"] == [0.0, 0.1, 0.2]
+    code, _, err = run_cli(capsys, "loads", "--aircraft", str(path), "--tuned")
+    assert code == 2 and "--tuned takes the prototype's airframe only" in err

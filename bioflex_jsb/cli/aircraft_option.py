@@ -24,9 +24,10 @@ LINEAR_COMMANDS = ("modes", "flutter", "export")
 # The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
 # flight_refusal: its own JSBSim aircraft, a glider in its steady glide; trim reads its own
 # --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's copy with the wing:
-# docs/native.md; sitl flies a glider with the glider's autopilot: cli/sitl.py); the others
-# (ardupilot, loads) refuse an airframe other than the prototype's in one line.
-FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl")
+# docs/native.md; sitl flies a glider with the glider's autopilot: cli/sitl.py; loads flies
+# one gust on it, its --tuned and --frequency studies refuse it: cli/loads.py); the others
+# (ardupilot) refuse an airframe other than the prototype's in one line.
+FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl", "loads")
 
 
 class CruiseSpeed(float):
@@ -143,7 +144,9 @@ def resolve_flight(args: argparse.Namespace) -> None:
                          f"speeds {speeds[0]:g}..{speeds[1]:g} m/s (its airframe."
                          "speed_range_m_s)")
     gust = getattr(args, "gust", None)
-    if chord is not None and gust is not None:
+    # a parsed gust (gust, compare, sitl) is read again with the chord; loads parses its
+    # own text (str) with the chord when it flies
+    if chord is not None and gust is not None and not isinstance(gust, str):
         from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 
         try:

@@ -9,7 +9,6 @@ import re
 import sys
 
 from bioflex_jsb.cli.case import (
-    DEFAULT_SPEED_M_S,
     DEFAULT_WING,
     add_force_argument,
     airspeed,
@@ -138,8 +137,12 @@ def register(sub) -> None:
     p = sub.add_parser("loads", help="wing section loads in a gust; --tuned: critical 1-cos "
                        "gradients and load envelopes", description=text)
     add_wing_arguments(p, default=DEFAULT_WING)
-    p.add_argument("--speed", type=airspeed, default=DEFAULT_SPEED_M_S, metavar="V",
-                   help="trim " + speed_help())
+    from bioflex_jsb.cli.aircraft_option import cruise_speed_default
+
+    # DEFAULT_SPEED_M_S, marked: an aircraft definition's cruise speed replaces it
+    p.add_argument("--speed", type=airspeed, default=cruise_speed_default(), metavar="V",
+                   help="trim " + speed_help() + "; with --aircraft: within its "
+                   "airframe.speed_range_m_s, default its cruise_speed_m_s")
     p.add_argument("--gust", default=DEFAULT_GUST,
                    help=f"gust specification (default {DEFAULT_GUST}; forms as in `gust`)")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=3.0,
@@ -197,24 +200,41 @@ def register(sub) -> None:
 
 
 def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
-    from bioflex_jsb import api
+    """One run of ``--model`` through ``gust_text`` on the JSBSim airframe of ``--aircraft``
+    (the prototype's without it; as ``gust`` flies it) and its section loads."""
+    from bioflex_jsb.cli.aircraft_option import airframe_from_args
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.loads import section_loads
     from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.simulation.gusts import parse_gust
 
     try:
-        run = api.fly_gust(build, args.speed, gust_text, models=(args.model,),
-                           duration_s=duration_s, gust_start_s=gust_start_s, dt_s=args.dt,
-                           trim=args.trim)[args.model]
+        chord = build.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
+        setup = RunSetup(args.speed, parse_gust(gust_text, chord), duration_s, gust_start_s,
+                         0.0, args.dt)
+        elastic = args.trim == "elastic" and args.model != "rigid"
+        run = run_gust(airframe_from_args(args), build if elastic else build.model,
+                       args.model, setup, trim_mode="elastic" if elastic else "rigid",
+                       loads=build)
         return run, section_loads(build, run, args.stations, static=args.static)
     except (FdmError, InputError) as exc:
         raise UsageError(str(exc)) from None
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.loads import monitoring_stations
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
+    resolve_flight(args)  # --speed: the aircraft's cruise speed, within its speeds
     build = wing_from_args(args)
+    aircraft = getattr(args, "aircraft_definition", None)
+    if build.airframe is not PROTOTYPE_AIRFRAME and (args.tuned or args.frequency):
+        raise UsageError(f"--aircraft {aircraft.name}: --{'tuned' if args.tuned else 'frequency'}"
+                         " takes the prototype's airframe only in this version (its gust "
+                         "lengths and JSBSim rigid block are the prototype's); loads of one "
+                         "--gust take this aircraft")
     if args.stations is None:  # the aircraft definition's, else the default stations
         args.stations = monitoring_stations(getattr(args, "aircraft_definition", None))
     if args.model == "rigid" and args.static == "elastic":

@@ -23,6 +23,7 @@ from bioflex_jsb.definition.flying import (
     flying_wing,
 )
 from bioflex_jsb.definition.model import (
+    DEFAULT_MONITORING_STATIONS,
     AeroSettings,
     Air,
     AnalysisSettings,
@@ -73,9 +74,9 @@ LIFT_SLOPES = ("strip", "vlm")
 METHODS = ("pk", "state-space")
 INERTIA_AXES = ("elastic-axis", "centre-of-mass")
 TWIST_UNITS = ("deg", "rad")
-# Monitoring stations of the section loads [fraction of the semispan]: the root and the
-# quarter points (issue 24's stations; the tip, s = 1, carries no load and is refused).
-DEFAULT_MONITORING_STATIONS = (0.0, 0.25, 0.5, 0.75)
+# Monitoring stations of the section loads [fraction of the semispan]: model.py's
+# DEFAULT_MONITORING_STATIONS, the root and the quarter points (issue 24's stations; the
+# tip, s = 1, carries no load and is refused).
 MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distribution
 
 

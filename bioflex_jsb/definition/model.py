@@ -24,6 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# The section loads' monitoring stations when a definition names none: root, 25, 50, 75 %
+# of the semispan (issue 24); the loads' default (loads/model.py) is this one.
+DEFAULT_MONITORING_STATIONS = (0.0, 0.25, 0.5, 0.75)
+
 
 @dataclass(frozen=True)
 class WingStation:
@@ -184,8 +188,8 @@ class Definition:
     flying: FlyingWing | None = None  # with an airframe
     # [loads] stations: the monitoring stations of the wing's section loads, fractions of
     # the semispan from the root [-], sorted, distinct, each 0 <= s < 1 (the tip carries no
-    # load); the default is the loader's DEFAULT_MONITORING_STATIONS.
-    monitoring_stations: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
+    # load); default DEFAULT_MONITORING_STATIONS.
+    monitoring_stations: tuple[float, ...] = DEFAULT_MONITORING_STATIONS
 
     @property
     def clamped(self) -> bool:

@@ -196,6 +196,13 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
                            f"only); give at least one of {', '.join(sorted(_VARIANT_KEYS))} "
                            "(docs/wing_variants.md), or --wing NAME for a named wing")
     unknown = sorted(set(data) - _VARIANT_KEYS)
+    if "airframe" in unknown:
+        raise VariantError(f"{source} is an aircraft definition (it has [airframe]), not a "
+                           "wing variant: give it as --aircraft FILE (docs/aircraft.md)")
+    if isinstance(data.get("wing"), dict) and "stations" in data["wing"]:
+        raise VariantError(f"{source} is a clamped-wing definition (it has [wing] stations), "
+                           "not a wing variant: analyse it with flutter --clamped FILE "
+                           "(docs/aircraft.md)")
     if unknown:
         raise VariantError(
             f"{source}: unknown key {unknown[0]!r}; accepted: {', '.join(sorted(_VARIANT_KEYS))}"
@@ -341,6 +348,9 @@ class WingBuild:
     physical_c_eta1_q1: float
     e_shift_frac: float = 0.0  # pin of C_η1^Q1: shift of e(y) [fraction of chord]
     planform: Planform = DEFAULT_PLANFORM  # the strips' planform (and the CG's x_cg_m)
+    # the section loads' monitoring stations [fractions of the semispan, root 0]: an aircraft
+    # definition's [loads] stations (Aircraft.wing), None: the loads' default stations
+    monitoring_stations: tuple[float, ...] | None = None
 
     @property
     def airframe(self) -> AirframeData:

@@ -41,10 +41,11 @@ def monitoring_stations(aircraft=None) -> tuple[float, ...]:
     return tuple(float(s) for s in definition.monitoring_stations)
 
 
-def section_loads(build, run, stations=DEFAULT_STATION_FRACTIONS, *, static: str | None = None,
+def section_loads(build, run, stations=None, *, static: str | None = None,
                   density_kg_m3: float | None = None) -> SectionLoads:
     """Section loads of the nonlinear ``run`` (a TimeHistory of ``build``'s wing) at
-    ``stations`` (fractions of the semispan) by both methods. ``static``: the 1 g part,
+    ``stations`` (fractions of the semispan; None: the wing's ``monitoring_stations``, else
+    :data:`DEFAULT_STATION_FRACTIONS`) by both methods. ``static``: the 1 g part,
     ``elastic`` (default for the coupled and qsd models) or ``rigid`` (the rigid model's
     only choice). ``density_kg_m3`` [kg/m³]: default the density of the run's own loads
     (``meta["loads"]``, a run of ``run_gust(loads=...)``: JSBSim's at its trim), else sea

@@ -49,13 +49,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bioflex_jsb.definition.model import DEFAULT_MONITORING_STATIONS
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import prototype as P
 
-DEFAULT_STATION_FRACTIONS = (0.0, 0.25, 0.5, 0.75)  # root, 25, 50, 75 % semispan (issue 24)
+# root, 25, 50, 75 % semispan (issue 24): a definition's default [loads] stations
+DEFAULT_STATION_FRACTIONS = DEFAULT_MONITORING_STATIONS
 QUANTITIES = ("shear_n", "bending_n_m", "torque_n_m")
 QUANTITY_UNITS = {"shear_n": "N", "bending_n_m": "N*m", "torque_n_m": "N*m"}
 METHODS = ("force_summation", "mode_displacement")
@@ -393,7 +395,7 @@ def _elements_at(nodes: np.ndarray, y: float) -> list[int]:
     return [int(np.clip(np.searchsorted(nodes, y) - 1, 0, nodes.size - 2))]
 
 
-def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTIONS, *,
+def build_loads_model(build, speed_m_s: float, stations=None, *,
                       density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
                       static: str = "elastic") -> LoadsModel:
     """The :class:`LoadsModel` of ``build`` (a :class:`~bioflex_jsb.flight_dynamics.
@@ -403,13 +405,17 @@ def build_loads_model(build, speed_m_s: float, stations=DEFAULT_STATION_FRACTION
     fitted to its generalised masses (:func:`modal_mass_sections`; InputError if that fit
     fails).
 
-    ``stations``: fractions of the semispan. ``static``: the 1 g static part,
+    ``stations``: fractions of the semispan (None: the wing's own,
+    ``build.monitoring_stations``, an aircraft definition's ``[loads] stations``, else
+    :data:`DEFAULT_STATION_FRACTIONS`). ``static``: the 1 g static part,
     ``elastic`` (the elastic trim's η₀ and Δα, :mod:`bioflex_jsb.flight_dynamics.
     elastic_trim`: the deformed wing the rigid reading's airframe carries) or ``rigid``
     (η₀ = 0: the undeformed wing at the rigid trim). ``elastic`` beyond the wing's static
     divergence speed is refused (InputError from the elastic trim)."""
     if static not in ("elastic", "rigid"):
         raise InputError(f"unknown static part {static!r}; accepted: elastic, rigid")
+    if stations is None:
+        stations = getattr(build, "monitoring_stations", None) or DEFAULT_STATION_FRACTIONS
     variant, modes, aero = build.variant, build.modes, build.aero
     planform = build.planform
     if abs(aero.semispan_m - planform.semispan_m) > 1e-9 * planform.semispan_m:
