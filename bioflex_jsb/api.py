@@ -34,6 +34,7 @@ from bioflex_jsb.definition import Definition
 from bioflex_jsb.definition import load_definition as _load_definition
 from bioflex_jsb.definition.aircraft import Aircraft
 from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
+from bioflex_jsb.definition.clamped import free_speed_range_m_s as _free_speed_range_m_s
 from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
 from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
 from bioflex_jsb.drivers.compare import Comparison, check_comparable, compare_run
@@ -143,6 +144,29 @@ def _density(wing, density_kg_m3: float | None) -> dict:
     return {}
 
 
+def _analysis_speed(wing, speed_m_s: float | None) -> float:
+    """The speed [m/s] of a linear analysis: ``speed_m_s`` when given, else an
+    :class:`Aircraft`'s cruise speed (the prototype's 15 m/s on its airframe, Table 1; the
+    file's ``airframe.cruise_speed_m_s`` on another), or the prototype's for a bare wing
+    built on the prototype's airframe (or None, the rigid prototype); one line when no
+    cruise speed is known (a wing of another airframe without its Aircraft, an aircraft
+    without the field)."""
+    if speed_m_s is not None:
+        return float(speed_m_s)
+    if isinstance(wing, Aircraft):
+        cruise = (CRUISE_SPEED_M_S if wing.flight_problem() is None
+                  else wing.airframe.cruise_speed_m_s)
+        if cruise is None:
+            raise InputError(f"aircraft {wing.name!r} has no airframe.cruise_speed_m_s: give "
+                             "speed_m_s [m/s]")
+        return float(cruise)
+    if wing is None or wing.model.airframe is PROTOTYPE_AIRFRAME:
+        return CRUISE_SPEED_M_S
+    raise InputError(f"wing {wing.variant.name!r} is built for airframe "
+                     f"{wing.model.airframe.name!r}: give speed_m_s [m/s] (or pass its "
+                     "Aircraft, whose cruise speed is the default)")
+
+
 def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:3",
              models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
@@ -243,10 +267,12 @@ def metrics(run: TimeHistory, gust_start_s: float = 0.5) -> GustMetrics:
     return gust_metrics(run, gust_start_s)
 
 
-def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "coupled",
-                 aero: str = "quasi-steady", trim: str = "rigid") -> StateSpace:
-    """The paper's LTI model (Eq. 4) at ``speed_m_s`` [m/s]: ``rigid`` (A_RR), ``coupled``
-    or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units.
+def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
+                 model: str = "coupled", aero: str = "quasi-steady",
+                 trim: str = "rigid") -> StateSpace:
+    """The paper's LTI model (Eq. 4) at ``speed_m_s`` [m/s] (None: the aircraft's cruise
+    speed, the prototype's 15 m/s): ``rigid`` (A_RR), ``coupled`` or ``qsd`` (Eq. 9-10),
+    with named states, inputs, outputs and their units.
 
     ``aero="unsteady"`` (``coupled`` only): Eq. (4) on unsteady strips with the Küssner gust
     (:func:`bioflex_jsb.aeroelasticity.free_aircraft.unsteady_state_space`, ``gust=True``),
@@ -262,6 +288,7 @@ def linear_model(wing: WingBuild | None, speed_m_s: float = 15.0, model: str = "
     derivatives of its file, its planform; the air of its [air]); ``None`` the prototype's
     rigid aircraft."""
     air = _density(wing, None)
+    speed_m_s = _analysis_speed(wing, speed_m_s)
     wing = _wing(wing)
     if trim not in ("rigid", "elastic"):
         raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
@@ -323,10 +350,11 @@ def _check_density(rho: float) -> float:
     return float(rho)
 
 
-def modes(wing, speed_m_s: float = 15.0, model: str = "coupled", *,
+def modes(wing, speed_m_s: float | None = None, model: str = "coupled", *,
           aero: str = "quasi-steady", clamped: bool = False, method: str = "state-space",
           structural_damping: float | None = None) -> ModeSet:
-    """Labelled eigenvalues at ``speed_m_s`` [m/s].
+    """Labelled eigenvalues at ``speed_m_s`` [m/s] (free aircraft, None: its cruise speed,
+    the prototype's 15 m/s; clamped: required).
 
     Free aircraft (``wing`` a :class:`WingBuild`): ``model`` rigid, coupled or qsd of the
     paper (short period, phugoid, aeroelastic_i), ``aero="unsteady"`` the coupled model on
@@ -336,8 +364,11 @@ def modes(wing, speed_m_s: float = 15.0, model: str = "coupled", *,
     An :class:`Aircraft` is analysed with its own airframe, planform and air."""
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if clamped:
+        if speed_m_s is None:
+            raise InputError("a clamped wing's modes need speed_m_s [m/s]")
         return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
     air = _density(wing, None)
+    speed_m_s = _analysis_speed(wing, speed_m_s)
     wing = _wing(wing)
     if aero == "unsteady":
         if model != "coupled":
@@ -420,29 +451,17 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     return find_flutter(model, rng, **air)
 
 
-PAPER_FLUTTER_RANGE_M_S = (5.0, 40.0)  # the paper's scans of the prototype (Figs. 11-13)
-
-
 def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:
-    """The default speed range [m/s] of a free aircraft's flutter search: the paper's
-    5-40 m/s for the prototype's airframe; another aircraft's derived from its wing as a
-    clamped wing's is (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`):
-    150 % of the wing's static divergence speed in the aircraft (A_EE singular, the body
-    held: :func:`bioflex_jsb.flight_dynamics.eigen.wing_divergence_speed_m_s`) down to 5 %
-    of that, the search's top at most 400 m/s (the strips are incompressible). A fixed
-    5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s."""
-    from bioflex_jsb.definition.clamped import BOTTOM_FRACTION, TOP_OVER_DIVERGENCE
-    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
-    from bioflex_jsb.flight_dynamics.eigen import wing_divergence_speed_m_s
-    from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
-
-    if build.model.airframe.reference == PROTOTYPE_AIRFRAME.reference:
-        return PAPER_FLUTTER_RANGE_M_S
-    rho = SEA_LEVEL_DENSITY_KG_M3 if density_kg_m3 is None else density_kg_m3
-    v_div = wing_divergence_speed_m_s(build.model, rho,
-                                      (2.0, SPEED_LIMIT_M_S / TOP_OVER_DIVERGENCE))
-    top = SPEED_LIMIT_M_S if v_div is None else TOP_OVER_DIVERGENCE * v_div
-    return BOTTOM_FRACTION * top, top
+    """The default speed range [m/s] of a free aircraft's flutter search
+    (:func:`bioflex_jsb.definition.clamped.free_speed_range_m_s`): the paper's 5-40 m/s for
+    the prototype's airframe; another aircraft's derived from its wing (150 % of the wing's
+    static divergence speed in the aircraft, the body held, down to 5 % of that; a fixed
+    5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s).
+    ``build``: a :class:`WingBuild` or an :class:`Aircraft` (its wing; the density of its
+    [air] when ``density_kg_m3`` is None)."""
+    if density_kg_m3 is None:
+        density_kg_m3 = _density(build, None).get("density_kg_m3")
+    return _free_speed_range_m_s(_wing(build), density_kg_m3)
 
 
 def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope):
@@ -468,10 +487,11 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope)
                                       and d.analysis.speed_range_m_s is None))
 
 
-def section_loads(wing, run: TimeHistory, stations=(0.0, 0.25, 0.5, 0.75), *,
+def section_loads(wing, run: TimeHistory, stations=None, *,
                   static: str | None = None, density_kg_m3: float | None = None):
     """Wing section loads of the gust ``run`` (from :func:`fly_gust` with ``wing``) at the
-    monitoring ``stations`` (fractions of the semispan; default root, 25, 50, 75 %): shear
+    monitoring ``stations`` (fractions of the semispan; default the wing's, an aircraft
+    definition's ``[loads] stations``, else root, 25, 50, 75 %): shear
     [N, up +], bending moment [N·m, tip up +] and torque about the elastic axis [N·m,
     leading edge up +] by force summation and by mode displacement, with their difference
     (:class:`bioflex_jsb.loads.SectionLoads`: ``.values``, ``.difference()``, ``.plot()``;

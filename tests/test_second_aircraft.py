@@ -30,6 +30,7 @@ import pytest
 from bioflex_jsb import api
 from bioflex_jsb.definition import load_definition
 from bioflex_jsb.definition.clamped import beam_sections
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
@@ -220,3 +221,20 @@ def test_commands_take_the_aircraft_file(capsys, tmp_path):
     mine = api.linear_model(sgs_wing := api.load_aircraft("sgs_elastic").wing(), 25.0,
                             "coupled")
     assert ss.a == pytest.approx(mine.a, rel=1e-12, abs=1e-12), sgs_wing.variant.name
+
+
+def test_the_api_defaults_to_the_aircrafts_cruise_speed(sgs):
+    """``api.modes``, ``api.linear_model`` without a speed analyse an Aircraft at its own
+    cruise speed (the SGS: 25 m/s, its file), as the CLI's ``modes --aircraft`` does; they
+    said 15 m/s, the prototype's, outside the glider's 20-28 m/s. A bare wing of another
+    airframe has no cruise speed: one line asks for it. ``free_speed_range_m_s`` takes the
+    Aircraft too (it raised AttributeError)."""
+    ms = api.modes(sgs)
+    assert ms.speed_m_s == 25.0
+    assert ms.as_dict() == api.modes(sgs, 25.0).as_dict()
+    assert np.array_equal(api.linear_model(sgs).a, api.linear_model(sgs, 25.0).a)
+    with pytest.raises(InputError, match="give speed_m_s"):
+        api.modes(sgs.wing())
+    assert api.modes(api.load_wing("optimised")).speed_m_s == 15.0  # the prototype's
+    assert api.free_speed_range_m_s(sgs) == api.free_speed_range_m_s(sgs.wing(), 1.225)
+    assert api.free_speed_range_m_s(api.load_wing("optimised")) == (5.0, 40.0)

@@ -92,3 +92,29 @@ def derived_speed_range_m_s(model: ClampedWingModel, density_kg_m3: float
 def scan_step_m_s(range_m_s: tuple[float, float]) -> float:
     """The scan step [m/s] for ``range_m_s`` (module docstring)."""
     return min(MAX_STEP_M_S, (range_m_s[1] - range_m_s[0]) / STEPS_PER_RANGE)
+
+
+PAPER_FLUTTER_RANGE_M_S = (5.0, 40.0)  # the paper's scans of the prototype (Figs. 11-13)
+
+
+def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:
+    """The default speed range [m/s] of a free aircraft's flutter search for the wing
+    ``build`` (a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`): the paper's
+    5-40 m/s for the prototype's airframe; another aircraft's derived from its wing as a
+    clamped wing's is (:func:`derived_speed_range_m_s`): 150 % of the wing's static
+    divergence speed in the aircraft (A_EE singular, the body held:
+    :func:`bioflex_jsb.flight_dynamics.eigen.wing_divergence_speed_m_s`) down to 5 % of
+    that, the search's top at most 400 m/s (the strips are incompressible). A fixed
+    5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s.
+    ``density_kg_m3`` [kg/m³]: None, sea level."""
+    from bioflex_jsb.flight_dynamics.eigen import wing_divergence_speed_m_s
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+    from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
+
+    if build.model.airframe.reference == PROTOTYPE_AIRFRAME.reference:
+        return PAPER_FLUTTER_RANGE_M_S
+    rho = SEA_LEVEL_DENSITY_KG_M3 if density_kg_m3 is None else density_kg_m3
+    v_div = wing_divergence_speed_m_s(build.model, rho,
+                                      (2.0, SPEED_LIMIT_M_S / TOP_OVER_DIVERGENCE))
+    top = SPEED_LIMIT_M_S if v_div is None else TOP_OVER_DIVERGENCE * v_div
+    return BOTTOM_FRACTION * top, top

@@ -84,7 +84,9 @@ _DIGESTS: dict[str, str] = {}
 
 def aircraft_identity(aircraft) -> dict[str, Any]:
     """What of ``aircraft`` enters its cases' ids: its name and the SHA-256 of its
-    definition file's bytes (read once per process and file)."""
+    definition file's bytes (read once per process and file); for an aircraft on another
+    airframe also that its default flutter range is derived from its wing (before, it was
+    the prototype's 5-40 m/s: ids made then are not reused)."""
     path = str(aircraft.definition.path)
     if path not in _DIGESTS:
         from bioflex_jsb.definition.loader import DefinitionError
@@ -92,4 +94,7 @@ def aircraft_identity(aircraft) -> dict[str, Any]:
 
         data = read_input_bytes(path, "definition file", DefinitionError)
         _DIGESTS[path] = hashlib.sha256(data).hexdigest()
-    return {"name": aircraft.name, "definition_sha256": _DIGESTS[path]}
+    out = {"name": aircraft.name, "definition_sha256": _DIGESTS[path]}
+    if aircraft.flight_problem() is not None:
+        out["flutter_range"] = "derived"
+    return out

@@ -187,15 +187,22 @@ def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
 @dataclass(frozen=True)
 class RunSettings:
     """Settings shared by every case: gust-run duration and gust start [s], co-simulation
-    step [s], mass basis, flutter search range [m/s], the coupled step's strips
+    step [s], mass basis, flutter search range [m/s] (None: each wing's default,
+    ``definition.clamped.free_speed_range_m_s``: the paper's 5-40 m/s for the prototype's
+    airframe, derived from the wing for another aircraft), the coupled step's strips
     (``aero``: quasi-steady or unsteady)."""
 
     duration_s: float = 5.0
     gust_start_s: float = 0.5
     dt_s: float = DEFAULT_DT_S
     mass_basis: str = DEFAULT_MASS_BASIS
-    flutter_range_m_s: tuple[float, float] = (5.0, 40.0)
+    flutter_range_m_s: tuple[float, float] | None = None
     aero: str = DEFAULT_AERO
+
+
+# the range a case id records for "none given": the prototype's, once the fixed default (its
+# ids stay; another airframe's ids record "derived": aircraft_axis.aircraft_identity)
+DEFAULT_FLUTTER_RANGE_ID = (5.0, 40.0)
 
 
 def settings_identity(settings: RunSettings) -> dict[str, Any]:
@@ -204,6 +211,8 @@ def settings_identity(settings: RunSettings) -> dict[str, Any]:
     d = dataclasses.asdict(settings)
     if d["aero"] == DEFAULT_AERO:
         del d["aero"]
+    if d["flutter_range_m_s"] is None:
+        d["flutter_range_m_s"] = DEFAULT_FLUTTER_RANGE_ID
     return d
 
 
@@ -574,16 +583,17 @@ def _settings(run: Any) -> RunSettings:
     if basis not in MASS_BASES:
         raise CampaignError(f"run.mass_basis: unknown mass basis {basis!r}; accepted: "
                             f"{', '.join(MASS_BASES)}")
-    fr = run.get("flutter_range_m_s", list(d.flutter_range_m_s))
-    if not isinstance(fr, list) or len(fr) != 2 or not all(_is_number(x) for x in fr) \
-            or not 0.0 < fr[0] < fr[1]:
+    fr = run.get("flutter_range_m_s")
+    if fr is not None and not (isinstance(fr, list) and len(fr) == 2
+                               and all(_is_number(x) for x in fr) and 0.0 < fr[0] < fr[1]):
         raise CampaignError(f"run.flutter_range_m_s: must be [low, high] with 0 < low < high "
                             f"m/s, got {fr!r}")
     aero = run.get("aero", d.aero)
     if aero not in AERO_MODELS:
         raise CampaignError(f"run.aero: unknown aerodynamics {aero!r}; accepted: "
                             f"{', '.join(AERO_MODELS)}")
-    return RunSettings(duration, start, dt, basis, (float(fr[0]), float(fr[1])), aero)
+    return RunSettings(duration, start, dt, basis,
+                       None if fr is None else (float(fr[0]), float(fr[1])), aero)
 
 
 def _wings(axes: dict, base_dir: Path | None, required: bool = True) -> list[WingVariant]:

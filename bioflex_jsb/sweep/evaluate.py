@@ -207,7 +207,12 @@ def _flutter(case: Case, build):
 
     key = (*_wing_key(case), case.settings.flutter_range_m_s)
     if key not in _FLUTTER_CACHE:
-        _FLUTTER_CACHE[key] = find_flutter(build.model, case.settings.flutter_range_m_s)
+        rng = case.settings.flutter_range_m_s
+        if rng is None:  # the wing's own default (the prototype's: 5-40 m/s)
+            from bioflex_jsb.definition.clamped import free_speed_range_m_s
+
+            rng = free_speed_range_m_s(build)
+        _FLUTTER_CACHE[key] = find_flutter(build.model, rng)
     return _FLUTTER_CACHE[key]
 
 
@@ -223,7 +228,7 @@ def case_description(case: Case):
                           duration_s=s.duration_s, gust_start_s=s.gust_start_s,
                           dt_s=s.dt_s, mass_basis=s.mass_basis,
                           extra={"case_id": case.case_id, "aero": s.aero,
-                                 **({"aircraft": str(case.aircraft.definition.path)}
+                                 **({"aircraft": case.aircraft.source}
                                     if case.aircraft is not None else {})})
 
 
