@@ -67,6 +67,11 @@ def test_the_glide_trim_against_the_polar_by_hand(sgs):
     assert math.degrees(trim.flight_path_rad) == pytest.approx(-2.316, abs=1e-3)
     assert 20.0 < lift_to_drag < 40.0
     assert -25.0 * math.sin(trim.flight_path_rad) == pytest.approx(1.010, abs=1e-3)
+    # the elevator's normalised command with the pitch trim, not SGS.xml's never-written
+    # fcs/elevator-pos-norm (which read 0): its FCS maps −1..0 onto −28..0 times its gain
+    # 0.01745 rad (its "degree")
+    assert trim.elevator_norm < 0.0
+    assert trim.elevator_norm == pytest.approx(trim.elevator_rad / (28.0 * 0.01745), rel=1e-9)
 
 
 def test_the_glide_drifts_as_the_air_gets_denser(sgs):
@@ -86,8 +91,8 @@ def test_the_glide_drifts_as_the_air_gets_denser(sgs):
 def test_the_nonlinear_glide_against_the_lti_model(sgs):
     """``compare`` at the glide trim (A_RR JSBSim's by central differences, the calm-air
     drift added to the prediction: drivers/compare.py). A 0.05 m/s 1-cos gust over 25 m:
-    NRMSE α 0.0070, q 0.0094, θ 0.0042, η1 0.0205, u 0.078 (measured); bars about 2.5 ×
-    those: the trim's α 1.96° sits 0.04° below the 2° point of SGS.xml's CLwbh table, whose
+    NRMSE α 0.0070, q 0.0094, θ 0.0042, η1 0.0196, u 0.078 (measured 2026-12-03); bars
+    about 2.5 × those: the trim's α 1.96° sits 0.04° below the 2° point of SGS.xml's CLwbh table, whose
     slope falls there from 4.60 to 4.0 /rad, so the linear model is exact only below it.
     A 0.5 m/s gust crosses that point: α 0.044, q 0.17 (the tables', not the wing's, limit)."""
     result = api.compare(sgs, gust="1cos:0.05:25", model="coupled", duration_s=8.0)
@@ -328,3 +333,28 @@ def test_rerun_flies_the_gliders_log_from_its_definition(tmp_path, capsys):
     assert argv[1:3] == ["gust", "--aircraft"] and argv[3].endswith("sgs_elastic.toml")
     assert "--wing" not in argv
     assert report["equal"] is True and report["messages"] > 0
+
+
+def test_rerun_finds_a_relative_definition_from_another_directory(tmp_path, capsys,
+                                                                  monkeypatch):
+    """A log of ``gust --aircraft my_glider.toml`` (a path relative to the working
+    directory) records the definition's absolute path, so ``rerun`` reads it from any
+    directory (it recorded 'my_glider.toml' and failed elsewhere: cannot read definition
+    file)."""
+    work = tmp_path / "work"
+    work.mkdir()
+    shutil.copy(DATA / "sgs_elastic_modes.toml", work / "sgs_elastic_modes.toml")
+    text = (DATA / "sgs_elastic.toml").read_text(encoding="utf-8")
+    (work / "my_glider.toml").write_text(text.replace('name = "sgs_elastic"',
+                                                      'name = "my_glider"', 1), encoding="utf-8")
+    monkeypatch.chdir(work)
+    code, _, err = run_cli(capsys, "gust", "--aircraft", "my_glider.toml", "--duration",
+                           "0.3", "--gust-start", "0.1", "--models", "rigid", "--out",
+                           "run.mcap", "--json")
+    assert code == 0, err
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, "rerun", "work/run.mcap", "--out", "again.mcap", "--json")
+    assert code == 0, err
+    report = json.loads(out)
+    assert report["command"][3] == str((work / "my_glider.toml").resolve())
+    assert report["equal"] is True

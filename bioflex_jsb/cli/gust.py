@@ -214,7 +214,7 @@ def run_description(args, kind: str, models):
         extra["trim"] = args.trim
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
-        extra["aircraft"] = str(aircraft.definition.path or aircraft.name)
+        extra["aircraft"] = aircraft.source
     return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
                           gust=args.gust.text(), models=tuple(models),
                           duration_s=args.duration, gust_start_s=args.gust_start,

@@ -264,7 +264,7 @@ def _airframe(args: argparse.Namespace):
 
 def _aircraft_source(args: argparse.Namespace) -> str:
     aircraft = args.aircraft_definition
-    return str(aircraft.definition.path or aircraft.name)
+    return aircraft.source
 
 
 def _parse_home(text: str | None, default: tuple[float, float, float]):

@@ -180,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
         ("thrust", f"{result.thrust_n:.3f}", "N"),
     ]
     if airframe.glider:  # no engine: the steady glide (runtime/other_airframe.py)
+        rows[5] = ("elevator", f"{result.elevator_norm:.3f}", "command with pitch trim, -1..1")
         rows[6:9] = [("gamma", f"{deg(result.flight_path_rad):.3f}", "deg (flight path, + up)"),
                      ("sink", f"{-result.speed_m_s * math.sin(result.flight_path_rad):.3f}",
                       "m/s"),

@@ -37,7 +37,12 @@ from pathlib import Path
 from bioflex_jsb.definition.airframe import GENERATED
 from bioflex_jsb.definition.flying import FLYING_N_MODES, axes
 from bioflex_jsb.definition.loader import load_definition
-from bioflex_jsb.definition.model import Definition, MembraneStructure, ModalStructure
+from bioflex_jsb.definition.model import (
+    DEFAULT_MONITORING_STATIONS,
+    Definition,
+    MembraneStructure,
+    ModalStructure,
+)
 from bioflex_jsb.definition.reader import DefinitionError
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
@@ -85,6 +90,13 @@ class Aircraft:
     @property
     def airframe(self):
         return self.definition.airframe
+
+    @property
+    def source(self) -> str:
+        """Where the definition was read: its file's absolute path (a log records it, and
+        ``rerun`` reads it from any directory), or its name when it has no file."""
+        path = self.definition.path
+        return str(Path(path).resolve()) if path else self.name
 
     def __repr__(self) -> str:
         return (f"Aircraft({self.name!r}, jsbsim={self.airframe.jsbsim!r}, "
@@ -207,8 +219,9 @@ class Aircraft:
                     f"in flight the wing's modes come from 'prototype-membrane' or a 'modal' "
                     f"file{tail}")
         if a.jsbsim != GENERATED:
-            return (f"{head}airframe.jsbsim = {a.jsbsim!r}: the flight models of this version "
-                    f"are those of the generated prototype {GENERATED!r}{tail}")
+            return (f"{head}airframe.jsbsim = {a.jsbsim!r} is not the generated prototype "
+                    f"airframe {GENERATED!r}: the aircraft flies on its own JSBSim aircraft "
+                    f"where definition.flying.flight_refusal allows it{tail}")
         g, ref = AIRFRAME_GEOMETRY, REFERENCE_GEOMETRY
         rows = [
             ("airframe.reference_area_m2", a.reference_area_m2, ref.area_m2),
@@ -253,11 +266,17 @@ class Aircraft:
         if self.flight_problem() is None:
             # the prototype's own planform and airframe objects: flight_problem has checked
             # these equal them, and the nonlinear runs read those objects
-            return build_wing(self.variant(), FLYING_N_MODES, mass_basis, DEFAULT_PLANFORM,
-                              PROTOTYPE_AIRFRAME)
-        airframe = self.airframe_data()
-        return build_wing(self.variant(), FLYING_N_MODES, mass_basis, self.planform(),
-                          airframe)
+            build = build_wing(self.variant(), FLYING_N_MODES, mass_basis, DEFAULT_PLANFORM,
+                               PROTOTYPE_AIRFRAME)
+        else:
+            build = build_wing(self.variant(), FLYING_N_MODES, mass_basis, self.planform(),
+                               self.airframe_data())
+        stations = tuple(float(s) for s in self.definition.monitoring_stations)
+        if stations == DEFAULT_MONITORING_STATIONS:
+            return build  # the cached build itself
+        # the definition's [loads] stations go with its wing into every analysis that
+        # reports section loads (gust, compare, api.fly_gust, sweeps)
+        return dataclasses.replace(build, monitoring_stations=stations)
 
     def summary(self) -> dict[str, object]:
         """The definition's airframe and wing as plain data (for logs and --json)."""

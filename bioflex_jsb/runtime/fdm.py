@@ -496,13 +496,16 @@ class Airframe:
             )
 
     def _trim_result(self, v: float, h: float) -> TrimResult:
+        from bioflex_jsb.runtime.other_airframe import glide_elevator_norm
+
         fdm = self._fdm
         return TrimResult(
             speed_m_s=v,
             altitude_m=h,
             alpha_rad=float(fdm["aero/alpha-rad"]),
             theta_rad=float(fdm["attitude/theta-rad"]),
-            elevator_norm=float(fdm["fcs/elevator-pos-norm"]),
+            elevator_norm=(glide_elevator_norm(fdm) if self.glider  # its command: SGS.xml
+                           else float(fdm["fcs/elevator-pos-norm"])),  # writes no position
             elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
             throttle=0.0 if self.glider else float(fdm["fcs/throttle-pos-norm"]),
             aileron_norm=float(fdm["fcs/left-aileron-pos-norm"]),

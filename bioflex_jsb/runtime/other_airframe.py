@@ -309,6 +309,15 @@ JACOBIAN_STEPS = (0.01, 1e-4, 1e-4, 1e-4)
 ALPHADOT_PASSES = 3
 
 
+def glide_elevator_norm(fdm) -> float:
+    """A glider's trimmed elevator, −1..1: its normalised command (elevator command + the
+    pitch trim :func:`glide_trim` moves, clipped to ±1), what an FCS like SGS.xml's moves
+    the surface by; that FCS writes only the deflection in rad, and its never-written
+    ``fcs/elevator-pos-norm`` read 0 whatever the trim."""
+    command = float(fdm["fcs/elevator-cmd-norm"]) + float(fdm[PITCH_TRIM])
+    return min(1.0, max(-1.0, command))
+
+
 def rigid_jacobian(fdm) -> np.ndarray:
     """A_RR (4×4, x_R = [u [m/s], α [rad], q [rad/s], θ [rad]], SI) of ``fdm`` at its
     current state (the glide trim, wings level, no wind), by central differences of JSBSim's

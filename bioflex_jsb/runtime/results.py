@@ -32,7 +32,8 @@ class TrimResult:
     Attributes:
         speed_m_s: true airspeed [m/s]; altitude_m: altitude above sea level [m].
         alpha_rad, theta_rad: angle of attack and pitch attitude [rad] (θ = α in level flight).
-        elevator_norm: elevator position, −1..1 of its travel (+ = trailing edge down).
+        elevator_norm: elevator position, −1..1 of its travel (+ = trailing edge down); a
+            glider's: its elevator command with the pitch trim (runtime/fdm.py).
         elevator_rad: elevator deflection [rad] (+ = trailing edge down, nose-down moment).
         throttle: throttle position 0..1 of every motor of the contra-rotating pair
             (fraction of the maximum shaft power).
