@@ -431,6 +431,24 @@ def test_live_refusals(capsys, tmp_path, monkeypatch, argv, needle):
     assert not list(tmp_path.iterdir())
 
 
+def test_live_refusals_come_before_the_ardupilot_port(capsys, tmp_path, monkeypatch):
+    """``ardupilot``'s live refusals are checked before its UDP port is bound: with the
+    port taken by another program, bad --live input still gets its own line (it got
+    "cannot bind UDP 127.0.0.1:9002" when another session held the port)."""
+    import socket
+
+    monkeypatch.chdir(tmp_path)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as taken:
+        taken.bind(("127.0.0.1", 0))
+        port = taken.getsockname()[1]
+        for argv, needle in ((["--live", "0.0.0.0:0"], "would listen on the network"),
+                             (["--live", "127.0.0.1:0", "--no-log"], "needs the log"),
+                             (["--live-any-host"], "--live-any-host without --live")):
+            code, _, err = run_cli(capsys, "ardupilot", "--port", str(port), *argv)
+            assert_one_line_error(code, err, needle)
+    assert not list(tmp_path.iterdir())
+
+
 def test_loopback_rule():
     from bioflex_jsb.sinks.live import is_loopback
 

@@ -60,17 +60,16 @@ def add_live_arguments(parser: argparse.ArgumentParser) -> None:
         "authentication: whoever reaches the port sees the run)")
 
 
-def start_live(args: argparse.Namespace, command: str) -> None:
-    """Start the live server of ``args.live`` (kept as ``args.live_server``) before the log
-    file is made; a UsageError (one line) for what cannot be served."""
+def check_live(args: argparse.Namespace) -> None:
+    """The live options' refusals (one line, a UsageError), with nothing opened or bound:
+    a command checks them before it takes any port (``ardupilot``'s UDP port) or file."""
     from bioflex_jsb.cli.common import UsageError
 
-    args.live_server = None
     if getattr(args, "live", None) is None:
         if getattr(args, "live_any_host", False):
             raise UsageError("--live-any-host without --live: give --live HOST:PORT")
         return
-    from bioflex_jsb.sinks.live import LiveError, LiveServer, is_loopback
+    from bioflex_jsb.sinks.live import is_loopback
 
     host, port = args.live
     if not is_loopback(host) and not args.live_any_host:
@@ -80,6 +79,20 @@ def start_live(args: argparse.Namespace, command: str) -> None:
     if getattr(args, "no_log", False):
         raise UsageError("--live serves the log as it is written: it needs the log "
                          "(drop --no-log)")
+
+
+def start_live(args: argparse.Namespace, command: str) -> None:
+    """Start the live server of ``args.live`` (kept as ``args.live_server``) before the log
+    file is made; a UsageError (one line) for what cannot be served."""
+    from bioflex_jsb.cli.common import UsageError
+
+    args.live_server = None
+    check_live(args)
+    if getattr(args, "live", None) is None:
+        return
+    from bioflex_jsb.sinks.live import LiveError, LiveServer
+
+    host, port = args.live
     try:
         args.live_server = LiveServer(host, port, name=f"bioflex-jsb {command}")
     except LiveError as exc:

@@ -19,7 +19,13 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
-from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
+from bioflex_jsb.cli.live_option import (
+    add_live_arguments,
+    check_live,
+    live_opener,
+    start_live,
+    stop_live,
+)
 from bioflex_jsb.cli.preflight import NATIVE, add_allow_unstable, checked, preflight
 
 __all__ = ("preflight", "register", "run", "session_summary")
@@ -241,6 +247,7 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.links.ardupilot_json import LockstepServer
 
     wall0 = time.monotonic()
+    check_live(args)  # its refusals before the UDP port is taken
     physics, variant, overrides, check = _build(args)
     try:
         server = LockstepServer(physics, port=args.port, instance=args.instance,
