@@ -117,6 +117,60 @@ def test_signal_inside_a_jsbsim_callback_during_a_sitl_session(tmp_path):
     assert time.monotonic() - t0 < 120  # stopped: the session would fly 150 s
 
 
+# The stop handler run between a chunk's bytes written and their offset and CRC counted:
+# where Python runs a handler for a signal caught just before the writer blocked the
+# signals. It raised KeyboardInterrupt there, and 5 of 22 logs of SIGINT-ed `gust` runs had
+# their footer and data CRC wrong (the review of 2026-12-03).
+IN_CHUNK_WRITE = """
+from bioflex_jsb.sinks.mcap import writer as _w
+_orig = _w.McapFileWriter._write_now
+_n = [0]
+def _wrapped(self, data):
+    _n[0] += 1
+    if _n[0] == {nth}:  # the handler runs as the bytes are written, before they are counted
+        real = self._stream
+        class _Stream:
+            def write(_, b):
+                real.write(b)
+                signal.getsignal(signal.{sig})(signal.{sig}, sys._getframe())
+            def __getattr__(_, name):
+                return getattr(real, name)
+        self._stream = _Stream()
+        try:
+            return _orig(self, data)
+        finally:
+            self._stream = real
+    return _orig(self, data)
+_w.McapFileWriter._write_now = _wrapped
+"""
+
+
+# the 4th write: a schema record at the first run's start; the 29th: the second block's
+# steps' chunk of the rigid run (a 3 s rigid,coupled run writes 24 records, then chunks)
+@pytest.mark.parametrize("nth", [4, 29])
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_stop_handler_inside_a_chunk_write_leaves_a_finished_log(tmp_path, sig, nth):
+    """Exit 130 in one line, and the log finished: the official reader reads its summary
+    and every message, and ``info --check`` passes."""
+    from mcap.reader import make_reader
+
+    out = tmp_path / "run.mcap"
+    argv = ["gust", "--duration", "3", "--gust-start", "0.1", "--models", "rigid,coupled",
+            "--json", "--plot", "", "--out", str(out)]
+    r = harness(tmp_path, IN_CHUNK_WRITE.format(nth=nth, sig=sig), *argv)
+    assert r.returncode == 130, r.stderr[-3000:]
+    assert "interrupted" in one_line(r.stderr)
+    with out.open("rb") as f:
+        reader = make_reader(f)
+        summary = reader.get_summary()
+        n = sum(1 for _ in reader.iter_messages())
+    assert summary is not None and n == summary.statistics.message_count
+    assert n > 0 if nth > 24 else n >= 0
+    check = subprocess.run([PY, "-m", "bioflex_jsb", "info", "--check", str(out)],
+                           capture_output=True, text=True, timeout=120, env=env())
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
 def test_signal_inside_an_import_exits_130_in_one_line(tmp_path):
     """A signal while a module is being imported (here: from inside the import system, as
     an extension module's initialisation would run Python code) is raised once the import

@@ -32,6 +32,8 @@ from mcap.records import (
     SummaryOffset,
 )
 
+from bioflex_jsb.interrupts import critical_section
+
 MAGIC = b"\x89MCAP0\r\n"
 # simulated time per chunk [s]: the most a SIGKILL can lose (with one step, < 1 s); long
 # chunks spread the fixed cost of writing one (≈ 0.7 ms measured in a run) over more steps
@@ -70,13 +72,16 @@ _FINISH_FIXED_BYTES = 13 + 37 + 58 + 5 * 26
 
 @contextmanager
 def _signals_deferred():
-    """Hold SIGINT/SIGTERM while a chunk or the summary is written (no half-written record)."""
+    """Hold SIGINT/SIGTERM while a chunk or the summary is written (no half-written record):
+    blocked at the operating system, and a handler already due deferred
+    (:func:`~bioflex_jsb.interrupts.critical_section`)."""
     try:
         old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
     except (AttributeError, ValueError, OSError):  # not Unix or not the main thread
         old = None
     try:
-        yield
+        with critical_section():
+            yield
     finally:
         if old is not None:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
@@ -173,9 +178,13 @@ class McapFileWriter:
         self._write_now(data)
 
     def _write_now(self, data: bytes) -> None:
-        self._stream.write(data)
-        self._crc = zlib.crc32(data, self._crc)
-        self._offset += len(data)
+        # the bytes and their count are one step: a stop between them (a schema or channel
+        # record written outside a chunk's deferred block) would leave every later offset
+        # and the data section's CRC wrong
+        with critical_section():
+            self._stream.write(data)
+            self._crc = zlib.crc32(data, self._crc)
+            self._offset += len(data)
 
     def flush(self) -> None:
         """Hand everything written so far to the operating system."""
