@@ -46,6 +46,32 @@ def _description():
                           duration_s=20.0)
 
 
+def test_a_later_file_never_replaces_a_users_file(steps, build, tmp_path):  # noqa: F811
+    """The session's later files take the first free ``<stem>-NNN`` names: a user's
+    ``s-001.mcap`` is left as it was (it was replaced silently: the review of 2026-12-03);
+    with ``--force`` (``replace=True``) the names are the plain sequence."""
+    _, rows = steps
+    mine = tmp_path / "s-001.mcap"
+    mine.write_bytes(b"precious\n")
+    log = SplitLog(str(tmp_path / "s.mcap"), _description(), build, 0.3, open_log)
+    for rep in range(2):
+        for t, row in rows:
+            log.sample("coupled", t + 2.0 * rep, row)
+    log.close()
+    assert mine.read_bytes() == b"precious\n"
+    names = [os.path.basename(p) for p in log.paths]
+    assert names[:3] == ["s.mcap", "s-002.mcap", "s-003.mcap"], names
+    for p in log.paths:
+        summarise(p)  # each finished and readable
+    log = SplitLog(str(tmp_path / "f.mcap"), _description(), build, 0.3, open_log,
+                   replace=True)
+    (tmp_path / "f-001.mcap").write_bytes(b"old\n")
+    for t, row in rows:
+        log.sample("coupled", t, row)
+    log.close()
+    assert [os.path.basename(p) for p in log.paths][:2] == ["f.mcap", "f-001.mcap"]
+
+
 @pytest.mark.parametrize("slack", [False, True], ids=["no-slack", "idle-flushes"])
 def test_split_files_never_exceed_the_limit(slack, steps, build, tmp_path):  # noqa: F811
     """No call of ``idle`` (a loop with no slack, as under load or at a high speed-up): the

@@ -363,10 +363,11 @@ def models_list(text: str) -> tuple[str, ...]:
 
 def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original") -> None:
     """--wing and --mass-basis, shared by every command that builds the elastic wing."""
+    from bioflex_jsb.cli.aircraft_option import WingAction
     from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS, MASS_BASES, VARIANTS
 
     parser.add_argument(
-        "--wing", default=default, metavar="NAME|FILE.toml",
+        "--wing", default=default, metavar="NAME|FILE.toml", action=WingAction,
         help=f"wing variant: {', '.join(VARIANTS)}, or a variant file (docs/wing_variants.md); "
         f"default {default}",
     )
@@ -420,7 +421,8 @@ def add_log_arguments(parser: argparse.ArgumentParser) -> None:
         f"directory from ${LOG_DIR_ENV_VAR} when set, never an existing file; an existing "
         "--out is refused unless --force; docs/logging.md)")
     parser.add_argument("--force", action="store_true",
-                        help="replace an existing --out file")
+                        help="replace existing output files (--out and the command's other "
+                        "outputs: plots, tables, summaries)")
     parser.add_argument("--no-log", action="store_true", help="write no MCAP log")
 
 
@@ -441,11 +443,11 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
     from pathlib import Path
 
     if getattr(args, "no_log", False):
-        if args.out:
+        if args.out is not None:
             raise UsageError("--out and --no-log contradict each other; give one")
         return None
-    if args.out:
-        check_output(args.out, getattr(args, "force", False), "--out")
+    if args.out is not None:
+        check_new_file(args.out, getattr(args, "force", False), "--out", (".mcap",))
         return args.out
     from_env = os.environ.get(LOG_DIR_ENV_VAR)
     folder = Path(from_env or "logs")
@@ -515,6 +517,42 @@ def check_output(path: str, force: bool, what: str, ours=None) -> None:
         return
     raise UsageError(f"{what} {path!r} already exists; give another name or --force to "
                      "replace it")
+
+
+def check_new_file(path: str, force: bool, what: str, suffixes: tuple[str, ...] = (),
+                   ours=None) -> None:
+    """Refuse an output file before any work (one-line UsageError): an empty or unusable
+    name (:func:`check_file_name`), a suffix not in ``suffixes`` (lower case, with the dot;
+    empty: any), an existing file without ``force`` (:func:`check_output`), a directory
+    that does not exist."""
+    from pathlib import Path
+
+    if not path:
+        raise UsageError(f"{what}: the file name is empty")
+    if suffixes and Path(path).suffix.lower() not in suffixes:
+        raise UsageError(f"{what} {path!r}: give a name ending in {', '.join(suffixes)}")
+    check_output(path, force, what, ours=ours)
+    parent = Path(path).parent
+    if not parent.is_dir():
+        raise UsageError(f"{what} {path!r}: the directory {str(parent)!r} does not exist")
+
+
+def check_distinct_outputs(*named: tuple[str, str | None]) -> None:
+    """Refuse two outputs of one command naming the same file (``named``: (option, path)
+    pairs, None or empty for an output not written): the second would replace the first
+    while both are reported written."""
+    import os.path
+
+    seen: dict[str, str] = {}
+    for option, path in named:
+        if not path:
+            continue
+        check_file_name(path, option)  # a NUL or control character: its own one line
+        key = os.path.realpath(path)
+        if key in seen:
+            raise UsageError(f"{seen[key]} and {option} name the same file {path!r}; give "
+                             "each its own")
+        seen[key] = option
 
 
 # Longest name of one path component and whole path [bytes] where the file system cannot be

@@ -17,6 +17,7 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    check_distinct_outputs,
     closing,
     log_path,
     print_json,
@@ -71,7 +72,12 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.cli.aircraft_option import airframe_from_args, resolve_flight
-    from bioflex_jsb.drivers.compare import check_comparable, compare_run, linear_prediction
+    from bioflex_jsb.drivers.compare import (
+        check_comparable,
+        check_gust_excites,
+        compare_run,
+        linear_prediction,
+    )
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.runtime.fdm import FdmError
     from bioflex_jsb.simulation.gusts import parse_gust
@@ -83,8 +89,13 @@ def run(args: argparse.Namespace) -> int:
     except InputError as exc:
         raise UsageError(f"--model {args.model} --aero {args.aero} --trim {args.trim}: "
                          f"{exc}") from None
+    try:
+        check_gust_excites(args.gust)
+    except InputError as exc:
+        raise UsageError(f"--gust {exc}") from None
     check_run_arguments(args)
     check_plot_path(args.plot, args.force)
+    check_distinct_outputs(("--out", args.out), ("--plot", args.plot))
     args.out = log_path(args, "compare", args.wing)
     log = None
     try:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 
 from bioflex_jsb.cli.case import (
@@ -23,6 +24,7 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    check_distinct_outputs,
     closing,
     log_path,
     models_list,
@@ -215,7 +217,10 @@ def run_description(args, kind: str, models):
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
         extra["aircraft"] = aircraft.source
-    return RunDescription(kind=kind, wing=args.wing, speed_m_s=args.speed,
+    wing = args.wing  # a variant file by its absolute path: rerun reads it from anywhere
+    if wing.lower().endswith(".toml") and os.path.isfile(wing):
+        wing = os.path.abspath(wing)
+    return RunDescription(kind=kind, wing=wing, speed_m_s=args.speed,
                           gust=args.gust.text(), models=tuple(models),
                           duration_s=args.duration, gust_start_s=args.gust_start,
                           dt_s=args.dt, mass_basis=args.mass_basis, extra=extra)
@@ -299,6 +304,7 @@ def run(args: argparse.Namespace) -> int:
     check_plot_path(plot, args.force)
     log = None
     start_live(args, "gust")  # before log_path creates the file: a refusal leaves none
+    check_distinct_outputs(("--out", args.out), ("--plot", plot))
     args.out = log_path(args, "gust", args.wing)
     if args.out:
         log = live_opener(args, open_log)(args.out, run_description(args, "gust", args.models),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from bioflex_jsb.cli.common import UsageError, print_json
+from bioflex_jsb.cli.common import UsageError, check_new_file, print_json
 
 HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels
 (topic, schema, message count), the number of messages and chunks, the time span [s of
@@ -31,6 +31,8 @@ def register(sub) -> None:
     p.add_argument("file", metavar="FILE.mcap", help="the log")
     p.add_argument("--recover", metavar="FIXED.mcap",
                    help="write the complete records of a truncated FILE.mcap to FIXED.mcap")
+    p.add_argument("--force", action="store_true",
+                   help="replace an existing --recover file")
     p.add_argument("--check", action="store_true",
                    help="verify every chunk's checksum or CRC, the data section's and the "
                         "summary's CRCs and that the file is finished (exit 1 if not)")
@@ -43,8 +45,12 @@ def run(args: argparse.Namespace) -> int:
 
     from bioflex_jsb.sinks.mcap import LogError, LogWriteError, check_chunks, recover, summarise
 
-    if args.check and args.recover:
+    if args.check and args.recover is not None:
         raise UsageError("--check and --recover are separate jobs; give one")
+    if args.force and args.recover is None:
+        raise UsageError("--force replaces an existing --recover file; give --recover")
+    if args.recover is not None:  # a user's file is never replaced without --force
+        check_new_file(args.recover, args.force, "--recover", (".mcap",))
     try:
         if args.recover:
             result = recover(args.file, args.recover)

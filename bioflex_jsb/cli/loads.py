@@ -27,9 +27,14 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.sweep import positive_int, scheduler_address
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S
 
 _PLAIN = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
 DEFAULT_GUST = "1cos:3:5"  # the paper's 3 m/s, 2.5 m gradient (between the tuned ends)
+# the options of each study and their defaults (None in the parser: given or not is known)
+TUNED_OPTIONS = {"gradients": None, "amplitude": 3.0, "scaling": "cs25", "csv": None}
+FREQUENCY_OPTIONS = {"sigmas": (0.1, 3.0), "scale": 30.0, "spectrum": "vonkarman",
+                     "record": 120.0, "bode": None}
 
 HELP = f"""Fly one gust (--gust, default {DEFAULT_GUST}) with the elastic wing (--model,
 default coupled) and report the wing's section loads at the monitoring stations (--stations,
@@ -146,7 +151,8 @@ def register(sub) -> None:
     p.add_argument("--gust", default=DEFAULT_GUST,
                    help=f"gust specification (default {DEFAULT_GUST}; forms as in `gust`)")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=3.0,
-                   help="simulated time [s] of a single run (default 3)")
+                   help="simulated time [s] of a single run (default 3; up to "
+                   f"{KEEP_ALL_MAX_S:g} s: the loads need every step kept)")
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
                    help="time the gust starts [s] (default 0.5)")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
@@ -164,23 +170,24 @@ def register(sub) -> None:
     p.add_argument("--tuned", action="store_true", help="the tuned discrete gust (above)")
     p.add_argument("--frequency", action="store_true",
                    help="continuous turbulence in the frequency domain (above)")
-    p.add_argument("--sigmas", type=sigma_list, default=(0.1, 3.0),
+    p.add_argument("--sigmas", type=sigma_list, default=None,
                    help="--frequency: turbulence intensities sigma_w [m/s] (default 0.1,3)")
-    p.add_argument("--scale", type=positive_float("turbulence scale", "m"), default=30.0,
+    p.add_argument("--scale", type=positive_float("turbulence scale", "m"), default=None,
                    help="--frequency: turbulence length scale L_w [m] (default 30: "
                    "MIL-F-8785C's L_w = h at 30 m above ground)")
-    p.add_argument("--spectrum", choices=("vonkarman", "dryden"), default="vonkarman",
+    p.add_argument("--spectrum", choices=("vonkarman", "dryden"), default=None,
                    help="--frequency: turbulence spectrum (default vonkarman)")
-    p.add_argument("--record", type=positive_float("record", "s"), default=120.0,
+    p.add_argument("--record", type=positive_float("record", "s"), default=None,
                    help="--frequency: length of each nonlinear run [s] (default 120; at "
-                   "least 2 Welch segments of 8 s)")
+                   "least 2 Welch segments of 8 s, at most "
+                   f"{KEEP_ALL_MAX_S:g} s: the loads need every step kept)")
     p.add_argument("--bode", metavar="FILE.png", default=None,
                    help="--frequency: Bode plots (default loads_bode.png without --json)")
     p.add_argument("--gradients", type=gradients, default=None,
                    help="--tuned gradients H [m]: MIN:MAX:N (log-spaced) or H1,H2,...")
-    p.add_argument("--amplitude", type=positive_float("amplitude", "m/s"), default=3.0,
+    p.add_argument("--amplitude", type=positive_float("amplitude", "m/s"), default=None,
                    help="--tuned reference gust velocity U_ref [m/s] (default 3)")
-    p.add_argument("--scaling", choices=("cs25", "fixed"), default="cs25",
+    p.add_argument("--scaling", choices=("cs25", "fixed"), default=None,
                    help="--tuned amplitude: cs25 U_ref (H/H_max)^(1/6) (default) or fixed")
     p.add_argument("--csv", metavar="FILE.csv", default=None,
                    help="--tuned: the critical-case table as CSV")
@@ -244,6 +251,16 @@ def run(args: argparse.Namespace) -> int:
     for opt in ("workers", "scheduler"):
         if getattr(args, opt) is not None and not args.tuned:
             raise UsageError(f"--{opt} applies to --tuned (its gusts run in parallel)")
+    for study, options in (("tuned", TUNED_OPTIONS), ("frequency", FREQUENCY_OPTIONS)):
+        for opt, default in options.items():  # never silently ignored
+            if getattr(args, opt) is not None and not getattr(args, study):
+                raise UsageError(f"--{opt} applies to --{study}")
+            if getattr(args, opt) is None:
+                setattr(args, opt, default)
+    longest = args.record if args.frequency else args.duration
+    if not args.tuned and longest > KEEP_ALL_MAX_S:
+        raise UsageError(f"--{'record' if args.frequency else 'duration'} {longest:g} s: the "
+                         f"section loads need every step kept, up to {KEEP_ALL_MAX_S:g} s")
     if args.scheduler and args.scheduler != "local" and args.workers is not None:
         raise UsageError("--workers applies to local processes and --scheduler local; a "
                          "cluster's workers are started with it (dask worker)")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
@@ -21,7 +20,8 @@ from bioflex_jsb.cli.case import (
 from bioflex_jsb.cli.common import (
     UsageError,
     add_wing_arguments,
-    check_output,
+    check_distinct_outputs,
+    check_new_file,
     models_list,
     print_json,
     wing_from_args,
@@ -93,7 +93,7 @@ def register(sub) -> None:
 
 def _check_shape_outputs(args, speeds) -> None:
     """--animate and --mode-sheet: one --speed, the quasi-steady model, files we may write."""
-    if not (args.animate or args.mode_sheet):
+    if args.animate is None and args.mode_sheet is None:
         return
     if len(speeds) != 1:
         raise UsageError(f"--animate and --mode-sheet show the modes at one --speed; "
@@ -102,13 +102,10 @@ def _check_shape_outputs(args, speeds) -> None:
         raise UsageError("--animate and --mode-sheet show the quasi-steady coupled model's "
                          "modes; drop --aero unsteady")
     check_plot_path(args.mode_sheet, args.force)
-    if args.animate:
-        check_output(args.animate, args.force, "animation file")
-        if Path(args.animate).suffix.lower() != ".mcap":
-            raise UsageError(f"animation file {args.animate!r}: give a name ending in .mcap")
-        if not Path(args.animate).parent.is_dir():
-            raise UsageError(f"animation file {args.animate!r}: the directory "
-                             f"{str(Path(args.animate).parent)!r} does not exist")
+    if args.animate is not None:
+        check_new_file(args.animate, args.force, "animation file", (".mcap",))
+    check_distinct_outputs(("--plot", args.plot), ("--mode-sheet", args.mode_sheet),
+                           ("--animate", args.animate))
 
 
 def run(args: argparse.Namespace) -> int:

@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from bioflex_jsb.cli.common import UsageError, check_file_name, number_type, print_json
+from bioflex_jsb.cli.common import UsageError, check_new_file, number_type, print_json
 
 HELP = """Repeat the gust run, sweep case or comparison recorded in FILE.mcap from its metadata
 record bioflex.run (wing, mass basis, speed, gust and seed, duration, gust start, time step,
@@ -121,15 +121,30 @@ def compare_logs(old: str, new: str, rtol: float) -> dict:
         raise UsageError(str(exc)) from None
 
 
+def _check_intact(path: str) -> None:
+    """The original log's chunks and CRCs all check (``info --check``), else one line."""
+    from bioflex_jsb.sinks.mcap import LogError, check_chunks
+
+    try:
+        result = check_chunks(path)
+    except LogError as exc:
+        raise UsageError(str(exc)) from None
+    if result["problems"]:
+        raise UsageError(f"{path!r} is damaged ({'; '.join(result['problems'][:2])}): a run "
+                         "is repeated from an intact log; `bioflex-jsb info FILE --recover "
+                         "FIXED.mcap` copies its intact chunks")
+
+
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from bioflex_jsb import cli
 
-    check_file_name(args.out, "--out")
-    argv = argv_from_log(args.file)  # also checks that the file is a finished log
     if Path(args.out).resolve() == Path(args.file).resolve():
         raise UsageError("--out must name a new file, not the original log")
+    check_new_file(args.out, False, "--out", (".mcap",))  # before flying, not after
+    argv = argv_from_log(args.file)  # also checks that the file is a finished log
+    _check_intact(args.file)  # every byte, before a run of hours is flown to compare with it
     import contextlib
     import io
 
@@ -138,8 +153,7 @@ def run(args: argparse.Namespace) -> int:
     with contextlib.redirect_stdout(captured):
         status = cli.main(full)
     if status not in (0, 3):  # 3: the run diverged, as the original may have
-        raise UsageError(f"the repeated run failed (exit status {status}): "
-                         f"bioflex-jsb {' '.join(full)}")
+        return status  # the repeated run said why, in its one line
     result = compare_logs(args.file, args.out, args.rtol)
     result.update(command=["bioflex-jsb", *full], original=args.file, rerun=args.out)
     if args.json:

@@ -175,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
                    **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
         try:
             log = SplitLog(args.out, description, build, args.log_max_mb,
-                           live_opener(args, open_log))
+                           live_opener(args, open_log), replace=args.force)
         except UsageError:
             link.close()
             raise
@@ -303,11 +303,13 @@ class SplitLog:
     starts the new file after that sample and the step's events: the reset's event is the
     last record of the file that ends and the first of the new one."""
 
-    def __init__(self, path: str, description, build, max_mb: float, open_log) -> None:
+    def __init__(self, path: str, description, build, max_mb: float, open_log,
+                 replace: bool = False) -> None:
         import dataclasses
         from pathlib import Path
 
         self._base = Path(path)
+        self._replace_files = replace  # --force: a later file may replace an existing one
         self._description, self._build, self._open = description, build, open_log
         self._replace = dataclasses.replace
         self.max_bytes = int(max_mb * 1e6)
@@ -320,8 +322,7 @@ class SplitLog:
 
     def _next(self, reason: str | None):
         n = len(self.paths)
-        path = self._base if n == 0 else self._base.with_name(
-            f"{self._base.stem}-{n:03d}{self._base.suffix}")
+        path = self._base if n == 0 else self._free_name(n)
         d = self._description
         if n:
             extra = dict(d.extra, segment=n, **({"after_reset": reason} if reason else {}))
@@ -329,6 +330,25 @@ class SplitLog:
         log = self._open(str(path), d, self._build)
         self.paths.append(str(path))
         return log
+
+    def _free_name(self, n: int):
+        """The name of the file after ``n`` others: ``<stem>-NNN<suffix>`` with the first
+        number from ``n`` whose file does not exist, created here (``O_EXCL``: a user's
+        file of that name is never replaced, without ``--force``, nor one another process
+        made meanwhile); with ``--force`` the ``n``-th name, replaced."""
+        import os
+
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+        for k in range(n, n + 10_000):
+            path = self._base.with_name(f"{self._base.stem}-{k:03d}{self._base.suffix}")
+            if self._replace_files:
+                return path
+            try:
+                os.close(os.open(path, flags, 0o644))
+            except FileExistsError:
+                continue
+            return path
+        raise UsageError(f"no free name for the log after {str(self._base)!r}: 10000 taken")
 
     def attach(self, sim):
         """Log the session of ``sim``: its resets and its vehicle's STATUSTEXT; returns the

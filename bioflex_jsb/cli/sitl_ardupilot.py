@@ -12,6 +12,8 @@ from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
     add_wing_arguments,
+    check_distinct_outputs,
+    check_new_file,
     closing,
     finite_float,
     log_path,
@@ -128,8 +130,14 @@ def _build(args: argparse.Namespace):
         raise UsageError(f"--gust-at must be >= 0 s, got {args.gust_at:g}")
     if args.record_every < 0:
         raise UsageError(f"--record-every must be >= 0, got {args.record_every}")
-    if args.table is not None and not args.table.endswith(".npz"):
-        raise UsageError(f"--table must name a .npz file, got {args.table!r}")
+    # the session's outputs checked before it starts (a session of hours must not find at
+    # its end that a file cannot be written, nor replace a user's file)
+    if args.table is not None:
+        check_new_file(args.table, args.force, "--table", (".npz",))
+    if args.summary is not None:
+        check_new_file(args.summary, args.force, "--summary", (".json",))
+    check_distinct_outputs(("--out", args.out), ("--table", args.table),
+                           ("--summary", args.summary))
     if args.aero == "unsteady" and args.model != "coupled":
         raise UsageError(f"--aero unsteady is for --model coupled, not {args.model} (the "
                          "rigid, qsd and native wings are quasi-steady)")

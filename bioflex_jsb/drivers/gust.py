@@ -34,7 +34,7 @@ from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
-from bioflex_jsb.simulation.results import TimeHistory
+from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
 
 
 @dataclass(frozen=True)
@@ -50,10 +50,6 @@ class RunSetup:
     dt_s: float = DEFAULT_DT_S
 
 
-# A run keeps every step (keep="all") up to this duration by default [s] (≈ 0.24 MB per
-# simulated second of table, and as much again for the returned history); longer runs keep
-# an envelope (keep="envelope").
-KEEP_ALL_MAX_S = 120.0
 # The envelope: per this span of simulated time [s], the first and last step and the steps
 # where each summary channel reaches its minimum and maximum.
 ENVELOPE_S = 0.25

@@ -22,6 +22,10 @@ SETTLING_BAND = 0.05  # settled: |Δα| stays within 5 % of its peak (a common 5
 # 15 m/s: Table 3) and cannot absorb a short period that is still ringing.
 SLOW_FIT_FRACTION = 0.5
 SLOW_FIT_MIN_RECORD_S = 2.0
+# A gust run keeps every step (keep="all") up to this duration by default [s] (≈ 0.24 MB
+# per simulated second of table, and as much again for the returned history); longer runs
+# keep an envelope (keep="envelope": drivers/gust.py), which section loads cannot use.
+KEEP_ALL_MAX_S = 120.0
 TURBULENCE_KINDS = ("dryden", "vonkarman")  # continuous gusts: no single peak to settle from
 
 # How a run left its valid range (the stop messages of simulation/limits.py), as a name.
