@@ -128,6 +128,9 @@ def test_ranges_and_axis_positions():
      "run.dt"),
     ("[axes]\nwings=['original']\nspeeds_m_s=[15]", "axes.gusts"),
     ("[axes\nwings=['original']", "not valid TOML"),
+    # num = 1e8 built the list before any check: the command hung (the review, 2026-12-03)
+    ("[axes]\nwings=['original']\nspeeds_m_s={start=10.0, stop=40.0, num=100000000}\n"
+     "gusts=['sharp:3']", "axes.speeds_m_s: 100000000 values is too many"),
 ])
 def test_bad_campaign_exits_2_with_one_line_naming_the_key(tmp_path, monkeypatch, capsys,
                                                            text, key):
@@ -233,6 +236,25 @@ def test_resume_runs_only_the_missing_cases(small, tmp_path, monkeypatch, capsys
         assert [p.name for p in out.iterdir() if not p.name.startswith(".")] == [
             "results.parquet"]  # merged: one visible file
         assert not list(out.rglob("part-*.parquet"))
+
+
+def test_resume_refuses_another_campaigns_table(small, tmp_path, monkeypatch, capsys):
+    """``--resume`` onto a table whose rows are not this campaign's cases (another campaign,
+    or this one with other settings) is refused in one line and the table left as it was;
+    it merged them silently (the review, 2026-12-03)."""
+    out = tmp_path / "r.csv"
+    campaign = load_campaign(small)
+    store = open_store(out, campaign.columns(), resume=False)
+    with LocalExecutor(1) as ex:
+        run_sweep(campaign.cases()[:1], store, ex)
+    store.close()
+    before = out.read_bytes()
+    other = tmp_path / "other.toml"
+    other.write_text(SMALL.replace("duration_s = 1.0", "duration_s = 1.5"))
+    assert sweep([other, "--out", out, "--resume"], monkeypatch) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "1 of its 1 cases are not cases of campaign" in err[0], err
+    assert out.read_bytes() == before
 
 
 def test_csv_row_cut_off_by_a_kill_is_dropped_on_resume(small, tmp_path):

@@ -147,6 +147,14 @@ def _run_locked(args, campaign, out: Path) -> int:
         print(f"bioflex-jsb sweep: {len(store.damaged)} damaged part(s) of {out} set aside "
               f"as {', '.join(store.damaged[:3])}{' …' if len(store.damaged) > 3 else ''}; "
               "their cases run again", file=sys.stderr)
+    if store.done_ids:  # a table of another campaign (or other settings) is not merged into
+        ours = {c.case_id for c in campaign.iter_cases()}
+        foreign = len(store.done_ids - ours)
+        if foreign:
+            store.close()
+            raise UsageError(f"--resume {str(out)!r}: {foreign} of its {len(store.done_ids)} "
+                             f"cases are not cases of campaign {campaign.name!r} (another "
+                             "campaign, or its settings or axes changed); give another --out")
     done = store.done_ids - store.failed_ids if args.retry_failed else store.done_ids
     todo = MissingCases(campaign.iter_cases(), done)
     total = campaign.n_cases

@@ -435,19 +435,16 @@ def _values(v: Any, key: str, integer: bool = False) -> list:
             num = v["num"]
             if isinstance(num, bool) or not isinstance(num, int) or num < 1:
                 raise CampaignError(f"{key}.num: must be a whole number ≥ 1, got {num!r}")
-            if num == 1:
-                values = [start]
-            else:
-                values = [start + (stop - start) * k / (num - 1) for k in range(num)]
+            n, step = num, (stop - start) / max(num - 1, 1)
         else:
             step = v.get("step", 1 if integer else None)
             if step is None:
                 raise CampaignError(f"{key}: a range needs step or num")
             step = _number(step, f"{key}.step", "the axis unit", positive=True)
             n = int(math.floor((stop - start) / step + 1e-9)) + 1
-            if n > MAX_CASES:
-                raise CampaignError(f"{key}: {n} values is too many (step too small)")
-            values = [start + k * step for k in range(n)]
+        if n > MAX_CASES:  # before the list is made (num = 1e8 hung the command)
+            raise CampaignError(f"{key}: {n} values is too many; accepted: up to {MAX_CASES}")
+        values = [start + k * step for k in range(n)]
         values = [round(x, 12) for x in values]
         if integer:
             if not all(float(x).is_integer() for x in values):
