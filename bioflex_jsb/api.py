@@ -37,7 +37,12 @@ from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
 from bioflex_jsb.definition.clamped import free_speed_range_m_s as _free_speed_range_m_s
 from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
 from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
-from bioflex_jsb.drivers.compare import Comparison, check_comparable, compare_run
+from bioflex_jsb.drivers.compare import (
+    Comparison,
+    check_comparable,
+    check_gust_excites,
+    compare_run,
+)
 from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.eigen import FlutterResult, ModeSet, find_flutter, modes_at
@@ -250,6 +255,7 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
+    check_gust_excites(parse_gust(gust))
     runs, airframe, build, speed = _fly_gust(
         wing, speed_m_s, gust, (model,), duration_s, gust_start_s, 0.0, DEFAULT_DT_S,
         {model: recorder} if recorder is not None else None, aero, trim)

@@ -292,6 +292,12 @@ def test_aircraft_option_errors_are_one_line(tmp_path, capsys):
     code, _, err = run_cli(capsys, "gust", "--no-log", "--wing", "elastic-backward",
                            "--aircraft", "bioflex_original")
     assert_one_line_error(code, err, "give one of them")
+    # the command's default wing given explicitly, and either order: refused too (modes'
+    # default is optimised; both were used silently as the aircraft's wing)
+    for argv in (["--wing", "optimised", "--aircraft", "bioflex_original"],
+                 ["--aircraft", "bioflex_original", "--wing", "optimised"]):
+        code, _, err = run_cli(capsys, "modes", *argv)
+        assert_one_line_error(code, err, "give one of them")
 
 
 def test_api_takes_the_aircraft_and_load_wing_is_its_shorthand():

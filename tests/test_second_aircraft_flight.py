@@ -92,8 +92,9 @@ def test_the_nonlinear_glide_against_the_lti_model(sgs):
     """``compare`` at the glide trim (A_RR JSBSim's by central differences, the calm-air
     drift added to the prediction: drivers/compare.py). A 0.05 m/s 1-cos gust over 25 m:
     NRMSE α 0.0070, q 0.0094, θ 0.0042, η1 0.0196, u 0.078 (measured 2026-12-03); bars
-    about 2.5 × those: the trim's α 1.96° sits 0.04° below the 2° point of SGS.xml's CLwbh table, whose
-    slope falls there from 4.60 to 4.0 /rad, so the linear model is exact only below it.
+    about 2.5 × those: the trim's α 1.96° sits 0.04° below the 2° point of SGS.xml's CLwbh
+    table, whose slope falls there from 4.60 to 4.0 /rad, so the linear model is exact only
+    below it.
     A 0.5 m/s gust crosses that point: α 0.044, q 0.17 (the tables', not the wing's, limit)."""
     result = api.compare(sgs, gust="1cos:0.05:25", model="coupled", duration_s=8.0)
     assert not result.diverged and result.linear.meta["drift"]

@@ -52,6 +52,18 @@ class _ShippedOrFile(tuple):
         return isinstance(value, str)
 
 
+class WingAction(argparse._StoreAction):
+    """``--wing``: remembers that it was given (``wing_given``), and refuses an
+    ``--aircraft`` given before it (the other order: :class:`_AircraftAction`)."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        if getattr(namespace, "aircraft_definition", None) is not None:
+            parser.error(f"--aircraft {namespace.aircraft} and --wing {values}: give one of "
+                         "them (the aircraft's definition holds its wing)")
+        setattr(namespace, self.dest, values)
+        namespace.wing_given = True
+
+
 class _AircraftAction(argparse._StoreAction):
     """Reads the definition when the option is parsed (module docstring); a store action,
     so that the shared parser refuses it given twice like every single-valued option."""
@@ -66,10 +78,9 @@ class _AircraftAction(argparse._StoreAction):
         from bioflex_jsb.errors import InputError
         from bioflex_jsb.flight_dynamics.wing_model import VARIANTS
 
-        given = getattr(namespace, "wing", None)
-        if given not in (None, self.wing_default):
-            parser.error(f"--aircraft {values} and --wing {given}: give one of them (the "
-                         "aircraft's definition holds its wing)")
+        if getattr(namespace, "wing_given", False):  # --wing given, even its default
+            parser.error(f"--aircraft {values} and --wing {namespace.wing}: give one of them "
+                         "(the aircraft's definition holds its wing)")
         try:
             aircraft = load_aircraft(values)
             # the linear analyses take any airframe; the flight commands the prototype's

@@ -107,6 +107,16 @@ class Comparison:
                                        nrmse=None if self.diverged else self.nrmse)
 
 
+def check_gust_excites(gust) -> None:
+    """Raise InputError (one line) for a ``gust`` (a parsed
+    :class:`~bioflex_jsb.simulation.gusts.GustSpec`) that excites nothing: a comparison's
+    errors are normalised by the response to the gust, so without one they read 1.0 on
+    every channel (the trim's 1e-6 drift against itself)."""
+    if gust.kind == "none" or gust.amplitude_m_s == 0.0:
+        raise InputError(f"{gust.text()}: a comparison needs a gust that excites the "
+                         "aircraft (its errors are relative to the response to it)")
+
+
 def check_comparable(model: str, aero: str, trim: str) -> None:
     """Raise InputError (one line) for a model, aerodynamics and trim with no linear model."""
     if trim == "elastic" and (aero == "unsteady" or model == "rigid"):
