@@ -145,6 +145,54 @@ def test_recover_resyncs_after_a_damaged_record_length(log2s, tmp_path, capsys):
     _doctor_ok(fixed)
 
 
+def test_recover_of_a_finished_log_reads_its_summary(log2s, tmp_path, capsys):
+    """A damaged Header length (the review of 2026-12-03: the scan jumped past the schemas
+    and the first chunk; the recovered file had every channel without its schema, and
+    ``info --check`` passed it): with the summary intact, the schemas, channels and metadata
+    come from it and each chunk is read where its index says. Every message comes back,
+    decodable."""
+    contents = _chunk_messages(log2s)
+    data = bytearray(log2s.read_bytes())
+    data[10] ^= 0x55  # the Header record's length
+    damaged = tmp_path / "header.mcap"
+    damaged.write_bytes(bytes(data))
+    fixed = tmp_path / "fixed.mcap"
+    assert cli.main(["info", str(damaged), "--recover", str(fixed), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["messages"] == _count(contents) and report["skipped"] == []
+    from mcap.reader import make_reader
+
+    with open(log2s, "rb") as a, open(fixed, "rb") as b:
+        old, new = make_reader(a), make_reader(b)
+        assert {s.name for s in new.get_summary().schemas.values()} == \
+            {s.name for s in old.get_summary().schemas.values()}
+        assert all(c.schema_id in new.get_summary().schemas
+                   for c in new.get_summary().channels.values())
+        assert sorted(m.name for m in new.iter_metadata()) == \
+            sorted(m.name for m in old.iter_metadata())
+    _doctor_ok(fixed)
+
+
+def test_a_channel_whose_schema_is_lost_is_not_copied_without_it():
+    """In a scan (no summary), a channel record whose schema record was lost: its messages
+    are counted lost, not written on a channel without a schema."""
+    import io
+    import struct
+
+    from bioflex_jsb.sinks.mcap.recover import _Copier
+    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+
+    copier = _Copier(McapFileWriter(io.BytesIO(), library="test"))
+
+    def string(text: str) -> bytes:
+        return struct.pack("<I", len(text)) + text.encode()
+
+    channel = struct.pack("<HH", 1, 7) + string("/t") + string("protobuf") + struct.pack("<I", 0)
+    copier.record(4, channel)  # schema 7 was never seen
+    copier.record(5, struct.pack("<HIQQ", 1, 0, 10, 10) + b"\x08\x01")
+    assert copier.channels == {1: None} and copier.lost == {1: 1} and copier.messages == 0
+
+
 def test_a_truncated_log_recovers_every_complete_chunk(log2s, tmp_path, capsys):
     chunks = _chunks(log2s)
     contents = _chunk_messages(log2s)

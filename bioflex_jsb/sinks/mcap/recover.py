@@ -10,6 +10,11 @@ says) and its records fit. Both read the file sequentially, record by record
 compression or records do not check is *skipped* and the scan goes on with the next
 record (or, where the damage hit a record's length, with the next place that holds a
 whole, valid chunk), so every intact chunk after a damaged one is kept.
+A finished file whose summary is intact (its CRC checks) is recovered from it instead: its
+schemas, channels and the metadata records its index points at first, then each chunk read
+where its Chunk Index says (a damaged record length before them cannot make the scan skip
+schemas or intact chunks). In a scan, a channel whose schema record is lost is not copied
+(its messages would be undecodable) and its messages are reported skipped.
 The recovered file is written by our own :class:`~.writer.McapFileWriter`: finished and
 indexed like any log (the tests run ``pymcap-cli doctor`` on it).
 """
@@ -173,7 +178,8 @@ class _Copier:
     def __init__(self, writer: McapFileWriter) -> None:
         self.w = writer
         self.schemas: dict[int, int] = {0: 0}
-        self.channels: dict[int, int] = {}
+        self.channels: dict[int, int | None] = {}  # None: its schema is lost, not copied
+        self.lost: dict[int, int] = {}  # messages not copied, per channel whose schema is lost
         self.messages = 0
         self.last_ns: int | None = None
 
@@ -191,8 +197,11 @@ class _Copier:
             encoding, at = _string(b, at)
             meta, _ = _string_map(b, at)
             if cid not in self.channels:
-                self.channels[cid] = self.w.add_channel(topic, self.schemas.get(sid, 0), meta,
-                                                        encoding)
+                # a channel whose schema record is lost would be written without one (its
+                # protobuf messages undecodable): not copied, its messages counted lost
+                self.channels[cid] = (None if sid not in self.schemas else
+                                      self.w.add_channel(topic, self.schemas[sid], meta,
+                                                         encoding))
         elif op == _OP_METADATA:
             name, at = _string(b, 0)
             meta, _ = _string_map(b, at)
@@ -201,7 +210,11 @@ class _Copier:
             cid, seq, log_ns, _pub = struct.unpack_from("<HIQQ", b, 0)
             if cid not in self.channels:
                 raise ValueError(f"message on channel {cid} before its channel record")
-            self.w.append(self.channels[cid], log_ns, seq, bytes(b[22:]))
+            out = self.channels[cid]
+            if out is None:
+                self.lost[cid] = self.lost.get(cid, 0) + 1
+                return
+            self.w.append(out, log_ns, seq, bytes(b[22:]))
             self.messages += 1
             self.last_ns = log_ns if self.last_ns is None else max(self.last_ns, log_ns)
 
@@ -230,7 +243,13 @@ def recover(path: str | Path, out: str | Path) -> dict:
         copier = _Copier(writer)
         skipped: list[str] = []
         stop, chunks = "end of file", 0
-        for offset, op, body in scan(data):
+        # an intact summary (its CRC checks) gives the schemas, channels and metadata first:
+        # a damaged record before the first chunk (the header's length) loses them otherwise
+        taken, chunk_offsets = _from_summary(data, copier)
+        # with it, the chunks are read where its chunk index says they are (a damaged record
+        # length cannot make the scan skip an intact chunk); without it, the file is scanned
+        records = scan(data) if chunk_offsets is None else _indexed_chunks(data, chunk_offsets)
+        for offset, op, body in records:
             if isinstance(body, BaseException):
                 if op == _OP_CHUNK:
                     skipped.append(f"chunk at byte {offset} ({body})")
@@ -251,12 +270,14 @@ def recover(path: str | Path, out: str | Path) -> dict:
                     continue
                 writer.close_chunk()  # one chunk out per chunk in
                 chunks += 1
-            elif op != _OP_HEADER:
+            elif op != _OP_HEADER and not (op == _OP_METADATA and offset in taken):
                 try:
                     copier.record(op, body)
                 except (ValueError, struct.error, UnicodeDecodeError) as exc:
                     skipped.append(f"record at byte {offset} ({exc})")
         writer.finish()
+    skipped += [f"{n} messages of channel {cid} (its schema record is lost)"
+                for cid, n in copier.lost.items()]
     last = copier.last_ns
     return {"file": str(p), "out": str(dst), "messages": copier.messages,
             "channels": len(copier.channels), "chunks": chunks,
@@ -265,6 +286,67 @@ def recover(path: str | Path, out: str | Path) -> dict:
 
 
 _FOOTER_BYTES = 9 + 20  # opcode, length, summary start, summary offset start, summary CRC
+_OP_CHUNK_INDEX, _OP_METADATA_INDEX = 0x08, 0x0D
+
+
+def _summary_span(data) -> tuple[int, int] | None:
+    """(start, end) of the summary's records when the file has a footer whose summary CRC
+    checks, else None."""
+    footer = len(data) - len(MAGIC) - _FOOTER_BYTES
+    if footer <= len(MAGIC) or data[footer] != _OP_FOOTER:
+        return None
+    length, start, offsets, crc = struct.unpack_from("<QQQI", data, footer + 1)
+    if length != 20 or not len(MAGIC) < start <= footer:
+        return None
+    if zlib.crc32(data[start:footer + _FOOTER_BYTES - 4]) != crc:
+        return None
+    return start, (offsets if start <= offsets <= footer else footer)
+
+
+def _from_summary(data, copier: _Copier) -> tuple[set[int], list[int] | None]:
+    """The schemas and channels of an intact summary into ``copier``, and the metadata
+    records its Metadata Index points at; returns those records' offsets (the scan then
+    skips them) and the chunks' offsets of its Chunk Index (None when the summary is absent
+    or damaged: then nothing is taken from it)."""
+    span = _summary_span(data)
+    taken: set[int] = set()
+    if span is None:
+        return taken, None
+    chunks: list[int] = []
+    pos, end = span
+    while pos + 9 <= end:
+        op, length = data[pos], struct.unpack_from("<Q", data, pos + 1)[0]
+        body = memoryview(data)[pos + 9:pos + 9 + length]
+        if op in (_OP_SCHEMA, _OP_CHANNEL):
+            copier.record(op, body)
+        elif op == _OP_METADATA_INDEX:
+            at, size = struct.unpack_from("<QQ", body, 0)
+            if data[at] == _OP_METADATA and at + size <= len(data):
+                copier.record(_OP_METADATA, memoryview(data)[at + 9:at + size])
+                taken.add(at)
+        elif op == _OP_CHUNK_INDEX:
+            chunks.append(struct.unpack_from("<Q", body, 16)[0])  # chunk_start_offset
+        pos += 9 + length
+    return taken, sorted(chunks)
+
+
+def _indexed_chunks(data, offsets: list[int]) -> Iterator[tuple[int, int, object]]:
+    """(offset, opcode, body or the error) of the chunks at ``offsets`` (a Chunk Index's),
+    as :func:`scan` yields them, then the end of the data section."""
+    view = memoryview(data)
+    for at in offsets:
+        if at + 9 > len(data) or data[at] != _OP_CHUNK:
+            yield at, _OP_CHUNK, ValueError("no chunk record where the chunk index says")
+            continue
+        end = at + 9 + struct.unpack_from("<Q", data, at + 1)[0]
+        if end > len(data):
+            yield at, _OP_CHUNK, ValueError("damaged chunk length")
+            continue
+        try:
+            yield at, _OP_CHUNK, _chunk_records(view[at + 9:end])
+        except bad_data_errors() as exc:
+            yield at, _OP_CHUNK, exc
+    yield len(data), _OP_DATA_END, b""
 
 
 def check_chunks(path: str | Path) -> dict:
