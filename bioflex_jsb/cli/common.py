@@ -529,9 +529,9 @@ def check_new_file(path: str, force: bool, what: str, suffixes: tuple[str, ...] 
 
     if not path:
         raise UsageError(f"{what}: the file name is empty")
+    check_output(path, force, what, ours=ours)  # a directory, an existing file: said first
     if suffixes and Path(path).suffix.lower() not in suffixes:
         raise UsageError(f"{what} {path!r}: give a name ending in {', '.join(suffixes)}")
-    check_output(path, force, what, ours=ours)
     parent = Path(path).parent
     if not parent.is_dir():
         raise UsageError(f"{what} {path!r}: the directory {str(parent)!r} does not exist")
