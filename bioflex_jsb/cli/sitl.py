@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from bioflex_jsb.cli.case import airspeed, speed_help
 from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
@@ -60,9 +61,9 @@ def register(sub) -> None:
     add_wing_arguments(p, default="optimised")
     from bioflex_jsb.cli.aircraft_option import cruise_speed_default
 
-    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=cruise_speed_default(),
-                   help="trim airspeed [m/s] (default 15; with --aircraft: its "
-                   "cruise_speed_m_s, within its speed_range_m_s)")
+    p.add_argument("--speed", type=airspeed, default=cruise_speed_default(),
+                   help="trim " + speed_help(extra="; with --aircraft: its cruise_speed_m_s, "
+                   "within its speed_range_m_s"))
     p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
                    help="the trim the session starts from (and resets to): rigid (the paper's "
                    "reading, default) or elastic (the static aeroelastic equilibrium: the "
@@ -167,8 +168,11 @@ def run(args: argparse.Namespace) -> int:
         description = RunDescription(
             kind="sitl", wing=args.wing, speed_m_s=args.speed, gust="none",
             models=(args.model,), mass_basis=args.mass_basis,
+            altitude_m=home[2] + args.start_height,  # where it starts, above sea level (it
+            # read 0 for a session flown 684 m up at the default home)
             **({} if args.duration is None else {"duration_s": args.duration}),
             extra={"until_stopped": args.duration is None, "speedup": args.speedup,
+                   "home": list(home), "start_height_m": args.start_height,
                    "mavlink": endpoint.text(), "signed": key is not None,
                    "trim": args.trim, "aero": args.aero,
                    "preflight_stable": check["stable"], "glider": sim.glider,

@@ -8,6 +8,7 @@ import json
 import sys
 import time
 
+from bioflex_jsb.cli.case import airspeed, speed_help
 from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
@@ -76,8 +77,8 @@ def register(sub) -> None:
     add_wing_arguments(p, default="optimised")
     p.add_argument("--model", choices=("coupled", "rigid", "qsd", NATIVE), default="coupled",
                    help="wing model (default coupled; native: the exported JSBSim wing)")
-    p.add_argument("--speed", type=positive_float("speed", "m/s"), default=15.0,
-                   help="trim and launcher exit airspeed [m/s] (default 15)")
+    p.add_argument("--speed", type=airspeed, default=15.0,
+                   help="trim and launcher exit " + speed_help())
     p.add_argument("--altitude", type=finite_float("altitude", "m"), default=0.0,
                    help="launch altitude [m above sea level, ISA] (default 0)")
     p.add_argument("--launch-accel", type=positive_float("launch acceleration", "m/s^2"),
