@@ -182,8 +182,14 @@ def _round(x: float | None, digits: int) -> float | None:
 def _formatted(res, digits: int) -> dict:
     """The api result's dictionary with the speeds and frequencies rounded for printing."""
     d = res.as_dict()
-    d["flutter_speed_m_s"] = _round(res.speed_m_s, digits)
+    # unstable already at the range's lower end: no onset speed was found (null, not the
+    # lower end: a script reading the speed alone took it for a flutter speed); the lower
+    # end is unstable_at_and_below_m_s
+    onset = None if res.present_at_lower_end else res.speed_m_s
+    d["flutter_speed_m_s"] = _round(onset, digits)
     d["speed_m_s"] = d["flutter_speed_m_s"]
+    d["unstable_at_and_below_m_s"] = (_round(res.speed_m_s, digits)
+                                      if res.present_at_lower_end else None)
     d["frequency_rad_s"] = _round(res.frequency_rad_s, 2)
     d["reduced_frequency"] = _round(res.reduced_frequency, 4)
     d["divergence_speed_m_s"] = _round(res.divergence_speed_m_s, 2)
@@ -270,7 +276,7 @@ def text_report(p: dict) -> str:
     lo, hi = p["range_m_s"]
     div = p.get("divergence_speed_m_s")
     own_divergence = p.get("divergence_is_instability")
-    if p["flutter_speed_m_s"] is None:
+    if p["flutter_speed_m_s"] is None and not p["present_at_lower_end"]:
         lines.append(f"  no instability between {lo:g} and {hi:g} m/s")
     else:
         partner = f" with {p['partner_mode']}" if p.get("partner_mode") else ""
