@@ -59,6 +59,12 @@ def test_a_users_file_is_not_replaced(here, capsys, argv, name, needle):
     # the loads need every step kept: refused up front, not after the run
     (["loads", "--duration", "200"], "up to 120 s"),
     (["loads", "--frequency", "--record", "300"], "up to 120 s"),
+    # a step too fine for JSBSim's trim was reported as a motor short of thrust
+    (["gust", "--dt", "3e-5"], "outside 0.0001..0.02 s"),
+    (["loads", "--dt", "3e-5"], "outside 0.0001..0.02 s"),
+    # the SITL vehicle's and the ArduPilot backend's speed: the range every command has
+    (["sitl", "--speed", "100"], "outside 5..40 m/s"),
+    (["ardupilot", "--speed", "100"], "outside 5..40 m/s"),
 ])
 def test_outputs_and_options_refused_before_any_work(here, capsys, argv, needle):
     (here / "log.mcap").write_bytes(b"")

@@ -10,6 +10,8 @@ import sys
 
 from bioflex_jsb.cli.case import (
     DEFAULT_WING,
+    MAX_DT_S,
+    MIN_DT_S,
     add_force_argument,
     airspeed,
     check_plot_path,
@@ -156,7 +158,8 @@ def register(sub) -> None:
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
                    help="time the gust starts [s] (default 0.5)")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
-                   help=f"co-simulation step [s] (default {DEFAULT_DT_S:.6f})")
+                   help=f"co-simulation step [s], {MIN_DT_S:g} to {MAX_DT_S:g} (default "
+                   f"{DEFAULT_DT_S:.6f})")
     p.add_argument("--model", choices=("coupled", "qsd", "rigid"), default="coupled",
                    help="wing model flown (default coupled; rigid: force summation only)")
     p.add_argument("--trim", choices=("rigid", "elastic"), default="rigid",
@@ -235,6 +238,8 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
     resolve_flight(args)  # --speed: the aircraft's cruise speed, within its speeds
+    if not MIN_DT_S <= args.dt <= MAX_DT_S:
+        raise UsageError(f"--dt {args.dt:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
     build = wing_from_args(args)
     aircraft = getattr(args, "aircraft_definition", None)
     if build.airframe is not PROTOTYPE_AIRFRAME and (args.tuned or args.frequency):

@@ -52,7 +52,7 @@ from bioflex_jsb.tomlfile import read_toml
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
 MAX_CASES = 1_000_000
-MAX_DT_S = 0.02  # as the gust command: coarser co-simulation steps are refused
+MIN_DT_S, MAX_DT_S = 1e-4, 0.02  # as the gust command's (cli/case.py: why)
 
 METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
 TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
@@ -575,7 +575,8 @@ def _settings(run: Any) -> RunSettings:
     if start >= duration:
         raise CampaignError(f"run.gust_start_s: {start:g} s must be before the end of the run "
                             f"(run.duration_s {duration:g} s)")
-    dt = _number(run.get("dt_s", d.dt_s), "run.dt_s", "s", positive=True, maximum=MAX_DT_S)
+    dt = _number(run.get("dt_s", d.dt_s), "run.dt_s", "s", positive=True, minimum=MIN_DT_S,
+                 maximum=MAX_DT_S)
     basis = run.get("mass_basis", d.mass_basis)
     if basis not in MASS_BASES:
         raise CampaignError(f"run.mass_basis: unknown mass basis {basis!r}; accepted: "
