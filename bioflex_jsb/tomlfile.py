@@ -80,8 +80,13 @@ def read_input_bytes(path: str | Path, what: str, error: type[Exception],
 
 def read_input_text(path: str | Path, what: str, error: type[Exception],
                     limit: int = MAX_TOML_BYTES) -> str:
-    """:func:`read_input_bytes` decoded as UTF-8 (a BOM is refused by TOML, not here)."""
+    """:func:`read_input_bytes` decoded as UTF-8; a leading byte-order mark is refused in
+    a line that says so (TOML does not allow one; tomllib said "Invalid statement (at line
+    1, column 1)")."""
     data = read_input_bytes(path, what, error, limit)
+    if data.startswith(b"\xef\xbb\xbf"):
+        raise error(f"cannot read {what} {str(path)!r}: it starts with a UTF-8 byte-order "
+                    "mark, which TOML does not allow; save it as UTF-8 without a BOM")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

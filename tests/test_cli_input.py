@@ -601,3 +601,24 @@ def test_an_edited_modes_file_is_read_again_in_the_same_process(tmp_path):
     second = build_wing(load_variant_file(wing)).model.frequencies_rad_s[0]
     assert first == pytest.approx(2 * math.pi * 30.8976, rel=1e-5)
     assert second == pytest.approx(2 * math.pi * 25.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("argv, needle", [
+    # argparse took these for options: "expected one argument", nothing about the range
+    (["trim", "--speed", "-inf"], "outside 5..40 m/s"),
+    (["trim", "--speed", "-nan"], "outside 5..40 m/s"),
+    (["flutter", "--range", "-5:40"], "0 < LOW < HIGH"),
+])
+def test_negative_non_finite_values_and_ranges_get_their_options_message(capsys, argv,
+                                                                         needle):
+    code, _, err = run_cli(capsys, *argv)
+    assert_one_line_error(code, err, needle)
+
+
+def test_a_toml_file_with_a_byte_order_mark_is_refused_saying_so(capsys, tmp_path):
+    """Windows editors write one; tomllib said only 'Invalid statement (at line 1, column
+    1)'."""
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbfx_elastic_frac = 0.3\n")
+    code, _, err = run_cli(capsys, "modes", "--wing", str(bom))
+    assert_one_line_error(code, err, "byte-order mark")

@@ -211,8 +211,12 @@ class OneLineParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._given: dict[int, str] = {}
         # a value that starts with "-" is a negative number, not an option, when it is a
-        # plain number (argparse's own rule misses "-20." and "-1e3")
-        self._negative_number_matcher = re.compile(r"\A-" + _UNSIGNED_PLAIN + r"\Z")
+        # plain number (argparse's own rule misses "-20." and "-1e3"), a non-finite one
+        # ("-inf": the option's own check then names the range) or a LOW:HIGH range
+        # ("-5:40"); argparse said "expected one argument" for those
+        self._negative_number_matcher = re.compile(
+            r"\A-(?:" + _UNSIGNED_PLAIN + r"(?::[-+]?" + _UNSIGNED_PLAIN + r")?"
+            r"|inf|infinity|nan)\Z", re.IGNORECASE)
 
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USAGE, f"{self.prog}: error: {' '.join(message.split())} (see --help)\n")
