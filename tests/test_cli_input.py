@@ -622,3 +622,21 @@ def test_a_toml_file_with_a_byte_order_mark_is_refused_saying_so(capsys, tmp_pat
     bom.write_bytes(b"\xef\xbb\xbfx_elastic_frac = 0.3\n")
     code, _, err = run_cli(capsys, "modes", "--wing", str(bom))
     assert_one_line_error(code, err, "byte-order mark")
+
+
+def test_help_ranges_are_the_checks_ranges(capsys):
+    """The ranges the help states (written out: the CLI's help is built without importing
+    JSBSim) are the ones the code checks."""
+    from bioflex_jsb.drivers.sitl import START_HEIGHT_RANGE_M
+    from bioflex_jsb.runtime.fdm import ALTITUDE_RANGE_M
+
+    def flat(command):
+        code, out, _ = run_cli(capsys, command, "--help")
+        assert code == 0
+        return " ".join(out.split())
+
+    lo, hi = ALTITUDE_RANGE_M
+    for command in ("trim", "linearize", "ardupilot"):
+        assert f"{lo:g} to {hi:g}" in flat(command), command
+    lo, hi = START_HEIGHT_RANGE_M
+    assert f"{lo:g} to {hi:g}" in flat("sitl")

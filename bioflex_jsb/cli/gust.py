@@ -82,7 +82,7 @@ def add_run_arguments(p: argparse.ArgumentParser, default_gust: str = DEFAULT_GU
     p.add_argument("--duration", type=positive_float("duration", "s"), default=5.0,
                    help=f"simulated time [s], up to {MAX_DURATION_S:g} (default 5)")
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
-                   help="time the gust starts [s] (default 0.5)")
+                   help="time the gust starts [s], before the end of --duration (default 0.5)")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
                    help=f"co-simulation (JSBSim) time step [s] (default {DEFAULT_DT_S:.6f})")
 

@@ -80,7 +80,7 @@ def register(sub) -> None:
                    help="udpout:HOST:PORT, udpin:HOST:PORT or tcpin:HOST:PORT "
                    "(default udpout:127.0.0.1:14550)")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=None,
-                   help="simulated time [s] (default: until Ctrl-C)")
+                   help="simulated time [s], > 0 (default: until Ctrl-C)")
     p.add_argument("--speedup", type=positive_float("speed-up", "x"), default=1.0,
                    help="simulated seconds per wall-clock second (default 1, 0.1..50)")
     p.add_argument("--home", metavar="LAT,LON,ALT", default=None,
@@ -88,7 +88,7 @@ def register(sub) -> None:
                    "[m AMSL] (default -35.363261,149.165230,584: the CMAC field ArduPilot's "
                    "SITL uses)")
     p.add_argument("--start-height", type=positive_float("start height", "m"), default=100.0,
-                   help="start (and reset) height above home [m] (default 100)")
+                   help="start (and reset) height above home [m], 20 to 3000 (default 100)")
     p.add_argument("--log-max-mb", type=positive_float("log size", "MB"), default=256.0,
                    help="start a new log file (NAME-001.mcap, ...) when one reaches this size "
                    "[MB] (default 256); each file is a finished MCAP")

@@ -80,7 +80,7 @@ def register(sub) -> None:
     p.add_argument("--speed", type=airspeed, default=15.0,
                    help="trim and launcher exit " + speed_help())
     p.add_argument("--altitude", type=finite_float("altitude", "m"), default=0.0,
-                   help="launch altitude [m above sea level, ISA] (default 0)")
+                   help="launch altitude [m above sea level, ISA], -500 to 11000 (default 0)")
     p.add_argument("--launch-accel", type=positive_float("launch acceleration", "m/s^2"),
                    default=40.0, help="launcher push [m/s^2] (default 40, 5..200)")
     p.add_argument("--launch-height", type=positive_float("launcher height", "m"),

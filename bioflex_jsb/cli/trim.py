@@ -38,7 +38,8 @@ def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--altitude", type=finite_float("altitude", "m"), default=0.0, metavar="M",
-        help="altitude above sea level [m], standard atmosphere (default 0: ISA sea level)",
+        help="altitude above sea level [m], -500 to 11000 (ISA, up to the tropopause; "
+        "default 0: sea level)",
     )  # fmt: skip
     p.add_argument(
         "--jsbsim-root", metavar="DIR", default=None,
