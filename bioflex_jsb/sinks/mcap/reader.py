@@ -75,7 +75,10 @@ def open_reader(path: str | Path, verified: bool = False):
             reader = make_reader(f, validate_crcs=True)
             summary = reader.get_summary()
         except bad_data_errors() as exc:
-            raise LogError(f"{str(p)!r}: unreadable MCAP summary ({exc})") from None
+            why = str(exc) or type(exc).__name__  # some of mcap's errors carry no text
+            raise LogError(f"{str(p)!r}: unreadable MCAP summary ({why}): the file is "
+                           "damaged; `bioflex-jsb info FILE --check` says where, "
+                           "`--recover FIXED.mcap` copies its intact chunks") from None
         if summary is None:
             raise _truncated(p)
         yield reader, summary
