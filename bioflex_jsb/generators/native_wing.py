@@ -237,8 +237,10 @@ class ExportSpec:
                 break
         raise ExportError(
             f"time step {self.dt_s:.6g} s is too coarse for wing {self.variant!r}: the "
-            f"integration's eigenvalues are {err:.1%} off the exact ones at {at:g} m/s "
-            f"(accepted: {EIGEN_REL_TOL:.0%}); {ok:.6g} s is within it")
+            f"integration's eigenvalues are {err:.1%} off the exact ones at {at:g} m/s of the "
+            f"0..{GRID_SPEED_MAX_M_S:g} m/s the exported wing's tables cover (trimmed at "
+            f"{self.speed_m_s:g} m/s; accepted: {EIGEN_REL_TOL:.0%}); --dt {ok:.6g} s is "
+            "within it")
 
     @property
     def cl_trim(self) -> float:
