@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import jsbsim
 
-from bioflex_jsb.interrupts import native_callback, raise_if_stopped
+from bioflex_jsb.interrupts import critical_section, native_callback, raise_if_stopped
 
 
 @dataclass(frozen=True)
@@ -70,10 +70,16 @@ class _CapturingLogger(jsbsim.FGLogger):
 
 @contextlib.contextmanager
 def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
-    previous = jsbsim.get_logger()
-    jsbsim.set_logger(logger)
+    # the swap of JSBSim's logger is one step for a stop signal (interrupts.
+    # critical_section): a KeyboardInterrupt between taking the previous logger and giving
+    # it back would leave JSBSim and Python each holding one (an interrupted gust run once
+    # aborted at exit with "free(): double free detected", 2026-12-03, not reproduced since)
+    with critical_section():
+        previous = jsbsim.get_logger()
+        jsbsim.set_logger(logger)
     try:
         yield logger
     finally:
-        jsbsim.set_logger(previous)
+        with critical_section():
+            jsbsim.set_logger(previous)
     raise_if_stopped()  # a stop signal deferred inside JSBSim's calls is raised here
