@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -70,6 +71,8 @@ __all__ = [
 ]
 
 
+RUN_MODELS = ("rigid", "coupled", "qsd")  # the models fly_gust flies (native: fly_fig21)
+
 def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BASIS
               ) -> WingBuild:
     """The elastic wing of a named variant (``original``, ``optimised``,
@@ -80,6 +83,11 @@ def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BA
     A shorthand: ``load_wing("optimised")`` is the wing of
     ``load_aircraft("bioflex_optimised")``; a shipped aircraft name (``bioflex_<variant>``)
     is accepted too."""
+    if isinstance(name_or_file, Path):  # a variant file as a Path, as load_aircraft takes
+        name_or_file = str(name_or_file)
+    if not isinstance(name_or_file, str):
+        raise InputError(f"a wing is a variant name or a variant file's path, got "
+                         f"{name_or_file!r}")
     if name_or_file in SHIPPED_AIRCRAFT:
         return _load_aircraft(name_or_file).wing(mass_basis)
     return build_wing(resolve_variant(name_or_file), mass_basis=mass_basis)
@@ -202,14 +210,66 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
                      dt_s, recorders, aero, trim)[0]
 
 
+def _real(value, what: str) -> float:
+    """``value`` as a finite float (InputError, one line, for anything else)."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+        raise InputError(f"{what} must be a number, got {value!r}")
+    if not np.isfinite(value):
+        raise InputError(f"{what} must be finite, got {value!r}")
+    return float(value)
+
+
+def _check_run(gust, models, duration_s, gust_start_s, dt_s, trim, recorders) -> tuple:
+    """The checked run arguments of :func:`fly_gust` / :func:`compare` (one-line
+    InputErrors before anything is flown): the models a tuple of known names (a string of
+    names is one name), ``0 < duration_s``, ``0 <= gust_start_s`` and, with a gust, before
+    the end of the run; ``dt_s`` in MIN_DT_S..MAX_DT_S; ``trim`` rigid or elastic;
+    ``recorders`` for models that are flown."""
+    from bioflex_jsb.simulation.modal_wing import MAX_DT_S, MIN_DT_S
+
+    if isinstance(models, str) or not isinstance(models, Iterable):
+        raise InputError(f"models must be a tuple of model names ({', '.join(RUN_MODELS)}), "
+                         f"got {models!r}")
+    models = tuple(models)
+    bad = [m for m in models if m not in RUN_MODELS]
+    if not models or bad:
+        raise InputError(f"unknown model {bad[0] if bad else models!r}; give one or more of "
+                         f"{', '.join(RUN_MODELS)}")
+    duration_s = _real(duration_s, "duration_s [s]")
+    gust_start_s = _real(gust_start_s, "gust_start_s [s]")
+    dt_s = _real(dt_s, "dt_s [s]")
+    if duration_s <= 0.0:
+        raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
+    if gust_start_s < 0.0 or (gust.kind != "none" and gust_start_s >= duration_s):
+        raise InputError(f"gust_start_s {gust_start_s:g} s must be within the run: 0 <= "
+                         f"gust_start_s < duration_s ({duration_s:g} s)")
+    if not MIN_DT_S <= dt_s <= MAX_DT_S:
+        raise InputError(f"dt_s {dt_s:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
+    if trim not in ("rigid", "elastic"):
+        raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
+    if recorders is not None:
+        if not isinstance(recorders, dict):
+            raise InputError(f"recorders must be a dict model -> recorder, got {recorders!r}")
+        unflown = sorted(set(recorders) - set(models))
+        if unflown:
+            raise InputError(f"recorders for {', '.join(unflown)}, which is not flown "
+                             f"(models {', '.join(models)})")
+    return models, duration_s, gust_start_s, dt_s
+
+
 def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
               recorders, aero, trim):
     """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build."""
-    wing, airframe, speed_m_s = _flight(wing, speed_m_s)
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
+    if not isinstance(gust, str):
+        raise InputError(f"gust must be a gust text (sharp:A, 1cos:A:L, ...), got {gust!r}")
+    _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
+    models, duration_s, gust_start_s, dt_s = _check_run(
+        parse_gust(gust), models, duration_s, gust_start_s, dt_s, trim, recorders)
+    wing, airframe, speed_m_s = _flight(wing, speed_m_s)
     chord = wing.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
     setup = RunSetup(speed_m_s, parse_gust(gust, chord), duration_s, gust_start_s,
                      altitude_m, dt_s)
@@ -267,9 +327,12 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
                        drift=drift)
 
 
-def metrics(run: TimeHistory, gust_start_s: float = 0.5) -> GustMetrics:
-    """Peaks of the response to a gust starting at ``gust_start_s`` [s] (units in the
-    field names)."""
+def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
+    """Peaks of the response to a gust starting at ``gust_start_s`` [s] (None: the run's
+    own, ``run.meta["gust_start_s"]``, else 0.5 s; units in the field names)."""
+    if gust_start_s is None:
+        gust_start_s = run.meta.get("gust_start_s", 0.5)
+    gust_start_s = _real(gust_start_s, "gust_start_s [s]")
     return gust_metrics(run, gust_start_s)
 
 
@@ -312,7 +375,7 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     if aero not in AERO_MODELS:
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if model not in MODELS:
-        raise ValueError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+        raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     if aero == "unsteady":
         if model != "coupled" or wing is None:
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
@@ -349,11 +412,24 @@ def _check_choice(what: str, value, accepted) -> None:
 
 
 def _check_density(rho: float) -> float:
+    rho = _real(rho, "density_kg_m3 [kg/m^3]")
     lo, hi = DENSITY_RANGE_KG_M3
     if not lo <= float(rho) <= hi:
         raise InputError(f"density {rho!r} kg/m^3 is outside {lo:g}..{hi:g} kg/m^3 (about 33 "
                          "km altitude to denser than any surface air)")
     return float(rho)
+
+
+def _check_damping(zeta: float | None) -> float | None:
+    """A structural damping ratio ζ [-] (None: the wing's own): finite, 0 <= ζ < 1 (a
+    structural mode is under-damped; a variant file refuses the same)."""
+    if zeta is None:
+        return None
+    zeta = _real(zeta, "structural_damping [-]")
+    if not 0.0 <= zeta < 1.0:
+        raise InputError(f"structural_damping {zeta:g} must satisfy 0 <= structural_damping "
+                         "< 1 (a fraction of critical damping)")
+    return zeta
 
 
 def modes(wing, speed_m_s: float | None = None, model: str = "coupled", *,
@@ -369,6 +445,7 @@ def modes(wing, speed_m_s: float | None = None, model: str = "coupled", *,
     ``method`` (``pk`` or ``state-space``) on ``aero`` strips (lag roots left out).
     An :class:`Aircraft` is analysed with its own airframe, planform and air."""
     _check_choice("aerodynamics", aero, AERO_MODELS)
+    structural_damping = _check_damping(structural_damping)
     if clamped:
         if speed_m_s is None:
             raise InputError("a clamped wing's modes need speed_m_s [m/s]")
@@ -434,6 +511,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
             raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
     if density_kg_m3 is not None:
         _check_density(density_kg_m3)
+    structural_damping = _check_damping(structural_damping)
     if clamped:
         return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
                                 density_kg_m3, lift_slope)
@@ -467,6 +545,8 @@ def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[flo
     [air] when ``density_kg_m3`` is None)."""
     if density_kg_m3 is None:
         density_kg_m3 = _density(build, None).get("density_kg_m3")
+    else:
+        density_kg_m3 = _check_density(density_kg_m3)
     return _free_speed_range_m_s(_wing(build), density_kg_m3)
 
 
@@ -506,4 +586,6 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
     from bioflex_jsb.loads import section_loads as _section_loads
 
     build = wing.wing() if callable(getattr(wing, "wing", None)) else wing
+    if density_kg_m3 is not None:
+        density_kg_m3 = _check_density(density_kg_m3)
     return _section_loads(build, run, stations, static=static, density_kg_m3=density_kg_m3)

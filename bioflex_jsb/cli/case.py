@@ -29,11 +29,6 @@ SPEED_RANGE_TEXT = (f"{SPEED_MIN_M_S:g} to {SPEED_MAX_M_S:g} m/s (the native exp
 # the limit is the wall time (6 h of flight is ~20 M steps, ~3 min) and the steps' count.
 MAX_DURATION_S = 6 * 3600.0
 MAX_STEPS = 50_000_000  # steps per run (--duration / --dt), whatever the step
-# The co-simulation step's range [s]. Finest: below ~6e-5 s JSBSim's trim of the prototype
-# fails, reported as a motor short of thrust (measured 2026-12-03: 5e-5 and 3e-5 s fail, 6e-5
-# and 1e-4 trim at 15 m/s), so 1e-4 s (10 kHz, 90 steps a period of the wing's 110 Hz third
-# mode) with margin; coarsest 0.02 s (50 Hz: the wing's modes unresolved beyond it).
-MIN_DT_S, MAX_DT_S = 1e-4, 0.02
 # Turbulence is synthesised for the whole run up front (an inverse FFT of its spectrum, 8
 # bytes per step and a power-of-two transform twice that long): bounded at 1 h of flight.
 MAX_TURBULENCE_DURATION_S = 3600.0
@@ -106,7 +101,7 @@ def check_plot_path(path: str | None, force: bool) -> None:
     """Refuse a plot file before any work: a name that is not a usable file name
     (:func:`~bioflex_jsb.cli.common.check_file_name`), a suffix not among
     :data:`PLOT_FORMATS`, or an existing file that is not a plot of ours
-    (:func:`~bioflex_jsb.sinks.plotting.is_our_plot`) without --force. One-line
+    (:func:`~bioflex_jsb.plot_files.is_our_plot`) without --force. One-line
     UsageError."""
     if not path:
         return
@@ -117,7 +112,7 @@ def check_plot_path(path: str | None, force: bool) -> None:
         what = f".{suffix}" if suffix else "a file without a suffix"
         raise UsageError(f"plot file {path!r}: cannot write {what}; give a name ending in "
                          f"{', '.join('.' + s for s in formats)}")
-    from bioflex_jsb.sinks.plotting import is_our_plot
+    from bioflex_jsb.plot_files import is_our_plot
 
     check_output(path, force, "plot file", ours=is_our_plot)
     parent = Path(path).parent

@@ -133,7 +133,8 @@ def run(args: argparse.Namespace) -> int:
                                          result.diverged)
     if args.plot:
         try:
-            result.plot(args.plot, f"{build.variant.name} wing, {args.speed:g} m/s, gust "
+            result.plot(args.plot, force=True, title=f"{build.variant.name} wing, "
+                        f"{args.speed:g} m/s, gust "
                         f"{args.gust.text()}: LTI (Eq. 4) vs JSBSim, {args.model} model")
         except OSError as exc:
             raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None

@@ -99,10 +99,14 @@ class Comparison:
                 "duration_s": float(self.nonlinear.time_s[-1])
                 if len(self.nonlinear.time_s) else 0.0}
 
-    def plot(self, path: str | Path, title: str) -> Path:
-        """Both time histories on the gust figure's panels, NRMSE in each panel's legend."""
+    def plot(self, path: str | Path, title: str, force: bool = False) -> Path:
+        """Both time histories on the gust figure's panels, NRMSE in each panel's legend,
+        written to ``path`` (a figure suffix; an existing file only if it is a plot of ours,
+        or with ``force``: :func:`~bioflex_jsb.plot_files.check_plot_target`)."""
+        from bioflex_jsb.plot_files import check_plot_target
         from bioflex_jsb.sinks import plotting
 
+        check_plot_target(path, force)
         return plotting.time_histories([self.nonlinear, self.linear], path, title,
                                        nrmse=None if self.diverged else self.nrmse)
 

@@ -79,10 +79,15 @@ class SectionLoads:
                     units[name] = QUANTITY_UNITS[quantity]
         return out, units
 
-    def plot(self, path=None, gust_start_s: float | None = None):
-        """The figure (a matplotlib Figure; written to ``path`` when given)."""
+    def plot(self, path=None, gust_start_s: float | None = None, force: bool = False):
+        """The figure (a matplotlib Figure; written to ``path`` when given: a figure
+        suffix, an existing file only if it is a plot of ours or with ``force``)."""
         from bioflex_jsb.loads.plots import plot_section_loads
 
+        if path is not None:
+            from bioflex_jsb.plot_files import check_plot_target
+
+            check_plot_target(path, force)
         return plot_section_loads(self, path, gust_start_s)
 
 
@@ -152,7 +157,18 @@ def modal_accelerations(lm: LoadsModel, run: TimeHistory, q_pa, v, d_alpha, q, d
 
 
 def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
-    """The loads of ``run`` at ``lm``'s stations by both methods (MD absent for ``rigid``)."""
+    """The loads of ``run`` at ``lm``'s stations by both methods (MD absent for ``rigid``).
+    Refused (InputError, one line): the native model's run (its wing is in JSBSim's XML,
+    with no modal loads model), and a run flown with another wing than ``lm``'s, as its own
+    loads say (``meta["loads"]["wing"]``: another variant's or aircraft's wing gave root
+    bending moments off by up to four orders of magnitude, silently)."""
+    if run.model == "native":
+        raise InputError("the native wing (in the aircraft's XML) has no section loads "
+                         "model; fly the coupled model")
+    flown = (run.meta.get("loads") or {}).get("wing")
+    if flown is not None and flown != lm.wing:
+        raise InputError(f"the run was flown with wing {flown!r}; its section loads need "
+                         f"that wing, not {lm.wing!r}")
     if abs(float(run.meta.get("speed_m_s", lm.speed_m_s)) - lm.speed_m_s) > 1e-9:
         raise InputError(f"the loads model is for {lm.speed_m_s:g} m/s, the run was trimmed at "
                          f"{run.meta.get('speed_m_s')} m/s")

@@ -70,6 +70,12 @@ def _one_blas_thread():
 # of it on u, α, q, θ and η₁ (tests/test_cosim.py). JSBSim's aircraft default, 1/120 s,
 # leaves 4 samples per period.
 DEFAULT_DT_S = 1.0 / 960.0
+# The co-simulation step's range [s]. Finest: below ~6e-5 s JSBSim's trim of the prototype
+# fails, reported as a motor short of thrust (measured 2026-12-03: 5e-5 and 3e-5 s fail,
+# 6e-5 and 1e-4 trim at 15 m/s), so 1e-4 s (10 kHz, 90 steps a period of the wing's 110 Hz
+# third mode) with margin; coarsest 0.02 s (50 Hz: at 0.04-0.1 s the propeller's RPM does
+# not settle in the trim, and the wing's modes are unresolved).
+MIN_DT_S, MAX_DT_S = 1e-4, 0.02
 
 
 @dataclass(frozen=True)

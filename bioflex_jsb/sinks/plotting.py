@@ -2,7 +2,7 @@
 
 Every figure is written with ``Software = "bioflex-jsb <version>"`` in its metadata
 (:data:`SOFTWARE_TAG`), so a later run can tell a plot of ours (which it may replace) from a
-user's file (which needs ``--force``): :func:`is_our_plot`.
+user's file (which needs ``--force``): :func:`~bioflex_jsb.plot_files.is_our_plot`.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
 
 from bioflex_jsb import __version__  # noqa: E402
 from bioflex_jsb.flight_dynamics.eigen import Sweep  # noqa: E402
+from bioflex_jsb.plot_files import is_our_plot  # noqa: F401 (the CLI's and tests' name)
 from bioflex_jsb.simulation.results import TimeHistory  # noqa: E402
 
 SOFTWARE_TAG = f"bioflex-jsb {__version__}"
@@ -55,20 +56,6 @@ UNSTABLE_SHADE = dict(color="tab:red", alpha=0.06, lw=0)
 def supported_formats() -> dict[str, str]:
     """File suffixes (no dot) that :func:`time_histories` and :func:`root_locus` can write."""
     return dict(FigureCanvasBase.get_supported_filetypes())
-
-
-def is_our_plot(path: str | Path) -> bool:
-    """Whether ``path`` is a PNG that bioflex-jsb wrote (its Software tag starts with
-    ``bioflex-jsb``); anything else, or an unreadable file, is not ours."""
-    from PIL import Image
-
-    try:
-        with Image.open(path) as image:
-            if image.format != "PNG":
-                return False
-            return str(image.info.get("Software", "")).startswith("bioflex-jsb")
-    except OSError:  # not an image PIL can read (PIL.UnidentifiedImageError is an OSError)
-        return False
 
 
 def _save(fig, path: str | Path) -> Path:

@@ -47,12 +47,11 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     load_variant_file,
 )
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.tomlfile import read_toml
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
 MAX_CASES = 1_000_000
-MIN_DT_S, MAX_DT_S = 1e-4, 0.02  # as the gust command's (cli/case.py: why)
 
 METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
 TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
