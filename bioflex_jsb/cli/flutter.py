@@ -52,7 +52,8 @@ chord 1.8288 m; bioflex_jsb/data/aircraft/goland.toml), published strip theory r
 from the definition (Goland: --aero unsteady, --method pk, --lift-slope strip,
 --structural-damping 0, --inertia-about elastic-axis, --density 1.225 kg/m^3; the issue's
 literal reading of the data is --inertia-about centre-of-mass --density 1.02); default
---range derived from the wing: 5 % to 150 % of its static divergence speed (docs/aircraft.md).
+--range derived from the wing: up to 1.5 x its static divergence speed, from 5 % of that
+(docs/aircraft.md).
 An instability already present at the range's lower end is reported as "unstable at and
 below LOW m/s", never as no instability."""
 
