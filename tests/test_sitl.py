@@ -481,6 +481,8 @@ def test_the_paced_loop_keeps_the_start_ups_objects_out_of_the_collector_while_i
     try:
         before = gc.get_freeze_count()
         run_paced(Fake(), 0.003)
-        assert min(seen) >= before and gc.get_freeze_count() >= before
+        # not thawed (the count only falls by the frozen objects freed meanwhile: 11 of
+        # 304 465 seen in a full suite run; thawing would take it to 0)
+        assert min(seen) > before // 2 and gc.get_freeze_count() > before // 2
     finally:
         gc.unfreeze()
