@@ -108,8 +108,16 @@ def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
 def _wing(wing):
     """The :class:`WingBuild` of an :class:`Aircraft` (the wing itself otherwise): its
     model carries the aircraft's :class:`~bioflex_jsb.parameters.airframe.AirframeData`,
-    which every linear analysis below takes."""
-    return wing.wing() if isinstance(wing, Aircraft) else wing
+    which every linear analysis below takes. Anything else (a name, a path, a Definition)
+    is refused in one line saying what to pass."""
+    if isinstance(wing, Aircraft):
+        return wing.wing()
+    if wing is not None and not isinstance(wing, WingBuild):
+        hint = ("; a name or file is loaded first (api.load_wing, api.load_aircraft), and a "
+                "clamped wing's definition is analysed with clamped=True"
+                if isinstance(wing, str | Path | Definition) else "")
+        raise InputError(f"give a wing (a WingBuild) or an Aircraft, not {wing!r}{hint}")
+    return wing
 
 
 def _flying_wing(wing):
@@ -157,6 +165,18 @@ def _density(wing, density_kg_m3: float | None) -> dict:
     return {}
 
 
+def _linear_speed(speed_m_s) -> float:
+    """A linear analysis' speed [m/s]: finite, 0 < V <= SPEED_LIMIT_M_S (the strips are
+    incompressible; a speed of 1e5 m/s took 71 s and answered nothing physical)."""
+    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
+
+    v = _real(speed_m_s, "speed_m_s [m/s]")
+    if not 0.0 < v <= SPEED_LIMIT_M_S:
+        raise InputError(f"speed {v:g} m/s is outside 0..{SPEED_LIMIT_M_S:g} m/s (the strip "
+                         "aerodynamics are incompressible)")
+    return v
+
+
 def _analysis_speed(wing, speed_m_s: float | None) -> float:
     """The speed [m/s] of a linear analysis: ``speed_m_s`` when given, else an
     :class:`Aircraft`'s cruise speed (the prototype's 15 m/s on its airframe, Table 1; the
@@ -165,7 +185,7 @@ def _analysis_speed(wing, speed_m_s: float | None) -> float:
     cruise speed is known (a wing of another airframe without its Aircraft, an aircraft
     without the field)."""
     if speed_m_s is not None:
-        return float(speed_m_s)
+        return _linear_speed(speed_m_s)
     if isinstance(wing, Aircraft):
         cruise = (CRUISE_SPEED_M_S if wing.flight_problem() is None
                   else wing.airframe.cruise_speed_m_s)
@@ -449,6 +469,7 @@ def modes(wing, speed_m_s: float | None = None, model: str = "coupled", *,
     if clamped:
         if speed_m_s is None:
             raise InputError("a clamped wing's modes need speed_m_s [m/s]")
+        speed_m_s = _linear_speed(speed_m_s)
         return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
     air = _density(wing, None)
     speed_m_s = _analysis_speed(wing, speed_m_s)
@@ -506,9 +527,14 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     default to the definition's; the range to the one derived from the wing
     (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`)."""
     if range_m_s is not None:
-        lo, hi = (float(x) for x in range_m_s)
-        if not 0.0 < lo < hi:
-            raise InputError(f"flutter range must satisfy 0 < low < high, got {lo}:{hi}")
+        from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
+
+        if isinstance(range_m_s, str) or len(tuple(range_m_s)) != 2:
+            raise InputError(f"flutter range must be (low, high) [m/s], got {range_m_s!r}")
+        lo, hi = (_real(x, "flutter range [m/s]") for x in range_m_s)
+        if not 0.0 < lo < hi <= SPEED_LIMIT_M_S:
+            raise InputError(f"flutter range must satisfy 0 < low < high <= "
+                             f"{SPEED_LIMIT_M_S:g} m/s, got {lo:g}:{hi:g}")
     if density_kg_m3 is not None:
         _check_density(density_kg_m3)
     structural_damping = _check_damping(structural_damping)

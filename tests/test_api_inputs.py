@@ -102,3 +102,22 @@ def test_a_plot_never_replaces_a_users_file(tmp_path, wing):
     comparison.plot(ours, "t")  # a plot of ours: replaced
     comparison.plot(mine, "t", force=True)  # a user's file: only when told
     assert mine.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("call, needle", [
+    (lambda w: api.modes(w, 1e5), "outside 0..400 m/s"),  # 71 s for no physical answer
+    (lambda w: api.linear_model(w, 0.0), "outside 0..400 m/s"),  # a numpy ValueError
+    (lambda w: api.modes(w, math.nan), "must be finite"),  # "arange: cannot compute length"
+    (lambda w: api.flutter(w, (5.0, math.inf)), "must be finite"),  # "Maximum allowed size"
+    (lambda w: api.flutter(w, "5:40"), "must be \\(low, high\\)"),
+    (lambda w: api.fly_gust("optimised"), "a WingBuild\\) or an Aircraft"),  # AttributeError
+    (lambda w: api.flutter("goland"), "clamped=True"),  # "'str' object has no attribute"
+])
+def test_speeds_and_wings_of_the_linear_analyses(wing, call, needle):
+    with pytest.raises(InputError, match=needle):
+        call(wing)
+
+
+def test_a_missing_channel_names_the_channels_there(run):
+    with pytest.raises(KeyError, match="channels: u, alpha"):
+        run["nope"]

@@ -61,7 +61,11 @@ class TimeHistory:
     stopped: str | None = None  # why the run stopped early (divergence), None if it finished
 
     def __getitem__(self, name: str) -> np.ndarray:
-        return self.channels[name]
+        try:
+            return self.channels[name]
+        except KeyError:  # the channels it has, in the message (a bare KeyError said none)
+            raise KeyError(f"no channel {name!r} in this {self.model} run; channels: "
+                           f"{', '.join(self.channels)}") from None
 
     @property
     def stop_time_s(self) -> float | None:
