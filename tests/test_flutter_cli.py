@@ -191,3 +191,15 @@ def test_free_aircraft_lower_end_is_flagged(capsys):
     assert d["kind"] == "flutter" and d["mode"] is not None
     code, out, _ = run_cli(capsys, "flutter", "--wing", "elastic-backward")
     assert "flutter at 15.4 m/s" in out or "flutter at 15.5 m/s" in out
+
+
+@pytest.mark.parametrize("argv, needle", [
+    # each was ignored silently: the clamped Goland wing analysed as if not given
+    (["--clamped", "goland", "--aircraft", "bioflex_original"], "--aircraft is the free"),
+    (["--clamped", "goland", "--wing", "optimised"], "give one of them"),
+    (["--clamped", "goland", "--mass-basis", "paper"], "--mass-basis is the free"),
+])
+def test_options_a_clamped_analysis_does_not_take_are_refused(capsys, argv, needle):
+    code, _, err = run_cli(capsys, "flutter", *argv)
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert code == 2 and len(lines) == 1 and needle in lines[0], err

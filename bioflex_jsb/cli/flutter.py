@@ -157,6 +157,18 @@ def clamped_target(args: argparse.Namespace) -> str | None:
                                  "paper wings take the vortex lattice's span loading "
                                  "(Table B1)")
         return None
+    from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS
+
+    # what a clamped analysis does not take is refused, not ignored
+    if getattr(args, "aircraft_definition", None) is not None:
+        raise UsageError("--clamped analyses a clamped-wing definition; --aircraft is the free "
+                         "aircraft's: give one of them")
+    if args.clamped and getattr(args, "wing_given", False):
+        raise UsageError(f"--clamped {args.clamped} and --wing {args.wing}: give one of them "
+                         "(--wing NAME --clamped analyses that definition)")
+    if args.mass_basis != DEFAULT_MASS_BASIS:
+        raise UsageError("--mass-basis is the free aircraft's generalised masses; a clamped "
+                         "wing's come from its beam (drop it)")
     target = args.clamped or args.wing
     if target not in SHIPPED and not target.endswith(".toml"):
         raise UsageError(f"--clamped takes a clamped-wing definition: a shipped name "
