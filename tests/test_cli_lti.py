@@ -83,6 +83,7 @@ def test_export_npz_keeps_names_and_matrices(capsys, tmp_path):
         (["flutter", "--range", "a:b"], "range must be LOW:HIGH"),
         (["modes", "--wing", "missing.toml", "--speed", "15"], "not found"),
         (["export", "--speed", "15", "--out", "model.txt"], "unknown model file type"),
+        (["modes", "--aero", "unsteady", "--models", "qsd"], "the coupled model's"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):

@@ -111,6 +111,9 @@ def _check_shape_outputs(args, speeds) -> None:
 def run(args: argparse.Namespace) -> int:
     default_speed, flight_top = aircraft_speeds(args)
     speeds = args.speed or [default_speed]
+    if args.aero == "unsteady" and "coupled" not in args.models:  # it would change nothing
+        raise UsageError(f"--aero unsteady is the coupled model's; --models "
+                         f"{','.join(args.models)} has none (add coupled)")
     check_plot_path(args.plot, args.force)
     _check_shape_outputs(args, speeds)
     build = wing_for_run(wing_from_args(args), args)
