@@ -88,7 +88,8 @@ def density(text: str) -> float:
     try:
         rho = float(text)
     except ValueError:
-        rho = math.nan
+        raise argparse.ArgumentTypeError(
+            f"density must be a number in kg/m^3, got {text!r}") from None
     if not (MIN_DENSITY_KG_M3 <= rho <= MAX_DENSITY_KG_M3):
         raise argparse.ArgumentTypeError(
             f"density must satisfy {MIN_DENSITY_KG_M3:g} <= RHO <= {MAX_DENSITY_KG_M3:g} "

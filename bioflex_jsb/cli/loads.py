@@ -106,7 +106,7 @@ def gradients(text: str) -> tuple[float, ...]:
             if len(parts) != 3:
                 raise InputError("give MIN:MAX:N")
             lo, hi = plain_number(parts[0], "MIN"), plain_number(parts[1], "MAX")
-            n = plain_integer(parts[2], "N")
+            n = plain_integer(parts[2], "N (2 to 200)")
             if not (0 < lo < hi) or not 2 <= n <= 200:
                 raise InputError("need 0 < MIN < MAX and 2 <= N <= 200")
             values = tuple(float(x) for x in np.geomspace(lo, hi, n))
