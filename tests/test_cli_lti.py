@@ -99,6 +99,9 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):
         ("[overrides]\n'C_banana' = 1.0\n", "unknown coefficient"),
         ("x_inertial_frac = \n", "not valid TOML"),
         ("modes_file = 'nowhere.toml'\n", "nowhere.toml"),
+        # a base that is a file: "unknown wing (or a variant file ending in .toml)", though
+        # it was one
+        ("base = 'f/phys.toml'\n", "is not a named wing; accepted: original"),
         # a definition given as a variant: pointed at the option that takes it
         ("name = 'g'\n[airframe]\njsbsim = 'SGS'\n", "give it as --aircraft FILE"),
         ("name = 'w'\n[wing]\nstations = []\n", "flutter --clamped FILE"),

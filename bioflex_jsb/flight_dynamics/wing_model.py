@@ -210,6 +210,9 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
     base_name = data.get("base", "original")
     if not isinstance(base_name, str):
         raise VariantError(f"{source}: 'base' must be a variant name")
+    if base_name not in VARIANTS:  # a base is a named wing only (a file's base is not a file)
+        raise VariantError(f"{source}: base {base_name!r} is not a named wing; accepted: "
+                           f"{', '.join(VARIANTS)}")
     base = get_variant(base_name)
     values: dict[str, object] = {"name": data.get("name", Path(source).stem)}
     if not isinstance(values["name"], str) or not values["name"]:
