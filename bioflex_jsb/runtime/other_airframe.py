@@ -266,6 +266,9 @@ def definition_mismatch(fdm, airframe) -> str | None:
     return None
 
 
+_CHECKED: dict[tuple, str | None] = {}  # airframe_for's check, per definition and XML file
+
+
 def _mass_balance_probe(airframe) -> jsbsim.FGFDMExec:
     """A throwaway JSBSim instance of ``airframe``'s aircraft with its initial conditions
     run once: JSBSim computes the mass balance (inertia, CG) only when its models run, and
@@ -292,7 +295,11 @@ def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None
         return Airframe(root)
     airframe = airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m,
                                   Airframe, aircraft.name, systems)
-    problem = definition_mismatch(_mass_balance_probe(airframe), aircraft.airframe)
+    xml = os.stat(aircraft.airframe.jsbsim_path)
+    key = (aircraft.airframe.jsbsim_path, xml.st_mtime_ns, xml.st_size, repr(aircraft.airframe))
+    if key not in _CHECKED:  # once per definition and XML (a sweep loads one per case)
+        _CHECKED[key] = definition_mismatch(_mass_balance_probe(airframe), aircraft.airframe)
+    problem = _CHECKED[key]
     if problem is not None:
         raise AircraftLoadError(f"aircraft {aircraft.name!r}: {problem}")
     return airframe
