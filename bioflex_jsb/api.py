@@ -239,6 +239,13 @@ def _real(value, what: str) -> float:
     return float(value)
 
 
+def _gust_text(gust) -> str:
+    """``gust`` if it is a gust text, else one line saying what one is."""
+    if not isinstance(gust, str):
+        raise InputError(f"gust must be a gust text (sharp:A, 1cos:A:L, ...), got {gust!r}")
+    return gust
+
+
 def _check_run(gust, models, duration_s, gust_start_s, dt_s, trim, recorders) -> tuple:
     """The checked run arguments of :func:`fly_gust` / :func:`compare` (one-line
     InputErrors before anything is flown): the models a tuple of known names (a string of
@@ -284,11 +291,9 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
         raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
-    if not isinstance(gust, str):
-        raise InputError(f"gust must be a gust text (sharp:A, 1cos:A:L, ...), got {gust!r}")
     _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
     models, duration_s, gust_start_s, dt_s = _check_run(
-        parse_gust(gust), models, duration_s, gust_start_s, dt_s, trim, recorders)
+        parse_gust(_gust_text(gust)), models, duration_s, gust_start_s, dt_s, trim, recorders)
     wing, airframe, speed_m_s = _flight(wing, speed_m_s)
     chord = wing.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
     setup = RunSetup(speed_m_s, parse_gust(gust, chord), duration_s, gust_start_s,
@@ -335,7 +340,7 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
-    check_gust_excites(parse_gust(gust))
+    check_gust_excites(parse_gust(_gust_text(gust)))
     runs, airframe, build, speed = _fly_gust(
         wing, speed_m_s, gust, (model,), duration_s, gust_start_s, 0.0, DEFAULT_DT_S,
         {model: recorder} if recorder is not None else None, aero, trim)
