@@ -71,7 +71,7 @@ __all__ = [
 ]
 
 
-RUN_MODELS = ("rigid", "coupled", "qsd")  # the models fly_gust flies (native: fly_fig21)
+RUN_MODELS = MODELS  # the models fly_gust flies, the LTI models (native: fly_fig21)
 
 def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BASIS
               ) -> WingBuild:
