@@ -8,7 +8,12 @@ that is. Two places cannot take an exception there:
   the C++ caller does not check for a Python error, so an exception raised inside ends as
   ``SystemError: <cyfunction FGFDMExec.run> returned a result with an exception set``;
 * an import in progress: an extension module whose initialisation runs Python code turns the
-  exception into ``ImportError: initialization failed``.
+  exception into ``ImportError: initialization failed``;
+* a finalizer (a ``__del__`` method, a weakref callback: the garbage collector runs them at
+  any bytecode boundary, numba's compiler drops many): Python prints an exception raised
+  there as "Exception ignored in …" and goes on, so the stop was lost and its traceback
+  printed (a fresh-cache CI run, 2026-12-03: the re-delivered SIGINT of a deferred stop
+  landed in llvmlite's ``ObjectRef.__del__``).
 
 The CLI's handler (:mod:`bioflex_jsb.cli.common`) looks at the interrupted frame and its
 callers (:func:`unsafe_frame`); in such a frame it only sets :data:`STOP` ``.pending`` and
@@ -22,6 +27,7 @@ This module imports nothing of the project: every layer may read the flag.
 
 from __future__ import annotations
 
+import weakref
 from contextlib import contextmanager
 from types import CodeType, FrameType
 
@@ -43,6 +49,9 @@ STOP = StopFlag()
 
 _CALLBACK_CODES: set[CodeType] = set()
 _IMPORT_FILES = ("<frozen importlib._bootstrap>", "<frozen importlib._bootstrap_external>")
+# finalizers: any ``__del__``, and the module that runs weakref callbacks and finalize()
+_FINALIZER_NAMES = ("__del__",)
+_FINALIZER_FILES = (weakref.__file__,)
 
 
 def native_callback(func):
@@ -74,13 +83,14 @@ def critical_section():
 
 def unsafe_frame(frame: FrameType | None) -> bool:
     """Whether an exception raised in ``frame`` now would cross native code that cannot
-    carry it (``frame`` or one of its callers is a :func:`native_callback` or an import) or
-    cut a :func:`critical_section`."""
+    carry it (``frame`` or one of its callers is a :func:`native_callback`, an import or a
+    finalizer) or cut a :func:`critical_section`."""
     if STOP.critical:
         return True
     while frame is not None:
         code = frame.f_code
-        if code in _CALLBACK_CODES or code.co_filename in _IMPORT_FILES:
+        if (code in _CALLBACK_CODES or code.co_filename in _IMPORT_FILES
+                or code.co_name in _FINALIZER_NAMES or code.co_filename in _FINALIZER_FILES):
             return True
         frame = frame.f_back
     return False

@@ -226,6 +226,66 @@ def test_unsafe_frame_sees_a_native_callback_and_its_callees():
     assert seen == {"callback": True, "inner": True, "outside": False}
 
 
+def test_unsafe_frame_sees_a_finalizer_and_its_callees():
+    """A ``__del__`` and a ``weakref.finalize`` callback: Python ignores (prints) what they
+    raise, so a stop raised there was lost (a fresh-cache CI run, 2026-12-03)."""
+    import sys as _sys
+    import weakref
+
+    seen = []
+
+    def inner():
+        seen.append(interrupts.unsafe_frame(_sys._getframe()))
+
+    class Dropped:
+        def __del__(self):
+            inner()
+
+    class Target:
+        pass
+
+    Dropped()  # dropped at once: its __del__ runs here
+    target = Target()
+    weakref.finalize(target, inner)
+    del target
+    assert seen == [True, True]
+
+
+# The stop handler run by the garbage collector inside a finalizer, where Python ignores an
+# exception: numba's compiler (a fresh cache) drops llvmlite objects whose __del__ the
+# re-delivered signal of a deferred stop landed in; the run then went on to its end with
+# "Exception ignored in: <function ObjectRef.__del__ …> … KeyboardInterrupt" on stderr.
+IN_FINALIZER = """
+from bioflex_jsb.drivers import gust as _g
+_orig = _g.raise_if_stopped
+_n = [0]
+class _Dropped:
+    def __del__(self):
+        signal.getsignal(signal.{sig})(signal.{sig}, sys._getframe())
+def _wrapped():
+    _n[0] += 1
+    if _n[0] == 2:  # after the rigid run's second block, in the loop (no critical section)
+        _Dropped()
+    return _orig()
+_g.raise_if_stopped = _wrapped
+"""
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_stop_inside_a_finalizer_exits_130_in_one_line(tmp_path, sig):
+    out = tmp_path / "run.mcap"
+    t0 = time.monotonic()
+    r = harness(tmp_path, IN_FINALIZER.format(sig=sig), "gust", "--duration", "3",
+                "--gust-start", "0.1", "--models", "rigid,coupled", "--json", "--plot", "",
+                "--out", str(out))
+    assert r.returncode == 130, r.stderr[-3000:]
+    assert "interrupted" in one_line(r.stderr)
+    assert time.monotonic() - t0 < 120
+    check = subprocess.run([PY, "-m", "bioflex_jsb", "info", "--check", str(out)],
+                           capture_output=True, text=True, timeout=120, env=env())
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
 # ---------------------------------------------------------------------------------------
 # Random moments, real processes
 # ---------------------------------------------------------------------------------------
