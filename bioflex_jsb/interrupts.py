@@ -13,7 +13,11 @@ that is. Two places cannot take an exception there:
   any bytecode boundary, numba's compiler drops many): Python prints an exception raised
   there as "Exception ignored in …" and goes on, so the stop was lost and its traceback
   printed (a fresh-cache CI run, 2026-12-03: the re-delivered SIGINT of a deferred stop
-  landed in llvmlite's ``ObjectRef.__del__``).
+  landed in llvmlite's ``ObjectRef.__del__``);
+* llvmlite's bindings (``llvmlite/binding``, the Python wrappers that own LLVM objects, run
+  while numba compiles or loads a kernel): an exception between an object's native free and
+  its "closed" mark leaves it to be freed again by its finalizer (a "free(): double free"
+  abort at exit was seen once after a stopped run in CI).
 
 The CLI's handler (:mod:`bioflex_jsb.cli.common`) looks at the interrupted frame and its
 callers (:func:`unsafe_frame`); in such a frame it only sets :data:`STOP` ``.pending`` and
@@ -27,6 +31,8 @@ This module imports nothing of the project: every layer may read the flag.
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import weakref
 from contextlib import contextmanager
 from types import CodeType, FrameType
@@ -52,6 +58,11 @@ _IMPORT_FILES = ("<frozen importlib._bootstrap>", "<frozen importlib._bootstrap_
 # finalizers: any ``__del__``, and the module that runs weakref callbacks and finalize()
 _FINALIZER_NAMES = ("__del__",)
 _FINALIZER_FILES = (weakref.__file__,)
+# the directories of wrappers of native objects (found without importing them)
+_NATIVE_WRAPPER_DIRS = tuple(
+    os.path.join(location, "binding") + os.sep
+    for location in getattr(importlib.util.find_spec("llvmlite"), "submodule_search_locations",
+                            None) or ())
 
 
 def native_callback(func):
@@ -83,14 +94,15 @@ def critical_section():
 
 def unsafe_frame(frame: FrameType | None) -> bool:
     """Whether an exception raised in ``frame`` now would cross native code that cannot
-    carry it (``frame`` or one of its callers is a :func:`native_callback`, an import or a
-    finalizer) or cut a :func:`critical_section`."""
+    carry it (``frame`` or one of its callers is a :func:`native_callback`, an import, a
+    finalizer or a wrapper of native objects) or cut a :func:`critical_section`."""
     if STOP.critical:
         return True
     while frame is not None:
         code = frame.f_code
         if (code in _CALLBACK_CODES or code.co_filename in _IMPORT_FILES
-                or code.co_name in _FINALIZER_NAMES or code.co_filename in _FINALIZER_FILES):
+                or code.co_name in _FINALIZER_NAMES or code.co_filename in _FINALIZER_FILES
+                or code.co_filename.startswith(_NATIVE_WRAPPER_DIRS)):
             return True
         frame = frame.f_back
     return False

@@ -251,6 +251,27 @@ def test_unsafe_frame_sees_a_finalizer_and_its_callees():
     assert seen == [True, True]
 
 
+def test_unsafe_frame_sees_llvmlites_bindings():
+    """A frame of llvmlite's bindings (here: code compiled under its file name) and what it
+    calls are unsafe; llvmlite's package elsewhere (its top level) is not."""
+    import sys as _sys
+    from pathlib import Path as _Path
+
+    import llvmlite
+    import llvmlite.binding.ffi
+
+    seen = []
+
+    def probe():
+        seen.append(interrupts.unsafe_frame(_sys._getframe()))
+
+    for filename in (llvmlite.binding.ffi.__file__, llvmlite.__file__):
+        assert _Path(filename).exists()
+        code = compile("probe()", filename, "exec")
+        exec(code, {"probe": probe})
+    assert seen == [True, False]
+
+
 # The stop handler run by the garbage collector inside a finalizer, where Python ignores an
 # exception: numba's compiler (a fresh cache) drops llvmlite objects whose __del__ the
 # re-delivered signal of a deferred stop landed in; the run then went on to its end with
