@@ -8,6 +8,8 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 >>> wing = api.load_wing("optimised")
 >>> runs = api.fly_gust(wing, speed_m_s=15.0, gust="sharp:3", models=("rigid", "coupled"))
 >>> runs["coupled"]["q"]               # pitch rate [rad/s] at runs["coupled"].time_s [s]
+>>> api.plot_runs(runs, "gust.png")   # the figure of `bioflex-jsb gust`
+>>> api.modes(wing, 15.0)["short_period"].damping  # [-]; a ModeSet is a sequence of modes
 >>> lti = api.linear_model(wing, speed_m_s=15.0, model="coupled")
 >>> unsteady = api.fly_gust(wing, gust="sharp:0.3", aero="unsteady")  # Jones/Küssner strips
 >>> api.flutter(wing).flutter_speed_m_s  # [m/s]
@@ -66,8 +68,8 @@ from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metric
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
     "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
-    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "section_loads",
-    "to_python_control",
+    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "plot_runs",
+    "section_loads", "to_python_control",
 ]
 
 
@@ -309,6 +311,8 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
         else:
             out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder,
                                   loads=wing)
+        # which wing flew, as the command's runs say (plot_runs' title, a user's table)
+        out[model].meta.update(wing=wing.variant.name, mass_basis=wing.mass_basis)
     return out, airframe, wing, speed_m_s
 
 
@@ -359,6 +363,42 @@ def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
         gust_start_s = run.meta.get("gust_start_s", 0.5)
     gust_start_s = _real(gust_start_s, "gust_start_s [s]")
     return gust_metrics(run, gust_start_s)
+
+
+def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = False) -> Path:
+    """The gust figure of ``runs`` (a :class:`TimeHistory`, a sequence of them or the dict
+    :func:`fly_gust` returns) written to ``path`` (a figure suffix: ``.png``, ``.svg``,
+    ``.pdf`` …; an existing file only if it is a plot of ours, or with ``force``): Δu, Δα,
+    q, Δθ, n_z, the gust w_g and η₁ against time [s], the command's ``gust.png``; its path.
+    ``title`` None: the first run's speed and gust, as ``bioflex-jsb gust`` titles it.
+
+    >>> api.plot_runs(api.fly_gust(wing, gust="sharp:3"), "gust.png", "sharp:3 at 15 m/s")
+    """
+    from bioflex_jsb.plot_files import check_plot_target
+    from bioflex_jsb.sinks import plotting
+
+    if isinstance(runs, TimeHistory):
+        runs = [runs]
+    elif isinstance(runs, dict):
+        runs = list(runs.values())
+    elif not isinstance(runs, str | bytes) and isinstance(runs, Iterable):
+        runs = list(runs)
+    else:
+        raise InputError(f"runs: a TimeHistory, a sequence of them or fly_gust's dict, not "
+                         f"{type(runs).__name__}")
+    wrong = [type(r).__name__ for r in runs if not isinstance(r, TimeHistory)]
+    if wrong or not runs:
+        raise InputError("runs: give one TimeHistory or more (fly_gust's results), not "
+                         + (wrong[0] if wrong else "none"))
+    if title is None:
+        meta = runs[0].meta
+        title = ", ".join(x for x in (
+            f"{meta['wing']} wing" if meta.get("wing") else "",
+            f"{meta['speed_m_s']:g} m/s" if isinstance(meta.get("speed_m_s"), float) else "",
+            f"gust {meta['gust']}" if meta.get("gust") else "") if x)
+    if not isinstance(title, str):
+        raise InputError(f"title: a text, not {type(title).__name__}")
+    return plotting.time_histories(runs, check_plot_target(path, force), title)
 
 
 def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,

@@ -121,3 +121,33 @@ def test_speeds_and_wings_of_the_linear_analyses(wing, call, needle):
 def test_a_missing_channel_names_the_channels_there(run):
     with pytest.raises(KeyError, match="channels: u, alpha"):
         run["nope"]
+
+
+def test_plot_runs_draws_fly_gusts_results_and_refuses_what_is_not_a_run(tmp_path, wing):
+    runs = api.fly_gust(wing, gust="sharp:3", models=("rigid", "coupled"), duration_s=0.5,
+                        gust_start_s=0.1)
+    assert runs["coupled"].meta["wing"] == "optimised"  # which wing flew (the title's)
+    out = api.plot_runs(runs, tmp_path / "g.png", "sharp:3")
+    assert out == tmp_path / "g.png" and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert api.plot_runs(runs["coupled"], tmp_path / "one.svg").stat().st_size > 0
+    mine = tmp_path / "mine.png"
+    mine.write_text("USER DATA")
+    for call, needle in ((lambda: api.plot_runs(runs, mine), "not a plot bioflex-jsb wrote"),
+                         (lambda: api.plot_runs({}, tmp_path / "e.png"), "not none"),
+                         (lambda: api.plot_runs([1.0], tmp_path / "f.png"), "not float"),
+                         (lambda: api.plot_runs("coupled", tmp_path / "s.png"), "not str"),
+                         (lambda: api.plot_runs(runs, tmp_path / "t.png", title=3), "title")):
+        with pytest.raises(InputError, match=needle):
+            call()
+    assert mine.read_text() == "USER DATA"
+
+
+def test_a_mode_set_is_a_sequence_of_its_modes(wing):
+    ms = api.modes(wing, 15.0)
+    assert len(ms) == len(ms.modes) and list(ms) == list(ms.modes) and ms[0] is ms.modes[0]
+    assert ms["short_period"] is ms.get("short_period")
+    assert "short_period" in ms and "phugoid" in ms and "no_such_mode" not in ms
+    assert "" not in ms and 3 not in ms
+    assert ms.names == tuple(m.mode for m in ms.modes)
+    with pytest.raises(KeyError, match="no mode 'no_such_mode'"):
+        ms["no_such_mode"]

@@ -91,11 +91,35 @@ class Mode:
 
 @dataclass(frozen=True)
 class ModeSet:
-    """The labelled modes of one model at one speed (one entry per conjugate pair)."""
+    """The labelled modes of one model at one speed (one entry per conjugate pair).
+
+    A sequence of its modes: ``len(ms)``, ``for m in ms``, ``ms[0]``; ``ms["short_period"]``
+    is :meth:`get`; ``"phugoid" in ms`` whether :meth:`get` finds that name."""
 
     speed_m_s: float
     model: str
     modes: tuple[Mode, ...]
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __getitem__(self, key: int | str) -> Mode:
+        """``key`` a name (:meth:`get`) or a position in :attr:`modes`."""
+        if isinstance(key, str):
+            return self.get(key)
+        return self.modes[key]
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and bool(name) and any(name in (m.mode, m.branch)
+                                                            for m in self.modes)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The modes' names, in order (a real pair's two roots: the name twice)."""
+        return tuple(m.mode for m in self.modes)
 
     def get(self, name: str) -> Mode:
         """The mode called ``name`` (for a real pair, the less stable root); failing that, the
