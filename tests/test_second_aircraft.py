@@ -238,3 +238,11 @@ def test_the_api_defaults_to_the_aircrafts_cruise_speed(sgs):
     assert api.modes(api.load_wing("optimised")).speed_m_s == 15.0  # the prototype's
     assert api.free_speed_range_m_s(sgs) == api.free_speed_range_m_s(sgs.wing(), 1.225)
     assert api.free_speed_range_m_s(api.load_wing("optimised")) == (5.0, 40.0)
+
+
+def test_a_modes_file_wing_reports_no_ribs(sgs):
+    """The log's and JSON's wing variant said ``ribs: true`` for the SGS's modes-file wing,
+    which has no ribs: the flag only chooses the prototype's beam."""
+    variant = sgs.wing().variant
+    assert variant.modes_file and variant.as_dict()["ribs"] is None
+    assert api.load_wing("optimised").variant.as_dict()["ribs"] is True

@@ -64,11 +64,12 @@ class WingVariant:
 
     x_inertial_frac, x_elastic_frac: axis positions as fractions of the chord aft of the
     leading edge [-]; ribs: the ribbed structure of Fig. 2(b) (Table 2 "with ribs") or the
-    homogeneous membrane; modes_file: a modal-data file (docs/structures.md) that replaces
-    the beam model; overrides: pinned Table B1 coefficients (reported by every output);
-    pinned_c_eta1_q1: pin C_η1^Q1 by shifting the aerodynamic offset e(y) of every mode
-    uniformly (the paper's "adjusted to"; reported by every output); published_c_eta1_q1:
-    the paper's value for comparison (None for user variants).
+    homogeneous membrane (unused with a modes file: None in :meth:`as_dict`); modes_file: a
+    modal-data file (docs/structures.md) that replaces the beam model; overrides: pinned
+    Table B1 coefficients (reported by every output); pinned_c_eta1_q1: pin C_η1^Q1 by
+    shifting the aerodynamic offset e(y) of every mode uniformly (the paper's "adjusted
+    to"; reported by every output); published_c_eta1_q1: the paper's value for comparison
+    (None for user variants).
     """
 
     name: str
@@ -87,7 +88,9 @@ class WingVariant:
             "name": self.name,
             "x_inertial_frac": self.x_inertial_frac,
             "x_elastic_frac": self.x_elastic_frac,
-            "ribs": self.ribs,
+            # a modes file's wing has no beam whose ribs the flag would choose: null, not a
+            # "true" a reader of the log's metadata would take for a property of the wing
+            "ribs": None if self.modes_file else self.ribs,
             "structural_damping": self.structural_damping,
             "modes_file": self.modes_file,
             "overrides": dict(self.overrides),
