@@ -130,6 +130,42 @@ def test_recover_skips_a_damaged_chunk_and_keeps_every_intact_one_after_it(log2s
     _doctor_ok(fixed)
 
 
+def test_plot_says_damage_it_does_not_read_and_refuses_damage_it_does(log2s, tmp_path,
+                                                                      capsys):
+    """A figure drawn from a log whose 3-D scene chunk was damaged said nothing of it (the
+    review of 2026-12-03): now one warning line and ``damaged`` in the JSON; damage in what
+    the figure reads stays exit 2, one line, pointing to ``--recover``."""
+    from mcap.reader import make_reader
+
+    with open(log2s, "rb") as f:
+        summary = make_reader(f).get_summary()
+    topics = {cid: ch.topic for cid, ch in summary.channels.items()}
+
+    def damaged(name: str, topic: str) -> Path:
+        chunk = next(c for c in summary.chunk_indexes
+                     if topic in {topics[i] for i in c.message_index_offsets})
+        data = bytearray(log2s.read_bytes())
+        data[chunk.chunk_start_offset + 400] ^= 0xFF  # inside the compressed records
+        out = tmp_path / name
+        out.write_bytes(bytes(data))
+        return out
+
+    assert cli.main(["plot", str(log2s), "--out", str(tmp_path / "ok.png"), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["damaged"] == [] and captured.err == ""
+    scene = damaged("scene.mcap", "/bioflex/coupled/scene")
+    assert cli.main(["plot", str(scene), "--out", str(tmp_path / "s.png"), "--json"]) == 0
+    captured = capsys.readouterr()
+    line = _one_line(captured.err)
+    assert "warning" in line and "damaged" in line and "--recover" in line
+    assert any("1 of" in d for d in json.loads(captured.out)["damaged"])
+    assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG"
+    rigid = damaged("rigid.mcap", RIGID)
+    assert cli.main(["plot", str(rigid), "--out", str(tmp_path / "r.png")]) == 2
+    line = _one_line(capsys.readouterr().err)
+    assert "--recover" in line and not (tmp_path / "r.png").exists()
+
+
 def test_recover_resyncs_after_a_damaged_record_length(log2s, tmp_path, capsys):
     chunks = _chunks(log2s)
     contents = _chunk_messages(log2s)

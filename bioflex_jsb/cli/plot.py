@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from bioflex_jsb.cli.case import add_force_argument, check_plot_path
 from bioflex_jsb.cli.common import UsageError, print_json
@@ -10,7 +11,9 @@ from bioflex_jsb.cli.common import UsageError, print_json
 HELP = """Draw the time histories logged in FILE.mcap (every wing model's run, and the LTI
 prediction where one was logged): airspeed perturbation u [m/s], angle of attack alpha
 [deg], pitch rate q [deg/s], pitch angle theta [deg], load factor n_z [-] and the first
-modal coordinate eta1 [deg], against simulation time [s]. Read through the mcap package."""
+modal coordinate eta1 [deg], against simulation time [s]. Read through the mcap package;
+every chunk is checked first, and damage where the figure does not read (the 3-D scene,
+the section loads) is said on stderr, the figure drawn from the intact chunks."""
 
 
 def register(sub) -> None:
@@ -27,14 +30,21 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from bioflex_jsb.sinks.mcap import LogError, histories
+    from bioflex_jsb.sinks.mcap import LogError, check_chunks, histories
 
     out = args.out or str(Path(args.file).with_suffix(".png"))
     check_plot_path(out, args.force)  # before reading the log: nothing is overwritten
+    # every chunk checked, not only the ones plotted: a figure drawn from a log damaged
+    # elsewhere (its scene, its loads) said nothing of it (the review of 2026-12-03)
+    try:
+        damage = check_chunks(args.file)["problems"]
+    except LogError as exc:
+        raise UsageError(str(exc)) from None
+    recover = "`bioflex-jsb info FILE --recover FIXED.mcap` copies its intact chunks"
     try:
         runs, meta = histories(args.file)
     except LogError as exc:
-        raise UsageError(str(exc)) from None
+        raise UsageError(f"{exc}; {recover}" if damage else str(exc)) from None
     if not runs or all(len(r.time_s) == 0 for r in runs):
         raise UsageError(f"{args.file!r} holds no bioflex run topics to plot")
     title = _title(meta, runs, Path(args.file).name)
@@ -44,8 +54,11 @@ def run(args: argparse.Namespace) -> int:
         plotting.time_histories(runs, out, title)
     except OSError as exc:
         raise UsageError(f"cannot write plot {out!r}: {exc.strerror}") from None
+    if damage:  # the figure is of intact chunks (each read is checked); the rest is not
+        print(f"bioflex-jsb plot: warning: {args.file!r} is damaged where the figure does "
+              f"not read ({'; '.join(damage[:2])}); {recover}", file=sys.stderr)
     if args.json:
-        print_json({"file": args.file, "plot": out,
+        print_json({"file": args.file, "plot": out, "damaged": damage,
                     "runs": [{"model": r.model, "label": str(r.meta.get("label", r.model)),
                               "samples": len(r.time_s)} for r in runs]})
     else:
