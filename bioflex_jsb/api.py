@@ -39,7 +39,7 @@ from bioflex_jsb.definition.aircraft import Aircraft
 from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
 from bioflex_jsb.definition.clamped import free_speed_range_m_s as _free_speed_range_m_s
 from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
-from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3
+from bioflex_jsb.definition.loader import DAMPING_RANGE, DENSITY_RANGE_KG_M3, LIFT_SLOPES
 from bioflex_jsb.drivers.compare import (
     Comparison,
     check_comparable,
@@ -64,6 +64,7 @@ from bioflex_jsb.runtime.other_airframe import airframe_for
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
+from bioflex_jsb.simulation.run import check_run_length
 
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
@@ -133,7 +134,10 @@ def _flying_wing(wing):
         if problem:
             raise InputError(problem)
     build = _wing(wing)
-    if (not isinstance(wing, Aircraft) and build is not None
+    if build is None:
+        raise InputError("give a wing (a WingBuild: api.load_wing) or an Aircraft "
+                         "(api.load_aircraft) to fly, not None")
+    if (not isinstance(wing, Aircraft)
             and build.model.airframe is not PROTOTYPE_AIRFRAME):
         raise InputError(f"wing {build.variant.name!r} is built for airframe "
                          f"{build.model.airframe.name!r}: a bare wing flies on the "
@@ -167,15 +171,23 @@ def _density(wing, density_kg_m3: float | None) -> dict:
     return {}
 
 
+# The lowest speed of a linear analysis [m/s]: its dynamic pressure at sea level is 6 mPa,
+# nothing an aircraft flies on; at 1e-300 m/s V² underflowed to 0 and the rigid model
+# divided by it (ZeroDivisionError, the review of 2026-12-04).
+LINEAR_SPEED_MIN_M_S = 0.1
+
+
 def _linear_speed(speed_m_s) -> float:
-    """A linear analysis' speed [m/s]: finite, 0 < V <= SPEED_LIMIT_M_S (the strips are
-    incompressible; a speed of 1e5 m/s took 71 s and answered nothing physical)."""
+    """A linear analysis' speed [m/s]: finite, LINEAR_SPEED_MIN_M_S <= V <= SPEED_LIMIT_M_S
+    (the strips are incompressible; a speed of 1e5 m/s took 71 s and answered nothing
+    physical)."""
     from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
     v = _real(speed_m_s, "speed_m_s [m/s]")
-    if not 0.0 < v <= SPEED_LIMIT_M_S:
-        raise InputError(f"speed {v:g} m/s is outside 0..{SPEED_LIMIT_M_S:g} m/s (the strip "
-                         "aerodynamics are incompressible)")
+    if not LINEAR_SPEED_MIN_M_S <= v <= SPEED_LIMIT_M_S:
+        raise InputError(f"speed {v:g} m/s is outside {LINEAR_SPEED_MIN_M_S:g}.."
+                         f"{SPEED_LIMIT_M_S:g} m/s (the strip aerodynamics are "
+                         "incompressible)")
     return v
 
 
@@ -269,6 +281,7 @@ def _check_run(gust, models, duration_s, gust_start_s, dt_s, trim, recorders) ->
     dt_s = _real(dt_s, "dt_s [s]")
     if duration_s <= 0.0:
         raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
+    check_run_length(duration_s, dt_s, gust.kind in ("dryden", "vonkarman"))
     if gust_start_s < 0.0 or (gust.kind != "none" and gust_start_s >= duration_s):
         raise InputError(f"gust_start_s {gust_start_s:g} s must be within the run: 0 <= "
                          f"gust_start_s < duration_s ({duration_s:g} s)")
@@ -283,6 +296,11 @@ def _check_run(gust, models, duration_s, gust_start_s, dt_s, trim, recorders) ->
         if unflown:
             raise InputError(f"recorders for {', '.join(unflown)}, which is not flown "
                              f"(models {', '.join(models)})")
+        for model, rec in recorders.items():  # a file name: "'str' has no attribute start"
+            if not all(callable(getattr(rec, m, None)) for m in ("start", "rows", "stop")):
+                raise InputError(f"the recorder of {model} must be a StepRecorder (start, "
+                                 f"rows, stop: e.g. RunLog.open(path, …).recorder(model)), "
+                                 f"not {rec!r}")
     return models, duration_s, gust_start_s, dt_s
 
 
@@ -320,6 +338,11 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
     """The paper's Fig. 21 case (optimised wing, 15 m/s, 3 m/s sharp-edged gust at 0.5 s)
     through ``model``: ``rigid``, ``coupled``, ``qsd``, or ``native`` (the repository's
     native XML wing, ``aircraft/bioflex_optimised``). The golden check cases."""
+    _check_choice("model", model, (*RUN_MODELS, "native"))
+    duration_s = _real(duration_s, "duration_s [s]")
+    if duration_s <= 0.0:  # 0 s returned an empty run, −1 s a numpy "negative dimensions"
+        raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
+    check_run_length(duration_s, DEFAULT_DT_S, turbulence=False)
     setup = RunSetup(15.0, parse_gust("sharp:3"), duration_s)
     if model == "native":
         from bioflex_jsb.generators.native_wing import aircraft_name
@@ -359,6 +382,8 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
 def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
     """Peaks of the response to a gust starting at ``gust_start_s`` [s] (None: the run's
     own, ``run.meta["gust_start_s"]``, else 0.5 s; units in the field names)."""
+    if not isinstance(run, TimeHistory):
+        raise InputError(f"run: a TimeHistory (fly_gust's), not {type(run).__name__}")
     if gust_start_s is None:
         gust_start_s = run.meta.get("gust_start_s", 0.5)
     gust_start_s = _real(gust_start_s, "gust_start_s [s]")
@@ -374,31 +399,9 @@ def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = Fa
 
     >>> api.plot_runs(api.fly_gust(wing, gust="sharp:3"), "gust.png", "sharp:3 at 15 m/s")
     """
-    from bioflex_jsb.plot_files import check_plot_target
-    from bioflex_jsb.sinks import plotting
+    from bioflex_jsb.sinks.plotting import gust_figure
 
-    if isinstance(runs, TimeHistory):
-        runs = [runs]
-    elif isinstance(runs, dict):
-        runs = list(runs.values())
-    elif not isinstance(runs, str | bytes) and isinstance(runs, Iterable):
-        runs = list(runs)
-    else:
-        raise InputError(f"runs: a TimeHistory, a sequence of them or fly_gust's dict, not "
-                         f"{type(runs).__name__}")
-    wrong = [type(r).__name__ for r in runs if not isinstance(r, TimeHistory)]
-    if wrong or not runs:
-        raise InputError("runs: give one TimeHistory or more (fly_gust's results), not "
-                         + (wrong[0] if wrong else "none"))
-    if title is None:
-        meta = runs[0].meta
-        title = ", ".join(x for x in (
-            f"{meta['wing']} wing" if meta.get("wing") else "",
-            f"{meta['speed_m_s']:g} m/s" if isinstance(meta.get("speed_m_s"), float) else "",
-            f"gust {meta['gust']}" if meta.get("gust") else "") if x)
-    if not isinstance(title, str):
-        raise InputError(f"title: a text, not {type(title).__name__}")
-    return plotting.time_histories(runs, check_plot_target(path, force), title)
+    return gust_figure(runs, path, title, force)
 
 
 def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
@@ -467,7 +470,16 @@ def load_definition(name_or_file: str = "goland") -> Definition:
 def _clamped(definition, lift_slope: str | None):
     from bioflex_jsb.definition.clamped import clamped_model
 
-    d = load_definition(definition) if isinstance(definition, str) else definition
+    if isinstance(definition, str | Path):
+        d = load_definition(str(definition))
+    elif isinstance(definition, Definition):
+        d = definition
+    else:  # a WingBuild, an Aircraft, None: an AttributeError deep in the model before
+        raise InputError(f"clamped=True analyses a clamped wing's definition (a name such as "
+                         f"'goland', a TOML file or api.load_definition's result), not "
+                         f"{type(definition).__name__}")
+    if lift_slope is not None:
+        _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
     return d, clamped_model(d, lift_slope)
 
 
@@ -486,14 +498,16 @@ def _check_density(rho: float) -> float:
 
 
 def _check_damping(zeta: float | None) -> float | None:
-    """A structural damping ratio ζ [-] (None: the wing's own): finite, 0 <= ζ < 1 (a
-    structural mode is under-damped; a variant file refuses the same)."""
+    """A structural damping ratio ζ [-] (None: the wing's own): finite, within the
+    definition files' DAMPING_RANGE, 0 <= ζ <= 0.3 (built-up wings measure 0.005-0.05; the
+    p-k method failed with an IndexError at 0.95, where modes are overdamped)."""
     if zeta is None:
         return None
     zeta = _real(zeta, "structural_damping [-]")
-    if not 0.0 <= zeta < 1.0:
-        raise InputError(f"structural_damping {zeta:g} must satisfy 0 <= structural_damping "
-                         "< 1 (a fraction of critical damping)")
+    lo, hi = DAMPING_RANGE
+    if not lo <= zeta <= hi:
+        raise InputError(f"structural_damping {zeta:g} must satisfy {lo:g} <= "
+                         f"structural_damping <= {hi:g} (a fraction of critical damping)")
     return zeta
 
 
@@ -574,7 +588,8 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
-        if isinstance(range_m_s, str) or len(tuple(range_m_s)) != 2:
+        if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
+                or len(tuple(range_m_s)) != 2:  # a bare number: "int is not iterable"
             raise InputError(f"flutter range must be (low, high) [m/s], got {range_m_s!r}")
         lo, hi = (_real(x, "flutter range [m/s]") for x in range_m_s)
         if not 0.0 < lo < hi <= SPEED_LIMIT_M_S:
@@ -656,7 +671,20 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
     ``static``: the 1 g part, ``elastic`` (default for coupled/qsd) or ``rigid``."""
     from bioflex_jsb.loads import section_loads as _section_loads
 
-    build = wing.wing() if callable(getattr(wing, "wing", None)) else wing
+    build = _wing(wing)
+    if build is None:
+        raise InputError("section loads need the wing the run flew (a WingBuild or an "
+                         "Aircraft), not None")
+    if isinstance(run, dict):
+        raise InputError("give one run (e.g. runs['coupled'] of fly_gust's dict), not the "
+                         "dict of runs")
+    if not isinstance(run, TimeHistory):
+        raise InputError(f"run: a TimeHistory (fly_gust's), not {type(run).__name__}")
+    if stations is not None:
+        if isinstance(stations, str | bytes) or not isinstance(stations, Iterable):
+            raise InputError(f"stations: a sequence of fractions of the semispan (e.g. "
+                             f"(0.0, 0.5)), not {stations!r}")
+        stations = [_real(x, "station [fraction of the semispan]") for x in stations]
     if density_kg_m3 is not None:
         density_kg_m3 = _check_density(density_kg_m3)
     return _section_loads(build, run, stations, static=static, density_kg_m3=density_kg_m3)

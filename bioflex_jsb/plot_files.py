@@ -22,7 +22,10 @@ def is_our_plot(path: str | Path) -> bool:
             if image.format != "PNG":
                 return False
             return str(image.info.get("Software", "")).startswith("bioflex-jsb")
-    except OSError:  # not an image PIL can read (PIL.UnidentifiedImageError is an OSError)
+    # not an image PIL can read (PIL.UnidentifiedImageError is an OSError); a header that
+    # claims more pixels than PIL opens (DecompressionBombError); a broken chunk (PIL raises
+    # SyntaxError or ValueError for some): none of them is a plot of ours
+    except (OSError, ValueError, SyntaxError, Image.DecompressionBombError):
         return False
 
 

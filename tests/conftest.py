@@ -34,3 +34,20 @@ def _log_directory(tmp_path_factory):
     mp.setenv(LOG_DIR_ENV_VAR, str(tmp_path_factory.mktemp("logs")))
     yield
     mp.undo()
+
+
+@pytest.fixture(scope="module")
+def optimised_wing():
+    """The optimised wing's build (api.load_wing), for the API's input tests."""
+    from bioflex_jsb import api
+
+    return api.load_wing("optimised")
+
+
+@pytest.fixture(scope="module")
+def optimised_run(optimised_wing):
+    """A 0.6 s coupled run of the optimised wing through the default gust from 0.1 s."""
+    from bioflex_jsb import api
+
+    return api.fly_gust(optimised_wing, models=("coupled",), duration_s=0.6,
+                        gust_start_s=0.1)["coupled"]

@@ -24,14 +24,6 @@ SPEED_RANGE_TEXT = (f"{SPEED_MIN_M_S:g} to {SPEED_MAX_M_S:g} m/s (the native exp
                     "flutter scan end at 40 m/s; the aircraft flies 10-25 m/s and cannot trim "
                     "below about 9 m/s)")
 
-# Longest simulated run of gust/compare [s]: 6 h. A run keeps one block of rows plus a
-# bounded-rate envelope beyond 120 s (drivers/gust.py: memory flat in the run's length), so
-# the limit is the wall time (6 h of flight is ~20 M steps, ~3 min) and the steps' count.
-MAX_DURATION_S = 6 * 3600.0
-MAX_STEPS = 50_000_000  # steps per run (--duration / --dt), whatever the step
-# Turbulence is synthesised for the whole run up front (an inverse FFT of its spectrum, 8
-# bytes per step and a power-of-two transform twice that long): bounded at 1 h of flight.
-MAX_TURBULENCE_DURATION_S = 3600.0
 
 
 def airspeed(text: str) -> float:
@@ -121,16 +113,13 @@ def check_plot_path(path: str | None, force: bool) -> None:
 
 
 def check_run_length(duration_s: float, dt_s: float, turbulence: bool = False) -> None:
-    """--duration and --dt within :data:`MAX_DURATION_S` (:data:`MAX_TURBULENCE_DURATION_S`
-    for a Dryden or von Kármán gust) and :data:`MAX_STEPS`."""
-    if duration_s > MAX_DURATION_S:
-        raise UsageError(f"--duration {duration_s:g} s is too long; accepted: up to "
-                         f"{MAX_DURATION_S:g} s per run (longer records: a sweep of cases)")
-    if turbulence and duration_s > MAX_TURBULENCE_DURATION_S:
-        raise UsageError(f"--duration {duration_s:g} s is too long for a turbulence record; "
-                         f"accepted: up to {MAX_TURBULENCE_DURATION_S:g} s (it is synthesised "
-                         "for the whole run up front)")
-    steps = duration_s / dt_s
-    if steps > MAX_STEPS:
-        raise UsageError(f"--duration {duration_s:g} s at --dt {dt_s:g} s is {steps:.3g} steps; "
-                         f"accepted: up to {MAX_STEPS:g} steps per run")
+    """--duration and --dt within the run's limits (:func:`bioflex_jsb.simulation.run.
+    check_run_length`: MAX_DURATION_S, MAX_TURBULENCE_DURATION_S for a Dryden or von Kármán
+    gust, MAX_STEPS); exit 2, one line."""
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.simulation.run import check_run_length as _check
+
+    try:
+        _check(duration_s, dt_s, turbulence)
+    except InputError as exc:
+        raise UsageError(f"--{exc}") from None  # "--duration … s is too long; …"

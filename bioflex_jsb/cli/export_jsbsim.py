@@ -51,7 +51,7 @@ package's SGS glider) as aircraft/<definition name>/, a copy of that file with t
 
 def register(sub) -> None:
     from bioflex_jsb.generators.native_wing import EXPORT_MODELS
-    from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+    from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 
     p = sub.add_parser("export-jsbsim", help="write the modal wing as JSBSim systems, an "
                        "aircraft, its trim and a console-program script", description=HELP)
@@ -61,7 +61,8 @@ def register(sub) -> None:
                         "default coupled")
     p.add_argument("--out", required=True, metavar="DIR", help="JSBSim root to write into")
     p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
-                   help=f"JSBSim step the system is exported for [s] (default {DEFAULT_DT_S:.6g})")
+                   help=f"JSBSim step the system is exported for [s], {MIN_DT_S:g}..{MAX_DT_S:g} "
+                        f"(and fine enough for the wing's modes; default {DEFAULT_DT_S:.6g})")
     p.add_argument("--speed", type=airspeed, default=None, metavar="V",
                    help=speed_help(DEFAULT_SPEED_M_S,
                                    extra="; it sets the script's level trim (the airframe trims "
@@ -137,12 +138,22 @@ def _check_csv_target(path: Path) -> None:
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.native import aircraft_spec, export_flight, write_export
     from bioflex_jsb.generators import native_wing as J
+    from bioflex_jsb.simulation.modal_wing import MAX_DT_S, MIN_DT_S
 
     check_file_name(args.out, "--out")
     build = wing_from_args(args)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} is not a directory")
+    parent = out.absolute().parent
+    if not out.exists() and not parent.is_dir():  # a mistyped path: no tree made for it
+        raise UsageError(f"cannot write into {args.out!r}: {str(parent)!r} "
+                         + ("is not a directory" if parent.exists() else
+                            "does not exist (DIR itself is made, not its parents)"))
+    # the co-simulation's range (gust --dt): below it JSBSim's trim of the exported aircraft
+    # failed and said "needs more thrust than the motor gives" (the review of 2026-12-04)
+    if not MIN_DT_S <= args.dt <= MAX_DT_S:
+        raise UsageError(f"--dt {args.dt:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
     from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.simulation.gusts import parse_gust
 

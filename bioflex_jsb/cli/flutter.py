@@ -74,13 +74,19 @@ def speed_range(text: str) -> tuple[float, float]:
 
 
 def damping_ratio(text: str) -> float:
+    """--structural-damping: a ratio within the definition files' DAMPING_RANGE (0..0.3;
+    the p-k method failed with an IndexError at 0.95, where modes are overdamped)."""
+    from bioflex_jsb.definition.loader import DAMPING_RANGE
+
+    lo, hi = DAMPING_RANGE
     try:
         z = float(text)
     except ValueError:
         z = math.nan
-    if not (0.0 <= z < 1.0):
+    if not (lo <= z <= hi):
         raise argparse.ArgumentTypeError(
-            f"structural damping must be a ratio 0 <= Z < 1 (e.g. 0.02), got {text!r}")
+            f"structural damping must be a ratio {lo:g} <= Z <= {hi:g} (e.g. 0.02), got "
+            f"{text!r}")
     return z
 
 
@@ -117,7 +123,7 @@ def register(sub) -> None:
                    "(eigen-analysis with mode tracking); default the definition's for "
                    "--clamped, state-space for paper wings")
     p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
-                   help="viscous modal damping ratio zeta [-], 0 <= Z < 1, on every mode "
+                   help="viscous modal damping ratio zeta [-], 0 <= Z <= 0.3, on every mode "
                    "(2 zeta omega_i); default the definition's for --clamped, the variant's "
                    "(0.02) for paper wings")
     p.add_argument("--lift-slope", choices=LIFT_SLOPE_CHOICES, default=None,

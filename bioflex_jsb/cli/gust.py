@@ -11,7 +11,6 @@ from bioflex_jsb.cli.case import (
     DEFAULT_GUST,
     DEFAULT_SPEED_M_S,
     DEFAULT_WING,
-    MAX_DURATION_S,
     SPEED_RANGE_TEXT,
     add_force_argument,
     airspeed,
@@ -35,6 +34,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
+from bioflex_jsb.simulation.run import MAX_DURATION_S
 
 HELP = f"""Trim the JSBSim airframe at --speed [m/s], fly it through --gust with the elastic
 wing as each of --models (rigid: wing loads off; coupled: dynamic modal states; qsd:

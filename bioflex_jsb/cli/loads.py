@@ -20,6 +20,7 @@ from bioflex_jsb.cli.common import (
     EnvironmentFault,
     UsageError,
     add_wing_arguments,
+    check_distinct_outputs,
     check_output,
     positive_float,
     print_json,
@@ -460,6 +461,7 @@ def _frequency(args, build) -> int:
                          f"{2 * 8.0 + FREQUENCY_START_S:g} s (two Welch segments of 8 s)")
     plot = args.plot if args.plot is not None else (None if args.json else "loads_psd.png")
     bode = args.bode if args.bode is not None else (None if args.json else "loads_bode.png")
+    check_distinct_outputs(("--plot", plot), ("--bode", bode))
     check_plot_path(plot, args.force)
     check_plot_path(bode, args.force)
     try:

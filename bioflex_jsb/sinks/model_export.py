@@ -10,6 +10,7 @@ mass basis, aerodynamic model, overrides, …). :func:`read_state_space` reads i
 from __future__ import annotations
 
 import json
+import zipfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -86,12 +87,16 @@ def state_space_from_arrays(data: Mapping[str, object], source: str = "model fil
         speed = float(np.asarray(data["speed_m_s"], dtype=float).reshape(-1)[0])
     except KeyError as exc:
         raise InputError(f"{source}: not a bioflex-jsb model file (no {exc.args[0]!r})") from None
+    except (IndexError, TypeError, ValueError) as exc:  # an empty speed, text for a matrix
+        raise InputError(f"{source}: not a bioflex-jsb model file ({exc})") from None
     notes: dict[str, object] = {}
     if "metadata" in data:
         try:
             notes = json.loads(_scalar_text(data["metadata"]))
         except ValueError:
             raise InputError(f"{source}: its metadata is not valid JSON") from None
+        if not isinstance(notes, dict):
+            raise InputError(f"{source}: its metadata is not a JSON object")
     n, m, p = a.shape[0], b.shape[1], c.shape[0]
     if (b.shape[0], c.shape[1], d.shape) != (n, n, (p, m)) or len(names["states"]) != n \
             or len(names["inputs"]) != m or len(names["outputs"]) != p:
@@ -109,12 +114,21 @@ def read_state_space(path: str | Path) -> StateSpace:
             with np.load(p, allow_pickle=False) as data:
                 return state_space_from_arrays(dict(data), str(p))
         from scipy.io import loadmat
+        from scipy.io.matlab import MatReadError
 
-        return state_space_from_arrays(loadmat(p), str(p))
+        try:
+            arrays = loadmat(p)
+        except MatReadError as exc:  # truncated, or not a .mat file at all
+            raise InputError(f"{str(p)!r} is not a model file: {exc}") from None
+        return state_space_from_arrays(arrays, str(p))
+    except InputError:
+        raise
     except OSError as exc:
         raise InputError(f"cannot read {str(p)!r}: {exc.strerror or exc}") from None
-    except ValueError as exc:  # not a zip/mat file
-        raise InputError(f"{str(p)!r} is not a model file: {exc}") from None
+    # not a zip/mat file: an empty .npz is an EOFError, a damaged zip a BadZipFile
+    except (ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise InputError(f"{str(p)!r} is not a model file: "
+                         f"{exc or type(exc).__name__}") from None
 
 
 def to_python_control(model):

@@ -7,7 +7,7 @@ user's file (which needs ``--force``): :func:`~bioflex_jsb.plot_files.is_our_plo
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -381,3 +381,37 @@ def _distinct_styles(runs: Sequence[TimeHistory]) -> dict[int, dict]:
         seen.add(key)
         out[id(run)] = style
     return out
+
+
+def gust_figure(runs, path: str | Path, title: str | None = None, force: bool = False
+                ) -> Path:
+    """:func:`time_histories` of ``runs`` (a TimeHistory, a sequence of them or a dict of
+    them: ``api.fly_gust``'s) to ``path`` (:func:`~bioflex_jsb.plot_files.check_plot_target`:
+    a figure suffix; an existing file only if it is a plot of ours, or ``force``); ``title``
+    None: the first run's wing, speed and gust (the ``gust`` command's). InputError, one
+    line, for anything that is not runs."""
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.plot_files import check_plot_target
+
+    if isinstance(runs, TimeHistory):
+        runs = [runs]
+    elif isinstance(runs, Mapping):
+        runs = list(runs.values())
+    elif not isinstance(runs, str | bytes) and isinstance(runs, Iterable):
+        runs = list(runs)
+    else:
+        raise InputError(f"runs: a TimeHistory, a sequence of them or fly_gust's dict, not "
+                         f"{type(runs).__name__}")
+    wrong = [type(r).__name__ for r in runs if not isinstance(r, TimeHistory)]
+    if wrong or not runs:
+        raise InputError("runs: give one TimeHistory or more (fly_gust's results), not "
+                         + (wrong[0] if wrong else "none"))
+    if title is None:
+        meta = runs[0].meta
+        title = ", ".join(x for x in (
+            f"{meta['wing']} wing" if meta.get("wing") else "",
+            f"{meta['speed_m_s']:g} m/s" if isinstance(meta.get("speed_m_s"), float) else "",
+            f"gust {meta['gust']}" if meta.get("gust") else "") if x)
+    if not isinstance(title, str):
+        raise InputError(f"title: a text, not {type(title).__name__}")
+    return time_histories(runs, check_plot_target(path, force), title)

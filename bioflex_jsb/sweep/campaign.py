@@ -402,6 +402,9 @@ def _unknown(table: dict, allowed: set[str], where: str) -> None:
         raise CampaignError(f"{key}: unknown key; accepted: {', '.join(sorted(allowed))}")
 
 
+MIN_SPEED_M_S = 1.0  # DECISION: a case's lowest airspeed [m/s] (1e-300 was a failed row)
+
+
 def _number(v: Any, key: str, unit: str, positive: bool = False, minimum: float | None = None,
             maximum: float | None = None) -> float:
     if not _is_number(v):
@@ -531,7 +534,7 @@ def parse_campaign(
 
     if "speeds_m_s" not in axes:
         raise CampaignError("axes.speeds_m_s: missing; give the airspeeds [m/s]")
-    speeds = [_number(v, f"axes.speeds_m_s[{i}]", "m/s", positive=True, maximum=100.0)
+    speeds = [_number(v, f"axes.speeds_m_s[{i}]", "m/s", minimum=MIN_SPEED_M_S, maximum=100.0)
               for i, v in enumerate(_values(axes["speeds_m_s"], "axes.speeds_m_s"))]
     speeds = _unique(speeds, "axes.speeds_m_s")
 
