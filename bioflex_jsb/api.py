@@ -395,7 +395,8 @@ def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = Fa
     :func:`fly_gust` returns) written to ``path`` (a figure suffix: ``.png``, ``.svg``,
     ``.pdf`` …; an existing file only if it is a plot of ours, or with ``force``): Δu, Δα,
     q, Δθ, n_z, the gust w_g and η₁ against time [s], the command's ``gust.png``; its path.
-    ``title`` None: the first run's speed and gust, as ``bioflex-jsb gust`` titles it.
+    ``title`` None: the first run's wing, speed and gust, as ``bioflex-jsb gust`` titles
+    it.
 
     >>> api.plot_runs(api.fly_gust(wing, gust="sharp:3"), "gust.png", "sharp:3 at 15 m/s")
     """

@@ -25,7 +25,6 @@ SPEED_RANGE_TEXT = (f"{SPEED_MIN_M_S:g} to {SPEED_MAX_M_S:g} m/s (the native exp
                     "below about 9 m/s)")
 
 
-
 def airspeed(text: str) -> float:
     """argparse type: an airspeed in :data:`AIRSPEED_RANGE_M_S` [m/s], a plain ASCII number
     (:func:`bioflex_jsb.errors.plain_number`)."""
@@ -110,6 +109,15 @@ def check_plot_path(path: str | None, force: bool) -> None:
     parent = Path(path).parent
     if not parent.is_dir():
         raise UsageError(f"plot file {path!r}: the directory {str(parent)!r} does not exist")
+
+
+def check_time_step(dt_s: float) -> None:
+    """--dt within the co-simulation's MIN_DT_S..MAX_DT_S [s] (gust, loads, export-jsbsim);
+    exit 2, one line."""
+    from bioflex_jsb.simulation.modal_wing import MAX_DT_S, MIN_DT_S
+
+    if not MIN_DT_S <= dt_s <= MAX_DT_S:
+        raise UsageError(f"--dt {dt_s:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
 
 
 def check_run_length(duration_s: float, dt_s: float, turbulence: bool = False) -> None:

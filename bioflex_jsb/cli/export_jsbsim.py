@@ -13,6 +13,7 @@ from bioflex_jsb.cli.case import (
     DEFAULT_WING,
     add_force_argument,
     airspeed,
+    check_time_step,
     speed_help,
 )
 from bioflex_jsb.cli.common import (
@@ -138,7 +139,6 @@ def _check_csv_target(path: Path) -> None:
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.native import aircraft_spec, export_flight, write_export
     from bioflex_jsb.generators import native_wing as J
-    from bioflex_jsb.simulation.modal_wing import MAX_DT_S, MIN_DT_S
 
     check_file_name(args.out, "--out")
     build = wing_from_args(args)
@@ -152,8 +152,7 @@ def run(args: argparse.Namespace) -> int:
                             "does not exist (DIR itself is made, not its parents)"))
     # the co-simulation's range (gust --dt): below it JSBSim's trim of the exported aircraft
     # failed and said "needs more thrust than the motor gives" (the review of 2026-12-04)
-    if not MIN_DT_S <= args.dt <= MAX_DT_S:
-        raise UsageError(f"--dt {args.dt:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
+    check_time_step(args.dt)
     from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.simulation.gusts import parse_gust
 

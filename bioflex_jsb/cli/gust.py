@@ -16,6 +16,7 @@ from bioflex_jsb.cli.case import (
     airspeed,
     check_plot_path,
     check_run_length,
+    check_time_step,
     speed_help,
 )
 from bioflex_jsb.cli.common import (
@@ -189,8 +190,7 @@ def close_bar(bar) -> None:
 
 def check_run_arguments(args) -> None:
     """The run arguments that argparse cannot check alone (before any file is written)."""
-    if not MIN_DT_S <= args.dt <= MAX_DT_S:
-        raise UsageError(f"--dt {args.dt:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
+    check_time_step(args.dt)
     check_run_length(args.duration, args.dt,
                      turbulence=args.gust.kind in ("dryden", "vonkarman"))
     from bioflex_jsb.simulation.gusts import check_gust_resolution

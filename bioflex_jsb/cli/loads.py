@@ -13,6 +13,7 @@ from bioflex_jsb.cli.case import (
     add_force_argument,
     airspeed,
     check_plot_path,
+    check_time_step,
     speed_help,
 )
 from bioflex_jsb.cli.common import (
@@ -239,8 +240,7 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
     resolve_flight(args)  # --speed: the aircraft's cruise speed, within its speeds
-    if not MIN_DT_S <= args.dt <= MAX_DT_S:
-        raise UsageError(f"--dt {args.dt:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
+    check_time_step(args.dt)
     build = wing_from_args(args)
     aircraft = getattr(args, "aircraft_definition", None)
     if build.airframe is not PROTOTYPE_AIRFRAME and (args.tuned or args.frequency):

@@ -30,14 +30,13 @@ class RunDescriptionError(InputError):
 
 # Longest simulated run of gust/compare [s]: 6 h. A run keeps one block of rows plus a
 # bounded-rate envelope beyond 120 s (memory flat in the run's length, drivers/gust.py),
-# so the limit is the wall time (6 h of flight is ~20 M steps, ~3 min) and the steps' count. The
-# CLI (cli/case.py) and the API (api.fly_gust, api.compare) refuse longer runs.
+# so the limit is the wall time (6 h of flight is ~20 M steps, ~3 min) and the steps'
+# count. The CLI (cli/case.py) and the API (api.fly_gust, api.compare) refuse longer runs.
 MAX_DURATION_S = 6 * 3600.0
 MAX_STEPS = 50_000_000  # steps per run (duration / dt), whatever the step
 # Turbulence is synthesised for the whole run up front (an inverse FFT of its spectrum, 8
 # bytes per step and a power-of-two transform twice that long): bounded at 1 h of flight.
 MAX_TURBULENCE_DURATION_S = 3600.0
-
 
 
 def check_run_length(duration_s: float, dt_s: float, turbulence: bool = False) -> None:
@@ -54,6 +53,7 @@ def check_run_length(duration_s: float, dt_s: float, turbulence: bool = False) -
         raise InputError(f"duration {duration_s:g} s at a step of {dt_s:g} s is "
                          f"{duration_s / dt_s:.3g} steps; accepted: up to {MAX_STEPS:g} steps "
                          "per run")
+
 
 @dataclass(frozen=True)
 class RunDescription:
