@@ -48,7 +48,11 @@ from bioflex_jsb.flight_dynamics import eigen
 from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
-from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
+from bioflex_jsb.flight_dynamics.rigid import (
+    alpha_rate_scale,
+    level_flight_condition,
+    rigid_derivatives,
+)
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 
 AERO_MODELS = engine.AERO_MODELS
@@ -167,6 +171,7 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
     af = cond.airframe
     mass, iyy = af.mass.mass_kg, af.mass.iyy_kg_m2
     rd = rigid_derivatives(cond)
+    _div, f = alpha_rate_scale(rd)  # the lift of α̇ (C_Lα̇), where the derivatives have it
     mi = np.asarray(model.generalised_masses_kg_m2, dtype=float)
     k_ind = af.aero.k_induced
 
@@ -176,8 +181,8 @@ def unsteady_descriptor(build, speed_m_s: float, *, structural_damping: float | 
         q = q.reshape(n, -1)
         out = np.zeros((n_all, z.size))
         out[0] = 2.0 * k_ind * cond.cl_trim * z / mass
-        out[ia] = z / (mass * v)
-        out[iq] = m / iyy + rd.m_wdot * z / mass
+        out[ia] = z / (mass * v) * f
+        out[iq] = m / iyy + rd.m_wdot * z / mass * f
         out[ied] = q / mi[:, None]
         return out
 

@@ -35,6 +35,7 @@ from bioflex_jsb.flight_dynamics.rigid import (
     RIGID_STATES,
     FlightCondition,
     RigidDerivatives,
+    alpha_rate_scale,
     rigid_derivatives,
     rigid_matrices,
 )
@@ -189,9 +190,10 @@ def coupled_blocks(
         g_r = (a_rr[:, 1] / condition.speed_m_s).reshape(4, 1)
     u0 = condition.speed_m_s
     n = wing.n_modes
+    div, f = alpha_rate_scale(rd)
 
     def rigid_rows(x, z, m):
-        return np.vstack([x, z / u0, m + rd.m_wdot * z, np.zeros(n)])
+        return np.vstack([x, z / div, m + rd.m_wdot * z * f, np.zeros(n)])
 
     omega = np.asarray(wing.frequencies_rad_s, dtype=float)
     zeta = np.asarray(wing.damping_ratios, dtype=float)
@@ -232,9 +234,10 @@ def control_columns(condition: FlightCondition, aero: RigidAerodynamics | None =
     and the induced drag of that lift, 2 k C_L0 C_Lδe; the tail does not load the wing's
     modes. Throttle: X_δt = ∂T/∂δt / m at the trim airspeed with the propeller RPM
     quasi-static (:func:`thrust_per_throttle_n`); the thrust line passes through the centre
-    of gravity (no moment); an airframe without propulsion (a glider) has a zero throttle
-    column. Units: per rad of elevator, per unit throttle. S, c̄, mass, I_yy and the
-    derivatives are the condition's airframe's unless given.
+    of gravity (no moment); an airframe without the prototype's propulsion model takes the
+    derivatives' C_Tδt and C_mδt (a JSBSim aircraft's, identified; zero for a glider).
+    Units: per rad of elevator, per unit throttle. S, c̄, mass, I_yy and the derivatives
+    are the condition's airframe's unless given.
     """
     af = condition.airframe
     aero = af.aero if aero is None else aero
@@ -246,9 +249,15 @@ def control_columns(condition: FlightCondition, aero: RigidAerodynamics | None =
     z_de = -aero.cl_delta_e_per_rad * qs / mass_kg
     x_de = -2.0 * aero.k_induced * condition.cl_trim * aero.cl_delta_e_per_rad * qs / mass_kg
     m_de = aero.cm_delta_e_per_rad * qs * cb / iyy_kg_m2
+    div, f = alpha_rate_scale(rigid_derivatives(condition, aero, mass_kg, iyy_kg_m2))
     m_wdot = aero.cm_alphadot_per_rad * qs * cb**2 / (2.0 * iyy_kg_m2 * u0**2)
-    x_dt = 0.0 if af.propulsion is None else thrust_per_throttle_n(condition) / mass_kg
-    return np.array([[x_de, x_dt], [z_de / u0, 0.0], [m_de + m_wdot * z_de, 0.0], [0.0, 0.0]])
+    if af.propulsion is None:
+        x_dt = aero.ct_delta_t * qs / mass_kg
+        m_dt = aero.cm_delta_t * qs * cb / iyy_kg_m2
+    else:
+        x_dt, m_dt = thrust_per_throttle_n(condition) / mass_kg, 0.0
+    return np.array([[x_de, x_dt], [z_de / div, 0.0], [m_de + m_wdot * z_de * f, m_dt],
+                     [0.0, 0.0]])
 
 
 def _drive(condition: FlightCondition):

@@ -73,7 +73,9 @@ def level_flight_condition(
     """
     if not (np.isfinite(speed_m_s) and speed_m_s > 0.0):
         raise ValueError(f"speed_m_s must be finite and > 0, got {speed_m_s!r}")
-    if aero is not None and aero is not airframe.aero:
+    if aero is None:
+        airframe = airframe.at_speed(speed_m_s)  # an identified schedule's derivatives
+    elif aero is not airframe.aero:
         airframe = replace(airframe, aero=aero)
     if mass_kg is not None and mass_kg != airframe.mass.mass_kg:
         airframe = replace(airframe, mass=replace(airframe.mass, mass_kg=float(mass_kg)))
@@ -90,7 +92,8 @@ class RigidDerivatives:
     """Dimensional longitudinal derivatives of Table B2 at one flight condition.
 
     Units: X_u, Z_u [1/s]; X_α, Z_α [m/s²/rad]; M_u [rad/(s²·m/s)]; M_α [1/s²];
-    M_q [1/s]; M_ẇ [1/m] (M_ẇ·u_0 = M_α̇ [1/s]).
+    M_q [1/s]; M_ẇ [1/m] (M_ẇ·u_0 = M_α̇ [1/s]); Z_q [m/s per rad/s] and Z_ẇ [-] (the lift
+    of pitch rate and of α̇ = ẇ/u_0: C_Lq, C_Lα̇; zero in Table B2).
     """
 
     condition: FlightCondition
@@ -102,6 +105,8 @@ class RigidDerivatives:
     m_alpha: float
     m_q: float
     m_wdot: float
+    z_q: float = 0.0
+    z_wdot: float = 0.0
 
 
 def rigid_derivatives(
@@ -110,10 +115,14 @@ def rigid_derivatives(
     mass_kg: float | None = None,
     iyy_kg_m2: float | None = None,
 ) -> RigidDerivatives:
-    """Table B2 derivatives. C_Du = C_Lu = C_mu = 0 (incompressible, no Reynolds effect);
-    C_Dα = 2 k C_L0 C_Lα from the parabolic polar; thrust is taken speed-independent
-    (Table B2 has no thrust term). S, c̄, the mass, I_yy and the derivatives are the
-    condition's airframe's; ``aero``, ``mass_kg``, ``iyy_kg_m2`` replace them."""
+    """Table B2 derivatives, with the terms Table B2 leaves out where the derivatives give
+    them (:class:`~bioflex_jsb.parameters.airframe.RigidAerodynamics`: 0 for the paper's
+    aircraft, where C_Du = C_Lu = C_mu = 0, incompressible and no Reynolds effect, thrust
+    speed-independent, no C_Lq, C_Lα̇): X_u = (C_Tu − 2 C_D − C_Du) Q S/(m u_0), Z_u =
+    −(2 C_L + C_Lu) Q S/(m u_0), M_u = C_mu Q S c̄/(I_yy u_0), Z_q = −C_Lq Q S c̄/(2 m u_0),
+    Z_ẇ = −C_Lα̇ Q S c̄/(2 m u_0²). C_Dα = 2 k C_L0 C_Lα from the parabolic polar. S, c̄, the
+    mass, I_yy and the derivatives are the condition's airframe's; ``aero``, ``mass_kg``,
+    ``iyy_kg_m2`` replace them."""
     af = condition.airframe
     aero = af.aero if aero is None else aero
     mass_kg = af.mass.mass_kg if mass_kg is None else mass_kg
@@ -122,35 +131,50 @@ def rigid_derivatives(
     qs = condition.dynamic_pressure_pa * af.reference.area_m2
     cbar = af.reference.mean_chord_m
     cd_alpha = 2.0 * aero.k_induced * condition.cl_trim * aero.cl_alpha_per_rad
+    # written so that the paper's aircraft (every extra term 0) gives Table B2 to the bit
     return RigidDerivatives(
         condition=condition,
-        x_u=-(2.0 * condition.cd_trim) * qs / (mass_kg * u0),
+        x_u=-(2.0 * condition.cd_trim + aero.cd_u - aero.ct_u) * qs / (mass_kg * u0),
         x_alpha=-(cd_alpha - condition.cl_trim) * qs / mass_kg,
-        z_u=-(2.0 * condition.cl_trim) * qs / (mass_kg * u0),
+        z_u=-(2.0 * condition.cl_trim + aero.cl_u) * qs / (mass_kg * u0),
         z_alpha=-(aero.cl_alpha_per_rad + condition.cd_trim) * qs / mass_kg,
-        m_u=0.0,
+        m_u=aero.cm_u * qs * cbar / (iyy_kg_m2 * u0),
         m_alpha=aero.cm_alpha_per_rad * qs * cbar / iyy_kg_m2,
         m_q=aero.cm_q_per_rad * qs * cbar**2 / (2.0 * iyy_kg_m2 * u0),
         m_wdot=aero.cm_alphadot_per_rad * qs * cbar**2 / (2.0 * iyy_kg_m2 * u0**2),
+        z_q=-aero.cl_q_per_rad * qs * cbar / (2.0 * mass_kg * u0),
+        z_wdot=-aero.cl_alphadot_per_rad * qs * cbar / (2.0 * mass_kg * u0**2),
     )
 
 
+def alpha_rate_scale(d: RigidDerivatives) -> tuple[float, float]:
+    """(the divisor of the α̇ equation u_0 (1 − Z_ẇ) [m/s], the factor u_0 divided by it
+    [-]): with the lift of α̇ (Z_ẇ) the α equation u_0 α̇ = Z_u u + Z_α α + (u_0 + Z_q) q
+    + Z_ẇ u_0 α̇ is solved for α̇. Without it the divisor is u_0 and the factor exactly 1."""
+    u0 = d.condition.speed_m_s
+    divisor = u0 - d.z_wdot * u0
+    return divisor, u0 / divisor
+
+
 def rigid_matrices(d: RigidDerivatives) -> tuple[np.ndarray, np.ndarray]:
-    """A_RR (4×4) and G_R (4×1) of Appendix B, states [u, α, q, θ], input w_g [m/s]."""
+    """A_RR (4×4) and G_R (4×1) of Appendix B, states [u, α, q, θ], input w_g [m/s]; the
+    α row solved for α̇ (:func:`alpha_rate_scale`) and the pitch row with M_ẇ u_0 α̇."""
     u0 = d.condition.speed_m_s
     g = STANDARD_GRAVITY_M_S2
+    div, f = alpha_rate_scale(d)
     a = np.array(
         [
             [d.x_u, d.x_alpha, 0.0, -g],
-            [d.z_u / u0, d.z_alpha / u0, 1.0, 0.0],
+            [d.z_u / div, d.z_alpha / div, (u0 + d.z_q) / div, 0.0],
             [
-                d.m_u + d.m_wdot * d.z_u,
-                d.m_alpha + d.m_wdot * d.z_alpha,
-                d.m_q + d.m_wdot * u0,
+                d.m_u + d.m_wdot * d.z_u * f,
+                d.m_alpha + d.m_wdot * d.z_alpha * f,
+                d.m_q + d.m_wdot * (u0 + d.z_q) * f,
                 0.0,
             ],
             [0.0, 0.0, 1.0, 0.0],
         ]
     )
-    g_r = np.array([d.x_alpha, d.z_alpha / u0, d.m_alpha + d.m_wdot * d.z_alpha, 0.0]) / u0
+    g_r = np.array([d.x_alpha, d.z_alpha / div, d.m_alpha + d.m_wdot * d.z_alpha * f,
+                    0.0]) / u0
     return a, g_r.reshape(4, 1)

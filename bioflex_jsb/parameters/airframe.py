@@ -13,7 +13,7 @@ C_L is positive up, C_m positive nose-up, C_D positive aft, C_Y positive to star
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from bioflex_jsb.parameters import prototype as P
 
@@ -104,6 +104,24 @@ class RigidAerodynamics:
     cn_r_per_rad: float
     cn_delta_r_per_rad: float
     cy_delta_r_per_rad: float
+    # Terms the paper's Table B2 leaves out (0: the prototype's model), identified from a
+    # JSBSim aircraft (runtime/identification.py) or typed. Rates non-dimensional with
+    # c̄/(2V); speed derivatives are V ∂C/∂V at constant α and throttle [-].
+    cl_q_per_rad: float = 0.0  # ∂C_L/∂(q c̄/2V)
+    cl_alphadot_per_rad: float = 0.0  # ∂C_L/∂(α̇ c̄/2V)
+    cl_u: float = 0.0  # V ∂C_L/∂V (compressibility, Reynolds number, propwash)
+    cd_u: float = 0.0  # V ∂C_D/∂V
+    # V ∂C_m/∂V of the whole pitching moment about the CG, the thrust's included (thrust
+    # line off the CG, propwash on the tail)
+    cm_u: float = 0.0
+    # The thrust along the trim's stability x axis [-]: V/(Q S) ∂T/∂V at constant throttle
+    # with the engines at their steady RPM (a fixed-pitch propeller at constant power:
+    # about −C_T; a jet: about 0), and per unit of throttle, ∂T/∂δt/(Q S) and its pitching
+    # moment ∂M/∂δt/(Q S c̄). Zero for a glider, and for the prototype, whose propeller
+    # model gives them (flight_dynamics/lti.py).
+    ct_u: float = 0.0
+    ct_delta_t: float = 0.0
+    cm_delta_t: float = 0.0
 
 
 # CALIBRATED (docs/decisions.md, "Rigid short period"): with S = b·c̄ and C_Lα fixed by the
@@ -372,6 +390,41 @@ CONTROL_LIMITS = ControlLimits(
 # One aircraft's rigid data as one object (passed into every linear analysis)
 # --------------------------------------------------------------------------------------
 @dataclass(frozen=True)
+class DerivativeSchedule:
+    """Rigid derivatives identified at several speeds (a JSBSim aircraft's, whose tables
+    depend on α: the trim α, and so the derivatives, change with speed):
+    ``speeds_m_s`` ascending [m/s], ``points`` the :class:`RigidAerodynamics` at each,
+    ``source`` where they come from (the JSBSim aircraft, the altitude). :meth:`at`
+    interpolates every field linearly in speed and holds the end values beyond the speeds
+    identified (outside its flight envelope an aircraft cannot be trimmed; the
+    non-dimensional derivatives of its nearest edge are kept)."""
+
+    speeds_m_s: tuple[float, ...]
+    points: tuple[RigidAerodynamics, ...]
+    source: str
+
+    def __post_init__(self) -> None:
+        if len(self.speeds_m_s) != len(self.points) or not self.points:
+            raise ValueError("a derivative schedule needs one point per speed, at least one")
+        if any(b <= a for a, b in zip(self.speeds_m_s[:-1], self.speeds_m_s[1:], strict=True)):
+            raise ValueError(f"speeds must ascend, got {self.speeds_m_s}")
+
+    def at(self, speed_m_s: float) -> RigidAerodynamics:
+        """The derivatives at ``speed_m_s`` [m/s] (class docstring)."""
+        v = float(speed_m_s)
+        speeds = self.speeds_m_s
+        if v <= speeds[0]:
+            return self.points[0]
+        if v >= speeds[-1]:
+            return self.points[-1]
+        k = next(i for i in range(1, len(speeds)) if v <= speeds[i])
+        w = (v - speeds[k - 1]) / (speeds[k] - speeds[k - 1])
+        a, b = self.points[k - 1], self.points[k]
+        return RigidAerodynamics(**{f: (1.0 - w) * getattr(a, f) + w * getattr(b, f)
+                                    for f in RigidAerodynamics.__dataclass_fields__})
+
+
+@dataclass(frozen=True)
 class AirframeData:
     """What the linear analyses take from an aircraft besides its elastic wing: the reference
     geometry of the coefficients (S [m²], b [m], c̄ [m]), the mass properties about the CG
@@ -389,6 +442,17 @@ class AirframeData:
     mass: MassProperties
     aero: RigidAerodynamics
     propulsion: Propulsion | None = None
+    # derivatives identified at several speeds (a JSBSim aircraft's); ``aero`` is then the
+    # schedule's at the cruise speed, and :meth:`at_speed` gives each speed's
+    schedule: DerivativeSchedule | None = None
+
+    def at_speed(self, speed_m_s: float) -> AirframeData:
+        """This airframe with the derivatives at ``speed_m_s`` [m/s] (itself without a
+        schedule)."""
+        if self.schedule is None:
+            return self
+        aero = self.schedule.at(speed_m_s)
+        return self if aero == self.aero else replace(self, aero=aero)
 
 
 PROTOTYPE_AIRFRAME = AirframeData("bioflex", REFERENCE_GEOMETRY, MASS_PROPERTIES,
