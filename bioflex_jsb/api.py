@@ -60,7 +60,8 @@ from bioflex_jsb.flight_dynamics.wing_model import (
 )
 from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
-from bioflex_jsb.runtime.other_airframe import airframe_for
+from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+from bioflex_jsb.runtime.jsbsim_aircraft import complete as complete_aircraft
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
@@ -104,8 +105,10 @@ def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
     wing. Every field is checked when read (one line naming it). Pass the
     :class:`Aircraft` to :func:`fly_gust`, :func:`compare`, :func:`linear_model`,
     :func:`modes`, :func:`flutter` in place of a wing (``aircraft.wing()`` is its
-    :class:`WingBuild`)."""
-    return _load_aircraft(name_or_file)
+    :class:`WingBuild`). What the file leaves out of its ``[airframe]`` (mass, CG, inertia,
+    S, b, c̄, the speeds, the rigid derivatives) is read or identified from its JSBSim
+    aircraft, and what it gives is checked against it (docs/aircraft.md)."""
+    return complete_aircraft(_load_aircraft(name_or_file))
 
 
 def _wing(wing):

@@ -208,7 +208,7 @@ def fly_sgs_case(case: str, wing="stored", **setup):
     """Fly one SGS golden case (a TimeHistory, every step) on the glider's own JSBSim
     airframe; ``wing`` as :func:`fly_case`'s (``"stored"``, ``"built"`` or a model)."""
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
 
     aircraft = sgs_aircraft()

@@ -16,6 +16,7 @@ from bioflex_jsb.generators import airframe as X
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import POST_STALL, PROPULSION, RIGID_AERODYNAMICS
 from bioflex_jsb.runtime import fdm as jsbsim_fdm
+from bioflex_jsb.runtime.engines import zero_thrust_advance_ratio
 from tests.tools import env_program
 
 REPO = Path(__file__).resolve().parents[1]
@@ -211,7 +212,7 @@ def test_propeller_tables_are_plausible_and_size_the_motor():
     assert 0.6 < j0 < 1.0 and j[-1] > j0  # the table runs past zero thrust
     # and the runtime reads the same zero-thrust point from the file JSBSim flies
     path = jsbsim_fdm.aircraft_file(REPO, jsbsim_fdm.DEFAULT_AIRCRAFT)
-    assert jsbsim_fdm._zero_thrust_advance_ratio(path) == pytest.approx(j0, rel=1e-9)
+    assert zero_thrust_advance_ratio(path) == pytest.approx(j0, rel=1e-9)
 
 
 def test_hand_derived_short_period_matches_jsbsim_linearization():
@@ -370,9 +371,9 @@ def test_the_capturing_logger_keeps_each_message_whole_with_its_level_and_nothin
     the next (the logger's cheap path for silent steps, runtime/jsbsim_log.py)."""
     import jsbsim
 
-    from bioflex_jsb.runtime.jsbsim_log import _CapturingLogger
+    from bioflex_jsb.runtime.jsbsim_log import CapturingLogger
 
-    log = _CapturingLogger()
+    log = CapturingLogger()
     for _ in range(3):  # silent steps
         log.set_level(jsbsim.LogLevel.INFO)
         log.flush()

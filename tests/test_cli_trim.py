@@ -157,7 +157,7 @@ def test_linearize_takes_an_aircraft_definition(capsys):
     from bioflex_jsb import api
     from bioflex_jsb.flight_dynamics.lti import control_columns
     from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 
     code, out, err = _run(capsys, ["linearize", "--aircraft", "sgs_elastic", "--json"])
     assert code == 0 and err == ""

@@ -192,7 +192,7 @@ def test_native_sgs_matches_the_cosimulation(exported, amplitude):
     the rigid SGS of the same file is 8.6 % off in q: the wing is seen."""
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import nrmse
 

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import api
-from bioflex_jsb.runtime.other_airframe import airframe_for
+from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import nrmse
 from tests.cli_helpers import assert_one_line_error, run_cli
@@ -182,18 +182,18 @@ def test_compare_takes_a_definition_on_a_users_jsbsim_directory(tmp_path, capsys
 
 
 @pytest.mark.parametrize("line, field", [
-    ("mass_kg = 354.26", "airframe.mass_kg = 354.26 kg but"),  # +10 %: the XML's 710 lb
-    ("span_m = 14.3", "airframe.span_m = 14.3 m but"),  # +1.6 %
-    ("cg_m = [0.02, 0.0, 0.0]", "airframe.cg_m (x) = 0.02 m but"),  # 2 % of the chord aft
+    ("mass_kg = 354.26", "mass_kg 354.26 kg (JSBSim: 322.05"),  # +10 %: the XML's 710 lb
+    ("span_m = 14.3", "span_m 14.3 m (JSBSim: 14.07"),  # +1.6 %
+    ("cg_m = [0.02, 0.0, 0.0]", "cg_m (x) 0.02 m (JSBSim: 0 m"),  # 2 % of the chord aft
     ("inertia_kg_m2 = { ixx = 1376.2, iyy = 911.11, izz = 2254.7, ixz = 73.892 }",
-     "airframe.inertia_kg_m2.ixz = 73.892"),  # the sign flipped
+     "inertia_kg_m2.ixz 73.892 kg·m² (JSBSim: -73.89"),  # the sign flipped
 ])
 def test_a_file_that_is_not_its_jsbsim_aircraft_is_refused(tmp_path, capsys, line, field):
     """The definition's airframe numbers must be its JSBSim aircraft's
-    (other_airframe.definition_mismatch, 1 %): JSBSim flies the XML's mass and geometry
-    while the wing's trim and loads take the file's. A file 10 % heavier than SGS.xml was
-    flown at the XML's 322 kg with the loads of 354 kg; now every flight command refuses it
-    in one line naming the field."""
+    (Aircraft.jsbsim_mismatches, 1 %): JSBSim flies the XML's mass and geometry while the
+    wing's trim and loads take the file's. A file 10 % heavier than SGS.xml was flown at the
+    XML's 322 kg with the loads of 354 kg; now every command that takes the aircraft refuses
+    it in one line naming the field and JSBSim's value."""
     shutil.copy(DATA / "sgs_elastic_modes.toml", tmp_path / "sgs_elastic_modes.toml")
     text = (DATA / "sgs_elastic.toml").read_text(encoding="utf-8")
     key = line.split(" =")[0]
@@ -201,27 +201,42 @@ def test_a_file_that_is_not_its_jsbsim_aircraft_is_refused(tmp_path, capsys, lin
     assert lines != text.splitlines()
     definition = tmp_path / "glider.toml"
     definition.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    for command in (("gust", "--no-log"), ("trim",)):
+    for command in (("gust", "--no-log"), ("trim",), ("modes", "--speed", "25")):
         code, _, err = run_cli(capsys, *command, "--aircraft", str(definition))
         assert_one_line_error(code, err, field)
-    # the analyses without JSBSim still take the file (they use its numbers only)
-    code, _, _ = run_cli(capsys, "modes", "--aircraft", str(definition), "--speed", "25")
-    assert code == 0
 
 
-def test_a_glider_without_its_speeds_is_analysed_not_flown(tmp_path, capsys):
-    """Without airframe.cruise_speed_m_s and speed_range_m_s the linear analyses take the
-    file, the flight commands refuse it in one line naming the fields."""
+def test_every_mismatch_is_listed_in_one_line(tmp_path, capsys):
+    """Two fields that are not the JSBSim aircraft's: both in the one line (a user fixes
+    the file once, not one field per run)."""
+    shutil.copy(DATA / "sgs_elastic_modes.toml", tmp_path / "sgs_elastic_modes.toml")
+    text = (DATA / "sgs_elastic.toml").read_text(encoding="utf-8")
+    text = text.replace("mass_kg = 322.05 ", "mass_kg = 354.26 ").replace(
+        "span_m = 14.073 ", "span_m = 14.3 ")
+    definition = tmp_path / "glider.toml"
+    definition.write_text(text, encoding="utf-8")
+    code, _, err = run_cli(capsys, "trim", "--aircraft", str(definition))
+    assert_one_line_error(code, err, "span_m 14.3 m (JSBSim: 14.07")
+    assert "mass_kg 354.26 kg (JSBSim: 322.05" in err
+
+
+def test_a_glider_without_its_speeds_flies_at_the_speeds_of_its_jsbsim_model(tmp_path, capsys):
+    """Without airframe.cruise_speed_m_s and speed_range_m_s the speeds come from the JSBSim
+    aircraft's glide trims (runtime/jsbsim_aircraft.py envelope): 1.3 x its stall speed
+    (17.7 m/s at CLwbh's peak 1.26) to its fastest glide 1 deg inside its alpha tables, the
+    cruise its best glide ratio; the file's own estimates were 20-28 m/s, cruise 25."""
     shutil.copy(DATA / "sgs_elastic_modes.toml", tmp_path / "sgs_elastic_modes.toml")
     text = (DATA / "sgs_elastic.toml").read_text(encoding="utf-8")
     text = "\n".join(ln for ln in text.splitlines()
                      if not ln.startswith(("cruise_speed_m_s", "speed_range_m_s")))
     definition = tmp_path / "glider.toml"
     definition.write_text(text + "\n", encoding="utf-8")
-    code, _, err = run_cli(capsys, "gust", "--aircraft", str(definition), "--no-log")
-    assert_one_line_error(code, err, "airframe.cruise_speed_m_s and airframe.speed_range_m_s")
-    code, _, _ = run_cli(capsys, "modes", "--aircraft", str(definition), "--speed", "25")
+    code, out, _ = run_cli(capsys, "trim", "--aircraft", str(definition), "--json")
     assert code == 0
+    trim = json.loads(out)
+    assert trim["speed_m_s"] == pytest.approx(28.0)
+    code, _, err = run_cli(capsys, "trim", "--aircraft", str(definition), "--speed", "29")
+    assert_one_line_error(code, err, "outside aircraft 'sgs_elastic'")
     bad = text.replace("[airframe]", "[airframe]\nspeed_range_m_s = [28.0, 20.0]", 1)
     definition.write_text(bad + "\n", encoding="utf-8")
     code, _, err = run_cli(capsys, "gust", "--aircraft", str(definition), "--no-log")

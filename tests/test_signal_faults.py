@@ -38,7 +38,7 @@ sys.exit(main())
 IN_CALLBACK = """
 from bioflex_jsb.interrupts import native_callback
 from bioflex_jsb.runtime import jsbsim_log as _jl
-_orig = getattr(_jl._CapturingLogger, {method!r})
+_orig = getattr(_jl.CapturingLogger, {method!r})
 _n = [0]
 @native_callback
 def _wrapped(self, *a):
@@ -48,7 +48,7 @@ def _wrapped(self, *a):
         for _ in range(1000):  # many bytecode boundaries inside the callback
             pass
     return _orig(self, *a)
-setattr(_jl._CapturingLogger, {method!r}, _wrapped)
+setattr(_jl.CapturingLogger, {method!r}, _wrapped)
 """
 
 
@@ -81,13 +81,13 @@ def test_every_method_jsbsim_calls_back_is_marked_a_native_callback():
     the SystemError back."""
     import jsbsim
 
-    from bioflex_jsb.runtime.jsbsim_log import _CapturingLogger
+    from bioflex_jsb.runtime.jsbsim_log import CapturingLogger
 
     called_back = [n for n in dir(jsbsim.FGLogger) if not n.startswith("_")]
-    overridden = [n for n in called_back if n in vars(_CapturingLogger)]
+    overridden = [n for n in called_back if n in vars(CapturingLogger)]
     assert set(overridden) >= {"set_level", "message", "flush"}, overridden
     unmarked = [n for n in overridden
-                if not interrupts.is_native_callback(getattr(_CapturingLogger, n))]
+                if not interrupts.is_native_callback(getattr(CapturingLogger, n))]
     assert not unmarked, unmarked
 
 

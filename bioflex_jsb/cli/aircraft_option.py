@@ -77,12 +77,13 @@ class _AircraftAction(argparse._StoreAction):
         from bioflex_jsb.definition.flying import flight_refusal
         from bioflex_jsb.errors import InputError
         from bioflex_jsb.flight_dynamics.wing_model import VARIANTS
+        from bioflex_jsb.runtime.jsbsim_aircraft import complete
 
         if getattr(namespace, "wing_given", False):  # --wing given, even its default
             parser.error(f"--aircraft {values} and --wing {namespace.wing}: give one of them "
                          "(the aircraft's definition holds its wing)")
         try:
-            aircraft = load_aircraft(values)
+            aircraft = complete(load_aircraft(values))  # JSBSim's numbers where it has none
             # the linear analyses take any airframe; the flight commands the prototype's
             command = parser.prog.rsplit(" ", 1)[-1]
             if command in LINEAR_COMMANDS:
@@ -168,7 +169,7 @@ def resolve_flight(args: argparse.Namespace) -> None:
 
 def airframe_from_args(args: argparse.Namespace):
     """The JSBSim airframe of ``--aircraft`` (its own aircraft; the generated prototype
-    without the option): runtime/other_airframe.py ``airframe_for``."""
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    without the option): runtime/jsbsim_aircraft.py ``airframe_for``."""
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 
     return airframe_for(getattr(args, "aircraft_definition", None))

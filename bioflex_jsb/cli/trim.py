@@ -121,12 +121,13 @@ def aircraft_definition(args: argparse.Namespace):
     from bioflex_jsb.definition.aircraft import load_aircraft
     from bioflex_jsb.definition.flying import flight_refusal
     from bioflex_jsb.errors import InputError
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
 
     try:
-        aircraft = load_aircraft(name)
+        aircraft = complete(load_aircraft(name))  # JSBSim's numbers where it has none
+        problem = flight_refusal(aircraft)
     except InputError as exc:
         raise UsageError(f"--aircraft: {exc}") from None
-    problem = flight_refusal(aircraft)
     if problem:
         raise UsageError(f"--aircraft: {problem}")
     if getattr(args, "wing", None) is not None:
@@ -140,7 +141,7 @@ def definition_airframe(args: argparse.Namespace, aircraft):
     against its speeds first); its errors one line (UsageError)."""
     from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.runtime.fdm import FdmError
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 
     args.aircraft_definition = aircraft
     resolve_flight(args)

@@ -34,16 +34,19 @@ import dataclasses
 import math
 from pathlib import Path
 
+import numpy as np
+
 from bioflex_jsb.definition.airframe import GENERATED
-from bioflex_jsb.definition.flying import FLYING_N_MODES, axes
+from bioflex_jsb.definition.flying import FLYING_N_MODES, axes, check_span
 from bioflex_jsb.definition.loader import load_definition
 from bioflex_jsb.definition.model import (
     DEFAULT_MONITORING_STATIONS,
     Definition,
+    JSBSimValues,
     MembraneStructure,
     ModalStructure,
 )
-from bioflex_jsb.definition.reader import DefinitionError
+from bioflex_jsb.definition.reader import DefinitionError, Reader
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
     WingBuild,
@@ -63,6 +66,17 @@ from bioflex_jsb.parameters.airframe import (
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
+
+# DECISION: the definition's [airframe] numbers and the JSBSim aircraft they describe must
+# agree: JSBSim flies its XML's mass, inertia and geometry while the modal wing, the elastic
+# trim and the section loads take the file's, so a mismatch would make the run and the linear
+# analyses two different aircraft (a user's 10 % heavier file with SGS.xml's 710 lb: the
+# loads carried ΔW/2 = 158 N of lift that was never flown). Relative tolerance 1 %: a
+# value rounded to 3 significant digits is off by at most 0.5 % (the shipped sgs_elastic
+# file, 5 digits: largest 2.5e-5, S); the CG within 1 % of the mean chord (a 1 % static
+# margin; an inch rounded in metres is 1.3 mm, 0.13 % of SGS's chord).
+CONSISTENCY_REL = 0.01
+CONSISTENCY_CG_CHORDS = 0.01
 
 # Equal to the prototype's: 1e-9 relative (printed values carry 4-10 digits; the shipped
 # files repeat parameters/ to the last digit: measured 0 difference).
@@ -105,18 +119,24 @@ class Aircraft:
     # -- the airframe as the analyses' parameter types ---------------------------------
     def reference_geometry(self) -> ReferenceGeometry:
         """S [m²], b [m], c̄ [m] of the coefficients."""
+        self.require_complete()
         a = self.airframe
         return ReferenceGeometry(a.reference_area_m2, a.span_m, a.mean_chord_m)
 
     def mass_properties(self) -> MassProperties:
         """Mass [kg] and inertia about the CG [kg·m²]."""
+        self.require_complete()
         a, i = self.airframe, self.airframe.inertia
         return MassProperties(a.mass_kg, i.ixx_kg_m2, i.iyy_kg_m2, i.izz_kg_m2, i.ixz_kg_m2)
 
-    def rigid_aerodynamics(self) -> RigidAerodynamics | None:
-        """The rigid derivatives of the file, or ``None`` (from JSBSim's linearisation)."""
-        d = self.airframe.derivatives
-        return None if d is None else RigidAerodynamics(**d)
+    def rigid_aerodynamics(self) -> RigidAerodynamics:
+        """The rigid derivatives: the file's table, else those identified from the JSBSim
+        aircraft at its cruise speed (:meth:`airframe_data` carries them at every speed)."""
+        self.require_complete()
+        a = self.airframe
+        if a.derivatives is not None:
+            return RigidAerodynamics(**a.derivatives)
+        return a.schedule.at(a.cruise_speed_m_s)
 
     def airframe_data(self) -> AirframeData:
         """The airframe as the linear analyses take it (module docstring): the prototype's
@@ -129,8 +149,9 @@ class Aircraft:
         problem = self.linear_problem()
         if problem:
             raise DefinitionError(problem)
+        schedule = self.airframe.schedule if self.airframe.derivatives is None else None
         return AirframeData(self.name, self.reference_geometry(), self.mass_properties(),
-                            self.rigid_aerodynamics(), None)
+                            self.rigid_aerodynamics(), None, schedule)
 
     # -- the wing ---------------------------------------------------------------------
     def planform(self) -> Planform:
@@ -182,6 +203,94 @@ class Aircraft:
                            published_c_eta1_q1=f.published_c_eta1_q1,
                            description=d.description)
 
+    # -- the JSBSim aircraft's own numbers ---------------------------------------------
+    def jsbsim_mismatches(self, values: JSBSimValues) -> list[str]:
+        """Every number the file gives that its JSBSim aircraft (``values``) disagrees with
+        beyond :data:`CONSISTENCY_REL` (the CG: :data:`CONSISTENCY_CG_CHORDS` of the mean
+        chord), one phrase each."""
+        a = self.airframe
+        out = []
+        rows = [("reference_area_m2", "m²"), ("span_m", "m"), ("mean_chord_m", "m"),
+                ("mass_kg", "kg")]
+        for field, unit in rows:
+            mine, theirs = getattr(a, field), getattr(values, field)
+            if mine is not None and not abs(mine - theirs) <= CONSISTENCY_REL * max(
+                    abs(mine), abs(theirs)):
+                out.append(f"{field} {mine:.6g} {unit} (JSBSim: {theirs:.6g} {unit})")
+        if a.inertia is not None:
+            theirs_i = values.inertia
+            largest = max(theirs_i.ixx_kg_m2, theirs_i.iyy_kg_m2, theirs_i.izz_kg_m2)
+            for k in ("ixx", "iyy", "izz", "ixz"):
+                mine, theirs = (getattr(a.inertia, f"{k}_kg_m2"),
+                                getattr(theirs_i, f"{k}_kg_m2"))
+                scale = largest if k == "ixz" else max(abs(mine), abs(theirs))
+                if not abs(mine - theirs) <= CONSISTENCY_REL * scale:
+                    out.append(f"inertia_kg_m2.{k} {mine:.6g} kg·m² (JSBSim: {theirs:.6g}; "
+                               "about the CG with its point masses and fuel)")
+        if a.cg_m is not None:
+            chord = a.mean_chord_m if a.mean_chord_m is not None else values.mean_chord_m
+            limit = CONSISTENCY_CG_CHORDS * chord
+            for axis, mine, theirs in zip("xyz", a.cg_m, values.cg_m, strict=True):
+                if not abs(mine - theirs) <= limit:
+                    out.append(f"cg_m ({axis}) {mine:.6g} m (JSBSim: {theirs:.6g} m, "
+                               "structural frame)")
+        return out
+
+    def mac_leading_edge_m(self) -> tuple[float, float]:
+        """(x of the wing's mean aerodynamic chord's leading edge aft of the root's [m], the
+        mean aerodynamic chord [m]) from the stations (chord and leading edge linear
+        between them): c̄ = ∫c² dy / ∫c dy, x_le = ∫x_le c dy / ∫c dy."""
+        d = self.definition
+        y = np.linspace(0.0, d.semispan_m, 401)
+        c = np.interp(y, d.column("y_m"), d.column("chord_m"))
+        x = np.interp(y, d.column("y_m"), d.column("leading_edge_x_m"))
+        area = float(np.trapezoid(c, y))
+        return float(np.trapezoid(x * c, y)) / area, float(np.trapezoid(c * c, y)) / area
+
+    def with_jsbsim(self, values: JSBSimValues) -> Aircraft:
+        """This aircraft with the fields its file leaves out taken from its JSBSim aircraft
+        (``values``), the file's own compared with them (one line listing every mismatch),
+        and ``checked`` set. The wing's attachment, when not given, is estimated from the
+        aerodynamic reference point: the wing's mean aerodynamic chord's quarter-chord point
+        there (JSBSim's AERORP is conventionally at the wing's quarter MAC), on the plane of
+        symmetry."""
+        a = self.airframe
+        bad = self.jsbsim_mismatches(values)
+        if bad:
+            raise DefinitionError(
+                f"aircraft {self.name!r}: its [airframe] disagrees with the JSBSim aircraft "
+                f"{a.jsbsim!r} (more than {CONSISTENCY_REL:.0%}): " + "; ".join(bad)
+                + ": leave a field out to take JSBSim's, or make them the same aircraft")
+        fill: dict[str, object] = {}
+        for field in ("reference_area_m2", "span_m", "mean_chord_m", "mass_kg", "cg_m",
+                      "inertia", "cruise_speed_m_s", "speed_range_m_s"):
+            if getattr(a, field) is None and getattr(values, field) is not None:
+                fill[field] = getattr(values, field)
+        if a.wing_root_leading_edge_m is None:
+            x_le, mac = self.mac_leading_edge_m()
+            arp = values.aero_reference_point_m
+            fill["wing_root_leading_edge_m"] = (arp[0] - x_le - 0.25 * mac, 0.0, arp[2])
+        if a.derivatives is None and values.schedule is not None:
+            fill["schedule"] = values.schedule
+        done = dataclasses.replace(a, **fill, from_jsbsim=tuple(fill), checked=True)
+        if a.span_m is None:
+            check_span(Reader({}, f"aircraft {self.name!r}"), self.definition.stations, done)
+        missing = done.missing()
+        if missing:
+            raise DefinitionError(f"aircraft {self.name!r}: {', '.join(missing)} neither in "
+                                  "the file nor found from the JSBSim aircraft")
+        return Aircraft(dataclasses.replace(self.definition, airframe=done))
+
+    def require_complete(self) -> None:
+        """A :class:`DefinitionError` when fields are still to come from the JSBSim
+        aircraft (the aircraft was loaded without completing it)."""
+        missing = self.airframe.missing()
+        if missing:
+            raise DefinitionError(
+                f"aircraft {self.name!r}: airframe.{missing[0]} (and {len(missing) - 1} more) "
+                "come from its JSBSim aircraft: load it with api.load_aircraft or the "
+                "commands' --aircraft, which read them from JSBSim")
+
     def linear_problem(self) -> str | None:
         """Why the linear analyses (``modes``, ``flutter``, ``linear_model``: module
         docstring) cannot take this aircraft, or ``None``."""
@@ -192,9 +301,9 @@ class Aircraft:
                     "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
                     "on the aircraft the wing's modes come from 'prototype-membrane' or a "
                     "'modal' file (docs/aircraft.md: write the beam's modes to one)")
-        if a.derivatives is None:
-            return (f"{head}airframe.derivatives = 'jsbsim': the linear analyses take the "
-                    "rigid derivatives from the file (a table of the 22: docs/aircraft.md)")
+        if a.missing():
+            return (f"{head}airframe.{a.missing()[0]} comes from its JSBSim aircraft: load "
+                    "it with api.load_aircraft or the commands' --aircraft")
         if isinstance(d.structure, MembraneStructure) and a.jsbsim != GENERATED:
             return (f"{head}structure.kind = 'prototype-membrane' is the prototype's wing "
                     "(its calibrated half-wing beam); on another airframe give the wing's "

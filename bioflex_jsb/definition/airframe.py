@@ -19,7 +19,11 @@ import numpy as np
 
 from bioflex_jsb.definition.model import Airframe, Inertia
 from bioflex_jsb.definition.reader import Reader
-from bioflex_jsb.parameters.airframe import RigidAerodynamics
+from bioflex_jsb.parameters.airframe import (
+    AIRSPEED_RANGE_M_S,
+    CRUISE_SPEED_M_S,
+    RigidAerodynamics,
+)
 
 GENERATED = "bioflex"  # the generated prototype (bioflex_jsb.generators)
 # Reference area S [m²]: 1e-3 (a 3 cm × 3 cm model) to 1e4 (an A380 has 845 m²); a file in
@@ -48,7 +52,10 @@ DERIVATIVE_RANGES = {
     "k_induced": (0.0, 1.0),  # 1/(π AR e): AR ≥ 0.4 at e = 0.8
 }
 DERIVATIVE_FIELDS = tuple(f.name for f in dataclasses.fields(RigidAerodynamics))
-FROM_JSBSIM = "jsbsim"  # derivatives = "jsbsim": from JSBSim's linearisation
+# the fields a typed table must give (the Table B2 set); the others default to 0
+REQUIRED_DERIVATIVES = tuple(f.name for f in dataclasses.fields(RigidAerodynamics)
+                             if f.default is dataclasses.MISSING)
+FROM_JSBSIM = "jsbsim"  # derivatives = "jsbsim" (or no table): identified from JSBSim
 AIRFRAME_FIELDS = ("jsbsim", "reference_area_m2", "span_m", "mean_chord_m", "mass_kg",
                    "cg_m", "inertia_kg_m2", "wing_root_leading_edge_m", "derivatives",
                    "cruise_speed_m_s", "speed_range_m_s")
@@ -58,17 +65,6 @@ AIRFRAME_FIELDS = ("jsbsim", "reference_area_m2", "span_m", "mean_chord_m", "mas
 # runtime). Optional: a file without them is analysed (modes, flutter) but not flown.
 FLIGHT_SPEED_MAX_M_S = 110.0
 INERTIA_FIELDS = ("ixx", "iyy", "izz", "ixz")
-
-
-@dataclasses.dataclass(frozen=True)
-class FlightAirframe(Airframe):
-    """The ``[airframe]`` table with the flight commands' speeds: ``cruise_speed_m_s``
-    [m/s] (the default trim speed of gust, compare, trim and sitl) and ``speed_range_m_s``
-    (low, high) [m/s] (the speeds they accept), or ``None`` when the file gives none (the
-    aircraft is then analysed, not flown: definition/flying.py ``flight_refusal``)."""
-
-    cruise_speed_m_s: float | None = None
-    speed_range_m_s: tuple[float, float] | None = None
 
 
 def _flight_speeds(r: Reader, t: dict) -> tuple[float | None, tuple[float, float] | None]:
@@ -150,14 +146,18 @@ def _derivatives(r: Reader, t: dict) -> dict[str, float] | None:
         raise r.fail(where, f"must be {FROM_JSBSIM!r} (from JSBSim's linearisation) or a table "
                      f"of the rigid derivatives {', '.join(DERIVATIVE_FIELDS)}")
     r.keys(v, where, DERIVATIVE_FIELDS)
-    missing = [k for k in DERIVATIVE_FIELDS if k not in v]
+    missing = [k for k in REQUIRED_DERIVATIVES if k not in v]
     if missing:
-        raise r.fail(f"{where}.{missing[0]}", "missing (every rigid derivative is needed: "
-                     f"{len(missing)} of {len(DERIVATIVE_FIELDS)} are absent)")
+        raise r.fail(f"{where}.{missing[0]}", "missing (a typed table gives the "
+                     f"{len(REQUIRED_DERIVATIVES)} derivatives of Table B2: {len(missing)} are "
+                     "absent; leave the table out to take them from JSBSim)")
     out = {}
     for k in DERIVATIVE_FIELDS:
+        if k not in v:
+            continue  # a term beyond Table B2, 0 unless given
         lo, hi = DERIVATIVE_RANGES.get(k, (-DERIVATIVE_LIMIT, DERIVATIVE_LIMIT))
-        unit = "-" if k in ("cl0", "cl_max", "cd0", "k_induced", "cm0") else "1/rad"
+        unit = "-" if k in ("cl0", "cl_max", "cd0", "k_induced", "cm0", "cl_u", "cd_u",
+                            "cm_u", "ct_u", "ct_delta_t", "cm_delta_t") else "1/rad"
         if k == "alpha_stall_rad":
             unit = "rad"
         out[k] = r.number(v, where, k, lo, hi, unit)
@@ -165,26 +165,47 @@ def _derivatives(r: Reader, t: dict) -> dict[str, float] | None:
 
 
 def parse_airframe(r: Reader, data: dict, base_dir: Path | None) -> Airframe:
-    """The :class:`Airframe` of the ``[airframe]`` table (module docstring for the ranges)."""
+    """The :class:`Airframe` of the ``[airframe]`` table (module docstring for the ranges).
+    On a JSBSim aircraft every field but ``jsbsim`` is optional (None: taken from the
+    JSBSim aircraft when the aircraft is completed); the generated prototype ``bioflex``
+    needs its numbers written (they are the paper's, and its model is generated from
+    them)."""
     t = r.table("airframe", AIRFRAME_FIELDS)
     name = r.text(t, "airframe", "jsbsim")
     path = _jsbsim_path(r, name, base_dir)
+    generated = name == GENERATED
     w = "airframe"
+
+    def given(key: str) -> bool:
+        return generated or key in t
+
     area = r.number(t, w, "reference_area_m2", *AREA_RANGE_M2, "m^2",
-                    hint=" (the format is SI: m^2, not mm^2 or ft^2)")
-    span = r.number(t, w, "span_m", *SPAN_RANGE_M, "m", hint=" (the format is SI: m)")
+                    hint=" (the format is SI: m^2, not mm^2 or ft^2)") \
+        if given("reference_area_m2") else None
+    span = r.number(t, w, "span_m", *SPAN_RANGE_M, "m", hint=" (the format is SI: m)") \
+        if given("span_m") else None
     chord = r.number(t, w, "mean_chord_m", *MEAN_CHORD_RANGE_M, "m",
-                     hint=" (the format is SI: m)")
-    ratio = area / (span * chord)
-    if not AREA_RATIO_RANGE[0] <= ratio <= AREA_RATIO_RANGE[1]:
-        raise r.fail(f"{w}.reference_area_m2", f"{area:g} m^2 is {ratio:.3g} x span_m x "
-                     f"mean_chord_m; accepted {AREA_RATIO_RANGE[0]:g}..{AREA_RATIO_RANGE[1]:g} "
-                     "(is one of the three in another unit?)")
-    mass = r.number(t, w, "mass_kg", *MASS_RANGE_KG, "kg", hint=" (the format is SI: kg)")
-    cg = r.vector(t, w, "cg_m", *POSITION_RANGE_M, "m")
-    root = r.vector(t, w, "wing_root_leading_edge_m", *POSITION_RANGE_M, "m")
+                     hint=" (the format is SI: m)") if given("mean_chord_m") else None
+    if area is not None and span is not None and chord is not None:
+        ratio = area / (span * chord)
+        if not AREA_RATIO_RANGE[0] <= ratio <= AREA_RATIO_RANGE[1]:
+            raise r.fail(f"{w}.reference_area_m2", f"{area:g} m^2 is {ratio:.3g} x span_m x "
+                         f"mean_chord_m; accepted {AREA_RATIO_RANGE[0]:g}.."
+                         f"{AREA_RATIO_RANGE[1]:g} (is one of the three in another unit?)")
+    mass = r.number(t, w, "mass_kg", *MASS_RANGE_KG, "kg", hint=" (the format is SI: kg)") \
+        if given("mass_kg") else None
+    cg = r.vector(t, w, "cg_m", *POSITION_RANGE_M, "m") if given("cg_m") else None
+    root = r.vector(t, w, "wing_root_leading_edge_m", *POSITION_RANGE_M, "m") \
+        if given("wing_root_leading_edge_m") else None
+    inertia = _inertia(r, t) if given("inertia_kg_m2") else None
+    derivatives = _derivatives(r, t) if given("derivatives") else None
+    if generated and derivatives is None:
+        raise r.fail(f"{w}.derivatives", f"the generated prototype {GENERATED!r} needs its "
+                     "table (its JSBSim model is generated from it)")
     cruise, speeds = _flight_speeds(r, t)
-    return FlightAirframe(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
-                          mean_chord_m=chord, mass_kg=mass, cg_m=cg, inertia=_inertia(r, t),
-                          wing_root_leading_edge_m=root, derivatives=_derivatives(r, t),
-                          cruise_speed_m_s=cruise, speed_range_m_s=speeds)
+    if generated and cruise is None:  # the prototype's: Table 1's cruise, the paper's speeds
+        cruise, speeds = CRUISE_SPEED_M_S, AIRSPEED_RANGE_M_S
+    return Airframe(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
+                    mean_chord_m=chord, mass_kg=mass, cg_m=cg, inertia=inertia,
+                    wing_root_leading_edge_m=root, derivatives=derivatives,
+                    cruise_speed_m_s=cruise, speed_range_m_s=speeds, checked=generated)

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bioflex_jsb.parameters.airframe import DerivativeSchedule
+
 # The section loads' monitoring stations when a definition names none: root, 25, 50, 75 %
 # of the semispan (issue 24); the loads' default (loads/model.py) is this one.
 DEFAULT_MONITORING_STATIONS = (0.0, 0.25, 0.5, 0.75)
@@ -123,24 +125,71 @@ class Airframe:
     [m] in the structural frame (module docstring), ``inertia`` (:class:`Inertia`).
     ``derivatives``: the rigid aerodynamic derivatives of
     :class:`~bioflex_jsb.parameters.airframe.RigidAerodynamics` by field name [per rad,
-    non-dimensional, moments about the CG], or ``None``: from JSBSim's linearisation of the
-    aircraft."""
+    non-dimensional, moments about the CG], or ``None``: identified from the JSBSim
+    aircraft (``schedule``). ``cruise_speed_m_s`` [m/s] (the flight commands' default
+    speed) and ``speed_range_m_s`` (low, high) [m/s] (the speeds they accept).
+
+    A field the file leaves out is ``None`` until the aircraft is completed from its JSBSim
+    model (``runtime.jsbsim_aircraft.complete``: mass, CG and inertia with its point masses
+    and fuel, S, b, c̄, the wing's attachment estimated from the aerodynamic reference
+    point, the speeds from its trims, the derivatives identified at several speeds);
+    ``from_jsbsim`` names the fields it gave, and ``checked`` is True once the file's own
+    numbers were compared with the JSBSim aircraft's (or it is the generated prototype)."""
 
     jsbsim: str
     jsbsim_path: str
+    reference_area_m2: float | None
+    span_m: float | None
+    mean_chord_m: float | None
+    mass_kg: float | None
+    cg_m: tuple[float, float, float] | None
+    inertia: Inertia | None
+    wing_root_leading_edge_m: tuple[float, float, float] | None
+    derivatives: dict[str, float] | None
+    cruise_speed_m_s: float | None = None
+    speed_range_m_s: tuple[float, float] | None = None
+    schedule: DerivativeSchedule | None = None
+    from_jsbsim: tuple[str, ...] = ()
+    checked: bool = False
+
+    @property
+    def wing_cg_x_m(self) -> float:
+        """The CG aft of the wing's root leading edge [m] (the wing frame's x_cg)."""
+        return self.cg_m[0] - self.wing_root_leading_edge_m[0]
+
+    def missing(self) -> tuple[str, ...]:
+        """The fields still to be taken from the JSBSim aircraft (class docstring)."""
+        out = tuple(f for f in ("reference_area_m2", "span_m", "mean_chord_m", "mass_kg",
+                                "cg_m", "inertia", "wing_root_leading_edge_m",
+                                "cruise_speed_m_s", "speed_range_m_s")
+                    if getattr(self, f) is None)
+        if self.derivatives is None and self.schedule is None:
+            out += ("derivatives",)
+        return out
+
+
+@dataclass(frozen=True)
+class JSBSimValues:
+    """What a JSBSim aircraft's own model gives (``runtime.jsbsim_aircraft``), in SI and
+    the structural frame: S [m²], b [m], c̄ [m] (its ``<metrics>``); mass [kg], CG (x, y, z)
+    [m] and inertia about the CG (its empty weight with its point masses and fuel, as it
+    flies); ``aero_reference_point_m`` (x, y, z) [m] (AERORP); the speeds [m/s] from its
+    trims (``stall_speed_m_s`` level flight at C_L,max; ``cruise_speed_m_s``;
+    ``speed_range_m_s``) or None when not asked for; the identified derivatives
+    (``schedule``) or None; ``source`` (the file, the altitude [m])."""
+
     reference_area_m2: float
     span_m: float
     mean_chord_m: float
     mass_kg: float
     cg_m: tuple[float, float, float]
     inertia: Inertia
-    wing_root_leading_edge_m: tuple[float, float, float]
-    derivatives: dict[str, float] | None
-
-    @property
-    def wing_cg_x_m(self) -> float:
-        """The CG aft of the wing's root leading edge [m] (the wing frame's x_cg)."""
-        return self.cg_m[0] - self.wing_root_leading_edge_m[0]
+    aero_reference_point_m: tuple[float, float, float]
+    source: str
+    stall_speed_m_s: float | None = None
+    cruise_speed_m_s: float | None = None
+    speed_range_m_s: tuple[float, float] | None = None
+    schedule: DerivativeSchedule | None = None
 
 
 @dataclass(frozen=True)

@@ -103,7 +103,7 @@ def glider_airframe(aircraft) -> Airframe:
     """The JSBSim airframe of an aircraft definition (``--aircraft``: its own JSBSim
     aircraft, runtime/other_airframe.py) with the glider's autopilot system added
     (:func:`~bioflex_jsb.generators.autopilot.render_glider_autopilot`)."""
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 
     return airframe_for(aircraft, systems={GLIDER_SYSTEM_FILE: render_glider_autopilot()})
 

@@ -576,7 +576,7 @@ def _check_pair(airframe: Airframe, data) -> None:
                                                           and mine != data.name):
         raise InputError(f"the wing is built for aircraft {data.name!r}, the JSBSim airframe "
                          f"is {mine or airframe.aircraft!r}: fly a wing on its own aircraft's "
-                         "airframe (runtime/other_airframe.py airframe_for)")
+                         "airframe (runtime/jsbsim_aircraft.py airframe_for)")
 
 
 class _ZeroNode:

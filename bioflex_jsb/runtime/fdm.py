@@ -62,9 +62,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
-from functools import lru_cache
 from pathlib import Path
 
 import jsbsim
@@ -74,7 +72,10 @@ from bioflex_jsb import units as U
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.parameters.airframe import PROPULSION
-from bioflex_jsb.runtime.jsbsim_log import LogRecord, _captured, _CapturingLogger
+from bioflex_jsb.runtime.aircraft_files import alpha_limits_rad
+from bioflex_jsb.runtime.engines import engines_of, zero_thrust_advance_ratio
+from bioflex_jsb.runtime.engines import start as start_engines
+from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, LogRecord, captured
 from bioflex_jsb.runtime.linearization import reduce_to_rigid
 from bioflex_jsb.runtime.results import (  # noqa: F401  (the runtime's errors and results)
     RIGID_STATE_UNITS,
@@ -167,52 +168,9 @@ def _check_altitude(altitude_m: float) -> float:
     return h
 
 
-def _alpha_limits_rad(path: Path) -> tuple[float, float]:
-    """The <alphalimits> of the aircraft file [rad] (the range JSBSim's trim searches)."""
-    try:
-        tree = ET.parse(path)
-    except ET.ParseError as exc:
-        raise AircraftLoadError(f"aircraft file {str(path)!r} is not valid XML: {exc}") from None
-    lim = tree.getroot().find("aerodynamics/alphalimits")
-    if lim is None:
-        # JSBSim's trim then searches −5°..20° (FGTrimAxis); report that range.
-        return math.radians(-5.0), math.radians(20.0)
-    scale = 1.0 if lim.get("unit", "RAD").upper() == "RAD" else math.pi / 180.0
-    try:
-        return float(lim.findtext("min")) * scale, float(lim.findtext("max")) * scale
-    except (TypeError, ValueError):
-        raise AircraftLoadError(f"malformed <alphalimits> in {str(path)!r}") from None
-
-
-@lru_cache(maxsize=8)
-def _zero_thrust_advance_ratio(aircraft_path: Path) -> float:
-    """J at which the propeller's C_T(J) crosses zero [-] (windmilling), from the C_THRUST
-    table of the aircraft's first thruster file (``Engines/<file>.xml`` beside it): the
-    table JSBSim flies, read rather than recomputed (the blade-element model that wrote it,
-    :mod:`bioflex_jsb.aerodynamics.propeller`, needs scipy's optimisers, ~30 MB of memory a
-    run does not otherwise need)."""
-    aircraft = ET.parse(aircraft_path).getroot()
-    thruster = aircraft.find(".//propulsion/engine/thruster")
-    if thruster is None or not thruster.get("file"):
-        raise AircraftLoadError(f"{str(aircraft_path)!r} has no propeller (thruster file)")
-    prop_path = aircraft_path.parent / "Engines" / f"{thruster.get('file')}.xml"
-    try:
-        table = ET.parse(prop_path).getroot().find(".//table[@name='C_THRUST']/tableData")
-    except (OSError, ET.ParseError) as exc:
-        raise AircraftLoadError(f"cannot read the propeller {str(prop_path)!r}: {exc}") from None
-    if table is None or not (table.text or "").strip():
-        raise AircraftLoadError(f"{str(prop_path)!r} has no C_THRUST table")
-    rows = np.array([float(x) for x in table.text.split()]).reshape(-1, 2)
-    j, ct = rows[:, 0], rows[:, 1]
-    if not np.any(ct <= 0.0) or ct[0] <= 0.0:
-        raise AircraftLoadError(f"the C_THRUST table of {str(prop_path)!r} does not cross zero")
-    k = int(np.argmax(ct <= 0.0))
-    return float(j[k - 1] + (j[k] - j[k - 1]) * ct[k - 1] / (ct[k - 1] - ct[k]))
-
-
-def _load_fdm(root: Path, aircraft: str, path: Path, log: _CapturingLogger) -> jsbsim.FGFDMExec:
+def load_fdm(root: Path, aircraft: str, path: Path, log: CapturingLogger) -> jsbsim.FGFDMExec:
     """A JSBSim instance with ``aircraft`` loaded (messages into ``log``)."""
-    with _captured(log):
+    with captured(log):
         fdm = jsbsim.FGFDMExec(str(root), None)
         try:
             loaded = fdm.load_model(aircraft)
@@ -253,21 +211,28 @@ class Airframe:
         self.root = locate_root(root, aircraft)
         self.aircraft = aircraft
         self.aircraft_path = aircraft_file(self.root, aircraft)
-        self.alpha_limits_rad = _alpha_limits_rad(self.aircraft_path)
-        self._log = _CapturingLogger()
-        self._fdm = _load_fdm(self.root, aircraft, self.aircraft_path, self._log)
+        self.alpha_limits_rad = alpha_limits_rad(self.aircraft_path)
+        self._log = CapturingLogger()
+        self._fdm = load_fdm(self.root, aircraft, self.aircraft_path, self._log)
         self._dt_nominal_s = float(self._fdm.get_delta_t())
         self.engine_count = int(self._fdm.get_propulsion().get_num_engines())
+        self.engines = engines_of(self.aircraft_path)
+        if len(self.engines) != self.engine_count:
+            raise AircraftLoadError(f"{str(self.aircraft_path)!r}: JSBSim loaded "
+                                    f"{self.engine_count} engines, its file names "
+                                    f"{len(self.engines)}")
         self.load_messages: tuple[LogRecord, ...] = tuple(self._log.records)
         self._log.records.clear()
         companion = aircraft + airframe_xml.TRIM_SUFFIX
         companion_path = aircraft_file(self.root, companion)
         self.trim_load_messages: tuple[LogRecord, ...] = ()
         self._trim_aircraft_path = self.aircraft_path
-        if companion_path.is_file():
+        # the generated prototype's electric pair trims on its companion (module docstring)
+        self.has_companion = companion_path.is_file()
+        if self.has_companion:
             self.trim_aircraft = companion
             self._trim_aircraft_path = companion_path
-            self._trim_fdm = _load_fdm(self.root, companion, companion_path, self._log)
+            self._trim_fdm = load_fdm(self.root, companion, companion_path, self._log)
             self._trim_fdm.set_dt(self._dt_nominal_s)
             self.trim_load_messages = tuple(self._log.records)
             self._log.records.clear()
@@ -312,6 +277,13 @@ class Airframe:
             float(self._fdm[f"propulsion/engine[{i}]/thrust-lbs"]) for i in range(self.engine_count)
         )
         return lbs * U.N_PER_LBF
+
+    @property
+    def jsbsim(self):
+        """The flying JSBSim instance (``jsbsim.FGFDMExec``), for the runtime's own modules
+        that evaluate the model at chosen states (runtime/identification.py); every other
+        caller goes through this class's methods."""
+        return self._fdm
 
     def __getitem__(self, name: str) -> float:
         """Raw JSBSim property value (JSBSim units, as the property name says)."""
@@ -358,7 +330,7 @@ class Airframe:
         fdm["ic/vt-fps"] = v * U.FT_PER_M
         for name in TRIM_CONTROLS:
             fdm[name] = 0.0
-        with _captured(self._log):
+        with captured(self._log):
             fdm.run_ic()
 
     def _spin_up_propeller(self, fdm: jsbsim.FGFDMExec, speed_m_s: float) -> None:
@@ -374,14 +346,14 @@ class Airframe:
         n = PROPULSION.rotor_count
         omega_rad_s = (
             2.0 * math.pi * speed_m_s
-            / (_zero_thrust_advance_ratio(self._trim_aircraft_path) * PROPULSION.prop_diameter_m)
+            / (zero_thrust_advance_ratio(self._trim_aircraft_path) * PROPULSION.prop_diameter_m)
         )
         inertia_slug_ft2 = PROPULSION.trim_rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
         power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
         throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
         for i in range(self.engine_count):
             fdm[f"fcs/throttle-cmd-norm[{i}]"] = throttle
-        with _captured(self._log):
+        with captured(self._log):
             fdm.run()
 
     # ---- trim -----------------------------------------------------------------------
@@ -405,14 +377,18 @@ class Airframe:
         if self.glider:  # no engine: the steady glide at v (runtime/other_airframe.py)
             from bioflex_jsb.runtime.other_airframe import glide_trim
 
-            with _captured(self._log):
+            with captured(self._log):
                 glide_trim(tfdm, v)
             result = self._trim_result(v, h)
             self._check_in_trim(result)
             return result
-        self._spin_up_propeller(tfdm, v)
+        if self.has_companion:
+            self._spin_up_propeller(tfdm, v)
+        else:
+            with captured(self._log):
+                start_engines(tfdm, self.engines)
         self._log.records.clear()
-        with _captured(self._log), trim_report(tfdm):
+        with captured(self._log), trim_report(tfdm):
             try:
                 tfdm.do_trim(TRIM_MODE_FULL)
                 failed = False
@@ -455,7 +431,7 @@ class Airframe:
         integrators = {name: fdm[name] for name in _INTEGRATOR_PROPERTIES}
         dt = fdm.get_delta_t()
         steps = 0
-        with _captured(self._log):
+        with captured(self._log):
             fdm.run_ic()
             try:  # hold the airframe at the trim state; the propellers integrate their RPM
                 for name in _INTEGRATOR_PROPERTIES:
@@ -508,9 +484,8 @@ class Airframe:
                            else float(fdm["fcs/elevator-pos-norm"])),  # writes no position
             elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
             throttle=0.0 if self.glider else float(fdm["fcs/throttle-pos-norm"]),
-            aileron_norm=float(fdm["fcs/left-aileron-pos-norm"]),
-            propeller_rpm=(0.0 if self.glider
-                           else float(fdm["propulsion/engine[0]/propeller-rpm"])),
+            aileron_norm=self._aileron_norm(),
+            propeller_rpm=self._propeller_rpm(),
             thrust_n=self.total_thrust_n,
             converged=True,
             residuals={
@@ -523,11 +498,34 @@ class Airframe:
             flight_path_rad=float(fdm["flight-path/gamma-rad"]) if self.glider else 0.0,
         )
 
+    def _has(self, name: str) -> bool:
+        return bool(self._fdm.get_property_manager().hasNode(name))
+
+    def _aileron_norm(self) -> float:
+        """The aileron position −1..1 (+ roll right): the left surface's normalised
+        position where the FCS writes one per side (c172p, the prototype), else the single
+        ``fcs/aileron-pos-norm``, else the command with its trim (an FCS that writes only
+        radians)."""
+        for name in ("fcs/left-aileron-pos-norm", "fcs/aileron-pos-norm"):
+            if self._has(name):
+                return float(self._fdm[name])
+        command = float(self._fdm["fcs/aileron-cmd-norm"]) + float(
+            self._fdm["fcs/roll-trim-cmd-norm"])
+        return min(1.0, max(-1.0, command))
+
+    def _propeller_rpm(self) -> float:
+        """Engine 0's propeller speed [rev/min]; 0 for an aircraft without a propeller (a
+        glider, a jet)."""
+        name = "propulsion/engine[0]/propeller-rpm"
+        return float(self._fdm[name]) if self.engines and self._has(name) else 0.0
+
     def _diagnose_trim_failure(self, v: float) -> str:
         """One line: which control saturated or which condition failed."""
         text = "\n".join(r.text for r in self._log.records)
+        engine = "the motor gives" if self.has_companion else (
+            "the engine gives" if len(self.engines) == 1 else "the engines give")
         return diagnose_trim_failure(text, v, self.alpha_limits_rad,
-                                     self._first_message(jsbsim.LogLevel.WARN))
+                                     self._first_message(jsbsim.LogLevel.WARN), engine)
 
     # ---- linearization ----------------------------------------------------------------
     def linearize(self, speed_m_s: float, altitude_m: float = 0.0) -> RigidLinearization:
@@ -542,10 +540,10 @@ class Airframe:
         if self.glider:  # FGLinearization needs an engine: runtime/other_airframe.py
             from bioflex_jsb.runtime.other_airframe import rigid_jacobian
 
-            with _captured(self._log):
+            with captured(self._log):
                 a, names, residualised = rigid_jacobian(self._fdm), RIGID_STATES, ()
         else:
-            with _captured(self._log):  # the companion, at its trim (module docstring)
+            with captured(self._log):  # the companion, at its trim (module docstring)
                 lin = jsbsim.FGLinearization(self._trim_fdm)
                 a_full = np.array(lin.system_matrix, dtype=float)
                 names, units = tuple(lin.x_names), tuple(lin.x_units)
@@ -620,19 +618,19 @@ class Airframe:
         (position, attitude, velocities), keeping the propellers' RPM and every control (a
         SITL reset moves the trimmed aircraft to a new place this way; setting the state
         properties instead would stop the propellers)."""
-        with _captured(self._log):
+        with captured(self._log):
             self._fdm.run_ic()
 
     def run(self, steps: int = 1) -> None:
         """Advance JSBSim by ``steps`` time steps of its integration step."""
-        with _captured(self._log):
+        with captured(self._log):
             for _ in range(int(steps)):
                 self._fdm.run()
 
     @contextlib.contextmanager
     def capturing(self) -> Iterator[None]:
         """Capture JSBSim's console output for a whole loop of :meth:`step` calls."""
-        with _captured(self._log):
+        with captured(self._log):
             yield
 
     def step(self) -> None:

@@ -31,7 +31,7 @@ class LogRecord:
     text: str
 
 
-class _CapturingLogger(jsbsim.FGLogger):
+class CapturingLogger(jsbsim.FGLogger):
     """Keeps JSBSim's messages instead of printing them."""
 
     def __init__(self) -> None:
@@ -69,7 +69,7 @@ class _CapturingLogger(jsbsim.FGLogger):
 
 
 @contextlib.contextmanager
-def _captured(logger: _CapturingLogger) -> Iterator[_CapturingLogger]:
+def captured(logger: CapturingLogger) -> Iterator[CapturingLogger]:
     # the swap of JSBSim's logger is one step for a stop signal (interrupts.
     # critical_section): a KeyboardInterrupt between taking the previous logger and giving
     # it back would leave JSBSim and Python each holding one (an interrupted gust run once

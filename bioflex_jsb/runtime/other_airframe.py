@@ -27,15 +27,14 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import jsbsim
 import numpy as np
 
 from bioflex_jsb.generators import airframe as airframe_xml
+from bioflex_jsb.runtime.aircraft_files import private_root, read_aircraft_xml
 from bioflex_jsb.runtime.results import AircraftLoadError, TrimError
 
 INCH_PER_M = 1.0 / 0.0254  # the inch is 0.0254 m exactly
@@ -69,11 +68,7 @@ def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float],
     (one line) for a file JSBSim could not read either or one that has the reactions
     already."""
     src = Path(jsbsim_path)
-    name = src.stem
-    try:
-        tree = ET.parse(src)
-    except (OSError, ET.ParseError) as exc:
-        raise AircraftLoadError(f"cannot read the aircraft {str(src)!r}: {exc}") from None
+    tree = read_aircraft_xml(src)
     root = tree.getroot()
     ext = root.find("external_reactions")
     if ext is None:
@@ -100,21 +95,8 @@ def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float],
             root.insert(at + i, ET.Element("system", file=file))
     for key in [k for k in root.attrib if k.startswith("{")]:  # the schema's location
         del root.attrib[key]
-    work = tempfile.TemporaryDirectory(prefix="bioflex-jsb-aircraft-")
-    base = Path(work.name)
-    shutil.copytree(src.parent, base / "aircraft" / name)
-    tree.write(base / "aircraft" / name / f"{name}.xml", encoding="utf-8",
-               xml_declaration=True)
-    for file, text in (systems or {}).items():
-        target = base / "aircraft" / name / "Systems" / f"{file}.xml"
-        target.parent.mkdir(exist_ok=True)
-        target.write_text(text, encoding="utf-8")
-    package = Path(jsbsim.get_default_root_dir())
-    for sub in ("engine", "systems"):
-        if (package / sub).is_dir():
-            os.symlink(package / sub, base / sub, target_is_directory=True)
-        else:
-            (base / sub).mkdir()
+    own = {f"{file}.xml": text for file, text in (systems or {}).items()}
+    work, name = private_root(src, tree, own)
     return work, name
 
 
@@ -124,14 +106,14 @@ def _direction(parent: ET.Element, direction: tuple[float, float, float]) -> Non
         ET.SubElement(d, axis).text = repr(float(value))
 
 
-def alpha_table_range_rad(path: str | os.PathLike) -> tuple[float, float]:
-    """The α range [rad] every aerodynamic table with α as its row variable covers (their
-    common part): beyond it JSBSim holds a table's end value, so the aircraft's
-    aerodynamics end there (the run stops: simulation/limits.py). Tables on
-    ``aero/alpha-rad`` or ``aero/alpha-deg``; one without any such table is refused."""
-    tree = ET.parse(path)
-    lo, hi = -math.inf, math.inf
-    for table in tree.getroot().iter("table"):
+LIFT_AXES = ("LIFT", "NORMAL", "Z")  # JSBSim's names of the axis that carries the lift
+
+
+def _alpha_tables(element: ET.Element) -> list[tuple[float, float]]:
+    """The α range [rad] of each table under ``element`` with α as its row variable
+    (``aero/alpha-rad`` or ``aero/alpha-deg``)."""
+    out = []
+    for table in element.iter("table"):
         variables = table.findall("independentVar")
         if not variables:
             continue
@@ -145,7 +127,26 @@ def alpha_table_range_rad(path: str | os.PathLike) -> tuple[float, float]:
             lines = lines[1:]  # the first line holds the column breakpoints
         alphas = [float(ln[0]) for ln in lines]
         scale = 1.0 if var.endswith("rad") else math.pi / 180.0
-        lo, hi = max(lo, min(alphas) * scale), min(hi, max(alphas) * scale)
+        out.append((min(alphas) * scale, max(alphas) * scale))
+    return out
+
+
+def alpha_table_range_rad(path: str | os.PathLike) -> tuple[float, float]:
+    """The α range [rad] of the aircraft's lift curve: the widest table over α in its lift
+    axis (``<axis name="LIFT">``, or ``NORMAL``/``Z``). Beyond it JSBSim holds the table's
+    end value, so the aircraft's aerodynamics end there (the run stops:
+    simulation/limits.py). Narrower α tables (increments of flaps, ground effect, stall
+    hysteresis) are held constant outside their range by their authors' design and do not
+    bound it. An aircraft whose lift axis names its tables only through functions defined
+    elsewhere: the common α range of all its tables. One without any α table is refused."""
+    root = read_aircraft_xml(path).getroot()
+    lift = [r for axis in root.iter("axis") if axis.get("name", "").upper() in LIFT_AXES
+            for r in _alpha_tables(axis)]
+    if lift:
+        return max(lift, key=lambda r: r[1] - r[0])
+    every = _alpha_tables(root)
+    lo = max((r[0] for r in every), default=math.inf)
+    hi = min((r[1] for r in every), default=-math.inf)
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise AircraftLoadError(f"{str(path)!r} has no aerodynamic table over the angle of "
                                 "attack (aero/alpha-rad or -deg): its valid range of alpha is "
@@ -207,101 +208,6 @@ def airframe_from_file(jsbsim_path: str, cg_m: tuple[float, float, float], airfr
     airframe._workdir = work
     airframe.alpha_table_range_rad = alpha_table_range_rad(jsbsim_path)
     airframe.definition_name = definition_name
-    return airframe
-
-
-# DECISION: the definition's [airframe] numbers and the JSBSim aircraft they describe must
-# agree: JSBSim flies its XML's mass, inertia and geometry while the modal wing, the elastic
-# trim and the section loads take the file's, so a mismatch would make the run and the linear
-# analyses two different aircraft (a user's 10 % heavier file with SGS.xml's 710 lb: the
-# loads carried ΔW/2 = 158 N of lift that was never flown). Relative tolerance 1 %: a
-# value rounded to 3 significant digits is off by at most 0.5 % (the shipped sgs_elastic
-# file, 5 digits: largest 2.5e-5, S); the CG within 1 % of the mean chord (a 1 % static
-# margin; an inch rounded in metres is 1.3 mm, 0.13 % of SGS's chord).
-CONSISTENCY_REL = 0.01
-CONSISTENCY_CG_CHORDS = 0.01
-_LB_KG = 0.45359237  # exact
-_FT_M = 0.3048  # exact
-_SLUG_FT2_KG_M2 = 14.59390294 * _FT_M ** 2  # slug = lbf s²/ft; 1.35581795 kg·m² a slug ft²
-
-
-def definition_mismatch(fdm, airframe) -> str | None:
-    """The first of the definition's ``[airframe]`` numbers (``airframe``: its
-    :class:`~bioflex_jsb.definition.model.AirframeDefinition`) that the loaded JSBSim
-    aircraft ``fdm`` (a ``jsbsim.FGFDMExec`` or an Airframe) disagrees with beyond
-    :data:`CONSISTENCY_REL` (:data:`CONSISTENCY_CG_CHORDS` of the mean chord for the CG),
-    as one line; None when they agree. Compared: mass (JSBSim's weight with its point
-    masses and fuel), S, b, c̄, Ixx, Iyy, Izz, Ixz (against the largest moment: a product of
-    inertia is small and its sign JSBSim's) and the CG (structural frame)."""
-    inertia = airframe.inertia
-    rows = [
-        ("mass_kg", airframe.mass_kg, fdm["inertia/weight-lbs"] * _LB_KG, "kg"),
-        ("reference_area_m2", airframe.reference_area_m2,
-         fdm["metrics/Sw-sqft"] * _FT_M ** 2, "m²"),
-        ("span_m", airframe.span_m, fdm["metrics/bw-ft"] * _FT_M, "m"),
-        ("mean_chord_m", airframe.mean_chord_m, fdm["metrics/cbarw-ft"] * _FT_M, "m"),
-    ]
-    jsb_i = {k: fdm[f"inertia/{k}-slugs_ft2"] * _SLUG_FT2_KG_M2
-             for k in ("ixx", "iyy", "izz", "ixz")}
-    rows += [(f"inertia_kg_m2.{k}", getattr(inertia, f"{k}_kg_m2"), jsb_i[k], "kg·m²")
-             for k in ("ixx", "iyy", "izz")]
-    where = "the JSBSim aircraft's XML"
-    for field, mine, theirs, unit in rows:
-        if not abs(mine - theirs) <= CONSISTENCY_REL * max(abs(mine), abs(theirs)):
-            return (f"airframe.{field} = {mine:.6g} {unit} but {where} has {theirs:.6g} {unit} "
-                    f"(more than {CONSISTENCY_REL:.0%} apart): JSBSim would fly the XML's "
-                    "and the wing's analyses the file's; make them the same aircraft")
-    largest = max(jsb_i["ixx"], jsb_i["iyy"], jsb_i["izz"])
-    if not abs(inertia.ixz_kg_m2 - jsb_i["ixz"]) <= CONSISTENCY_REL * largest:
-        return (f"airframe.inertia_kg_m2.ixz = {inertia.ixz_kg_m2:.6g} kg·m² but {where} has "
-                f"{jsb_i['ixz']:.6g} kg·m² (JSBSim's inertia/ixz-slugs_ft2, its sign; more than "
-                f"{CONSISTENCY_REL:.0%} of the largest moment apart)")
-    cg = [fdm[f"inertia/cg-{a}-in"] / INCH_PER_M for a in "xyz"]
-    limit = CONSISTENCY_CG_CHORDS * airframe.mean_chord_m
-    for axis, mine, theirs in zip("xyz", airframe.cg_m, cg, strict=True):
-        if not abs(mine - theirs) <= limit:
-            return (f"airframe.cg_m ({axis}) = {mine:.6g} m but {where} puts the CG at "
-                    f"{theirs:.6g} m (structural frame; more than {limit:.3g} m, "
-                    f"{CONSISTENCY_CG_CHORDS:.0%} of the mean chord, apart)")
-    return None
-
-
-_CHECKED: dict[tuple, str | None] = {}  # airframe_for's check, per definition and XML file
-
-
-def _mass_balance_probe(airframe) -> jsbsim.FGFDMExec:
-    """A throwaway JSBSim instance of ``airframe``'s aircraft with its initial conditions
-    run once: JSBSim computes the mass balance (inertia, CG) only when its models run, and
-    the flying instance is left as it was loaded."""
-    from bioflex_jsb.runtime.fdm import _captured, _CapturingLogger, _load_fdm
-
-    log = _CapturingLogger()
-    probe = _load_fdm(Path(airframe.root), airframe.aircraft, Path(airframe.aircraft_path), log)
-    with _captured(log):
-        probe.run_ic()
-    return probe
-
-
-def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None):
-    """The JSBSim airframe (:class:`~bioflex_jsb.runtime.fdm.Airframe`) an aircraft
-    definition flies (an :class:`~bioflex_jsb.definition.aircraft.Aircraft`; None: the
-    generated prototype): the prototype's generated ``bioflex`` (under ``root``, the default
-    search without it) for the prototype's airframe, else its ``airframe.jsbsim`` aircraft
-    with the modal wing's hooks (:func:`airframe_from_file`) and ``systems`` added (the SITL
-    glider's autopilot; the prototype's SITL aircraft has its own: generators/autopilot.py)."""
-    from bioflex_jsb.runtime.fdm import Airframe
-
-    if aircraft is None or not aircraft.airframe.jsbsim_path:
-        return Airframe(root)
-    airframe = airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m,
-                                  Airframe, aircraft.name, systems)
-    xml = os.stat(aircraft.airframe.jsbsim_path)
-    key = (aircraft.airframe.jsbsim_path, xml.st_mtime_ns, xml.st_size, repr(aircraft.airframe))
-    if key not in _CHECKED:  # once per definition and XML (a sweep loads one per case)
-        _CHECKED[key] = definition_mismatch(_mass_balance_probe(airframe), aircraft.airframe)
-    problem = _CHECKED[key]
-    if problem is not None:
-        raise AircraftLoadError(f"aircraft {aircraft.name!r}: {problem}")
     return airframe
 
 

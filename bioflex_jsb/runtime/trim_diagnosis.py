@@ -22,9 +22,10 @@ REPORT_LINE = re.compile(
 UNTRIMMABLE = re.compile(r"Sorry, (?P<state>\w+) doesn't appear to be trimmable")
 
 def diagnose_trim_failure(text: str, v: float, alpha_limits_rad: tuple[float, float],
-                          first_warning: str = "") -> str:
+                          first_warning: str = "", engine: str = "the motor gives") -> str:
     """One line: which control saturated or which condition failed (from JSBSim's
-    trim messages: the 'not trimmable' verdict and the final axis report)."""
+    trim messages: the 'not trimmable' verdict and the final axis report); ``engine``: what
+    gives the thrust, with its verb ("the motor gives", "the engines give")."""
     axes: dict[str, tuple[str, float, float, bool]] = {}
     for m in REPORT_LINE.finditer(text):
         try:
@@ -45,7 +46,7 @@ def diagnose_trim_failure(text: str, v: float, alpha_limits_rad: tuple[float, fl
     if "udot" in untrimmable or saturated("udot", 1.0):
         if sign("udot") < 0.0 or saturated("udot", 1.0):
             return (
-                f"cannot trim {where}: level flight needs more thrust than the motor gives "
+                f"cannot trim {where}: level flight needs more thrust than {engine} "
                 "(throttle saturated at 1)"
             )
         return f"cannot trim {where}: the aircraft accelerates even at zero throttle"

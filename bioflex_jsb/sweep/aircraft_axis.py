@@ -9,7 +9,7 @@ bad file is one line (exit 2) before any case runs:
 * with the ``gust`` metric, the aircraft must fly
   (:func:`~bioflex_jsb.definition.flying.flight_refusal`, the line of ``gust --aircraft``):
   the prototype's airframe with any wing, or another airframe on its own JSBSim aircraft
-  (``runtime.other_airframe.airframe_for``; a glider in its steady glide). A case whose
+  (``runtime.jsbsim_aircraft.airframe_for``; a glider in its steady glide). A case whose
   speed is outside the aircraft's ``speed_range_m_s`` is a failed row saying so (one
   campaign may sweep aircraft of different speeds);
 * with the linear metrics only (``flutter``, ``eigenvalues``, ``coefficients``) any airframe
@@ -42,6 +42,7 @@ def aircraft_axis(values: list, base_dir: Path | None, metrics: tuple[str, ...])
     from bioflex_jsb.definition.aircraft import load_aircraft
     from bioflex_jsb.definition.flying import flight_refusal
     from bioflex_jsb.errors import InputError
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
 
     out = []
     names: set[str] = set()
@@ -56,7 +57,8 @@ def aircraft_axis(values: list, base_dir: Path | None, metrics: tuple[str, ...])
             source = base_dir / path if base_dir is not None and not path.is_absolute() \
                 else path
         try:
-            aircraft = load_aircraft(source)
+            # JSBSim's numbers where the file has none, its own checked against JSBSim
+            aircraft = complete(load_aircraft(source))
             aircraft.variant()  # a wing the flight model takes (a beam wing is refused)
         except InputError as exc:  # the definition's one line, naming the field
             raise _fail(f"{key}: {exc}") from None
@@ -65,6 +67,13 @@ def aircraft_axis(values: list, base_dir: Path | None, metrics: tuple[str, ...])
                 problem = flight_refusal(aircraft)
             except InputError as exc:  # its planform, in one line
                 problem = str(exc)
+            if not problem:  # it must trim where its cases fly: found now, not per case
+                from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+
+                try:
+                    airframe_for(aircraft).trim(aircraft.airframe.cruise_speed_m_s)
+                except InputError as exc:
+                    problem = str(exc)
             if problem:
                 raise _fail(f"{key}: {problem}; with metrics from flutter, eigenvalues, "
                             "coefficients only (no gust runs) its linear analyses sweep")

@@ -81,7 +81,7 @@ def airframe(aircraft=None):
         from bioflex_jsb.runtime.fdm import Airframe
 
         return Airframe()
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 
     return airframe_for(aircraft)
 

@@ -89,7 +89,7 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
     from bioflex_jsb.flight_dynamics.wing_model import WingVariant
     from bioflex_jsb.loads import section_loads
     from bioflex_jsb.runtime.fdm import FdmError
-    from bioflex_jsb.runtime.other_airframe import airframe_for
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
 
     row: dict[str, Any] = {"case_id": case.case_id, "index": case.index, "gust": case.gust}
