@@ -18,11 +18,26 @@ started at the wind-off roots p = iω_i√(1 − ζ²) − ζω_i at the lowest 
 from their linear extrapolation over the two previous speeds; at each pass of a branch's
 frequency iteration the roots are shared out among all branches by the engine's joint
 assignment, so that two branches cannot settle on one root near a coalescence.
+
+**Over-damped (aperiodic) roots.** A branch whose mode is over-damped has a real root,
+ω = 0, where C = C(0) = 1 and the frozen problem is real: its real roots are exact p-k
+solutions (as in NASTRAN's PK method, aperiodic roots are solved at k = 0). Frozen at another
+branch's ω > 0, C is complex and the roots near the real axis fall on either side of it
+(the Patil-Hodges flying wing's first bending mode, over-damped from a few m/s, had both of
+its near-real roots just below the axis at 19 rad/s: the upper-half filter kept five roots
+for six branches). So the candidates a branch's pass shares out are the roots of the
+problem frozen at its ω that lie clearly above the axis (Im p above the engine's static
+frequency, :func:`real_root_tolerance_rad_s`) together with the real roots of the problem
+at ω = 0 (computed once per speed); a branch that takes a real root has converged. The two
+sets hold at least as many roots as branches when the upper-half roots at ω = 0 are added,
+which they are when the first two fall short (one branch per mode: of an over-damped mode's
+two real roots the branch follows the one nearest its prediction).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -49,9 +64,8 @@ DEFAULT_SPEED_STEP_M_S = 2.0
 CLAMPED_TOL_M_S = 1e-7
 
 
-def _roots(model, mats, damping, omega_ref, aero):
-    """All 2n eigenvalues of the frozen-C quadratic problem with C at ω_ref."""
-    c = circulation_functions(mats, max(omega_ref, 0.0), aero)
+def _frozen_matrix(model, mats, damping, c: np.ndarray) -> np.ndarray:
+    """The first-order companion matrix (2n, 2n) of the quadratic problem with C = ``c``."""
     n = model.n_modes
     m_t = model.mass + mats.apparent_mass
     c_t = damping + mats.apparent_damping - mats.force @ (c[:, None] * mats.upwash_rate)
@@ -60,25 +74,70 @@ def _roots(model, mats, damping, omega_ref, aero):
     a[:n, n:] = np.eye(n)
     a[n:, :n] = -np.linalg.solve(m_t, k_t)
     a[n:, n:] = -np.linalg.solve(m_t, c_t)
-    return np.linalg.eigvals(a)
+    return a
 
 
-def _branch_root(model, mats, damping, aero, guesses: np.ndarray, branch: int) -> complex:
+def _roots(model, mats, damping, omega_ref, aero):
+    """All 2n eigenvalues of the frozen-C quadratic problem with C at ω_ref."""
+    c = circulation_functions(mats, max(omega_ref, 0.0), aero)
+    return np.linalg.eigvals(_frozen_matrix(model, mats, damping, c))
+
+
+def real_root_tolerance_rad_s(model: ClampedWingModel) -> float:
+    """|Im p| [rad/s] at or below which a p-k root is real (aperiodic): the engine's static
+    frequency (a fraction of the lowest natural frequency, at least its absolute floor)."""
+    low = float(model.natural_frequencies_rad_s.min())
+    return max(engine.IMAG_TOL_RAD_S, engine.STATIC_FREQUENCY_FRACTION * low)
+
+
+@dataclass(frozen=True, eq=False)
+class ZeroFrequencyRoots:
+    """The roots of the problem at ω = 0 (C = 1, a real matrix): ``real`` (exact aperiodic
+    p-k roots, Im = 0) and ``upper`` (Im > 0; candidates only when too few others)."""
+
+    real: np.ndarray
+    upper: np.ndarray
+
+
+def zero_frequency_roots(model, mats, damping) -> ZeroFrequencyRoots:
+    """The roots at ω = 0 of one speed's frozen problem (module docstring)."""
+    c0 = np.ones(mats.semichord_m.size)
+    lam = np.linalg.eigvals(_frozen_matrix(model, mats, damping, c0).real)
+    real = lam.imag == 0.0  # a real matrix: LAPACK returns real roots with Im exactly 0
+    return ZeroFrequencyRoots(real=lam[real].real.astype(complex), upper=lam[lam.imag > 0.0])
+
+
+def candidates(roots: np.ndarray, zero: ZeroFrequencyRoots, n_branches: int,
+               tol_rad_s: float) -> np.ndarray:
+    """The roots one pass shares out among ``n_branches`` branches (module docstring):
+    ``roots`` of the frozen problem with Im p > ``tol_rad_s``, the real roots at ω = 0, and,
+    when these are fewer than the branches, the upper-half roots at ω = 0."""
+    out = np.concatenate([roots[roots.imag > tol_rad_s], zero.real])
+    if out.size < n_branches:
+        out = np.concatenate([out, zero.upper])
+    return out
+
+
+def _branch_root(model, mats, damping, aero, guesses: np.ndarray, branch: int,
+                 zero: ZeroFrequencyRoots) -> complex:
     """The root of one branch at one speed, iterated on its own frequency.
 
-    ``guesses`` (n,) are the predicted roots of all branches. At each pass the roots of the
-    problem frozen at this branch's frequency are shared out among all branches by joint
-    nearest assignment, and this branch takes its share: near a coalescence two branches
-    then cannot both settle on the same (stable) root.
+    ``guesses`` (n,) are the predicted roots of all branches. At each pass the
+    :func:`candidates` of the problem frozen at this branch's frequency are shared out among
+    all branches by joint nearest assignment, and this branch takes its share: near a
+    coalescence two branches then cannot both settle on the same (stable) root. A real
+    share is an aperiodic root at ω = 0, consistent as it stands.
     """
+    n = model.n_modes
     tol = _OMEGA_TOL_FRAC * float(model.natural_frequencies_rad_s.min())
+    tol_real = real_root_tolerance_rad_s(model)
     guesses = np.asarray(guesses, dtype=complex)
     p = complex(guesses[branch])
     for _ in range(_MAX_ITER):
         roots = _roots(model, mats, damping, abs(p.imag), aero)
-        upper = roots[roots.imag >= -1e-9 * np.abs(roots).max()]
-        new = complex(upper[engine.assign(guesses, upper)[branch]])
-        if abs(abs(new.imag) - abs(p.imag)) <= tol:
+        pool = candidates(roots, zero, n, tol_real)
+        new = complex(pool[engine.assign(guesses, pool)[branch]])
+        if new.imag == 0.0 or abs(abs(new.imag) - abs(p.imag)) <= tol:
             return new
         p = new
     return p
@@ -110,8 +169,9 @@ class PkFamily(engine.RootFamily):
 
     def _at(self, v: float, guesses: np.ndarray) -> engine.Point:
         mats = modal_strip_matrices(self.model, speed_m_s=v, density_kg_m3=self.density_kg_m3)
-        roots = np.array([_branch_root(self.model, mats, self.damping, self.aero, guesses, b)
-                          for b in range(self.model.n_modes)])
+        zero = zero_frequency_roots(self.model, mats, self.damping)
+        roots = np.array([_branch_root(self.model, mats, self.damping, self.aero, guesses, b,
+                                       zero) for b in range(self.model.n_modes)])
         return engine.Point(float(v), roots)
 
     def first(self, speed_m_s: float) -> engine.Point:
