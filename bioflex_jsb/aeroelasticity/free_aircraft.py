@@ -232,7 +232,8 @@ def free_family(build, *, aero: str = "unsteady", structural_damping: float | No
     fam = engine.EigenFamily(
         lambda v: _system(build, v, aero, structural_damping, density_kg_m3),
         ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=EXCLUDED,
-        rigid_labels=eigen.RIGID_LABELS,
+        rigid_labels=eigen.RIGID_LABELS, paired_labels=eigen.RIGID_LABELS,
+        partition=eigen.mode_labels_of_roots,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
         reference_semichord_m=model.airframe.reference.mean_chord_m / 2.0,
         method="state-space", aero=aero, name=build.variant.name)

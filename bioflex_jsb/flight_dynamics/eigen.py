@@ -14,6 +14,7 @@ EigenFamily`), for the default rigid parameter set or another one (``aero``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -151,14 +152,65 @@ def airframe_of(wing: ElasticWingModel | None, airframe: AirframeData | None) ->
     return wing.airframe
 
 
+def _pair_units(lam: np.ndarray) -> list[tuple[int, ...]]:
+    """The roots of a real matrix as units: each conjugate pair (indices of both roots) and
+    each real root (|Im λ| <= :data:`IMAG_TOL_RAD_S`) alone."""
+    free = list(range(lam.size))
+    units: list[tuple[int, ...]] = []
+    while free:
+        i = free.pop(0)
+        if abs(lam[i].imag) <= IMAG_TOL_RAD_S:
+            units.append((i,))
+            continue
+        j = min(free, key=lambda k: abs(lam[k] - np.conj(lam[i])))
+        free.remove(j)
+        units.append((i, j))
+    return units
+
+
+def mode_labels_of_roots(lam: np.ndarray) -> tuple[str, ...]:
+    """``short_period`` or ``phugoid`` for each of the four roots ``lam`` of a real rigid
+    longitudinal model (A_RR, or the rigid-body roots of a coupled one).
+
+    Each mode is a second-order factor s² + 2ζω_n s + ω_n² of the characteristic polynomial:
+    one conjugate pair or two real roots (an over-damped short period, as the J3Cub's), never
+    a pair split between the two, with ω_n² the product of its two roots. The short period is
+    the factor of the larger ω_n: of the ways to share the roots so, the one with the largest
+    ratio of the short period's ω_n to the phugoid's. With two pairs this is the pair of the
+    larger modulus; with four real roots, the two largest. Ranking single roots by modulus
+    instead called the phugoid pair "short_period" when one real short-period root was
+    slower than the phugoid.
+    """
+    lam = np.asarray(lam, dtype=complex)
+    if lam.shape != (4,):
+        raise ValueError(f"expected the 4 rigid eigenvalues, got shape {lam.shape}")
+    best, best_sp = -math.inf, ()
+    for sp in _two_root_choices(_pair_units(lam)):
+        ph = [i for i in range(4) if i not in sp]
+        w_sp = abs(lam[sp[0]] * lam[sp[1]])
+        w_ph = abs(lam[ph[0]] * lam[ph[1]])
+        ratio = math.inf if w_ph == 0.0 else w_sp / w_ph
+        if ratio > best:
+            best, best_sp = ratio, sp
+    return tuple(RIGID_LABELS[0] if i in best_sp else RIGID_LABELS[1] for i in range(4))
+
+
+def _two_root_choices(units: list[tuple[int, ...]]) -> list[tuple[int, ...]]:
+    """The sets of two roots made of whole units: one pair, or two real roots."""
+    out = [u for u in units if len(u) == 2]
+    singles = [u[0] for u in units if len(u) == 1]
+    out += [(a, b) for k, a in enumerate(singles) for b in singles[k + 1:]]
+    return out
+
+
 def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition,
                aero: RigidAerodynamics | None = None):
     """Uncoupled reference eigenvalues with labels, for the first speed of a sweep."""
     ss_rigid = build_state_space("rigid", cond, aero=aero)
     lam = np.linalg.eigvals(ss_rigid.a)
-    order = np.argsort(-np.abs(lam))  # short period: the two largest |λ|
-    labels = [RIGID_LABELS[0]] * 2 + [RIGID_LABELS[1]] * 2
-    ref = [(labels[k], lam[i]) for k, i in enumerate(order)]
+    labels = mode_labels_of_roots(lam)
+    order = sorted(range(4), key=lambda i: (labels[i] != RIGID_LABELS[0], -abs(lam[i])))
+    ref = [(labels[i], lam[i]) for i in order]
     if model == "coupled":
         assert wing is not None
         blk = coupled_blocks(wing, cond, aero)
@@ -207,6 +259,7 @@ def paper_family(model: str, wing: ElasticWingModel | None, density_kg_m3: float
     return engine.EigenFamily(
         matrix, np.array([r[1] for r in ref]), [r[0] for r in ref], rest_label="lag",
         excluded=EXCLUDED_FROM_FLUTTER, rigid_labels=RIGID_LABELS,
+        paired_labels=RIGID_LABELS, partition=mode_labels_of_roots,
         natural_frequencies_rad_s=natural,
         reference_semichord_m=af.reference.mean_chord_m / 2.0, method="state-space",
         aero="quasi-steady", name="" if wing is None else wing.name)

@@ -138,18 +138,37 @@ class RootFamily:
 
 
 class EigenFamily(RootFamily):
-    """The eigenvalues of a state matrix A(V) (every root tracked, conjugates included)."""
+    """The eigenvalues of a state matrix A(V) (every root tracked, conjugates included).
+
+    ``paired_labels`` (the rigid ``short_period`` and ``phugoid``) name modes that are each
+    one second-order factor of a real matrix (one conjugate pair or two real roots) told
+    apart by a rule, not by continuity: at every speed ``partition`` (the roots of those
+    branches → a label per root, whole factors) names them, and the tracker only orders the
+    roots within a name (:func:`share_paired`). Tracked root by root, a real root of the
+    over-damped short period that met a real phugoid root made a pair carrying both names,
+    and identities carried from the lowest speed, where the two time scales cross, named
+    the phugoid "short_period" at cruise (the J3Cub)."""
 
     def __init__(self, matrix: Callable[[float], np.ndarray], reference: np.ndarray,
                  reference_labels: Sequence[str], *, rest_label: str = "lag",
-                 excluded: Sequence[str] = (), **attrs) -> None:
+                 excluded: Sequence[str] = (), paired_labels: Sequence[str] = (),
+                 partition: Callable[[np.ndarray], Sequence[str]] | None = None,
+                 **attrs) -> None:
         self.matrix = matrix
         self.reference = np.asarray(reference, dtype=complex)
         self.reference_labels = tuple(reference_labels)
         self.rest_label = rest_label
         self.excluded = tuple(excluded) + (rest_label,)
+        self.paired_labels = tuple(paired_labels)
+        self.partition = partition
         for k, v in attrs.items():
             setattr(self, k, v)
+
+    def _shared(self, lam, order, predicted):
+        if not self.paired_labels or self.partition is None:
+            return order
+        return share_paired(self.labels, self.paired_labels, self.partition, lam, order,
+                            predicted)
 
     def first(self, speed_m_s: float) -> Point:
         lam, vec = np.linalg.eig(self.matrix(float(speed_m_s)))
@@ -158,12 +177,39 @@ class EigenFamily(RootFamily):
         order = np.array(chosen + rest)
         self.labels = self.reference_labels + (self.rest_label,) * len(rest)
         self.considered = np.array([lab not in self.excluded for lab in self.labels])
+        order = self._shared(lam, order, np.concatenate([self.reference, lam[rest]]))
         return Point(float(speed_m_s), lam[order], vec[:, order])
 
     def follow(self, speed_m_s: float, previous: Point, predicted: np.ndarray) -> Point:
         lam, vec = np.linalg.eig(self.matrix(float(speed_m_s)))
         order = assign(predicted, lam, previous.vectors, vec)
+        order = self._shared(lam, order, predicted)
         return Point(float(speed_m_s), lam[order], vec[:, order])
+
+
+def share_paired(labels: Sequence[str], paired: Sequence[str],
+                 partition: Callable[[np.ndarray], Sequence[str]], lam: np.ndarray,
+                 order: np.ndarray, predicted: np.ndarray) -> np.ndarray:
+    """``order`` (root index per branch) with the roots on the ``paired`` labels' branches
+    named by ``partition``: each label's branches take the roots it names, each root the
+    branch it is nearest the prediction of (joint assignment). Unchanged where the tracker's
+    names already are the partition's."""
+    pos = [j for j, lab in enumerate(labels) if lab in paired]
+    roots_idx = [int(order[j]) for j in pos]
+    named = list(partition(lam[roots_idx]))
+    if named == [labels[j] for j in pos]:
+        return order
+    out = np.array(order)
+    for lab in paired:
+        branches = [j for j in pos if labels[j] == lab]
+        mine = [r for r, nl in zip(roots_idx, named, strict=True) if nl == lab]
+        if len(mine) != len(branches):
+            raise ValueError(f"partition named {len(mine)} roots {lab!r}, which has "
+                             f"{len(branches)} branches")
+        cols = assign(predicted[branches], lam[mine])
+        for b, c in zip(branches, cols, strict=True):
+            out[b] = mine[c]
+    return out
 
 
 def _predict(points: Sequence[Point], speed_m_s: float, extrapolate: bool) -> np.ndarray:

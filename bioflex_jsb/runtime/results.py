@@ -115,24 +115,29 @@ class RigidLinearization:
 
 
 def label_modes(eigenvalues: np.ndarray) -> tuple[ModeEigenvalue, ...]:
-    """Label the 4 longitudinal eigenvalues by frequency and keep one per conjugate pair.
+    """Label the 4 longitudinal eigenvalues and keep one per conjugate pair.
 
-    The two of larger modulus are the short period, the two of smaller the phugoid. Complex
+    Each mode is one conjugate pair or two real roots, the short period the one of the
+    larger natural frequency (:func:`bioflex_jsb.flight_dynamics.eigen.mode_labels_of_roots`:
+    an over-damped short period's two real roots stay together). Short period first; complex
     pairs are reported once (im > 0); real roots each appear (im = 0).
     """
+    from bioflex_jsb.flight_dynamics.eigen import mode_labels_of_roots
+
     lam = np.asarray(eigenvalues, dtype=complex)
     if lam.shape != (4,):
         raise ValueError(f"expected 4 longitudinal eigenvalues, got {lam.shape}")
-    order = np.argsort(-np.abs(lam), kind="stable")
+    labels = mode_labels_of_roots(lam)
+    order = sorted(range(4), key=lambda i: (labels[i] != "short_period", -abs(lam[i])))
     out = []
-    for rank, i in enumerate(order):
+    for i in order:
         value = lam[i]
         if value.imag < 0.0:
             continue
         modulus = abs(value)
         out.append(
             ModeEigenvalue(
-                mode="short_period" if rank < 2 else "phugoid",
+                mode=labels[i],
                 re=float(value.real),
                 im=float(abs(value.imag)),
                 damping=float(-value.real / modulus) if modulus > 0 else 1.0,
