@@ -576,19 +576,27 @@ def _clamped_modes(definition, speed_m_s, aero, method, structural_damping) -> M
 def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
             aero: str | None = None, method: str | None = None, clamped: bool = False,
             structural_damping: float | None = None, density_kg_m3: float | None = None,
-            lift_slope: str | None = None) -> FlutterResult:
+            lift_slope: str | None = None, progress=None,
+            full_scan: bool = False) -> FlutterResult:
     """The first instability [m/s] in ``range_m_s``: flutter, body-freedom flutter or
     static divergence, its frequency [rad/s], k, modes, mechanism, and whether it is
-    already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``).
+    already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``,
+    ``.plot(path)`` the V-g / V-f diagram; ``speed_m_s`` is ``None`` when nothing crosses
+    and when the system is unstable at and below the lower end, ``present_at_lower_end``).
 
-    Free aircraft (``wing`` a :class:`WingBuild`): Eq. (4) on ``aero`` strips (default
-    ``quasi-steady``, the paper's; ``unsteady``: Jones lag states), ``method``
-    ``state-space``; range default 5-40 m/s for the prototype, derived from the wing for
-    another aircraft (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-] replaces
-    the wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML
-    file): ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and ρ
-    default to the definition's; the range to the one derived from the wing
-    (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`)."""
+    Free aircraft (``wing`` a :class:`WingBuild`): Eq. (4) on ``aero`` strips, default
+    ``unsteady`` (Theodorsen strips with Jones lag states: the pitch damping the
+    quasi-steady strips lack); ``quasi-steady`` is the paper's model (its tables), whose
+    single-mode torsion instability is flagged (``quasi_steady_artefact``, ``caveat``);
+    ``method`` ``state-space``; range default 5-40 m/s for the prototype, derived from the
+    wing for another aircraft (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-]
+    replaces the wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name
+    or a TOML file): ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and
+    ρ default to the definition's; the range to the one derived from the wing
+    (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`). ``progress``: called
+    with each scanned speed [m/s] and the scan's top [m/s] (a progress bar's);
+    ``full_scan``: scan the whole range, not only up to the first instability (for the
+    diagram)."""
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
@@ -602,12 +610,13 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if density_kg_m3 is not None:
         _check_density(density_kg_m3)
     structural_damping = _check_damping(structural_damping)
+    scan = dict(progress=progress, full_scan=bool(full_scan))
     if clamped:
         return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
-                                density_kg_m3, lift_slope)
+                                density_kg_m3, lift_slope, scan)
     air = _density(wing, density_kg_m3)
     wing = _wing(wing)
-    aero = aero or "quasi-steady"
+    aero = aero or FREE_FLUTTER_DEFAULT_AERO
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if method not in (None, "state-space"):
         raise InputError("the free aircraft's flutter is by state-space eigen-analysis; "
@@ -619,10 +628,18 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
         else range_m_s
     if aero == "unsteady":
         return free_flutter(wing, aero="unsteady", structural_damping=structural_damping,
-                            range_m_s=rng, **air)
+                            range_m_s=rng, **air, **scan)
     model = wing.model if structural_damping is None else with_damping(wing,
                                                                        structural_damping)
-    return find_flutter(model, rng, **air)
+    return find_flutter(model, rng, **air, **scan)
+
+
+# The free aircraft's flutter is analysed on unsteady strips unless asked otherwise: the
+# quasi-steady strips (the paper's) have no aerodynamic pitch damping, and their single-mode
+# torsion instability moves with the assumed structural damping (inertial-backward: <= 5
+# m/s at zeta 0, 16.6 m/s at 0.05) where the unsteady strips' body-freedom flutter stays at
+# 18.9 m/s (docs/aeroelasticity.md).
+FREE_FLUTTER_DEFAULT_AERO = "unsteady"
 
 
 def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:
@@ -640,7 +657,7 @@ def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[flo
     return _free_speed_range_m_s(_wing(build), density_kg_m3)
 
 
-def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope):
+def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope, scan):
     from bioflex_jsb.aeroelasticity import pk, state_space
     from bioflex_jsb.definition.clamped import derived_speed_range_m_s, scan_step_m_s
 
@@ -657,7 +674,7 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope)
         scan_step_m_s(rng)
     res = solve(m, density_kg_m3=rho, aero=aero, structural_damping=zeta,
                 speed_range_m_s=tuple(rng), speed_step_m_s=min(step, scan_step_m_s(rng)),
-                name=d.name)
+                name=d.name, **scan)
     return replace(res, settings=dict(res.settings, definition=d.path or d.name,
                                       range_derived=range_m_s is None
                                       and d.analysis.speed_range_m_s is None))

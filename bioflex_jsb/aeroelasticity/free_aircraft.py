@@ -235,6 +235,7 @@ def free_family(build, *, aero: str = "unsteady", structural_damping: float | No
         rigid_labels=eigen.RIGID_LABELS, paired_labels=eigen.RIGID_LABELS,
         partition=eigen.mode_labels_of_roots,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
+        mode_labels=eigen.structural_mode_labels(model.frequencies_rad_s),
         reference_semichord_m=model.airframe.reference.mean_chord_m / 2.0,
         method="state-space", aero=aero, name=build.variant.name)
     fam.divergence_speed_m_s = wing_divergence_speed_m_s(build, density_kg_m3=density_kg_m3,
@@ -302,10 +303,13 @@ FREE_TOL_M_S = 1e-4
 def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | None = None,
                  range_m_s: tuple[float, float] = (5.0, 40.0),
                  step_m_s: float = eigen.SCAN_STEP_M_S,
-                 density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> engine.FlutterResult:
+                 density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3, progress=None,
+                 full_scan: bool = False) -> engine.FlutterResult:
     """First instability of the free aircraft (phugoid left out, as in the paper): the
     engine's scan from 2 m/s in ``step_m_s``, bisection to :data:`FREE_TOL_M_S`;
-    mechanism by the engine's rule (body-freedom when the short period goes unstable)."""
+    mechanism by the engine's rule (body-freedom when the short period goes unstable).
+    ``progress``, ``full_scan``:
+    :func:`~bioflex_jsb.flight_dynamics.flutter_engine.first_instability`'s."""
     lo, hi = range_m_s
     top = max(eigen.DIVERGENCE_SEARCH_TOP_M_S, eigen.DIVERGENCE_TOP_OVER_RANGE * hi)
     fam = free_family(build, aero=aero, structural_damping=structural_damping,
@@ -314,7 +318,7 @@ def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | N
     return engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, eigen.SCAN_START_M_S), (lo, hi),
         tol_m_s=FREE_TOL_M_S, structural_damping=structural_damping,
-        density_kg_m3=density_kg_m3)
+        density_kg_m3=density_kg_m3, progress=progress, full_scan=full_scan)
 
 
 # --------------------------------------------------------------------------------------

@@ -158,6 +158,7 @@ class PkFamily(engine.RootFamily):
         self.zeta = float(structural_damping)
         self.damping = structural_damping_matrix(model, self.zeta)
         self.labels = model.mode_labels()
+        self.mode_labels = self.labels
         self.considered = np.ones(model.n_modes, dtype=bool)
         self.natural_frequencies_rad_s = tuple(float(w) for w in
                                                model.natural_frequencies_rad_s)
@@ -210,20 +211,26 @@ def pk_flutter(
     speed_range_m_s: tuple[float, float] = (20.0, 260.0),
     speed_step_m_s: float = DEFAULT_SPEED_STEP_M_S,
     name: str = "",
+    progress=None,
+    full_scan: bool = False,
 ) -> engine.FlutterResult:
     """First flutter or divergence of ``model`` in ``speed_range_m_s`` by the p-k method
-    (the engine's search, bisected to :data:`CLAMPED_TOL_M_S`)."""
+    (the engine's search, bisected to :data:`CLAMPED_TOL_M_S`; ``progress``, ``full_scan``:
+    :func:`~bioflex_jsb.flight_dynamics.flutter_engine.first_instability`'s)."""
     fam = PkFamily(model, density_kg_m3=density_kg_m3, aero=aero,
                    structural_damping=structural_damping, name=name)
-    return clamped_search(fam, model, speed_range_m_s, speed_step_m_s)
+    return clamped_search(fam, model, speed_range_m_s, speed_step_m_s, progress=progress,
+                          full_scan=full_scan)
 
 
 def clamped_search(fam: engine.RootFamily, model: ClampedWingModel,
                    speed_range_m_s: tuple[float, float],
-                   speed_step_m_s: float) -> engine.FlutterResult:
+                   speed_step_m_s: float, *, progress=None,
+                   full_scan: bool = False) -> engine.FlutterResult:
     """The engine's search over a clamped wing's family (p-k or state space) on a grid of
     ``speed_step_m_s`` [m/s], bisected to :data:`CLAMPED_TOL_M_S`."""
     return engine.first_instability(
         fam, engine.default_grid(speed_range_m_s, speed_step_m_s), speed_range_m_s,
         tol_m_s=CLAMPED_TOL_M_S, structural_damping=float(fam.zeta),
-        density_kg_m3=fam.density_kg_m3, settings={"lift_slope": model.lift_slope})
+        density_kg_m3=fam.density_kg_m3, settings={"lift_slope": model.lift_slope},
+        progress=progress, full_scan=full_scan)

@@ -113,7 +113,7 @@ def state_space_family(model: ClampedWingModel, *, density_kg_m3: float,
 
     fam = engine.EigenFamily(
         matrix, np.concatenate([upper, upper.conj()]), labels + labels, rest_label="lag",
-        extrapolate=True, method="state-space", aero=aero, name=name,
+        extrapolate=True, method="state-space", aero=aero, name=name, mode_labels=labels,
         natural_frequencies_rad_s=tuple(float(w) for w in w0),
         reference_semichord_m=float(np.mean(model.semichord_m)),
         divergence_speed_m_s=_finite_or_none(divergence_speed_m_s(model, density_kg_m3)),
@@ -147,9 +147,13 @@ def state_space_flutter(
     speed_range_m_s: tuple[float, float] = (20.0, 260.0),
     speed_step_m_s: float = DEFAULT_SPEED_STEP_M_S,
     name: str = "",
+    progress=None,
+    full_scan: bool = False,
 ) -> engine.FlutterResult:
     """First flutter or divergence of ``model`` in ``speed_range_m_s`` by eigen-analysis
-    (the engine's search, bisected to 1e-7 m/s)."""
+    (the engine's search, bisected to 1e-7 m/s; ``progress``, ``full_scan``:
+    :func:`~bioflex_jsb.flight_dynamics.flutter_engine.first_instability`'s)."""
     fam = state_space_family(model, density_kg_m3=density_kg_m3, aero=aero,
                              structural_damping=structural_damping, name=name)
-    return clamped_search(fam, model, speed_range_m_s, speed_step_m_s)
+    return clamped_search(fam, model, speed_range_m_s, speed_step_m_s, progress=progress,
+                          full_scan=full_scan)

@@ -3,20 +3,25 @@
 Two analyses, chosen by --wing and --clamped (docs/aeroelasticity.md, docs/aircraft.md),
 both :func:`bioflex_jsb.api.flutter` (this module only formats its result):
 
-* a paper wing (``original``, ``optimised``, ... or a variant file), free aircraft: the
-  coupled model of Eq. (4) on quasi-steady or unsteady strips;
+* a paper wing (``original``, ``optimised``, ... or a variant file) or ``--aircraft``, free
+  aircraft: the coupled model of Eq. (4) on unsteady strips (default) or the paper's
+  quasi-steady ones;
 * ``--clamped FILE`` (or ``--clamped goland``, or ``--wing goland --clamped``): a clamped
   wing from its definition file, by p-k or by state-space eigen-analysis.
 
 Combinations that are not available are refused with one line (exit 2) naming what is.
+``--plot FILE`` draws the V-g / V-f diagram (:meth:`FlutterResult.plot`) of a scan over the
+whole range; on a terminal a progress bar on stderr follows the scan.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import sys
 from dataclasses import replace
 
+from bioflex_jsb.cli.case import add_force_argument, check_plot_path
 from bioflex_jsb.cli.common import UsageError, add_wing_arguments, print_json, wing_from_args
 from bioflex_jsb.definition.loader import DENSITY_RANGE_KG_M3, SHIPPED
 
@@ -37,12 +42,16 @@ right half plane in --range. Reports the speed [m/s], the frequency of the cross
 the mechanism (coalescence with another branch and which, single-mode, or static
 divergence) and the wind-off natural frequencies [rad/s]; null when nothing crosses.
 
-Paper wings (free aircraft, Eq. 4): --aero quasi-steady (default; the paper's strips) or
-unsteady (Theodorsen strips with two Jones lag states per strip added to Eq. 4;
-docs/aeroelasticity.md), eigen-analysis (--method state-space) scanned in 0.1 m/s steps
-from 2 m/s with mode tracking and bisected (printed to 0.1 m/s); the phugoid is left out,
-as in the paper; with unsteady strips also the wing's divergence speed with the body held.
-Not available for them: --clamped, --method pk, --lift-slope, --inertia-about.
+Paper wings and --aircraft (free aircraft, Eq. 4): --aero unsteady (default: Theodorsen
+strips with two Jones lag states per strip added to Eq. 4, docs/aeroelasticity.md) or
+quasi-steady (the paper's strips, C = 1: the model of its tables). Quasi-steady strips have
+no aerodynamic pitch damping: their single-mode torsion instability is the model's
+artefact, its speed set by the assumed structural damping, and is marked so beside the
+number ("quasi_steady_artefact": true and a "caveat" in --json). Eigen-analysis (--method
+state-space) scanned in 0.1 m/s steps from 2 m/s with mode tracking and bisected (printed
+to 0.1 m/s); the phugoid is left out, as in the paper; also the wing's divergence speed
+with the body held (not an instability of the aircraft). Not available for them:
+--clamped, --method pk, --lift-slope, --inertia-about.
 
 --clamped FILE.toml: any clamped wing from its definition file (docs/aircraft.md: span
 stations, beam sections, aerodynamics, air; units and ranges checked when read). --clamped
@@ -55,7 +64,11 @@ literal reading of the data is --inertia-about centre-of-mass --density 1.02); d
 --range derived from the wing: up to 1.5 x its static divergence speed, from 5 % of that
 (docs/aircraft.md).
 An instability already present at the range's lower end is reported as "unstable at and
-below LOW m/s", never as no instability."""
+below LOW m/s" with no speed (JSON: flutter_speed_m_s null, present_at_lower_end true,
+unstable_at_and_below_m_s LOW), never as no instability. --plot FILE.png (.pdf, .svg):
+the V-g / V-f diagram, damping ratio and frequency of every branch against airspeed over
+the whole --range, the first instability marked. On a terminal a progress bar (stderr)
+follows the scan."""
 
 
 def speed_range(text: str) -> tuple[float, float]:
@@ -116,8 +129,9 @@ def register(sub) -> None:
                    "--clamped takes the name from --wing")
     p.add_argument("--aero", choices=AERO_CHOICES, default=None,
                    help="strip aerodynamics: unsteady (Theodorsen C(k); Jones lag states in "
-                   "state-space) or quasi-steady (C = 1); default the definition's for "
-                   "--clamped, quasi-steady (the paper's) for paper wings")
+                   "state-space) or quasi-steady (C = 1, the paper's: no pitch damping, its "
+                   "single-mode torsion flutter marked as an artefact); default the "
+                   "definition's for --clamped, unsteady for the free aircraft")
     p.add_argument("--method", choices=METHOD_CHOICES, default=None,
                    help="pk (frequency domain, --clamped only) or state-space "
                    "(eigen-analysis with mode tracking); default the definition's for "
@@ -142,6 +156,12 @@ def register(sub) -> None:
                    f"{PAPER_DEFAULT_RANGE_M_S[1]:g} for the prototype's wings, derived from "
                    "the wing for another aircraft and for --clamped (5 %% to 150 %% of its "
                    "static divergence speed, at most 400)")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="draw the V-g / V-f diagram (damping ratio and frequency of each "
+                   "branch against airspeed over the whole range, the first instability "
+                   "marked) to FILE (.png, .pdf, .svg; an existing file is replaced only if "
+                   "bioflex-jsb wrote it)")
+    add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -187,12 +207,44 @@ def clamped_target(args: argparse.Namespace) -> str | None:
 
 def run(args: argparse.Namespace) -> int:
     target = clamped_target(args)
-    payload = paper_payload(args) if target is None else clamped_payload(args, target)
+    check_plot_path(args.plot, args.force)
+    with ScanProgress() as progress:
+        payload = paper_payload(args, progress) if target is None else \
+            clamped_payload(args, target, progress)
     if args.json:
         print_json(payload)
         return 0
     print(text_report(payload))
     return 0
+
+
+class ScanProgress:
+    """A tqdm bar over the scanned airspeed [m/s] on a terminal (stderr), nothing
+    otherwise: pipes and CI stay clean. Called with each scanned speed and the scan's top
+    (:func:`bioflex_jsb.flight_dynamics.flutter_engine.first_instability`)."""
+
+    def __init__(self) -> None:
+        self.bar = None
+        self.at = 0.0
+
+    def __enter__(self):
+        """The progress callable on a terminal, None otherwise."""
+        return self if sys.stderr.isatty() else None
+
+    def __call__(self, speed_m_s: float, top_m_s: float) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=round(top_m_s, 1), desc="flutter scan", leave=False,
+                            file=sys.stderr, mininterval=0.2,
+                            bar_format="{desc}: {n:.1f}/{total:.1f} m/s |{bar}| {elapsed}")
+        if speed_m_s > self.at:
+            self.bar.update(round(speed_m_s - self.at, 6))
+            self.at = speed_m_s
+
+    def __exit__(self, *exc) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def _round(x: float | None, digits: int) -> float | None:
@@ -202,14 +254,12 @@ def _round(x: float | None, digits: int) -> float | None:
 def _formatted(res, digits: int) -> dict:
     """The api result's dictionary with the speeds and frequencies rounded for printing."""
     d = res.as_dict()
-    # unstable already at the range's lower end: no onset speed was found (null, not the
-    # lower end: a script reading the speed alone took it for a flutter speed); the lower
-    # end is unstable_at_and_below_m_s
-    onset = None if res.present_at_lower_end else res.speed_m_s
-    d["flutter_speed_m_s"] = _round(onset, digits)
+    # unstable already at the range's lower end: the result has no speed (null: a script
+    # reading the speed alone took the lower end for a flutter speed); the lower end is
+    # unstable_at_and_below_m_s
+    d["flutter_speed_m_s"] = _round(res.speed_m_s, digits)
     d["speed_m_s"] = d["flutter_speed_m_s"]
-    d["unstable_at_and_below_m_s"] = (_round(res.speed_m_s, digits)
-                                      if res.present_at_lower_end else None)
+    d["unstable_at_and_below_m_s"] = _round(res.unstable_at_and_below_m_s, digits)
     d["frequency_rad_s"] = _round(res.frequency_rad_s, 2)
     d["reduced_frequency"] = _round(res.reduced_frequency, 4)
     d["divergence_speed_m_s"] = _round(res.divergence_speed_m_s, 2)
@@ -218,7 +268,18 @@ def _formatted(res, digits: int) -> dict:
     return d
 
 
-def clamped_payload(args: argparse.Namespace, target: str) -> dict:
+def _plot(res, args: argparse.Namespace) -> str | None:
+    """Draw the V-g / V-f diagram to --plot (a one-line refusal if it cannot be written)."""
+    if not args.plot:
+        return None
+    try:
+        res.plot(args.plot, force=True)  # check_plot_path refused what --force must allow
+    except OSError as exc:
+        raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None
+    return args.plot
+
+
+def clamped_payload(args: argparse.Namespace, target: str, progress=None) -> dict:
     """A clamped wing's first instability (:func:`bioflex_jsb.api.flutter`), beside the
     published one for the Goland wing."""
     from bioflex_jsb import api
@@ -229,8 +290,11 @@ def clamped_payload(args: argparse.Namespace, target: str) -> dict:
             definition.structure, inertia_axis=args.inertia_about))
     res = api.flutter(definition, args.range, aero=args.aero, method=args.method,
                       clamped=True, structural_damping=args.structural_damping,
-                      density_kg_m3=args.density, lift_slope=args.lift_slope)
+                      density_kg_m3=args.density, lift_slope=args.lift_slope,
+                      progress=progress,
+                      full_scan=bool(args.plot))
     d = _formatted(res, 2)
+    d["plot"] = _plot(res, args)
     lift_slope = res.settings["lift_slope"]
     d.update(wing=definition.name, clamped=True, lift_slope=lift_slope,
              inertia_about=definition.structure.inertia_axis)
@@ -263,7 +327,7 @@ def goland_published(res, lift_slope: str) -> dict:
     }
 
 
-def paper_payload(args: argparse.Namespace) -> dict:
+def paper_payload(args: argparse.Namespace, progress=None) -> dict:
     """The free aircraft's first instability (:func:`bioflex_jsb.api.flutter`)."""
     from bioflex_jsb import api
     from bioflex_jsb.aeroelasticity.free_aircraft import with_damping
@@ -271,10 +335,11 @@ def paper_payload(args: argparse.Namespace) -> dict:
     build = wing_from_args(args)
     model = build.model if args.structural_damping is None else with_damping(
         build, args.structural_damping)
-    res = api.flutter(build, args.range,
-                      aero=args.aero or "quasi-steady", method=args.method,
-                      structural_damping=args.structural_damping, density_kg_m3=args.density)
+    res = api.flutter(build, args.range, aero=args.aero, method=args.method,
+                      structural_damping=args.structural_damping, density_kg_m3=args.density,
+                      progress=progress, full_scan=bool(args.plot))
     d = _formatted(res, 1)
+    d["plot"] = _plot(res, args)
     d.update(
         wing=build.variant.name, clamped=False,
         structural_damping=[float(z) for z in model.damping_ratios],
@@ -285,7 +350,7 @@ def paper_payload(args: argparse.Namespace) -> dict:
 
 def text_report(p: dict) -> str:
     head = f"wing {p['wing']}" + (" (clamped)" if p["clamped"] else "")
-    setup = f"{p['aero']}, {p['method']}"
+    setup = f"{p['aero']} strips, {p['method']}"
     if p["clamped"]:
         setup += f", lift slope {p['lift_slope']}, rho {p['density_kg_m3']:g} kg/m^3"
     zeta = p["structural_damping"]
@@ -300,15 +365,20 @@ def text_report(p: dict) -> str:
         lines.append(f"  no instability between {lo:g} and {hi:g} m/s")
     else:
         partner = f" with {p['partner_mode']}" if p.get("partner_mode") else ""
-        what = (f"{p['kind']}, mode {p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, "
+        # beside the number: what a quasi-steady single-mode result is
+        tag = " [quasi-steady artefact: see the caveat]" if p.get("quasi_steady_artefact") \
+            else ""
+        what = (f"{p['kind']}{tag}, mode {p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, "
                 f"k = {p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
         if p["present_at_lower_end"]:
             lines.append(f"  unstable at and below {lo:g} m/s (already at the range's lower "
                          f"end; lower LOW to find the onset): {what}")
         else:
-            lines.append(f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s, mode "
+            lines.append(f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s{tag}, mode "
                          f"{p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, k = "
                          f"{p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
+        if p.get("caveat"):
+            lines.append(f"  caveat: {p['caveat']}")
     pub = p.get("published")
     if pub is not None:
         line = (f"  published: {pub['flutter_speed_m_s']} m/s, {pub['frequency_rad_s']} rad/s "
@@ -324,5 +394,8 @@ def text_report(p: dict) -> str:
         lines.append(f"  static divergence at {div:.1f} m/s{where}")
     if p.get("wing_divergence_speed_m_s") is not None:
         lines.append(f"  wing divergence with the body held at "
-                     f"{p['wing_divergence_speed_m_s']:.1f} m/s")
+                     f"{p['wing_divergence_speed_m_s']:.1f} m/s (not an instability of the "
+                     "aircraft)")
+    if p.get("plot"):
+        lines.append(f"  V-g / V-f diagram written to {p['plot']}")
     return "\n".join(lines)

@@ -224,6 +224,15 @@ def _reference(model: str, wing: ElasticWingModel | None, cond: FlightCondition,
     return ref if model == "coupled" else ref[:4]
 
 
+def structural_mode_labels(natural_rad_s: Sequence[float]) -> tuple[str, ...]:
+    """The coupled model's name of each wing mode, in the order of ``natural_rad_s``
+    (``aeroelastic_k``: the k-th lowest natural frequency, as :func:`_reference` numbers
+    the branches)."""
+    rank = np.argsort(np.argsort(np.asarray(natural_rad_s, dtype=float), kind="stable"),
+                      kind="stable")
+    return tuple(f"aeroelastic_{int(r) + 1}" for r in rank)
+
+
 def _collapse(speed: float, model: str, labels: Sequence[str], lam: np.ndarray) -> ModeSet:
     """One entry per conjugate pair (im ≥ 0); both roots of a real pair."""
     modes: list[Mode] = []
@@ -260,7 +269,7 @@ def paper_family(model: str, wing: ElasticWingModel | None, density_kg_m3: float
         matrix, np.array([r[1] for r in ref]), [r[0] for r in ref], rest_label="lag",
         excluded=EXCLUDED_FROM_FLUTTER, rigid_labels=RIGID_LABELS,
         paired_labels=RIGID_LABELS, partition=mode_labels_of_roots,
-        natural_frequencies_rad_s=natural,
+        natural_frequencies_rad_s=natural, mode_labels=structural_mode_labels(natural),
         reference_semichord_m=af.reference.mean_chord_m / 2.0, method="state-space",
         aero="quasi-steady", name="" if wing is None else wing.name)
 
@@ -365,6 +374,9 @@ def find_flutter(
     tol_m_s: float = SCAN_TOL_M_S,
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics | None = None,
+    *,
+    progress=None,
+    full_scan: bool = False,
 ) -> FlutterResult:
     """The coupled model's first instability in ``range_m_s`` (the engine's search: scan
     from 2 m/s in ``step_m_s``, bisection to ``tol_m_s``, speed rounded to 0.01 m/s).
@@ -373,7 +385,8 @@ def find_flutter(
     (Section 3.2: the vortex model cannot give the drag the phugoid depends on): in the
     linear model it goes unstable below about 10 m/s, where the formal trim C_L exceeds 2,
     for the rigid aircraft as well. ``divergence_speed_m_s`` is the wing's with the body
-    held (:func:`wing_divergence_speed_m_s`).
+    held (:func:`wing_divergence_speed_m_s`). ``progress``, ``full_scan``:
+    :func:`~bioflex_jsb.flight_dynamics.flutter_engine.first_instability`'s.
     """
     from dataclasses import replace
 
@@ -387,7 +400,7 @@ def find_flutter(
     res = engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, SCAN_START_M_S), (lo, hi),
         tol_m_s=tol_m_s, structural_damping=_common_zeta(wing),
-        density_kg_m3=density_kg_m3)
+        density_kg_m3=density_kg_m3, progress=progress, full_scan=full_scan)
     if res.speed_m_s is None:
         return res
     v = round(res.speed_m_s, 2)

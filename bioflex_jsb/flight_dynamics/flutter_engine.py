@@ -19,11 +19,12 @@ growth) depend on the airspeed V [m/s]. The engine
    :data:`GROWTH_TOL_1_S`, then bisection on the largest considered Re λ between the last
    stable and first unstable grid speed (the roots continued from the last stable one) to
    ``tol_m_s``; the reported speed is the bracket's unstable end. A branch already unstable
-   at the range's lower end is reported there with ``present_at_lower_end=True`` ("unstable
-   at and below"), never as "no instability"; a static divergence of the analysed system
-   (``RootFamily.divergence_is_instability``) inside the range and below the first crossing
-   is the first instability (mechanism ``static divergence``), and one below the range
-   makes the system unstable at its lower end;
+   at the range's lower end is reported with ``present_at_lower_end=True`` and no speed
+   ("unstable at and below" the lower end, ``unstable_at_and_below_m_s``), never as "no
+   instability" and never with the lower end as its speed; a static divergence of the
+   analysed system (``RootFamily.divergence_is_instability``) inside the range and below
+   the first crossing is the first instability (mechanism ``static divergence``), and one
+   below the range makes the system unstable at its lower end;
 3. names the **mechanism** by one rule (:func:`mechanism`), written there;
 4. returns one :class:`FlutterResult` for all of them.
 """
@@ -113,7 +114,9 @@ class RootFamily:
     ``natural_frequencies_rad_s``, ``reference_semichord_m`` (for k = ωb/V),
     ``divergence_speed_m_s`` (``None`` if none is known), ``divergence_is_instability``
     (whether that divergence is one of this system: the clamped wing's; the free
-    aircraft's "wing with the body held" is not), ``method``, ``aero``, ``name``.
+    aircraft's "wing with the body held" is not), ``method``, ``aero``, ``name``,
+    ``mode_labels`` (the names of the wing's modes in the order of
+    ``natural_frequencies_rad_s``; empty: the considered branches' names).
     """
 
     labels: tuple[str, ...] = ()
@@ -127,6 +130,7 @@ class RootFamily:
     method: str = "state-space"
     aero: str = "quasi-steady"
     name: str = ""
+    mode_labels: tuple[str, ...] = ()
 
     def first(self, speed_m_s: float) -> Point:
         """The labelled roots at the first speed of a scan."""
@@ -299,6 +303,14 @@ def mechanism(labels: Sequence[str], considered: np.ndarray, roots: np.ndarray, 
     return "coalescence", labels[partner]
 
 
+# The caveat a quasi-steady single-mode result carries beside its number (the result's
+# ``caveat``; the CLI prints it on the result's line and in --json).
+QUASI_STEADY_CAVEAT = (
+    "quasi-steady strips (C = 1) have no aerodynamic pitch damping: a single-mode torsion "
+    "instability on them is the model's artefact, its speed set by the assumed structural "
+    "damping; unsteady strips (aero 'unsteady', the default) give the physical result")
+
+
 @dataclass(frozen=True)
 class FlutterResult:
     """The first instability of a system over a speed range (any model, any method).
@@ -306,21 +318,29 @@ class FlutterResult:
     Attributes:
         name: the wing or aircraft.
         speed_m_s: flutter (or divergence) speed [m/s]; ``None`` if nothing is unstable in
-            the range; the range's lower end when ``present_at_lower_end``.
+            the range, and ``None`` when ``present_at_lower_end`` (no onset was found: the
+            range's lower end is ``unstable_at_and_below_m_s``, never a flutter speed).
         frequency_rad_s: |Im λ| of the unstable root there [rad/s] (0: divergence).
         reduced_frequency: k = ωb/V [-], b = ``semichord_m``.
         mode, partner_mode: the unstable branch and (coalescence only) its partner.
         mechanism: one of :data:`MECHANISMS` (:func:`mechanism`), ``None`` if stable.
-        present_at_lower_end: the system is already unstable at the range's lower end
-            ("unstable at and below ``speed_m_s``"): the crossing is below the range.
+        present_at_lower_end: the system is already unstable at the range's lower end: the
+            crossing is below the range; frequency, mode and mechanism are the instability's
+            there.
+        unstable_at_and_below_m_s: the range's lower end [m/s] when
+            ``present_at_lower_end`` ("unstable at and below"), else ``None``.
         divergence_speed_m_s: static divergence speed [m/s] (``None``: none found);
             ``divergence_is_instability`` says whether it is one of the analysed system
             (clamped wing) or of the wing with the body held (free aircraft).
-        natural_frequencies_rad_s, mode_labels: wind-off frequencies [rad/s] and names.
+        natural_frequencies_rad_s, mode_labels: the wing's wind-off natural frequencies
+            [rad/s] and, in the same order, the names of their modes (one each: zip them).
         range_m_s: the speed range searched [m/s]; method (pk, state-space), aero
             (quasi-steady, unsteady), structural_damping ζ [-] (``None``: the wing's own),
             density_kg_m3 [kg/m³], semichord_m [m], settings (other inputs).
-        speeds_m_s, branch_roots: the tracked scan (not in :meth:`as_dict`).
+        speeds_m_s, branch_roots, branch_labels, branch_considered: the tracked scan
+            (``branch_roots[k, j]`` [1/s] of branch ``branch_labels[j]`` at
+            ``speeds_m_s[k]``; ``branch_considered[j]``: whether it counts for the search:
+            not the phugoid, not a lag root); not in :meth:`as_dict`; drawn by :meth:`plot`.
     """
 
     name: str
@@ -346,6 +366,8 @@ class FlutterResult:
                                    compare=False)
     branch_roots: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False,
                                      compare=False)
+    branch_labels: tuple[str, ...] = field(default=(), repr=False, compare=False)
+    branch_considered: tuple[bool, ...] = field(default=(), repr=False, compare=False)
 
     @property
     def flutter_speed_m_s(self) -> float | None:
@@ -353,11 +375,29 @@ class FlutterResult:
         return self.speed_m_s
 
     @property
+    def unstable_at_and_below_m_s(self) -> float | None:
+        """The range's lower end [m/s] when the system is unstable there, else ``None``."""
+        return float(self.range_m_s[0]) if self.present_at_lower_end else None
+
+    @property
     def kind(self) -> str | None:
         """``flutter`` (oscillatory), ``divergence`` (real root) or ``None``."""
         if self.mechanism is None:
             return None
         return "divergence" if self.mechanism == "static divergence" else "flutter"
+
+    @property
+    def quasi_steady_artefact(self) -> bool:
+        """Whether the result is the quasi-steady strips' single-mode torsion instability
+        (:data:`QUASI_STEADY_CAVEAT`): quasi-steady aerodynamics and a single-mode
+        mechanism. A quasi-steady coalescence or divergence is not flagged (their pitch
+        damping does not make them)."""
+        return self.aero == "quasi-steady" and self.mechanism == "single-mode"
+
+    @property
+    def caveat(self) -> str | None:
+        """What the number does not mean (:data:`QUASI_STEADY_CAVEAT`), or ``None``."""
+        return QUASI_STEADY_CAVEAT if self.quasi_steady_artefact else None
 
     @property
     def wing(self) -> str:
@@ -372,10 +412,12 @@ class FlutterResult:
         return {
             "name": self.name, "wing": self.name,
             "speed_m_s": self.speed_m_s, "flutter_speed_m_s": self.speed_m_s,
+            "unstable_at_and_below_m_s": self.unstable_at_and_below_m_s,
             "frequency_rad_s": self.frequency_rad_s,
             "reduced_frequency": self.reduced_frequency, "mode": self.mode,
             "partner_mode": self.partner_mode, "mechanism": self.mechanism,
             "kind": self.kind, "present_at_lower_end": self.present_at_lower_end,
+            "quasi_steady_artefact": self.quasi_steady_artefact, "caveat": self.caveat,
             "divergence_speed_m_s": self.divergence_speed_m_s,
             "divergence_is_instability": self.divergence_is_instability,
             "natural_frequencies_rad_s": list(self.natural_frequencies_rad_s),
@@ -386,17 +428,33 @@ class FlutterResult:
             **self.settings,
         }
 
+    def plot(self, path, force: bool = False):
+        """The V-g / V-f diagram: damping ratio and frequency of every considered branch
+        against airspeed, the first instability marked (a matplotlib Figure; written to
+        ``path``: a figure suffix, an existing file only if it is a plot of ours or with
+        ``force``). The lines end where the search's scan ended: at the first instability,
+        or at the range's top for a result of a full scan (``full_scan=True``, as the
+        CLI's ``flutter --plot`` asks)."""
+        from bioflex_jsb.flight_dynamics.flutter_plot import plot_flutter
+        from bioflex_jsb.plot_files import check_plot_target
+
+        return plot_flutter(self, check_plot_target(path, force))
+
 
 def first_instability(
     family: RootFamily, grid_m_s: Sequence[float], range_m_s: tuple[float, float], *,
     tol_m_s: float, structural_damping: float | None, density_kg_m3: float,
-    settings: dict | None = None,
+    settings: dict | None = None, progress: Callable[[float, float], None] | None = None,
+    full_scan: bool = False,
 ) -> FlutterResult:
     """The first instability of ``family`` in ``range_m_s`` (module docstring, step 2).
 
     ``grid_m_s`` is the tracking grid; it may start below the range (labels are then fixed
     at a lower speed, as the free aircraft's are at 2 m/s); only speeds ≥ the range's lower
-    end count.
+    end count. ``progress`` is called with each grid speed [m/s] as it is scanned and the
+    grid's top [m/s] (a progress bar's). ``full_scan``: scan the whole grid, not only up
+    to the first instability (the result's scan then covers the range: its
+    :meth:`FlutterResult.plot`).
     """
     lo, hi = (float(x) for x in range_m_s)
     grid = np.asarray(grid_m_s, dtype=float)
@@ -406,31 +464,41 @@ def first_instability(
     def growth(p: Point) -> float:
         return float(p.roots[considered_mask[0]].real.max())
 
-    def stop(p: Point) -> bool:
+    def unstable(p: Point) -> bool:
         if not considered_mask:
             considered_mask.append(np.asarray(family.considered, dtype=bool))
         return p.speed_m_s >= in_range_from and growth(p) > GROWTH_TOL_1_S
 
-    track = scan(family, grid, stop=stop)
-    labels, considered = track.labels, considered_mask[0]
-    pts = track.points
+    def stop(p: Point) -> bool:
+        if progress is not None:
+            progress(p.speed_m_s, float(grid[-1]))
+        return unstable(p) and not full_scan
+
+    full = scan(family, grid, stop=stop)
+    labels, considered = full.labels, considered_mask[0]
+    first_bad = next((k for k, p in enumerate(full.points) if unstable(p)), None)
+    pts = full.points if first_bad is None else full.points[:first_bad + 1]
+    track = Track(labels, tuple(pts))
     v_div = family.divergence_speed_m_s
+    structural = tuple(getattr(family, "mode_labels", ()) or ())
+    if not structural:  # the considered branches, one name each
+        structural = tuple(dict.fromkeys(lab for lab, c in zip(labels, considered,
+                                                                 strict=True) if c))
     base = dict(
         name=family.name, divergence_speed_m_s=v_div,
         divergence_is_instability=family.divergence_is_instability,
         natural_frequencies_rad_s=tuple(float(w) for w in family.natural_frequencies_rad_s),
-        mode_labels=tuple(dict.fromkeys(lab for lab, c in zip(labels, considered,
-                                                                strict=True) if c)),
+        mode_labels=structural,
         range_m_s=(lo, hi), method=family.method, aero=family.aero,
         structural_damping=structural_damping, density_kg_m3=float(density_kg_m3),
         semichord_m=float(family.reference_semichord_m), settings=dict(settings or {}),
-        speeds_m_s=track.speeds_m_s, branch_roots=track.roots,
+        speeds_m_s=full.speeds_m_s, branch_roots=full.roots, branch_labels=tuple(labels),
+        branch_considered=tuple(bool(c) for c in considered),
     )
     first_roots = pts[0].roots
     last = pts[-1]
-    crossed = last.speed_m_s >= in_range_from and growth(last) > GROWTH_TOL_1_S
     div_counts = family.divergence_is_instability and v_div is not None
-    if crossed:
+    if first_bad is not None:
         k = len(pts) - 1
         at_lower = k == 0 or pts[k - 1].speed_m_s < in_range_from
         if at_lower:
@@ -454,7 +522,7 @@ def first_instability(
         if mech == "static divergence":
             omega = 0.0
         return FlutterResult(
-            speed_m_s=float(v_cross), frequency_rad_s=float(omega),
+            speed_m_s=None if at_lower else float(v_cross), frequency_rad_s=float(omega),
             reduced_frequency=float(omega * family.reference_semichord_m / v_cross),
             mode=labels[j], partner_mode=partner, mechanism=mech,
             present_at_lower_end=bool(at_lower), **base)
@@ -466,10 +534,10 @@ def first_instability(
 
 
 def _divergence_result(base: dict, v_div: float, lo: float) -> FlutterResult:
-    """The static divergence of the analysed system as its first instability (at the lower
-    end if it lies below the range)."""
+    """The static divergence of the analysed system as its first instability (unstable at
+    and below the lower end if it lies below the range: no speed)."""
     below = v_div < lo
-    return FlutterResult(speed_m_s=float(lo if below else v_div), frequency_rad_s=0.0,
+    return FlutterResult(speed_m_s=None if below else float(v_div), frequency_rad_s=0.0,
                          reduced_frequency=0.0, mode="divergence", partner_mode=None,
                          mechanism="static divergence", present_at_lower_end=bool(below),
                          **base)
