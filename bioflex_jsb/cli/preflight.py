@@ -61,7 +61,8 @@ def refusal(args: argparse.Namespace, build, check: dict) -> str:
             f"{args.model} wing: its {worst['mode']} root is unstable there "
             f"(Re = {worst['re_1_s']:+.3g} 1/s)")
     if args.model in ("coupled", NATIVE):
-        first = api.flutter(build).flutter_speed_m_s if args.aero == "quasi-steady" \
+        first = api.flutter(build, aero="quasi-steady").flutter_speed_m_s \
+            if args.aero == "quasi-steady" \
             else free_flutter(build, aero="unsteady").speed_m_s
         if first is not None:
             text += f"; its {args.aero} flutter speed is {first:.1f} m/s"
