@@ -154,7 +154,9 @@ def airframe_of(wing: ElasticWingModel | None, airframe: AirframeData | None) ->
 
 def _pair_units(lam: np.ndarray) -> list[tuple[int, ...]]:
     """The roots of a real matrix as units: each conjugate pair (indices of both roots) and
-    each real root (|Im λ| <= :data:`IMAG_TOL_RAD_S`) alone."""
+    each real root (|Im λ| <= :data:`IMAG_TOL_RAD_S`) alone; ValueError for a complex root
+    without its conjugate (:func:`~bioflex_jsb.flight_dynamics.flutter_engine.closed_under_
+    conjugation` tells beforehand)."""
     free = list(range(lam.size))
     units: list[tuple[int, ...]] = []
     while free:
@@ -162,9 +164,11 @@ def _pair_units(lam: np.ndarray) -> list[tuple[int, ...]]:
         if abs(lam[i].imag) <= IMAG_TOL_RAD_S:
             units.append((i,))
             continue
-        j = min(free, key=lambda k: abs(lam[k] - np.conj(lam[i])))
-        free.remove(j)
-        units.append((i, j))
+        partner = [k for k in free if engine.conjugates(lam[i], lam[k])]
+        if not partner:
+            raise ValueError(f"root {lam[i]:.6g} has no conjugate among {lam}")
+        free.remove(partner[0])
+        units.append((i, partner[0]))
     return units
 
 

@@ -191,15 +191,45 @@ class EigenFamily(RootFamily):
         return Point(float(speed_m_s), lam[order], vec[:, order])
 
 
+# DEFINITION: two complex roots are a conjugate pair when |λ_1 − conj(λ_2)| is below this
+# fraction of 1 + |λ_1| (a real matrix's pairs agree to rounding, ~1e-15 relative).
+CONJUGATE_REL_TOL = 1e-8
+
+
+def conjugates(a: complex, b: complex) -> bool:
+    """Whether roots ``a`` and ``b`` are a conjugate pair (:data:`CONJUGATE_REL_TOL`)."""
+    return abs(a - np.conj(b)) <= CONJUGATE_REL_TOL * (1.0 + abs(a))
+
+
+def closed_under_conjugation(lam: np.ndarray) -> bool:
+    """Whether every complex root of ``lam`` has its conjugate among the others (each used
+    once); a real root (|Im λ| <= :data:`IMAG_TOL_RAD_S`) stands alone."""
+    free = list(range(len(lam)))
+    while free:
+        i = free.pop(0)
+        if abs(lam[i].imag) <= IMAG_TOL_RAD_S:
+            continue
+        partner = [k for k in free if conjugates(lam[i], lam[k])]
+        if not partner:
+            return False
+        free.remove(partner[0])
+    return True
+
+
 def share_paired(labels: Sequence[str], paired: Sequence[str],
                  partition: Callable[[np.ndarray], Sequence[str]], lam: np.ndarray,
                  order: np.ndarray, predicted: np.ndarray) -> np.ndarray:
     """``order`` (root index per branch) with the roots on the ``paired`` labels' branches
     named by ``partition``: each label's branches take the roots it names, each root the
     branch it is nearest the prediction of (joint assignment). Unchanged where the tracker's
-    names already are the partition's."""
+    names already are the partition's, and where the roots on those branches are not whole
+    factors (a complex root whose conjugate the tracker gave another branch, as a lag's,
+    near a coalescence of a rigid root with a wing or lag root): there the tracker's names
+    stand."""
     pos = [j for j, lab in enumerate(labels) if lab in paired]
     roots_idx = [int(order[j]) for j in pos]
+    if not closed_under_conjugation(lam[roots_idx]):
+        return order
     named = list(partition(lam[roots_idx]))
     if named == [labels[j] for j in pos]:
         return order
