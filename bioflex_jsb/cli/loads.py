@@ -491,7 +491,8 @@ def _frequency(args, build) -> int:
         plot_psd(cases, plot)
     if args.json:
         print_json({"wing": build.variant.name, "speed_m_s": args.speed,
-                    "rigid_block": "JSBSim linearization", "cases": [c.as_dict() for c in cases],
+                    "rigid_block": ss.notes["rigid_block"],
+                    "cases": [c.as_dict() for c in cases],
                     "stopped": stopped, "plot": plot, "bode": bode})
     else:
         print(f"Continuous turbulence ({args.spectrum}, L = {args.scale:g} m): wing "

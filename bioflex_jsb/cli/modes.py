@@ -28,6 +28,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.gust import damping_ratio, wing_for_run
 from bioflex_jsb.flight_dynamics import eigen
+from bioflex_jsb.flight_dynamics.lti import RIGID_BLOCK_ANALYTIC
 from bioflex_jsb.sinks.mcap import scene_modes
 
 PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
@@ -45,7 +46,10 @@ below the speed at which the aircraft can trim (the phugoid of the linear model 
 there). Default: the {DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s (the paper's Fig. 21
 case); with --aircraft its [airframe] cruise speed (the plot to 1.5 x its top flight
 speed). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization of the
-airframe), which includes the thrust's change with airspeed; see its --help."""
+airframe), which includes the thrust's change with airspeed; see its --help (JSON:
+"rigid_block"). A mode is one conjugate pair or two real roots (an over-damped short period
+is listed as two real short_period roots); the short period is the one of the larger
+natural frequency at each speed."""
 
 
 def register(sub) -> None:
@@ -127,6 +131,7 @@ def run(args: argparse.Namespace) -> int:
         "wing": build.variant.name,
         "mass_basis": build.mass_basis,
         "overrides": dict(build.model.coefficients.overrides),
+        "rigid_block": RIGID_BLOCK_ANALYTIC,
         "results": [s.as_dict() for s in results],
         "unstable": [{"speed_m_s": s.speed_m_s, "model": s.model, "mode": m.mode,
                       "branch": m.branch, "re": m.re, "im": m.im}

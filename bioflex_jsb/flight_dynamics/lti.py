@@ -385,6 +385,7 @@ def build_state_space(
             raise ValueError("elastic= is for the sensitivity models, without controls")
         return _with_controls(model, condition, wing, aero, a_rr)
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
+    block = {"rigid_block": rigid_block_note(a_rr)}
     if model == "rigid":
         a, g = rigid_matrices(rigid_derivatives(condition, aero))
         if a_rr is not None:
@@ -393,14 +394,14 @@ def build_state_space(
         return StateSpace(
             model=model, a=a, b=g, c=np.eye(4), d=np.zeros((4, 1)),
             states=RIGID_STATES, state_units=RIGID_STATE_UNITS,
-            outputs=RIGID_STATES, output_units=RIGID_STATE_UNITS, **common,
+            outputs=RIGID_STATES, output_units=RIGID_STATE_UNITS, notes=block, **common,
         )
     if wing is None:
         raise InputError(f"the {model} model needs an elastic wing")
     blk = coupled_blocks(wing, condition, aero, a_rr, elastic)
     n = wing.n_modes
     e_names, e_units = elastic_state_names(n)
-    notes = {"wing": wing.name, "overrides": dict(wing.coefficients.overrides)}
+    notes = {"wing": wing.name, "overrides": dict(wing.coefficients.overrides), **block}
     if model == "coupled":
         a = np.block(
             [
@@ -432,6 +433,19 @@ def build_state_space(
     )
 
 
+# Which rigid block a model carries (its notes["rigid_block"]): the analytic A_RR of the
+# Table B2 derivatives, with the thrust independent of airspeed (the propeller's dT/dV
+# missing from X_u: the coupled phugoid is near neutral, docs/aeroelasticity.md "Two coupled
+# LTI models"), or JSBSim's linearization of the airframe at the trim (``a_rr``), which has it.
+RIGID_BLOCK_ANALYTIC = "analytic (Table B2; thrust independent of airspeed)"
+RIGID_BLOCK_JSBSIM = "JSBSim linearization (with the propeller's thrust change)"
+
+
+def rigid_block_note(a_rr: np.ndarray | None) -> str:
+    """The ``rigid_block`` note of a model built with ``a_rr`` (None: the analytic one)."""
+    return RIGID_BLOCK_ANALYTIC if a_rr is None else RIGID_BLOCK_JSBSIM
+
+
 def _with_controls(model, condition, wing, aero, a_rr) -> StateSpace:
     """:func:`build_state_space` with the elevator and throttle inputs and the n_z and
     tip-twist outputs."""
@@ -445,7 +459,7 @@ def _with_controls(model, condition, wing, aero, a_rr) -> StateSpace:
     d_ctrl = np.zeros((base.d.shape[0], 2))
     notes = dict(base.notes, aerodynamics=AERODYNAMIC_MODEL,
                  density_kg_m3=condition.density_kg_m3, trim_cl=condition.cl_trim,
-                 rigid_block="JSBSim linearization" if a_rr is not None else "analytic")
+                 rigid_block=rigid_block_note(a_rr))
     ss = StateSpace(
         model=base.model, speed_m_s=base.speed_m_s, a=base.a,
         b=np.hstack([base.b, b_ctrl]), c=base.c, d=np.hstack([base.d, d_ctrl]),

@@ -178,8 +178,10 @@ def plot_bode(ss: StateSpace, outputs, units, path=None, f_max_hz: float = DEFAU
         ax[1, i].set_xlabel("frequency [Hz]")
         for a in ax[:, i]:
             a.grid(True, which="both", alpha=0.3)
+    block = ss.notes.get("rigid_block")
     fig.suptitle(f"Frequency response of the {ss.model} LTI model to an upward gust w_g, "
-                 f"{ss.speed_m_s:g} m/s", fontsize=10)
+                 f"{ss.speed_m_s:g} m/s" + (f"; rigid block: {block}" if block else ""),
+                 fontsize=10)
     if path is not None:
         save(fig, path)
     return fig
