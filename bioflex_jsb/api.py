@@ -28,7 +28,9 @@ import numpy as np
 
 from bioflex_jsb.aeroelasticity.free_aircraft import (
     AERO_MODELS,
+    FREE_DEFAULT_AERO,
     free_flutter,
+    free_scan_step_m_s,
     unsteady_mode_sets,
     unsteady_state_space,
     with_damping,
@@ -585,18 +587,14 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     and when the system is unstable at and below the lower end, ``present_at_lower_end``).
 
     Free aircraft (``wing`` a :class:`WingBuild`): Eq. (4) on ``aero`` strips, default
-    ``unsteady`` (Theodorsen strips with Jones lag states: the pitch damping the
-    quasi-steady strips lack); ``quasi-steady`` is the paper's model (its tables), whose
-    single-mode torsion instability is flagged (``quasi_steady_artefact``, ``caveat``);
-    ``method`` ``state-space``; range default 5-40 m/s for the prototype, derived from the
-    wing for another aircraft (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-]
-    replaces the wing's. Clamped (``clamped=True``; ``wing`` a definition, a shipped name
-    or a TOML file): ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and
-    ρ default to the definition's; the range to the one derived from the wing
-    (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`). ``progress``: called
-    with each scanned speed [m/s] and the scan's top [m/s] (a progress bar's);
-    ``full_scan``: scan the whole range, not only up to the first instability (for the
-    diagram)."""
+    ``unsteady`` (Jones lag states); ``quasi-steady`` is the paper's model, its single-mode
+    torsion instability flagged (``quasi_steady_artefact``, ``caveat``); range default 5-40
+    m/s for the prototype, derived from the wing for another aircraft
+    (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-] replaces the wing's.
+    Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML file):
+    ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and ρ default to the
+    definition's; the range to the one derived from the wing. ``progress(speed, top)`` [m/s]
+    is called as the scan goes; ``full_scan``: scan the whole range (for the diagram)."""
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
@@ -616,7 +614,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
                                 density_kg_m3, lift_slope, scan)
     air = _density(wing, density_kg_m3)
     wing = _wing(wing)
-    aero = aero or FREE_FLUTTER_DEFAULT_AERO
+    aero = aero or FREE_DEFAULT_AERO
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if method not in (None, "state-space"):
         raise InputError("the free aircraft's flutter is by state-space eigen-analysis; "
@@ -626,34 +624,13 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
                          "vortex lattice's span loading (Table B1)")
     rng = free_speed_range_m_s(wing, air.get("density_kg_m3")) if range_m_s is None \
         else range_m_s
-    step = free_scan_step_m_s(rng)
+    step = free_scan_step_m_s(rng)  # 0.1 m/s, or the range in 350 steps
     if aero == "unsteady":
         return free_flutter(wing, aero="unsteady", structural_damping=structural_damping,
                             range_m_s=rng, step_m_s=step, **air, **scan)
     model = wing.model if structural_damping is None else with_damping(wing,
                                                                        structural_damping)
     return find_flutter(model, rng, step, **air, **scan)
-
-
-# The free aircraft's flutter is analysed on unsteady strips unless asked otherwise: the
-# quasi-steady strips (the paper's) have no aerodynamic pitch damping, and their single-mode
-# torsion instability moves with the assumed structural damping (inertial-backward: <= 5
-# m/s at zeta 0, 16.6 m/s at 0.05) where the unsteady strips' body-freedom flutter stays at
-# 18.9 m/s (docs/aeroelasticity.md).
-FREE_FLUTTER_DEFAULT_AERO = "unsteady"
-# The free aircraft's scan step [m/s]: 0.1 m/s (the prototype's 5-40 m/s in 350 steps), or
-# the range in this many steps where it is wider (the SGS's derived 9.1-182 m/s: 0.49 m/s,
-# where the unsteady scan finds the same 138.93 m/s as at 0.1 m/s in a fifth of the time;
-# tests/test_second_aircraft.py).
-FREE_SCAN_STEPS = 350
-
-
-def free_scan_step_m_s(range_m_s: tuple[float, float]) -> float:
-    """The scan step [m/s] of the free aircraft's flutter search over ``range_m_s``."""
-    from bioflex_jsb.flight_dynamics.eigen import SCAN_STEP_M_S
-
-    lo, hi = range_m_s
-    return max(SCAN_STEP_M_S, (float(hi) - float(lo)) / FREE_SCAN_STEPS)
 
 
 def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:

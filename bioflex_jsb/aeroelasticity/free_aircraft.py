@@ -298,6 +298,23 @@ def unsteady_mode_sets(build, speeds_m_s, structural_damping: float | None = Non
 
 # Bisection tolerance of the free aircraft's search [m/s].
 FREE_TOL_M_S = 1e-4
+# The free aircraft's flutter is analysed on unsteady strips unless asked otherwise
+# (api.flutter, the flutter command): quasi-steady strips (the paper's) have no aerodynamic
+# pitch damping, and their single-mode torsion instability moves with the assumed structural
+# damping (inertial-backward: <= 5 m/s at zeta 0, 16.6 m/s at 0.05) where the unsteady
+# strips' body-freedom flutter stays at 18.9 m/s (docs/aeroelasticity.md).
+FREE_DEFAULT_AERO = "unsteady"
+# The free aircraft's scan step [m/s]: eigen.SCAN_STEP_M_S (0.1, the prototype's 5-40 m/s in
+# 350 steps), or the range in this many steps where it is wider (the SGS's derived 9.1-182
+# m/s: 0.49 m/s, where the unsteady scan finds the same 138.93 m/s as at 0.1 m/s in a fifth
+# of the time; tests/test_second_aircraft.py).
+FREE_SCAN_STEPS = 350
+
+
+def free_scan_step_m_s(range_m_s: tuple[float, float]) -> float:
+    """The scan step [m/s] of the free aircraft's flutter search over ``range_m_s``."""
+    lo, hi = range_m_s
+    return max(eigen.SCAN_STEP_M_S, (float(hi) - float(lo)) / FREE_SCAN_STEPS)
 
 
 def free_flutter(build, *, aero: str = "unsteady", structural_damping: float | None = None,
