@@ -181,7 +181,10 @@ def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
             row[f"{name}_frequency_rad_s"] = m.frequency_rad_s
     if "flutter" in case.metrics:
         f = _flutter(case, build)
-        row["flutter_speed_m_s"] = f.flutter_speed_m_s
+        # empty means none in the range: an instability at and below the range's lower end
+        # (the result has no speed then) is written as that end, as the column always had it
+        row["flutter_speed_m_s"] = f.flutter_speed_m_s if not f.present_at_lower_end \
+            else f.unstable_at_and_below_m_s
         row["flutter_mode"] = f.mode
         row["flutter_frequency_rad_s"] = f.frequency_rad_s
         row["flutter_kind"] = f.kind
