@@ -91,7 +91,10 @@ def flutter(mass_basis: str) -> None:
     print("20 m/s; original, optimised and forward: none up to 25 m/s)")
     for r in validation.flutter_rows(mass_basis=mass_basis):
         backward = r.wing.endswith("backward")
-        if r.flutter_speed_m_s is None:
+        if r.present_at_lower_end:
+            print(f"{r.wing:<18} {r.kind} at and below {r.unstable_at_and_below_m_s:g} m/s, "
+                  f"{r.mode}  DISAGREES")
+        elif r.flutter_speed_m_s is None:
             print(f"{r.wing:<18} none {'DISAGREES' if backward else 'agrees'}")
         else:
             agrees = backward and r.flutter_speed_m_s > 20.0

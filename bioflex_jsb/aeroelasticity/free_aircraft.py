@@ -380,6 +380,9 @@ def _print_table(rows: list[dict]) -> None:
         return f"{r[0]:.2f}{r[1]:+.2f}j"
 
     def fl(f):
+        if f["present_at_lower_end"]:
+            return (f"<= {f['unstable_at_and_below_m_s']:g} m/s (unstable at the range's "
+                    f"start), {f['frequency_rad_s']:.1f} rad/s {f['mode']} {f['mechanism']}")
         if f["speed_m_s"] is None:
             return "none <= 40"
         return (f"{f['speed_m_s']:.2f} m/s {f['frequency_rad_s']:.1f} rad/s "
