@@ -48,9 +48,10 @@ quasi-steady (the paper's strips, C = 1: the model of its tables). Quasi-steady 
 no aerodynamic pitch damping: their single-mode torsion instability is the model's
 artefact, its speed set by the assumed structural damping, and is marked so beside the
 number ("quasi_steady_artefact": true and a "caveat" in --json). Eigen-analysis (--method
-state-space) scanned in 0.1 m/s steps from 2 m/s with mode tracking and bisected (printed
-to 0.1 m/s); the phugoid is left out, as in the paper; also the wing's divergence speed
-with the body held (not an instability of the aircraft). Not available for them:
+state-space) scanned from 2 m/s in 0.1 m/s steps (a range wider than 35 m/s: in 350 steps)
+with mode tracking and bisected (printed to 0.1 m/s); the phugoid is left out, as in the
+paper; also the wing's divergence speed with the body held (not an instability of the
+aircraft). Not available for them:
 --clamped, --method pk, --lift-slope, --inertia-about.
 
 --clamped FILE.toml: any clamped wing from its definition file (docs/aircraft.md: span
