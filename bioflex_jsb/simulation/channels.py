@@ -1,28 +1,125 @@
-"""The channels of a run: names, units and the row of one step, built by name.
+"""The channels of a run: names, units, meanings and the row of one step, built by name.
 
 Every driver logs the same channels (``docs/logging.md``): perturbations from the trim at the
-start of the run (u, alpha, q, theta), the load factor, the gust, the air data, the modal
-loads applied, the absolute pose and the rest of the state (for logs and ground stations) and
-the modal state η_i, η̇_i. Frames: NED Euler angles, FRD body rates, NED velocities
-(``docs/conventions.md``).
+start of the run (u, alpha, theta), the pitch rate q, the load factor, the gust, the air data,
+the modal loads applied, the absolute pose and the rest of the state (for logs and ground
+stations) and the modal state η_i, η̇_i. Frames: NED Euler angles, FRD body rates, NED
+velocities (``docs/conventions.md``).
+
+Two kinds of angle share a unit and differ in what they are measured from: ``alpha`` and
+``theta`` are *perturbations* from the trim (0 at the start of the run), ``alpha_rad`` and
+``theta_rad`` the *absolute* angles. The short names are the paper's state names (Eq. 4) and
+the stored golden histories' columns; each perturbation also answers to a name that says what
+it is, the MCAP log's field name (:data:`ALIASES`: ``run["dalpha_rad"]`` is ``run["alpha"]``).
+:func:`describe` gives every channel's unit, kind, meaning (frame and sign) and that name.
 """
 
 from __future__ import annotations
 
+import re
+from dataclasses import dataclass
 from operator import itemgetter
 
-# name → unit, in the order of the table's columns (the order of this mapping is the only
-# place an order is defined; rows are built by name)
-BASE_UNITS: dict[str, str] = {
-    "u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-", "w_g": "m/s",
-    "airspeed_m_s": "m/s", "altitude_m": "m",
-    "lift_n": "N", "drag_n": "N", "pitch_moment_n_m": "N*m",
-    "latitude_rad": "rad", "longitude_rad": "rad", "phi_rad": "rad",
-    "theta_rad": "rad", "psi_rad": "rad", "p_rad_s": "rad/s", "r_rad_s": "rad/s",
-    "elevator_rad": "rad", "throttle": "-",
-    "alpha_rad": "rad", "beta_rad": "rad", "v_north_m_s": "m/s", "v_east_m_s": "m/s",
-    "v_down_m_s": "m/s",
+PERTURBATION = "perturbation"  # measured from the trim at the start of the run (0 there)
+ABSOLUTE = "absolute"  # the quantity itself
+
+
+@dataclass(frozen=True)
+class Channel:
+    """What a channel holds: ``unit``; ``kind`` :data:`PERTURBATION` (from the trim at the
+    start of the run) or :data:`ABSOLUTE`; ``meaning``: the quantity, its frame and sign;
+    ``alias``: the name that says what it is (the MCAP log's field), or None when the
+    channel's own name says it."""
+
+    unit: str
+    kind: str
+    meaning: str
+    alias: str | None = None
+
+    def as_dict(self) -> dict[str, str | None]:
+        return {"unit": self.unit, "kind": self.kind, "meaning": self.meaning,
+                "alias": self.alias}
+
+
+_P, _A = PERTURBATION, ABSOLUTE
+# name → what it holds, in the order of the table's columns (the order of this mapping is the
+# only place an order is defined; rows are built by name)
+CHANNELS: dict[str, Channel] = {
+    "u": Channel("m/s", _P, "true airspeed minus its trim value, faster positive", "du_m_s"),
+    "alpha": Channel("rad", _P, "angle of attack against the air (the gust included) minus "
+                     "its trim value, nose up positive", "dalpha_rad"),
+    "q": Channel("rad/s", _A, "pitch rate about the body y axis (starboard), nose up "
+                 "positive; 0 at the trim, so also its perturbation", "q_rad_s"),
+    "theta": Channel("rad", _P, "pitch angle (NED Euler θ) minus its trim value, nose up "
+                     "positive", "dtheta_rad"),
+    "n_z": Channel("-", _A, "normal load factor (JSBSim's accelerations/Nz), up positive, 1 "
+                   "in level flight"),
+    "w_g": Channel("m/s", _A, "vertical gust velocity, up positive (JSBSim's wind-down is "
+                   "−w_g)", "w_g_m_s"),
+    "airspeed_m_s": Channel("m/s", _A, "true airspeed"),
+    "altitude_m": Channel("m", _A, "altitude above sea level"),
+    "lift_n": Channel("N", _A, "the elastic wing's incremental lift applied to the airframe, "
+                      "up, normal to the air velocity (0 for the rigid model)"),
+    "drag_n": Channel("N", _A, "the elastic wing's incremental drag applied to the airframe, "
+                      "aft, along the air velocity"),
+    "pitch_moment_n_m": Channel("N*m", _A, "the elastic wing's incremental pitching moment "
+                                "applied to the airframe, about the CG, nose up"),
+    "latitude_rad": Channel("rad", _A, "geodetic latitude (WGS-84), north positive"),
+    "longitude_rad": Channel("rad", _A, "longitude, east positive"),
+    "phi_rad": Channel("rad", _A, "roll angle φ (NED Euler), right wing down positive"),
+    "theta_rad": Channel("rad", _A, "pitch angle θ (NED Euler), nose up positive"),
+    "psi_rad": Channel("rad", _A, "heading ψ (NED Euler), clockwise from north"),
+    "p_rad_s": Channel("rad/s", _A, "roll rate about the body x axis (forward)"),
+    "r_rad_s": Channel("rad/s", _A, "yaw rate about the body z axis (down)"),
+    "elevator_rad": Channel("rad", _A, "elevator deflection, trailing edge down positive "
+                            "(held at trim in a gust run)"),
+    "throttle": Channel("-", _A, "throttle, 0 to 1 (held at trim in a gust run)"),
+    "alpha_rad": Channel("rad", _A, "angle of attack against the air (the gust included), "
+                         "nose up positive"),
+    "beta_rad": Channel("rad", _A, "sideslip angle, wind from starboard positive"),
+    "v_north_m_s": Channel("m/s", _A, "inertial velocity, north (NED)"),
+    "v_east_m_s": Channel("m/s", _A, "inertial velocity, east (NED)"),
+    "v_down_m_s": Channel("m/s", _A, "inertial velocity, down (NED)"),
 }
+BASE_UNITS: dict[str, str] = {name: c.unit for name, c in CHANNELS.items()}
+# the self-describing name → the channel's own (``TimeHistory`` answers to both)
+ALIASES: dict[str, str] = {c.alias: name for name, c in CHANNELS.items() if c.alias}
+
+# Channels by pattern: the modal state, the section loads, the LTI model's inertial α
+_ETA = re.compile(r"eta(\d+)")
+_ETA_DOT = re.compile(r"eta(\d+)_dot")
+_LOADS = re.compile(r"loads_(fs|md)_(shear_n|bending_n_m|torque_n_m)_s(\d+)")
+_LOAD_METHOD = {"fs": "force summation", "md": "mode displacement"}
+_LOAD_QUANTITY = {
+    "shear_n": ("N", "vertical shear of the wing outboard, up positive"),
+    "bending_n_m": ("N*m", "bending moment, tip up positive"),
+    "torque_n_m": ("N*m", "torque about the elastic axis, leading edge up positive"),
+}
+
+
+def describe(name: str, unit: str | None = None) -> Channel:
+    """What the channel ``name`` holds (:class:`Channel`). A name this module does not know
+    (a channel another source added) is described by its ``unit`` alone (kind and meaning
+    ``unknown``)."""
+    if name in CHANNELS:
+        return CHANNELS[name]
+    if m := _ETA.fullmatch(name):
+        return Channel("rad", _P, f"modal coordinate of wing mode {m.group(1)} (twist-"
+                       "normalised: its largest section twist per unit η is 1 rad, tip twist "
+                       "positive, leading edge up) from its value at the trim (0 at a rigid "
+                       "trim, the static deflection at an elastic one)")
+    if m := _ETA_DOT.fullmatch(name):
+        return Channel("rad/s", _P, f"rate of the modal coordinate of wing mode {m.group(1)}")
+    if m := _LOADS.fullmatch(name):
+        method, quantity, station = m.groups()
+        q_unit, what = _LOAD_QUANTITY[quantity]
+        return Channel(q_unit, _A, f"{what}, by {_LOAD_METHOD[method]}, at monitoring station "
+                       f"{station} (run.meta['loads']['stations_m']), the 1 g part included "
+                       "(its value: run.meta['loads']['static_1g'])")
+    if name == "alpha_inertial":
+        return Channel("rad", _P, "the LTI model's state α: inertial angle of attack θ − γ "
+                       "(the gust not included), its perturbation from trim")
+    return Channel(unit or "?", "unknown", "unknown")
 
 
 def eta_names(n_modes: int) -> tuple[tuple[str, ...], tuple[str, ...]]:

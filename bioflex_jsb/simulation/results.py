@@ -1,10 +1,12 @@
 """Results of a run as data: named channels with units, and the gust-response metrics.
 
-Channels of a gust run (perturbations are from the trim at the start of the run):
-    time_s [s], u [m/s] airspeed perturbation, alpha [rad], q [rad/s], theta [rad] (all
-    perturbations), n_z [-] load factor (1 in level flight, positive up), w_g [m/s] gust
-    (up), eta1..etan [rad] modal coordinates, lift_n / drag_n / pitch_moment_n_m the modal
-    loads applied.
+Channels of a gust run (:mod:`bioflex_jsb.simulation.channels` describes each one:
+``run.describe()``): time_s [s]; u [m/s], alpha [rad], theta [rad] perturbations from the
+trim at the start of the run (also named du_m_s, dalpha_rad, dtheta_rad, the log's names),
+q [rad/s] the pitch rate; n_z [-] load factor (1 in level flight, positive up), w_g [m/s]
+gust (up); the absolute state (airspeed_m_s, alpha_rad, theta_rad, phi_rad, psi_rad, …),
+eta1..etan [rad] modal coordinates, lift_n / drag_n / pitch_moment_n_m the modal loads
+applied, loads_<fs|md>_<quantity>_s<j> the wing's section loads.
 """
 
 from __future__ import annotations
@@ -13,6 +15,9 @@ import re
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from bioflex_jsb.simulation.channels import ALIASES
+from bioflex_jsb.simulation.channels import describe as describe_channel
 
 SETTLING_BAND = 0.05  # settled: |Δα| stays within 5 % of its peak (a common 5 % criterion)
 # The short-period settling (GustMetrics.short_period_settling_time_s) separates the slow
@@ -51,7 +56,10 @@ def divergence_mode(stopped: str) -> str:
 
 @dataclass
 class TimeHistory:
-    """One run: ``channels[name]`` sampled at ``time_s``; ``units[name]`` says the unit."""
+    """One run: ``channels[name]`` sampled at ``time_s`` [s]; ``units[name]`` says the unit
+    and :meth:`describe` what each channel is (perturbation or absolute, frame, sign).
+    ``run[name]`` also takes a perturbation's self-describing name (``run["dalpha_rad"]`` is
+    ``run["alpha"]``: :data:`~bioflex_jsb.simulation.channels.ALIASES`)."""
 
     model: str
     time_s: np.ndarray
@@ -62,10 +70,22 @@ class TimeHistory:
 
     def __getitem__(self, name: str) -> np.ndarray:
         try:
-            return self.channels[name]
+            return self.channels[ALIASES.get(name, name)]
         except KeyError:  # the channels it has, in the message (a bare KeyError said none)
             raise KeyError(f"no channel {name!r} in this {self.model} run; channels: "
                            f"{', '.join(self.channels)}") from None
+
+    def __contains__(self, name: str) -> bool:
+        return ALIASES.get(name, name) in self.channels
+
+    def describe(self) -> dict[str, dict[str, str | None]]:
+        """Every channel's unit, kind (``perturbation`` from the trim at the start of the
+        run, or ``absolute``), meaning (the quantity, its frame and sign) and alias (the
+        self-describing name it also answers to, None when its own name says it), by
+        channel name in the run's order."""
+        return {name: dict(describe_channel(name, self.units.get(name)).as_dict(),
+                           unit=self.units.get(name, "?"))
+                for name in self.channels}
 
     @property
     def stop_time_s(self) -> float | None:
@@ -92,9 +112,11 @@ NUMERIC_METRICS = (
     "overshoot", "settling_time_s", "rms_du_m_s", "rms_dalpha_rad", "rms_dq_rad_s",
     "rms_dtheta_rad", "rms_dn_z", "divergence_time_s", "short_period_settling_time_s",
 )
+# The RMS metrics, given for turbulence (GustMetrics)
+RMS_METRICS = tuple(k for k in NUMERIC_METRICS if k.startswith("rms_"))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class GustMetrics:
     """Gust-response summary of one run (perturbations from trim, after the gust start).
 
@@ -162,6 +184,17 @@ class GustMetrics:
     divergence: str | None = None
     loads: dict[str, object] | None = None
 
+    def __repr__(self) -> str:
+        """One line: the kind, the metrics that have a value (4 digits), the divergence and
+        a summary of ``loads`` (the full dict is ``.loads``)."""
+        parts = [f"kind={self.kind!r}"]
+        parts += [f"{k}={v:.4g}" for k, v in self.as_dict().items() if v is not None]
+        if self.diverged:
+            parts.append(f"diverged=True, divergence_mode={self.divergence_mode!r}")
+        if self.loads is not None:
+            parts.append(f"loads=<{_loads_summary(self.loads)}: .loads>")
+        return f"GustMetrics({', '.join(parts)})"
+
     def as_dict(self) -> dict[str, float | None]:
         """The numeric metrics only (:data:`NUMERIC_METRICS`: numbers or None)."""
         return {k: getattr(self, k) for k in NUMERIC_METRICS}
@@ -170,6 +203,14 @@ class GustMetrics:
         """Every field: the numeric metrics and ``kind``, ``diverged``, ``divergence_mode``,
         ``divergence``."""
         return dict(self.__dict__)
+
+
+def _loads_summary(loads: dict) -> str:
+    """``GustMetrics.loads`` in a few words: its methods and stations, or why it has none."""
+    if "unavailable" in loads:
+        return f"unavailable: {loads['unavailable']}"
+    methods = ", ".join(loads.get("methods", {})) or "no methods"
+    return f"{methods} at {len(loads.get('stations_m', []))} stations"
 
 
 def is_turbulence(gust_text: str) -> bool:
