@@ -60,7 +60,8 @@ wire format, schemas and a decoder), :mod:`.foxglove_descriptors` (Foxglove's pu
 schemas), :mod:`.writer` (the MCAP file writer), :mod:`.formatting` (a chunk's steps as
 protobuf records), :mod:`.log` (:class:`RunLog`, :class:`TableRecorder`,
 :class:`AutopilotRecorder`), :mod:`.metadata` (the ``bioflex.run`` record),
-:mod:`.reader` (summaries, messages, time histories), :mod:`.recover`, :mod:`.compare`
+:mod:`.reader` (summaries, messages), :mod:`.history` (a log's runs as time histories,
+every channel), :mod:`.recover`, :mod:`.compare`
 (two logs message by message), :mod:`.errors`. A sink takes a run description and the run's
 data, never command-line arguments, and raises its own one-line errors
 (:class:`LogError`, :class:`LogWriteError`), which the CLI reports.
@@ -69,11 +70,11 @@ data, never command-line arguments, and raises its own one-line errors
 from bioflex_jsb.sinks.mcap.compare import compare_logs
 from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError
 from bioflex_jsb.sinks.mcap.formatting import enu_quaternion
+from bioflex_jsb.sinks.mcap.history import READ_MAX_STEPS, histories
 from bioflex_jsb.sinks.mcap.log import AutopilotRecorder, RunLog, TableRecorder
 from bioflex_jsb.sinks.mcap.metadata import description_from_metadata, run_metadata
 from bioflex_jsb.sinks.mcap.reader import (
     check_file,
-    histories,
     messages_by_topic,
     open_reader,
     read_metadata,
@@ -105,7 +106,7 @@ from bioflex_jsb.sinks.mcap.writer import (
 __all__ = [
     "AUTOPILOT_ACTIONS", "AUTOPILOT_PHASES", "AutopilotRecorder",
     "CHUNK_MAX_BYTES", "CHUNK_SPAN_S", "CHUNK_WALL_S", "EVENTS_TOPIC", "EVENT_LEVELS",
-    "FRAME_METADATA", "GROUPS", "MAGIC",
+    "FRAME_METADATA", "GROUPS", "MAGIC", "READ_MAX_STEPS",
     "PROTO_SCHEMAS", "RUN_METADATA", "SCHEMAS", "WORLD_FRAME", "LogError", "LogWriteError",
     "McapFileWriter",
     "RunLog", "TableRecorder", "body_frame", "check_chunks", "check_file", "compare_logs",

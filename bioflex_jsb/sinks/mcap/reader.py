@@ -13,7 +13,7 @@ from pathlib import Path
 
 from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
 from bioflex_jsb.sinks.mcap.protobuf import decoder
-from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC, RUN_METADATA
+from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC
 from bioflex_jsb.sinks.mcap.writer import MAGIC
 
 
@@ -104,14 +104,16 @@ def message_decoder(schema, channel):
                    "that bioflex-jsb writes (protobuf, or json in older logs)")
 
 
-def iter_messages(reader, topics: list[str] | None = None
-                  ) -> Iterator[tuple[str, int, dict]]:
-    """(topic, log time [ns], decoded message) of every message, in log-time order."""
+def iter_messages(reader, topics: list[str] | None = None, start_ns: int | None = None,
+                  end_ns: int | None = None) -> Iterator[tuple[str, int, dict]]:
+    """(topic, log time [ns], decoded message) of every message, in log-time order; with
+    ``start_ns``/``end_ns`` those logged at start_ns <= t < end_ns only (the chunks outside
+    are not read)."""
     decoders: dict[int, object] = {}
     where = ""  # the record being decoded, for the message of a failure
     try:
-        for schema, channel, message in reader.iter_messages(topics=topics,
-                                                             log_time_order=True):
+        for schema, channel, message in reader.iter_messages(
+                topics=topics, log_time_order=True, **_time_bounds(reader, start_ns, end_ns)):
             where = f" of the message on {channel.topic!r} at log time " \
                     f"{message.log_time * 1e-9:.6g} s"
             decode = decoders.get(channel.id)
@@ -126,6 +128,17 @@ def iter_messages(reader, topics: list[str] | None = None
         if isinstance(exc, LogError):
             raise
         raise LogError(f"unreadable message data{where} ({exc})") from None
+
+
+def _time_bounds(reader, start_ns: int | None, end_ns: int | None) -> dict[str, int]:
+    """The ``iter_messages`` keywords of start_ns <= t < end_ns: ``starting_at`` and
+    ``ending_before`` where the installed mcap has them (``start_time``/``end_time``, the
+    same bounds, are deprecated there), else the older names."""
+    import inspect
+
+    new = "starting_at" in inspect.signature(reader.iter_messages).parameters
+    names = ("starting_at", "ending_before") if new else ("start_time", "end_time")
+    return {k: v for k, v in zip(names, (start_ns, end_ns), strict=True) if v is not None}
 
 
 class NotOurs(LogError):
@@ -203,53 +216,6 @@ def summarise(path: str | Path) -> dict:
             "metadata": meta,
             "events": read_events(reader, summary),
         }
-
-
-def histories(path: str | Path) -> tuple[list, dict[str, str]]:
-    """The runs of a log rebuilt as TimeHistory objects (JSBSim runs, then LTI predictions),
-    and its ``bioflex.run`` metadata."""
-    import numpy as np
-
-    from bioflex_jsb.simulation.results import TimeHistory
-
-    with open_reader(path) as (reader, summary):
-        meta = read_metadata(reader).get(RUN_METADATA, {})
-        # our run topics: /bioflex/<model>/<group> (docs/logging.md); any other is not read
-        wanted = [ch.topic for ch in summary.channels.values()
-                  if len(parts := ch.topic.split("/")) == 4 and parts[:2] == ["", "bioflex"]
-                  and parts[3] in ("rigid_body", "modal", "gust", "lti_prediction")]
-        cols: dict[tuple[str, str], dict[str, list]] = {}
-        for top, ns, msg in iter_messages(reader, wanted):
-            _, _, model, group = top.split("/", 3)
-            key = (model, "lti" if group == "lti_prediction" else "run")
-            d = cols.setdefault(key, {})
-            if group == "rigid_body" or group == "lti_prediction":
-                d.setdefault("time_s", []).append(ns * 1e-9)
-                for name, field in (("u", "du_m_s"), ("alpha", "dalpha_rad"), ("q", "q_rad_s"),
-                                    ("theta", "dtheta_rad"), ("n_z", "n_z")):
-                    d.setdefault(name, []).append(_number(msg, field, top, ns, optional=True))
-                if group == "lti_prediction":
-                    for i, v in enumerate(_numbers(msg, "eta_rad", top, ns, optional=True)):
-                        d.setdefault(f"eta{i + 1}", []).append(v)
-            elif group == "modal":
-                for i, v in enumerate(_numbers(msg, "eta_rad", top, ns)):
-                    d.setdefault(f"eta{i + 1}", []).append(v)
-            elif group == "gust":
-                d.setdefault("w_g", []).append(_number(msg, "w_g_m_s", top, ns))
-    units = {"u": "m/s", "alpha": "rad", "q": "rad/s", "theta": "rad", "n_z": "-",
-             "w_g": "m/s"}
-    runs = []
-    for (model, kind), d in sorted(cols.items(), key=lambda kv: kv[0][1] == "lti"):
-        t = np.asarray(d.pop("time_s", []), dtype=float)
-        n = len(t)
-        channels = {k: np.asarray([np.nan if x is None else x for x in v[:n]], dtype=float)
-                    for k, v in d.items() if len(v) >= n}
-        run = TimeHistory(model, t, channels,
-                          {k: units.get(k, "rad") for k in channels}, {})
-        if kind == "lti":
-            run.meta.update(label=f"LTI {model}", linestyle="--")
-        runs.append(run)
-    return runs, meta
 
 
 def messages_by_topic(path: str | Path) -> dict[str, list[tuple[int, dict]]]:

@@ -79,6 +79,10 @@ _RIGID_OPTIONAL = (
     ("v_down_m_s", "inertial velocity, down [m/s]"),
 )
 
+# rigid_body's field → the run's channel it holds (what a reader rebuilds the run with)
+RIGID_BODY_CHANNELS: dict[str, str] = {
+    **{f: k for f, k, _ in _RIGID_FIELDS}, **{f: f for f, _ in _RIGID_OPTIONAL}}
+
 SCHEMAS: dict[str, dict] = {
     "rigid_body": {
         "title": "bioflex.RigidBody",
