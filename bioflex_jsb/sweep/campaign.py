@@ -30,7 +30,6 @@ import dataclasses
 import hashlib
 import json
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -39,7 +38,6 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import MODELS
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
-    DEFAULT_N_MODES,
     MASS_BASES,
     VARIANTS,
     VariantError,
@@ -48,6 +46,8 @@ from bioflex_jsb.flight_dynamics.wing_model import (
 )
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
+from bioflex_jsb.sweep.columns import DEFAULT_AERO, result_columns
+from bioflex_jsb.sweep.columns import RUN_INFO_COLUMNS as RUN_INFO_COLUMNS  # re-exported
 from bioflex_jsb.tomlfile import read_toml
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
@@ -57,7 +57,6 @@ METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
 TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
 RUN_KEYS = {"duration_s", "gust_start_s", "dt_s", "mass_basis", "flutter_range_m_s", "aero"}
 AERO_MODELS = ("quasi-steady", "unsteady")  # the coupled step's strips (run.aero)
-DEFAULT_AERO = "quasi-steady"
 # the metrics the unsteady strips are offered for: the gust run (the coupled step) and the
 # wing's coefficients (no aerodynamics); flutter and eigenvalues are the quasi-steady LTI
 # model's, so with run.aero = "unsteady" they are refused rather than given quasi-steady
@@ -66,12 +65,6 @@ AXIS_KEYS = {"wings", "aircraft", "x_inertial_frac", "x_elastic_frac", "speeds_m
              "seeds", "models"}
 RANGE_KEYS = {"start", "stop", "step", "num"}
 TURBULENCE = ("dryden", "vonkarman")
-
-# Modes whose eigenvalues the "eigenvalues" metric records (NaN where a model has no such
-# mode: the rigid and QSD models have no aeroelastic modes).
-EIGEN_MODES = ("short_period", "phugoid") + tuple(
-    f"aeroelastic_{i + 1}" for i in range(DEFAULT_N_MODES)
-)
 
 
 class CampaignError(InputError):
@@ -91,93 +84,6 @@ class RecordingError(Exception):
     def __str__(self) -> str:
         return str(self.args[0])
 
-
-# ---------------------------------------------------------------------------------------
-# Result columns
-# ---------------------------------------------------------------------------------------
-# name -> type ("str", "float", "int"); None is allowed in every column.
-INPUT_COLUMNS: dict[str, str] = {
-    "case_id": "str",
-    "case_index": "int",
-    "wing": "str",
-    "x_inertial_frac": "float",
-    "x_elastic_frac": "float",
-    "pinned_c_eta1_q1": "float",
-    "speed_m_s": "float",
-    "gust": "str",
-    "gust_kind": "str",
-    "gust_amplitude_m_s": "float",
-    "gust_length_m": "float",
-    "seed": "int",
-    "model": "str",
-    "duration_s": "float",
-    "gust_start_s": "float",
-    "dt_s": "float",
-    "mass_basis": "str",
-}
-STATUS_COLUMNS: dict[str, str] = {
-    "status": "str",  # ok | diverged (the gust run left the valid range) | failed
-    "error": "str",
-}
-METRIC_COLUMNS: dict[str, dict[str, str]] = {
-    "gust": {
-        "peak_du_m_s": "float",
-        "peak_dalpha_rad": "float",
-        "peak_dq_rad_s": "float",
-        "peak_dtheta_rad": "float",
-        "peak_dn_z": "float",
-        "overshoot": "float",
-        "settling_time_s": "float",
-        "time_beyond_stall_s": "float",
-        "time_flown_s": "float",
-    },
-    "flutter": {
-        "flutter_speed_m_s": "float",
-        "flutter_mode": "str",
-        "flutter_frequency_rad_s": "float",
-        "flutter_kind": "str",
-    },
-    "eigenvalues": {
-        f"{mode}_{part}": "float"
-        for mode in EIGEN_MODES
-        for part in ("re_rad_s", "im_rad_s", "damping", "frequency_rad_s")
-    },
-    "coefficients": {
-        "c_eta1_q1": "float",
-        "c_eta1_q1_physical": "float",
-        "e_shift_frac": "float",
-        **{f"mode{i + 1}_frequency_hz": "float" for i in range(DEFAULT_N_MODES)},
-    },
-}
-# Where and when a case ran: differs between runs of the same case, so comparisons of
-# results tables leave these out (:data:`RUN_INFO_COLUMNS`).
-RUN_INFO_COLUMNS: dict[str, str] = {
-    "worker": "str",
-    "started_unix_s": "float",
-    "wall_time_s": "float",
-}
-
-
-def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
-                   aircraft: bool = False) -> dict[str, str]:
-    """Every column of a results table for ``metrics``, in order, with its type. A campaign
-    of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``, one with
-    an ``aircraft`` axis an ``aircraft`` column after ``wing`` (the definition's name, empty
-    for the wings of ``axes.wings``); other tables are the ones they always were (their
-    files resume as before)."""
-    cols = {}
-    for name, kind in INPUT_COLUMNS.items():
-        cols[name] = kind
-        if name == "wing" and aircraft:
-            cols["aircraft"] = "str"
-    if aero != DEFAULT_AERO:
-        cols["aero"] = "str"
-    cols.update(STATUS_COLUMNS)
-    for m in METRICS:
-        if m in metrics:
-            cols.update(METRIC_COLUMNS[m])
-    cols.update(RUN_INFO_COLUMNS)
-    return cols
 
 
 # ---------------------------------------------------------------------------------------
@@ -220,7 +126,7 @@ class Case:
     """One point of a campaign: a wing at a speed through a gust, as one model. A case of
     the ``aircraft`` axis has its :class:`~bioflex_jsb.definition.aircraft.Aircraft` in
     ``aircraft`` (``wing`` its wing's variant); ``aircraft_column``: the campaign's table has
-    the ``aircraft`` column."""
+    the ``aircraft`` column, ``turbulence_columns`` the RMS columns (a turbulence gust)."""
 
     index: int
     wing: WingVariant
@@ -232,10 +138,12 @@ class Case:
     case_id: str = ""
     aircraft: Any = None
     aircraft_column: bool = False
+    turbulence_columns: bool = False
 
     def columns(self) -> dict[str, str]:
         """The columns of this case's results table."""
-        return result_columns(self.metrics, self.settings.aero, self.aircraft_column)
+        return result_columns(self.metrics, self.settings.aero, self.aircraft_column,
+                              self.turbulence_columns)
 
     def inputs(self) -> dict[str, Any]:
         """The input columns of this case's row."""
@@ -358,7 +266,7 @@ class Campaign:
         settings_json = dumps(settings_identity(self.settings), sort_keys=True, default=str)
         metrics_json = dumps(sorted(self.metrics))
         index = 0
-        column = bool(self.aircraft)
+        column, turbulence = bool(self.aircraft), self.has_turbulence
         wings = [(w, None) for w in self.wings] + [(a.variant(), a) for a in self.aircraft]
         for wing, aircraft in wings:
             wing_json = dumps(_wing_identity(wing, aircraft), sort_keys=True, default=str)
@@ -369,7 +277,7 @@ class Campaign:
                                         metrics_json)
                         cid = hashlib.sha256(text.encode()).hexdigest()[:16]
                         yield Case(index, wing, speed, gust, model, self.settings,
-                                   self.metrics, cid, aircraft, column)
+                                   self.metrics, cid, aircraft, column, turbulence)
                         index += 1
 
     @property
@@ -377,8 +285,14 @@ class Campaign:
         return (len(self.wings) + len(self.aircraft)) * len(self.speeds_m_s) * \
             len(self.gusts) * len(self.models)
 
+    @property
+    def has_turbulence(self) -> bool:
+        """Whether a gust of the campaign is turbulence (its table has the RMS columns)."""
+        return any(parse_gust(g).kind in TURBULENCE for g in self.gusts)
+
     def columns(self) -> dict[str, str]:
-        return result_columns(self.metrics, self.settings.aero, bool(self.aircraft))
+        return result_columns(self.metrics, self.settings.aero, bool(self.aircraft),
+                              self.has_turbulence)
 
 
 # ---------------------------------------------------------------------------------------

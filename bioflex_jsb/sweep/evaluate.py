@@ -41,12 +41,8 @@ from pathlib import Path
 from typing import Any
 
 from bioflex_jsb.sinks.mcap.scene import DEFAULT_EXAGGERATION
-from bioflex_jsb.sweep.campaign import (
-    EIGEN_MODES,
-    Case,
-    RecordingError,
-    failed_row,
-)
+from bioflex_jsb.sweep.campaign import Case, RecordingError, failed_row
+from bioflex_jsb.sweep.columns import EIGEN_MODES
 
 _FLUTTER_CACHE: dict[tuple, Any] = {}
 _EIGEN_CACHE: dict[tuple, Any] = {}

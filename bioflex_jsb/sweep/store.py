@@ -141,6 +141,23 @@ def open_store(path: str | Path, columns: dict[str, str], resume: bool):
     raise StoreError(f"--out {str(p)!r}: unknown suffix {p.suffix!r}; accepted: .parquet, .csv")
 
 
+def _resumed_columns(path: Path, found: list[str], columns: dict[str, str]
+                     ) -> dict[str, str]:
+    """The columns to go on writing an existing table with: the campaign's, or the same
+    campaign's table written before the RMS columns of turbulence existed
+    (:data:`~bioflex_jsb.sweep.columns.TURBULENCE_COLUMNS`), which is resumed as it is,
+    without them (its rows then have no RMS values, as its earlier rows); StoreError for
+    any other table."""
+    from bioflex_jsb.sweep.columns import TURBULENCE_COLUMNS
+
+    if found == list(columns):
+        return columns
+    if found == [c for c in columns if c not in TURBULENCE_COLUMNS]:
+        return {c: columns[c] for c in found}
+    raise StoreError(f"--out {str(path)!r} has other columns than this campaign (other "
+                     "metrics?); choose another --out")
+
+
 def _exists_error(p: Path) -> StoreError:
     return StoreError(f"--out {str(p)!r} exists; add --resume to complete it, or choose "
                       "another --out")
@@ -194,7 +211,7 @@ class CsvStore:
             self._recover()
         _check_writable(path)
         self._fd: int | None = None  # opened with the first row: a sweep that never starts
-        self._header = list(columns)  # leaves no file
+        self._header = list(self.columns)  # leaves no file
 
     def _open(self) -> None:
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -236,9 +253,7 @@ class CsvStore:
             header = next(reader, None)
             if header is None:
                 return
-            if header != list(self.columns):
-                raise StoreError(f"--out {str(self.path)!r} has other columns than this "
-                                 "campaign (other metrics?); choose another --out")
+            self.columns = _resumed_columns(self.path, header, self.columns)
             k = header.index("case_id")
             st = header.index("status")
             for r in reader:
@@ -301,8 +316,8 @@ class ParquetStore:
             try:
                 schema = self._pq.read_schema(part)
                 if schema.names != self.schema.names:
-                    raise StoreError(f"--out {str(self.path)!r} has other columns than this "
-                                     "campaign (other metrics?); choose another --out")
+                    self.columns = _resumed_columns(self.path, schema.names, self.columns)
+                    self.schema = _schema(self.columns)
                 table = self._pq.read_table(part, columns=["case_id", "status"])
             except (pa.ArrowException, OSError, ValueError) as exc:
                 if isinstance(exc, StoreError):
@@ -399,9 +414,10 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
             reader = csv.DictReader(fh)
             raw = [r for r in reader if None not in r.values()]
         if columns is None:
-            from bioflex_jsb.sweep.campaign import METRIC_COLUMNS, result_columns
+            from bioflex_jsb.sweep.columns import METRIC_COLUMNS, result_columns
 
-            columns = result_columns(list(METRIC_COLUMNS), "unsteady")  # aero: text
+            # every column a table can have, with its type (aero: text)
+            columns = result_columns(list(METRIC_COLUMNS), "unsteady", turbulence=True)
         rows = [{k: _parse(v, columns.get(k, "float")) for k, v in r.items()} for r in raw]
     else:
         import pyarrow.parquet as pq
