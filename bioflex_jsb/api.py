@@ -8,8 +8,11 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 >>> wing = api.load_wing("optimised")
 >>> runs = api.fly_gust(wing, speed_m_s=15.0, gust="sharp:3", models=("rigid", "coupled"))
 >>> runs["coupled"]["q"]               # pitch rate [rad/s] at runs["coupled"].time_s [s]
+>>> runs["coupled"].describe()["alpha"]  # unit, perturbation or absolute, frame and sign
+>>> api.read_log("gust.mcap")         # a log's runs, every channel, as fly_gust returns them
 >>> api.plot_runs(runs, "gust.png")   # the figure of `bioflex-jsb gust`
 >>> api.modes(wing, 15.0)["short_period"].damping  # [-]; a ModeSet is a sequence of modes
+>>> api.modes(wing, [10.0, 15.0, 20.0])  # one ModeSet per speed [m/s]
 >>> lti = api.linear_model(wing, speed_m_s=15.0, model="coupled")
 >>> unsteady = api.fly_gust(wing, gust="sharp:0.3", aero="unsteady")  # Jones/Küssner strips
 >>> api.flutter(wing).flutter_speed_m_s  # [m/s]
@@ -68,12 +71,14 @@ from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
 from bioflex_jsb.simulation.run import check_run_length
+from bioflex_jsb.simulation.run_checks import check_run_arguments
+from bioflex_jsb.simulation.run_checks import finite_number as _real
 
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
     "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
     "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "plot_runs",
-    "section_loads", "to_python_control",
+    "read_log", "section_loads", "to_python_control",
 ]
 
 
@@ -81,9 +86,9 @@ RUN_MODELS = MODELS  # the models fly_gust flies, the LTI models (native: fly_fi
 
 def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BASIS
               ) -> WingBuild:
-    """The elastic wing of a named variant (``original``, ``optimised``,
+    """The elastic wing ``name_or_file``: a named variant (``original``, ``optimised``,
     ``inertial-forward``, ``elastic-forward``, ``inertial-backward``, ``elastic-backward``)
-    or of a variant file (``docs/wing_variants.md``): modes, strips and the Table B1/B2
+    or a variant file (``docs/wing_variants.md``): modes, strips and the Table B1/B2
     model. ``mass_basis``: ``consistent`` or ``paper`` (``docs/decisions.md``).
 
     A shorthand: ``load_wing("optimised")`` is the wing of
@@ -100,16 +105,16 @@ def load_wing(name_or_file: str = "optimised", mass_basis: str = DEFAULT_MASS_BA
 
 
 def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
-    """An aircraft definition (docs/aircraft.md): a shipped one by name (``bioflex_original``,
-    ``bioflex_optimised``, ``bioflex_inertial-forward``, ``bioflex_elastic-forward``,
-    ``bioflex_inertial-backward``, ``bioflex_elastic-backward``) or a TOML file with an
-    ``[airframe]``: the JSBSim airframe, reference geometry, mass properties, the elastic
-    wing. Every field is checked when read (one line naming it). Pass the
-    :class:`Aircraft` to :func:`fly_gust`, :func:`compare`, :func:`linear_model`,
-    :func:`modes`, :func:`flutter` in place of a wing (``aircraft.wing()`` is its
-    :class:`WingBuild`). What the file leaves out of its ``[airframe]`` (mass, CG, inertia,
-    S, b, c̄, the speeds, the rigid derivatives) is read or identified from its JSBSim
-    aircraft, and what it gives is checked against it (docs/aircraft.md)."""
+    """The aircraft definition ``name_or_file`` (docs/aircraft.md): a shipped one by name
+    (``bioflex_original``, ``bioflex_optimised``, ``bioflex_inertial-forward``,
+    ``bioflex_elastic-forward``, ``bioflex_inertial-backward``,
+    ``bioflex_elastic-backward``) or a TOML file with an ``[airframe]``: the JSBSim
+    airframe, reference geometry, mass properties, the elastic wing. Every field is checked
+    when read (one line naming it). What the file leaves out of its ``[airframe]`` (mass,
+    CG, inertia, S, b, c̄, the speeds, the rigid derivatives) is read or identified from its
+    JSBSim aircraft, and what it gives is checked against it. Pass the :class:`Aircraft` to
+    :func:`fly_gust`, :func:`compare`, :func:`linear_model`, :func:`modes`, :func:`flutter`
+    in place of a wing (``aircraft.wing()`` is its :class:`WingBuild`)."""
     return complete_aircraft(_load_aircraft(name_or_file))
 
 
@@ -224,24 +229,26 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
              aero: str = "quasi-steady", trim: str = "rigid") -> dict[str, TimeHistory]:
-    """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing``, one per model
-    (``rigid``, ``coupled``, ``qsd``; default all three, or ``coupled`` alone with
-    ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and ``altitude_m`` [m],
-    then fly ``duration_s`` [s] at the step ``dt_s`` [s] through ``gust`` (``sharp:A``,
-    ``1cos:A:L``, ``dryden:SIGMA:SCALE[:SEED]``, ``vonkarman:…``; m/s, m) starting at
-    ``gust_start_s`` [s]. ``recorders``: a step recorder (an MCAP log) per model.
-    ``aero``: the wing's strips, ``quasi-steady`` (the paper's) or ``unsteady`` (Jones lag
-    states, apparent mass, Küssner gust: :mod:`bioflex_jsb.simulation.unsteady_wing`; the
-    coupled model only, compiled: :mod:`bioflex_jsb.simulation.unsteady_kernel`).
-    ``trim``: ``rigid`` (the paper's reading) or
-    ``elastic`` (start from the static aeroelastic equilibrium: the wing's static deflection
-    and its loads carried by JSBSim's trim; the rigid model is flown from the rigid trim).
-    ``speed_m_s`` None: the aircraft's cruise speed (the prototype's 15 m/s).
+    """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing`` (a WingBuild or an
+    Aircraft), one per model of ``models`` (``rigid``, ``coupled``, ``qsd``; None: all
+    three, or ``coupled`` alone with ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and
+    ``altitude_m`` [m], then fly ``duration_s`` [s] at the step ``dt_s`` [s] through
+    ``gust`` (``sharp:A``, ``1cos:A:L``, ``dryden:SIGMA:SCALE[:SEED]``, ``vonkarman:…``;
+    m/s, m) starting at ``gust_start_s`` [s]. ``recorders``: a step recorder (an MCAP log)
+    per model. ``aero``: the wing's strips, ``quasi-steady`` (the paper's) or ``unsteady``
+    (Jones lag states, apparent mass, Küssner gust:
+    :mod:`bioflex_jsb.simulation.unsteady_wing`; the coupled model only, compiled:
+    :mod:`bioflex_jsb.simulation.unsteady_kernel`). ``trim``: ``rigid`` (the paper's
+    reading) or ``elastic`` (start from the static aeroelastic equilibrium: the wing's
+    static deflection and its loads carried by JSBSim's trim; the rigid model is flown from
+    the rigid trim). ``speed_m_s`` None: the aircraft's cruise speed (the prototype's 15
+    m/s).
 
-    Returns {model: TimeHistory}; a run that left the valid range has ``stopped`` set (the
-    reason, the time and the mode) and holds every step up to then. Each run carries the
-    wing's section loads at the root, 25, 50 and 75 % semispan as channels
-    ``loads_<fs|md>_<quantity>_s<j>`` (:func:`bioflex_jsb.drivers.gust.run_gust`'s
+    Returns {model: TimeHistory} (``run.describe()``: every channel's unit, whether it is a
+    perturbation from the trim or absolute, its frame and sign); a run that left the valid
+    range has ``stopped`` set (the reason, the time and the mode) and holds every step up to
+    then. Each run carries the wing's section loads at the root, 25, 50 and 75 % semispan as
+    channels ``loads_<fs|md>_<quantity>_s<j>`` (:func:`bioflex_jsb.drivers.gust.run_gust`'s
     ``loads``; docs/loads.md), and :func:`metrics` their peaks. An :class:`Aircraft` flies
     on its own JSBSim airframe (an aircraft without an engine in its steady glide;
     docs/aircraft.md)."""
@@ -249,64 +256,11 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
                      dt_s, recorders, aero, trim)[0]
 
 
-def _real(value, what: str) -> float:
-    """``value`` as a finite float (InputError, one line, for anything else)."""
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
-        raise InputError(f"{what} must be a number, got {value!r}")
-    if not np.isfinite(value):
-        raise InputError(f"{what} must be finite, got {value!r}")
-    return float(value)
-
-
 def _gust_text(gust) -> str:
     """``gust`` if it is a gust text, else one line saying what one is."""
     if not isinstance(gust, str):
         raise InputError(f"gust must be a gust text (sharp:A, 1cos:A:L, ...), got {gust!r}")
     return gust
-
-
-def _check_run(gust, models, duration_s, gust_start_s, dt_s, trim, recorders) -> tuple:
-    """The checked run arguments of :func:`fly_gust` / :func:`compare` (one-line
-    InputErrors before anything is flown): the models a tuple of known names (a string of
-    names is one name), ``0 < duration_s``, ``0 <= gust_start_s`` and, with a gust, before
-    the end of the run; ``dt_s`` in MIN_DT_S..MAX_DT_S; ``trim`` rigid or elastic;
-    ``recorders`` for models that are flown."""
-    from bioflex_jsb.simulation.modal_wing import MAX_DT_S, MIN_DT_S
-
-    if isinstance(models, str) or not isinstance(models, Iterable):
-        raise InputError(f"models must be a tuple of model names ({', '.join(RUN_MODELS)}), "
-                         f"got {models!r}")
-    models = tuple(models)
-    bad = [m for m in models if m not in RUN_MODELS]
-    if not models or bad:
-        raise InputError(f"unknown model {bad[0] if bad else models!r}; give one or more of "
-                         f"{', '.join(RUN_MODELS)}")
-    duration_s = _real(duration_s, "duration_s [s]")
-    gust_start_s = _real(gust_start_s, "gust_start_s [s]")
-    dt_s = _real(dt_s, "dt_s [s]")
-    if duration_s <= 0.0:
-        raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
-    check_run_length(duration_s, dt_s, gust.kind in ("dryden", "vonkarman"))
-    if gust_start_s < 0.0 or (gust.kind != "none" and gust_start_s >= duration_s):
-        raise InputError(f"gust_start_s {gust_start_s:g} s must be within the run: 0 <= "
-                         f"gust_start_s < duration_s ({duration_s:g} s)")
-    if not MIN_DT_S <= dt_s <= MAX_DT_S:
-        raise InputError(f"dt_s {dt_s:g} s is outside {MIN_DT_S:g}..{MAX_DT_S:g} s")
-    if trim not in ("rigid", "elastic"):
-        raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
-    if recorders is not None:
-        if not isinstance(recorders, dict):
-            raise InputError(f"recorders must be a dict model -> recorder, got {recorders!r}")
-        unflown = sorted(set(recorders) - set(models))
-        if unflown:
-            raise InputError(f"recorders for {', '.join(unflown)}, which is not flown "
-                             f"(models {', '.join(models)})")
-        for model, rec in recorders.items():  # a file name: "'str' has no attribute start"
-            if not all(callable(getattr(rec, m, None)) for m in ("start", "rows", "stop")):
-                raise InputError(f"the recorder of {model} must be a StepRecorder (start, "
-                                 f"rows, stop: e.g. RunLog.open(path, …).recorder(model)), "
-                                 f"not {rec!r}")
-    return models, duration_s, gust_start_s, dt_s
 
 
 def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
@@ -317,7 +271,7 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
     _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
-    models, duration_s, gust_start_s, dt_s = _check_run(
+    models, duration_s, gust_start_s, dt_s = check_run_arguments(
         parse_gust(_gust_text(gust)), models, duration_s, gust_start_s, dt_s, trim, recorders)
     wing, airframe, speed_m_s = _flight(wing, speed_m_s)
     chord = wing.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
@@ -342,7 +296,8 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
 def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
     """The paper's Fig. 21 case (optimised wing, 15 m/s, 3 m/s sharp-edged gust at 0.5 s)
     through ``model``: ``rigid``, ``coupled``, ``qsd``, or ``native`` (the repository's
-    native XML wing, ``aircraft/bioflex_optimised``). The golden check cases."""
+    native XML wing, ``aircraft/bioflex_optimised``), flown for ``duration_s`` [s]. The
+    golden check cases."""
     _check_choice("model", model, (*RUN_MODELS, "native"))
     duration_s = _real(duration_s, "duration_s [s]")
     if duration_s <= 0.0:  # 0 s returned an empty run, −1 s a numpy "negative dimensions"
@@ -360,15 +315,16 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
             model: str = "coupled", duration_s: float = 5.0, gust_start_s: float = 0.5,
             aero: str = "quasi-steady", trim: str = "rigid",
             recorder: StepRecorder | None = None) -> Comparison:
-    """The nonlinear gust run of ``model`` (as :func:`fly_gust`: ``speed_m_s`` [m/s],
-    ``gust``, ``duration_s`` [s] from ``gust_start_s`` [s]) and the LTI model of Eq. (4)
+    """The nonlinear gust run of ``model`` with ``wing`` (as :func:`fly_gust`: ``speed_m_s``
+    [m/s], ``gust``, ``duration_s`` [s] from ``gust_start_s`` [s]) and the LTI model of Eq. (4)
     driven by the same gust samples at the same trim (its rigid block JSBSim's own
     linearisation, so the two differ only by the nonlinearity), with the NRMSE [-] and the
     largest difference of u, α, q, θ, η₁ (:class:`Comparison`; ``.plot(path, title)``).
     Small gusts (``sharp:0.3``) agree to a few per cent; a diverged run has no errors (None).
     ``aero``/``trim`` as for :func:`fly_gust` (unsteady: coupled only; elastic: coupled or
     qsd). ``wing`` an :class:`Aircraft`: its own airframe, linearised at its trim (a
-    glider's steady glide), ``speed_m_s`` None its cruise speed."""
+    glider's steady glide), ``speed_m_s`` None its cruise speed. ``recorder``: a step
+    recorder (an MCAP log) of the nonlinear run."""
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
     check_comparable(model, aero, trim)  # before flying
@@ -385,14 +341,33 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
 
 
 def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
-    """Peaks of the response to a gust starting at ``gust_start_s`` [s] (None: the run's
-    own, ``run.meta["gust_start_s"]``, else 0.5 s; units in the field names)."""
+    """Peaks of the response of ``run`` (a :class:`TimeHistory`) to a gust starting at
+    ``gust_start_s`` [s] (None: the run's own, ``run.meta["gust_start_s"]``, else 0.5 s;
+    units in the field names): :class:`GustMetrics` (RMS values for turbulence)."""
     if not isinstance(run, TimeHistory):
         raise InputError(f"run: a TimeHistory (fly_gust's), not {type(run).__name__}")
     if gust_start_s is None:
         gust_start_s = run.meta.get("gust_start_s", 0.5)
     gust_start_s = _real(gust_start_s, "gust_start_s [s]")
     return gust_metrics(run, gust_start_s)
+
+
+def read_log(path: str | Path, *, start_s: float | None = None,
+             end_s: float | None = None) -> dict[str, TimeHistory]:
+    """The runs of the MCAP log ``path`` (``bioflex-jsb gust``'s, a sweep case's, a log of
+    :func:`fly_gust`'s ``recorders``) as :func:`fly_gust` returned them: {model:
+    TimeHistory} with every channel under the same names and units, the section loads and
+    their layout (so :func:`metrics` and :func:`section_loads` take them), ``stopped`` from
+    the log's stop event; an LTI prediction (``compare``'s log) as ``"<model>_lti"``.
+    Latitude and longitude are logged at 60 Hz and interpolated to every step
+    (``meta["resampled"]``); times are the log's, to the nanosecond. ``start_s`` and
+    ``end_s`` [s]: the steps logged at start_s <= t < end_s only (a read takes at most
+    :data:`~bioflex_jsb.sinks.mcap.READ_MAX_STEPS` steps). One line (InputError) for a file
+    that is not a finished log of ours."""
+    from bioflex_jsb.sinks.mcap import histories
+
+    runs, _ = histories(path, loads=True, start_s=start_s, end_s=end_s)
+    return {r.model + ("_lti" if "label" in r.meta else ""): r for r in runs}
 
 
 def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = False) -> Path:
@@ -413,9 +388,18 @@ def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = Fa
 def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
                  model: str = "coupled", aero: str = "quasi-steady",
                  trim: str = "rigid") -> StateSpace:
-    """The paper's LTI model (Eq. 4) at ``speed_m_s`` [m/s] (None: the aircraft's cruise
-    speed, the prototype's 15 m/s): ``rigid`` (A_RR), ``coupled`` or ``qsd`` (Eq. 9-10),
-    with named states, inputs, outputs and their units.
+    """The paper's LTI model (Eq. 4) of ``wing`` at ``speed_m_s`` [m/s] (None: the
+    aircraft's cruise speed, the prototype's 15 m/s): ``model`` ``rigid`` (A_RR),
+    ``coupled`` or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units.
+    ``aero`` ``quasi-steady`` (the paper's strips) or ``unsteady``; ``trim`` ``rigid`` or
+    ``elastic``.
+
+    Quasi-steady about the rigid trim: the model ``bioflex-jsb export`` writes
+    (:func:`~bioflex_jsb.flight_dynamics.lti.build_state_space` with ``controls``): inputs
+    w_g [m/s] (gust, up), elevator [rad] (+ trailing edge down) and throttle [-]; outputs
+    the states (QSD: and its quasi-static η), n_z [-] (load-factor perturbation, up) and,
+    for an elastic wing model, tip_twist [rad] (leading edge up). The rigid block is the
+    analytic Table B2 one (``notes["rigid_block"]``; ``compare`` uses JSBSim's).
 
     ``aero="unsteady"`` (``coupled`` only): Eq. (4) on unsteady strips with the Küssner gust
     (:func:`bioflex_jsb.aeroelasticity.free_aircraft.unsteady_state_space`, ``gust=True``),
@@ -425,7 +409,8 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     ``trim="elastic"`` (``coupled``, ``qsd``): linearised about the elastic trim
     (:func:`bioflex_jsb.flight_dynamics.elastic_trim.linearise_about_elastic_trim`: the
     modes' force per unit airspeed from the deflected wing); ``notes["eta_static_rad"]``
-    holds the static deflection η₀ the states are measured from.
+    holds the static deflection η₀ the states are measured from. The unsteady and the
+    elastic-trim models take the gust w_g alone and output their states.
 
     ``wing`` an :class:`Aircraft` (or its wing): the model is its own (S, c̄, mass, I_yy, the
     derivatives of its file, its planform; the air of its [air]); ``None`` the prototype's
@@ -456,20 +441,22 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
         return unsteady_state_space(wing, speed_m_s, gust=True, **air)
     airframe = PROTOTYPE_AIRFRAME if wing is None else wing.model.airframe
     return build_state_space(model, level_flight_condition(speed_m_s, airframe=airframe, **air),
-                             None if wing is None else wing.model)
+                             None if wing is None else wing.model, controls=True)
 
 
 def to_python_control(ss: StateSpace):
-    """``ss`` as a python-control ``StateSpace`` (named signals); needs the ``control``
-    extra (``pip install "bioflex-jsb[control]"``)."""
+    """``ss`` (a :class:`StateSpace`, a model file's path or its arrays) as a
+    python-control ``StateSpace`` (named signals); needs the ``control`` extra
+    (``pip install "bioflex-jsb[control]"``)."""
     from bioflex_jsb.sinks.model_export import to_python_control as convert
 
     return convert(ss)
 
 
 def load_definition(name_or_file: str = "goland") -> Definition:
-    """An aircraft definition (docs/aircraft.md): a shipped name (``goland``) or a TOML
-    file; today a clamped wing (a definition without an airframe). Checked when read."""
+    """The aircraft definition ``name_or_file`` (docs/aircraft.md): a shipped name
+    (``goland``) or a TOML file; today a clamped wing (a definition without an airframe).
+    Checked when read."""
     return _load_definition(name_or_file)
 
 
@@ -517,20 +504,28 @@ def _check_damping(zeta: float | None) -> float | None:
     return zeta
 
 
-def modes(wing, speed_m_s: float | None = None, model: str = "coupled", *,
+def modes(wing, speed_m_s: float | Iterable[float] | None = None, model: str = "coupled", *,
           aero: str = "quasi-steady", clamped: bool = False, method: str = "state-space",
-          structural_damping: float | None = None) -> ModeSet:
-    """Labelled eigenvalues at ``speed_m_s`` [m/s] (free aircraft, None: its cruise speed,
-    the prototype's 15 m/s; clamped: required).
+          structural_damping: float | None = None) -> ModeSet | list[ModeSet]:
+    """Labelled eigenvalues of ``wing`` at ``speed_m_s`` [m/s] (free aircraft, None: its
+    cruise speed, the prototype's 15 m/s; clamped: required): a :class:`ModeSet`, or for a
+    sequence of speeds (``[10, 15, 20]``) a list of them, one per speed in its order.
 
     Free aircraft (``wing`` a :class:`WingBuild`): ``model`` rigid, coupled or qsd of the
     paper (short period, phugoid, aeroelastic_i), ``aero="unsteady"`` the coupled model on
     unsteady strips (lag roots left out). Clamped (``clamped=True``, ``wing`` a definition
     or its name/file): the wing's branches tracked from the bottom of its derived range by
     ``method`` (``pk`` or ``state-space``) on ``aero`` strips (lag roots left out).
+    ``structural_damping`` ζ [-] replaces the wing's (None: its own).
     An :class:`Aircraft` is analysed with its own airframe, planform and air."""
     _check_choice("aerodynamics", aero, AERO_MODELS)
     structural_damping = _check_damping(structural_damping)
+    if isinstance(speed_m_s, Iterable) and not isinstance(speed_m_s, str | bytes):
+        speeds = list(speed_m_s)
+        if not speeds:
+            raise InputError("speed_m_s: give a speed [m/s] or a non-empty sequence of them")
+        return [modes(wing, v, model, aero=aero, clamped=clamped, method=method,
+                      structural_damping=structural_damping) for v in speeds]
     if clamped:
         if speed_m_s is None:
             raise InputError("a clamped wing's modes need speed_m_s [m/s]")
@@ -580,9 +575,9 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
             structural_damping: float | None = None, density_kg_m3: float | None = None,
             lift_slope: str | None = None, progress=None,
             full_scan: bool = False) -> FlutterResult:
-    """The first instability [m/s] in ``range_m_s``: flutter, body-freedom flutter or
-    static divergence, its frequency [rad/s], k, modes, mechanism, and whether it is
-    already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``,
+    """The first instability of ``wing`` in ``range_m_s`` [m/s]: flutter, body-freedom
+    flutter or static divergence, its frequency [rad/s], k, modes, mechanism, and whether it
+    is already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``,
     ``.plot(path)`` the V-g / V-f diagram; ``speed_m_s`` is ``None`` when nothing crosses
     and when the system is unstable at and below the lower end, ``present_at_lower_end``).
 
@@ -592,9 +587,11 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     m/s for the prototype, derived from the wing for another aircraft
     (:func:`free_speed_range_m_s`); ``structural_damping`` ζ [-] replaces the wing's.
     Clamped (``clamped=True``; ``wing`` a definition, a shipped name or a TOML file):
-    ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and ρ default to the
-    definition's; the range to the one derived from the wing. ``progress(speed, top)`` [m/s]
-    is called as the scan goes; ``full_scan``: scan the whole range (for the diagram)."""
+    ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and
+    ``density_kg_m3`` [kg/m^3] default to the definition's; the range to the one derived
+    from the wing (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`).
+    ``progress(speed, top)`` [m/s] is called as the scan goes; ``full_scan``: scan the
+    whole range (for the diagram)."""
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
@@ -639,8 +636,8 @@ def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[flo
     the prototype's airframe; another aircraft's derived from its wing (150 % of the wing's
     static divergence speed in the aircraft, the body held, down to 5 % of that; a fixed
     5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s).
-    ``build``: a :class:`WingBuild` or an :class:`Aircraft` (its wing; the density of its
-    [air] when ``density_kg_m3`` is None)."""
+    ``build``: a :class:`WingBuild` or an :class:`Aircraft` (its wing); ``density_kg_m3``
+    [kg/m^3]: the air's (None: an Aircraft's [air], else sea level)."""
     if density_kg_m3 is None:
         density_kg_m3 = _density(build, None).get("density_kg_m3")
     else:
@@ -680,7 +677,8 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
     leading edge up +] by force summation and by mode displacement, with their difference
     (:class:`bioflex_jsb.loads.SectionLoads`: ``.values``, ``.difference()``, ``.plot()``;
     :func:`bioflex_jsb.loads.loads_metrics` the metrics' ``loads`` sub-dict; docs/loads.md).
-    ``static``: the 1 g part, ``elastic`` (default for coupled/qsd) or ``rigid``."""
+    ``static``: the 1 g part, ``elastic`` (default for coupled/qsd) or ``rigid``;
+    ``density_kg_m3`` [kg/m^3]: the air's (None: the run's own)."""
     from bioflex_jsb.loads import section_loads as _section_loads
 
     build = _wing(wing)

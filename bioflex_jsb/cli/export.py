@@ -61,9 +61,7 @@ def _is_our_model(path) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb import __version__
-    from bioflex_jsb.flight_dynamics.lti import build_state_space
-    from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+    from bioflex_jsb import __version__, api
     from bioflex_jsb.sinks.model_export import FORMATS, write_state_space
 
     if not args.out.endswith(FORMATS):
@@ -73,9 +71,8 @@ def run(args: argparse.Namespace) -> int:
     build = wing_from_args(args)
     if args.speed is None:
         args.speed = aircraft_speeds(args)[0]
-    # the flight condition of the wing's own aircraft (its S, mass, derivatives)
-    condition = level_flight_condition(args.speed, airframe=build.model.airframe)
-    ss = build_state_space(args.model, condition, build.model, controls=True)
+    # the API's model (one builder): the wing's own aircraft (its S, mass, derivatives)
+    ss = api.linear_model(build, args.speed, args.model)
     metadata = {"software": f"bioflex-jsb {__version__}", "wing": build.variant.name,
                 "wing_variant": build.variant.as_dict(), "speed_m_s": args.speed,
                 "mass_basis": build.mass_basis, "model": args.model,
@@ -97,5 +94,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"{ss.model} model of wing {build.variant.name} at {ss.speed_m_s:g} m/s "
               f"(mass basis {build.mass_basis}; {len(ss.states)} states; inputs "
               f"{', '.join(f'{n} [{u}]' for n, u in zip(ss.inputs, ss.input_units, strict=True))};"
-              f" {len(ss.outputs)} outputs incl. n_z, tip_twist) written to {args.out}")
+              f" {len(ss.outputs)} outputs incl. "
+              f"{', '.join(o for o in ('n_z', 'tip_twist') if o in ss.outputs)}) written to "
+              f"{args.out}")
     return 0
