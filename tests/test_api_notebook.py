@@ -196,3 +196,21 @@ def test_the_docs_channel_table_is_the_channels():
     for name, c in CHANNELS.items():
         alias = f"`{c.alias}`" if c.alias else ""
         assert f"| `{name}` | {c.unit} | {c.kind} | {c.meaning} | {alias} |" in text, name
+
+
+def test_a_sweep_cases_log_reads_back_as_its_row_says(tmp_path):
+    """A sweep case's log is read back like a gust run's: a diverged case (elastic-backward
+    at 15 m/s, past its flutter speed) reads back stopped, as its row's error says."""
+    from bioflex_jsb.sweep.campaign import parse_campaign
+    from bioflex_jsb.sweep.evaluate import run_case
+
+    camp = parse_campaign({
+        "name": "stop", "metrics": ["gust"], "run": {"duration_s": 1.0, "gust_start_s": 0.2},
+        "axes": {"wings": ["elastic-backward"], "speeds_m_s": [15.0], "gusts": ["sharp:3"],
+                 "models": ["coupled"]}})
+    case = camp.cases()[0]
+    row = run_case(case, str(tmp_path))
+    assert row["status"] == "diverged"
+    back = api.read_log(tmp_path / f"{case.case_id}.mcap")["coupled"]
+    assert " ".join(str(back.stopped).split()) == row["error"]
+    assert back.meta["gust_start_s"] == 0.2 and api.metrics(back).diverged

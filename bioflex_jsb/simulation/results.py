@@ -54,6 +54,13 @@ def divergence_mode(stopped: str) -> str:
     return "other"
 
 
+def stop_event_text(model: str, stopped: str) -> str:
+    """The text of a log's event for ``model``'s run that stopped (``stopped``: why):
+    "<model> run stopped (<divergence mode>): <why>", as ``gust`` logs it; reading a log
+    back takes ``stopped`` from it."""
+    return f"{model} run stopped ({divergence_mode(stopped)}): {stopped}"
+
+
 @dataclass
 class TimeHistory:
     """One run: ``channels[name]`` sampled at ``time_s`` [s]; ``units[name]`` says the unit

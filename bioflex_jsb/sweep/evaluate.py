@@ -234,7 +234,7 @@ def case_description(case: Case):
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
     from bioflex_jsb.drivers.gust import RunSetup, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
-    from bioflex_jsb.simulation.results import gust_metrics
+    from bioflex_jsb.simulation.results import gust_metrics, stop_event_text
 
     s = case.settings
     chord_m = build.model.airframe.reference.mean_chord_m  # the shortest gust: one chord
@@ -266,6 +266,9 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         wing = build if s.aero == "unsteady" else build.model
         run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
                        aero=s.aero)
+        if log is not None and run.stopped:  # as a gust log says it: read_log's stopped
+            log.event(run.stop_time_s, "ERROR", stop_event_text(case.model, run.stopped),
+                      name=case.model)
     finally:
         if log is not None:
             log.close()
