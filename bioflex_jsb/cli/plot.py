@@ -8,10 +8,14 @@ import sys
 from bioflex_jsb.cli.case import add_force_argument, check_plot_path
 from bioflex_jsb.cli.common import UsageError, print_json
 
-HELP = """Draw the time histories logged in FILE.mcap (every wing model's run, and the LTI
-prediction where one was logged): airspeed perturbation u [m/s], angle of attack alpha
-[deg], pitch rate q [deg/s], pitch angle theta [deg], load factor n_z [-] and the first
-modal coordinate eta1 [deg], against simulation time [s]. Read through the mcap package;
+HELP = """Draw the time histories logged in FILE.mcap against simulation time [s]. A gust or
+compare log (every wing model's run, and the LTI prediction where one was logged):
+perturbations of airspeed u [m/s], angle of attack alpha [deg], pitch rate q [deg/s] and
+pitch angle theta [deg], load factor n_z [-], the gust w_g [m/s] and the first wing mode
+as the tip twist [deg] (or, for a bending mode, the tip deflection [m]) it makes. A sitl or
+ardupilot session is drawn as a flight: altitude [m], airspeed [m/s], bank, pitch and
+heading [deg], every wing mode, n_z, alpha (and the gust), the track north against east
+[m] and the session's events (mode changes, waypoints). Read through the mcap package;
 every chunk is checked first, and damage where the figure does not read (the 3-D scene,
 the section loads) is said on stderr, the figure drawn from the intact chunks."""
 
@@ -50,8 +54,15 @@ def run(args: argparse.Namespace) -> int:
     title = _title(meta, runs, Path(args.file).name)
     from bioflex_jsb.sinks import plotting
 
+    flight = meta.get("command") in FLIGHT_COMMANDS
     try:
-        plotting.time_histories(runs, out, title)
+        if flight:  # a session: a flight, not a gust response (no gust onset, no trim)
+            from bioflex_jsb.sinks.flight_plot import flight_figure
+            from bioflex_jsb.sinks.mcap import summarise
+
+            flight_figure(runs, out, title, summarise(args.file)["events"])
+        else:
+            plotting.time_histories(runs, out, title)
     except OSError as exc:
         raise UsageError(f"cannot write plot {out!r}: {exc.strerror}") from None
     if damage:  # the figure is of intact chunks (each read is checked); the rest is not
@@ -59,11 +70,16 @@ def run(args: argparse.Namespace) -> int:
               f"not read ({'; '.join(damage[:2])}); {recover}", file=sys.stderr)
     if args.json:
         print_json({"file": args.file, "plot": out, "damaged": damage,
+                    "figure": "flight" if flight else "gust",
                     "runs": [{"model": r.model, "label": str(r.meta.get("label", r.model)),
                               "samples": len(r.time_s)} for r in runs]})
     else:
-        print(f"time histories of {len(runs)} run(s) written to {out}")
+        what = "the flight" if flight else f"time histories of {len(runs)} run(s)"
+        print(f"{what} written to {out}")
     return 0
+
+
+FLIGHT_COMMANDS = ("sitl", "ardupilot")  # logs drawn as a flight (sinks/flight_plot.py)
 
 
 def _title(meta: dict, runs, file_name: str) -> str:

@@ -32,6 +32,7 @@ from bioflex_jsb.loads.model import LoadsModel, build_loads_model
 from bioflex_jsb.loads.stream import LoadStream
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.simulation.channels import mode_tips
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
@@ -350,6 +351,9 @@ def run_gust(
         history = "envelope"
     if stream is not None:
         units.update(stream.units)
+    # what each η_i does at the tip (twist or deflection), for figures: from the build
+    build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
+        else None
     return TimeHistory(
         model=model,
         time_s=time_s,
@@ -374,6 +378,7 @@ def run_gust(
                                else [float(e) for e in step.elastic_trim.eta_rad]),
             "steps": n,
             "envelope_s": envelope.span_s if envelope is not None else None,
+            "mode_tips": None if build is None else mode_tips(build.modes),
             **loads_meta,
         },
         stopped=stopped,

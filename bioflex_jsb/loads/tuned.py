@@ -191,15 +191,21 @@ def plot_envelopes(result: TunedGustResult, path=None, method: str = "force_summ
     fig, ax = _figure(rows, cols, (5.6 * cols, 4.6 * rows))
     qb, qt = QUANTITIES.index("bending_n_m"), QUANTITIES.index("torque_n_m")
     h_all = np.array([c["gradient_m"] for c in result.cases])
-    norm = np.log(h_all / h_all.min()) / max(np.log(h_all.max() / h_all.min()), 1e-12)
-    import matplotlib.cm as cm
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm, Normalize
+    from matplotlib.lines import Line2D
 
+    # colour = gradient length H [m] on a log scale (the lengths are log-spaced), with its bar
+    norm = (LogNorm(h_all.min(), h_all.max()) if h_all.max() > h_all.min()
+            else Normalize(h_all.min() * 0.9, h_all.max() * 1.1))
+    cmap = plt.get_cmap("viridis")
+    labels = []  # (axes, x, y, text) of the critical cases, written once the limits are set
     for j in range(len(stations)):
         a = ax[j // cols, j % cols]
         pts = []
-        for case, sl, c in zip(result.cases, result.loads, norm, strict=True):
+        for case, sl in zip(result.cases, result.loads, strict=True):
             m, t = sl.values[method][:, qb, j], sl.values[method][:, qt, j]
-            a.plot(t, m, lw=0.6, color=cm.viridis(c), alpha=0.8,
+            a.plot(t, m, lw=0.6, color=cmap(norm(case["gradient_m"])), alpha=0.8,
                    ls="-" if case["sign"] == "up" else "--")
             pts.append(np.column_stack([t, m]))
         pts = np.concatenate(pts)
@@ -220,21 +226,41 @@ def plot_envelopes(result: TunedGustResult, path=None, method: str = "force_summ
             a.plot(x, y, mark, color="C3", ms=7)
             name = "M" if r["quantity"] == "bending_n_m" else "T"
             tag = f"{name}{'max' if r['direction'] == 'up' else 'min'}"
-            a.annotate(f"{tag} H={r['gradient_m']:.3g} m {r['sign']}", (x, y),
-                       textcoords="offset points", xytext=(4, 4), fontsize=7, color="C3")
+            labels.append((a, x, y, f"{tag} H={r['gradient_m']:.3g} m {r['sign']}"))
         a.set_title(f"{result.loads[0].station_label(j)} (y = {stations[j]:.3f} m)", fontsize=10)
         a.set_xlabel("torque T [N·m] (leading edge up +)")
         a.set_ylabel("bending moment M [N·m] (tip up +)")
         a.grid(True, alpha=0.3)
     for k in range(len(stations), rows * cols):
         ax[k // cols, k % cols].axis("off")
-    handles, labels = ax[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=8)
+    for a, x, y, text in labels:  # inside the axes: towards its centre from the point
+        (x0, x1), (y0, y1) = a.get_xlim(), a.get_ylim()
+        right = x > 0.5 * (x0 + x1)
+        above = y > 0.5 * (y0 + y1)
+        a.annotate(text, (x, y), textcoords="offset points",
+                   xytext=(-6 if right else 6, -6 if above else 6), fontsize=7, color="C3",
+                   ha="right" if right else "left", va="top" if above else "bottom",
+                   annotation_clip=True,
+                   bbox=dict(boxstyle="round,pad=0.1", facecolor="white", alpha=0.75, lw=0))
+    handles, names = ax[0, 0].get_legend_handles_labels()
+    handles += [Line2D([], [], color="0.3", lw=0.8, ls="-"),
+                Line2D([], [], color="0.3", lw=0.8, ls="--"),
+                Line2D([], [], color="C3", marker="^", ls="none"),
+                Line2D([], [], color="C3", marker="v", ls="none")]
+    names += ["gust up", "gust down", "critical case, largest", "critical case, smallest"]
+    fig.legend(handles, names, loc="outside lower center", ncol=6, fontsize=8)
+    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6,
+                       pad=0.02)
+    bar.set_label("gust gradient length H [m] (line colour)")
+    lengths = np.unique(h_all)
+    ticks = lengths if len(lengths) <= 10 else lengths[np.unique(
+        np.round(np.linspace(0, len(lengths) - 1, 10)).astype(int))]
+    bar.ax.minorticks_off()
+    bar.set_ticks(ticks, labels=[f"{h:.2g}" for h in ticks])
     st = result.settings
     fig.suptitle(f"Correlated loads ({method.replace('_', ' ')}), wing {st['wing']}, "
                  f"{st['speed_m_s']:g} m/s, 1-cos gusts H = {min(st['gradients_m']):.2g}-"
-                 f"{max(st['gradients_m']):.3g} m up (solid) and down (dashed), colour: H "
-                 "short (dark) to long (yellow)", fontsize=9)
+                 f"{max(st['gradients_m']):.3g} m, up and down", fontsize=10)
     if path is not None:
         save(fig, path)
     return fig

@@ -140,3 +140,21 @@ def channel_units(n_modes: int) -> dict[str, str]:
 def row_getter(names: tuple[str, ...]):
     """``getter(row)``: the values of the dict ``row`` in the order of ``names`` (a tuple)."""
     return itemgetter(*names)
+
+
+def mode_tips(modes) -> list[dict[str, object]]:
+    """What each wing mode's coordinate η_i [rad] does at the wing tip, for figures: a mode
+    without twist (``ModalData.twist_free``: pure bending, a sailplane's first) moves the tip
+    by ``per_rad`` [m] per rad of η_i (``quantity`` "tip deflection", up +); any other twists
+    the tip by ``per_rad`` [rad] per rad (``quantity`` "tip twist", leading edge up +).
+    ``modes``: a ``ModalData`` (signs: docs/conventions.md, bending positive down)."""
+    free = modes.twist_free()
+    out: list[dict[str, object]] = []
+    for i in range(modes.n_modes):
+        if free[i]:
+            out.append({"quantity": "tip deflection", "unit": "m",
+                        "per_rad": float(-modes.bending_m[i, -1])})
+        else:
+            out.append({"quantity": "tip twist", "unit": "rad",
+                        "per_rad": float(modes.twist_rad[i, -1])})
+    return out

@@ -1,4 +1,4 @@
-"""Plots (the only module that imports matplotlib): root loci and time histories.
+"""Plots: root loci and time histories (a flight's figure: :mod:`.flight_plot`).
 
 Every figure is written with ``Software = "bioflex-jsb <version>"`` in its metadata
 (:data:`SOFTWARE_TAG`), so a later run can tell a plot of ours (which it may replace) from a
@@ -58,7 +58,8 @@ def supported_formats() -> dict[str, str]:
     return dict(FigureCanvasBase.get_supported_filetypes())
 
 
-def _save(fig, path: str | Path) -> Path:
+def save_figure(fig, path: str | Path) -> Path:
+    """Write ``fig`` to ``path`` with the Software tag (:data:`SOFTWARE_TAG`) and close it."""
     out = Path(path)
     suffix = out.suffix.lower().lstrip(".")
     meta = {"Software": SOFTWARE_TAG} if suffix == "png" else {"Creator": SOFTWARE_TAG}
@@ -85,17 +86,68 @@ def _branches(sweep: Sweep):
     return out
 
 
-def _speed_labels(ax, lam, speeds, colour, every_m_s=5.0, inside=None):
-    """Write the airspeed [m/s] beside the root at each multiple of ``every_m_s``."""
-    for v in np.arange(np.ceil(speeds[0] / every_m_s) * every_m_s, speeds[-1] + 1e-9, every_m_s):
-        k = int(np.argmin(np.abs(speeds - v)))
-        if abs(speeds[k] - v) > 1e-6:
-            continue
-        z = lam[k]
-        if not np.isfinite(z) or (inside is not None and not inside(z)):
-            continue
-        ax.annotate(f"{v:g}", (z.real, z.imag), textcoords="offset points", xytext=(4, 4),
-                    fontsize=7, color=colour)
+# below this relative gap the coupled and QSD branches coincide at the figure's scale (a
+# line width in a zoom spanning |λ|), and the zoom says so
+AGREE_NOTE_BELOW = 0.01
+LABEL_CLEARANCE_PX = 18.0  # a speed label is left out nearer than this to one already placed
+
+
+def _speed_labels(jobs, fig) -> None:
+    """Write the airspeed [m/s] beside the root at each multiple of ``every_m_s`` of each job
+    (ax, roots, speeds [m/s], colour, every_m_s), once the axes' limits and the layout are
+    final: a label that would land within :data:`LABEL_CLEARANCE_PX` of one already written
+    on the same axes (where a branch crowds, as the phugoid does at high speed) or outside
+    the axes is left out; each branch's end speeds are placed first."""
+    fig.canvas.draw()  # the final transforms
+    placed: dict[int, list[np.ndarray]] = {}
+    for ax, lam, speeds, colour, every_m_s in jobs:
+        marks = np.arange(np.ceil(speeds[0] / every_m_s) * every_m_s, speeds[-1] + 1e-9,
+                          every_m_s)
+        order = sorted(range(len(marks)), key=lambda i: (0 if i in (0, len(marks) - 1)
+                                                          else 1, i))
+        box = ax.get_window_extent()
+        for i in order:
+            v = marks[i]
+            k = int(np.argmin(np.abs(speeds - v)))
+            if abs(speeds[k] - v) > 1e-6 or not np.isfinite(lam[k]):
+                continue
+            xy = ax.transData.transform((lam[k].real, lam[k].imag))
+            if not box.contains(*xy):
+                continue
+            mine = placed.setdefault(id(ax), [])
+            if any(np.hypot(*(xy - p)) < LABEL_CLEARANCE_PX for p in mine):
+                continue
+            mine.append(xy)
+            # beside the branch, not on it: offset along its normal (left of travel)
+            ends = [j for j in (k - 1, k + 1) if 0 <= j < len(lam) and np.isfinite(lam[j])]
+            d = (ax.transData.transform((lam[max(ends)].real, lam[max(ends)].imag))
+                 - ax.transData.transform((lam[min(ends)].real, lam[min(ends)].imag))
+                 if len(ends) == 2 else np.array([1.0, 0.0]))
+            n = np.array([-d[1], d[0]]) / max(float(np.hypot(*d)), 1e-9)
+            ax.annotate(f"{v:g}", (lam[k].real, lam[k].imag), textcoords="offset pixels",
+                        xytext=tuple(11.0 * n), fontsize=7, color=colour, ha="center",
+                        va="center", zorder=7,
+                        bbox=dict(boxstyle="round,pad=0.15", facecolor="white", alpha=0.8,
+                                  lw=0))
+
+
+def _agreement(sweeps: Sequence[Sweep], name: str, a: str = "coupled", b: str = "qsd"
+               ) -> float | None:
+    """The largest |λ_a − λ_b| / |λ_a| [-] of branch ``name`` between models ``a`` and ``b``
+    over the speeds both swept; None if either lacks it."""
+    by_model = {s.model: s for s in sweeps}
+    if a not in by_model or b not in by_model or name not in by_model[a].labels \
+            or name not in by_model[b].labels:
+        return None
+    sa, sb = by_model[a], by_model[b]
+    va, vb = np.asarray(sa.speeds_m_s, dtype=float), np.asarray(sb.speeds_m_s, dtype=float)
+    common = np.intersect1d(va, vb)
+    if not len(common):
+        return None
+    la = sa.eigenvalues[np.searchsorted(va, common), sa.labels.index(name)]
+    lb = sb.eigenvalues[np.searchsorted(vb, common), sb.labels.index(name)]
+    rel = np.abs(la - lb) / np.maximum(np.abs(la), 1e-12)
+    return float(np.nanmax(rel)) if np.any(np.isfinite(rel)) else None
 
 
 def _box(points: np.ndarray, margin: float = 0.12, min_span: float = 0.2):
@@ -123,6 +175,7 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
     fig, axes = plt.subplots(2, 2, figsize=(14, 11))
     ax_all, ax_sp, ax_ph, ax_re = axes.flat
     sp_points, ph_points = [], []
+    label_jobs: list[tuple] = []  # speed labels, written once the layout is final
     v_lo = min(float(s.speeds_m_s[0]) for s in sweeps)
     v_hi = max(float(s.speeds_m_s[-1]) for s in sweeps)
     for sweep in sweeps:
@@ -161,11 +214,11 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
                     ax.plot(lam.real[unstable], lam.imag[unstable], ls="none", marker="x",
                             color="tab:red", ms=5, mew=1.2)
             if name.startswith("aeroelastic") or name == "short_period":
-                _speed_labels(ax_all, lam, speeds, colour, every_m_s=10.0)
+                label_jobs.append((ax_all, lam, speeds, colour, 10.0))
             if name == "short_period":
-                _speed_labels(ax_sp, lam, speeds, colour)
+                label_jobs.append((ax_sp, lam, speeds, colour, 5.0))
             if name == "phugoid":
-                _speed_labels(ax_ph, lam, speeds, colour)
+                label_jobs.append((ax_ph, lam, speeds, colour, 5.0))
         for name, re in growth.items():
             marker, ls = MODE_MARKERS.get(name, (".", "-"))
             line = LOCUS_LINE.get(sweep.model, dict(lw=1.0, zorder=3))
@@ -202,8 +255,16 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
     ax_re.set_ylabel("Re λ [rad/s]")
     ax_re.grid(True, alpha=0.3)
     ax_re.legend(fontsize=7, loc="best", ncol=2)
+    for ax, name in ((ax_sp, "short_period"), (ax_ph, "phugoid")):
+        gap = _agreement(sweeps, name)
+        if gap is not None and gap < AGREE_NOTE_BELOW:  # coinciding lines: say so
+            ax.text(0.02, 0.02, f"coupled and QSD roots agree within {100 * gap:.2g} % of |λ|"
+                    " here:\nthe wide pale blue line lies under the red one",
+                    transform=ax.transAxes, fontsize=8, va="bottom", ha="left",
+                    bbox=dict(facecolor="white", alpha=0.85, lw=0))
     fig.tight_layout()
-    return _save(fig, path)
+    _speed_labels(label_jobs, fig)
+    return save_figure(fig, path)
 
 
 # ---------------------------------------------------------------------------------------
@@ -216,19 +277,62 @@ TIME_PANELS = (
     ("theta", "Δθ [deg]", 180.0 / np.pi),
     ("n_z", "n_z [-]", 1.0),
     ("w_g", "gust w_g [m/s] (up)", 1.0),
-    ("eta1", "η₁ [deg]: 0.1 s envelope, mean", 180.0 / np.pi),
-    ("eta1_zoom", "η₁ [deg] at the gust onset", 180.0 / np.pi),
+    ("eta1", "{label}, 0.1 s envelope", None),  # scale: ModeDisplay's
+    ("eta1_zoom", "{label}, gust onset", None),
 )
-# η₁ is the first wing mode's coordinate; each mode is scaled so that its largest section
-# twist is 1 rad/rad (docs/conventions.md), so η₁ reads as the twist of that section (the tip).
-ETA1_NOTE = ("η₁: first wing mode (the prototype's: twist-dominated, scaled to equal its "
-             "largest section twist, at the tip, leading edge up positive; another wing's as "
-             "its modes are scaled). Shaded: running min/max over 0.1 s")
+ENVELOPE_NOTE = "Left: its running mean, the running min/max over 0.1 s shaded"
 # Runs that share a model's style (e.g. two wings flown with the same model) get these
 # colours instead, in order, so that every line in a figure can be told apart.
 EXTRA_COLOURS = ("tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 ENVELOPE_WINDOW_S = 0.1  # η₁ envelope: max/min over 0.1 s (three cycles of a 31 Hz mode)
 ZOOM_BEFORE_S, ZOOM_AFTER_S = 0.05, 0.35  # the η₁ zoom around the gust onset [s]
+
+
+class ModeDisplay:
+    """How a figure draws wing mode ``mode`` (1-based) of ``runs``: as what its coordinate η
+    [rad] does at the wing tip (``run.meta["mode_tips"]``, :func:`~bioflex_jsb.simulation.
+    channels.mode_tips`): the tip twist [deg] of a twisting mode (the prototype's three), the
+    tip deflection [m, up] of a bending one (a sailplane's first). Runs without the shape (an
+    LTI prediction) take the other runs'; runs whose wings disagree (one twists, one bends)
+    or that carry no shape at all are drawn as η itself [deg], and the note says so.
+
+    ``scale(run)``: the factor from η [rad] to the drawn unit; ``label``: the axis label
+    without the unit's brackets … with them (``label``); ``note``: one line for the figure."""
+
+    def __init__(self, runs: Sequence[TimeHistory], mode: int = 1):
+        self.mode = mode
+        sub = "₁₂₃₄₅₆₇₈₉"[mode - 1] if 1 <= mode <= 9 else str(mode)
+        tips: dict[int, dict] = {}
+        for run in runs:
+            table = run.meta.get("mode_tips")
+            if isinstance(table, Sequence) and len(table) >= mode and isinstance(
+                    table[mode - 1], Mapping):
+                tips[id(run)] = table[mode - 1]
+        kinds = {str(t.get("quantity")) for t in tips.values()}
+        self._tips = tips
+        self._default = next(iter(tips.values()), None)
+        if len(kinds) == 1 and kinds <= {"tip twist", "tip deflection"}:
+            self.quantity = kinds.pop()
+            twist = self.quantity == "tip twist"
+            self.unit = "deg" if twist else "m"
+            self.label = f"η{sub} tip {'twist' if twist else 'deflection'} [{self.unit}]"
+            self.note = (f"η{sub}: wing mode {mode}, drawn as the tip "
+                         + ("twist it makes (leading edge up +)" if twist else
+                            "deflection it makes (a bending mode; up +)"))
+        else:
+            self.quantity, self.unit = "eta", "deg"
+            self.label = f"η{sub} [deg]"
+            why = ("the wings' modes differ (one twists, one bends)" if len(kinds) > 1 else
+                   "the runs do not carry its shape")
+            self.note = (f"η{sub}: the coordinate of wing mode {mode} in degrees ({why}; "
+                         "docs/conventions.md for its scaling)")
+
+    def scale(self, run: TimeHistory) -> float:
+        if self.quantity == "eta":
+            return 180.0 / np.pi
+        tip = self._tips.get(id(run), self._default)
+        per_rad = float(tip["per_rad"])
+        return per_rad * 180.0 / np.pi if self.unit == "deg" else per_rad
 
 
 def _style(run: TimeHistory) -> dict:
@@ -239,7 +343,7 @@ def _style(run: TimeHistory) -> dict:
     return style
 
 
-def _envelope(t: np.ndarray, x: np.ndarray, window_s: float):
+def running_envelope(t: np.ndarray, x: np.ndarray, window_s: float):
     """Running minimum, maximum and mean of ``x`` over windows of ``window_s`` [s]."""
     if len(t) < 2:
         return t, x, x, x
@@ -268,14 +372,17 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                    nrmse: Mapping[str, float] | None = None) -> Path:
     """Gust time histories of several runs on shared axes (like Figs. 21 and 22).
 
-    Eight panels against time [s]: Δu, Δα, q, Δθ, n_z, the gust input w_g, η₁ as an envelope
-    (running min/max over 0.1 s, shaded, with the running mean: the 31 Hz oscillation would
-    otherwise fill a solid band) and η₁ itself around the gust onset. A run that stopped
+    Eight panels against time [s]: Δu, Δα, q, Δθ, n_z, the gust input w_g, the first wing
+    mode η₁ as an envelope (running min/max over 0.1 s, shaded, with the running mean: the
+    31 Hz oscillation would otherwise fill a solid band) and η₁ itself around the gust onset;
+    η₁ drawn as the tip twist [deg] or, for a bending mode, the tip deflection [m] it makes
+    (:class:`ModeDisplay`). A run that stopped
     early (diverged) ends in a red × on every panel and says when in the legend; the axes
     are scaled to the runs that finished, so they stay readable. ``nrmse`` (channel →
     NRMSE [-]) labels the LTI prediction's line in every panel (``compare``).
     """
     fig, axes = plt.subplots(4, 2, figsize=(12, 12.6), sharex=False)
+    shown = ModeDisplay([r for r in runs if r.model != "rigid"])
     t_gust = _gust_onset(runs)
     styles = _distinct_styles(runs)
     elastic = [r for r in runs if r.model != "rigid" and "eta1" in r.channels]
@@ -299,7 +406,7 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                     continue  # one gust input: every run flies the same samples
                 drawn_gust = True
             style = dict(styles[id(run)])
-            t, y = run.time_s, run[channel] * scale
+            t, y = run.time_s, run[channel] * (shown.scale(run) if scale is None else scale)
             label = str(run.meta.get("label", run.model))
             if nrmse is not None and run.meta.get("source") == "lti" and channel in nrmse:
                 label += f", NRMSE {nrmse[channel]:.3f}"
@@ -315,7 +422,7 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                 if not len(t):
                     continue
             if name == "eta1" and len(t) > 2:
-                tc, lo, hi, mean = _envelope(t, y, ENVELOPE_WINDOW_S)
+                tc, lo, hi, mean = running_envelope(t, y, ENVELOPE_WINDOW_S)
                 ax.fill_between(tc, lo, hi, color=style["color"], alpha=0.18, lw=0,
                                 zorder=style["zorder"] - 1)
                 ax.plot(tc, mean, label=label, **style)
@@ -342,7 +449,7 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
             ax.set_xlim(0.0, t_end)
         if t_gust > 0.0 and (zoom is None or zoom[0] <= t_gust <= zoom[1]):
             ax.axvline(t_gust, color="0.6", lw=0.7, ls=":")
-        ax.set_ylabel(ylabel)
+        ax.set_ylabel(ylabel.format(label=shown.label))
         ax.grid(True, alpha=0.3)
         if nrmse is not None or name == "w_g":
             ax.legend(fontsize=7, loc="best")  # NRMSE differs by panel: a legend in each
@@ -360,10 +467,10 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                        ncol=min(len(handles), 4), fontsize=9, frameon=False,
                        bbox_to_anchor=(0.5, 0.975))
     if any("eta1" in r.channels and r.model != "rigid" for r in runs):
-        fig.text(0.5, 0.004, ETA1_NOTE, ha="center", va="bottom", fontsize=8, color="0.25",
-                 wrap=True)
+        fig.text(0.5, 0.004, f"{shown.note}. {ENVELOPE_NOTE}", ha="center", va="bottom",
+                 fontsize=8, color="0.25", wrap=True)
     fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955 if nrmse is None else 0.98))
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _distinct_styles(runs: Sequence[TimeHistory]) -> dict[int, dict]:

@@ -318,6 +318,8 @@ def _run_meta(meta: dict[str, str], path, layout, channels) -> dict:
     out.update({k: meta[k] for k in ("gust", "wing", "mass_basis", "command") if k in meta})
     if "overrides" in meta:
         out["overrides"] = _json(meta["overrides"], "run metadata overrides")
+    if "mode_tips" in meta:  # what η_i does at the tip (a gust run's meta says so too)
+        out["mode_tips"] = _json(meta["mode_tips"], "run metadata mode_tips")
     if layout is not None:
         out["loads"] = layout
     resampled = [n for n in ("latitude_rad", "longitude_rad") if n in channels]

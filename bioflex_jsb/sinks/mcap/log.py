@@ -102,6 +102,12 @@ class RunLog:
         A file that cannot be created is a :class:`LogWriteError` (one line)."""
         p = Path(path)
         meta = run_metadata(description, wing_variant, overrides)
+        if build is not None:  # what each η_i does at the tip: how `plot` draws the modes
+            import json
+
+            from bioflex_jsb.simulation.channels import mode_tips
+
+            meta["mode_tips"] = json.dumps(mode_tips(build.modes))
         try:
             stream = open(p, "wb")  # noqa: SIM115 - closed in close()
         except OSError as exc:

@@ -228,7 +228,8 @@ def draw_mode_sheet(path: str | Path, build, speed_m_s: float,
     y = shape.stations_m
     cols = max(sum(s.kind == "structural" for s in shapes),
                sum(s.kind == "aeroelastic" for s in shapes))
-    fig, axes = plt.subplots(2, cols, figsize=(3.9 * cols, 6.4), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(2, cols, figsize=(4.6 * cols, 7.0), sharex=True, squeeze=False)
+    legend: dict[str, object] = {}
     for row, kind in enumerate(("structural", "aeroelastic")):
         mine = [s for s in shapes if s.kind == kind]
         for c in range(cols):
@@ -239,31 +240,36 @@ def draw_mode_sheet(path: str | Path, build, speed_m_s: float,
             s = mine[c]
             twist = s.eta @ shape.twist_rad
             heave_mm = -1e3 * (s.eta @ shape.bending_m)
-            ax.plot(y, twist.real, color="C0", lw=1.8, label="twist θ (real)")
+            legend.setdefault("twist", ax.plot(y, twist.real, color="C0", lw=1.8,
+                                               label="twist θ, real part (leading edge up +)"
+                                               )[0])
             if np.abs(twist.imag).max() > 1e-3:
-                ax.plot(y, twist.imag, color="C0", lw=1.2, ls=":", label="twist θ (imag.)")
+                legend.setdefault("twist_imag", ax.plot(
+                    y, twist.imag, color="C0", lw=1.2, ls=":",
+                    label="twist θ, imaginary part (a quarter period behind)")[0])
             ax.axhline(0.0, color="0.6", lw=0.6)
             ax.set_ylim(-1.15, 1.15)
-            ax.set_ylabel("twist per unit amplitude [rad]" if c == 0 else "")
+            ax.set_ylabel("twist θ [rad]", color="C0")  # every panel: each its own pair
+            ax.tick_params(axis="y", colors="C0")
             bx = ax.twinx()
-            bx.plot(y, heave_mm.real, color="C3", lw=1.5, ls="--", label="bending w, up")
+            legend.setdefault("bending", bx.plot(y, heave_mm.real, color="C3", lw=1.5,
+                                                 ls="--", label="bending w, real part (up +)"
+                                                 )[0])
             lim = max(1e-3, 1.15 * np.abs(heave_mm).max())
             bx.set_ylim(-lim, lim)
-            bx.set_ylabel("bending up per unit amplitude [mm]" if c == cols - 1 else "",
-                          color="C3")
+            bx.set_ylabel("bending w [mm]", color="C3")  # its scale differs per mode
             bx.tick_params(axis="y", colors="C3")
             title = s.label(speed_m_s).replace(": ", ":\n", 1)
             ax.set_title(title, fontsize=9)
             if row == 1:
                 ax.set_xlabel("spanwise station y [m]")
-            if row == 0 and c == 0:
-                lines = ax.get_lines()[:1] + bx.get_lines()
-                ax.legend(lines, [ln.get_label() for ln in lines], fontsize=8,
-                          loc="lower left")
     fig.suptitle(f"Mode shapes of the {build.variant.name} wing (starboard half, root "
-                 f"clamped; positive twist leading edge up); aeroelastic modes of the coupled "
+                 f"clamped), per unit modal amplitude; aeroelastic modes of the coupled "
                  f"model at {speed_m_s:g} m/s", fontsize=10)
-    fig.tight_layout()
+    fig.legend(list(legend.values()), [h.get_label() for h in legend.values()],
+               loc="upper center", bbox_to_anchor=(0.5, 0.965), ncol=len(legend), fontsize=8,
+               frameon=False)
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.945))
     out = Path(path)
     fig.savefig(out, dpi=150, metadata={"Software": software} if software else None)
     plt.close(fig)
