@@ -14,7 +14,12 @@ finish, so ``--resume`` completes an interrupted run), then draws three maps ove
 * the peak |Δn_z| [-] of the nonlinear JSBSim gust run; hatched where the run diverged
   (the wing past its divergence / flutter speed), with the flutter speed [m/s] written in.
 
-The paper's original (0.50, 0.50) and optimised (0.25, 0.22) axes are marked. The table
+Every cell is the strip model's own wing (unpinned), the only coefficient defined across
+the grid. The paper's original (0.50, 0.50) and optimised (0.25, 0.22) axes are marked; as
+named wings (``--wing original``, ``flutter``, ``gust``) they fly with C_η1^Q1 pinned to the
+published value, so the figure says, beside each mark, the pinned value and the flutter
+speed of the wing so pinned, next to the same axes unpinned (the original's strip value
++0.19 is unstable from 12 m/s; pinned to the paper's −0.03 it is stable to 40 m/s). The table
 also prints, best first, the wings that neither diverge nor flutter within the campaign's
 range.
 """
@@ -49,7 +54,52 @@ def grid(rows, key):
     return xe, xi, z
 
 
-def plot(rows, path: Path, title: str) -> None:
+def named_wings(flutter_range_m_s) -> dict[str, dict]:
+    """The paper's two wings as the named variants fly them (C_η1^Q1 pinned to the published
+    value): axis positions, pinned C_η1^Q1 [-] and the coupled LTI model's flutter or
+    divergence speed [m/s] in ``flutter_range_m_s`` (None: none there), by the campaign's
+    own flutter search (sweep/evaluate.py)."""
+    from bioflex_jsb.flight_dynamics.eigen import find_flutter
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.sweep.campaign import axis_variant
+
+    out = {}
+    for name, (x_i, x_e) in MARKS.items():
+        variant = VARIANTS[name]
+        f = find_flutter(build_wing(variant).model, flutter_range_m_s)
+        # the same axes unpinned, as the map's cells are (the marks fall between cells)
+        free = build_wing(axis_variant(x_i, x_e)).model
+        g = find_flutter(free, flutter_range_m_s)
+        out[name] = {"x_inertial_frac": x_i, "x_elastic_frac": x_e,
+                     "pinned_c_eta1_q1": variant.pinned_c_eta1_q1,
+                     "flutter_speed_m_s": f.flutter_speed_m_s, "kind": f.kind,
+                     "unpinned_c_eta1_q1": float(free.coefficients.c_eta_q[0, 0]),
+                     "unpinned_flutter_speed_m_s": g.flutter_speed_m_s, "unpinned_kind": g.kind,
+                     "range_m_s": tuple(flutter_range_m_s)}
+    return out
+
+
+def _mark_text(name: str, named: dict | None) -> str:
+    """The label beside a paper's wing: its cell (unpinned) and the named wing (pinned)."""
+    if not named or name not in named:
+        return f"{name} (Table 8)"
+    w = named[name]
+
+    def status(speed, kind) -> str:
+        if speed is None:
+            return f"stable to {w['range_m_s'][1]:g} m/s"
+        return f"{kind} at {speed:.0f} m/s"
+
+    return (f"{name} (Table 8)\n"
+            f"unpinned, as mapped: C = {w['unpinned_c_eta1_q1']:+.2f}, "
+            f"{status(w['unpinned_flutter_speed_m_s'], w['unpinned_kind'])}\n"
+            f"--wing {name}, pinned: C = {w['pinned_c_eta1_q1']:+.2f}, "
+            f"{status(w['flutter_speed_m_s'], w['kind'])}")
+
+
+def plot(rows, path: Path, title: str, named: dict | None = None) -> None:
+    """The three maps of ``rows`` to ``path``; ``named``: :func:`named_wings`, for the marks'
+    labels (without it the marks say only their name)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -57,7 +107,7 @@ def plot(rows, path: Path, title: str) -> None:
     import numpy as np
 
     panels = [
-        ("c_eta1_q1", "C_η1^Q1 (physical) [-]", "RdBu_r"),
+        ("c_eta1_q1", "C_η1^Q1 (strip model, unpinned) [-]", "RdBu_r"),
         ("short_period_damping", "short-period damping ζ [-]", "viridis"),
         ("peak_dn_z", "peak |Δn_z| of the gust run [-]", "magma_r"),
     ]
@@ -100,13 +150,24 @@ def plot(rows, path: Path, title: str) -> None:
                 ax.text(x, y, r["status"] if fs is None else f"{fs:.0f} m/s", ha="center",
                         va="center", fontsize=7, color="0.2")
         for name, (x_i, x_e) in MARKS.items():
-            ax.plot(x_e, x_i, "o", mfc="none", mec="k")
-            ax.annotate(name, (x_e, x_i), textcoords="offset points", xytext=(5, 5),
-                        fontsize=8)
+            ax.plot(x_e, x_i, "o", mfc="white", mec="k", ms=8, mew=1.5, zorder=5)
+            # on a light box: the maps run from white to black under a mark
+            ax.annotate(name, (x_e, x_i), textcoords="offset points", xytext=(7, 7),
+                        fontsize=8,
+                        zorder=6, va="bottom",
+                        ha="right" if x_e > 0.5 * (xe[0] + xe[-1]) else "left",
+                        bbox=dict(boxstyle="round,pad=0.25", facecolor="white", alpha=0.9,
+                                  edgecolor="0.5", lw=0.5))
         ax.set_xlabel("elastic axis x_E [fraction of chord]")
         ax.set_ylabel("inertial axis x_I [fraction of chord]")
         ax.set_title(label.split(" [")[0])
-        if key != "c_eta1_q1":
+        if key == "c_eta1_q1":  # which C_η1^Q1: the map's (unpinned) and the named wings'
+            ax.legend(handles=[plt.Line2D([], [], ls="none", marker="o", mfc="white", mec="k")
+                               for _ in MARKS],
+                      labels=[_mark_text(name, named) for name in MARKS],
+                      loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8,
+                      frameon=False, ncol=1)
+        else:
             what = ("gust run diverged (status or LTI flutter speed written)"
                     if key == "peak_dn_z" else
                     "LTI model unstable at this speed (its flutter speed written)")
@@ -116,7 +177,8 @@ def plot(rows, path: Path, title: str) -> None:
                                           label="paper's wings (Table 8)")],
                       loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8,
                       frameon=False, ncol=1)
-    fig.suptitle(title)
+    fig.suptitle(f"{title}; every cell the strip model's wing, C_η1^Q1 unpinned (the named "
+                 "wings pin it to the paper's value: left map)")
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -148,8 +210,9 @@ def main(argv: list[str] | None = None) -> int:
     wanted = {c.case_id for c in cases}
     rows = [r for r in read_results(args.out) if r["case_id"] in wanted]
     speed = campaign.speeds_m_s[0]
+    named = named_wings(cases[0].settings.flutter_range_m_s or (5.0, 40.0))
     plot(rows, Path(args.plot), f"{campaign.name}: {speed:g} m/s, gust {campaign.gusts[0]}, "
-         f"{campaign.models[0]} model")
+         f"{campaign.models[0]} model", named)
     print(f"{len(rows)} wings ({summary.run} run now) -> {args.out}; maps -> {args.plot}")
     print(f"{'x_I':>5} {'x_E':>5} {'C_η1^Q1':>8} {'ζ_sp':>6} {'|Δn_z|':>7} {'V_f [m/s]':>9}  "
           "status")
@@ -158,6 +221,8 @@ def main(argv: list[str] | None = None) -> int:
         stable = r["status"] == "ok" and r["flutter_speed_m_s"] is None
         return (not stable, r["peak_dn_z"] if r["peak_dn_z"] is not None else math.inf)
 
+    for name in named:
+        print(" | ".join(_mark_text(name, named).splitlines()))
     for r in sorted(rows, key=key):
         vf = "-" if r["flutter_speed_m_s"] is None else f"{r['flutter_speed_m_s']:.1f}"
         dn = "-" if r["peak_dn_z"] is None else f"{r['peak_dn_z']:.3f}"
