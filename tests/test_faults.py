@@ -190,6 +190,10 @@ def test_default_log_names_are_created_exclusively(tmp_path, monkeypatch):
         "gust-optimised-20260101T000000Z.mcap", "gust-optimised-20260101T000000Z-2.mcap",
         "gust-optimised-20260101T000000Z-3.mcap"]
     assert all(Path(n).is_file() and Path(n).stat().st_size == 0 for n in names)  # reserved
+    # an aircraft's wing name has a colon: no default name carries one (Windows refuses it,
+    # scp reads it as a host), nor any other character Windows refuses
+    name = Path(log_path(args, "gust", 'aircraft:sgs_elastic<>"|?*')).name
+    assert name == "gust-aircraft_sgs_elastic______-20260101T000000Z.mcap", name
 
 
 def test_existing_out_is_refused_unless_force(tmp_path, capsys):

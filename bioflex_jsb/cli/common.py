@@ -494,13 +494,18 @@ def log_path(args: argparse.Namespace, command: str, wing: str) -> str | None:
 MAX_LOG_NAME_WING_CHARS = 64
 
 
+# characters no default file name carries: path separators, and what Windows refuses in a
+# file name (a colon also reads as a host to scp and rsync: aircraft:sgs_elastic)
+NOT_IN_FILE_NAMES = '/\\<>:"|?*'
+
+
 def _name_part(text: str) -> str:
-    """``text`` fit for a default file name: refused characters (a newline, ...) and path
-    separators replaced by ``_``, cut to :data:`MAX_LOG_NAME_WING_CHARS`."""
+    """``text`` fit for a default file name: refused characters (a newline, ...) and
+    :data:`NOT_IN_FILE_NAMES` replaced by ``_``, cut to :data:`MAX_LOG_NAME_WING_CHARS`."""
     import unicodedata
 
-    safe = "".join("_" if unicodedata.category(c) in REFUSED_NAME_CATEGORIES or c in "/\\"
-                   else c for c in text)
+    safe = "".join("_" if unicodedata.category(c) in REFUSED_NAME_CATEGORIES
+                   or c in NOT_IN_FILE_NAMES else c for c in text)
     return safe[:MAX_LOG_NAME_WING_CHARS] or "wing"
 
 
