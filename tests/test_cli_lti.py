@@ -70,6 +70,15 @@ def test_export_npz_keeps_names_and_matrices(capsys, tmp_path):
     assert list(d["outputs"][-2:]) == ["n_z", "tip_twist"]
 
 
+def test_export_of_the_rigid_model_announces_the_outputs_it_has(capsys, tmp_path):
+    path = tmp_path / "rigid.npz"
+    code, out, _ = run_cli(capsys, "export", "--model", "rigid", "--out", str(path))
+    assert code == 0
+    outputs = list(np.load(path)["outputs"])
+    assert "tip_twist" not in outputs  # no wing to twist
+    assert f"outputs: {', '.join(outputs)})" in out and "tip_twist" not in out, out
+
+
 @pytest.mark.parametrize(
     "argv, needle",
     [

@@ -27,7 +27,8 @@ alpha [rad], q [rad/s], theta [rad], eta_i [rad], eta_i_dot [rad/s] (QSD: the fo
 states). Inputs: w_g [m/s] (vertical gust, up), elevator [rad] (+ trailing edge down) and
 throttle [-] (fraction of the motor's maximum shaft power). Outputs: the states (QSD: and
 its quasi-static eta_i [rad]), n_z [-] (load-factor perturbation, up; q is the pitch rate)
-and tip_twist [rad] (wing tip section twist, leading edge up). The file's "metadata" entry
+and, for the coupled and QSD models, tip_twist [rad] (wing tip section twist, leading edge
+up; the rigid model has no wing to twist). The file's "metadata" entry
 (JSON text) records the wing, speed, mass basis, aerodynamic model and overrides. Read it
 back in Python with bioflex_jsb.sinks.model_export.read_state_space(path), or as a
 python-control StateSpace with to_python_control(path) (pip install ".[control]").
@@ -94,7 +95,5 @@ def run(args: argparse.Namespace) -> int:
         print(f"{ss.model} model of wing {build.variant.name} at {ss.speed_m_s:g} m/s "
               f"(mass basis {build.mass_basis}; {len(ss.states)} states; inputs "
               f"{', '.join(f'{n} [{u}]' for n, u in zip(ss.inputs, ss.input_units, strict=True))};"
-              f" {len(ss.outputs)} outputs incl. "
-              f"{', '.join(o for o in ('n_z', 'tip_twist') if o in ss.outputs)}) written to "
-              f"{args.out}")
+              f" {len(ss.outputs)} outputs: {', '.join(ss.outputs)}) written to {args.out}")
     return 0
