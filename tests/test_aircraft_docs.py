@@ -32,5 +32,5 @@ def test_worked_example_runs_verbatim(tmp_path, monkeypatch, capsys):
             assert argv[0] == "bioflex-jsb"
             assert main(argv[1:]) == 0, line
     out = capsys.readouterr().out
-    assert "flutter at 32.5 m/s, mode mode 3 (torsion), frequency 22.37 rad/s" in out
+    assert "flutter at 32.5 m/s, mode 3 (torsion), frequency 22.37 rad/s" in out
     assert "static divergence at 37.2 m/s" in out

@@ -369,14 +369,16 @@ def text_report(p: dict) -> str:
         # beside the number: what a quasi-steady single-mode result is
         tag = " [quasi-steady artefact: see the caveat]" if p.get("quasi_steady_artefact") \
             else ""
-        what = (f"{p['kind']}{tag}, mode {p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, "
+        # a clamped wing's label is "mode 3 (torsion)", a free aircraft's "aeroelastic_3"
+        mode = p["mode"] if str(p["mode"]).startswith("mode ") else f"mode {p['mode']}"
+        what = (f"{p['kind']}{tag}, {mode}, frequency {p['frequency_rad_s']:.2f} rad/s, "
                 f"k = {p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
         if p["present_at_lower_end"]:
             lines.append(f"  unstable at and below {lo:g} m/s (already at the range's lower "
                          f"end; lower LOW to find the onset): {what}")
         else:
-            lines.append(f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s{tag}, mode "
-                         f"{p['mode']}, frequency {p['frequency_rad_s']:.2f} rad/s, k = "
+            lines.append(f"  {p['kind']} at {p['flutter_speed_m_s']:.1f} m/s{tag}, "
+                         f"{mode}, frequency {p['frequency_rad_s']:.2f} rad/s, k = "
                          f"{p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
         if p.get("caveat"):
             lines.append(f"  caveat: {p['caveat']}")
