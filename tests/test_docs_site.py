@@ -129,3 +129,52 @@ def test_every_page_and_tutorial_in_docs_is_in_the_navigation():
     pages = {p.relative_to(REPO / "docs").as_posix() for p in (REPO / "docs").rglob("*")
              if p.suffix in (".md", ".ipynb") and ".ipynb_checkpoints" not in p.parts}
     assert pages <= listed, f"docs pages missing from mkdocs.yml nav: {sorted(pages - listed)}"
+
+
+def test_the_tutorials_leave_only_ignored_files(executed_docs):
+    """What building the site writes beside the notebooks (their figures, logs, the wing
+    files of own_wing.ipynb) is ignored by git: a build leaves the working tree clean."""
+    made = sorted(p.relative_to(executed_docs["docs"]).as_posix()
+                  for p in (executed_docs["docs"] / "tutorials").iterdir()
+                  if not (REPO / "docs" / p.relative_to(executed_docs["docs"])).exists())
+    assert made, "the tutorials wrote nothing: this test checks nothing"
+    proc = subprocess.run(["git", "check-ignore", "--no-index", *[f"docs/{m}" for m in made]],
+                          cwd=REPO, capture_output=True, text=True)
+    ignored = set(proc.stdout.split())
+    assert not [m for m in made if f"docs/{m}" not in ignored], (made, proc.stdout)
+
+
+def test_no_cell_shows_a_stray_return_value(executed_docs):
+    """A cell's last expression is shown: a file write's byte count (own_wing's 584) is
+    noise on the page."""
+    import nbformat
+
+    stray = []
+    for name in TUTORIALS:
+        nb = nbformat.read(executed_docs["docs"] / "tutorials" / name, as_version=4)
+        for i, cell in enumerate(nb.cells):
+            for out in cell.get("outputs", []):
+                text = out.get("data", {}).get("text/plain", "")
+                if out.get("output_type") == "execute_result" and text.strip().isdigit():
+                    stray.append((name, i, text))
+    assert not stray, stray
+
+
+def test_figures_fill_the_page_and_enlarge_on_a_click(site):
+    page = (site / "tutorials" / "figures" / "index.html").read_text(encoding="utf-8")
+    images = page.count("<img")
+    assert images >= 8 and page.count('class="glightbox"') >= images - 1  # the logo: not
+    assert "stylesheets/extra.css" in page
+    css = (site / "stylesheets" / "extra.css").read_text(encoding="utf-8")
+    assert "white-space: pre-wrap" in css and "max-width: 90rem" in css
+    # the commands' JSON is not on the page: figures and their captions are
+    assert '"peak_du_m_s"' not in page and page.count("<strong>Figure ") >= 8
+
+
+def test_the_front_page_links_to_the_tutorials_and_pages(site):
+    index = (site / "index.html").read_text(encoding="utf-8")
+    for target in ("tutorials/fig21_gust/", "tutorials/own_wing/", "tutorials/sitl_mission/",
+                   "tutorials/figures/", "api/", "conventions/", "loads/"):
+        assert f'href="{target}"' in index, target
+    # a page named as code (`docs/logging.md`) is a link to it
+    assert '<a href="logging/"><code>docs/logging.md</code></a>' in index
