@@ -490,8 +490,8 @@ def test_second_sender_interleaving_frames_causes_no_reset_and_no_step(bound):
     assert not second.pending()
     # reported: the first one, then at 10 and 100 (not 120 lines)
     warnings = [t for lvl, t in events if lvl == "WARNING"]
-    assert len(warnings) == 3 and "10 servo packets" in warnings[1] \
-        and "100 servo packets" in warnings[2]
+    assert len(warnings) == 3 and "10 packets" in warnings[1] \
+        and "100 packets" in warnings[2]
     assert server.peer == ap.source
 
 
