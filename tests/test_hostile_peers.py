@@ -19,10 +19,13 @@ limits.
 from __future__ import annotations
 
 import socket
+import time
 
 import pytest
+from pymavlink.dialects.v20 import common as M
 
 from bioflex_jsb.links import ardupilot_json as aj
+from bioflex_jsb.links import mavlink as ml
 from tests.ardupilot_standin import ArduPilotStandin
 from tests.test_ardupilot_json import DT_S, FakeClock, LevelTurn, _pwm
 
@@ -211,3 +214,240 @@ def test_the_receive_buffer_is_enlarged_within_the_kernels_limit(server):
         pytest.skip("no /proc/sys/net/core/rmem_max here")
     # Linux reports twice what it grants (its bookkeeping); root may exceed rmem_max
     assert granted >= min(aj.RECV_BUFFER_BYTES, rmem_max)
+
+
+# ------------------------------------------------------------------------------- MAVLink
+class Params:
+    names = ("A",)
+
+    def get(self, name: str) -> float:
+        return 1.0
+
+    def set(self, name: str, value: float) -> float:
+        return 1.0
+
+
+def _mav(system: int = 255):
+    return M.MAVLink(None, srcSystem=system, srcComponent=190)
+
+
+def _heartbeat(system: int = 255) -> bytes:
+    mav = _mav(system)
+    return mav.heartbeat_encode(M.MAV_TYPE_GCS, M.MAV_AUTOPILOT_INVALID, 0, 0, 0).pack(mav)
+
+
+class Station:
+    """A UDP socket speaking MAVLink to the link (a ground station, a squatter, a flood)."""
+
+    def __init__(self, target, system: int = 255) -> None:
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.setblocking(False)
+        self.target = target
+        self.system = system
+        self.parser = M.MAVLink(None)
+        self.parser.robust_parsing = True
+
+    @property
+    def addr(self):
+        return self.sock.getsockname()
+
+    def send(self, data: bytes) -> None:
+        self.sock.sendto(data, self.target)
+
+    def beat(self) -> None:
+        self.send(_heartbeat(self.system))
+
+    def received(self) -> list:
+        out = []
+        while True:
+            try:
+                data = self.sock.recv(65536)
+            except BlockingIOError:
+                return out
+            out += [m for m in (self.parser.parse_buffer(data) or [])
+                    if m.get_type() != "BAD_DATA"]
+
+    def close(self) -> None:
+        self.sock.close()
+
+
+@pytest.fixture
+def udpin():
+    link = ml.MavlinkLink("udpin:127.0.0.1:0", Params())
+    made: list[Station] = []
+
+    def station(system: int = 255) -> Station:
+        s = Station(link.local_address, system)
+        made.append(s)
+        return s
+
+    yield link, station
+    for s in made:
+        s.close()
+    link.close()
+
+
+def _queued_bytes(port: int) -> int | None:
+    """The receive queue of the UDP socket on ``port`` [bytes] (/proc/net/udp), or None."""
+    try:
+        with open("/proc/net/udp") as fh:
+            lines = fh.readlines()[1:]
+    except OSError:
+        return None
+    for line in lines:
+        f = line.split()
+        if int(f[1].rsplit(":", 1)[1], 16) == port:
+            return int(f[4].split(":")[1], 16)
+    return None
+
+
+def _settle(link) -> None:
+    """Wait until what was sent to the link is in its socket's queue: loopback delivers it
+    within the send, unless the kernel defers its network work to ksoftirqd on a busy
+    machine; the queue's size unchanged over three looks 10 ms apart (a failure limit of
+    5 s, not a measurement)."""
+    port = link.local_address[1]
+    seen, same = None, 0
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline and same < 3:
+        now = _queued_bytes(port)
+        if now is None:
+            return
+        same = same + 1 if now == seen and now > 0 else 0
+        seen = now
+        time.sleep(0.01)
+
+
+def test_a_flood_from_another_port_is_drained_and_the_station_answered_in_one_call(udpin):
+    link, station = udpin
+    state = ml.VehicleState()
+    gs = station()
+    gs.beat()
+    link.service(state, now_s=100.0)
+    assert link.peer_count == 1
+    flood = station(250)
+    junk = bytes([0xFD, 9, 0, 0, 7, 250, 190, 0, 0, 0]) + bytes(range(11))
+    for _ in range(100):
+        flood.send(junk)
+    mav = _mav()
+    gs.send(mav.param_request_read_encode(1, 1, b"A", -1).pack(mav))
+    for _ in range(100):
+        flood.send(_heartbeat(250))
+    _settle(link)
+    before = link.stats.datagrams
+    link.service(state, now_s=100.01)
+    assert link.stats.datagrams - before == 201  # drained in one call (bounded: MAX_DRAIN)
+    assert 201 <= ml.MAX_DRAIN
+    assert any(m.get_type() == "PARAM_VALUE" for m in gs.received())
+    # the flood's source: its first few of the call parsed, the rest dropped unread
+    assert link.stats.unknown_dropped >= 200 - ml.NEW_SOURCE_DATAGRAMS_PER_CALL
+    assert link.peer_count <= 2
+
+
+def test_each_service_call_reads_at_most_max_drain_datagrams(udpin):
+    link, station = udpin
+    state = ml.VehicleState()
+    flood = station(250)
+    n = ml.MAX_DRAIN + 40
+    for _ in range(n):
+        flood.send(b"\x00" * 30)
+    _settle(link)
+    link.service(state, now_s=10.0)
+    assert link.stats.datagrams == ml.MAX_DRAIN
+    link.service(state, now_s=10.005)
+    assert link.stats.datagrams == n
+
+
+def test_peers_are_kept_while_the_link_is_flooded_and_expire_after(udpin):
+    """While service calls find a full batch waiting (the kernel may be dropping datagrams,
+    the station's among them), a silent peer is not forgotten; once the flood is over it
+    expires after PEER_TIMEOUT_S of silence as usual."""
+    link, station = udpin
+    state = ml.VehicleState()
+    gs = station()
+    gs.beat()
+    t = 50.0
+    link.service(state, now_s=t)
+    flood = station(250)
+    for _ in range(int(2 * ml.PEER_TIMEOUT_S) + 2):  # 12 s of a flood, 1 s apart
+        t += 1.0
+        for _ in range(ml.MAX_DRAIN):
+            flood.send(b"\x00" * 30)
+        _settle(link)
+        link.service(state, now_s=t)
+        assert link.peer_count == 1 and link.stats.peers_expired == 0, t
+    link.service(state, now_s=t + 0.5)  # the flood stopped
+    assert link.peer_count == 1
+    link.service(state, now_s=t + ml.PEER_TIMEOUT_S + 1.0)
+    assert link.peer_count == 0 and link.stats.peers_expired == 1
+
+
+def test_four_squatters_do_not_lock_out_a_new_ground_station(udpin):
+    """Four sockets sending a heartbeat every 2 s hold all MAX_PEERS slots; a ground station
+    that then sends its heartbeat every second is told at once that no slot is free, takes
+    the slot of the quietest squatter as soon as it has been heard more (within PRESENCE_S),
+    the eviction is said (STATUSTEXT to the peers), and it keeps the slot while the squatters
+    go on, the evicted one included."""
+    link, station = udpin
+    state = ml.VehicleState()
+    squatters = [station(200 + i) for i in range(ml.MAX_PEERS)]
+    t = 10.0
+
+    def second(k: int, gs=None) -> None:
+        nonlocal t
+        for i, s in enumerate(squatters):
+            if (k + i) % 2 == 0:
+                s.beat()
+        if gs is not None:
+            gs.beat()
+        link.service(state, now_s=t)
+        t += 1.0
+
+    for k in range(10):
+        second(k)
+    assert link.peer_count == ml.MAX_PEERS
+    gs = station()
+    joined_after = None
+    for k in range(10, 10 + ml.PRESENCE_S):
+        second(k, gs)
+        if gs.addr in link.peer_addresses:
+            joined_after = k - 9
+            break
+    assert joined_after is not None and joined_after <= ml.PRESENCE_S
+    assert link.stats.peers_evicted == 1 and link.peer_count == ml.MAX_PEERS
+    first = [m for m in gs.received() if m.get_type() == "STATUSTEXT"]
+    if joined_after > 1:  # it waited: told once, at its first heartbeat
+        assert "no ground-station slot" in first[0].text
+    evicted = [s for s in squatters if s.addr not in link.peer_addresses]
+    assert len(evicted) == 1
+    texts = [m.text for s in squatters for m in s.received() if m.get_type() == "STATUSTEXT"]
+    assert any(str(evicted[0].addr[1]) in x and "slot" in x for x in texts), texts
+    for k in range(20, 40):  # the squatters go on (the evicted one too); 20 s
+        second(k, gs)
+        assert gs.addr in link.peer_addresses, k
+    assert sum(m.get_type() == "HEARTBEAT" for m in gs.received()) >= 15
+
+
+def test_a_new_station_is_told_when_no_slot_can_be_freed(udpin):
+    """With every slot held by a peer that has sent more than the newcomer could have (a
+    peer is evicted only when it is the quietest and the newcomer is not quieter), the
+    newcomer is told in one STATUSTEXT, once per PEER_TIMEOUT_S, and the session notes it."""
+    link, station = udpin
+    state = ml.VehicleState()
+    busy = [station(200 + i) for i in range(ml.MAX_PEERS)]
+    t = 5.0
+    for _ in range(6):
+        for s in busy:
+            for _ in range(5):
+                s.beat()
+        link.service(state, now_s=t)
+        t += 0.2
+    gs = station()
+    for _ in range(3):
+        gs.beat()
+        link.service(state, now_s=t)
+        t += 0.1
+    texts = [m.text for m in gs.received() if m.get_type() == "STATUSTEXT"]
+    assert len(texts) == 1 and "no ground-station slot" in texts[0]
+    assert gs.addr not in link.peer_addresses and link.stats.peers_refused >= 1

@@ -15,7 +15,7 @@ from pymavlink.dialects.v20 import common as M
 
 from bioflex_jsb.drivers.sitl import SitlParameters
 from bioflex_jsb.links import mavlink_modes as MODES
-from bioflex_jsb.links.mavlink import MavlinkLink, _Peer
+from bioflex_jsb.links.mavlink import MavlinkLink, Peer
 from bioflex_jsb.simulation import guidance as G
 from tests.test_sitl import build, make_sim  # noqa: F401  (the module's wing fixture)
 
@@ -39,7 +39,7 @@ class Bench:
         self.link._send = self.out.append  # everything the vehicle sends, unpacked
         self.link.mission._send = self.out.append
         self.gcs = M.MAVLink(None, srcSystem=255, srcComponent=190)
-        self.peer = _Peer(("127.0.0.1", 9), self.link._new_parser())
+        self.peer = Peer(("127.0.0.1", 9), self.link._new_parser())
         self.events: list[tuple[float, int, str]] = []
         sim.vehicle.on_status = lambda t, sev, text: self.events.append((t, sev, text))
 

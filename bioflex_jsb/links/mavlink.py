@@ -15,12 +15,11 @@ HOST is an IPv4 address or ``localhost``; omitted (``udpin:14550``, ``udpout::14
 127.0.0.1: the link binds and sends to loopback only unless another address is given
 explicitly.
 
-Safety of the loop: every socket is non-blocking; :meth:`MavlinkLink.service` reads at most
-:data:`MAX_DATAGRAMS` datagrams and parses at most :data:`MAX_PARSE_BYTES` bytes per call
-(a flood is dropped by the kernel, not queued in the simulation); malformed or truncated
-input is skipped by the parser (robust parsing, CRC checked); a peer that is absent or gone
-never blocks (sends that would block are dropped; a TCP client whose backlog exceeds
-:data:`MAX_TCP_BACKLOG` is disconnected).
+Safety of the loop: every socket is non-blocking; malformed or truncated input is skipped
+by the parser (robust parsing, CRC checked); a peer that is absent or gone never blocks
+(sends that would block are dropped; a TCP client whose backlog exceeds
+:data:`MAX_TCP_BACKLOG` is disconnected). Floods from other local ports and the ``udpin``
+slots: :mod:`bioflex_jsb.links.mavlink_peers`.
 
 Units: :class:`VehicleState` is SI (rad, m, m/s); conversion to MAVLink's integer units
 (degE7, mm, cm/s, cdeg) happens here only.
@@ -67,12 +66,27 @@ import socket
 import struct
 import time
 from collections import deque
-from dataclasses import dataclass, field
 
 from pymavlink.dialects.v20 import common as mavlink
 
 from bioflex_jsb.links.mavlink_commands import CommandHandler
 from bioflex_jsb.links.mavlink_mission import MissionProtocol
+from bioflex_jsb.links.mavlink_peers import (  # noqa: F401  (the link's peers and floods)
+    DRAIN_RATE_PER_S,
+    MAX_CANDIDATES,
+    MAX_DRAIN,
+    MAX_PARSE_BYTES,
+    MAX_PEERS,
+    MIN_DRAIN,
+    NEW_SOURCE_DATAGRAMS_PER_CALL,
+    NEW_SOURCES_PER_CALL,
+    PEER_DATAGRAMS_PER_CALL,
+    PRESENCE_S,
+    RECV_BUFFER_BYTES,
+    LinkStats,
+    Peer,
+    Slots,
+)
 from bioflex_jsb.links.mavlink_setup import (  # noqa: F401  (the link's set-up and state)
     SIGNING_EPOCH_UNIX_S,
     SIGNING_KEY_BYTES,
@@ -100,10 +114,7 @@ _CODEC_ERRORS = (mavlink.MAVError, struct.error, ValueError, IndexError, KeyErro
 
 SYSTEM_ID = 1
 COMPONENT_ID = 1
-MAX_PEERS = 4
 PEER_TIMEOUT_S = 5.0  # a udpin peer silent this long [wall s] is dropped
-MAX_DATAGRAMS = 16  # datagrams read per service call
-MAX_PARSE_BYTES = 4096  # bytes handed to the parser per service call
 MAX_TCP_BACKLOG = 256 * 1024  # unsent bytes to one TCP client before it is dropped
 PARAMS_PER_SERVICE = 8  # PARAM_VALUE messages of a list request sent per service call
 STATUSTEXTS_PER_SERVICE = 4
@@ -144,31 +155,6 @@ class _Parser(mavlink.MAVLink):
         return True
 
 
-@dataclass
-class LinkStats:
-    received: int = 0  # valid MAVLink messages
-    bad: int = 0  # bad-CRC / unparseable chunks
-    datagrams: int = 0
-    bytes_dropped: int = 0  # read but not parsed (over the per-call budget)
-    rejected_signature: int = 0  # unsigned, wrongly signed or replayed (signing on)
-    sent: int = 0
-    send_dropped: int = 0
-    peers_expired: int = 0
-    by_type: dict[str, int] = field(default_factory=dict)  # bounded: MAVLink's message names
-
-
-class _Peer:
-    """One conversation: its own parser (stream state), and for TCP its socket."""
-
-    def __init__(self, addr, parser: mavlink.MAVLink, sock: socket.socket | None = None) -> None:
-        self.addr = addr
-        self.sock = sock
-        self.parser = parser
-        self.backlog = bytearray()
-        self.last_seen = time.monotonic()
-        self.fixed = False  # udpout's one destination: never expires
-
-
 class MavlinkLink:
     """The vehicle's MAVLink link (module docstring). Call :meth:`service` from the loop.
 
@@ -197,7 +183,11 @@ class MavlinkLink:
         self.intervals_s = {mid: 1.0 / hz for mid, hz in DEFAULT_RATES_HZ.items()}
         self._next_due: dict[int, float] = {}
         self._param_queue: deque[int] = deque()
-        self._peers: list[_Peer] = []
+        self.slots = Slots(self.stats, self._notice, self._tell, self._send_pending_notices,
+                           self._drop)
+        self._peers = self.slots.peers  # the same list
+        self._now = time.monotonic()  # the wall time of the service call in progress [s]
+        self._last_service_s: float | None = None
         self._listener: socket.socket | None = None
         self._udp: socket.socket | None = None
         self.sticks = Sticks(self, vehicle)
@@ -230,10 +220,15 @@ class MavlinkLink:
                 finally:
                     probe.close()
                 s.bind((local, 0))
-                peer = _Peer((ep.host, ep.port), self._new_parser())
+                peer = Peer((ep.host, ep.port), self._new_parser())
                 peer.fixed = True
                 self._peers.append(peer)
             s.setblocking(False)
+            try:  # a flood between two calls waits (module docstring: Floods)
+                s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RECV_BUFFER_BYTES)
+            except OSError:  # a system that refuses the size keeps its default
+                pass
+            self.stats.recv_buffer_bytes = s.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
             self._udp = s
         except OSError as exc:
             verb = "send to" if ep.kind == "udpout" else "listen on"
@@ -259,6 +254,11 @@ class MavlinkLink:
     @property
     def peer_count(self) -> int:
         return len(self._peers)
+
+    @property
+    def peer_addresses(self) -> list:
+        """The peers' addresses ((host, port)), oldest first."""
+        return [p.addr for p in self._peers]
 
     def close(self) -> None:
         for p in self._peers:
@@ -288,7 +288,7 @@ class MavlinkLink:
             p.backlog += data
             self._flush_tcp(p)
 
-    def _flush_tcp(self, p: _Peer) -> None:
+    def _flush_tcp(self, p: Peer) -> None:
         try:
             while p.backlog:
                 n = p.sock.send(p.backlog)
@@ -301,25 +301,29 @@ class MavlinkLink:
         if len(p.backlog) > MAX_TCP_BACKLOG:
             self._drop(p)
 
-    def _drop(self, p: _Peer) -> None:
+    def _drop(self, p: Peer) -> None:
         if p in self._peers:
             self._peers.remove(p)
         if p.sock is not None:
             p.sock.close()
 
     def _expire_peers(self, now: float) -> None:
-        if self.endpoint.kind != "udpin":
-            return
-        for p in list(self._peers):
-            if not p.fixed and now - p.last_seen > PEER_TIMEOUT_S:
-                self._drop(p)
-                self.stats.peers_expired += 1
+        if self.endpoint.kind == "udpin":
+            self.slots.expire(now, PEER_TIMEOUT_S)
+
+    def _notice(self, severity: int, text: str) -> None:
+        """Tell the peers (STATUSTEXT) and, with a vehicle, the session log."""
+        if self.vehicle is not None:
+            self.vehicle.status(severity, text)  # sent by service with the vehicle's events
+        else:
+            self.statustext(severity, text)
 
     # -- the loop's entry ---------------------------------------------------------------
     def service(self, state: VehicleState, now_s: float | None = None) -> None:
         """Read (bounded), answer, and send what is due at wall time ``now_s`` [s,
         monotonic]. Never blocks."""
         now = time.monotonic() if now_s is None else now_s
+        self._now = now
         self._receive(state)
         self._expire_peers(now)
         for mid, interval in self.intervals_s.items():
@@ -379,30 +383,81 @@ class MavlinkLink:
                 if p.backlog:
                     self._flush_tcp(p)
             return
-        for _ in range(MAX_DATAGRAMS):
+        now, last = self._now, self._last_service_s
+        self._last_service_s = now
+        reads = MAX_DRAIN if last is None else int(min(MAX_DRAIN, max(
+            MIN_DRAIN, DRAIN_RATE_PER_S * (now - last))))
+        udp, stats, peers = self._udp, self.stats, self._peers
+        parsed: dict[tuple, int] = {}  # datagrams parsed this call, per source
+        n = 0
+        while n < reads:
             try:
-                data, addr = self._udp.recvfrom(65535)
+                data, addr = udp.recvfrom(65535)
             except (BlockingIOError, InterruptedError):
                 break
             except OSError as exc:  # ICMP port unreachable of an earlier send, etc.
                 if exc.errno in (errno.ECONNREFUSED, errno.ENETUNREACH, errno.EHOSTUNREACH):
                     continue
                 break
-            self.stats.datagrams += 1
-            if budget <= 0:
-                self.stats.bytes_dropped += len(data)
+            n += 1
+            peer = None
+            for p in peers:  # at most MAX_PEERS comparisons, before any parsing
+                if p.addr == addr:
+                    peer = p
+                    break
+            count = parsed.get(addr, 0)
+            if peer is not None:
+                if count >= PEER_DATAGRAMS_PER_CALL:
+                    stats.peer_dropped += 1
+                    continue
+            elif count >= NEW_SOURCE_DATAGRAMS_PER_CALL or (
+                    not count and len(parsed) >= NEW_SOURCES_PER_CALL + len(peers)):
+                stats.unknown_dropped += 1
                 continue
-            chunk = data[:budget]
-            self.stats.bytes_dropped += len(data) - len(chunk)
-            budget -= len(chunk)
-            peer = next((p for p in self._peers if p.addr == addr), None)
-            if peer is None:
-                peer = _Peer(addr, self._new_parser())  # known once it sends valid MAVLink
-                if self._handle_bytes(peer, chunk, state) and len(self._peers) < MAX_PEERS \
-                        and self.endpoint.kind == "udpin":
-                    self._peers.append(peer)
-            else:
+            parsed[addr] = count + 1
+            chunk = data[:MAX_PARSE_BYTES]
+            stats.bytes_dropped += len(data) - len(chunk)
+            if peer is not None:
                 self._handle_bytes(peer, chunk, state)
+            else:
+                self._newcomer(addr, chunk, state)
+        stats.datagrams += n
+        if n >= reads and reads >= MIN_DRAIN:
+            self.slots.flooded(now, PEER_TIMEOUT_S)
+
+    def _newcomer(self, addr, data: bytes, state: VehicleState) -> None:
+        """A datagram from a source without a slot: handled as any; a source of valid
+        (with signing on, validly signed) MAVLink may take a slot (:class:`Slots`)."""
+        slots = self.slots
+        cand = slots.candidate(addr, self._now, self._new_parser)
+        if self._handle_bytes(cand, data, state) and self.endpoint.kind == "udpin":
+            slots.admit(cand, self._now, PEER_TIMEOUT_S)
+        else:
+            slots.remember(cand)
+
+    def _tell(self, addr, text: str) -> None:
+        """One STATUSTEXT (WARNING, up to 50 characters) to one address that is not a peer
+        (a refusal)."""
+        mav = self._mav
+        msg = mav.statustext_encode(M.MAV_SEVERITY_WARNING, text.encode()[:50])
+        if self._rx_signing is not None:
+            mav.signing.timestamp = max(mav.signing.timestamp, signing_time_10us())
+        data = msg.pack(mav)
+        mav.seq = (mav.seq + 1) % 256
+        self.stats.sent += 1
+        try:
+            self._udp.sendto(data, addr)
+        except OSError:
+            self.stats.send_dropped += 1
+
+    def _send_pending_notices(self) -> None:
+        """The vehicle's queued STATUSTEXTs now (an eviction's notice reaches the evicted)."""
+        v = self.vehicle
+        if v is None:
+            return
+        while v.events:
+            severity, text = v.events.popleft()
+            self.statustext(severity, text)
 
     def _accept(self) -> None:
         for _ in range(MAX_PEERS):
@@ -415,9 +470,9 @@ class MavlinkLink:
                 continue
             conn.setblocking(False)
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._peers.append(_Peer(addr, self._new_parser(), conn))
+            self._peers.append(Peer(addr, self._new_parser(), conn))
 
-    def _handle_bytes(self, peer: _Peer, data: bytes, state: VehicleState) -> int:
+    def _handle_bytes(self, peer: Peer, data: bytes, state: VehicleState) -> int:
         """Parse and handle; the number of messages that qualify their sender as a peer
         (valid MAVLink; with signing on, validly signed)."""
         try:
@@ -442,7 +497,7 @@ class MavlinkLink:
                 self._handle_unsigned(msg)
                 continue
             good += 1
-            peer.last_seen = time.monotonic()
+            peer.hear(self._now, signing)
             self._handle(msg, state)  # every field's value is checked where it is used
         return good
 
@@ -585,6 +640,10 @@ class MavlinkLink:
     @property
     def mav(self):
         return self._mav
+
+
+def _addr_text(addr) -> str:
+    return f"{addr[0]}:{addr[1]}"
 
 
 def _param_name(raw) -> str:
