@@ -30,6 +30,12 @@ backend's, ArduPlane's from boot and ArduPlane's in flight), each named with its
 (``speedup_held``), the load average before and after and the CPU time [s] of the script,
 the physics and ArduPlane (``cpu_s``).
 
+The flight ends with ArduPlane stopped first; the physics (started with ``--end-when-silent
+2``) then ends by itself, a normal end (exit 0, its summary's ``ended``: "ArduPilot
+silent", ``interrupted`` false), and ``physics_end`` says so (``by``: "itself", ``status``:
+0); a physics that has not ended within 60 s is stopped with SIGTERM (``by``: "SIGTERM",
+status 130: an interrupt).
+
 Exit status: 0 the mission was completed (every waypoint of the square reached, then home
 in RTL); 1 the mission was not completed (timeout, a process exited, waypoints missed: the
 summary's ``incomplete`` says which); 2 the script could not run (bad arguments, no
@@ -59,8 +65,15 @@ MAVLINK_URL = "tcp:127.0.0.1:5760"  # ArduPilot SITL SERIAL0, instance 0
 # bioflex_jsb/drivers/ardupilot.py): the optimised wing, coupled, a 2 m/s 1-cosine gust of
 # 30 m (2 s at 15 m/s) 30 s after the launch (on the square's second leg); its JSON summary
 # goes to physics.json and its frames to physics.npz in --out. Override with --physics-cmd.
+# The physics ends by itself once ArduPlane, stopped first, has been silent for
+# PHYSICS_END_SILENCE_S (--end-when-silent): a normal end, exit 0, not an interrupt.
+PHYSICS_END_SILENCE_S = 2.0
+# How long the script waits for the physics to end by itself [s]: the silence, the server's
+# 0.5 s poll, and the log's close (its last chunk and summary, seconds for a long flight).
+PHYSICS_END_WAIT_S = 60.0
 DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb ardupilot "
                        "--wing optimised --model coupled --gust 1cos:2:30 --gust-at 30 "
+                       f"--end-when-silent {PHYSICS_END_SILENCE_S:g} "
                        "--summary physics.json --table physics.npz")
 # Mission (metres from home, NED; altitude above home [m]): a 300 m square flown clockwise.
 TAKEOFF_ALT_M = 40.0  # NAV_TAKEOFF altitude
@@ -198,13 +211,7 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float 
             mav = _connect(mavutil, procs)
             _run_mission(mav, procs, timeout_s, summary, speedup)
     finally:
-        for p in reversed(procs):
-            if p.poll() is None:
-                p.terminate()
-                try:
-                    p.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    p.kill()
+        summary["physics_end"] = end_processes(procs, PHYSICS_END_WAIT_S)
     summary["wall_s"] = time.monotonic() - wall0
     summary["loadavg_end"] = list(os.getloadavg())
     cpu1 = os.times()
@@ -223,6 +230,38 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float 
     summary.update(cross_track_report(summary.pop("xtrack_m")))
     summary["incomplete"] = incomplete(summary)
     return summary
+
+
+def _stop(p: subprocess.Popen) -> str:
+    """SIGTERM, then SIGKILL after 10 s; which one ended it."""
+    p.terminate()
+    try:
+        p.wait(timeout=10)
+        return "SIGTERM"
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+        return "SIGKILL"
+
+
+def end_processes(procs: list, physics_wait_s: float) -> dict:
+    """End a flight: ArduPlane (``procs[1:]``) stopped first (SIGTERM), then the physics
+    (``procs[0]``) given ``physics_wait_s`` [s] to end by itself (``--end-when-silent``:
+    ArduPlane's silence), and stopped only if it has not. How the physics ended:
+    ``by`` ("itself", "SIGTERM", "SIGKILL", or None if it never started) and its exit
+    ``status`` (0: a normal end; 130: it was interrupted)."""
+    for p in reversed(procs[1:]):
+        if p.poll() is None:
+            _stop(p)
+    if not procs:
+        return {"by": None, "status": None}
+    physics = procs[0]
+    by = "itself"
+    try:
+        physics.wait(timeout=physics_wait_s)
+    except subprocess.TimeoutExpired:
+        by = _stop(physics)
+    return {"by": by, "status": physics.returncode}
 
 
 def real_time_factors(summary: dict) -> dict:

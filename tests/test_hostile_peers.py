@@ -18,6 +18,7 @@ limits.
 
 from __future__ import annotations
 
+import json
 import socket
 import time
 
@@ -451,3 +452,59 @@ def test_a_new_station_is_told_when_no_slot_can_be_freed(udpin):
     texts = [m.text for m in gs.received() if m.get_type() == "STATUSTEXT"]
     assert len(texts) == 1 and "no ground-station slot" in texts[0]
     assert gs.addr not in link.peer_addresses and link.stats.peers_refused >= 1
+
+
+# --------------------------------------------------------------- a requested end of a flight
+def test_ardupilot_session_ends_normally_when_its_arduplane_goes_silent(tmp_path):
+    """``--end-when-silent S``: the session ends by itself once the bound ArduPilot has sent
+    nothing for S s (the fly script stops ArduPlane, then waits for the physics): exit 0,
+    the summary's ``ended`` says why and ``interrupted`` is false."""
+    from tests.test_ardupilot_driver import _cli_session, _free_port
+
+    summary = tmp_path / "s.json"
+    rc, _ = _cli_session(["--end-when-silent", "1", "--no-log", "--json", "--summary",
+                          str(summary)], _free_port())
+    assert rc == 0
+    s = json.loads(summary.read_text())
+    assert s["interrupted"] is False and s["ended"] == "ArduPilot silent"
+    assert s["frames"]["steps"] >= 700
+
+
+def test_the_fly_script_stops_arduplane_first_and_lets_the_physics_end_by_itself():
+    """scripts/ardupilot_sitl.py ``fly`` used to SIGTERM the physics (every flight's summary
+    read ``interrupted: true``, exit 130); now ArduPlane is stopped first and the physics,
+    started with --end-when-silent, ends by itself. Played with stand-in processes: a
+    "physics" that ends once its "ArduPlane" is gone, and one that never ends."""
+    import importlib.util
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "ardupilot_sitl.py"
+    spec = importlib.util.spec_from_file_location("ardupilot_sitl_script_end", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    assert f"--end-when-silent {script.PHYSICS_END_SILENCE_S:g}" in script.DEFAULT_PHYSICS_CMD
+    arduplane = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    # the physics: waits until the "ArduPlane" process is gone, then exits 0 by itself
+    follower = subprocess.Popen([sys.executable, "-c", (
+        "import os, sys, time\n"
+        f"while os.path.exists('/proc/{arduplane.pid}') and "
+        f"open('/proc/{arduplane.pid}/stat').read().split(')')[1].split()[0] != 'Z':\n"
+        "    time.sleep(0.05)\n"
+        "sys.exit(0)\n")])
+    try:
+        end = script.end_processes([follower, arduplane], physics_wait_s=30.0)
+    finally:
+        for p in (follower, arduplane):
+            if p.poll() is None:
+                p.kill()
+    assert end == {"by": "itself", "status": 0}
+    assert arduplane.returncode is not None
+    stuck = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    try:
+        end = script.end_processes([stuck], physics_wait_s=0.2)
+    finally:
+        if stuck.poll() is None:
+            stuck.kill()
+    assert end["by"] == "SIGTERM" and end["status"] != 0

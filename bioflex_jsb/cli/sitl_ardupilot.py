@@ -18,6 +18,7 @@ from bioflex_jsb.cli.common import (
     closing,
     finite_float,
     log_path,
+    number_type,
     positive_float,
     print_json,
     wing_from_args,
@@ -30,39 +31,49 @@ from bioflex_jsb.cli.live_option import (
     stop_live,
 )
 from bioflex_jsb.cli.preflight import NATIVE, add_allow_unstable, checked, preflight
+from bioflex_jsb.links.ardupilot_json import PEER_SILENCE_S
 
 __all__ = ("preflight", "register", "run", "session_summary")
 
 HELP = """Be ArduPilot's physics: answer ArduPlane SITL started with --model JSON:127.0.0.1
 (UDP 9002 + 10 x --instance) lock-step, one co-simulation step per ArduPilot frame, with the
-JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native; --aero
-unsteady for the coupled wing's unsteady strips; both run on the compiled step). The session
-binds to the first ArduPilot that sends (address and port); servo packets from any other
-source are counted and reported, never answered; a restart of that ArduPilot (frame 0
-again, or frame 0 from its address on a new port after 3 s of silence) resets the physics.
-The aircraft starts at rest on a launcher. Armed in AUTO at a NAV_TAKEOFF, ArduPlane keeps
-the throttle at 0 until the launch, so there the launch switch fires it: servo 5
-(SERVO5_FUNCTION 55, RC 5 passed through) at 1880..1920 us for 0.5 s; in TAKEOFF mode the
-idle throttle on servo 3 above 1020 us for 0.5 s fires it too (--launch-accel m/s^2 up to
-the trim speed --speed). A run that leaves the valid range is put back on the launcher once,
-reported, and stays there until ArduPilot restarts (no re-launch mid-mission). --gust starts
---gust-at seconds after the launch, once per session (--gust-repeat: after every launch).
-Before the flight the chosen model's stability at the trim speed is checked (eigenvalues of
-the linear model; the phugoid left out): an unstable wing is refused (exit 2) unless
---allow-unstable. Servo map, frames and the parameter file: docs/ardupilot.md,
-bioflex_jsb/drivers/ardupilot.py, bioflex_jsb/data/ardupilot/bioflex_plane.parm. Runs until
-Ctrl-C/SIGTERM or --duration simulated seconds, then prints a summary (--json: JSON; frames,
-resends, restarts, ignored packets, stops, re-launches, the real-time factor, the gust's
-eta1 peak). Every frame is logged to the MCAP log as for any run (--out, --no-log;
-docs/logging.md): ArduPilot's frame count, rate and servo PWM, the mapped controls, the
-lock-step action and the launcher phase on /bioflex/<model>/autopilot, every coupled step in
-flight on the run topics, and the session's events (binding, ignored packets, restarts,
-launches, stops, the summary at the end) on /bioflex/events. --table FILE.npz also keeps
-every --record-every-th frame (servos 1-4, ArduPilot's frame count, the step's channels) as
-a numpy table. Never expose ArduPlane's TCP ports: run both inside a loopback-only network
-namespace (scripts/ardupilot_sitl.py fly)."""
+JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native; --aero unsteady
+for the coupled wing's unsteady strips; both run on the compiled step). The session binds to
+the first ArduPilot that sends (address and port); packets from any other source are counted
+and reported, never answered, until the bound one has been silent for 3 s: then a new
+ArduPilot's frame 0, from any address and port, is bound and resets the physics (a restart;
+frame 0 again from the same port is one too), and a bound sender that never lock-stepped (a
+stray packet that reached the port before ArduPlane) gives way to the next sender without a
+reset (docs/ardupilot.md, "Sessions"). The aircraft starts at rest on a launcher. Armed in
+AUTO at a NAV_TAKEOFF, ArduPlane keeps the throttle at 0 until the launch, so there the
+launch switch fires it: servo 5 (SERVO5_FUNCTION 55, RC 5 passed through) at 1880..1920 us
+for 0.5 s; in TAKEOFF mode the idle throttle on servo 3 above 1020 us for 0.5 s fires it too
+(--launch-accel m/s^2 up to the trim speed --speed). A run that leaves the valid range is
+put back on the launcher once, reported, and stays there until ArduPilot restarts (no
+re-launch mid-mission). --gust starts --gust-at seconds after the launch, once per session
+(--gust-repeat: after every launch). Before the flight the chosen model's stability at the
+trim speed is checked (eigenvalues of the linear model; the phugoid left out): an unstable
+wing is refused (exit 2) unless --allow-unstable. Servo map, frames and the parameter file:
+docs/ardupilot.md, bioflex_jsb/drivers/ardupilot.py,
+bioflex_jsb/data/ardupilot/bioflex_plane.parm. Runs until --duration simulated seconds, or
+until ArduPilot has been silent for --end-when-silent seconds (ArduPlane stopped: the way a
+script ends a flight), both normal ends (exit 0), or until Ctrl-C/SIGTERM (an interrupt:
+exit 130); then prints a summary (--json: JSON; how it ended, frames, resends, restarts,
+ignored packets, stops, re-launches, the real-time factor, the gust's eta1 peak). Every
+frame is logged to the MCAP log as for any run (--out, --no-log; docs/logging.md):
+ArduPilot's frame count, rate and servo PWM, the mapped controls, the lock-step action and
+the launcher phase on /bioflex/<model>/autopilot, every coupled step in flight on the run
+topics, and the session's events (binding, ignored packets, restarts, launches, stops, the
+summary at the end) on /bioflex/events. --table FILE.npz also keeps every --record-every-th
+frame (servos 1-4, ArduPilot's frame count, the step's channels) as a numpy table. Never
+expose ArduPlane's TCP ports: run both inside a loopback-only network namespace
+(scripts/ardupilot_sitl.py fly)."""
 
 AERO_CHOICES = ("quasi-steady", "unsteady")
+# How a session ended (the summary's "ended"): the first two are normal ends (exit 0)
+ENDED_DURATION = "duration"
+ENDED_SILENT = "ArduPilot silent"
+ENDED_INTERRUPTED = "interrupted"
 RTF_DEFINITION = (
     "session_s / connected_wall_s: the physics time advanced (every frame stepped, k steps "
     "of dt_s each at ArduPilot's frame rate, across "
@@ -104,6 +115,13 @@ def register(sub) -> None:
     p.add_argument("--duration", type=positive_float("duration", "s"), default=None,
                    help="stop after this much session physics time [s], ArduPilot restarts "
                    "included (default: until Ctrl-C)")
+    p.add_argument("--end-when-silent", metavar="SECONDS", default=None,
+                   type=number_type("--end-when-silent", "s", low=0.5, high=3600.0),
+                   help="end the session normally (exit 0, the summary's ended: 'ArduPilot "
+                   "silent') once the bound ArduPilot has sent nothing for this long [s of "
+                   "wall time], 0.5..3600: stop ArduPlane, and the physics follows. A value "
+                   f"under {PEER_SILENCE_S:g} s ends the session where a killed ArduPilot's "
+                   "restart would have been bound (default: no such end)")
     p.add_argument("--table", metavar="FILE.npz", default=None,
                    help="write the recorded frames to this .npz (names, units, table)")
     p.add_argument("--record-every", type=int, default=8,
@@ -225,7 +243,7 @@ def session_summary(physics, server, wall_s: float) -> dict:
             "foreign_packets": st.foreign, "stale_packets": st.stale,
             "first_foreign": None if st.first_foreign is None
             else f"{st.first_foreign[0]}:{st.first_foreign[1]}",
-            "restarts_new_port": st.rebinds},
+            "restarts_new_port": st.rebinds, "strays": st.strays},
         wall_s=wall_s, connected_wall_s=connected,
         real_time_factor=physics.session_t_s / connected if connected > 0 else None,
         real_time_factor_definition=RTF_DEFINITION)
@@ -235,8 +253,9 @@ def session_summary(physics, server, wall_s: float) -> dict:
 def _text_report(s: dict) -> str:
     rtf = s["real_time_factor"]
     sc = s["source_check"]
-    lines = [f"flew {s['session_s']:.2f} s of physics ({s['flown_s']:.2f} s in flight), "
-             f"{s['frames']['steps']} frames, {s['restarts']} ArduPilot restarts, "
+    lines = [f"ended: {s['ended']}; flew {s['session_s']:.2f} s of physics "
+             f"({s['flown_s']:.2f} s in flight), {s['frames']['steps']} frames, "
+             f"{s['restarts']} ArduPilot restarts, "
              f"{s['launches']} launches ({s['relaunches']} re-launches), {s['stop_count']} "
              f"valid-range stops; {s['step']} step, {s['aero']} wing; last "
              f"{s['frame_steps']} step(s) a frame ({s['frame_rate_hz']:.4g} Hz)",
@@ -291,18 +310,27 @@ def run(args: argparse.Namespace) -> int:
     # make up)
     gc.freeze()
     interrupted = False
+    ended = ENDED_DURATION
     try:
         while args.duration is None or physics.session_t_s < args.duration:
             server.serve_once(0.5)
             physics.flush_events()  # the server's events between frames
+            silence = server.silence_s()
+            if args.end_when_silent is not None and silence is not None \
+                    and silence >= args.end_when_silent:
+                ended = ENDED_SILENT
+                physics.event("INFO", f"ArduPilot silent for {silence:.1f} s "
+                              f"(--end-when-silent {args.end_when_silent:g}): session ended")
+                break
     except KeyboardInterrupt:
         interrupted = True
+        ended = ENDED_INTERRUPTED
     finally:
         with closing():  # a stop signal now waits until the log is finished
             server.close()
             summary = session_summary(physics, server, time.monotonic() - wall0)
             summary.update(preflight=check, table=args.table, out=args.out,
-                           interrupted=interrupted)
+                           ended=ended, interrupted=interrupted)
             if log is not None:
                 physics.flush_events()
                 log.event(physics.session_t_s, "INFO", "session end: " + json.dumps(
