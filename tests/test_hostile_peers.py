@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import socket
+import sys
 import time
 
 import pytest
@@ -27,6 +28,7 @@ from pymavlink.dialects.v20 import common as M
 
 from bioflex_jsb.links import ardupilot_json as aj
 from bioflex_jsb.links import mavlink as ml
+from bioflex_jsb.links import udp_guard as ug
 from tests.ardupilot_standin import ArduPilotStandin
 from tests.test_ardupilot_json import DT_S, FakeClock, LevelTurn, _pwm
 
@@ -217,6 +219,80 @@ def test_the_receive_buffer_is_enlarged_within_the_kernels_limit(server):
     assert granted >= min(aj.RECV_BUFFER_BYTES, rmem_max)
 
 
+linux_only = pytest.mark.skipif(not sys.platform.startswith("linux"),
+                                reason="socket filters (SO_ATTACH_FILTER) are Linux's")
+
+
+def _drain(sock) -> list:
+    out = []
+    while True:
+        try:
+            out.append(sock.recvfrom(65536))
+        except BlockingIOError:
+            return out
+
+
+@linux_only
+def test_a_flooding_source_is_dropped_by_the_kernel_for_a_while_then_let_through():
+    """The filter program on a real socket: the blocked source's datagrams never reach the
+    queue, another source's do; after BLOCK_S it is let through (and blocked again only if
+    it floods again)."""
+    rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    rx.bind(("127.0.0.1", 0))
+    rx.setblocking(False)
+    flood, other = (socket.socket(socket.AF_INET, socket.SOCK_DGRAM) for _ in range(2))
+    try:
+        for s in (flood, other):
+            s.bind(("127.0.0.1", 0))
+        guard = ug.FloodGuard(rx)
+        t = 100.0
+        assert guard.check(t) == ([], [])
+        n = int(1.5 * ug.FLOOD_RATE_PER_S * ug.WINDOW_S)  # half as fast again as the limit
+        for _ in range(n):
+            guard.count(flood.getsockname())
+        guard.count(other.getsockname())
+        blocked, released = guard.check(t + 1.01 * ug.WINDOW_S)
+        assert blocked == [flood.getsockname()] and released == [] and guard.blocks == 1
+        for _ in range(50):
+            flood.sendto(b"flood", rx.getsockname())
+        other.sendto(b"hello", rx.getsockname())
+        _settle_port(rx.getsockname()[1])
+        assert [(d, a) for d, a in _drain(rx)] == [(b"hello", other.getsockname())]
+        assert guard.check(t + 1.01 * ug.WINDOW_S + ug.BLOCK_S) == ([], [flood.getsockname()])
+        flood.sendto(b"flood", rx.getsockname())
+        _settle_port(rx.getsockname()[1])
+        assert [d for d, _ in _drain(rx)] == [b"flood"]
+    finally:
+        for s in (rx, flood, other):
+            s.close()
+
+
+@linux_only
+def test_the_arduplane_server_blocks_a_flood_but_never_its_lockstepping_peer(server):
+    physics, srv, clock, events, standin = server
+    ap = standin()
+    for k in range(5):
+        _answered(srv, ap, _pwm(k), clock, pace_s=1e-4)
+    flood = standin()
+    n = int(1.5 * ug.FLOOD_RATE_PER_S * ug.WINDOW_S)
+    # more than the flood rate from the flooder, and from ArduPilot too (frames 0.1 ms apart)
+    for k in range(n):
+        flood.send_raw(b"x" * 40)
+        if k % 100 == 0:
+            _answered(srv, ap, _pwm(k), clock, pace_s=1e-4)
+    clock.t += 1.01 * ug.WINDOW_S  # the window's end
+    _answered(srv, ap, _pwm(1), clock, pace_s=0.0)
+    assert srv.stats.blocked == 1 and srv.guard.blocked == {flood.source: pytest.approx(
+        clock.t + ug.BLOCK_S)}
+    assert any("dropped by the kernel" in t and str(flood.source[1]) in t for _, t in events)
+    received = srv.stats.received
+    for _ in range(100):
+        flood.send_raw(b"x" * 40)
+    assert _answered(srv, ap, _pwm(2), clock) is not None
+    assert srv.stats.received == received + 1  # the frame only: the flood never queued
+    assert ap.source not in srv.guard.blocked
+
+
 # ------------------------------------------------------------------------------- MAVLink
 class Params:
     names = ("A",)
@@ -304,11 +380,14 @@ def _queued_bytes(port: int) -> int | None:
 
 
 def _settle(link) -> None:
-    """Wait until what was sent to the link is in its socket's queue: loopback delivers it
-    within the send, unless the kernel defers its network work to ksoftirqd on a busy
+    _settle_port(link.local_address[1])
+
+
+def _settle_port(port: int) -> None:
+    """Wait until what was sent to the socket on ``port`` is in its queue: loopback delivers
+    it within the send, unless the kernel defers its network work to ksoftirqd on a busy
     machine; the queue's size unchanged over three looks 10 ms apart (a failure limit of
     5 s, not a measurement)."""
-    port = link.local_address[1]
     seen, same = None, 0
     deadline = time.monotonic() + 5.0
     while time.monotonic() < deadline and same < 3:
@@ -382,6 +461,42 @@ def test_peers_are_kept_while_the_link_is_flooded_and_expire_after(udpin):
     assert link.peer_count == 1
     link.service(state, now_s=t + ml.PEER_TIMEOUT_S + 1.0)
     assert link.peer_count == 0 and link.stats.peers_expired == 1
+
+
+@linux_only
+def test_a_source_flooding_the_link_is_blocked_and_loses_its_slot(udpin):
+    """Valid heartbeats from one port, faster than FLOOD_RATE_PER_S: the source (it had
+    taken a free slot) is blocked in the kernel and dropped from the slots, said in one
+    STATUSTEXT; its next datagrams are never read; the ground station is served."""
+    link, station = udpin
+    state = ml.VehicleState()
+    gs = station()
+    gs.beat()
+    link.service(state, now_s=20.0)
+    flood = station(250)
+    n = int(1.5 * ug.FLOOD_RATE_PER_S * ug.WINDOW_S)  # half as fast again as the limit
+    t = 20.0
+    for k in range(n):
+        flood.beat()
+        if k % 100 == 99:
+            _settle(link)
+            link.service(state, now_s=t)
+            t += 0.001
+    _settle(link)
+    link.service(state, now_s=20.0 + 1.01 * ug.WINDOW_S)  # the window's end
+    assert link.stats.blocked == 1 and flood.addr in link.guard.blocked
+    assert flood.addr not in link.peer_addresses and gs.addr in link.peer_addresses
+    texts = [m.text for m in gs.received() if m.get_type() == "STATUSTEXT"]
+    assert any("dropped by the kernel" in x for x in texts), texts
+    before = link.stats.datagrams
+    for _ in range(200):
+        flood.beat()
+    mav = _mav()
+    gs.send(mav.param_request_read_encode(1, 1, b"A", -1).pack(mav))
+    _settle(link)
+    link.service(state, now_s=20.3)
+    assert link.stats.datagrams == before + 1  # the station's request only
+    assert any(m.get_type() == "PARAM_VALUE" for m in gs.received())
 
 
 def test_four_squatters_do_not_lock_out_a_new_ground_station(udpin):

@@ -243,7 +243,8 @@ def session_summary(physics, server, wall_s: float) -> dict:
             "foreign_packets": st.foreign, "stale_packets": st.stale,
             "first_foreign": None if st.first_foreign is None
             else f"{st.first_foreign[0]}:{st.first_foreign[1]}",
-            "restarts_new_port": st.rebinds, "strays": st.strays},
+            "restarts_new_port": st.rebinds, "strays": st.strays,
+            "blocked_sources": st.blocked},
         wall_s=wall_s, connected_wall_s=connected,
         real_time_factor=physics.session_t_s / connected if connected > 0 else None,
         real_time_factor_definition=RTF_DEFINITION)

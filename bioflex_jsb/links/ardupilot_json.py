@@ -57,11 +57,14 @@ frame holds the session for :data:`PEER_SILENCE_S` at most; ArduPlane, which re-
 frame 0 every second until it is answered, is bound at its first re-send after that.
 
 Reads (:meth:`LockstepServer.serve_once`): at most :data:`MAX_BATCH` datagrams per call,
-returning after the first one answered. The socket's receive buffer is asked for
-:data:`RECV_BUFFER_BYTES` (the kernel grants at most ``net.core.rmem_max``): a flood that
-arrives while a frame is stepped then waits in the buffer, to be dropped by its address,
-instead of pushing the peer's next frame out of it (a lost frame costs ArduPilot's 1 s
-re-send).
+returning after the first one answered. A source that floods the port (more than 2000
+datagrams a second; never the lock-stepping ArduPilot) is blocked in the kernel for 10 s at
+a time (:mod:`bioflex_jsb.links.udp_guard`; ``blocked``, a WARNING each time): its datagrams
+then cost nothing, take no buffer space and are not counted. The socket's receive buffer is
+asked for :data:`RECV_BUFFER_BYTES` (the kernel grants at most ``net.core.rmem_max``): a
+flood that arrives while a frame is stepped then waits in the buffer, to be dropped by its
+address, instead of pushing the peer's next frame out of it (a lost frame costs ArduPilot's
+1 s re-send).
 
 Wall time while connected (``ServerStats.connected_wall_s``, the denominator of the
 session's real-time factor): the sum of the wall-time intervals between consecutive frames
@@ -97,6 +100,7 @@ from bioflex_jsb.links.ardupilot_reply import (  # noqa: F401  (the reply's name
     encode_reply,
     encode_reply_json,
 )
+from bioflex_jsb.links.udp_guard import BLOCK_S, FLOOD_RATE_PER_S, FloodGuard
 
 # SIM_JSON.h, servo_packet_16 / servo_packet_32: magic, frame_rate, frame_count, pwm[]
 MAGIC_16 = 18458
@@ -245,6 +249,7 @@ class ServerStats:
     rebinds: int = 0  # new ArduPilot processes bound after the peer's silence (physics reset)
     strays: int = 0  # bound senders that never lock-stepped, replaced after their silence
     recv_buffer_bytes: int = 0  # the socket's receive buffer the kernel granted [bytes]
+    blocked: int = 0  # flooding sources blocked in the kernel (links/udp_guard.py)
     connected_wall_s: float = 0.0  # wall time while a peer was connected [s] (module doc)
 
 
@@ -299,6 +304,7 @@ class LockstepServer:
             pass
         self.stats.recv_buffer_bytes = self._sock.getsockopt(socket.SOL_SOCKET,
                                                              socket.SO_RCVBUF)
+        self.guard = FloodGuard(self._sock)
 
     @property
     def address(self) -> tuple[str, int]:
@@ -463,7 +469,7 @@ class LockstepServer:
         if not readable:
             return False
         sock, stats, clock, peer = self._sock, self.stats, self._clock, self.peer
-        recvfrom = sock.recvfrom
+        recvfrom, count = sock.recvfrom, self.guard.count
         # the peer's silence, once a batch: 3 s against a batch's 0.4 ms at most
         guarded = peer is not None and clock() - self._peer_reply_s < PEER_SILENCE_S
         for _ in range(MAX_BATCH):
@@ -473,10 +479,13 @@ class LockstepServer:
                 break
             stats.received += 1
             if guarded and source != peer:  # handle's first test, inline: a flood's path
+                count(source)
                 stats.foreign += 1
                 if stats.foreign == self._next_foreign_report or stats.first_foreign is None:
                     self._report_foreign(source)
                 continue
+            if source != peer or not self._lockstepped:
+                count(source)  # a stray that floods is blocked too; ArduPilot never
             reply = self.handle(data, source, clock())
             if reply is not None:
                 try:
@@ -484,7 +493,17 @@ class LockstepServer:
                 except BlockingIOError:
                     pass  # ArduPilot re-sends the frame after 1 s; it is answered then
                 break
+        self._guard_check()
         return True
+
+    def _guard_check(self) -> None:
+        """Block the sources that flood (never the lock-stepping peer); say so."""
+        blocked, _ = self.guard.check(self._clock(), self.peer if self._lockstepped else None)
+        for host, port in blocked:
+            self.stats.blocked += 1
+            self._event("WARNING", f"{host}:{port} sends more than {FLOOD_RATE_PER_S:g} "
+                        f"packets/s: dropped by the kernel for {BLOCK_S:g} s (not counted "
+                        "meanwhile)")
 
     def silence_s(self) -> float | None:
         """Wall time since the bound peer's last frame was answered [s] (None: no peer)."""

@@ -106,6 +106,7 @@ from bioflex_jsb.links.mavlink_telemetry import (  # noqa: F401
     STREAMS,
     encode,
 )
+from bioflex_jsb.links.udp_guard import BLOCK_S, FLOOD_RATE_PER_S, FloodGuard
 
 # What pymavlink's parser raises on bytes that are not MAVLink (hostile or corrupt input):
 # its own MAVError, and the struct/array/decoding errors of a truncated or mangled payload.
@@ -190,6 +191,7 @@ class MavlinkLink:
         self._last_service_s: float | None = None
         self._listener: socket.socket | None = None
         self._udp: socket.socket | None = None
+        self.guard: FloodGuard | None = None  # UDP only: a flooding source blocked
         self.sticks = Sticks(self, vehicle)
         self._last_mission_seq: int | None = None
         self.mission = (MissionProtocol(self._mav, self._send, vehicle)
@@ -230,6 +232,7 @@ class MavlinkLink:
                 pass
             self.stats.recv_buffer_bytes = s.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
             self._udp = s
+            self.guard = FloodGuard(s)
         except OSError as exc:
             verb = "send to" if ep.kind == "udpout" else "listen on"
             raise LinkError(f"cannot {verb} {ep.text()}: "
@@ -308,8 +311,11 @@ class MavlinkLink:
             p.sock.close()
 
     def _expire_peers(self, now: float) -> None:
-        if self.endpoint.kind == "udpin":
-            self.slots.expire(now, PEER_TIMEOUT_S)
+        if self.endpoint.kind != "udpin":
+            return
+        if self.guard.blocked:  # a flood goes on, dropped by the kernel: peers kept
+            self.slots.flood_until = max(self.slots.flood_until, now + PEER_TIMEOUT_S)
+        self.slots.expire(now, PEER_TIMEOUT_S)
 
     def _notice(self, severity: int, text: str) -> None:
         """Tell the peers (STATUSTEXT) and, with a vehicle, the session log."""
@@ -387,7 +393,7 @@ class MavlinkLink:
         self._last_service_s = now
         reads = MAX_DRAIN if last is None else int(min(MAX_DRAIN, max(
             MIN_DRAIN, DRAIN_RATE_PER_S * (now - last))))
-        udp, stats, peers = self._udp, self.stats, self._peers
+        udp, stats, peers, tally = self._udp, self.stats, self._peers, self.guard.count
         parsed: dict[tuple, int] = {}  # datagrams parsed this call, per source
         n = 0
         while n < reads:
@@ -400,6 +406,7 @@ class MavlinkLink:
                     continue
                 break
             n += 1
+            tally(addr)
             peer = None
             for p in peers:  # at most MAX_PEERS comparisons, before any parsing
                 if p.addr == addr:
@@ -424,6 +431,17 @@ class MavlinkLink:
         stats.datagrams += n
         if n >= reads and reads >= MIN_DRAIN:
             self.slots.flooded(now, PEER_TIMEOUT_S)
+        blocked, _ = self.guard.check(now)
+        for addr in blocked:  # said once a block (10 s); a peer that floods loses its slot
+            stats.blocked += 1
+            self.slots.flooded(now, PEER_TIMEOUT_S)
+            for p in peers:
+                if p.addr == addr:
+                    self._drop(p)
+                    break
+            self._notice(M.MAV_SEVERITY_WARNING,
+                         f"{addr[0]}:{addr[1]} sends more than {FLOOD_RATE_PER_S:g} "
+                         f"datagrams/s: dropped by the kernel for {BLOCK_S:g} s")
 
     def _newcomer(self, addr, data: bytes, state: VehicleState) -> None:
         """A datagram from a source without a slot: handled as any; a source of valid

@@ -21,7 +21,11 @@ more than a bounded share of its time. Each call of
   :data:`NEW_SOURCES_PER_CALL` in a call;
 * asks the kernel for a receive buffer of :data:`RECV_BUFFER_BYTES` (``net.core.rmem_max``
   caps it), so a flood arriving between two calls waits instead of pushing a ground
-  station's datagram out.
+  station's datagram out;
+* counts each source's datagrams: one that sends more than 2000 a second is blocked in the
+  kernel for 10 s at a time (:mod:`bioflex_jsb.links.udp_guard`; ``blocked``, a STATUSTEXT
+  each time; a peer that floods loses its slot), so a flood from one source soon costs
+  nothing at all.
 
 A call that reads a full batch means the kernel may have dropped datagrams of anyone, the
 peers' heartbeats too: while that happens, and for the link's peer timeout after
@@ -92,6 +96,7 @@ class LinkStats:
     full_batches: int = 0  # service calls that read a full batch (a flood)
     floods: int = 0  # floods noticed (a full batch after none for PEER_TIMEOUT_S)
     recv_buffer_bytes: int = 0  # the receive buffer the kernel granted [bytes]
+    blocked: int = 0  # flooding sources blocked in the kernel (links/udp_guard.py)
     by_type: dict[str, int] = field(default_factory=dict)  # bounded: MAVLink's message names
 
 
