@@ -530,7 +530,8 @@ def test_four_squatters_do_not_lock_out_a_new_ground_station(udpin):
         if gs.addr in link.peer_addresses:
             joined_after = k - 9
             break
-    assert joined_after is not None and joined_after <= ml.PRESENCE_S
+    # a squatter is heard in 2 or 3 of the last 5 intervals: 3 or 4 heartbeats outdo it
+    assert joined_after is not None and 3 <= joined_after <= 4, joined_after
     assert link.stats.peers_evicted == 1 and link.peer_count == ml.MAX_PEERS
     first = [m for m in gs.received() if m.get_type() == "STATUSTEXT"]
     if joined_after > 1:  # it waited: told once, at its first heartbeat
@@ -623,3 +624,10 @@ def test_the_fly_script_stops_arduplane_first_and_lets_the_physics_end_by_itself
         if stuck.poll() is None:
             stuck.kill()
     assert end["by"] == "SIGTERM" and end["status"] != 0
+
+
+def test_the_help_states_the_silence_the_server_uses():
+    from bioflex_jsb.cli.sitl_ardupilot import HELP
+
+    text = " ".join(HELP.split())
+    assert f"silent for {aj.PEER_SILENCE_S:g} s" in text and "--end-when-silent" in text
