@@ -326,15 +326,17 @@ def test_shipped_airframe_is_the_prototype_parameter_set(variant):
     assert aircraft.rigid_aerodynamics() == RIGID_AERODYNAMICS
 
 
-def test_beam_wing_on_an_airframe_is_analysed_clamped_not_flown(tmp_path):
+def test_beam_wing_on_an_airframe_is_analysed_clamped_and_flies_as_modes(tmp_path):
+    # a beam wing on an airframe: its modes are the flight model's (tests/
+    # test_beam_wing_flight.py), and the same wing is still analysed clamped
     goland = GOLAND_TEXT.split("[wing]", 1)[1]
     airframe = PROTO_TEXT.split("[wing]", 1)[0].replace("span_m = 1.7 ", "span_m = 12.2 ", 1)
     airframe = airframe.replace("reference_area_m2 = 0.3111", "reference_area_m2 = 2.23", 1)
     path = _write(tmp_path, airframe + "[wing]" + goland)
     aircraft = load_aircraft(path)
-    assert "structure.kind = 'beam'" in aircraft.flight_problem()
-    with pytest.raises(DefinitionError, match="not flown yet"):
-        aircraft.variant()
+    assert "airframe.reference_area_m2" in aircraft.flight_problem()  # not the prototype's
+    assert aircraft.linear_problem() is None
+    assert aircraft.variant().beam is not None
     ref = goland_flutter()
     res = api.flutter(aircraft.definition, clamped=True)
     assert res.speed_m_s == pytest.approx(ref.speed_m_s, abs=1e-6)

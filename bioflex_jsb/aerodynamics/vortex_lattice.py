@@ -21,6 +21,15 @@ Method (docs/aerodynamics.md):
   as a mirror image (sum or difference of the mirrored horseshoe's influence).
 * Lift by Kutta–Joukowski on the bound segments, linear (incompressible, inviscid, no
   thickness, no fuselage).
+* Dihedral (a planform with ``has_dihedral`` and ``height_at``: the leading edge's height
+  z(y), linear between stations): the panels, their control points and the trailing legs
+  (parallel to x from each bound segment's ends) sit at that height, the boundary
+  condition is the velocity normal to each strip's plane, n = (0, −dz/dy, 1)/√(1 + (dz/dy)²),
+  and l'(y) is the vertical force per unit y (Kutta–Joukowski: ρ V Γ Δy; the side forces
+  of the two halves cancel in symmetric flight). α(y) of the influence matrices is the
+  angle in each strip's own normal plane (a twist about the panel's axis enters whole); a
+  body angle of attack α gives α cos Γ there, so ``cl_alpha_c_m_per_rad`` (uniform body
+  α) carries cos Γ per strip. On 2-D strips that makes C_Lα ∝ cos Γ (docs/aerodynamics.md).
 
 Frames and signs: wing frame of :mod:`bioflex_jsb.parameters.wing`: origin at the root
 leading edge, x positive **aft**, y positive to **starboard**, z positive **up** (x × y = z).
@@ -124,6 +133,9 @@ class SpanwiseAerodynamics:
     influence_x_m2: np.ndarray = field(repr=False)
     influence_antisymmetric_m: np.ndarray = field(repr=False)
     influence_antisymmetric_x_m2: np.ndarray = field(repr=False)
+    # cos Γ of each strip's dihedral [-] (None: a flat wing): a body angle of attack α is
+    # α cos Γ in the strip's normal plane (module docstring)
+    cos_dihedral: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def span_m(self) -> float:
@@ -314,6 +326,7 @@ class _Lattice:
 def _lattice(planform: PlanformLike, edges_m: np.ndarray, n_chordwise: int, r: float, spacing: str):
     x_le = np.asarray(planform.leading_edge_x_at(edges_m), dtype=float)
     chord = np.asarray(planform.chord_at(edges_m), dtype=float)
+    height = _heights(planform, edges_m)
     k = edges_m.size - 1
     m = np.arange(n_chordwise)
     f_bound = (m + 0.25) / n_chordwise  # chord fractions of the bound segments
@@ -331,7 +344,29 @@ def _lattice(planform: PlanformLike, edges_m: np.ndarray, n_chordwise: int, r: f
     x_le_ctrl = (1.0 - frac) * x_le[:-1] + frac * x_le[1:]
     c_ctrl = (1.0 - frac) * chord[:-1] + frac * chord[1:]
     ctrl = np.column_stack([x_le_ctrl[j] + fm_c * c_ctrl[j], y_ctrl[j], zeros])
+    if height is not None:  # dihedral: every point at its leading edge's height
+        a[:, 2] = height[j]
+        b[:, 2] = height[j + 1]
+        ctrl[:, 2] = ((1.0 - frac) * height[:-1] + frac * height[1:])[j]
     return _Lattice(a, b, ctrl, j), x_le, chord, y_ctrl, c_ctrl
+
+
+def _heights(planform: PlanformLike, edges_m: np.ndarray) -> np.ndarray | None:
+    """The leading edge's height z [m] at the strip edges, or None for a flat wing."""
+    if not getattr(planform, "has_dihedral", False):
+        return None
+    return np.asarray(planform.height_at(edges_m), dtype=float)
+
+
+def _strip_normals(planform: PlanformLike, edges_m: np.ndarray) -> np.ndarray | None:
+    """(k, 3) unit normals of the strips' planes (0, −dz/dy, 1)/√(1 + (dz/dy)²) of a wing
+    with dihedral (starboard half), or None for a flat wing."""
+    height = _heights(planform, edges_m)
+    if height is None:
+        return None
+    slope = np.diff(height) / np.diff(edges_m)
+    norm = np.sqrt(1.0 + slope**2)
+    return np.column_stack([np.zeros_like(slope), -slope / norm, 1.0 / norm])
 
 
 # --------------------------------------------------------------------------------------
@@ -388,6 +423,12 @@ def _horseshoe_normalwash(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> n
     Horseshoe: trailing leg from +∞ to a, bound segment a → b, trailing leg b → +∞. With
     the bound segment pointing to +y, positive Γ means lift up (ρ V x̂ × Γ ŷ = +ẑ).
     """
+    return _horseshoe_velocity(points, a, b)[..., 2]
+
+
+def _horseshoe_velocity(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n, m, 3) velocity at ``points`` (n, 3) due to unit-Γ horseshoes a → b (m, 3) [1/m]
+    (:func:`_horseshoe_normalwash`'s horseshoes)."""
     p = points[:, None, :]
     aa = a[None, :, :]
     bb = b[None, :, :]
@@ -397,7 +438,7 @@ def _horseshoe_normalwash(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> n
         + _segment_velocity(p, aa, bb)
         + _semi_infinite_velocity(p, bb, length)
     )
-    return v[..., 2]
+    return v
 
 
 # --------------------------------------------------------------------------------------
@@ -429,10 +470,18 @@ def solve_spanwise_aerodynamics(
     )
 
     mirror = np.array([1.0, -1.0, 1.0])
-    w_self = _horseshoe_normalwash(lat.control_m, lat.a_m, lat.b_m)
-    # the port image of a starboard horseshoe a → b is the horseshoe b' → a' (bound segment
-    # still pointing to +y), which carries the same Γ in symmetric flight
-    w_image = _horseshoe_normalwash(lat.control_m, lat.b_m * mirror, lat.a_m * mirror)
+    normals = _strip_normals(planform, edges)
+    if normals is None:
+        w_self = _horseshoe_normalwash(lat.control_m, lat.a_m, lat.b_m)
+        # the port image of a starboard horseshoe a → b is the horseshoe b' → a' (bound
+        # segment still pointing to +y), which carries the same Γ in symmetric flight
+        w_image = _horseshoe_normalwash(lat.control_m, lat.b_m * mirror, lat.a_m * mirror)
+    else:  # dihedral: the velocity normal to each control point's strip
+        n_panel = normals[lat.strip_index][:, None, :]
+        w_self = np.sum(_horseshoe_velocity(lat.control_m, lat.a_m, lat.b_m) * n_panel,
+                        axis=-1)
+        w_image = np.sum(_horseshoe_velocity(lat.control_m, lat.b_m * mirror,
+                                             lat.a_m * mirror) * n_panel, axis=-1)
 
     k = edges.size - 1
     widths = np.diff(edges)
@@ -451,7 +500,8 @@ def solve_spanwise_aerodynamics(
     infl_s, infl_s_x = influence(w_self + w_image)
     infl_a, infl_a_x = influence(w_self - w_image)
 
-    ones = np.ones(k)
+    # a uniform body angle of attack: 1 rad on a flat wing, cos Γ in a dihedral strip's plane
+    ones = np.ones(k) if normals is None else normals[:, 2]
     cl_alpha_c = infl_s @ ones
     x_ac = (infl_s_x @ ones) / cl_alpha_c
     frac = (stations - edges[:-1]) / widths
@@ -476,4 +526,5 @@ def solve_spanwise_aerodynamics(
         influence_x_m2=infl_s_x,
         influence_antisymmetric_m=infl_a,
         influence_antisymmetric_x_m2=infl_a_x,
+        cos_dihedral=None if normals is None else normals[:, 2].copy(),
     )

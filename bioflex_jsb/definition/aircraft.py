@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.definition.airframe import GENERATED
+from bioflex_jsb.definition.clamped import beam_wing
 from bioflex_jsb.definition.flying import FLYING_N_MODES, axes, check_span
 from bioflex_jsb.definition.loader import load_definition
 from bioflex_jsb.definition.model import (
@@ -85,6 +86,24 @@ SAME_REL = 1e-9
 
 def _same(a: float, b: float) -> bool:
     return abs(a - b) <= SAME_REL * max(abs(a), abs(b), 1e-12)
+
+
+def _constant_chord_form(y, chord, x, z) -> tuple[float, float] | None:
+    """(outer panel start [m], its leading-edge sweep [rad]) when the stations are the
+    constant-chord :class:`Planform`'s form (one chord, flat, a straight inner panel and at
+    most one straight swept outer panel), else None."""
+    if float(chord.max() - chord.min()) > SAME_REL * float(chord.max()) or np.any(z != 0.0):
+        return None
+    straight = [i for i in range(len(y)) if x[i] == 0.0]
+    k = straight[-1]
+    if straight != list(range(k + 1)):
+        return None
+    semispan, start = float(y[-1]), float(y[k])
+    sweep = math.atan(float(x[-1]) / (semispan - start)) if k < len(y) - 1 else 0.0
+    for i in range(k + 1, len(y)):
+        if abs(x[i] - (y[i] - start) * math.tan(sweep)) > 1e-9 * semispan:
+            return None
+    return start, sweep
 
 
 class Aircraft:
@@ -155,53 +174,49 @@ class Aircraft:
 
     # -- the wing ---------------------------------------------------------------------
     def planform(self) -> Planform:
-        """The wing's planform (constant chord, a straight inner and a swept outer panel:
-        the one form the flight model's strips take) with the CG from the airframe."""
+        """The wing's planform with the CG from the airframe: the stations' chords, leading
+        edges and heights, linear between stations (a tapered, multi-panel or dihedral
+        wing: :meth:`Planform.from_stations`); a wing of constant chord, flat, with a
+        straight inner panel and at most one swept outer panel keeps the prototype's
+        constant-chord form (its numbers, to the bit)."""
         d = self.definition
         where = f"definition {d.name!r}"
         chord = d.column("chord_m")
-        if float(chord.max() - chord.min()) > SAME_REL * float(chord.max()):
-            raise DefinitionError(f"{where}: wing.stations.chord_m varies along the span: the "
-                                  "flight model's planform has a constant chord")
-        y, x = d.column("y_m"), d.column("leading_edge_x_m")
-        if abs(x[0]) > 0.0:
-            raise DefinitionError(f"{where}: wing.stations[0].leading_edge_x_m must be 0 (the "
-                                  "wing frame's origin is the root leading edge)")
-        straight = [i for i in range(len(y)) if x[i] == 0.0]
-        k = straight[-1]
-        if straight != list(range(k + 1)):
-            raise DefinitionError(f"{where}: wing.stations.leading_edge_x_m: a straight inner "
-                                  "panel (x = 0) then one swept outer panel is accepted")
-        semispan, start = float(y[-1]), float(y[k])
-        sweep = math.atan(float(x[-1]) / (semispan - start)) if k < len(y) - 1 else 0.0
-        for i in range(k + 1, len(y)):
-            if abs(x[i] - (y[i] - start) * math.tan(sweep)) > 1e-9 * semispan:
-                raise DefinitionError(f"{where}: wing.stations[{i}].leading_edge_x_m is off "
-                                      "the straight outer panel: one swept panel is accepted")
-        return Planform(semispan_m=semispan, chord_m=float(chord[0]),
-                        outer_panel_start_m=start, outer_sweep_rad=sweep,
-                        x_cg_m=self.airframe.wing_cg_x_m)
+        y, x, z = d.column("y_m"), d.column("leading_edge_x_m"), d.column("z_m")
+        if abs(x[0]) > 0.0 or abs(z[0]) > 0.0:
+            raise DefinitionError(f"{where}: wing.stations[0].leading_edge_x_m and z_m must "
+                                  "be 0 (the wing frame's origin is the root leading edge)")
+        x_cg = self.airframe.wing_cg_x_m
+        legacy = _constant_chord_form(y, chord, x, z)
+        if legacy is None:
+            return Planform.from_stations(y, chord, x, z, x_cg)
+        start, sweep = legacy
+        return Planform(semispan_m=float(y[-1]), chord_m=float(chord[0]),
+                        outer_panel_start_m=start, outer_sweep_rad=sweep, x_cg_m=x_cg)
 
     def variant(self) -> WingVariant:
-        """The wing as a :class:`WingVariant` (its axes, structure, damping, pin)."""
+        """The wing as a :class:`WingVariant` (its axes, structure, damping, pin); a
+        ``beam`` structure as its :class:`~bioflex_jsb.structures.beam_wing.BeamWing`,
+        whose modes take a modal file's place (axes: the stations' means, as a modal
+        file's [axes] are taken)."""
         d = self.definition
         x_i, x_e = axes(d.stations)
         s = d.structure
+        beam = None
         if isinstance(s, MembraneStructure):
             ribs, modes_file = s.ribs, None
         elif isinstance(s, ModalStructure):
             ribs, modes_file = True, s.modes_file
         else:
-            raise DefinitionError(f"definition {d.name!r}: structure.kind 'beam' on an "
-                                  "airframe is not flown yet (the flight model takes its "
-                                  "modes from 'prototype-membrane' or a 'modal' file; the "
-                                  "beam wing is analysed clamped: api.flutter(definition, "
-                                  "clamped=True))")
+            ribs, modes_file = True, None
+            beam = beam_wing(d)
+            x_i = float(np.mean(d.column("centre_of_mass")))
+            x_e = float(np.mean(d.column("elastic_axis")))
         f = d.flying
         return WingVariant(f.name, x_i, x_e, ribs=ribs, structural_damping=s.damping_ratio,
                            modes_file=modes_file, pinned_c_eta1_q1=f.pin_c_eta1_q1,
                            published_c_eta1_q1=f.published_c_eta1_q1,
-                           description=d.description)
+                           description=d.description, beam=beam)
 
     # -- the JSBSim aircraft's own numbers ---------------------------------------------
     def jsbsim_mismatches(self, values: JSBSimValues) -> list[str]:
@@ -296,11 +311,6 @@ class Aircraft:
         docstring) cannot take this aircraft, or ``None``."""
         a, d = self.airframe, self.definition
         head = f"aircraft {d.name!r}: "
-        if not isinstance(d.structure, MembraneStructure | ModalStructure):
-            return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
-                    "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
-                    "on the aircraft the wing's modes come from 'prototype-membrane' or a "
-                    "'modal' file (docs/aircraft.md: write the beam's modes to one)")
         if a.missing():
             return (f"{head}airframe.{a.missing()[0]} comes from its JSBSim aircraft: load "
                     "it with api.load_aircraft or the commands' --aircraft")
@@ -322,11 +332,6 @@ class Aircraft:
                 "another airframe flies on its own JSBSim aircraft, airframe.jsbsim; the "
                 "linear analyses modes, flutter and linear_model take this one: "
                 "docs/aircraft.md)")
-        if not isinstance(d.structure, MembraneStructure | ModalStructure):
-            return (f"{head}structure.kind = 'beam': a beam wing is analysed clamped "
-                    "(flutter --clamped FILE, api.flutter(aircraft.definition, clamped=True)); "
-                    f"in flight the wing's modes come from 'prototype-membrane' or a 'modal' "
-                    f"file{tail}")
         if a.jsbsim != GENERATED:
             return (f"{head}airframe.jsbsim = {a.jsbsim!r} is not the generated prototype "
                     f"airframe {GENERATED!r}: the aircraft flies on its own JSBSim aircraft "
@@ -356,6 +361,10 @@ class Aircraft:
             if not _same(mine, proto):
                 return f"{head}{field} = {mine:g} differs from the prototype's {proto:g}{tail}"
         pf = self.planform()
+        if pf.stations_m is not None:
+            return (f"{head}the wing's planform (tapered, multi-panel or with dihedral) "
+                    "differs from the prototype's constant-chord wing (wing.stations)"
+                    f"{tail}")
         for field in ("semispan_m", "chord_m", "outer_panel_start_m", "outer_sweep_rad",
                       "x_cg_m"):
             mine, proto = getattr(pf, field), getattr(DEFAULT_PLANFORM, field)

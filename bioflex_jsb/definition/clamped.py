@@ -23,6 +23,7 @@ from bioflex_jsb.aeroelasticity.strip_aero import divergence_speed_m_s
 from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S, DefinitionError
 from bioflex_jsb.definition.model import BeamStructure, Definition
 from bioflex_jsb.structures.beam import BeamSections
+from bioflex_jsb.structures.beam_wing import BeamWing
 
 TOP_OVER_DIVERGENCE = 1.5
 FLOOR_REDUCED_FREQUENCY = 0.1
@@ -32,7 +33,8 @@ STEPS_PER_RANGE = 120
 
 
 def beam_sections(d: Definition) -> BeamSections:
-    """The definition's beam sections (pitch inertia carried to the elastic axis)."""
+    """The definition's beam sections (pitch inertia carried to the elastic axis), with its
+    point masses and struts (vertical springs)."""
     s = d.structure
     chord = d.column("chord_m")
     ea, cg = d.column("elastic_axis"), d.column("centre_of_mass")
@@ -45,7 +47,29 @@ def beam_sections(d: Definition) -> BeamSections:
         mass_per_length_kg_m=s.mass_per_length_kg_m, torsional_inertia_kg_m=inertia,
         chord_m=chord, x_elastic_frac=ea, x_inertial_frac=cg,
         description=f"{d.name} ({s.pitch_inertia_kg_m[0]:g} kg·m about the "
-                    f"{s.inertia_axis})")
+                    f"{s.inertia_axis}" + _extras(s) + ")",
+        point_masses=s.point_masses, springs=s.struts)
+
+
+def _extras(s: BeamStructure) -> str:
+    """The point masses and struts in a few words (the modes' source line)."""
+    out = ""
+    if s.point_masses:
+        total = sum(p.mass_kg for p in s.point_masses)
+        out += f"; {len(s.point_masses)} point mass(es), {total:g} kg"
+    if s.struts:
+        out += f"; {len(s.struts)} strut(s)"
+    return out
+
+
+def beam_wing(d: Definition) -> BeamWing:
+    """The beam wing of a definition with ``kind = 'beam'`` as the flight model takes it
+    (its modes computed once per process: :class:`~bioflex_jsb.structures.beam_wing.
+    BeamWing`), with the structure's mesh and damping ratio."""
+    s = d.structure
+    if not isinstance(s, BeamStructure):
+        raise DefinitionError(f"definition {d.name!r}: structure.kind is not 'beam'")
+    return BeamWing(beam_sections(d), n_elements=s.n_elements, damping_ratio=s.damping_ratio)
 
 
 def clamped_model(d: Definition, lift_slope: str | None = None) -> ClampedWingModel:

@@ -32,6 +32,7 @@ from bioflex_jsb.definition.model import (
     WingStation,
 )
 from bioflex_jsb.definition.reader import DefinitionError, Reader
+from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 from bioflex_jsb.tomlfile import read_toml
 
 # Definitions in bioflex_jsb/data/aircraft/<name>.toml: the clamped (benchmark) wings, and
@@ -52,6 +53,23 @@ SEMISPAN_RANGE_M = (0.05, 100.0)
 CHORD_RANGE_M = (0.005, 30.0)  # a 5 mm model chord to a 30 m root chord
 LEADING_EDGE_RANGE_M = (-100.0, 100.0)
 TWIST_LIMIT_RAD = math.radians(30.0)  # beyond 30° the strip's attached flow is gone
+# Dihedral of a panel, |atan(Δz/Δy)| [rad]: up to 30°. The beam runs along y and the strips
+# lie in planes through it: at 30° the real spar is 1/cos 30° = 15 % longer than the beam,
+# and beyond it the wing is no longer a wing with some dihedral (docs/aircraft.md).
+DIHEDRAL_LIMIT_RAD = math.radians(30.0)
+# Point masses on the wing [kg]: 1e-6 (a milligram-scale balance weight of a model) to 1e6
+# (a transport's fuel per wing is ~1e5 kg); at most 100 of them (engines, tanks, pods).
+POINT_MASS_RANGE_KG = (1e-6, 1e6)
+POINT_MASS_INERTIA_RANGE_KG_M2 = (0.0, 1e7)  # its own pitch inertia; 0: a point
+# Chordwise position of a point mass's centre of mass [chord fraction aft of the LE]: a
+# wing-mounted engine or a pod sits ahead of the leading edge (negative), a tip tank or a
+# balance weight up to a few chords ahead or behind; -3..3 catches a value in metres or %.
+POINT_MASS_CHORD_RANGE = (-3.0, 3.0)
+MAX_POINT_MASSES = 100
+# A strut's vertical stiffness at its attachment [N/m] (k = (EA/L) sin² γ): a C172's
+# aluminium strut is ~2e6 N/m; the range is the beam stiffnesses' 1e-3..1e12.
+STRUT_STIFFNESS_RANGE_N_M = (1e-3, 1e12)
+MAX_STRUTS = 4
 # Stiffnesses [N·m²]: 1e-3 (a foam-and-film model wing) to 1e12 (a transport's root
 # bending is about 1e10).
 STIFFNESS_RANGE_N_M2 = (1e-3, 1e12)
@@ -102,7 +120,7 @@ def _stations(r: Reader, wing: dict) -> tuple[WingStation, ...]:
         raise r.fail("wing.stations", "need at least 2 stations (root y_m = 0, tip), each a "
                      "table {y_m, chord_m, leading_edge_x_m, twist, elastic_axis, "
                      "centre_of_mass}")
-    allowed = ("y_m", "chord_m", "leading_edge_x_m", "twist", "elastic_axis",
+    allowed = ("y_m", "chord_m", "leading_edge_x_m", "z_m", "twist", "elastic_axis",
                "centre_of_mass")
     tip = rows[-1].get("y_m")
     mm_hint = ""
@@ -115,25 +133,87 @@ def _stations(r: Reader, wing: dict) -> tuple[WingStation, ...]:
         y = r.number(row, w, "y_m", 0.0, SEMISPAN_RANGE_M[1], "m", hint=mm_hint)
         c = r.number(row, w, "chord_m", *CHORD_RANGE_M, "m", hint=mm_hint)
         x = r.number(row, w, "leading_edge_x_m", *LEADING_EDGE_RANGE_M, "m", default=0.0)
+        z = r.number(row, w, "z_m", *LEADING_EDGE_RANGE_M, "m", default=0.0)
         lim = TWIST_LIMIT_RAD if unit == "rad" else math.degrees(TWIST_LIMIT_RAD)
         tw = r.number(row, w, "twist", -lim, lim, unit, default=0.0)
         ea = r.number(row, w, "elastic_axis", 0.0, 1.0, "chord fraction")
         cg = r.number(row, w, "centre_of_mass", 0.0, 1.0, "chord fraction")
-        out.append(WingStation(y, c, x, tw if unit == "rad" else math.radians(tw), ea, cg))
+        out.append(WingStation(y, c, x, tw if unit == "rad" else math.radians(tw), ea, cg, z))
     ys = [s.y_m for s in out]
     if ys[0] != 0.0 or any(b <= a for a, b in zip(ys, ys[1:], strict=False)):
         raise r.fail("wing.stations.y_m", f"must start at the root (0) and increase strictly, "
                      f"got {ys}")
+    if out[0].z_m != 0.0:
+        raise r.fail("wing.stations[0].z_m", "must be 0: heights are the leading edge's above "
+                     "the root's")
+    for i in range(1, len(out)):
+        angle = math.atan2(out[i].z_m - out[i - 1].z_m, out[i].y_m - out[i - 1].y_m)
+        if abs(angle) > DIHEDRAL_LIMIT_RAD:
+            raise r.fail(f"wing.stations[{i}].z_m", f"the panel's dihedral "
+                         f"{math.degrees(angle):.3g} deg is outside "
+                         f"±{math.degrees(DIHEDRAL_LIMIT_RAD):g} deg (z_m is the height in m, "
+                         "not an angle)")
     if not SEMISPAN_RANGE_M[0] <= ys[-1]:
         raise r.fail(f"wing.stations[{len(ys) - 1}].y_m", f"semispan {ys[-1]:g} m is below "
                      f"{SEMISPAN_RANGE_M[0]:g} m (is the file in another unit?)")
     return tuple(out)
 
 
+def _rows(r: Reader, t: dict, key: str, limit: int, what: str) -> list[dict]:
+    """An array of tables ``[[structure.<key>]]`` (none: empty)."""
+    rows = t.get(key, [])
+    if not isinstance(rows, list) or not all(isinstance(x, dict) for x in rows):
+        raise r.fail(f"structure.{key}", f"must be an array of tables [[structure.{key}]], "
+                     f"each {what}")
+    if len(rows) > limit:
+        raise r.fail(f"structure.{key}", f"{len(rows)} entries; accepted at most {limit}")
+    return rows
+
+
+def _point_masses(r: Reader, t: dict, semispan_m: float) -> tuple[PointMass, ...]:
+    """``[[structure.point_masses]]``: y_m, mass_kg, chord_position, pitch_inertia_kg_m2,
+    name (docs/aircraft.md)."""
+    out = []
+    for i, row in enumerate(_rows(r, t, "point_masses", MAX_POINT_MASSES,
+                                  "{y_m, mass_kg, chord_position, pitch_inertia_kg_m2, name}")):
+        w = f"structure.point_masses[{i}]"
+        r.keys(row, w, ("y_m", "mass_kg", "chord_position", "pitch_inertia_kg_m2", "name"))
+        y = r.number(row, w, "y_m", 0.0, semispan_m, "m")
+        if y <= 0.0:
+            raise r.fail(f"{w}.y_m", "0 is the clamped root, where a mass does not move; "
+                         f"accepted 0 < y_m <= {semispan_m:g} m")
+        out.append(PointMass(
+            y_m=y, mass_kg=r.number(row, w, "mass_kg", *POINT_MASS_RANGE_KG, "kg"),
+            x_frac=r.number(row, w, "chord_position", *POINT_MASS_CHORD_RANGE,
+                            "chord fraction", hint=" (a fraction of the local chord aft of "
+                            "the leading edge, negative ahead of it)"),
+            pitch_inertia_kg_m2=r.number(row, w, "pitch_inertia_kg_m2",
+                                         *POINT_MASS_INERTIA_RANGE_KG_M2, "kg m^2",
+                                         default=0.0),
+            name=r.text(row, w, "name", "")))
+    return tuple(out)
+
+
+def _struts(r: Reader, t: dict, semispan_m: float) -> tuple[VerticalSpring, ...]:
+    """``[[structure.struts]]``: y_m (the attachment), stiffness_n_m, name."""
+    out = []
+    for i, row in enumerate(_rows(r, t, "struts", MAX_STRUTS, "{y_m, stiffness_n_m, name}")):
+        w = f"structure.struts[{i}]"
+        r.keys(row, w, ("y_m", "stiffness_n_m", "name"))
+        y = r.number(row, w, "y_m", 0.0, semispan_m, "m")
+        if y <= 0.0:
+            raise r.fail(f"{w}.y_m", f"accepted 0 < y_m <= {semispan_m:g} m (the attachment "
+                         "on the wing; the root is clamped already)")
+        out.append(VerticalSpring(y, r.number(row, w, "stiffness_n_m",
+                                              *STRUT_STIFFNESS_RANGE_N_M, "N/m"),
+                                  r.text(row, w, "name", "")))
+    return tuple(out)
+
+
 def _structure(r: Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
     allowed = ("kind", "bending_stiffness_n_m2", "torsional_stiffness_n_m2",
                "mass_per_length_kg_m", "pitch_inertia_kg_m", "inertia_axis", "damping_ratio",
-               "n_modes", "n_elements")
+               "n_modes", "n_elements", "point_masses", "struts")
     t = r.table("structure", allowed)
     r.choice(t, "structure", "kind", ("beam",), "beam")
     n = len(stations)
@@ -157,9 +237,11 @@ def _structure(r: Reader, stations: tuple[WingStation, ...]) -> BeamStructure:
                      f"axis at station {k} is below m'·d² = {m[k] * d[k] ** 2:g} kg m (d the "
                      "centre of mass's offset): the section mass matrix is not positive "
                      "definite")
+    semispan = stations[-1].y_m
     return BeamStructure(ei, gj, m, inertia, axis, zeta,
                          r.integer(t, "structure", "n_modes", *N_MODES_RANGE, 6),
-                         r.integer(t, "structure", "n_elements", *N_ELEMENTS_RANGE, 40))
+                         r.integer(t, "structure", "n_elements", *N_ELEMENTS_RANGE, 40),
+                         _point_masses(r, t, semispan), _struts(r, t, semispan))
 
 
 def _monitoring_stations(r: Reader) -> tuple[float, ...]:

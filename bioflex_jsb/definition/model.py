@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bioflex_jsb.parameters.airframe import DerivativeSchedule
+from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 
 # The section loads' monitoring stations when a definition names none: root, 25, 50, 75 %
 # of the semispan (issue 24); the loads' default (loads/model.py) is this one.
@@ -37,7 +38,8 @@ class WingStation:
 
     ``y_m`` [m] from the root; ``chord_m`` [m]; ``leading_edge_x_m`` [m] aft of the root
     leading edge; ``twist_rad`` [rad] (LE up); ``elastic_axis`` and ``centre_of_mass``:
-    chord fractions aft of the leading edge [-]."""
+    chord fractions aft of the leading edge [-]; ``z_m`` [m] the leading edge's height above
+    the root's (positive up: dihedral)."""
 
     y_m: float
     chord_m: float
@@ -45,6 +47,7 @@ class WingStation:
     twist_rad: float
     elastic_axis: float
     centre_of_mass: float
+    z_m: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -55,7 +58,8 @@ class BeamStructure:
     ``mass_per_length_kg_m`` m' [kg/m], ``pitch_inertia_kg_m`` I_α' [kg·m] about
     ``inertia_axis`` (``elastic-axis`` or ``centre-of-mass``), ``damping_ratio`` ζ [-] of
     every mode (viscous, 2ζω), ``n_modes`` and ``n_elements`` of the finite-element
-    solution."""
+    solution; ``point_masses`` (fuel, engines, pods, tip masses) and ``struts`` (a braced
+    wing's strut as a vertical spring at its attachment) on the beam."""
 
     bending_stiffness_n_m2: np.ndarray
     torsional_stiffness_n_m2: np.ndarray
@@ -65,6 +69,8 @@ class BeamStructure:
     damping_ratio: float
     n_modes: int
     n_elements: int
+    point_masses: tuple[PointMass, ...] = ()
+    struts: tuple[VerticalSpring, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ from bioflex_jsb.parameters.wing import (
     PUBLISHED_C_ETA1_Q1,
     Planform,
 )
+from bioflex_jsb.structures.beam_wing import BeamWing
 from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.tomlfile import read_toml
 
@@ -64,8 +65,11 @@ class WingVariant:
 
     x_inertial_frac, x_elastic_frac: axis positions as fractions of the chord aft of the
     leading edge [-]; ribs: the ribbed structure of Fig. 2(b) (Table 2 "with ribs") or the
-    homogeneous membrane (unused with a modes file: None in :meth:`as_dict`); modes_file: a
-    modal-data file (docs/structures.md) that replaces the beam model; overrides: pinned
+    homogeneous membrane (unused with a modes file or a beam: None in :meth:`as_dict`);
+    modes_file: a modal-data file (docs/structures.md) that replaces the beam model; beam: a
+    definition's beam wing (:class:`~bioflex_jsb.structures.beam_wing.BeamWing`: its
+    sections, point masses, struts), whose modes replace the beam model as a modes file's
+    do (not both); overrides: pinned
     Table B1 coefficients (reported by every output); pinned_c_eta1_q1: pin C_η1^Q1 by
     shifting the aerodynamic offset e(y) of every mode uniformly (the paper's "adjusted
     to"; reported by every output); published_c_eta1_q1: the paper's value for comparison
@@ -82,15 +86,22 @@ class WingVariant:
     pinned_c_eta1_q1: float | None = None
     published_c_eta1_q1: float | None = None
     description: str = ""
+    beam: BeamWing | None = None
+
+    def __post_init__(self) -> None:
+        if self.beam is not None and self.modes_file:
+            raise VariantError(f"wing {self.name!r}: a beam and a modes file both give the "
+                               "modes; give one")
 
     def as_dict(self) -> dict[str, object]:
-        return {
+        out = {
             "name": self.name,
             "x_inertial_frac": self.x_inertial_frac,
             "x_elastic_frac": self.x_elastic_frac,
-            # a modes file's wing has no beam whose ribs the flag would choose: null, not a
-            # "true" a reader of the log's metadata would take for a property of the wing
-            "ribs": None if self.modes_file else self.ribs,
+            # a modes file's (or a beam's) wing has no membrane beam whose ribs the flag
+            # would choose: null, not a "true" a reader of the log's metadata would take for
+            # a property of the wing
+            "ribs": None if (self.modes_file or self.beam is not None) else self.ribs,
             "structural_damping": self.structural_damping,
             "modes_file": self.modes_file,
             "overrides": dict(self.overrides),
@@ -98,6 +109,9 @@ class WingVariant:
             "published_c_eta1_q1": self.published_c_eta1_q1,
             "description": self.description,
         }
+        if self.beam is not None:  # the beam's content (sections, masses, mesh) by digest
+            out["beam"] = f"sha256:{self.beam.digest}"
+        return out
 
 
 def _pub(name: str) -> float:
@@ -414,8 +428,11 @@ def modes_used_note(variant: WingVariant, n_modes: int = DEFAULT_N_MODES) -> str
 
 
 def _all_modes(variant: WingVariant, n_modes: int):
-    """Every mode of the variant's modal file, or ``n_modes`` of the calibrated beam."""
-    if variant.modes_file:
+    """Every mode of the variant's modal file, or ``n_modes`` of its beam wing (a
+    definition's) or of the calibrated membrane beam."""
+    if variant.beam is not None:
+        modes = variant.beam.modes(n_modes)
+    elif variant.modes_file:
         from bioflex_jsb.structures.modal_file import read_modal_file
 
         modes = read_modal_file(variant.modes_file)
@@ -489,7 +506,7 @@ def _check_modes_fit(variant: WingVariant, modes: ModalData, planform: Planform)
     half = planform.semispan_m
     y = modes.stations_m
     off = max(y[0], abs(y[-1] - half))  # from the root, and from the tip [m]
-    if variant.modes_file and off > STATION_SPAN_TOLERANCE * half:
+    if (variant.modes_file or variant.beam is not None) and off > STATION_SPAN_TOLERANCE * half:
         raise VariantError(
             f"wing {variant.name!r}: the modes file's stations run {y[0]:g}..{y[-1]:g} m; "
             f"accepted: from the root (0 m) to the tip (b/2 = {half:g} m) within "

@@ -185,7 +185,18 @@ class LoadsModel:
 
 
 def _sections(variant):
-    """The beam sections of a beam-model variant (mass, stiffness); refused for a modes file."""
+    """The beam sections of a beam-model variant (mass, stiffness): a definition's beam wing's
+    own, else the prototype's membrane beam; refused for a modes file, and for a beam with
+    point masses or struts (the force summation has no concentrated loads: it would leave
+    out their inertia and the strut's reaction)."""
+    if variant.beam is not None:
+        sections = variant.beam.sections
+        if sections.point_masses or sections.springs:
+            raise InputError(
+                f"wing {variant.name!r}: section loads of a beam with point masses or struts "
+                "are not modelled (the force summation has no concentrated loads: it would "
+                "leave out their inertia and the strut's reaction)")
+        return sections
     if variant.modes_file:
         raise InputError(
             f"wing {variant.name!r}: section loads need the beam's mass and stiffness "
@@ -428,7 +439,9 @@ def build_loads_model(build, speed_m_s: float, stations=None, *,
     else:
         sections = _sections(variant)
         md_unavailable = None
-        mass_source = "the beam's sections (structures/wing_model.py)"
+        mass_source = ("the beam's sections (the definition's [structure])"
+                       if variant.beam is not None
+                       else "the beam's sections (structures/wing_model.py)")
     half = planform.semispan_m
     ys = station_positions_m(stations, half)
     condition = level_flight_condition(float(speed_m_s), density_kg_m3,

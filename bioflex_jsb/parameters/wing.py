@@ -25,14 +25,27 @@ from bioflex_jsb.parameters import prototype as P
 
 @dataclass(frozen=True)
 class Planform:
-    """Straight inner panel and swept-back outer panel of constant chord.
+    """The half wing's planform: a straight inner panel and a swept-back outer panel of
+    constant chord (the prototype's), or, with ``stations_m`` given
+    (:meth:`from_stations`), any wing whose chord, leading edge and height vary linearly
+    between span stations (a straight-tapered wing, a multi-panel wing, dihedral).
 
     Attributes:
         semispan_m: b/2 [m].
-        chord_m: constant chord [m].
-        outer_panel_start_m: spanwise station where the outer panel starts [m].
-        outer_sweep_rad: leading-edge sweep of the outer panel, positive swept back [rad].
+        chord_m: the constant chord [m]; for a station planform its mean geometric chord
+            S/b [m] (the length that makes a chord fraction of a uniform shift a length:
+            ``WingBuild.e_shift_frac``).
+        outer_panel_start_m: spanwise station where the swept outer panel starts [m] (a
+            station planform: the semispan, unused).
+        outer_sweep_rad: leading-edge sweep of the outer panel, positive swept back [rad]
+            (a station planform: 0, unused).
         x_cg_m: centre-of-gravity position aft of the root leading edge [m] (wing frame).
+        stations_m: span stations y [m], 0 … b/2 strictly increasing, or ``None`` (the
+            constant-chord form above).
+        chords_m: the chord c [m] at each station (linear between).
+        leading_edges_x_m: the leading edge x [m] aft of the root's at each station.
+        heights_m: the leading edge's height z [m] above the root's (positive up) at each
+            station: dihedral, tan Γ = Δz/Δy per panel.
     """
 
     semispan_m: float
@@ -40,21 +53,90 @@ class Planform:
     outer_panel_start_m: float
     outer_sweep_rad: float
     x_cg_m: float
+    stations_m: tuple[float, ...] | None = None
+    chords_m: tuple[float, ...] | None = None
+    leading_edges_x_m: tuple[float, ...] | None = None
+    heights_m: tuple[float, ...] | None = None
+
+    @classmethod
+    def from_stations(cls, stations_m, chords_m, leading_edges_x_m, heights_m,
+                      x_cg_m: float) -> Planform:
+        """A planform linear between span stations (class docstring); ValueError if the
+        stations do not start at the root and increase, a chord is not positive, or the
+        root's leading edge is not the origin (x = z = 0)."""
+        y = tuple(float(v) for v in stations_m)
+        c = tuple(float(v) for v in chords_m)
+        x = tuple(float(v) for v in leading_edges_x_m)
+        z = tuple(float(v) for v in heights_m)
+        if len(y) < 2 or not len(y) == len(c) == len(x) == len(z):
+            raise ValueError("a planform needs >= 2 stations, each with a chord, leading "
+                             "edge and height")
+        if y[0] != 0.0 or any(b <= a for a, b in zip(y, y[1:], strict=False)):
+            raise ValueError(f"planform stations must start at 0 and increase, got {y}")
+        if any(not v > 0.0 for v in c) or not all(math.isfinite(v) for v in y + c + x + z):
+            raise ValueError("planform chords must be positive and every value finite")
+        if x[0] != 0.0 or z[0] != 0.0:
+            raise ValueError("the root leading edge is the wing frame's origin (x = z = 0)")
+        area_half = sum(0.5 * (c[i] + c[i + 1]) * (y[i + 1] - y[i]) for i in range(len(y) - 1))
+        return cls(semispan_m=y[-1], chord_m=area_half / y[-1], outer_panel_start_m=y[-1],
+                   outer_sweep_rad=0.0, x_cg_m=float(x_cg_m), stations_m=y, chords_m=c,
+                   leading_edges_x_m=x, heights_m=z)
 
     def chord_at(self, y_m: np.ndarray | float) -> np.ndarray:
         """Local chord c(y) [m] at spanwise stations ``y_m`` (|y| ≤ b/2)."""
         y = np.abs(np.asarray(y_m, dtype=float))
-        return np.full_like(y, self.chord_m)
+        if self.stations_m is None:
+            return np.full_like(y, self.chord_m)
+        return np.interp(y, self.stations_m, self.chords_m)
 
     def leading_edge_x_at(self, y_m: np.ndarray | float) -> np.ndarray:
         """Leading-edge position x_le(y) aft of the root leading edge [m]."""
         y = np.abs(np.asarray(y_m, dtype=float))
-        return np.maximum(y - self.outer_panel_start_m, 0.0) * math.tan(self.outer_sweep_rad)
+        if self.stations_m is None:
+            return np.maximum(y - self.outer_panel_start_m, 0.0) * math.tan(self.outer_sweep_rad)
+        return np.interp(y, self.stations_m, self.leading_edges_x_m)
+
+    def height_at(self, y_m: np.ndarray | float) -> np.ndarray:
+        """Leading-edge height z(y) above the root's [m] (positive up; the same on both
+        halves: dihedral)."""
+        y = np.abs(np.asarray(y_m, dtype=float))
+        if self.stations_m is None:
+            return np.zeros_like(y)
+        return np.interp(y, self.stations_m, self.heights_m)
+
+    @property
+    def has_dihedral(self) -> bool:
+        """True when any station's leading edge is off the root's plane (z ≠ 0)."""
+        return self.heights_m is not None and any(z != 0.0 for z in self.heights_m)
+
+    @property
+    def breaks_m(self) -> tuple[float, ...]:
+        """Span stations [m] strictly inside the half wing where the planform kinks (the
+        slope of the chord, the leading edge or the height changes): the vortex lattice
+        puts a strip edge on each so that every panel edge is straight. The constant-chord
+        form: its outer panel's start."""
+        if self.stations_m is None:
+            return (self.outer_panel_start_m,)
+        y = np.array(self.stations_m)
+        out = []
+        for i in range(1, y.size - 1):
+            for v in (self.chords_m, self.leading_edges_x_m, self.heights_m):
+                left = (v[i] - v[i - 1]) / (y[i] - y[i - 1])
+                right = (v[i + 1] - v[i]) / (y[i + 1] - y[i])
+                # a slope change above 1e-9 (the rounding of a file's numbers) is a kink
+                if abs(right - left) > 1e-9 * max(1.0, abs(left), abs(right)):
+                    out.append(float(y[i]))
+                    break
+        return tuple(out)
 
     @property
     def area_m2(self) -> float:
-        """Planform area of both halves [m²]."""
-        return 2.0 * self.semispan_m * self.chord_m
+        """Planform area of both halves [m²] (projected on the wing's plane: the
+        chords times the spanwise widths)."""
+        if self.stations_m is None:
+            return 2.0 * self.semispan_m * self.chord_m
+        y, c = self.stations_m, self.chords_m
+        return sum((c[i] + c[i + 1]) * (y[i + 1] - y[i]) for i in range(len(y) - 1))
 
     @property
     def span_m(self) -> float:

@@ -17,6 +17,13 @@ Model (``docs/structures.md``):
   section properties interpolated linearly between the given stations and integrated with
   4-point Gauss–Legendre quadrature per element (exact for the cubic × cubic × linear
   integrands of the bending mass matrix);
+* point masses (:class:`PointMass`: fuel, an engine, a pod, a tip mass) and vertical
+  springs (:class:`VerticalSpring`: the strut of a braced wing) at any station y_p: added
+  consistently, with the element's own shape functions at y_p (exact at a node, and no
+  mesh dependence of where the mass sits). A mass m at d aft of the elastic axis moves down
+  by w + d θ and turns with θ, so it adds m (N_w + d N_θ)ᵀ(N_w + d N_θ) + I_cg N_θᵀ N_θ to M
+  (I_cg its pitch inertia about its own centre of mass); a spring k adds k N_wᵀ N_w to K.
+  Neither adds rotary inertia of bending (the mass's roll inertia about y is left out);
 * generalised eigenproblem K φ = ω² M φ solved with :func:`scipy.linalg.eigh` as the inverted
   pencil M φ = μ K φ, μ = 1/ω², for its largest μ (:func:`_lowest_modes`): K's condition
   number is about 2e11 for the prototype's wing, and the direct pencil's lowest ω² came out
@@ -65,6 +72,35 @@ class BeamInputError(InputError):
     """Invalid beam section data; the message names the offending field."""
 
 
+@dataclass(frozen=True)
+class PointMass:
+    """A concentrated mass on the half wing (fuel, an engine, a pod, a tip mass).
+
+    ``y_m`` [m] its spanwise station (0 < y ≤ b/2); ``mass_kg`` [kg]; ``x_frac`` [-] the
+    chordwise position of its centre of mass as a fraction of the local chord aft of the
+    leading edge (negative ahead of the leading edge: a wing-mounted engine); its offset aft
+    of the elastic axis is (x_frac − x_E(y)) c(y); ``pitch_inertia_kg_m2`` [kg·m²] its own
+    moment of inertia about a spanwise axis through its centre of mass; ``name`` for
+    reports."""
+
+    y_m: float
+    mass_kg: float
+    x_frac: float
+    pitch_inertia_kg_m2: float = 0.0
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class VerticalSpring:
+    """A vertical (bending) spring to ground at ``y_m`` [m], ``stiffness_n_m`` [N/m]: the
+    strut of a braced wing at its attachment (a strut of axial stiffness EA/L at an angle γ
+    to the wing gives k = (EA/L) sin²γ); it acts on the elastic axis's deflection only."""
+
+    y_m: float
+    stiffness_n_m: float
+    name: str = ""
+
+
 @dataclass(frozen=True, eq=False)
 class BeamSections:
     """Section properties of the half-wing beam at spanwise stations (linear in between).
@@ -79,6 +115,8 @@ class BeamSections:
         chord_m: c(y) [m].
         x_elastic_frac, x_inertial_frac: axes as chord fractions aft of the leading edge [-].
         description: what these sections represent (copied into ModalData.source).
+        point_masses: concentrated masses on the beam (:class:`PointMass`).
+        springs: vertical springs to ground (:class:`VerticalSpring`: a strut).
     """
 
     stations_m: np.ndarray
@@ -90,6 +128,8 @@ class BeamSections:
     x_elastic_frac: np.ndarray
     x_inertial_frac: np.ndarray
     description: str = "beam sections"
+    point_masses: tuple[PointMass, ...] = ()
+    springs: tuple[VerticalSpring, ...] = ()
 
     def __post_init__(self) -> None:
         y = np.array(self.stations_m, dtype=float)
@@ -123,6 +163,27 @@ class BeamSections:
                 "BeamSections.torsional_inertia_kg_m: smaller than m'·((x_I − x_E)c)², "
                 "impossible for inertia about the elastic axis (mass matrix not positive)"
             )
+        object.__setattr__(self, "point_masses", tuple(self.point_masses))
+        object.__setattr__(self, "springs", tuple(self.springs))
+        semispan = float(y[-1])
+        for i, p in enumerate(self.point_masses):
+            values = (p.y_m, p.mass_kg, p.x_frac, p.pitch_inertia_kg_m2)
+            if not all(np.isfinite(v) for v in values):
+                raise BeamInputError(f"BeamSections.point_masses[{i}]: non-finite value")
+            if not 0.0 < p.y_m <= semispan:
+                raise BeamInputError(f"BeamSections.point_masses[{i}].y_m: {p.y_m:g} m is "
+                                     f"outside the beam (0, {semispan:g}] m (a mass at the "
+                                     "clamped root does not move)")
+            if not p.mass_kg > 0.0 or p.pitch_inertia_kg_m2 < 0.0:
+                raise BeamInputError(f"BeamSections.point_masses[{i}]: mass_kg must be "
+                                     "positive and pitch_inertia_kg_m2 not negative")
+        for i, k in enumerate(self.springs):
+            if not (np.isfinite(k.y_m) and 0.0 < k.y_m <= semispan):
+                raise BeamInputError(f"BeamSections.springs[{i}].y_m: {k.y_m:g} m is outside "
+                                     f"the beam (0, {semispan:g}] m")
+            if not (np.isfinite(k.stiffness_n_m) and k.stiffness_n_m > 0.0):
+                raise BeamInputError(f"BeamSections.springs[{i}].stiffness_n_m: must be "
+                                     "positive")
 
     @property
     def semispan_m(self) -> float:
@@ -141,8 +202,18 @@ class BeamSections:
 
     @property
     def half_wing_mass_kg(self) -> float:
-        """∫ m' dy over the half wing [kg] (trapezoid rule: exact for linear m')."""
-        return float(np.trapezoid(self.mass_per_length_kg_m, self.stations_m))
+        """∫ m' dy over the half wing [kg] (trapezoid rule: exact for linear m'), plus the
+        point masses."""
+        return (float(np.trapezoid(self.mass_per_length_kg_m, self.stations_m))
+                + sum(p.mass_kg for p in self.point_masses))
+
+    def point_mass_offset_m(self, mass: PointMass) -> float:
+        """(x_p − x_E(y_p)) c(y_p) [m]: the point mass's centre of mass aft of the elastic
+        axis (the chord and the axis interpolated at its station)."""
+        at = np.array([mass.y_m])
+        chord = float(np.interp(at, self.stations_m, self.chord_m)[0])
+        x_e = float(np.interp(at, self.stations_m, self.x_elastic_frac)[0])
+        return (mass.x_frac - x_e) * chord
 
     def at(self, y_m: np.ndarray) -> dict[str, np.ndarray]:
         """Linearly interpolated properties at ``y_m`` (EI, GJ, m', I_α', S_α')."""
@@ -250,7 +321,29 @@ def assemble(sections: BeamSections, n_elements: int = DEFAULT_N_ELEMENTS):
         idx = np.arange(3 * e, 3 * e + 6)
         k_glob[np.ix_(idx, idx)] += ke
         m_glob[np.ix_(idx, idx)] += me
+    for p in sections.point_masses:
+        idx, n_w, n_t = _point_shape(nodes, p.y_m)
+        n_p = n_w + sections.point_mass_offset_m(p) * n_t  # the mass's vertical motion
+        m_glob[np.ix_(idx, idx)] += (p.mass_kg * np.outer(n_p, n_p)
+                                     + p.pitch_inertia_kg_m2 * np.outer(n_t, n_t))
+    for spring in sections.springs:
+        idx, n_w, _ = _point_shape(nodes, spring.y_m)
+        k_glob[np.ix_(idx, idx)] += spring.stiffness_n_m * np.outer(n_w, n_w)
     return k_glob[3:, 3:], m_glob[3:, 3:], nodes
+
+
+def _point_shape(nodes: np.ndarray, y_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The element dofs at station ``y_m`` [m] and the rows N_w (deflection w, down) and
+    N_θ (twist) that interpolate w(y_m) and θ(y_m) from them (the element's own Hermite
+    and linear shape functions)."""
+    e = int(np.clip(np.searchsorted(nodes, y_m, side="right") - 1, 0, nodes.size - 2))
+    h = float(nodes[e + 1] - nodes[e])
+    xi = (float(y_m) - float(nodes[e])) / h
+    n_w = np.zeros(6)
+    n_t = np.zeros(6)
+    n_w[_W_DOFS] = _hermite(np.array([xi]), h)[0]
+    n_t[_T_DOFS] = (1.0 - xi, xi)
+    return np.arange(3 * e, 3 * e + 6), n_w, n_t
 
 
 @dataclass(frozen=True, eq=False)
