@@ -48,6 +48,7 @@ COMMAND_MODULES = (
     "compare",
     "loads",
     "export_jsbsim",
+    "import_modes",
     "info",
     "plot",
     "rerun",
