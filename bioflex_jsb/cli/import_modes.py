@@ -17,10 +17,11 @@ positive leading edge up], stations their distance from the first grid along SPA
 generalised masses from the deck's LAMA table in SI (x mass unit x length unit^2). Units
 of the deck: --length-unit m|mm|cm|in|ft, --mass-unit kg|t|g|slinch|slug. Axes: --span,
 --up, --aft each one of +x, -x, +y, -y, +z, -z of the deck's basic frame (defaults +y, +z,
-+x: x aft, y to starboard, z up; a negative axis is written --aft=-y). --elastic-axis and --centre-of-mass: chord fractions
-0..1 aft of the leading edge (the chord fraction of the grids' line, and of the sections'
-centre of mass). Frequencies must be 0.01..1e5 rad/s (a free-free deck's rigid-body modes
-are refused). An existing --out is refused unless --force."""
++x: x aft, y to starboard, z up; a negative axis is written --aft=-y). --elastic-axis
+and --centre-of-mass: chord fractions 0..1 aft of the leading edge (the chord fraction of
+the grids' line, and of the sections' centre of mass). Frequencies must be 0.01..1e5
+rad/s (a free-free deck's rigid-body modes are refused). An existing --out is refused
+unless --force."""
 
 
 def _grids(text: str) -> list[int]:

@@ -8,8 +8,8 @@ modes (:meth:`BeamWing.modes`) where it would read a modal file, so everything d
 (Table B1/B2, modes, flutter of the free aircraft, gust runs) is the modal file's path.
 
 Cache: the modes are kept in this process, keyed on :attr:`BeamWing.digest` (a SHA-256 of
-every number the modes depend on: the sections, point masses, springs, mesh, damping, and
-the description that becomes the modes' source) and the number of modes. A 40-element
+every number the modes depend on: the sections, point masses, springs, mesh and damping;
+not the description, which only names the modes' source) and the number of modes. A 40-element
 solve takes a few milliseconds (``structures/beam.py``: a 120-dof dense eigenproblem), so
 there is no disk cache: recomputing in a new process costs less than reading a file.
 """
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -41,7 +41,7 @@ def _digest(sections: BeamSections, n_elements: int, damping_ratio: float) -> st
     h.update(repr([(float(p.y_m), float(p.mass_kg), float(p.x_frac),
                     float(p.pitch_inertia_kg_m2)) for p in sections.point_masses]).encode())
     h.update(repr([(float(k.y_m), float(k.stiffness_n_m)) for k in sections.springs]).encode())
-    h.update(repr((int(n_elements), float(damping_ratio), sections.description)).encode())
+    h.update(repr((int(n_elements), float(damping_ratio))).encode())
     return h.hexdigest()
 
 
@@ -49,7 +49,8 @@ def _digest(sections: BeamSections, n_elements: int, damping_ratio: float) -> st
 class BeamWing:
     """Beam sections and the settings of their modes: ``n_elements`` finite elements,
     ``damping_ratio`` ζ [-] of every mode. Equal (and hashed) by :attr:`digest`, the
-    content, so a wing variant holding one keys the build cache on what it is."""
+    physical content, so a wing variant holding one keys the build cache on what it is
+    (the sections' description, the modes' source line, is not part of it)."""
 
     sections: BeamSections
     n_elements: int = DEFAULT_N_ELEMENTS
@@ -83,4 +84,6 @@ class BeamWing:
                 _MODES.popitem(last=False)
         else:
             _MODES.move_to_end(key)
+        if got.source != self.sections.description:  # the same beam under another name
+            got = replace(got, source=self.sections.description)
         return got

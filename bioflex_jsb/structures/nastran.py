@@ -131,17 +131,11 @@ def fe_modal_data(fe: FEModes, *, span: str = "+y", up: str = "+z", aft: str = "
         raise NastranError(f"{fe.source}: {exc}") from None
 
 
-def _grid_rows(uset, grid: int):
-    """The six rows of ``grid`` in pyyeti's USET table (x, y, z columns: its position in
-    basic; its output frame's id and type; the frame's origin; its axes), or None if it is
-    not a grid."""
-    try:
-        rows = uset.loc[grid]
-    except KeyError:
-        return None
-    if len(rows) != 6:
-        return None
-    return np.asarray(rows[["x", "y", "z"]], dtype=float)
+def _row_index(frame) -> dict[tuple[int, int], int]:
+    """{(id, dof): row} of a pyyeti table indexed by (id, dof)."""
+    ids = frame.index.get_level_values(0).to_numpy()
+    dofs = frame.index.get_level_values(1).to_numpy()
+    return {(int(i), int(d)): k for k, (i, d) in enumerate(zip(ids, dofs, strict=True))}
 
 
 def read_op2_modes(path: str | Path, grids) -> FEModes:
@@ -183,23 +177,26 @@ def read_op2_modes(path: str | Path, grids) -> FEModes:
     if vectors.shape[1] != n:
         raise NastranError(f"OP2 file {str(p)!r}: {vectors.shape[1]} eigenvectors for {n} "
                            "eigenvalues")
+    # pyyeti's USET table: six rows per grid, columns x, y, z: its position in basic (dof
+    # 1), its output frame's id and type (dof 2), the frame's origin and axes (dofs 3-6)
+    where = _row_index(uset)
+    table = np.asarray(uset[["x", "y", "z"]], dtype=float)
+    rows_of = _row_index(shapes)
+    values = np.asarray(shapes, dtype=float)  # rows (id, dof): T1..T3, R1..R3; columns modes
     positions, trans, rots = [], [], []
     for g in ids:
-        rows = _grid_rows(uset, g)
-        if rows is None:
+        if (g, 1) not in where or (g, 6) not in where:
             raise NastranError(f"grid {g} is not a grid of {str(p)!r} (its USET table)")
-        if int(rows[1, 0]) != 0:
+        if int(table[where[(g, 2)], 0]) != 0:
             raise NastranError(f"grid {g}: its displacements are in output frame "
-                               f"{int(rows[1, 0])}; grids with the basic frame as their "
-                               "output frame (GRID CD = 0) are accepted")
+                               f"{int(table[where[(g, 2)], 0])}; grids with the basic frame "
+                               "as their output frame (GRID CD = 0) are accepted")
         try:
-            u = np.asarray(shapes.loc[g], dtype=float)  # (6, n): T1..T3, R1..R3
+            u = values[[rows_of[(g, dof)] for dof in range(1, 7)]]  # (6, n)
         except KeyError:
             raise NastranError(f"grid {g}: no eigenvector rows in {str(p)!r} (DISP(PLOT) = "
                                "ALL writes them)") from None
-        if u.shape != (6, n):
-            raise NastranError(f"grid {g}: {u.shape[0]} displacement rows, 6 accepted")
-        positions.append(rows[0])
+        positions.append(table[where[(g, 1)]])
         trans.append(u[:3].T)
         rots.append(u[3:].T)
     return FEModes(
