@@ -13,12 +13,14 @@ elastic trim) take the aircraft's values, passed down as one
 :class:`~bioflex_jsb.parameters.airframe.AirframeData` (:meth:`Aircraft.airframe_data`:
 S, b, c̄, mass, inertia, the 22 rigid derivatives) carried by the wing's model and by every
 flight condition built for it, and the wing's planform (:meth:`Aircraft.planform`) carried
-by the :class:`WingBuild`; :meth:`Aircraft.linear_problem` says what they cannot take (a
-beam structure, derivatives from JSBSim, the prototype's membrane on another airframe).
+by the :class:`WingBuild`; :meth:`Aircraft.linear_problem` says what they cannot take
+(derivatives from JSBSim, the prototype's membrane on another airframe). A ``beam`` wing's
+modes are computed from its beam (:meth:`Aircraft.variant`: a
+:class:`~bioflex_jsb.structures.beam_wing.BeamWing`) and flow where a modal file's do.
 
 What flies: the nonlinear co-simulation (the JSBSim runs of ``gust``, ``compare``,
 ``trim``, ``export-jsbsim``) flies the generated prototype airframe with any wing (axes,
-ribs, damping, a modal file, the C_η1^Q1 pin) when the file's airframe is the prototype's
+ribs, damping, a modal file or a beam, the C_η1^Q1 pin) when the file's airframe is the prototype's
 (:meth:`Aircraft.flight_problem` is None: each field equal to 1e-9 relative, the rounding of
 a printed value), and another aircraft on its own JSBSim aircraft (``airframe.jsbsim``: a
 package aircraft such as the SGS, or a directory; a glider in its steady glide) when the

@@ -1,14 +1,15 @@
 """The elastic wing of a definition with an airframe (docs/aircraft.md, "The wing on an
 airframe"): its structure kinds, its flight-model settings, and its fit to the airframe.
 
-A wing that flies carries one chordwise position of each axis (the flight model's x_I, x_E:
-Eq. 11-12 of the paper), so the stations' ``elastic_axis`` and ``centre_of_mass`` are
-constant along the span (a modal file's [axes] may vary: their mean is the wing's, as for a
-variant file). Structure kinds: ``prototype-membrane`` (the prototype's membrane half wing
-as calibrated to Table 2, ribbed or not: parameters/wing_structure.py) and ``modal`` (a
-modal file, docs/structures.md), and ``beam`` (beam sections as a clamped wing has them:
-read and checked, analysed clamped; not flown yet: the flight build takes its modes from the
-other two, and :meth:`~bioflex_jsb.definition.aircraft.Aircraft.flight_problem` says so).
+The prototype's membrane wing carries one chordwise position of each axis (Eq. 11-12 of the
+paper), so its stations' ``elastic_axis`` and ``centre_of_mass`` are constant along the
+span; a modal file's [axes] and a beam's stations may vary (the modes carry them; their
+mean is the variant's, as for a variant file). Structure kinds: ``prototype-membrane`` (the
+prototype's membrane half wing as calibrated to Table 2, ribbed or not:
+parameters/wing_structure.py), ``modal`` (a modal file, docs/structures.md) and ``beam``
+(beam sections as a clamped wing has them, with point masses and struts: its modes are
+computed from the beam and take a modal file's place in the flight build,
+structures/beam_wing.py; the same wing is analysed clamped too).
 """
 
 from __future__ import annotations
@@ -90,7 +91,7 @@ def flying_structure(r: Reader, stations: tuple[WingStation, ...], base_dir: Pat
 
     t = r.table("structure", None)
     if t.get("kind", "beam") == "beam":
-        return None  # beam sections, read as for a clamped wing (analysed clamped)
+        return None  # beam sections, read as for a clamped wing (and flown as its modes)
     r.keys(t, "structure", ("kind", "ribs", "modes_file", "damping_ratio", "n_modes"))
     kind = r.choice(t, "structure", "kind", FLYING_KINDS + ("beam",), None)
     zeta = r.number(t, "structure", "damping_ratio", *DAMPING_RANGE, "(ratio)",
@@ -131,7 +132,8 @@ def _pin(r: Reader, at: dict, key: str) -> float | None:
 def flying_wing(r: Reader, wing: dict, at: dict, aero: AeroSettings, name: str,
                 beam: bool = False) -> FlyingWing:
     """The flight-model settings of the wing (``[wing] name``, ``[aero]`` pins); a ``beam``
-    wing keeps the clamped wing's [aero] settings (it is analysed clamped)."""
+    wing keeps the clamped wing's [aero] settings too (for its clamped analysis; in flight
+    it takes the vortex lattice as every flying wing does)."""
     if not beam and "model" in at:
         raise r.fail("aero.model", "is a clamped-wing setting; an aircraft's commands choose "
                      "the aerodynamic model with --aero (docs/aircraft.md)")
@@ -156,8 +158,8 @@ def flight_refusal(aircraft) -> str | None:
     ``None``. The prototype's airframe (``aircraft.flight_problem()`` is None: every field
     the prototype's) flies with any wing. Another airframe flies on its own JSBSim aircraft
     (``airframe.jsbsim``: a package aircraft or a directory) when the linear analyses take
-    it (:meth:`~bioflex_jsb.definition.aircraft.Aircraft.linear_problem`: a modal wing, the
-    derivatives as a table: the wing's loads are built from them) and the file gives the
+    it (:meth:`~bioflex_jsb.definition.aircraft.Aircraft.linear_problem`: a beam or modal
+    wing, the derivatives as a table: the wing's loads are built from them) and the file gives the
     speeds it flies at (``airframe.cruise_speed_m_s``, ``speed_range_m_s``). The generated
     ``bioflex`` airframe with other numbers cannot fly: its JSBSim model holds the
     prototype's numbers (:meth:`flight_problem`'s line says which field differs)."""
