@@ -34,8 +34,11 @@ Loads per unit span (Q dynamic pressure [Pa], V airspeed [m/s]):
   θ_i) η̈_i including gravity (n_z the load factor at the CG, positive up; q̇ the pitch
   acceleration, nose up), so f = −m' n_z g + m' (x_I − x_cg) q̇ + Σ (m' φ_i + S' θ_i) η̈_i and
   t = S' n_z g − (I' + S'(x_E − x_cg)) q̇ − Σ (S' φ_i + I' θ_i) η̈_i, with m', S', I' the
-  beam's mass, static moment and torsional inertia about the elastic axis per span.
-  Centripetal terms (q²) and the chordwise loads are left out.
+  beam's mass, static moment and torsional inertia about the elastic axis per span; a
+  beam's point mass M (its centre of mass d aft of the elastic axis, its own pitch inertia
+  I_cg) adds the same terms concentrated at its station, with M, M d, I_cg + M d².
+  Centripetal terms (q²) and the chordwise loads are left out; a strut-braced beam has no
+  force summation (the strut's reaction k w is not a signal of z).
 
 Every FS load is linear in one signal vector z (:data:`SIGNALS`), so a
 :class:`LoadsModel` holds one matrix and the LTI model's loads outputs follow from it
@@ -185,17 +188,17 @@ class LoadsModel:
 
 
 def _sections(variant):
-    """The beam sections of a beam-model variant (mass, stiffness): a definition's beam wing's
-    own, else the prototype's membrane beam; refused for a modes file, and for a beam with
-    point masses or struts (the force summation has no concentrated loads: it would leave
-    out their inertia and the strut's reaction)."""
+    """The beam sections of a beam-model variant (mass, stiffness, point masses): a
+    definition's beam wing's own, else the prototype's membrane beam; refused for a modes
+    file, and for a beam with struts (the force summation has no signal of the deflection
+    itself, which the strut's reaction is)."""
     if variant.beam is not None:
         sections = variant.beam.sections
-        if sections.point_masses or sections.springs:
+        if sections.springs:
             raise InputError(
-                f"wing {variant.name!r}: section loads of a beam with point masses or struts "
-                "are not modelled (the force summation has no concentrated loads: it would "
-                "leave out their inertia and the strut's reaction)")
+                f"wing {variant.name!r}: section loads of a strut-braced beam are not "
+                "modelled (the force summation would leave out the strut's reaction, a load "
+                "of the deflection that its signals do not carry)")
         return sections
     if variant.modes_file:
         raise InputError(
@@ -324,6 +327,29 @@ def _cells(breaks: np.ndarray, width: float) -> tuple[np.ndarray, np.ndarray]:
         mids.append(0.5 * (edges[:-1] + edges[1:]))
         widths.append(np.diff(edges))
     return np.concatenate(mids), np.concatenate(widths)
+
+
+def _point_mass_rows(mass, sections, modes, planform, stations_m: np.ndarray,
+                     n_signals: int, n: int) -> np.ndarray:
+    """(3 s, signals) force-summation rows of a point mass (a beam's ``PointMass``) at the
+    stations inboard of it: the distributed inertia's terms (module docstring) with m' → M,
+    S' → M d, I' → I_cg + M d² (d its offset aft of the elastic axis), concentrated at y_p;
+    its columns are the inertial signals g·n_z, q̇, η̈_i."""
+    y = np.array([mass.y_m])
+    d = sections.point_mass_offset_m(mass)
+    static, inertia = mass.mass_kg * d, mass.pitch_inertia_kg_m2 + mass.mass_kg * d * d
+    x_le, chord = float(planform.leading_edge_x_at(y)[0]), float(planform.chord_at(y)[0])
+    x_e = x_le + float(np.interp(y, sections.stations_m, sections.x_elastic_frac)[0]) * chord
+    arm_cg_i, arm_cg_e = x_e + d - planform.x_cg_m, x_e - planform.x_cg_m
+    phi = np.array([np.interp(y, modes.stations_m, b)[0] for b in modes.bending_m])
+    theta = np.array([np.interp(y, modes.stations_m, t)[0] for t in modes.twist_rad])
+    f, t = np.zeros(n_signals), np.zeros(n_signals)
+    first = 3 + 2 * n  # g·n_z, then q̇, then η̈_i (signal_names)
+    f[first:] = [-mass.mass_kg, mass.mass_kg * arm_cg_i, *(mass.mass_kg * phi + static * theta)]
+    t[first:] = [static, -(inertia + static * arm_cg_e), *(-(static * phi + inertia * theta))]
+    inboard = (mass.y_m > stations_m).astype(float)[:, None]
+    arm = np.maximum(mass.y_m - stations_m, 0.0)[:, None]
+    return np.vstack([inboard * f, inboard * arm * f, inboard * t])
 
 
 def _md_matrix(sections, modes, stations_m: np.ndarray) -> np.ndarray:
@@ -484,6 +510,8 @@ def build_loads_model(build, speed_m_s: float, stations=None, *,
     a_v = out * wc[None, :]
     a_m = a_v * (yc[None, :] - ys[:, None])
     fs = np.vstack([a_v @ f_coef, a_m @ f_coef, a_v @ t_coef])
+    for mass in getattr(sections, "point_masses", ()):
+        fs += _point_mass_rows(mass, sections, modes, planform, ys, fs.shape[1], n)
     if static == "elastic":
         from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
 
