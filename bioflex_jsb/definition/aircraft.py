@@ -319,7 +319,7 @@ class Aircraft:
         if isinstance(d.structure, MembraneStructure) and a.jsbsim != GENERATED:
             return (f"{head}structure.kind = 'prototype-membrane' is the prototype's wing "
                     "(its calibrated half-wing beam); on another airframe give the wing's "
-                    "modes in a 'modal' file")
+                    "beam (kind = 'beam') or its modes in a 'modal' file")
         if isinstance(d.structure, MembraneStructure) and d.structure.n_modes != FLYING_N_MODES:
             return f"{head}structure.n_modes must be {FLYING_N_MODES}"
         return None
