@@ -590,8 +590,8 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     ``aero``, ``method`` (``pk`` or ``state-space``), ``lift_slope``, ζ and
     ``density_kg_m3`` [kg/m^3] default to the definition's; the range to the one derived
     from the wing (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`).
-    ``progress(speed, top)`` [m/s] is called as the scan goes; ``full_scan``: scan the
-    whole range (for the diagram)."""
+    ``progress`` is called as ``progress(speed, top)`` [m/s] while the scan goes;
+    ``full_scan``: scan the whole range (for the diagram)."""
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
