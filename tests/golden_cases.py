@@ -92,6 +92,18 @@ SGS_AIRCRAFT, SGS_SPEED_M_S, SGS_GUST, SGS_DURATION_S = "sgs_elastic", 25.0, "1c
 # (scripts/platform_spread.py's configurations, the SGS cases flown in each: see
 # SGS_MEASURED_SPREAD): written beside the figures in the test (tests/test_golden.py).
 SGS_RTOL_OF_RANGE = 1e-9
+# The powered aircraft's case: JSBSim's c172p with its beam wing
+# (bioflex_jsb/data/aircraft/c172_elastic.toml), everything rigid from its JSBSim model (its
+# derivatives identified at its trims: runtime/identification.py), in level flight at 55 m/s
+# (inside its 31-69 m/s) through a 2 m/s, 30 m (20 chords) 1-cos gust from 0.5 s, 3 s at the
+# default step: tests/golden/c172_<model>.csv, its wing tests/golden/c172_wing.json and the
+# rigid derivatives it flew with tests/golden/c172_airframe.json (both results of the
+# build: the beam's modes, the identification). Tolerances: the prototype's rule (1e-9).
+C172_CASES = ("c172_rigid", "c172_coupled", "c172_qsd")
+C172_WING_CASES = ("c172_coupled", "c172_qsd")
+C172_WING_FILE = GOLDEN_DIR / "c172_wing.json"
+C172_AIRFRAME_FILE = GOLDEN_DIR / "c172_airframe.json"
+C172_AIRCRAFT, C172_SPEED_M_S, C172_GUST, C172_DURATION_S = "c172_elastic", 55.0, "1cos:2:30", 3.0
 # Angles stored modulo 2 pi: compared by their wrapped difference, scaled by the range of the
 # unwrapped history (the heading sits at 0 and a last-bit change flips it to 2 pi).
 WRAPPED_CHANNELS = ("psi_rad",)
@@ -231,6 +243,91 @@ def write_sgs() -> None:
         print(f"wrote tests/golden/{case}.csv ({len(run.time_s)} steps)")
 
 
+def c172_aircraft():
+    """The c172 definition of the powered golden case, completed from its JSBSim model."""
+    from bioflex_jsb.definition.aircraft import load_aircraft
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
+
+    return complete(load_aircraft(C172_AIRCRAFT))
+
+
+def airframe_to_dict(airframe) -> dict:
+    """An AirframeData's identified derivatives (its schedule) as plain JSON values."""
+    sched = airframe.schedule
+    return {"speeds_m_s": list(sched.speeds_m_s), "source": sched.source,
+            "points": [wing_to_dict(p) for p in sched.points]}
+
+
+def airframe_from_dict(data: dict, airframe):
+    """``airframe`` (an AirframeData) with the stored schedule in place of its own."""
+    from bioflex_jsb.parameters.airframe import DerivativeSchedule, RigidAerodynamics
+
+    sched = DerivativeSchedule(tuple(data["speeds_m_s"]),
+                               tuple(RigidAerodynamics(**p) for p in data["points"]),
+                               data["source"])
+    return dataclasses.replace(airframe, schedule=sched,
+                               aero=sched.at(c172_aircraft().airframe.cruise_speed_m_s))
+
+
+def compare_airframe(stored_data: dict, airframe) -> dict[str, float]:
+    """Largest |built − stored| of each identified derivative over the schedule's speeds,
+    as a fraction of its largest stored magnitude."""
+    got = airframe_to_dict(airframe)
+    if got["speeds_m_s"] != stored_data["speeds_m_s"]:
+        raise AssertionError(f"schedule speeds {got['speeds_m_s']} vs stored "
+                             f"{stored_data['speeds_m_s']}")
+    out = {}
+    for key in stored_data["points"][0]:
+        ref = np.array([p[key] for p in stored_data["points"]])
+        new = np.array([p[key] for p in got["points"]])
+        scale = float(np.max(np.abs(ref)))
+        out[key] = float(np.max(np.abs(new - ref)) / scale) if scale > 0 else float(
+            np.max(np.abs(new)))
+    return out
+
+
+def c172_stored_wing():
+    """The c172 wing and airframe the stored histories were flown with."""
+    aircraft = c172_aircraft()
+    stored_airframe = json.loads(C172_AIRFRAME_FILE.read_text(encoding="utf-8"))
+    airframe = airframe_from_dict(stored_airframe, aircraft.airframe_data())
+    data = json.loads(C172_WING_FILE.read_text(encoding="utf-8"))
+    return dataclasses.replace(wing_from_dict(data), airframe=airframe)
+
+
+def c172_built_wing():
+    """The c172 wing built now (its beam's modes, its derivatives identified now)."""
+    return c172_aircraft().wing().model
+
+
+def fly_c172_case(case: str, wing="stored", **setup):
+    """Fly one c172 golden case on its own JSBSim airframe; ``wing`` as :func:`fly_case`'s."""
+    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    aircraft = c172_aircraft()
+    if isinstance(wing, str):
+        wing = {"stored": c172_stored_wing, "built": c172_built_wing}[wing]()
+    gust = parse_gust(C172_GUST, aircraft.airframe.mean_chord_m)
+    run_setup = RunSetup(C172_SPEED_M_S, gust, C172_DURATION_S, **setup)
+    return run_gust(airframe_for(aircraft), wing, case.removeprefix("c172_"), run_setup)
+
+
+def write_c172() -> None:
+    """Re-record the c172 case (its wing, its derivatives and its histories)."""
+    wing = c172_built_wing()
+    C172_AIRFRAME_FILE.write_text(json.dumps(airframe_to_dict(wing.airframe), indent=1)
+                                  + "\n", encoding="utf-8")
+    data = wing_to_dict(wing)
+    data.pop("airframe")  # stored beside it (c172_airframe.json)
+    C172_WING_FILE.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    for case in C172_CASES:
+        run = fly_c172_case(case, wing)
+        write_csv(GOLDEN_DIR / f"{case}.csv", run)
+        print(f"wrote tests/golden/{case}.csv ({len(run.time_s)} steps)")
+
+
 def write_csv(path: Path, run) -> None:
     names = list(run.channels)
     with path.open("w", newline="") as fh:
@@ -303,12 +400,17 @@ def main(argv: list[str] | None = None) -> int:
                         help="re-record the stored histories and wing (after a physics change)")
     parser.add_argument("--write-sgs", action="store_true",
                         help="re-record the SGS case alone (its wing and histories)")
+    parser.add_argument("--write-c172", action="store_true",
+                        help="re-record the c172 case alone (its wing, derivatives, histories)")
     parser.add_argument("--sgs", action="store_true",
                         help="check the SGS case alone: print the worst channel of each run")
     args = parser.parse_args(argv)
     GOLDEN_DIR.mkdir(exist_ok=True)
     if args.write_sgs:
         write_sgs()
+        return 0
+    if args.write_c172:
+        write_c172()
         return 0
     if args.sgs:
         worst = compare_wing(json_wing := sgs_stored_wing(), sgs_built_wing())

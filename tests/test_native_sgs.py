@@ -402,7 +402,7 @@ def test_cli_run_takes_the_aircrafts_speeds(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["speed_m_s"] == 25.0
     with pytest.raises(UsageError) as exc:
         _run_with_aircraft(["--out", str(tmp_path / "b"), "--speed", "30"])
-    assert "outside aircraft 'sgs_elastic''s speeds 20..28 m/s" in _one_line(exc)
+    assert "outside 20..28 m/s, the flight speeds of aircraft 'sgs_elastic'" in _one_line(exc)
     assert not (tmp_path / "b").exists()
 
 

@@ -137,7 +137,8 @@ def test_gust_and_trim_take_the_shipped_glider(capsys):
     # its speeds and its chord are the aircraft's: one line, exit 2
     code, _, err = run_cli(capsys, "gust", "--aircraft", "sgs_elastic", "--speed", "15",
                            "--no-log")
-    assert_one_line_error(code, err, "outside aircraft 'sgs_elastic''s speeds 20..28 m/s")
+    assert_one_line_error(code, err,
+                          "outside 20..28 m/s, the flight speeds of aircraft 'sgs_elastic'")
     code, _, err = run_cli(capsys, "gust", "--aircraft", "sgs_elastic", "--gust",
                            "1cos:1:0.5", "--no-log")
     assert_one_line_error(code, err, "shorter than one mean chord (accepted: 0.99974")
@@ -236,7 +237,7 @@ def test_a_glider_without_its_speeds_flies_at_the_speeds_of_its_jsbsim_model(tmp
     trim = json.loads(out)
     assert trim["speed_m_s"] == pytest.approx(28.0)
     code, _, err = run_cli(capsys, "trim", "--aircraft", str(definition), "--speed", "29")
-    assert_one_line_error(code, err, "outside aircraft 'sgs_elastic'")
+    assert_one_line_error(code, err, "the flight speeds of aircraft 'sgs_elastic'")
     bad = text.replace("[airframe]", "[airframe]\nspeed_range_m_s = [28.0, 20.0]", 1)
     definition.write_text(bad + "\n", encoding="utf-8")
     code, _, err = run_cli(capsys, "gust", "--aircraft", str(definition), "--no-log")

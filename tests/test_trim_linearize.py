@@ -12,6 +12,7 @@ from bioflex_jsb import units as U
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
 from bioflex_jsb.runtime import fdm as jsbsim_fdm
+from bioflex_jsb.runtime.companion import RPM_SETTLE_MAX_S
 
 REPO = Path(__file__).resolve().parents[1]
 SPEEDS_M_S = (10.0, 12.5, 15.0, 20.0, 25.0)  # the trim sweep
@@ -239,7 +240,7 @@ def test_flying_instance_is_set_to_the_companion_trim(airframe):
         assert acc * U.FT_PER_M <= jsbsim_fdm.TRIM_TOLERANCE_FT_S2
         for key in ("qdot_rad_s2", "pdot_rad_s2", "rdot_rad_s2"):
             assert abs(t.residuals[key]) <= jsbsim_fdm.TRIM_TOLERANCE_RAD_S2
-        assert 0.0 < airframe.last_rpm_settle_s < jsbsim_fdm.RPM_SETTLE_MAX_S
+        assert 0.0 < airframe.last_rpm_settle_s < RPM_SETTLE_MAX_S
 
 
 def test_propeller_rpm_follows_the_airspeed_quickly(airframe):

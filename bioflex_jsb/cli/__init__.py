@@ -99,6 +99,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None) -> int:
     from bioflex_jsb.cli import common
+    from bioflex_jsb.cli.case import check_speed
 
     parser = build_parser()
     try:
@@ -112,6 +113,9 @@ def _main(argv: list[str] | None) -> int:
         common.SIGNALS.command = args.command
     name = f"bioflex-jsb {args.command}"
     try:
+        if getattr(args, "aircraft_definition", None) is not None or \
+                getattr(args, "aircraft", None) is None:  # trim/linearize: theirs at run
+            check_speed(args)
         status = int(args.run(args) or 0)
     except (UsageError, InputError) as exc:  # what the user can fix: one line, exit 2
         print(f"{name}: error: {' '.join(str(exc).split())}", file=sys.stderr)

@@ -136,25 +136,22 @@ def resolve_flight(args: argparse.Namespace) -> None:
     """The trim speed and gust of a flight command from the aircraft (``--aircraft``, else
     the prototype): ``--speed`` not given (None or the marked :class:`CruiseSpeed`
     default) is the aircraft's cruise speed (the prototype's 15 m/s, Table 1), a given one
-    must lie in its ``airframe.speed_range_m_s`` (the
-    prototype's 5-40 m/s: the option's own check), and a 1-cos length or turbulence scale
+    must lie in its flight speeds (cli/case.py check_speed: the prototype's 5-40 m/s), and
+    a 1-cos length or turbulence scale
     must be at least the aircraft's mean chord (simulation/gusts.py). One line (a
     UsageError, exit 2) otherwise."""
-    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S
+    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S, check_speed
     from bioflex_jsb.cli.common import UsageError
     from bioflex_jsb.definition.flying import flight_speeds
 
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is None:
-        cruise, speeds, chord = DEFAULT_SPEED_M_S, None, None
+        cruise, chord = DEFAULT_SPEED_M_S, None
     else:
-        (cruise, speeds), chord = flight_speeds(aircraft), aircraft.airframe.mean_chord_m
+        (cruise, _speeds), chord = flight_speeds(aircraft), aircraft.airframe.mean_chord_m
+    check_speed(args)
     if args.speed is None or isinstance(args.speed, CruiseSpeed):
         args.speed = float(cruise)
-    elif speeds is not None and not speeds[0] <= args.speed <= speeds[1]:
-        raise UsageError(f"--speed {args.speed:g} m/s is outside aircraft {aircraft.name!r}'s "
-                         f"speeds {speeds[0]:g}..{speeds[1]:g} m/s (its airframe."
-                         "speed_range_m_s)")
     gust = getattr(args, "gust", None)
     # a parsed gust (gust, compare, sitl) is read again with the chord; loads parses its
     # own text (str) with the chord when it flies

@@ -28,7 +28,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.gust import damping_ratio, wing_for_run
 from bioflex_jsb.flight_dynamics import eigen
-from bioflex_jsb.flight_dynamics.lti import RIGID_BLOCK_ANALYTIC
+from bioflex_jsb.flight_dynamics.lti import rigid_block_note
 from bioflex_jsb.sinks.mcap import scene_modes
 
 PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
@@ -57,7 +57,8 @@ def register(sub) -> None:
     add_wing_arguments(p, default=DEFAULT_WING)
     p.add_argument(
         "--speed", type=airspeed, action="append", metavar="V",
-        help=f"airspeed [m/s], {SPEED_MIN_M_S:g}..{SPEED_MAX_M_S:g}; repeat for several "
+        help=f"airspeed [m/s] (the prototype {SPEED_MIN_M_S:g}..{SPEED_MAX_M_S:g}; an "
+        "--aircraft 1..110); repeat for several "
         f"speeds (default {DEFAULT_SPEED_M_S:g}; an --aircraft's own cruise speed)",
     )
     p.add_argument(
@@ -131,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         "wing": build.variant.name,
         "mass_basis": build.mass_basis,
         "overrides": dict(build.model.coefficients.overrides),
-        "rigid_block": RIGID_BLOCK_ANALYTIC,
+        "rigid_block": rigid_block_note(None, build.model.airframe),
         "results": [s.as_dict() for s in results],
         "unstable": [{"speed_m_s": s.speed_m_s, "model": s.model, "mode": m.mode,
                       "branch": m.branch, "re": m.re, "im": m.im}

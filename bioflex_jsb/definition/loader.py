@@ -41,7 +41,7 @@ SHIPPED = ("goland",)
 # The second aircraft (JSBSim's SGS glider with an estimated elastic wing: docs/aircraft.md)
 # and its wing clamped: loaded by name too (load_aircraft("sgs_elastic"),
 # load_definition("sgs_wing")); not benchmark wings.
-OTHER_SHIPPED = ("sgs_wing", "sgs_elastic")
+OTHER_SHIPPED = ("sgs_wing", "sgs_elastic", "c172_elastic")
 ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT + OTHER_SHIPPED
 FORMAT_VERSION = 1
 

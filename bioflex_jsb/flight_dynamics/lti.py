@@ -385,7 +385,7 @@ def build_state_space(
             raise ValueError("elastic= is for the sensitivity models, without controls")
         return _with_controls(model, condition, wing, aero, a_rr)
     common = dict(inputs=("w_g",), input_units=("m/s",), speed_m_s=condition.speed_m_s)
-    block = {"rigid_block": rigid_block_note(a_rr)}
+    block = {"rigid_block": rigid_block_note(a_rr, condition.airframe)}
     if model == "rigid":
         a, g = rigid_matrices(rigid_derivatives(condition, aero))
         if a_rr is not None:
@@ -437,13 +437,21 @@ def build_state_space(
 # Table B2 derivatives, with the thrust independent of airspeed (the propeller's dT/dV
 # missing from X_u: the coupled phugoid is near neutral, docs/aeroelasticity.md "Two coupled
 # LTI models"), or JSBSim's linearization of the airframe at the trim (``a_rr``), which has it.
+# A JSBSim aircraft's derivatives identified from its own model carry the thrust's speed
+# derivative (C_Tu, runtime/identification.py): its analytic block has it.
 RIGID_BLOCK_ANALYTIC = "analytic (Table B2; thrust independent of airspeed)"
+RIGID_BLOCK_IDENTIFIED = ("analytic, derivatives identified from the JSBSim aircraft (with "
+                          "the thrust's change with airspeed)")
 RIGID_BLOCK_JSBSIM = "JSBSim linearization (with the propeller's thrust change)"
 
 
-def rigid_block_note(a_rr: np.ndarray | None) -> str:
-    """The ``rigid_block`` note of a model built with ``a_rr`` (None: the analytic one)."""
-    return RIGID_BLOCK_ANALYTIC if a_rr is None else RIGID_BLOCK_JSBSIM
+def rigid_block_note(a_rr: np.ndarray | None, airframe: AirframeData | None = None) -> str:
+    """The ``rigid_block`` note of a model built with ``a_rr`` (None: the analytic one) for
+    ``airframe`` (an identified schedule's block says so)."""
+    if a_rr is not None:
+        return RIGID_BLOCK_JSBSIM
+    identified = airframe is not None and airframe.schedule is not None
+    return RIGID_BLOCK_IDENTIFIED if identified else RIGID_BLOCK_ANALYTIC
 
 
 def _with_controls(model, condition, wing, aero, a_rr) -> StateSpace:
@@ -459,7 +467,7 @@ def _with_controls(model, condition, wing, aero, a_rr) -> StateSpace:
     d_ctrl = np.zeros((base.d.shape[0], 2))
     notes = dict(base.notes, aerodynamics=AERODYNAMIC_MODEL,
                  density_kg_m3=condition.density_kg_m3, trim_cl=condition.cl_trim,
-                 rigid_block=rigid_block_note(a_rr))
+                 rigid_block=rigid_block_note(a_rr, condition.airframe))
     ss = StateSpace(
         model=base.model, speed_m_s=base.speed_m_s, a=base.a,
         b=np.hstack([base.b, b_ctrl]), c=base.c, d=np.hstack([base.d, d_ctrl]),

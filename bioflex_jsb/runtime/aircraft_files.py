@@ -6,11 +6,12 @@ Where JSBSim looks (JSBSim 1.2-1.3: ``FGModel::FindFullPathName`` and its overri
 
 * the aircraft file ``<aircraft dir>/<name>.xml``;
 * a top-level section with a ``file`` attribute (``<aerodynamics file=…/>``,
-  ``<mass_balance file=…/>``, …): the aircraft directory;
-* an engine or a thruster (``<engine file=…>``, ``<thruster file=…>``): the aircraft's
-  ``Engines/``, then the root's ``engine/``, then the aircraft directory;
-* a system (``<system file=…>``, ``<autopilot file=…>``, ``<flight_control file=…>``): the
-  aircraft's ``Systems/``, then the root's ``systems/``, then the aircraft directory.
+  ``<mass_balance file=…/>``, ``<autopilot file=…>``, ``<flight_control file=…>``, …): the
+  aircraft directory;
+* an engine or a thruster (``<engine file=…>``, ``<thruster file=…>``): the aircraft
+  directory, then its ``Engines/``, then the root's ``engine/``;
+* a system (``<system file=…>``): the aircraft directory, then its ``Systems/``, then the
+  root's ``systems/``.
 
 The root of an aircraft in a user's directory ``ROOT/aircraft/NAME/NAME.xml`` is ``ROOT``
 (its ``engine/`` and ``systems/`` come first); after it, the jsbsim package's own root, so
@@ -56,7 +57,7 @@ MAX_TOTAL_BYTES = 64 * 1024 * 1024
 MAX_FILES = 400
 
 ENGINE_ELEMENTS = ("engine", "thruster")
-SYSTEM_ELEMENTS = ("system", "autopilot", "flight_control")
+SYSTEM_ELEMENTS = ("system",)
 # Top-level sections JSBSim would open as sockets or output files: not copied.
 DROPPED_SECTIONS = ("input", "output")
 
@@ -108,9 +109,9 @@ def _inside(path: Path, folders: tuple[Path, ...]) -> bool:
 def _search(aircraft_dir: Path, element: str) -> tuple[Path, ...]:
     roots = [r for r in (user_root(aircraft_dir), package_root()) if r is not None]
     if element in ENGINE_ELEMENTS:
-        return (aircraft_dir / "Engines", *(r / "engine" for r in roots), aircraft_dir)
+        return (aircraft_dir, aircraft_dir / "Engines", *(r / "engine" for r in roots))
     if element in SYSTEM_ELEMENTS:
-        return (aircraft_dir / "Systems", *(r / "systems" for r in roots), aircraft_dir)
+        return (aircraft_dir, aircraft_dir / "Systems", *(r / "systems" for r in roots))
     return (aircraft_dir,)
 
 
@@ -131,7 +132,8 @@ def named_files(aircraft_path: Path, tree: ET.ElementTree,
         if el.tag in SYSTEM_ELEMENTS and str(rel) in skip:
             continue
         folders = _search(aircraft_dir, el.tag)
-        source = next((f / rel for f in folders if (f / rel).exists()), None)
+        found_in = next((f for f in folders if (f / rel).exists()), None)
+        source = None if found_in is None else found_in / rel
         if source is None:
             where = ", ".join(str(f) for f in folders)
             raise AircraftLoadError(f"{str(aircraft_path)!r}: <{el.tag} file="
@@ -141,8 +143,13 @@ def named_files(aircraft_path: Path, tree: ET.ElementTree,
         if not _inside(source, allowed):
             raise AircraftLoadError(f"{str(source)!r} (<{el.tag} file={el.get('file')!r}>) "
                                     "is a link leading out of the aircraft's folders: refused")
-        first = folders[0].relative_to(aircraft_dir) if folders[0] != aircraft_dir else None
-        target = PurePosixPath(*(first.parts if first else ()), *rel.parts)
+        # where the copy puts it: as found in the aircraft's folders, a root's engine/ or
+        # systems/ file in the copy's Engines/ or Systems/ (JSBSim's next place to look)
+        if found_in in (aircraft_dir, aircraft_dir / "Engines", aircraft_dir / "Systems"):
+            first = found_in.relative_to(aircraft_dir).parts
+        else:
+            first = ("Engines",) if el.tag in ENGINE_ELEMENTS else ("Systems",)
+        target = PurePosixPath(*first, *rel.parts)
         found.append(NamedFile(el.tag, el.get("file"), source, target))
         if len(found) > MAX_FILES:
             raise AircraftLoadError(f"{str(aircraft_path)!r} names more than {MAX_FILES} "

@@ -6,12 +6,12 @@ JSBSim finds it (:mod:`bioflex_jsb.runtime.aircraft_files`). A JSBSim aircraft i
 with its engines stopped; the co-simulation flies them running:
 
 * every kind: JSBSim's own ``propulsion/set-running`` (``FGPropulsion::InitRunning``: a
-  piston's magnetos on both, a turbine's spools at idle, the starter not needed), after the
-  initial condition is run so that the engines see the flight's air;
-* piston: the mixture lever full rich (``fcs/mixture-cmd-norm[i]`` = 1; JSBSim's piston
-  runs rich of best power there, the pilot's setting for climb and low altitude) and, on a
-  constant-speed propeller, the propeller lever fully forward (``fcs/advance-cmd-norm[i]``
-  = 1: the highest governed RPM), as a pilot sets them before take-off;
+  piston's magnetos on both, its propeller at twice its idle RPM and its mixture leaned
+  for the air's pressure, p/(29.92 inHg × 1.3), as a pilot leans it; a turbine's spools
+  at idle; the starter not needed), after the initial condition is run so that the
+  engines see the flight's air;
+* piston: nothing more (JSBSim's propeller lever, ``fcs/advance-cmd-norm``, is left where
+  the aircraft's file puts it: set to 1 it stopped the pa28's IO-360 in every trim);
 * turboprop: the condition lever (JSBSim's mixture command) forward;
 * electric: nothing more (a motor runs when it has a throttle);
 * rocket: refused (a rocket's burn is not a steady flight to trim).
@@ -78,8 +78,7 @@ def start(fdm, engines: tuple[Engine, ...]) -> None:
     fdm.run_ic()
     fdm["propulsion/set-running"] = -1
     for e in engines:
-        levers = {"piston": ("fcs/mixture-cmd-norm", "fcs/advance-cmd-norm"),
-                  "turboprop": ("fcs/mixture-cmd-norm",)}.get(e.kind, ())
+        levers = {"turboprop": ("fcs/mixture-cmd-norm",)}.get(e.kind, ())
         for lever in levers:
             name = f"{lever}[{e.index}]"
             if manager.hasNode(name):

@@ -71,9 +71,9 @@ import numpy as np
 from bioflex_jsb import units as U
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
-from bioflex_jsb.parameters.airframe import PROPULSION
 from bioflex_jsb.runtime.aircraft_files import alpha_limits_rad
-from bioflex_jsb.runtime.engines import engines_of, zero_thrust_advance_ratio
+from bioflex_jsb.runtime.companion import fly_at_companion_trim, spin_up_propellers
+from bioflex_jsb.runtime.engines import engines_of
 from bioflex_jsb.runtime.engines import start as start_engines
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, LogRecord, captured
 from bioflex_jsb.runtime.linearization import reduce_to_rigid
@@ -113,15 +113,6 @@ TRIM_MODE_FULL = 1
 # [rad/s²]; the flying instance, set to the companion's trim, must meet them too.
 TRIM_TOLERANCE_FT_S2 = 1e-3
 TRIM_TOLERANCE_RAD_S2 = 1e-4
-# Settling the flying instance's propeller RPM on the companion's trim RPM (airframe held):
-# relative RPM agreement asked for [-], and the longest settling time allowed [s] (the
-# physical rotor's time constant is ≈ 0.3 s at cruise).
-RPM_SETTLE_REL_TOL = 1e-9
-RPM_SETTLE_MAX_S = 60.0
-# JSBSim's integrator choices (FGPropagate) and the one that holds a state: 0 = eNone.
-_INTEGRATOR_PROPERTIES = tuple(f"simulation/integrator/{a}/{b}" for a in ("rate", "position")
-                               for b in ("rotational", "translational"))
-_INTEGRATOR_NONE = 0
 # Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
 # throttle commands of every engine are added per aircraft.
 TRIM_CONTROLS = (
@@ -333,29 +324,6 @@ class Airframe:
         with captured(self._log):
             fdm.run_ic()
 
-    def _spin_up_propeller(self, fdm: jsbsim.FGFDMExec, speed_m_s: float) -> None:
-        """Bring both propellers of ``fdm`` (the trim instance) from rest to their windmilling
-        RPM at ``speed_m_s`` in one step.
-
-        At 0 RPM JSBSim's propeller turns the engine power P [ft·lbf/s] into a torque of
-        P/(1 rad/s), so one step of dt [s] gives ω = throttle·P·dt/I per rotor (each rotor
-        has 1/rotor_count of the power and of the inertia, the companion's effective one).
-        The throttle for ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set on every
-        engine for that step.
-        """
-        n = PROPULSION.rotor_count
-        omega_rad_s = (
-            2.0 * math.pi * speed_m_s
-            / (zero_thrust_advance_ratio(self._trim_aircraft_path) * PROPULSION.prop_diameter_m)
-        )
-        inertia_slug_ft2 = PROPULSION.trim_rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
-        power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
-        throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
-        for i in range(self.engine_count):
-            fdm[f"fcs/throttle-cmd-norm[{i}]"] = throttle
-        with captured(self._log):
-            fdm.run()
-
     # ---- trim -----------------------------------------------------------------------
     def trim(self, speed_m_s: float, altitude_m: float = 0.0) -> TrimResult:
         """Trim for level flight in still air at ``speed_m_s`` [m/s], ``altitude_m`` [m]
@@ -383,7 +351,8 @@ class Airframe:
             self._check_in_trim(result)
             return result
         if self.has_companion:
-            self._spin_up_propeller(tfdm, v)
+            with captured(self._log):
+                spin_up_propellers(tfdm, v, self._trim_aircraft_path, self.engine_count)
         else:
             with captured(self._log):
                 start_engines(tfdm, self.engines)
@@ -399,65 +368,12 @@ class Airframe:
                 self._set_level_ic(self._fdm, v, h)
             raise TrimError(self._diagnose_trim_failure(v))
         if tfdm is not self._fdm:
-            self._fly_at_companion_trim(v)
+            with captured(self._log):
+                self.last_rpm_settle_s = fly_at_companion_trim(
+                    self._fdm, tfdm, v, TRIM_CONTROLS, self.engine_count)
         result = self._trim_result(v, h)
         self._check_in_trim(result)
         return result
-
-    def _fly_at_companion_trim(self, v: float) -> None:
-        """Set the flying instance to the companion's trim: state, controls, propeller RPM."""
-        src, fdm = self._trim_fdm, self._fdm
-        # position and attitude first, then the body velocities in that attitude
-        fdm["ic/lat-geod-rad"] = src["position/lat-geod-rad"]
-        fdm["ic/long-gc-rad"] = src["position/long-gc-rad"]
-        fdm["ic/terrain-elevation-ft"] = src["position/terrain-elevation-asl-ft"]
-        fdm["ic/h-sl-ft"] = src["position/h-sl-ft"]
-        fdm["ic/phi-rad"] = src["attitude/phi-rad"]
-        fdm["ic/theta-rad"] = src["attitude/theta-rad"]
-        fdm["ic/psi-true-rad"] = src["attitude/psi-rad"]
-        fdm["ic/u-fps"] = src["velocities/u-fps"]
-        fdm["ic/v-fps"] = src["velocities/v-fps"]
-        fdm["ic/w-fps"] = src["velocities/w-fps"]
-        fdm["ic/p-rad_sec"] = src["velocities/p-rad_sec"]
-        fdm["ic/q-rad_sec"] = src["velocities/q-rad_sec"]
-        fdm["ic/r-rad_sec"] = src["velocities/r-rad_sec"]
-        controls = TRIM_CONTROLS + tuple(
-            f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engine_count)
-        )
-        for name in controls:
-            fdm[name] = src[name]
-        rpm_names = [f"propulsion/engine[{i}]/propeller-rpm" for i in range(self.engine_count)]
-        targets = [float(src[name]) for name in rpm_names]
-        integrators = {name: fdm[name] for name in _INTEGRATOR_PROPERTIES}
-        dt = fdm.get_delta_t()
-        steps = 0
-        with captured(self._log):
-            fdm.run_ic()
-            try:  # hold the airframe at the trim state; the propellers integrate their RPM
-                for name in _INTEGRATOR_PROPERTIES:
-                    fdm[name] = _INTEGRATOR_NONE
-                limit = max(1, round(RPM_SETTLE_MAX_S / dt))
-                while steps < limit:
-                    fdm.run()
-                    steps += 1
-                    if all(
-                        abs(fdm[name] - target) <= RPM_SETTLE_REL_TOL * abs(target)
-                        for name, target in zip(rpm_names, targets, strict=True)
-                    ):
-                        break
-            finally:
-                for name, value in integrators.items():
-                    fdm[name] = value
-            fdm.run_ic()  # back to the trim state; the RPM carries over
-        self.last_rpm_settle_s = steps * dt
-        rpm = [float(fdm[name]) for name in rpm_names]
-        worst = max(abs(r - t) / abs(t) for r, t in zip(rpm, targets, strict=True))
-        if worst > RPM_SETTLE_REL_TOL:
-            raise TrimError(
-                f"cannot trim at {v:g} m/s: the flying aircraft's propeller RPM did not settle "
-                f"on the trim RPM {targets[0]:.1f} rev/min in {RPM_SETTLE_MAX_S:g} s "
-                f"(relative difference {worst:.1e})"
-            )
 
     def _check_in_trim(self, result: TrimResult) -> None:
         """The flying instance's accelerations are within JSBSim's trim tolerances."""
@@ -520,12 +436,22 @@ class Airframe:
         return float(self._fdm[name]) if self.engines and self._has(name) else 0.0
 
     def _diagnose_trim_failure(self, v: float) -> str:
-        """One line: which control saturated or which condition failed."""
+        """One line: which control saturated or which condition failed; an engine that
+        stopped during the trim is named first (its thrust was missing, not the throttle's)."""
         text = "\n".join(r.text for r in self._log.records)
         engine = "the motor gives" if self.has_companion else (
             "the engine gives" if len(self.engines) == 1 else "the engines give")
-        return diagnose_trim_failure(text, v, self.alpha_limits_rad,
+        line = diagnose_trim_failure(text, v, self.alpha_limits_rad,
                                      self._first_message(jsbsim.LogLevel.WARN), engine)
+        stopped = [e for e in self.engines
+                   if self._has(name := f"propulsion/engine[{e.index}]/engine-rpm")
+                   and self._trim_fdm[name] <= 0.0]
+        if stopped and not self.has_companion:
+            names = ", ".join(f"{e.index} ({e.kind}, {e.file})" for e in stopped)
+            line = (f"cannot trim at {v:g} m/s: engine {names} stopped during the trim (0 "
+                    "rev/min: its fuel feed or the aircraft's systems hold it; "
+                    f"JSBSim's trim then says: {line.split(': ', 1)[-1]})")
+        return line
 
     # ---- linearization ----------------------------------------------------------------
     def linearize(self, speed_m_s: float, altitude_m: float = 0.0) -> RigidLinearization:

@@ -143,15 +143,24 @@ def envelope(airframe: Airframe, reference: ReferenceGeometry, mass_kg: float,
         return math.sqrt(2.0 * weight / (rho * reference.area_m2 * cl))
 
     start = None
-    for cl in (0.5, 0.3, 0.8, 0.2, 1.0):  # a first trim (the aircraft's data decide where)
-        v = min(level_speed(cl), SPEED_CAP_M_S)
+    # a first trim: level-flight speeds of C_L 0.5, then the others of 0.2..1.2 in steps of
+    # 0.05 nearest it first (an aircraft whose engine holds it in a narrow band of speeds,
+    # the pa28 of the jsbsim package at 45-55 m/s, is found)
+    for cl in sorted(np.arange(0.2, 1.2001, 0.05), key=lambda c: abs(c - 0.5)):
+        v = min(level_speed(float(cl)), SPEED_CAP_M_S)
         if _trims(airframe, v, altitude_m) is not None:
             start = v
             break
     if start is None:
+        v = min(level_speed(0.5), SPEED_CAP_M_S)
+        try:
+            airframe.trim(v, altitude_m)
+            why = f"at {v:.1f} m/s its alpha leaves its tables"
+        except TrimError as exc:
+            why = str(exc)
         raise TrimError(f"aircraft {airframe.aircraft!r} trims at none of the level-flight "
-                        f"speeds of C_L 0.2..1 ({level_speed(1.0):.1f}.."
-                        f"{min(level_speed(0.2), SPEED_CAP_M_S):.1f} m/s)")
+                        f"speeds of C_L 0.2..1.2 ({level_speed(1.2):.1f}.."
+                        f"{min(level_speed(0.2), SPEED_CAP_M_S):.1f} m/s); {why}")
     point = identify_point(airframe, start, reference, mass_kg, altitude_m)
     stall = level_speed(point.aero.cl_max)
     low = STALL_MARGIN * stall

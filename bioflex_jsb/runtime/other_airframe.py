@@ -231,13 +231,17 @@ def glide_elevator_norm(fdm) -> float:
     return min(1.0, max(-1.0, command))
 
 
-def rigid_jacobian(fdm) -> np.ndarray:
+def rigid_jacobian(fdm, powered: bool = False) -> np.ndarray:
     """A_RR (4×4, x_R = [u [m/s], α [rad], q [rad/s], θ [rad]], SI) of ``fdm`` at its
     current state (the glide trim, wings level, no wind), by central differences of JSBSim's
     own state derivatives: V̇ = (u u̇ + w ẇ)/V, α̇ = (u ẇ − w u̇)/(u² + w²), q̇, θ̇ = q
-    (body axes). The glider's replacement for JSBSim's FGLinearization, which reads the
-    throttle of engine 0 and fails on an aircraft without one (it crashed the process in
-    JSBSim 1.3.3). The state is put back at the end."""
+    (body axes), each state evaluated until its α̇ is its own (:data:`ALPHADOT_PASSES`)
+    and, ``powered``, with the propellers at their steady RPM (quasi-static, as JSBSim's
+    trim and the linear model take them). The glider's replacement for JSBSim's
+    FGLinearization, which reads the throttle of engine 0 and fails on an aircraft without
+    one (it crashed the process in JSBSim 1.3.3), and the exact linearisation of JSBSim's
+    model the identified derivatives are checked against (FGLinearization takes α̇ after
+    one evaluation: tests/test_identification.py). The state is put back at the end."""
     m = 0.3048  # m per ft (exact), JSBSim's velocities and accelerations are in ft
     u0, w0 = fdm["velocities/u-fps"] * m, fdm["velocities/w-fps"] * m
     x0 = np.array([math.hypot(u0, w0), math.atan2(w0, u0), fdm["velocities/q-rad_sec"],
@@ -251,6 +255,8 @@ def rigid_jacobian(fdm) -> np.ndarray:
         fdm["ic/p-rad_sec"], fdm["ic/r-rad_sec"] = 0.0, 0.0
         for _ in range(ALPHADOT_PASSES):
             fdm.run_ic()
+            if powered:  # the propellers at their steady RPM, as JSBSim's trim puts them
+                fdm.get_propulsion().get_steady_state()
         udot = fdm["accelerations/udot-ft_sec2"] * m
         wdot = fdm["accelerations/wdot-ft_sec2"] * m
         return np.array([(u * udot + w * wdot) / v, (u * wdot - w * udot) / (u * u + w * w),
