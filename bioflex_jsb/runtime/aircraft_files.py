@@ -74,11 +74,16 @@ class NamedFile:
     target: PurePosixPath
 
 
-def package_root() -> Path:
-    """The jsbsim package's JSBSim root (its ``aircraft/``, ``engine/``, ``systems/``)."""
+def package_root() -> Path | None:
+    """The jsbsim package's JSBSim root (its ``aircraft/``, ``engine/``, ``systems/``), or
+    None where the installed jsbsim has none (a build without its data files: JSBSim's
+    ``get_default_root_dir`` refuses; the package's folders are then not searched)."""
     import jsbsim
 
-    return Path(jsbsim.get_default_root_dir()).resolve()
+    try:
+        return Path(jsbsim.get_default_root_dir()).resolve()
+    except OSError:
+        return None
 
 
 def user_root(aircraft_dir: Path) -> Path | None:
