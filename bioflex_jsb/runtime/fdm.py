@@ -160,7 +160,10 @@ def _check_altitude(altitude_m: float) -> float:
 
 
 def load_fdm(root: Path, aircraft: str, path: Path, log: CapturingLogger) -> jsbsim.FGFDMExec:
-    """A JSBSim instance with ``aircraft`` loaded (messages into ``log``)."""
+    """A JSBSim instance with ``aircraft`` loaded and its initial condition run once
+    (messages into ``log``): an aircraft JSBSim loads but cannot initialise (a system
+    reading a property nobody defines: JSBSim raises from ``RunIC``) is one line here
+    (AircraftLoadError), not a failure at the first trim."""
     with captured(log):
         fdm = jsbsim.FGFDMExec(str(root), None)
         try:
@@ -179,6 +182,12 @@ def load_fdm(root: Path, aircraft: str, path: Path, log: CapturingLogger) -> jsb
         raise AircraftLoadError(
             f"JSBSim could not load {str(path)!r}: {first or 'no reason given'}"
         )
+    with captured(log):
+        try:
+            fdm.run_ic()
+        except jsbsim.BaseError as exc:
+            raise AircraftLoadError(f"JSBSim loads {str(path)!r} but cannot initialise it: "
+                                    f"{_one_line(exc)}") from None
     return fdm
 
 
