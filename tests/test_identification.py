@@ -20,7 +20,7 @@ from bioflex_jsb.parameters.airframe import AirframeData
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.identification import identify_point
 from bioflex_jsb.runtime.jsbsim_aircraft import probe
-from bioflex_jsb.runtime.other_airframe import airframe_from_file, rigid_jacobian
+from bioflex_jsb.runtime.linearization import rigid_jacobian
 
 jsbsim = pytest.importorskip("jsbsim")
 PACKAGE = Path(jsbsim.get_default_root_dir()) / "aircraft"
@@ -34,7 +34,7 @@ def _setup(name: str, speed: float):
     ref = ReferenceGeometry(values.reference_area_m2, values.span_m, values.mean_chord_m)
     i = values.inertia
     mass = MassProperties(values.mass_kg, i.ixx_kg_m2, i.iyy_kg_m2, i.izz_kg_m2, i.ixz_kg_m2)
-    airframe = airframe_from_file(path, values.cg_m, Airframe, name)
+    airframe = Airframe.from_file(path, values.cg_m, name)
     point = identify_point(airframe, speed, ref, values.mass_kg)
     data = AirframeData(name, ref, mass, point.aero, None)
     a_model, _ = rigid_matrices(rigid_derivatives(level_flight_condition(speed, 1.225,
@@ -74,7 +74,7 @@ def test_the_identified_model_is_the_exact_linearisation_of_jsbsims(name, speed)
     """The rigid block built from the identified derivatives (Table B2 with C_Lq, C_Lα̇,
     the speed and thrust derivatives) against central differences of JSBSim's own state
     derivatives at the same trim with α̇ converged and the propellers at their steady RPM
-    (other_airframe.rigid_jacobian): the short-period and phugoid eigenvalues within 0.6 %
+    (linearization.rigid_jacobian): the short-period and phugoid eigenvalues within 0.6 %
     of their modulus. Measured (short period / phugoid): c172p 0.006 % / 0.013 %, J3Cub
     (over-damped short period) 0.04 % / 0.40 %, pa28 0.003 % / 0.012 %, 737 0.006 % /
     0.04 %; what is left is the level-flight idealisation (W/(Q S) for C_L, thrust along

@@ -185,7 +185,7 @@ def test_the_wings_gust_response_is_the_linear_models(exported):
 def test_native_sgs_matches_the_cosimulation(exported, amplitude):
     """Same sharp gust at 25 m/s, 3 s, from the same glide trim (Airframe.trim): the exported
     SGS (the wing in JSBSim's XML) against the Python co-simulation of the definition (its
-    wing through the SGS's external reactions, runtime/other_airframe.py), as
+    wing through the SGS's external reactions, runtime/aircraft_files.py), as
     tests/test_native.py compares the prototype's. NRMSE of u, alpha, q, theta, eta1, eta2
     under 2 % (measured: at most 0.88 % at 0.3 m/s, theta; 1.60 % at 3 m/s, q; the
     prototype's bar is 1 %, the SGS's gust swings alpha by up to 7 deg across its tables);

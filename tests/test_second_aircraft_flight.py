@@ -3,7 +3,7 @@
 
 Plausibility, each against a number worked out by hand from SGS.xml:
 
-* the steady glide (SGS.xml has no engine; runtime/other_airframe.py): L/D and C_L of the
+* the steady glide (SGS.xml has no engine; runtime/glide.py): L/D and C_L of the
   trim against the XML's CLwbh/CDwbh tables at the trim's α, and the weight balance;
 * the glide's own drift in calm air against the ISA density gradient it sinks through;
 * the short-period response of the nonlinear run against the LTI model (``compare``) at the
@@ -279,7 +279,7 @@ def test_a_wing_is_flown_on_its_own_aircrafts_airframe_only(sgs):
 
 
 def test_the_glide_linearisation_against_sgs_xml_by_hand(sgs):
-    """The glider's A_RR (runtime/other_airframe.py rigid_jacobian; JSBSim's FGLinearization
+    """The glider's A_RR (runtime/linearization.py rigid_jacobian; JSBSim's FGLinearization
     needs an engine) entry by entry against SGS.xml's coefficients at the 25 m/s glide:
     Z_α = −(C_Lα + C_D) Q S/(m V) with the table's local slopes (CLwbh 4.60, CDwbh 0.287
     /rad between 1° and 2°); M_q + M_α̇ = (C_mq + C_mα̇) Q S c̄²/(2 V I_yy); M_α + M_α̇ Z_α

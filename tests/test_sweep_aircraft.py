@@ -174,7 +174,7 @@ GUST_COLUMNS = ("peak_du_m_s", "peak_dalpha_rad", "peak_dq_rad_s", "peak_dtheta_
 
 def test_another_airframe_flies_its_gust_runs_as_the_gust_command(folder, monkeypatch,
                                                                    capsys):
-    """JSBSim's SGS glider on its own airframe (runtime/other_airframe.py): the sweep's row
+    """JSBSim's SGS glider on its own airframe (runtime/jsbsim_aircraft.py): the sweep's row
     is the gust command's summary to the last bit (the same code path), and a speed outside
     the aircraft's speed_range_m_s (20-28 m/s) is a failed row saying so."""
     import json

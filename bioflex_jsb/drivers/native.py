@@ -59,7 +59,7 @@ def glide_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimState:
     temporary root and loaded there, never into the user's): the steady, straight,
     wings-level glide at ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, by
     :meth:`Airframe.trim` (an aircraft without an engine: α, the flight-path angle γ and the
-    pitch trim by Newton in JSBSim's initial-condition run, runtime/other_airframe.py) with
+    pitch trim by Newton in JSBSim's initial-condition run, runtime/glide.py) with
     the export's step and integrators, as :func:`trim_state` trims the prototype. The modal
     loads are zero in it: the wing is held at its trim reference while JSBSim's step is 0.
     Raises TrimError (one line)."""

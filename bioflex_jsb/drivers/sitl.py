@@ -101,7 +101,7 @@ GLIDER_L1_PERIOD_S = 25.0
 
 def glider_airframe(aircraft) -> Airframe:
     """The JSBSim airframe of an aircraft definition (``--aircraft``: its own JSBSim
-    aircraft, runtime/other_airframe.py) with the glider's autopilot system added
+    aircraft, runtime/aircraft_files.py) with the glider's autopilot system added
     (:func:`~bioflex_jsb.generators.autopilot.render_glider_autopilot`)."""
     from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 

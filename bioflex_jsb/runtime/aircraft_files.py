@@ -43,6 +43,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
+from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.results import AircraftLoadError
 from bioflex_jsb.tomlfile import read_input_bytes
 
@@ -265,3 +266,111 @@ def alpha_limits_rad(path: Path) -> tuple[float, float]:
         return float(lim.findtext("min")) * scale, float(lim.findtext("max")) * scale
     except (TypeError, ValueError):
         raise AircraftLoadError(f"malformed <alphalimits> in {str(path)!r}") from None
+
+
+# -- the modal wing's hooks, the α range of the aircraft -------------------------------------
+# The co-simulation writes the elastic wing's incremental loads into four external reactions
+# (bioflex_jsb.generators.airframe: modal-lift, modal-drag at the CG, body axes; modal-pitch,
+# modal-roll moments). The generated prototype has them in its XML; another aircraft gets the
+# same four in its private copy, at its CG (structural frame, metres to inches).
+INCH_PER_M = 1.0 / 0.0254  # the inch is 0.0254 m exactly
+
+
+def derived_root(jsbsim_path: str, cg_m: tuple[float, float, float],
+                 systems: dict[str, str] | None = None
+                 ) -> tuple[tempfile.TemporaryDirectory, str]:
+    """A temporary JSBSim root holding a copy of the aircraft ``jsbsim_path``
+    (``<dir>/<name>.xml``) with the modal-wing reactions at ``cg_m`` [m, structural frame]:
+    (the directory, the aircraft's name). ``systems``: system files to add (file name
+    without ``.xml`` → its text; the SITL glider's autopilot,
+    :func:`bioflex_jsb.generators.autopilot.render_glider_autopilot`), written to the copy's
+    ``Systems/`` (JSBSim looks there first) and included ahead of its flight controls, in
+    order (JSBSim cannot add a system to a loaded model). Raises :class:`AircraftLoadError`
+    (one line) for a file JSBSim could not read either or one that has the reactions
+    already."""
+    src = Path(jsbsim_path)
+    tree = read_aircraft_xml(src)
+    root = tree.getroot()
+    ext = root.find("external_reactions")
+    if ext is None:
+        ext = ET.SubElement(root, "external_reactions")
+    taken = {e.get("name") for e in ext}
+    hooks = {**airframe_xml.EXTERNAL_FORCES, **airframe_xml.EXTERNAL_MOMENTS}
+    clash = sorted(taken & set(hooks))
+    if clash:
+        raise AircraftLoadError(f"{str(src)!r} already has an external reaction named "
+                                f"{clash[0]!r} (the modal wing's hooks' names)")
+    for name_, (direction, _text) in airframe_xml.EXTERNAL_FORCES.items():
+        f = ET.SubElement(ext, "force", name=name_, frame="BODY", unit="LBS")
+        loc = ET.SubElement(f, "location", unit="IN")
+        for axis, value in zip("xyz", cg_m, strict=True):
+            ET.SubElement(loc, axis).text = repr(value * INCH_PER_M)
+        _direction(f, direction)
+    for name_, (direction, _text) in airframe_xml.EXTERNAL_MOMENTS.items():
+        _direction(ET.SubElement(ext, "moment", name=name_, frame="BODY", unit="LBSFT"),
+                   direction)
+    if systems:
+        fcs = root.find("flight_control")
+        at = list(root).index(fcs) if fcs is not None else len(root)
+        for i, file in enumerate(systems):
+            root.insert(at + i, ET.Element("system", file=file))
+    for key in [k for k in root.attrib if k.startswith("{")]:  # the schema's location
+        del root.attrib[key]
+    own = {f"{file}.xml": text for file, text in (systems or {}).items()}
+    work, name = private_root(src, tree, own)
+    return work, name
+
+
+def _direction(parent: ET.Element, direction: tuple[float, float, float]) -> None:
+    d = ET.SubElement(parent, "direction")
+    for axis, value in zip("xyz", direction, strict=True):
+        ET.SubElement(d, axis).text = repr(float(value))
+
+
+
+LIFT_AXES = ("LIFT", "NORMAL", "Z")  # JSBSim's names of the axis that carries the lift
+
+
+def _alpha_tables(element: ET.Element) -> list[tuple[float, float]]:
+    """The α range [rad] of each table under ``element`` with α as its row variable
+    (``aero/alpha-rad`` or ``aero/alpha-deg``)."""
+    out = []
+    for table in element.iter("table"):
+        variables = table.findall("independentVar")
+        if not variables:
+            continue
+        row = next((v for v in variables if v.get("lookup") == "row"), variables[0])
+        var = (row.text or "").strip()
+        if var not in ("aero/alpha-rad", "aero/alpha-deg"):
+            continue
+        lines = [ln.split() for ln in (table.findtext("tableData") or "").strip().splitlines()
+                 if ln.split()]
+        if len(variables) > 1:
+            lines = lines[1:]  # the first line holds the column breakpoints
+        alphas = [float(ln[0]) for ln in lines]
+        scale = 1.0 if var.endswith("rad") else math.pi / 180.0
+        out.append((min(alphas) * scale, max(alphas) * scale))
+    return out
+
+
+def alpha_table_range_rad(path: str | os.PathLike) -> tuple[float, float]:
+    """The α range [rad] of the aircraft's lift curve: the widest table over α in its lift
+    axis (``<axis name="LIFT">``, or ``NORMAL``/``Z``). Beyond it JSBSim holds the table's
+    end value, so the aircraft's aerodynamics end there (the run stops:
+    simulation/limits.py). Narrower α tables (increments of flaps, ground effect, stall
+    hysteresis) are held constant outside their range by their authors' design and do not
+    bound it. An aircraft whose lift axis names its tables only through functions defined
+    elsewhere: the common α range of all its tables. One without any α table is refused."""
+    root = read_aircraft_xml(path).getroot()
+    lift = [r for axis in root.iter("axis") if axis.get("name", "").upper() in LIFT_AXES
+            for r in _alpha_tables(axis)]
+    if lift:
+        return max(lift, key=lambda r: r[1] - r[0])
+    every = _alpha_tables(root)
+    lo = max((r[0] for r in every), default=math.inf)
+    hi = min((r[1] for r in every), default=-math.inf)
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise AircraftLoadError(f"{str(path)!r} has no aerodynamic table over the angle of "
+                                "attack (aero/alpha-rad or -deg): its valid range of alpha is "
+                                "unknown")
+    return lo, hi

@@ -569,9 +569,9 @@ def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitu
 def _check_pair(airframe: Airframe, data) -> None:
     """The JSBSim airframe and the wing's aircraft are one aircraft: the generated prototype
     with the prototype's :class:`AirframeData`, a definition's JSBSim aircraft
-    (``airframe.definition_name``, runtime/other_airframe.py) with that definition's; else
+    (``airframe.definition_name``, runtime/aircraft_files.py) with that definition's; else
     InputError, one line (a wing's loads are in its aircraft's S, c̄)."""
-    mine = getattr(airframe, "definition_name", None)
+    mine = airframe.definition_name
     if (mine is None) != (data is PROTOTYPE_AIRFRAME) or (mine is not None
                                                           and mine != data.name):
         raise InputError(f"the wing is built for aircraft {data.name!r}, the JSBSim airframe "

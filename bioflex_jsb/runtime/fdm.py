@@ -71,12 +71,17 @@ import numpy as np
 from bioflex_jsb import units as U
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators import airframe as airframe_xml
-from bioflex_jsb.runtime.aircraft_files import alpha_limits_rad
+from bioflex_jsb.runtime.aircraft_files import (
+    alpha_limits_rad,
+    alpha_table_range_rad,
+    derived_root,
+)
 from bioflex_jsb.runtime.companion import fly_at_companion_trim, spin_up_propellers
 from bioflex_jsb.runtime.engines import engines_of
 from bioflex_jsb.runtime.engines import start as start_engines
+from bioflex_jsb.runtime.glide import glide_elevator_norm, glide_trim
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, LogRecord, captured
-from bioflex_jsb.runtime.linearization import reduce_to_rigid
+from bioflex_jsb.runtime.linearization import reduce_to_rigid, rigid_jacobian
 from bioflex_jsb.runtime.results import (  # noqa: F401  (the runtime's errors and results)
     RIGID_STATE_UNITS,
     RIGID_STATES,
@@ -249,8 +254,26 @@ class Airframe:
         self.last_rpm_settle_s = 0.0  # time the flying instance's RPM took to settle [s]
         # α range of the aerodynamic tables [rad] (the generated prototype's: limits.py)
         self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
-        self.glider = self.engine_count == 0  # trimmed to a glide (runtime/other_airframe.py)
-        self._workdir = None  # the temporary root of an aircraft from a file (other_airframe.py)
+        self.definition_name: str | None = None  # the aircraft definition it flies
+        self.glider = self.engine_count == 0  # trimmed to a glide (runtime/glide.py)
+        self._workdir = None  # the temporary root of an aircraft from a file (aircraft_files.py)
+
+    @classmethod
+    def from_file(cls, jsbsim_path: str, cg_m: tuple[float, float, float],
+                  definition_name: str | None = None,
+                  systems: dict[str, str] | None = None) -> Airframe:
+        """Another aircraft (``<dir>/<name>.xml``: a jsbsim package aircraft or a user's)
+        with the modal wing's hooks at ``cg_m`` [m, structural frame], loaded from its
+        private copy (:func:`~bioflex_jsb.runtime.aircraft_files.derived_root`, kept while
+        the airframe lives), its α range its lift curve's; ``definition_name``: the aircraft
+        definition it flies (the name of the AirframeData its wing carries: the coupled step
+        checks the pair); ``systems``: system files added to the copy."""
+        work, name = derived_root(jsbsim_path, cg_m, systems)
+        airframe = cls(work.name, name)
+        airframe._workdir = work
+        airframe.alpha_table_range_rad = alpha_table_range_rad(jsbsim_path)
+        airframe.definition_name = definition_name
+        return airframe
 
     # ---- JSBSim messages ----------------------------------------------------------
     @property
@@ -351,9 +374,7 @@ class Airframe:
                 fdm[name] = 0.0
         tfdm = self._trim_fdm
         self._set_level_ic(tfdm, v, h)
-        if self.glider:  # no engine: the steady glide at v (runtime/other_airframe.py)
-            from bioflex_jsb.runtime.other_airframe import glide_trim
-
+        if self.glider:  # no engine: the steady glide at v (runtime/glide.py)
             with captured(self._log):
                 glide_trim(tfdm, v)
             result = self._trim_result(v, h)
@@ -397,8 +418,6 @@ class Airframe:
             )
 
     def _trim_result(self, v: float, h: float) -> TrimResult:
-        from bioflex_jsb.runtime.other_airframe import glide_elevator_norm
-
         fdm = self._fdm
         return TrimResult(
             speed_m_s=v,
@@ -472,9 +491,7 @@ class Airframe:
                 cannot be residualised.
         """
         trim = self.trim(speed_m_s, altitude_m)
-        if self.glider:  # FGLinearization needs an engine: runtime/other_airframe.py
-            from bioflex_jsb.runtime.other_airframe import rigid_jacobian
-
+        if self.glider:  # FGLinearization needs an engine: runtime/linearization.py
             with captured(self._log):
                 a, names, residualised = rigid_jacobian(self._fdm), RIGID_STATES, ()
         else:

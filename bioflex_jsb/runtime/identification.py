@@ -147,7 +147,7 @@ class Evaluator:
         for hook in (HOOK_LIFT, HOOK_DRAG):
             if not m.hasNode(hook):
                 raise LinearizationError(f"{airframe.aircraft!r} has no modal-wing hook {hook!r}"
-                                         " (load it through airframe_from_file)")
+                                         " (load it with Airframe.from_file)")
         self.engines = airframe.engines
         self.elevator = _first(m, "fcs/elevator-pos-rad")
         left, right = "fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"

@@ -35,8 +35,8 @@ from bioflex_jsb import units as U
 from bioflex_jsb.definition.model import Inertia, JSBSimValues
 from bioflex_jsb.parameters.airframe import DerivativeSchedule, ReferenceGeometry
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
-from bioflex_jsb.runtime.aircraft_files import named_files, read_aircraft_xml
-from bioflex_jsb.runtime.fdm import Airframe
+from bioflex_jsb.runtime.aircraft_files import derived_root, named_files, read_aircraft_xml
+from bioflex_jsb.runtime.fdm import Airframe, load_fdm
 from bioflex_jsb.runtime.identification import identify_point
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, captured
 from bioflex_jsb.runtime.results import AircraftLoadError, TrimError
@@ -84,8 +84,6 @@ def _fingerprint(jsbsim_path: str) -> str:
 
 def probe(jsbsim_path: str) -> JSBSimValues:
     """The JSBSim aircraft's geometry and mass properties (module docstring), SI."""
-    from bioflex_jsb.runtime.fdm import load_fdm
-    from bioflex_jsb.runtime.other_airframe import derived_root
 
     work, name = derived_root(jsbsim_path, (0.0, 0.0, 0.0))
     log = CapturingLogger()
@@ -234,8 +232,6 @@ def complete(aircraft):
 
 
 def _identify(aircraft, altitude: float) -> JSBSimValues:
-    from bioflex_jsb.runtime.other_airframe import airframe_from_file
-
     a = aircraft.airframe
     values = probe(a.jsbsim_path)
     problems = aircraft.jsbsim_mismatches(values)
@@ -246,7 +242,7 @@ def _identify(aircraft, altitude: float) -> JSBSimValues:
           for f in ("reference_area_m2", "span_m", "mean_chord_m")))
     mass = a.mass_kg if a.mass_kg is not None else values.mass_kg
     cg = a.cg_m if a.cg_m is not None else values.cg_m
-    airframe = airframe_from_file(a.jsbsim_path, cg, Airframe, aircraft.name)
+    airframe = Airframe.from_file(a.jsbsim_path, cg, aircraft.name)
     if a.cruise_speed_m_s is None:
         stall, low, cruise, high = envelope(airframe, reference, mass, altitude)
         # to 0.1 m/s, inward: the range's ends are speeds that trim
@@ -271,13 +267,11 @@ def airframe_for(aircraft=None, root=None, systems: dict[str, str] | None = None
     prototype's generated ``bioflex`` (under ``root``, the default search without it) for
     the prototype's airframe, else its ``airframe.jsbsim`` aircraft, completed and checked
     (:func:`complete`), with the modal wing's hooks at its CG
-    (:func:`~bioflex_jsb.runtime.other_airframe.airframe_from_file`) and ``systems`` added
+    (:meth:`~bioflex_jsb.runtime.fdm.Airframe.from_file`) and ``systems`` added
     (the SITL glider's autopilot; the prototype's SITL aircraft has its own:
     generators/autopilot.py)."""
-    from bioflex_jsb.runtime.other_airframe import airframe_from_file
-
     if aircraft is None or not aircraft.airframe.jsbsim_path:
         return Airframe(root)
     aircraft = complete(aircraft)
-    return airframe_from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m,
-                              Airframe, aircraft.name, systems)
+    return Airframe.from_file(aircraft.airframe.jsbsim_path, aircraft.airframe.cg_m,
+                              aircraft.name, systems)

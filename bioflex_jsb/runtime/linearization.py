@@ -27,6 +27,8 @@ the two of smaller modulus the phugoid.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from bioflex_jsb import units as U
@@ -84,3 +86,55 @@ def reduce_to_rigid(
     if not np.all(np.isfinite(a_si)):
         raise LinearizationError("JSBSim's linear model has non-finite entries")
     return a_si, tuple(names[i] for i in fast)
+
+
+# Central-difference steps of the glider's A_RR (:func:`rigid_jacobian`): 0.01 m/s of
+# airspeed and 1e-4 rad (rad/s) of α, θ, q: inside one interval of SGS.xml's tables (1°
+# = 0.0175 rad), and large enough that JSBSim's accelerations (~10 ft/s² per rad, printed
+# to 1e-12 relative) keep 7 digits in the differences.
+JACOBIAN_STEPS = (0.01, 1e-4, 1e-4, 1e-4)
+# JSBSim's α̇ (in C_mα̇) is computed from the previous evaluation's accelerations: three
+# evaluations of one state make it that state's own (ẇ does not depend on α̇: the second
+# is already exact; the third confirms it).
+ALPHADOT_PASSES = 3
+
+
+
+def rigid_jacobian(fdm, powered: bool = False) -> np.ndarray:
+    """A_RR (4×4, x_R = [u [m/s], α [rad], q [rad/s], θ [rad]], SI) of ``fdm`` at its
+    current state (the glide trim, wings level, no wind), by central differences of JSBSim's
+    own state derivatives: V̇ = (u u̇ + w ẇ)/V, α̇ = (u ẇ − w u̇)/(u² + w²), q̇, θ̇ = q
+    (body axes), each state evaluated until its α̇ is its own (:data:`ALPHADOT_PASSES`)
+    and, ``powered``, with the propellers at their steady RPM (quasi-static, as JSBSim's
+    trim and the linear model take them). The glider's replacement for JSBSim's
+    FGLinearization, which reads the throttle of engine 0 and fails on an aircraft without
+    one (it crashed the process in JSBSim 1.3.3), and the exact linearisation of JSBSim's
+    model the identified derivatives are checked against (FGLinearization takes α̇ after
+    one evaluation: tests/test_identification.py). The state is put back at the end."""
+    m = 0.3048  # m per ft (exact), JSBSim's velocities and accelerations are in ft
+    u0, w0 = fdm["velocities/u-fps"] * m, fdm["velocities/w-fps"] * m
+    x0 = np.array([math.hypot(u0, w0), math.atan2(w0, u0), fdm["velocities/q-rad_sec"],
+                   fdm["attitude/theta-rad"]])
+
+    def derivatives(x: np.ndarray) -> np.ndarray:
+        v, alpha, q, theta = x
+        u, w = v * math.cos(alpha), v * math.sin(alpha)
+        fdm["ic/u-fps"], fdm["ic/v-fps"], fdm["ic/w-fps"] = u / m, 0.0, w / m
+        fdm["ic/theta-rad"], fdm["ic/q-rad_sec"] = theta, q
+        fdm["ic/p-rad_sec"], fdm["ic/r-rad_sec"] = 0.0, 0.0
+        for _ in range(ALPHADOT_PASSES):
+            fdm.run_ic()
+            if powered:  # the propellers at their steady RPM, as JSBSim's trim puts them
+                fdm.get_propulsion().get_steady_state()
+        udot = fdm["accelerations/udot-ft_sec2"] * m
+        wdot = fdm["accelerations/wdot-ft_sec2"] * m
+        return np.array([(u * udot + w * wdot) / v, (u * wdot - w * udot) / (u * u + w * w),
+                         fdm["accelerations/qdot-rad_sec2"], q])
+
+    a = np.empty((4, 4))
+    for j, h in enumerate(JACOBIAN_STEPS):
+        dx = np.zeros(4)
+        dx[j] = h
+        a[:, j] = (derivatives(x0 + dx) - derivatives(x0 - dx)) / (2.0 * h)
+    derivatives(x0)  # back at the trim state
+    return a

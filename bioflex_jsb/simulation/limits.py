@@ -28,7 +28,7 @@ def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float,
     names) at ``t_s`` [s], with the angle of attack ``alpha_rad`` [rad], the new modal
     state ``eta`` [rad] and the height above ground ``agl_m`` [m]; None if it may go on.
     ``alpha_range_rad``: the α range of the airframe's tables [rad] (the generated
-    prototype's by default; another aircraft's from its XML: runtime/other_airframe.py)."""
+    prototype's by default; another aircraft's from its XML: runtime/aircraft_files.py)."""
     isfinite = math.isfinite
     if not all(map(isfinite, values)):
         bad = next(n for n, v in zip(names, values, strict=True) if not isfinite(v))
