@@ -45,6 +45,7 @@ from pathlib import Path, PurePosixPath
 
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.results import AircraftLoadError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.tomlfile import read_input_bytes
 
 # One file JSBSim reads [bytes]: the largest of the jsbsim package is 1.6 MB (an aircraft
@@ -341,7 +342,7 @@ def _alpha_tables(element: ET.Element) -> list[tuple[float, float]]:
             continue
         row = next((v for v in variables if v.get("lookup") == "row"), variables[0])
         var = (row.text or "").strip()
-        if var not in ("aero/alpha-rad", "aero/alpha-deg"):
+        if var not in (JP.AERO_ALPHA_RAD, JP.AERO_ALPHA_DEG):
             continue
         lines = [ln.split() for ln in (table.findtext("tableData") or "").strip().splitlines()
                  if ln.split()]

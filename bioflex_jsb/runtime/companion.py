@@ -13,6 +13,7 @@ from bioflex_jsb import units as U
 from bioflex_jsb.parameters.airframe import PROPULSION
 from bioflex_jsb.runtime.engines import zero_thrust_advance_ratio
 from bioflex_jsb.runtime.results import TrimError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 # Settling the flying instance's propeller RPM on the companion's trim RPM (airframe held):
 # relative RPM agreement asked for [-], and the longest settling time allowed [s] (the
@@ -55,19 +56,19 @@ def fly_at_companion_trim(fdm, src, v: float, controls: tuple[str, ...],
     state, ``controls`` and every engine's throttle, propeller RPM; returns the time
     the RPM took to settle [s]."""
     # position and attitude first, then the body velocities in that attitude
-    fdm["ic/lat-geod-rad"] = src["position/lat-geod-rad"]
-    fdm["ic/long-gc-rad"] = src["position/long-gc-rad"]
-    fdm["ic/terrain-elevation-ft"] = src["position/terrain-elevation-asl-ft"]
-    fdm["ic/h-sl-ft"] = src["position/h-sl-ft"]
-    fdm["ic/phi-rad"] = src["attitude/phi-rad"]
-    fdm["ic/theta-rad"] = src["attitude/theta-rad"]
-    fdm["ic/psi-true-rad"] = src["attitude/psi-rad"]
-    fdm["ic/u-fps"] = src["velocities/u-fps"]
-    fdm["ic/v-fps"] = src["velocities/v-fps"]
-    fdm["ic/w-fps"] = src["velocities/w-fps"]
-    fdm["ic/p-rad_sec"] = src["velocities/p-rad_sec"]
-    fdm["ic/q-rad_sec"] = src["velocities/q-rad_sec"]
-    fdm["ic/r-rad_sec"] = src["velocities/r-rad_sec"]
+    fdm[JP.IC_LAT_GEOD_RAD] = src[JP.POSITION_LAT_GEOD_RAD]
+    fdm[JP.IC_LONG_GC_RAD] = src[JP.POSITION_LONG_GC_RAD]
+    fdm[JP.IC_TERRAIN_ELEVATION_FT] = src[JP.POSITION_TERRAIN_ELEVATION_ASL_FT]
+    fdm[JP.IC_H_SL_FT] = src[JP.POSITION_H_SL_FT]
+    fdm[JP.IC_PHI_RAD] = src[JP.ATTITUDE_PHI_RAD]
+    fdm[JP.IC_THETA_RAD] = src[JP.ATTITUDE_THETA_RAD]
+    fdm[JP.IC_PSI_TRUE_RAD] = src[JP.ATTITUDE_PSI_RAD]
+    fdm[JP.IC_U_FPS] = src[JP.VELOCITIES_U_FPS]
+    fdm[JP.IC_V_FPS] = src[JP.VELOCITIES_V_FPS]
+    fdm[JP.IC_W_FPS] = src[JP.VELOCITIES_W_FPS]
+    fdm[JP.IC_P_RAD_SEC] = src[JP.VELOCITIES_P_RAD_SEC]
+    fdm[JP.IC_Q_RAD_SEC] = src[JP.VELOCITIES_Q_RAD_SEC]
+    fdm[JP.IC_R_RAD_SEC] = src[JP.VELOCITIES_R_RAD_SEC]
     controls = controls + tuple(
         f"fcs/throttle-cmd-norm[{i}]" for i in range(engine_count)
     )

@@ -43,6 +43,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
@@ -62,18 +63,18 @@ ELASTIC_TRIM_TOL_RAD = 1e-6  # the elastic trim's fixed point on α with JSBSim'
 AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
 # The JSBSim properties of a snapshot (JSBSim units, as the names say).
 PROPERTIES: Mapping[str, str] = MappingProxyType({
-    "u": "velocities/u-fps", "v": "velocities/v-fps", "w": "velocities/w-fps",
-    "q": "velocities/q-rad_sec", "p": "velocities/p-rad_sec", "r": "velocities/r-rad_sec",
-    "theta": "attitude/theta-rad", "phi": "attitude/phi-rad", "psi": "attitude/psi-rad",
-    "rho": "atmosphere/rho-slugs_ft3", "nz": "accelerations/Nz", "h": "position/h-sl-ft",
-    "agl": "position/h-agl-ft", "lat": "position/lat-geod-rad", "lon": "position/long-gc-rad",
-    "vn": "velocities/v-north-fps", "ve": "velocities/v-east-fps", "vd": "velocities/v-down-fps",
-    "elevator": "fcs/elevator-pos-rad", "throttle": "fcs/throttle-pos-norm",
+    "u": JP.VELOCITIES_U_FPS, "v": JP.VELOCITIES_V_FPS, "w": JP.VELOCITIES_W_FPS,
+    "q": JP.VELOCITIES_Q_RAD_SEC, "p": JP.VELOCITIES_P_RAD_SEC, "r": JP.VELOCITIES_R_RAD_SEC,
+    "theta": JP.ATTITUDE_THETA_RAD, "phi": JP.ATTITUDE_PHI_RAD, "psi": JP.ATTITUDE_PSI_RAD,
+    "rho": JP.ATMOSPHERE_RHO_SLUGS_FT3, "nz": JP.ACCELERATIONS_NZ, "h": JP.POSITION_H_SL_FT,
+    "agl": JP.POSITION_H_AGL_FT, "lat": JP.POSITION_LAT_GEOD_RAD, "lon": JP.POSITION_LONG_GC_RAD,
+    "vn": JP.VELOCITIES_V_NORTH_FPS, "ve": JP.VELOCITIES_V_EAST_FPS, "vd": JP.VELOCITIES_V_DOWN_FPS,
+    "elevator": JP.FCS_ELEVATOR_POS_RAD, "throttle": JP.FCS_THROTTLE_POS_NORM,
 })
-WIND_DOWN = "atmosphere/wind-down-fps"
+WIND_DOWN = JP.ATMOSPHERE_WIND_DOWN_FPS
 # The native wing's published state and loads (bioflex_jsb.generators.native_wing).
 NATIVE_PREFIX = "bioflex/modal"
-NATIVE_LOADS = ("aero/force/modal-lift", "aero/force/modal-drag", "aero/moment/modal-pitch")
+NATIVE_LOADS = (JP.AERO_FORCE_MODAL_LIFT, JP.AERO_FORCE_MODAL_DRAG, JP.AERO_MOMENT_MODAL_PITCH)
 
 
 class Sensed(NamedTuple):
@@ -558,7 +559,7 @@ def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitu
         state["trim"] = airframe.trim(speed_m_s, altitude_m)
         return RigidTrimPoint(state["trim"].alpha_rad, state["trim"].elevator_rad)
 
-    rho = airframe["atmosphere/rho-slugs_ft3"] * U.KG_M3_PER_SLUG_FT3
+    rho = airframe[JP.ATMOSPHERE_RHO_SLUGS_FT3] * U.KG_M3_PER_SLUG_FT3
     # JSBSim's trim resolves α to its own tolerances: 1e-6 rad is well within them
     elastic = elastic_trim(build, speed_m_s, density_kg_m3=rho, rigid_trim=jsbsim_trim,
                            tol_rad=ELASTIC_TRIM_TOL_RAD)

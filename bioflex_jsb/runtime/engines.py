@@ -29,6 +29,7 @@ import numpy as np
 
 from bioflex_jsb.runtime.aircraft_files import named_files, read_aircraft_xml, read_xml
 from bioflex_jsb.runtime.results import AircraftLoadError, TrimError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 KINDS = {"piston_engine": "piston", "turbine_engine": "turbine",
          "turboprop_engine": "turboprop", "electric_engine": "electric",
@@ -76,9 +77,9 @@ def start(fdm, engines: tuple[Engine, ...]) -> None:
         return
     manager = fdm.get_property_manager()
     fdm.run_ic()
-    fdm["propulsion/set-running"] = -1
+    fdm[JP.PROPULSION_SET_RUNNING] = -1
     for e in engines:
-        levers = {"turboprop": ("fcs/mixture-cmd-norm",)}.get(e.kind, ())
+        levers = {"turboprop": (JP.FCS_MIXTURE_CMD_NORM,)}.get(e.kind, ())
         for lever in levers:
             name = f"{lever}[{e.index}]"
             if manager.hasNode(name):

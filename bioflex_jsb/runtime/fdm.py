@@ -101,6 +101,7 @@ from bioflex_jsb.runtime.roots import (  # noqa: F401  (where the JSBSim files a
     locate_root,
 )
 from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure, trim_report
+from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD
 
 DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
@@ -121,17 +122,17 @@ TRIM_TOLERANCE_RAD_S2 = 1e-4
 # Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
 # throttle commands of every engine are added per aircraft.
 TRIM_CONTROLS = (
-    "fcs/elevator-cmd-norm",
-    "fcs/aileron-cmd-norm",
-    "fcs/rudder-cmd-norm",
-    "fcs/pitch-trim-cmd-norm",
-    "fcs/roll-trim-cmd-norm",
-    "fcs/yaw-trim-cmd-norm",
+    JP.FCS_ELEVATOR_CMD_NORM,
+    JP.FCS_AILERON_CMD_NORM,
+    JP.FCS_RUDDER_CMD_NORM,
+    JP.FCS_PITCH_TRIM_CMD_NORM,
+    JP.FCS_ROLL_TRIM_CMD_NORM,
+    JP.FCS_YAW_TRIM_CMD_NORM,
 )
 _WIND_PROPERTIES = (
-    "atmosphere/wind-north-fps",
-    "atmosphere/wind-east-fps",
-    "atmosphere/wind-down-fps",
+    JP.ATMOSPHERE_WIND_NORTH_FPS,
+    JP.ATMOSPHERE_WIND_EAST_FPS,
+    JP.ATMOSPHERE_WIND_DOWN_FPS,
 )
 
 
@@ -342,15 +343,15 @@ class Airframe:
         self._set_level_ic(self._fdm, _check_speed(speed_m_s), _check_altitude(altitude_m))
 
     def _set_level_ic(self, fdm: jsbsim.FGFDMExec, v: float, h: float) -> None:
-        fdm["ic/lat-geod-rad"] = airframe_xml.INIT_LATITUDE_RAD  # standard gravity there
-        fdm["ic/long-gc-rad"] = 0.0
-        fdm["ic/terrain-elevation-ft"] = (h - airframe_xml.TERRAIN_CLEARANCE_M) * U.FT_PER_M
-        fdm["ic/h-sl-ft"] = h * U.FT_PER_M
-        for name in ("ic/phi-rad", "ic/psi-true-rad", "ic/beta-rad", "ic/gamma-rad"):
+        fdm[JP.IC_LAT_GEOD_RAD] = airframe_xml.INIT_LATITUDE_RAD  # standard gravity there
+        fdm[JP.IC_LONG_GC_RAD] = 0.0
+        fdm[JP.IC_TERRAIN_ELEVATION_FT] = (h - airframe_xml.TERRAIN_CLEARANCE_M) * U.FT_PER_M
+        fdm[JP.IC_H_SL_FT] = h * U.FT_PER_M
+        for name in (JP.IC_PHI_RAD, JP.IC_PSI_TRUE_RAD, JP.IC_BETA_RAD, JP.IC_GAMMA_RAD):
             fdm[name] = 0.0
-        for name in ("ic/p-rad_sec", "ic/q-rad_sec", "ic/r-rad_sec", "ic/alpha-rad"):
+        for name in (JP.IC_P_RAD_SEC, JP.IC_Q_RAD_SEC, JP.IC_R_RAD_SEC, JP.IC_ALPHA_RAD):
             fdm[name] = 0.0
-        fdm["ic/vt-fps"] = v * U.FT_PER_M
+        fdm[JP.IC_VT_FPS] = v * U.FT_PER_M
         for name in TRIM_CONTROLS:
             fdm[name] = 0.0
         with captured(self._log):
@@ -422,24 +423,24 @@ class Airframe:
         return TrimResult(
             speed_m_s=v,
             altitude_m=h,
-            alpha_rad=float(fdm["aero/alpha-rad"]),
-            theta_rad=float(fdm["attitude/theta-rad"]),
+            alpha_rad=float(fdm[JP.AERO_ALPHA_RAD]),
+            theta_rad=float(fdm[JP.ATTITUDE_THETA_RAD]),
             elevator_norm=(glide_elevator_norm(fdm) if self.glider  # its command: SGS.xml
-                           else float(fdm["fcs/elevator-pos-norm"])),  # writes no position
-            elevator_rad=float(fdm["fcs/elevator-pos-rad"]),
-            throttle=0.0 if self.glider else float(fdm["fcs/throttle-pos-norm"]),
+                           else float(fdm[JP.FCS_ELEVATOR_POS_NORM])),  # writes no position
+            elevator_rad=float(fdm[JP.FCS_ELEVATOR_POS_RAD]),
+            throttle=0.0 if self.glider else float(fdm[JP.FCS_THROTTLE_POS_NORM]),
             aileron_norm=self._aileron_norm(),
             propeller_rpm=self._propeller_rpm(),
             thrust_n=self.total_thrust_n,
             converged=True,
             residuals={
-                "udot_m_s2": float(fdm["accelerations/udot-ft_sec2"]) * U.M_PER_FT,
-                "wdot_m_s2": float(fdm["accelerations/wdot-ft_sec2"]) * U.M_PER_FT,
-                "qdot_rad_s2": float(fdm["accelerations/qdot-rad_sec2"]),
-                "pdot_rad_s2": float(fdm["accelerations/pdot-rad_sec2"]),
-                "rdot_rad_s2": float(fdm["accelerations/rdot-rad_sec2"]),
+                "udot_m_s2": float(fdm[JP.ACCELERATIONS_UDOT_FT_SEC2]) * U.M_PER_FT,
+                "wdot_m_s2": float(fdm[JP.ACCELERATIONS_WDOT_FT_SEC2]) * U.M_PER_FT,
+                "qdot_rad_s2": float(fdm[JP.ACCELERATIONS_QDOT_RAD_SEC2]),
+                "pdot_rad_s2": float(fdm[JP.ACCELERATIONS_PDOT_RAD_SEC2]),
+                "rdot_rad_s2": float(fdm[JP.ACCELERATIONS_RDOT_RAD_SEC2]),
             },
-            flight_path_rad=float(fdm["flight-path/gamma-rad"]) if self.glider else 0.0,
+            flight_path_rad=float(fdm[JP.FLIGHT_PATH_GAMMA_RAD]) if self.glider else 0.0,
         )
 
     def _has(self, name: str) -> bool:
@@ -450,17 +451,17 @@ class Airframe:
         position where the FCS writes one per side (c172p, the prototype), else the single
         ``fcs/aileron-pos-norm``, else the command with its trim (an FCS that writes only
         radians)."""
-        for name in ("fcs/left-aileron-pos-norm", "fcs/aileron-pos-norm"):
+        for name in (JP.FCS_LEFT_AILERON_POS_NORM, JP.FCS_AILERON_POS_NORM):
             if self._has(name):
                 return float(self._fdm[name])
-        command = float(self._fdm["fcs/aileron-cmd-norm"]) + float(
-            self._fdm["fcs/roll-trim-cmd-norm"])
+        command = float(self._fdm[JP.FCS_AILERON_CMD_NORM]) + float(
+            self._fdm[JP.FCS_ROLL_TRIM_CMD_NORM])
         return min(1.0, max(-1.0, command))
 
     def _propeller_rpm(self) -> float:
         """Engine 0's propeller speed [rev/min]; 0 for an aircraft without a propeller (a
         glider, a jet)."""
-        name = "propulsion/engine[0]/propeller-rpm"
+        name = JP.PROPULSION_ENGINE_0_PROPELLER_RPM
         return float(self._fdm[name]) if self.engines and self._has(name) else 0.0
 
     def _diagnose_trim_failure(self, v: float) -> str:

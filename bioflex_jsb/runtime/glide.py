@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from bioflex_jsb.runtime.results import TrimError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 # The glide trim's convergence: JSBSim's own trim tolerances are 1e-3 ft/s² on u̇, ẇ and
 # 1e-4 rad/s² on q̇ (FGTrimAxis; runtime/fdm.py TRIM_TOLERANCE_*); Newton is asked for
@@ -34,7 +35,7 @@ GLIDE_MAX_ITERATIONS = 30
 FD_STEP = 1e-7
 # The γ search is bounded: a glide steeper than 45° is no glide (L/D < 1).
 GAMMA_LIMIT_RAD = math.radians(45.0)
-PITCH_TRIM = "fcs/pitch-trim-cmd-norm"  # the control JSBSim's full trim moves for q̇
+PITCH_TRIM = JP.FCS_PITCH_TRIM_CMD_NORM  # the control JSBSim's full trim moves for q̇
 
 
 
@@ -44,12 +45,12 @@ def glide_trim(fdm, speed_m_s: float) -> int:
     Newton iterations taken. The instance is left at the trimmed initial condition.
     Raises :class:`TrimError` (one line) when no glide is found."""
     def residuals(x: np.ndarray) -> np.ndarray:
-        fdm["ic/gamma-rad"] = x[1]
-        fdm["ic/alpha-rad"] = x[0]
+        fdm[JP.IC_GAMMA_RAD] = x[1]
+        fdm[JP.IC_ALPHA_RAD] = x[0]
         fdm[PITCH_TRIM] = x[2]
         fdm.run_ic()
-        return np.array([fdm["accelerations/udot-ft_sec2"], fdm["accelerations/wdot-ft_sec2"],
-                         fdm["accelerations/qdot-rad_sec2"]])
+        return np.array([fdm[JP.ACCELERATIONS_UDOT_FT_SEC2], fdm[JP.ACCELERATIONS_WDOT_FT_SEC2],
+                         fdm[JP.ACCELERATIONS_QDOT_RAD_SEC2]])
 
     tol = np.array([GLIDE_TOL_FT_S2, GLIDE_TOL_FT_S2, GLIDE_TOL_RAD_S2])
     x = np.zeros(3)
@@ -83,5 +84,5 @@ def glide_elevator_norm(fdm) -> float:
     pitch trim :func:`glide_trim` moves, clipped to ±1), what an FCS like SGS.xml's moves
     the surface by; that FCS writes only the deflection in rad, and its never-written
     ``fcs/elevator-pos-norm`` read 0 whatever the trim."""
-    command = float(fdm["fcs/elevator-cmd-norm"]) + float(fdm[PITCH_TRIM])
+    command = float(fdm[JP.FCS_ELEVATOR_CMD_NORM]) + float(fdm[PITCH_TRIM])
     return min(1.0, max(-1.0, command))

@@ -51,6 +51,7 @@ from bioflex_jsb import units as U
 from bioflex_jsb.parameters.airframe import ReferenceGeometry, RigidAerodynamics
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.runtime.results import LinearizationError, TrimError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 # Central-difference steps, each inside one interval of the usual JSBSim table (1° = 0.0175
 # rad of α or β; 0.1 of a normalised rate) and large enough that the forces (printed by
@@ -149,11 +150,11 @@ class Evaluator:
                 raise LinearizationError(f"{airframe.aircraft!r} has no modal-wing hook {hook!r}"
                                          " (load it with Airframe.from_file)")
         self.engines = airframe.engines
-        self.elevator = _first(m, "fcs/elevator-pos-rad")
-        left, right = "fcs/left-aileron-pos-rad", "fcs/right-aileron-pos-rad"
+        self.elevator = _first(m, JP.FCS_ELEVATOR_POS_RAD)
+        left, right = JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD
         self.ailerons = ((left, right) if m.hasNode(left) and m.hasNode(right)
-                         else (_first(m, "fcs/aileron-pos-rad"),))
-        self.rudder = _first(m, "fcs/rudder-pos-rad")
+                         else (_first(m, JP.FCS_AILERON_POS_RAD),))
+        self.rudder = _first(m, JP.FCS_RUDDER_POS_RAD)
         if self.elevator is None:
             raise LinearizationError(f"{airframe.aircraft!r}: its flight controls write no "
                                      "fcs/elevator-pos-rad: the elevator's angle is unknown")
@@ -170,14 +171,14 @@ class Evaluator:
 
     def _evaluate(self, s: State) -> Reading:
         fdm = self.fdm
-        fdm["ic/vt-fps"] = s.speed_m_s * U.FT_PER_M
-        fdm["ic/alpha-rad"] = s.alpha_rad
-        fdm["ic/beta-rad"] = s.beta_rad
-        fdm["ic/p-rad_sec"], fdm["ic/q-rad_sec"], fdm["ic/r-rad_sec"] = (
+        fdm[JP.IC_VT_FPS] = s.speed_m_s * U.FT_PER_M
+        fdm[JP.IC_ALPHA_RAD] = s.alpha_rad
+        fdm[JP.IC_BETA_RAD] = s.beta_rad
+        fdm[JP.IC_P_RAD_SEC], fdm[JP.IC_Q_RAD_SEC], fdm[JP.IC_R_RAD_SEC] = (
             s.p_rad_s, s.q_rad_s, s.r_rad_s)
-        fdm["fcs/elevator-cmd-norm"] = s.elevator_cmd
-        fdm["fcs/aileron-cmd-norm"] = s.aileron_cmd
-        fdm["fcs/rudder-cmd-norm"] = s.rudder_cmd
+        fdm[JP.FCS_ELEVATOR_CMD_NORM] = s.elevator_cmd
+        fdm[JP.FCS_AILERON_CMD_NORM] = s.aileron_cmd
+        fdm[JP.FCS_RUDDER_CMD_NORM] = s.rudder_cmd
         for e in self.engines:
             fdm[f"fcs/throttle-cmd-norm[{e.index}]"] = s.throttle
         lift_hook = drag_hook = 0.0
@@ -187,10 +188,10 @@ class Evaluator:
             if k == 0 and self.engines:
                 fdm.get_propulsion().get_steady_state()
                 fdm.run_ic()
-            u, w = fdm["velocities/u-fps"], fdm["velocities/w-fps"]
-            udot = fdm["accelerations/udot-ft_sec2"]
-            wdot = fdm["accelerations/wdot-ft_sec2"] - s.alphadot_rad_s * (u * u + w * w) / u
-            slugs = fdm["inertia/mass-slugs"]
+            u, w = fdm[JP.VELOCITIES_U_FPS], fdm[JP.VELOCITIES_W_FPS]
+            udot = fdm[JP.ACCELERATIONS_UDOT_FT_SEC2]
+            wdot = fdm[JP.ACCELERATIONS_WDOT_FT_SEC2] - s.alphadot_rad_s * (u * u + w * w) / u
+            slugs = fdm[JP.INERTIA_MASS_SLUGS]
             lift_hook += wdot * slugs  # +lift hook (up) lowers ẇ by F/m
             drag_hook += udot * slugs
         if max(abs(udot), abs(wdot)) > HOLD_TOLERANCE_FT_S2:
@@ -201,13 +202,13 @@ class Evaluator:
         n, nm = U.N_PER_LBF, U.N_M_PER_LBF_FT
         powered = bool(self.engines)  # a glider's JSBSim has no propulsion forces at all
         return Reading(
-            lift=fdm["forces/fwz-aero-lbs"] * n, drag=fdm["forces/fwx-aero-lbs"] * n,
-            side=fdm["forces/fby-aero-lbs"] * n, roll=fdm["moments/l-aero-lbsft"] * nm,
-            pitch=fdm["moments/m-aero-lbsft"] * nm, yaw=fdm["moments/n-aero-lbsft"] * nm,
-            thrust_x=fdm["forces/fbx-prop-lbs"] * n if powered else 0.0,
-            thrust_z=fdm["forces/fbz-prop-lbs"] * n if powered else 0.0,
-            thrust_pitch=fdm["moments/m-prop-lbsft"] * nm if powered else 0.0,
-            q_pa=fdm["aero/qbar-psf"] * U.PA_PER_PSF,
+            lift=fdm[JP.FORCES_FWZ_AERO_LBS] * n, drag=fdm[JP.FORCES_FWX_AERO_LBS] * n,
+            side=fdm[JP.FORCES_FBY_AERO_LBS] * n, roll=fdm[JP.MOMENTS_L_AERO_LBSFT] * nm,
+            pitch=fdm[JP.MOMENTS_M_AERO_LBSFT] * nm, yaw=fdm[JP.MOMENTS_N_AERO_LBSFT] * nm,
+            thrust_x=fdm[JP.FORCES_FBX_PROP_LBS] * n if powered else 0.0,
+            thrust_z=fdm[JP.FORCES_FBZ_PROP_LBS] * n if powered else 0.0,
+            thrust_pitch=fdm[JP.MOMENTS_M_PROP_LBSFT] * nm if powered else 0.0,
+            q_pa=fdm[JP.AERO_QBAR_PSF] * U.PA_PER_PSF,
             elevator=fdm[self.elevator], aileron=self._surface(self.ailerons),
             rudder=self._surface((self.rudder,)))
 
@@ -227,10 +228,10 @@ def identify_point(airframe, speed_m_s: float, reference: ReferenceGeometry,
     ev = Evaluator(airframe)
     v, a0 = trim.speed_m_s, trim.alpha_rad
     s_ref, b, c = reference.area_m2, reference.span_m, reference.mean_chord_m
-    throttle = float(fdm["fcs/throttle-cmd-norm[0]"]) if airframe.engines else 0.0
-    base = State(v, a0, elevator_cmd=float(fdm["fcs/elevator-cmd-norm"]),
-                 aileron_cmd=float(fdm["fcs/aileron-cmd-norm"]),
-                 rudder_cmd=float(fdm["fcs/rudder-cmd-norm"]), throttle=throttle)
+    throttle = float(fdm[JP.FCS_THROTTLE_CMD_NORM_0]) if airframe.engines else 0.0
+    base = State(v, a0, elevator_cmd=float(fdm[JP.FCS_ELEVATOR_CMD_NORM]),
+                 aileron_cmd=float(fdm[JP.FCS_AILERON_CMD_NORM]),
+                 rudder_cmd=float(fdm[JP.FCS_RUDDER_CMD_NORM]), throttle=throttle)
 
     def at(**changes) -> State:
         return State(**{**base.__dict__, **changes})

@@ -40,6 +40,7 @@ from bioflex_jsb.runtime.fdm import Airframe, load_fdm
 from bioflex_jsb.runtime.identification import identify_point
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, captured
 from bioflex_jsb.runtime.results import AircraftLoadError, TrimError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 INCH_M = 0.0254  # exact
 SLUG_FT2_KG_M2 = U.KG_PER_SLUG * U.M_PER_FT**2
@@ -95,9 +96,9 @@ def probe(jsbsim_path: str) -> JSBSimValues:
         inertia = Inertia(*(fdm[f"inertia/{k}-slugs_ft2"] * SLUG_FT2_KG_M2
                             for k in ("ixx", "iyy", "izz", "ixz")))
         return JSBSimValues(
-            reference_area_m2=fdm["metrics/Sw-sqft"] * ft2, span_m=fdm["metrics/bw-ft"] *
-            U.M_PER_FT, mean_chord_m=fdm["metrics/cbarw-ft"] * U.M_PER_FT,
-            mass_kg=fdm["inertia/mass-slugs"] * U.KG_PER_SLUG,
+            reference_area_m2=fdm[JP.METRICS_SW_SQFT] * ft2, span_m=fdm[JP.METRICS_BW_FT] *
+            U.M_PER_FT, mean_chord_m=fdm[JP.METRICS_CBARW_FT] * U.M_PER_FT,
+            mass_kg=fdm[JP.INERTIA_MASS_SLUGS] * U.KG_PER_SLUG,
             cg_m=tuple(fdm[f"inertia/cg-{a}-in"] * INCH_M for a in "xyz"),
             inertia=inertia,
             aero_reference_point_m=tuple(fdm[f"metrics/aero-rp-{a}-in"] * INCH_M

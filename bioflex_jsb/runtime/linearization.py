@@ -33,6 +33,7 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.runtime.results import LinearizationError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 # JSBSim state names (FGStateSpace) of the rigid longitudinal model, in x_R order, and
 # the factor from JSBSim's unit to SI.
@@ -112,24 +113,24 @@ def rigid_jacobian(fdm, powered: bool = False) -> np.ndarray:
     model the identified derivatives are checked against (FGLinearization takes α̇ after
     one evaluation: tests/test_identification.py). The state is put back at the end."""
     m = 0.3048  # m per ft (exact), JSBSim's velocities and accelerations are in ft
-    u0, w0 = fdm["velocities/u-fps"] * m, fdm["velocities/w-fps"] * m
-    x0 = np.array([math.hypot(u0, w0), math.atan2(w0, u0), fdm["velocities/q-rad_sec"],
-                   fdm["attitude/theta-rad"]])
+    u0, w0 = fdm[JP.VELOCITIES_U_FPS] * m, fdm[JP.VELOCITIES_W_FPS] * m
+    x0 = np.array([math.hypot(u0, w0), math.atan2(w0, u0), fdm[JP.VELOCITIES_Q_RAD_SEC],
+                   fdm[JP.ATTITUDE_THETA_RAD]])
 
     def derivatives(x: np.ndarray) -> np.ndarray:
         v, alpha, q, theta = x
         u, w = v * math.cos(alpha), v * math.sin(alpha)
-        fdm["ic/u-fps"], fdm["ic/v-fps"], fdm["ic/w-fps"] = u / m, 0.0, w / m
-        fdm["ic/theta-rad"], fdm["ic/q-rad_sec"] = theta, q
-        fdm["ic/p-rad_sec"], fdm["ic/r-rad_sec"] = 0.0, 0.0
+        fdm[JP.IC_U_FPS], fdm[JP.IC_V_FPS], fdm[JP.IC_W_FPS] = u / m, 0.0, w / m
+        fdm[JP.IC_THETA_RAD], fdm[JP.IC_Q_RAD_SEC] = theta, q
+        fdm[JP.IC_P_RAD_SEC], fdm[JP.IC_R_RAD_SEC] = 0.0, 0.0
         for _ in range(ALPHADOT_PASSES):
             fdm.run_ic()
             if powered:  # the propellers at their steady RPM, as JSBSim's trim puts them
                 fdm.get_propulsion().get_steady_state()
-        udot = fdm["accelerations/udot-ft_sec2"] * m
-        wdot = fdm["accelerations/wdot-ft_sec2"] * m
+        udot = fdm[JP.ACCELERATIONS_UDOT_FT_SEC2] * m
+        wdot = fdm[JP.ACCELERATIONS_WDOT_FT_SEC2] * m
         return np.array([(u * udot + w * wdot) / v, (u * wdot - w * udot) / (u * u + w * w),
-                         fdm["accelerations/qdot-rad_sec2"], q])
+                         fdm[JP.ACCELERATIONS_QDOT_RAD_SEC2], q])
 
     a = np.empty((4, 4))
     for j, h in enumerate(JACOBIAN_STEPS):
