@@ -51,7 +51,7 @@ from bioflex_jsb.drivers.compare import (
     check_gust_excites,
     compare_run,
 )
-from bioflex_jsb.drivers.gust import RunSetup, StepRecorder, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, StepRecorder, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.eigen import FlutterResult, ModeSet, find_flutter, modes_at
 from bioflex_jsb.flight_dynamics.flutter_engine import METHODS
@@ -71,7 +71,7 @@ from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
 from bioflex_jsb.simulation.run import check_run_length
-from bioflex_jsb.simulation.run_checks import check_run_arguments
+from bioflex_jsb.simulation.run_checks import check_recorders
 from bioflex_jsb.simulation.run_checks import finite_number as _real
 
 __all__ = [
@@ -156,19 +156,27 @@ def _flying_wing(wing):
     return build
 
 
+def _flight_speed(wing, speed_m_s: float | None) -> float:
+    """The trim speed [m/s] of a nonlinear run of ``wing``: ``speed_m_s``, within an
+    :class:`Aircraft`'s flight speeds, default its cruise speed; the prototype's 15 m/s
+    (Table 1) for a bare wing."""
+    if isinstance(wing, Aircraft):
+        cruise, (lo, hi) = flight_speeds(wing)
+        v = cruise if speed_m_s is None else _real(speed_m_s, "speed_m_s [m/s]")
+        if not lo <= v <= hi:
+            raise InputError(f"speed {v:g} m/s is outside aircraft {wing.name!r}'s flight "
+                             f"speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
+        return v
+    return CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
+
+
 def _flight(wing, speed_m_s: float | None):
     """(the WingBuild, the JSBSim airframe, the trim speed [m/s]) of a nonlinear run of
     ``wing``: an :class:`Aircraft`'s own airframe and cruise speed (the default of
     ``speed_m_s``), else the prototype's (15 m/s, Table 1)."""
     build = _flying_wing(wing)
-    if isinstance(wing, Aircraft):
-        cruise, (lo, hi) = flight_speeds(wing)
-        v = cruise if speed_m_s is None else float(speed_m_s)
-        if not lo <= v <= hi:
-            raise InputError(f"speed {v:g} m/s is outside aircraft {wing.name!r}'s flight "
-                             f"speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
-        return build, airframe_for(wing), v
-    return build, Airframe(), CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
+    v = _flight_speed(wing, speed_m_s)
+    return build, airframe_for(wing) if isinstance(wing, Aircraft) else Airframe(), v
 
 
 def _density(wing, density_kg_m3: float | None) -> dict:
@@ -265,32 +273,28 @@ def _gust_text(gust) -> str:
 
 def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
               recorders, aero, trim):
-    """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build."""
-    if aero not in AERO_MODELS:
-        raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
+    """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build: the run's
+    configuration made (and so checked) before the airframe loads."""
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
-    _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
-    models, duration_s, gust_start_s, dt_s = check_run_arguments(
-        parse_gust(_gust_text(gust)), models, duration_s, gust_start_s, dt_s, trim, recorders)
-    wing, airframe, speed_m_s = _flight(wing, speed_m_s)
-    chord = wing.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
-    setup = RunSetup(speed_m_s, parse_gust(gust, chord), duration_s, gust_start_s,
-                     altitude_m, dt_s)
+    build = _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
+    if not isinstance(models, str) and "native" in tuple(models):
+        raise InputError(f"unknown model 'native'; give one or more of {', '.join(MODELS)} "
+                         "(the native wing is an exported aircraft's: docs/native.md)")
+    chord = build.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
+    config = RunConfig(_flight_speed(wing, speed_m_s), parse_gust(_gust_text(gust), chord),
+                       duration_s, gust_start_s, altitude_m, dt_s, models=models, aero=aero,
+                       trim=trim)
+    check_recorders(recorders, config.models)
+    airframe = airframe_for(wing) if isinstance(wing, Aircraft) else Airframe()
     out = {}
-    for model in models:
+    for model in map(str, config.models):
         recorder = (recorders or {}).get(model)
-        elastic = trim == "elastic" and model != "rigid"
-        if aero == "unsteady" or elastic:
-            out[model] = run_gust(airframe, wing, model, setup, recorder=recorder,
-                                  aero=aero, trim_mode="elastic" if elastic else "rigid",
-                                  loads=wing)
-        else:
-            out[model] = run_gust(airframe, wing.model, model, setup, recorder=recorder,
-                                  loads=wing)
+        flown = build if config.needs_build(model) else build.model
+        out[model] = run_gust(airframe, flown, model, config, recorder=recorder, loads=build)
         # which wing flew, as the command's runs say (plot_runs' title, a user's table)
-        out[model].meta.update(wing=wing.variant.name, mass_basis=wing.mass_basis)
-    return out, airframe, wing, speed_m_s
+        out[model].meta.update(wing=build.variant.name, mass_basis=build.mass_basis)
+    return out, airframe, build, config.speed_m_s
 
 
 def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
@@ -303,7 +307,7 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
     if duration_s <= 0.0:  # 0 s returned an empty run, −1 s a numpy "negative dimensions"
         raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
     check_run_length(duration_s, DEFAULT_DT_S, turbulence=False)
-    setup = RunSetup(15.0, parse_gust("sharp:3"), duration_s)
+    setup = RunConfig(15.0, parse_gust("sharp:3"), duration_s)
     if model == "native":
         from bioflex_jsb.generators.native_wing import aircraft_name
 

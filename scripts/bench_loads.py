@@ -9,7 +9,7 @@ import sys
 import time
 
 from bioflex_jsb import api
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.loads.model import build_loads_model
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -18,7 +18,7 @@ repeats = int(sys.argv[1]) if len(sys.argv) > 1 else 7
 model = sys.argv[2] if len(sys.argv) > 2 else "coupled"
 duration = float(sys.argv[3]) if len(sys.argv) > 3 else 10.0
 w = api.load_wing("optimised")
-setup = RunSetup(15.0, parse_gust("1cos:3:5"), duration)
+setup = RunConfig(15.0, parse_gust("1cos:3:5"), duration)
 af = Airframe()
 trim = None
 run_gust(af, w.model, model, setup, loads=w)  # warm: compile, caches

@@ -76,7 +76,7 @@ def worker(out: Path) -> None:
     import scipy.linalg  # noqa: F401  (loads scipy's OpenBLAS, for threadpoolctl's report)
     from threadpoolctl import threadpool_info
 
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.drivers.native import repository_files
     from bioflex_jsb.generators.xml_writer import number_difference
     from bioflex_jsb.runtime.fdm import Airframe
@@ -99,7 +99,7 @@ def worker(out: Path) -> None:
                 n: (np.unwrap if n in G.WRAPPED_CHANNELS else np.asarray)(v)[::G.DECIMATE]
                 for n, v in run.channels.items()}
     result["golden"], result["histories"] = golden, histories
-    setup = RunSetup(G.SPEED_M_S, parse_gust(G.GUST), G.DURATION_S)
+    setup = RunConfig(G.SPEED_M_S, parse_gust(G.GUST), G.DURATION_S)
     kernel = {}
     for model in ("rigid", "coupled", "qsd"):
         fast = run_gust(Airframe(), stored_wing, model, setup, compiled=True)

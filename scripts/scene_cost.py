@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -36,7 +36,7 @@ def main(argv: list[str]) -> int:
     build = build_wing(VARIANTS["optimised"])
     desc = RunDescription("gust", "optimised", 15.0, gust="sharp:3", models=("coupled",),
                           duration_s=DURATION_S)
-    setup = RunSetup(15.0, parse_gust("sharp:3"), DURATION_S, 0.5)
+    setup = RunConfig(15.0, parse_gust("sharp:3"), DURATION_S, 0.5)
     air = Airframe()
     cpu: dict[str, list[float]] = {m: [] for m in MODES}
     sizes = {}

@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def screenshot_log(path: str | Path, exaggeration: float = 1.0) -> Path:
     """Fly SCREENSHOT_CASE and log it with the scene to ``path``."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.flight_dynamics.wing_model import build_wing, resolve_variant
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
@@ -32,7 +32,7 @@ def screenshot_log(path: str | Path, exaggeration: float = 1.0) -> Path:
     log = RunLog.open(path, desc, wing_variant=build.variant.as_dict(), scene=exaggeration)
     try:
         run_gust(Airframe(), build.model, c["model"],
-                 RunSetup(c["speed_m_s"], parse_gust(c["gust"]), c["duration_s"],
+                 RunConfig(c["speed_m_s"], parse_gust(c["gust"]), c["duration_s"],
                           c["gust_start_s"]), recorder=log.recorder(c["model"]))
     finally:
         log.close()

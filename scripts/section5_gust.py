@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.flight_dynamics import lti
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
@@ -318,7 +318,7 @@ def main(argv: list[str] | None = None) -> int:
               "the short-period settling)", file=sys.stderr)
         return 2
     gust = GustSpec("sharp", P.SECTION5_GUST_AMPLITUDE_M_S)
-    setup = RunSetup(P.SECTION5_AIRSPEED_M_S, gust, args.duration, gust_start_s=gust_start_s)
+    setup = RunConfig(P.SECTION5_AIRSPEED_M_S, gust, args.duration, gust_start_s=gust_start_s)
     airframe = Airframe()
     optimised = build_wing(VARIANTS["optimised"]).model
     original = build_wing(VARIANTS["original"]).model

@@ -182,15 +182,15 @@ def compare_wing(stored, built) -> dict[str, float]:
 def fly_case(case: str, wing="stored", **setup):
     """Fly one golden case; a TimeHistory (every step). ``wing``: ``"stored"`` (the wing of
     the stored histories), ``"built"`` (:func:`built_wing`) or an ElasticWingModel (the
-    native case has its wing in its XML and takes none). ``setup``: RunSetup fields to
+    native case has its wing in its XML and takes none). ``setup``: RunConfig fields to
     change (a test's deliberate physics change)."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.generators.native_wing import aircraft_name
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
 
     model = case.removeprefix("fig21_")
-    run_setup = RunSetup(SPEED_M_S, parse_gust(GUST), DURATION_S, **setup)
+    run_setup = RunConfig(SPEED_M_S, parse_gust(GUST), DURATION_S, **setup)
     if model == "native":
         return run_gust(Airframe(aircraft=aircraft_name("optimised")), None, "native", run_setup)
     if isinstance(wing, str):
@@ -219,7 +219,7 @@ def sgs_built_wing():
 def fly_sgs_case(case: str, wing="stored", **setup):
     """Fly one SGS golden case (a TimeHistory, every step) on the glider's own JSBSim
     airframe; ``wing`` as :func:`fly_case`'s (``"stored"``, ``"built"`` or a model)."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
 
@@ -227,7 +227,7 @@ def fly_sgs_case(case: str, wing="stored", **setup):
     if isinstance(wing, str):
         wing = {"stored": sgs_stored_wing, "built": sgs_built_wing}[wing]()
     gust = parse_gust(SGS_GUST, aircraft.airframe.mean_chord_m)
-    run_setup = RunSetup(SGS_SPEED_M_S, gust, SGS_DURATION_S, **setup)
+    run_setup = RunConfig(SGS_SPEED_M_S, gust, SGS_DURATION_S, **setup)
     return run_gust(airframe_for(aircraft), wing, case.removeprefix("sgs_"), run_setup)
 
 
@@ -302,7 +302,7 @@ def c172_built_wing():
 
 def fly_c172_case(case: str, wing="stored", **setup):
     """Fly one c172 golden case on its own JSBSim airframe; ``wing`` as :func:`fly_case`'s."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
 
@@ -310,7 +310,7 @@ def fly_c172_case(case: str, wing="stored", **setup):
     if isinstance(wing, str):
         wing = {"stored": c172_stored_wing, "built": c172_built_wing}[wing]()
     gust = parse_gust(C172_GUST, aircraft.airframe.mean_chord_m)
-    run_setup = RunSetup(C172_SPEED_M_S, gust, C172_DURATION_S, **setup)
+    run_setup = RunConfig(C172_SPEED_M_S, gust, C172_DURATION_S, **setup)
     return run_gust(airframe_for(aircraft), wing, case.removeprefix("c172_"), run_setup)
 
 

@@ -71,7 +71,7 @@ def test_section_loads_of_the_runs_own_wing_only(run, other, kwargs, needle):
 
 def test_section_loads_refuse_the_native_wing(wing):
     with pytest.raises(InputError, match="native wing"):
-        api.section_loads(wing, api.fly_fig21("native", duration_s=0.3))
+        api.section_loads(wing, api.fly_fig21("native", duration_s=0.6))
 
 
 @pytest.mark.parametrize("call, needle", [

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb.cli import main
-from bioflex_jsb.drivers.gust import WINDOW_S, RunSetup, run_gust
+from bioflex_jsb.drivers.gust import WINDOW_S, RunConfig, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -29,9 +29,9 @@ def peaks(run):
 def test_halving_the_time_step_changes_peaks_by_less_than_1_percent(airframe, gust):
     # The Section 5 case (optimised wing, 15 m/s) at the default step and at half of it.
     wing = build_wing(VARIANTS["optimised"]).model
-    coarse = run_gust(airframe, wing, "coupled", RunSetup(15.0, parse_gust(gust), 3.0))
+    coarse = run_gust(airframe, wing, "coupled", RunConfig(15.0, parse_gust(gust), 3.0))
     fine = run_gust(airframe, wing, "coupled",
-                    RunSetup(15.0, parse_gust(gust), 3.0, dt_s=DEFAULT_DT_S / 2))
+                    RunConfig(15.0, parse_gust(gust), 3.0, dt_s=DEFAULT_DT_S / 2))
     pc, pf = peaks(coarse), peaks(fine)
     for name in pc:
         assert pc[name] == pytest.approx(pf[name], rel=0.01), name
@@ -44,9 +44,9 @@ def test_fig21_run_converges_with_the_step(airframe):
     from bioflex_jsb.simulation.results import nrmse
 
     wing = build_wing(VARIANTS["optimised"]).model
-    coarse = run_gust(airframe, wing, "coupled", RunSetup(15.0, parse_gust("sharp:3"), 3.0))
+    coarse = run_gust(airframe, wing, "coupled", RunConfig(15.0, parse_gust("sharp:3"), 3.0))
     fine = run_gust(airframe, wing, "coupled",
-                    RunSetup(15.0, parse_gust("sharp:3"), 3.0, dt_s=DEFAULT_DT_S / 4))
+                    RunConfig(15.0, parse_gust("sharp:3"), 3.0, dt_s=DEFAULT_DT_S / 4))
     errors = {c: nrmse(np.interp(coarse.time_s, fine.time_s, fine[c]), coarse[c])
               for c in ("u", "alpha", "q", "theta", "eta1")}
     assert max(errors.values()) < 0.01, errors
@@ -54,7 +54,7 @@ def test_fig21_run_converges_with_the_step(airframe):
 
 def test_rigid_run_has_no_modal_loads_and_coupled_run_has(airframe):
     wing = build_wing(VARIANTS["original"]).model
-    setup = RunSetup(15.0, parse_gust("sharp:0.5"), duration_s=1.5)
+    setup = RunConfig(15.0, parse_gust("sharp:0.5"), duration_s=1.5)
     rigid = run_gust(airframe, wing, "rigid", setup)
     coupled = run_gust(airframe, wing, "coupled", setup)
     assert np.all(rigid["lift_n"] == 0.0)
@@ -67,7 +67,7 @@ def test_progress_is_reported_once_a_block_up_to_every_step(airframe):
     """``progress`` (a progress bar's hook, drivers/gust.py) sees the steps flown after each
     block of WINDOW_S: increasing, the last the whole run, and nothing per step."""
     wing = build_wing(VARIANTS["original"]).model
-    setup = RunSetup(15.0, parse_gust("sharp:0.5"), duration_s=2.0)
+    setup = RunConfig(15.0, parse_gust("sharp:0.5"), duration_s=2.0)
     seen: list[int] = []
     run = run_gust(airframe, wing, "coupled", setup, progress=seen.append)
     n = len(run.time_s)
@@ -78,7 +78,7 @@ def test_progress_is_reported_once_a_block_up_to_every_step(airframe):
 
 def test_before_the_gust_the_trimmed_aircraft_stays_put(airframe):
     wing = build_wing(VARIANTS["original"]).model
-    run = run_gust(airframe, wing, "coupled", RunSetup(15.0, parse_gust("sharp:1"), 1.0,
+    run = run_gust(airframe, wing, "coupled", RunConfig(15.0, parse_gust("sharp:1"), 1.0,
                                                        gust_start_s=0.9))
     before = run.time_s < 0.9
     # trim residuals only: |Δα| < 0.01° and |q| < 0.01°/s over 0.9 s

@@ -12,7 +12,7 @@ import pytest
 
 from bioflex_jsb import api
 from bioflex_jsb.cli import main
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -24,8 +24,9 @@ def test_still_air_from_the_elastic_trim_stays_there(wing):
     static load or ΔQ forcing would start a pitching and modal transient of ~1e-2."""
     build = api.load_wing(wing)
     for compiled in (True, False):
-        run = run_gust(Airframe(), build, "coupled", RunSetup(15.0, parse_gust("none"), 1.0),
-                       trim_mode="elastic", compiled=compiled)
+        run = run_gust(Airframe(), build, "coupled",
+                       RunConfig(15.0, parse_gust("none"), 1.0, trim="elastic"),
+                       compiled=compiled)
         assert run.stopped is None
         # measured: |q| 7e-6 rad/s, |Δη1| 1e-6 rad (the trim's own residuals)
         assert np.abs(run["q"]).max() < 1e-4
@@ -39,8 +40,8 @@ def test_jsbsim_elastic_trim_agrees_with_the_linear_airframe_fixed_point():
     15 m/s (tests/test_elastic_trim.py), so the elastic α agree to a few tenths of a
     degree."""
     build = api.load_wing("optimised")
-    run = run_gust(Airframe(), build, "coupled", RunSetup(15.0, parse_gust("none"), 0.1),
-                   trim_mode="elastic")
+    run = run_gust(Airframe(), build, "coupled",
+                   RunConfig(15.0, parse_gust("none"), 0.1, trim="elastic"))
     linear = elastic_trim(build, 15.0)
     assert math.degrees(run.meta["trim_alpha_rad"]) == pytest.approx(
         math.degrees(linear.alpha_rad), abs=0.3)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import api, cli
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.loads import loads_metrics, section_loads
 from bioflex_jsb.loads.model import QUANTITIES, build_loads_model
 from bioflex_jsb.loads.stream import LoadStream, channel_names
@@ -34,9 +34,9 @@ def wing():
     return api.load_wing("optimised")
 
 
-def _fly(wing, model="coupled", gust="sharp:3", duration_s=1.5, **kw):
-    setup = RunSetup(15.0, parse_gust(gust), duration_s, 0.5)
-    flown_by = wing if kw.get("aero") == "unsteady" else wing.model
+def _fly(wing, model="coupled", gust="sharp:3", duration_s=1.5, aero="quasi-steady", **kw):
+    setup = RunConfig(15.0, parse_gust(gust), duration_s, 0.5, models=(model,), aero=aero)
+    flown_by = wing if aero == "unsteady" else wing.model
     return run_gust(Airframe(), flown_by, model, setup, loads=wing, **kw)
 
 
@@ -215,7 +215,7 @@ def test_a_diverged_run_and_a_run_without_loads(wing, coupled_run):
     stopped.stopped = "mode aeroelastic_1 diverged (test)"
     assert gust_metrics(stopped, 0.5).loads is None  # no response metrics once diverged
     assert section_load_metrics(_without_loads(coupled_run), 0.5) is None
-    plain = run_gust(Airframe(), wing.model, "coupled", RunSetup(15.0, parse_gust("sharp:1"),
+    plain = run_gust(Airframe(), wing.model, "coupled", RunConfig(15.0, parse_gust("sharp:1"),
                                                                  0.2, 0.1))
     assert "loads" not in plain.meta and not any(c.startswith("loads") for c in plain.channels)
 
@@ -238,7 +238,7 @@ def test_a_wing_without_section_loads_says_why(wing):
     from dataclasses import replace
 
     modes_file = replace(wing, variant=replace(wing.variant, modes_file="x.toml"))
-    setup = RunSetup(15.0, parse_gust("sharp:1"), 0.2, 0.1)
+    setup = RunConfig(15.0, parse_gust("sharp:1"), 0.2, 0.1)
     run = run_gust(Airframe(), wing.model, "coupled", setup, loads=modes_file)
     assert "modes file" in run.meta["loads_unavailable"] and "loads" not in run.meta
     assert not any(c.startswith("loads_") for c in run.channels)
@@ -264,7 +264,7 @@ def logged(wing, tmp_path_factory):
     try:
         for model in ("coupled", "rigid"):
             runs[model] = run_gust(Airframe(), wing.model, model,
-                                   RunSetup(15.0, parse_gust("sharp:3"), 2.0, 0.5),
+                                   RunConfig(15.0, parse_gust("sharp:3"), 2.0, 0.5),
                                    recorder=log.recorder(model), loads=wing)
     finally:
         log.close()

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import api
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.loads.model import build_loads_model
 from bioflex_jsb.loads.stream import LoadStream
@@ -29,7 +29,8 @@ def wing():
 
 def _fly(wing, gust: str, duration_s: float):
     return run_gust(Airframe(), wing, "coupled",
-                    RunSetup(SPEED_M_S, parse_gust(gust), duration_s, 0.5), aero="unsteady",
+                    RunConfig(SPEED_M_S, parse_gust(gust), duration_s, 0.5,
+                              models=("coupled",), aero="unsteady"),
                     loads=wing)
 
 

@@ -291,13 +291,13 @@ def test_a_long_run_keeps_an_envelope_with_the_exact_peaks():
     """keep="envelope": a bounded history whose gust summary has the peaks of every step
     (and the settling time to ENVELOPE_S); keep="all" is every step."""
     from bioflex_jsb.api import load_wing
-    from bioflex_jsb.drivers.gust import ENVELOPE_S, RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import ENVELOPE_S, RunConfig, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics
 
     wing = load_wing().model
-    setup = RunSetup(15.0, parse_gust("sharp:3"), 4.0, 0.5)
+    setup = RunConfig(15.0, parse_gust("sharp:3"), 4.0, 0.5)
     full = run_gust(Airframe(), wing, "coupled", setup, keep="all")
     env = run_gust(Airframe(), wing, "coupled", setup, keep="envelope")
     assert full.meta["history"] == "all" and env.meta["history"] == "envelope"

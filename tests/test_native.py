@@ -191,13 +191,13 @@ def test_native_xml_matches_the_cosimulation(variant, amplitude):
     """Same sharp gust at 15 m/s, 3 s: native XML vs Python co-simulation (measured: at most
     0.3 % for the original wing; η₁ of the optimised wing 0.72 % at 0.3 m/s, 0.75 % at 3 m/s,
     the other channels ≤ 0.53 %)."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import nrmse
 
     wing = build_wing(VARIANTS[variant]).model
-    setup = RunSetup(15.0, parse_gust(f"sharp:{amplitude}"), duration_s=3.0)
+    setup = RunConfig(15.0, parse_gust(f"sharp:{amplitude}"), duration_s=3.0)
     ref = run_gust(Airframe(), wing, "coupled", setup)
     nat = run_gust(Airframe(root=REPO, aircraft=J.aircraft_name(variant)), None, "native", setup)
     assert ref.stopped is None
@@ -274,7 +274,7 @@ def test_fig21_script_runs_in_the_console_program(fig21_console_csv):
     """No JSBSim trim (the Python trim as the initial condition, the airframe held while the
     propellers spin up), the modal wing active, η1 and q as the co-simulation's of the same
     case, the columns as docs/native.md lists them."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.parameters import prototype as P
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
@@ -288,7 +288,7 @@ def test_fig21_script_runs_in_the_console_program(fig21_console_csv):
     t = col["Time"]
     assert t[-1] >= J.FIG21_SETTLE_S + J.FIG21_DURATION_S - 2 * dt
     assert np.all(col["active [-]"][1:] == 1.0)
-    setup = RunSetup(P.SECTION5_AIRSPEED_M_S, parse_gust(f"sharp:{P.SECTION5_GUST_AMPLITUDE_M_S}"),
+    setup = RunConfig(P.SECTION5_AIRSPEED_M_S, parse_gust(f"sharp:{P.SECTION5_GUST_AMPLITUDE_M_S}"),
                      duration_s=J.FIG21_DURATION_S, gust_start_s=J.FIG21_GUST_START_S, dt_s=dt)
     ref = run_gust(Airframe(), build_wing(VARIANTS[J.FIG21_VARIANT]).model, "coupled", setup)
     assert ref.stopped is None

@@ -190,7 +190,7 @@ def test_native_sgs_matches_the_cosimulation(exported, amplitude):
     under 2 % (measured: at most 0.88 % at 0.3 m/s, theta; 1.60 % at 3 m/s, q; the
     prototype's bar is 1 %, the SGS's gust swings alpha by up to 7 deg across its tables);
     the rigid SGS of the same file is 8.6 % off in q: the wing is seen."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation.gusts import parse_gust
@@ -198,7 +198,7 @@ def test_native_sgs_matches_the_cosimulation(exported, amplitude):
 
     root = exported["gust"][0]
     aircraft = load_aircraft("sgs_elastic")
-    setup = RunSetup(SPEED_M_S, parse_gust(f"sharp:{amplitude}"), duration_s=3.0)
+    setup = RunConfig(SPEED_M_S, parse_gust(f"sharp:{amplitude}"), duration_s=3.0)
     ref = run_gust(airframe_for(aircraft), aircraft.wing().model, "coupled", setup)
     nat = run_gust(Airframe(root=root, aircraft="sgs_elastic"), None, "native", setup)
     assert ref.stopped is None and nat.stopped is None

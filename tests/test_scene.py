@@ -34,7 +34,7 @@ def build():
 @pytest.fixture(scope="module")
 def gust_log(tmp_path_factory, build):
     """1.2 s of the Fig. 21 case (coupled), logged with the scene at EXAGGERATION."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
 
@@ -45,7 +45,7 @@ def gust_log(tmp_path_factory, build):
                            scene=EXAGGERATION)
     try:
         run = run_gust(Airframe(), build.model, "coupled",
-                       RunSetup(15.0, parse_gust("sharp:3"), 1.2, 0.2),
+                       RunConfig(15.0, parse_gust("sharp:3"), 1.2, 0.2),
                        recorder=log.recorder("coupled"))
     finally:
         log.close()

@@ -28,7 +28,7 @@ TOL = 1e-12
 def _fly(path, build, duration_s: float, scene: float | None):
     """A coupled sharp 3 m/s gust from 0.2 s with both methods' section loads, logged to
     ``path`` (with the scene at ``scene``, or none)."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
 
@@ -37,7 +37,7 @@ def _fly(path, build, duration_s: float, scene: float | None):
     log = sink.RunLog.open(path, desc, wing_variant=build.variant.as_dict(), scene=scene)
     try:
         run = run_gust(Airframe(), build.model, "coupled",
-                       RunSetup(15.0, parse_gust("sharp:3"), duration_s, 0.2),
+                       RunConfig(15.0, parse_gust("sharp:3"), duration_s, 0.2),
                        recorder=log.recorder("coupled"), loads=build)
     finally:
         log.close()

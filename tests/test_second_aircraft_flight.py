@@ -265,12 +265,12 @@ def test_the_gliders_log_records_its_aircraft(tmp_path, capsys):
 def test_a_wing_is_flown_on_its_own_aircrafts_airframe_only(sgs):
     """The SGS wing on the prototype's JSBSim airframe, or the prototype's wing on SGS.xml:
     a caller's mix-up, one line (InputError), before anything flies."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.runtime.fdm import Airframe
     from bioflex_jsb.simulation.gusts import parse_gust
 
-    setup = RunSetup(25.0, parse_gust("none"), 0.1)
+    setup = RunConfig(25.0, parse_gust("none"), 0.1)
     with pytest.raises(InputError, match="built for aircraft 'sgs_elastic'"):
         run_gust(Airframe(), sgs.wing().model, "coupled", setup)
     proto = api.load_aircraft("bioflex_optimised").wing().model
@@ -317,16 +317,16 @@ def test_the_compiled_step_is_the_python_step_on_the_glider(sgs):
     aircraft): 1.5e-13 of a channel's range at most (coupled v_north; measured), bar 1e-9
     (tests/golden_cases.py's); and a 2 m/s down gust takes α below SGS.xml's tables (−1°):
     both stop at the same step with the same line."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from tests.golden_cases import compare_runs
 
     wing = sgs.wing().model
-    setup = RunSetup(25.0, parse_gust("1cos:1:25", 1.0), 1.5)
+    setup = RunConfig(25.0, parse_gust("1cos:1:25", 1.0), 1.5)
     runs = [run_gust(airframe_for(sgs), wing, "coupled", setup, compiled=c)
             for c in (True, False)]
     assert max(compare_runs(*runs).values()) < 1e-9
-    setup = RunSetup(25.0, parse_gust("sharp:-2", 1.0), 1.5)
+    setup = RunConfig(25.0, parse_gust("sharp:-2", 1.0), 1.5)
     stops = [run_gust(airframe_for(sgs), wing, "coupled", setup, compiled=c)
              for c in (True, False)]
     assert stops[0].stopped == stops[1].stopped

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -34,7 +34,7 @@ KERNEL_RTOL_OF_RANGE = 1e-9
 @pytest.mark.parametrize("model", ["rigid", "coupled", "qsd"])
 def test_kernel_and_python_step_agree_on_the_golden_case(model):
     wing = stored_wing()  # the golden cases' wing: the comparison below is then the flight's
-    setup = RunSetup(15.0, parse_gust("sharp:3"), 3.0)
+    setup = RunConfig(15.0, parse_gust("sharp:3"), 3.0)
     fast = run_gust(Airframe(), wing, model, setup, compiled=True)
     slow = run_gust(Airframe(), wing, model, setup, compiled=False)
     assert fast.stopped is None and slow.stopped is None
@@ -50,7 +50,7 @@ def test_kernel_stops_where_the_python_step_stops_with_the_same_message():
     """The backward-axis wing diverges at 20 m/s (issue 18): same step, same message. (Each
     run on a fresh airframe: a trim on a used one starts from another propeller history.)"""
     wing = build_wing(VARIANTS["elastic-backward"]).model
-    setup = RunSetup(20.0, parse_gust("sharp:3"), 1.0)
+    setup = RunConfig(20.0, parse_gust("sharp:3"), 1.0)
     fast = run_gust(Airframe(), wing, "coupled", setup, compiled=True)
     slow = run_gust(Airframe(), wing, "coupled", setup, compiled=False)
     assert slow.stopped is not None and "aeroelastic" in slow.stopped

@@ -4,12 +4,14 @@ on the same small gust: issue 15's done-when, NRMSE ≤ 0.05 on u, α, q, θ, η
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from bioflex_jsb import api
 from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
@@ -46,15 +48,17 @@ def test_cosim_agrees_with_the_unsteady_lti_model_on_a_small_gust(airframe, jsbs
     Without the body's accelerations in the apparent mass (backward differences) α, q and
     η₁ were 0.05-0.09 off: the test sees them."""
     build = build_wing(VARIANTS[name])
-    setup = RunSetup(SPEED_M_S, parse_gust("sharp:0.3"), 5.0)
-    run = run_gust(airframe, build, "coupled", setup, aero="unsteady")
+    setup = RunConfig(SPEED_M_S, parse_gust("sharp:0.3"), 5.0, models=("coupled",),
+                      aero="unsteady")
+    run = run_gust(airframe, build, "coupled", setup)
     assert run.stopped is None
     ss = unsteady_state_space(build, SPEED_M_S, gust=True, a_rr=jsbsim_a_rr)
     lti = simulate(ss, run.time_s, run["w_g"])
     errors = {c: nrmse(run[c], lti[c]) for c in CHANNELS}
     assert max(errors.values()) <= 0.05, errors
     # and the unsteady run is not the quasi-steady one: the check can tell them apart
-    quasi = run_gust(airframe, build.model, "coupled", setup)
+    quasi = run_gust(airframe, build.model, "coupled",
+                     dataclasses.replace(setup, aero="quasi-steady"))
     assert nrmse(run["eta1"], quasi["eta1"][: len(run.time_s)]) > 0.3
 
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.runtime.coupled_step import CoupledStep
@@ -55,9 +55,9 @@ STOP_SPEED_M_S = 20.0
 def fly(compiled: bool, airframe: Airframe | None = None):
     """The golden case through the compiled (True) or the Python (False) step."""
     build = build_wing(VARIANTS["optimised"])
-    setup = RunSetup(15.0, parse_gust("sharp:0.3"), 3.0)
-    return run_gust(airframe or Airframe(), build, "coupled", setup, compiled=compiled,
-                    aero="unsteady")
+    setup = RunConfig(15.0, parse_gust("sharp:0.3"), 3.0, models=("coupled",),
+                      aero="unsteady")
+    return run_gust(airframe or Airframe(), build, "coupled", setup, compiled=compiled)
 
 
 def relative_difference(a, b) -> dict[str, float]:
@@ -116,9 +116,10 @@ def test_kernel_stops_where_the_python_step_stops_with_the_same_message():
     message. (Each run on a fresh airframe: a trim on a used one starts from another
     propeller history.)"""
     build = build_wing(VARIANTS["elastic-backward"])
-    setup = RunSetup(STOP_SPEED_M_S, parse_gust("sharp:3"), 1.0)
-    fast = run_gust(Airframe(), build, "coupled", setup, aero="unsteady", compiled=True)
-    slow = run_gust(Airframe(), build, "coupled", setup, aero="unsteady", compiled=False)
+    setup = RunConfig(STOP_SPEED_M_S, parse_gust("sharp:3"), 1.0, models=("coupled",),
+                      aero="unsteady")
+    fast = run_gust(Airframe(), build, "coupled", setup, compiled=True)
+    slow = run_gust(Airframe(), build, "coupled", setup, compiled=False)
     assert slow.stopped is not None
     assert fast.stopped == slow.stopped
     assert len(fast.time_s) == len(slow.time_s)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 
 from bioflex_jsb.cli.case import (
@@ -27,9 +28,9 @@ from bioflex_jsb.cli.gust import (
     Interrupted,
     add_aero_arguments,
     add_run_arguments,
-    check_run_arguments,
     fly,
     open_log,
+    run_config,
     run_description,
     wing_for_run,
 )
@@ -93,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
         check_gust_excites(args.gust)
     except InputError as exc:
         raise UsageError(f"--gust {exc}") from None
-    check_run_arguments(args)
+    config = run_config(args, (args.model,))
     check_plot_path(args.plot, args.force)
     check_distinct_outputs(("--out", args.out), ("--plot", args.plot))
     args.out = log_path(args, "compare", args.wing)
@@ -107,10 +108,10 @@ def run(args: argparse.Namespace) -> int:
     drift = None
     try:
         try:
-            runs, stops = fly(args, build, (args.model,), log, airframe)
+            runs, stops = fly(args, build, config, log, airframe)
             if airframe.glider and not stops:  # a glide's drift in calm air (drivers/compare)
-                calm = argparse.Namespace(**{**vars(args), "gust": parse_gust("none")})
-                drift = fly(calm, build, (args.model,), None, airframe)[0][0]
+                calm = dataclasses.replace(config, gust=parse_gust("none"))
+                drift = fly(args, build, calm, None, airframe)[0][0]
         except Interrupted:
             kept = f"; the log {args.out} holds every step flown" if args.out else ""
             print(f"bioflex-jsb compare: interrupted{kept}", file=sys.stderr)

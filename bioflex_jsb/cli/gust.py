@@ -15,7 +15,6 @@ from bioflex_jsb.cli.case import (
     add_force_argument,
     airspeed,
     check_plot_path,
-    check_run_length,
     check_time_step,
     speed_help,
 )
@@ -127,18 +126,11 @@ damping_ratio = number_type("damping ratio", low=0.0, high=1.0, high_open=True, 
 
 
 def resolve_models(args) -> tuple[str, ...]:
-    """The models to fly: --models, or the default of the chosen aerodynamics; QSD has no
-    unsteady form (a quasi-static deflection carries no lag states)."""
+    """The models to fly: --models, or the default of the chosen aerodynamics (QSD has no
+    unsteady form: a quasi-static deflection carries no lag states); which of them may fly
+    together is the run configuration's rule (:func:`run_config`)."""
     unsteady = args.aero == "unsteady"
-    models = args.models or (("rigid", "coupled") if unsteady else ("rigid", "coupled", "qsd"))
-    if unsteady and "qsd" in models:
-        raise UsageError("--aero unsteady flies the coupled wing (rigid has no wing loads); "
-                         "the quasi-static model has no unsteady form: drop qsd from --models")
-    if getattr(args, "trim", "rigid") == "elastic" and set(models) == {"rigid"}:
-        raise UsageError("--trim elastic starts the elastic-wing runs from the wing's static "
-                         "deflection; the rigid model has no elastic wing (it always starts "
-                         "from the rigid trim): add coupled or qsd to --models, or drop --trim")
-    return models
+    return args.models or (("rigid", "coupled") if unsteady else ("rigid", "coupled", "qsd"))
 
 
 def wing_for_run(build, args):
@@ -188,19 +180,20 @@ def close_bar(bar) -> None:
     bar.stream.close()
 
 
-def check_run_arguments(args) -> None:
-    """The run arguments that argparse cannot check alone (before any file is written)."""
-    check_time_step(args.dt)
-    check_run_length(args.duration, args.dt,
-                     turbulence=args.gust.kind in ("dryden", "vonkarman"))
-    from bioflex_jsb.simulation.gusts import check_gust_resolution
+def run_config(args, models):
+    """The run's :class:`~bioflex_jsb.simulation.run_config.RunConfig` from the options
+    (made before any file is written: one line, exit 2, for each problem it finds; --dt's
+    range named as the option)."""
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.simulation.run_config import RunConfig
 
-    check_gust_resolution(args.gust, args.speed, args.dt)  # GustSpecError: one line
-    if args.gust_start >= args.duration:
-        raise UsageError(
-            f"--gust-start {args.gust_start:g} s must be before the end of the run "
-            f"(--duration {args.duration:g} s)"
-        )
+    check_time_step(args.dt)
+    try:
+        return RunConfig(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt,
+                         models=tuple(models), aero=getattr(args, "aero", "quasi-steady"),
+                         trim=getattr(args, "trim", "rigid"))
+    except InputError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def run_description(args, kind: str, models):
@@ -247,33 +240,28 @@ def open_log(path: str, description, build):
         raise UsageError(str(exc)) from None
 
 
-def fly(args, build, models, log=None, airframe=None):
-    """Run each model (all of them, also after one stops) on ``airframe`` (default: the
-    JSBSim airframe of ``--aircraft``, the prototype's without it); return (runs, stop
-    messages)."""
+def fly(args, build, config, log=None, airframe=None):
+    """Run each model of ``config`` (a RunConfig: all of them, also after one stops) on
+    ``airframe`` (default: the JSBSim airframe of ``--aircraft``, the prototype's without
+    it); return (runs, stop messages)."""
     from bioflex_jsb.cli.aircraft_option import airframe_from_args
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import run_gust
     from bioflex_jsb.runtime.fdm import FdmError
 
-    check_run_arguments(args)
-    setup = RunSetup(args.speed, args.gust, args.duration, args.gust_start, dt_s=args.dt)
     runs, stops = [], []
     try:
         if airframe is None:
             airframe = airframe_from_args(args)
-        for model in models:
-            steps = int(round(args.duration / args.dt))
+        for model in map(str, config.models):
+            steps = int(round(config.duration_s / config.dt_s))
             bar = progress_bar(steps, f"{build.variant.name} {model}")
             recorder = log.recorder(model) if log is not None else None
             # the bar moved once a block (0.9 s of flight), not by a callback every step
             progress = None if bar is None else (lambda k, bar=bar: bar.update(k - bar.n))
-            unsteady = getattr(args, "aero", "quasi-steady") == "unsteady" and model == "coupled"
-            elastic = getattr(args, "trim", "rigid") == "elastic" and model != "rigid"
             try:
-                run = run_gust(airframe, build if unsteady or elastic else build.model, model,
-                               setup, progress=progress, recorder=recorder,
-                               aero="unsteady" if unsteady else "quasi-steady",
-                               trim_mode="elastic" if elastic else "rigid", loads=build)
+                run = run_gust(airframe, build if config.needs_build(model) else build.model,
+                               model, config, progress=progress, recorder=recorder,
+                               loads=build)
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -300,7 +288,7 @@ def run(args: argparse.Namespace) -> int:
     resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
     args.models = resolve_models(args)
-    check_run_arguments(args)
+    config = run_config(args, args.models)
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     check_plot_path(plot, args.force)
     log = None
@@ -311,7 +299,7 @@ def run(args: argparse.Namespace) -> int:
         log = live_opener(args, open_log)(args.out, run_description(args, "gust", args.models),
                                           build)
     try:
-        runs, stops = fly(args, build, args.models, log)
+        runs, stops = fly(args, build, config, log)
     except Interrupted as stop:
         last = stop.runs[-1]
         kept = f"; the log {args.out} holds every step flown" if args.out else ""

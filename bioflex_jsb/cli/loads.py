@@ -215,7 +215,7 @@ def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
     """One run of ``--model`` through ``gust_text`` on the JSBSim airframe of ``--aircraft``
     (the prototype's without it; as ``gust`` flies it) and its section loads."""
     from bioflex_jsb.cli.aircraft_option import airframe_from_args
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.loads import section_loads
     from bioflex_jsb.runtime.fdm import FdmError
@@ -223,12 +223,10 @@ def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
 
     try:
         chord = build.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
-        setup = RunSetup(args.speed, parse_gust(gust_text, chord), duration_s, gust_start_s,
-                         0.0, args.dt)
-        elastic = args.trim == "elastic" and args.model != "rigid"
-        run = run_gust(airframe_from_args(args), build if elastic else build.model,
-                       args.model, setup, trim_mode="elastic" if elastic else "rigid",
-                       loads=build)
+        setup = RunConfig(args.speed, parse_gust(gust_text, chord), duration_s, gust_start_s,
+                          0.0, args.dt, models=(args.model,), trim=args.trim)
+        wing = build if setup.needs_build(args.model) else build.model
+        run = run_gust(airframe_from_args(args), wing, args.model, setup, loads=build)
         return run, section_loads(build, run, args.stations, static=args.static)
     except (FdmError, InputError) as exc:
         raise UsageError(str(exc)) from None

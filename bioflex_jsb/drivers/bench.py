@@ -55,7 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bioflex_jsb.drivers.gust import RunSetup, run_gust
+from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.drivers.native import native_airframe
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.runtime.coupled_step import configure_airframe
@@ -379,8 +379,9 @@ class StepBench:
         if log not in LOGS:
             raise ValueError(f"log must be one of {LOGS}, not {log!r}")
         dt = DEFAULT_DT_S
-        setup = RunSetup(self.speed_m_s, parse_gust(gust), duration_s=n * dt,
-                         gust_start_s=0.5 * self.steps * dt, dt_s=dt)
+        setup = RunConfig(self.speed_m_s, parse_gust(gust), duration_s=n * dt,
+                          gust_start_s=0.5 * self.steps * dt, dt_s=dt, models=("coupled",),
+                          aero=aero)
         trim = self.airframe.trim(self.speed_m_s)  # outside the timing, as for bare()
         run_log = None
         if log is not None:
@@ -397,7 +398,7 @@ class StepBench:
             c0, w0 = _clocks()
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=run_log.recorder("coupled") if run_log else None,
-                           compiled=compiled, aero=aero,
+                           compiled=compiled,
                            loads=self.build if log in ("loads", "gust") else None)
             if run_log is not None:  # closing writes the last chunks: part of the log's cost
                 run_log.close()

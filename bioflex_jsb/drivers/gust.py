@@ -19,7 +19,6 @@ loads`` topic).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -33,23 +32,9 @@ from bioflex_jsb.loads.stream import LoadStream
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.channels import mode_tips
-from bioflex_jsb.simulation.gusts import GustField, GustSpec
-from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.simulation.gusts import GustField
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
-
-
-@dataclass(frozen=True)
-class RunSetup:
-    """What a gust run needs: trim speed [m/s], gust, duration [s], gust start [s], altitude
-    [m], co-simulation step [s]."""
-
-    speed_m_s: float
-    gust: GustSpec
-    duration_s: float = 6.0
-    gust_start_s: float = 0.5
-    altitude_m: float = 0.0
-    dt_s: float = DEFAULT_DT_S
-
+from bioflex_jsb.simulation.run_config import RunConfig
 
 # The envelope: per this span of simulated time [s], the first and last step and the steps
 # where each summary channel reaches its minimum and maximum.
@@ -160,19 +145,20 @@ def run_gust(
     airframe: Airframe,
     wing: ElasticWingModel | WingBuild | None,
     model: str,
-    setup: RunSetup,
+    setup: RunConfig,
     on_sample: Callable[[int, float, np.ndarray], None] | None = None,
     trim: TrimResult | None = None,
     recorder: StepRecorder | None = None,
     compiled: bool = True,
     keep: str = "auto",
-    aero: str = "quasi-steady",
-    trim_mode: str = "rigid",
     loads: WingBuild | LoadsModel | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> TimeHistory:
-    """Trim, then fly ``setup`` with the wing ``model`` (rigid/coupled/qsd, or native for an
-    aircraft with the wing in its XML, ``wing`` then None).
+    """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
+    with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
+    its XML, ``wing`` then None), with the aerodynamics and the trim the configuration gives
+    that model (``setup.settings_for``: the unsteady strips and the elastic trim are the
+    elastic wings'; they need the wing's build, ``setup.needs_build``).
 
     ``on_sample(k, t_s, row)`` is called after every step, ``row`` the step's row (channel
     order; read it, do not keep it): it costs 0.28 µs a step of ~6.7 (a progress bar's
@@ -206,8 +192,10 @@ def run_gust(
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
-    step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m, setup.dt_s,
-                       trim=trim, compiled=compiled, aero=aero,
+    aero, trim_mode = (v.value for v in setup.settings_for(model))  # the run's rules
+    model = str(model)  # its name, as the history, the logs and the tables carry it
+    step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
+                       setup.dt_s, trim=trim, compiled=compiled, aero=aero,
                        trim_mode=trim_mode)
     dt = step.dt_s
     gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)

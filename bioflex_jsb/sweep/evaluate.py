@@ -232,7 +232,7 @@ def case_description(case: Case):
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics, stop_event_text
 
@@ -247,8 +247,8 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
             raise InputError(f"speed {case.speed_m_s:g} m/s is outside aircraft "
                              f"{case.aircraft.name!r}'s flight speeds {lo:g}..{hi:g} m/s "
                              "(airframe.speed_range_m_s)")
-    setup = RunSetup(case.speed_m_s, parse_gust(case.gust, chord_m), s.duration_s,
-                     s.gust_start_s, dt_s=s.dt_s)
+    setup = RunConfig(case.speed_m_s, parse_gust(case.gust, chord_m), s.duration_s,
+                      s.gust_start_s, dt_s=s.dt_s, models=(case.model,), aero=s.aero)
     log = None
     recorder = None
     if log_dir:
@@ -263,9 +263,8 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
 
     try:
         # the unsteady strips need the wing's build (its strips); the quasi-steady its model
-        wing = build if s.aero == "unsteady" else build.model
-        run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
-                       aero=s.aero)
+        wing = build if setup.needs_build(case.model) else build.model
+        run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder)
         if log is not None and run.stopped:  # as a gust log says it: read_log's stopped
             log.event(run.stop_time_s, "ERROR", stop_event_text(case.model, run.stopped),
                       name=case.model)

@@ -84,7 +84,7 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
     """Fly ``case`` (a fresh airframe) and return its row: ``status`` ok | diverged |
     failed, ``error``, ``loads`` (the SectionLoads, None when failed). ``log_dir`` is the
     executors' argument; the tuned gust writes no log."""
-    from bioflex_jsb.drivers.gust import RunSetup, run_gust
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.flight_dynamics.wing_model import WingVariant
     from bioflex_jsb.loads import section_loads
@@ -95,14 +95,14 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
     row: dict[str, Any] = {"case_id": case.case_id, "index": case.index, "gust": case.gust}
     try:
         build = _build(case)
-        setup = RunSetup(case.speed_m_s, parse_gust(case.gust), case.duration_s,
-                         case.gust_start_s, 0.0, case.dt_s)
-        elastic = case.trim == "elastic" and case.model != "rigid"
+        setup = RunConfig(case.speed_m_s, parse_gust(case.gust), case.duration_s,
+                          case.gust_start_s, 0.0, case.dt_s, models=(case.model,),
+                          trim=case.trim)
         # as api.fly_gust flies one model: the build for the elastic trim, else its model
         aircraft = None if isinstance(case.wing, WingVariant) else case.wing
         # the JSBSim airframe the wing's aircraft flies on (the prototype's for a variant)
-        run = run_gust(airframe_for(aircraft), build if elastic else build.model, case.model,
-                       setup, trim_mode="elastic" if elastic else "rigid", loads=build)
+        wing = build if setup.needs_build(case.model) else build.model
+        run = run_gust(airframe_for(aircraft), wing, case.model, setup, loads=build)
         loads = section_loads(build, run, case.stations, static=case.static)
     except (FdmError, InputError) as exc:  # the case's own problem, in one line
         return dict(row, status="failed", error=" ".join(str(exc).split()), loads=None)
