@@ -6,7 +6,7 @@ freed memory at the top of its heap back to the operating system as soon as more
 trim threshold is free there (by default twice the largest block it has mapped, about 0.75
 MB for these buffers), so each chunk's buffers come back as fresh pages, one page fault
 each: 0.14-0.20 faults a step of a gust log, 0.01-0.08 of an unlogged run, at about 1 µs a
-fault on this project's virtual machines (measured 2026-12-03: 0.9-1.1 µs a 4 kB page
+fault on this project's virtual machines (measured: 0.9-1.1 µs a 4 kB page
 touched for the first time, Intel Xeon guest). :func:`keep_freed_memory` raises the
 threshold, so freed memory stays in the process for the next chunk: no faults after the
 first chunk (0.001-0.014 faults a step), at the price of up to ``trim_bytes`` held free.

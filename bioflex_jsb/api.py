@@ -190,8 +190,8 @@ def _density(wing, density_kg_m3: float | None) -> dict:
 
 
 # The lowest speed of a linear analysis [m/s]: its dynamic pressure at sea level is 6 mPa,
-# nothing an aircraft flies on; at 1e-300 m/s V² underflowed to 0 and the rigid model
-# divided by it (ZeroDivisionError, the review of 2026-12-04).
+# nothing an aircraft flies on; at 1e-300 m/s V² underflows to 0 and the rigid model would
+# divide by it (ZeroDivisionError).
 LINEAR_SPEED_MIN_M_S = 0.1
 
 

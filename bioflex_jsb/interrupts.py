@@ -11,13 +11,13 @@ that is. Two places cannot take an exception there:
   exception into ``ImportError: initialization failed``;
 * a finalizer (a ``__del__`` method, a weakref callback: the garbage collector runs them at
   any bytecode boundary, numba's compiler drops many): Python prints an exception raised
-  there as "Exception ignored in …" and goes on, so the stop was lost and its traceback
-  printed (a fresh-cache CI run, 2026-12-03: the re-delivered SIGINT of a deferred stop
-  landed in llvmlite's ``ObjectRef.__del__``);
+  there as "Exception ignored in …" and goes on, so the stop is lost and its traceback
+  printed (the re-delivered SIGINT of a deferred stop can land in llvmlite's
+  ``ObjectRef.__del__`` while numba compiles on a fresh cache);
 * llvmlite's bindings (``llvmlite/binding``, the Python wrappers that own LLVM objects, run
   while numba compiles or loads a kernel): an exception between an object's native free and
   its "closed" mark leaves it to be freed again by its finalizer (a "free(): double free"
-  abort at exit was seen once after a stopped run in CI).
+  abort at exit of a stopped run).
 
 The CLI's handler (:mod:`bioflex_jsb.cli.common`) looks at the interrupted frame and its
 callers (:func:`unsafe_frame`); in such a frame it only sets :data:`STOP` ``.pending`` and
@@ -83,8 +83,8 @@ def critical_section():
     and CRC counted): a stop signal whose handler runs inside it is deferred like one in
     native code (:func:`unsafe_frame`), then raised at the next safe point. Blocking the
     signals (``pthread_sigmask``) is not enough: a signal caught just before the block has
-    its Python handler run at the block's first bytecodes (a SIGINT of ``gust`` left 5 of 22
-    logs with a chunk counted twice: the review of 2026-12-03)."""
+    its Python handler run at the block's first bytecodes (with the signals blocked only, a
+    SIGINT of ``gust`` left 5 of 22 logs with a chunk counted twice)."""
     STOP.critical += 1
     try:
         yield

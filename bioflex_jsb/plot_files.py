@@ -39,9 +39,9 @@ def figure_suffixes() -> list[str]:
 def check_plot_target(path, force: bool = False) -> Path:
     """``path`` as a figure file the library may write (InputError, one line, otherwise):
     a non-empty name with a suffix matplotlib writes, in a directory that exists, not an
-    existing file other than a plot of ours (:func:`is_our_plot`) unless ``force``. The
-    results' ``.plot(path)`` replaced a user's file, wrote ``x.png`` for ``x`` and returned
-    ``x``, and wrote ``plots.png`` for a directory ``plots`` (the review of 2026-12-03)."""
+    existing file other than a plot of ours (:func:`is_our_plot`) unless ``force``. Without
+    it the results' ``.plot(path)`` would replace a user's file, write ``x.png`` for ``x``
+    and return ``x``, and write ``plots.png`` for a directory ``plots``."""
     if not isinstance(path, str | Path) or not str(path):
         raise InputError(f"a plot needs a file name ending in a figure suffix, got {path!r}")
     out = Path(path)

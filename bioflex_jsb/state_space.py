@@ -1,4 +1,4 @@
-"""The one state-space type of the package (issue 23, item 3).
+"""The one state-space type of the package.
 
 Every linear model is a :class:`StateSpace` or converts to one through its
 ``to_state_space()``: the paper's LTI model of the free aircraft

@@ -94,7 +94,7 @@ ARM_RETRY_S = 5.0  # arming re-sent this often while refused [s of wall time at 
 STREAMS = ("MAV_DATA_STREAM_EXTENDED_STATUS", "MAV_DATA_STREAM_POSITION",
            "MAV_DATA_STREAM_EXTRA3")
 STREAM_RATE_HZ = 10
-# DEFINITION (issue 28): a speed-up is held when the backend's real-time factor is within
+# DEFINITION: a speed-up is held when the backend's real-time factor is within
 # this fraction of it (docs/ardupilot.md, "Faster than real time").
 HELD_TOLERANCE = 0.05
 PLANE_MODE_RTL = 11  # ArduPlane custom_mode of RTL

@@ -6,7 +6,7 @@ LocalCluster of 2 single-threaded worker processes.
 Prints, per configuration, the wall time [s] of the sweep with and without starting the
 workers (forkserver / LocalCluster), cases per second per worker (cases / sweep time /
 workers) with the load average after each run, the speedup of 2 local workers over 1 and
-the overhead of Dask against 2 local processes (targets of issue 7: speedup ≥ 1.7 on 2
+the overhead of Dask against 2 local processes (targets of docs/sweeps.md: speedup ≥ 1.7 on 2
 cores, Dask overhead ≤ 15 %), and the fixed cost of a case measured in a fresh process
 (``--costs``, :data:`COSTS`: imports, the step kernel's load, the wing's build and flutter
 search, the airframe's load, the trim, the eigenvalues; a worker's first case against a

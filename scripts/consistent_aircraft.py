@@ -1,11 +1,11 @@
-"""Paper vs default vs geometry-consistent aircraft, side by side (issue 15, item 5).
+"""Paper vs default vs geometry-consistent aircraft, side by side.
 
 Run:  python scripts/consistent_aircraft.py [--json]
 
 Prints the consistent set's geometry (tail, fuselage, CG), its rigid derivatives beside the
 default set's (the paper prints none), Tables 3 and 6 with both sets, the six named wings'
 short period and flutter speeds (quasi-steady and unsteady strips) with both sets, and the
-elastic trim (issue 15, item 4) with both. Consistent mass basis, ρ = 1.225 kg/m³; every
+elastic trim with both. Consistent mass basis, ρ = 1.225 kg/m³; every
 relative difference is (model − paper)/|paper|. See docs/consistent_aircraft.md.
 """
 

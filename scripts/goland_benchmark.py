@@ -6,7 +6,7 @@ Two readings of the published data (docs/aeroelasticity.md, bioflex_jsb/paramete
 
 * ``default``: 8.64 kg·m about the elastic axis, ρ = 1.225 kg/m³ (the reading the published
   natural frequencies and flutter point both support; the library's default);
-* ``issue``: 8.64 kg·m about the centre of mass, ρ = 1.02 kg/m³ (the issue's wording).
+* ``issue``: 8.64 kg·m about the centre of mass, ρ = 1.02 kg/m³ (the specification's wording).
 
 For each: the first three natural frequencies, and the flutter point by p-k (exact C(k)) and
 by state-space (Jones lag states), unsteady and quasi-steady, with the 2-D (2π) and the

@@ -1,5 +1,5 @@
 """How far the golden cases, the kernel-vs-Python agreement and the native export move when
-only the platform changes (issue 22): each configuration runs in its own subprocess.
+only the platform changes: each configuration runs in its own subprocess.
 
 Configurations (those the host's processor can run; ``/proc/cpuinfo`` flags): the host as
 it is; numba compiling for a generic x86-64 instead of the host CPU (``NUMBA_CPU_NAME``,

@@ -121,7 +121,8 @@ def goland_sections(*, inertia_about: str = G.DEFAULT_INERTIA_AXIS) -> BeamSecti
 
     ``inertia_about``: the axis of the published 8.64 kg·m, ``"elastic-axis"`` (default,
     the reading the published natural frequencies support) or ``"centre-of-mass"`` (the
-    issue's wording); see :func:`bioflex_jsb.parameters.goland.inertia_about_elastic_axis_kg_m`.
+    specification's wording); see
+    :func:`bioflex_jsb.parameters.goland.inertia_about_elastic_axis_kg_m`.
     """
     return uniform_sections(
         G.SEMISPAN_M,

@@ -53,7 +53,7 @@ def goland_flutter(
     on every mode. ``inertia_about`` (default ``goland.DEFAULT_INERTIA_AXIS``): see
     :func:`~bioflex_jsb.aeroelasticity.clamped_wing.goland_sections`. ``density_kg_m3``
     defaults to ``goland.FLUTTER_DENSITY_KG_M3`` (sea level, the density at which the
-    published flutter point is reproduced; the issue's 1.02 kg/m³ is
+    published flutter point is reproduced; the specification's 1.02 kg/m³ is
     ``goland.AIR_DENSITY_KG_M3``).
     """
     from bioflex_jsb.aeroelasticity.clamped_wing import (

@@ -91,8 +91,8 @@ def _gust_up_m_s(gust) -> float:
 
 
 # The export's record of what it wrote (file → SHA-256), in the root it writes: a later
-# export replaces a file of ours only as it was written (an edited one needs --force: a
-# user's edit under the GENERATED header was lost silently, the review of 2026-12-03).
+# export replaces a file of ours only as it was written (an edited one needs --force, so a
+# user's edit under the GENERATED header is never lost silently).
 MANIFEST = ".bioflex-jsb-export.json"
 
 
@@ -151,7 +151,7 @@ def run(args: argparse.Namespace) -> int:
                          + ("is not a directory" if parent.exists() else
                             "does not exist (DIR itself is made, not its parents)"))
     # the co-simulation's range (gust --dt): below it JSBSim's trim of the exported aircraft
-    # failed and said "needs more thrust than the motor gives" (the review of 2026-12-04)
+    # fails and says "needs more thrust than the motor gives"
     check_time_step(args.dt)
     from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.simulation.gusts import parse_gust

@@ -8,9 +8,9 @@ that server as it is written) and :func:`stop_live` when the run is over (it pri
 served). Without ``--live`` the four do nothing.
 
 One server per command, not per file: a SITL session's log rolls to a new file at every
-reset and size limit, and a server per file (an earlier design) stopped and bound again on
-the same port there failed ("Address already in use", 2 of 3 sessions with 17 files in 6 s)
-and disconnected the clients at each file.
+reset and size limit, and a server per file, stopped and bound again on the same port
+there, fails ("Address already in use", 2 of 3 sessions with 17 files in 6 s) and
+disconnects the clients at each file.
 
 The server listens on loopback unless ``--live-any-host``: a simulation server should not
 listen on the network by default (the Foxglove protocol has no authentication; anyone who

@@ -36,7 +36,7 @@ DEFAULT_GUST = "1cos:3:5"  # the paper's 3 m/s, 2.5 m gradient (between the tune
 # the options of each study and their defaults (None in the parser: given or not is known)
 TUNED_OPTIONS = {"gradients": None, "amplitude": 3.0, "scaling": "cs25", "csv": None}
 # sigmas: 0.1 and 2.5 m/s, the docs' table (loads.md); at 3 m/s the optimised wing's 120 s
-# von Kármán record leaves the valid range (|eta1| 0.53 rad at 76 s, measured 2026-12-03)
+# von Kármán record leaves the valid range (|eta1| 0.53 rad at 76 s, measured)
 FREQUENCY_OPTIONS = {"sigmas": (0.1, 2.5), "scale": 30.0, "spectrum": "vonkarman",
                      "record": 120.0, "bode": None}
 

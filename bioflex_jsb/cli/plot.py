@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or str(Path(args.file).with_suffix(".png"))
     check_plot_path(out, args.force)  # before reading the log: nothing is overwritten
     # every chunk checked, not only the ones plotted: a figure drawn from a log damaged
-    # elsewhere (its scene, its loads) said nothing of it (the review of 2026-12-03)
+    # elsewhere (its scene, its loads) would say nothing of it
     try:
         damage = check_chunks(args.file)["problems"]
     except LogError as exc:

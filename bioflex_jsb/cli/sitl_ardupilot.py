@@ -306,7 +306,7 @@ def run(args: argparse.Namespace) -> int:
           file=sys.stderr, flush=True)
     # the start-up's objects (modules, the airframe, the wing build: 67 000 tracked) out of
     # the collector's generations: a full collection in the session then scans only the
-    # session's own (measured here at load 5: 78 ms before, 0.003 ms after; one in flight
+    # session's own (measured here at load 5: 78 ms without, 0.003 ms with; one in flight
     # is a stall of the lock step that ArduPlane's sleep debt, floored at -0.1 s, may not
     # make up)
     gc.freeze()

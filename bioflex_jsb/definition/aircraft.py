@@ -74,7 +74,7 @@ from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
 # agree: JSBSim flies its XML's mass, inertia and geometry while the modal wing, the elastic
 # trim and the section loads take the file's, so a mismatch would make the run and the linear
 # analyses two different aircraft (a user's 10 % heavier file with SGS.xml's 710 lb: the
-# loads carried ΔW/2 = 158 N of lift that was never flown). Relative tolerance 1 %: a
+# loads carry ΔW/2 = 158 N of lift that is never flown). Relative tolerance 1 %: a
 # value rounded to 3 significant digits is off by at most 0.5 % (the shipped sgs_elastic
 # file, 5 digits: largest 2.5e-5, S); the CG within 1 % of the mean chord (a 1 % static
 # margin; an inch rounded in metres is 1.3 mm, 0.13 % of SGS's chord).

@@ -93,8 +93,8 @@ METHODS = ("pk", "state-space")
 INERTIA_AXES = ("elastic-axis", "centre-of-mass")
 TWIST_UNITS = ("deg", "rad")
 # Monitoring stations of the section loads [fraction of the semispan]: model.py's
-# DEFAULT_MONITORING_STATIONS, the root and the quarter points (issue 24's stations; the
-# tip, s = 1, carries no load and is refused).
+# DEFAULT_MONITORING_STATIONS, the root and the quarter points (the tip, s = 1, carries no
+# load and is refused).
 MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distribution
 
 

@@ -28,7 +28,7 @@ from bioflex_jsb.parameters.airframe import DerivativeSchedule
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 
 # The section loads' monitoring stations when a definition names none: root, 25, 50, 75 %
-# of the semispan (issue 24); the loads' default (loads/model.py) is this one.
+# of the semispan; the loads' default (loads/model.py) is this one.
 DEFAULT_MONITORING_STATIONS = (0.0, 0.25, 0.5, 0.75)
 
 

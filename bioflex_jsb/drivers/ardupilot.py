@@ -182,7 +182,7 @@ THROTTLE_CHANNEL = 2
 # through: the launch switch a ground station sets with RC_CHANNELS_OVERRIDE. In AUTO this
 # ArduPlane keeps the throttle at 0 until the launch is detected, so TKOFF_THR_IDLE cannot
 # signal it there). The window is narrow because SITL's own RC 5 idles at 1800 µs, which
-# fired the launcher at boot when the switch was "above 1700 µs".
+# would fire the launcher at boot with a switch "above 1700 µs".
 LAUNCH_THROTTLE_US = 1020
 LAUNCH_SWITCH_CHANNEL = 4  # servo 5
 LAUNCH_SWITCH_US = (1880, 1920)

@@ -1,8 +1,8 @@
 """Benchmarks of the coupled step: per-step costs that cannot come out negative.
 
-Machines are shared and noisy (load averages of 4-10 on 2 cores were seen): the difference of
-two run lengths, the earlier estimator, gave per-step costs below zero (ratio min −0.32 next to
-a median of 2.3) when one of the two runs was slowed. Here:
+Machines are shared and noisy (load averages of 4-10 on 2 cores): the difference of two run
+lengths, the simplest estimator, gives per-step costs below zero (ratio min −0.32 next to a
+median of 2.3) when one of the two runs is slowed. Here:
 
 * every configuration is timed at several run lengths N_j (``steps`` × 1, 2, 4; the unsteady
   wing's 4 times longer, :data:`LENGTH_SCALE`), the lengths and the configurations
@@ -24,9 +24,9 @@ a median of 2.3) when one of the two runs was slowed. Here:
 * the machine's own speed changes under the code: on the 2-core KVM machine of the project
   a fixed pure-Python workload ran 1.0-1.65 ms, in states of ~10-50 ms (a host core
   shared with other guests), and bare JSBSim's per-step time over 300-step blocks went
-  6.8-13.7 µs with it (correlation 0.6-0.7 with the workload's, measured 2026-12-02,
+  6.8-13.7 µs with it (correlation 0.6-0.7 with the workload's, measured at
   load 0.4-2): runs as long as those states mix them in proportions that differ from run
-  to run and from length to length, which bent the least times off a line (the residual
+  to run and from length to length, which bends the least times off a line (the residual
   of 11 % on a quiet machine). Runs are therefore short (:data:`DEFAULT_STEPS`: 3-25 ms)
   and many, so that the least time of each length is one of the fast state, the state in
   which the code's own cost shows;
@@ -35,7 +35,7 @@ a median of 2.3) when one of the two runs was slowed. Here:
   GROUPS interleaved groups of the repeats (a jackknife: how much the figure depends on
   which repeats came out fast; over the estimates trusted, at least :data:`MIN_GROUPS`);
   ratios and differences the same, estimate by estimate. (The slope of each group alone,
-  4 repeats, was biased: 15 % at the 95th percentile on the simulated machine of
+  4 repeats, is biased: 15 % at the 95th percentile on the simulated machine of
   tests/test_bench.py, against 0 for all 12 or for 8 of them.)
 """
 
@@ -72,10 +72,11 @@ DEFAULT_REPEAT = 12  # 4 repeats in each of the GROUPS groups
 GROUPS = 3  # interleaved groups of the repeats: the spread of every figure
 # A figure needs at least this many of its groups trusted (each group's estimate passes the
 # checks of estimate_per_step): under load 5-7 a group of 4 repeats failed the residual
-# check in about one figure of three while the whole set passed (measured 2026-12-02).
+# check in about one figure of three while the whole set passed (measured on the project's
+# 2-core machine).
 MIN_GROUPS = 2
 # ... and its estimates without a third of the repeats within 20 % of it (figures and ratios):
-# at load 7.5-8.9 (6 runs, 2026-12-02) 40 of 47 per-step figures and 22 of 24 ratios were
+# at load 7.5-8.9 (6 runs) 40 of 47 per-step figures and 22 of 24 ratios were
 # within 20 % (typically 2-15 %); the others (up to 52 %) included a ratio of 1.23 whose
 # estimates ran to 1.68, below the co-simulation's floor measured in blocks (1.43).
 MAX_SPREAD = 0.20

@@ -12,7 +12,7 @@ the rules below on synthetic runs):
 * :func:`sitl_speedup`: the ``sitl`` vehicle's pacing error at each speed-up.
 
 A speed-up is *held* when the paced run's real-time factor is within
-:data:`SPEEDUP_TOLERANCE` of it (the issue's criterion), and the figure is the highest held
+:data:`SPEEDUP_TOLERANCE` of it (docs/ardupilot.md's criterion), and the figure is the highest held
 with every lower one held too, per round.
 """
 
@@ -39,7 +39,7 @@ ARDUPILOT_SPEEDUPS = (1.0, 2.0, 5.0, 8.0, 10.0, 12.0, 15.0, 20.0, 30.0, 40.0)
 ARDUPILOT_SIM_RATES_HZ = (1200, 240)
 SPEEDUP_TOLERANCE = 0.05
 SITL_SPEEDUPS = (1.0, 2.0, 5.0, 8.0, 10.0, 12.0, 15.0, 20.0, 30.0)
-SITL_P99_BAR_MS = 5.0  # the sitl vehicle's pacing error bar at a speed-up (issue 28)
+SITL_P99_BAR_MS = 5.0  # the sitl vehicle's pacing error bar at a speed-up (docs/sitl.md)
 STANDIN = Path(__file__).resolve().parents[2] / "tests" / "ardupilot_standin.py"
 BACKEND_START_S = 300.0  # the backend's pre-flight check, imports and trim, under load
 # Between two stand-in processes: the backend re-binds to a new ArduPilot process (a reset)

@@ -161,8 +161,8 @@ def run_gust(
     elastic wings'; they need the wing's build, ``setup.needs_build``).
 
     ``on_sample(k, t_s, row)`` is called after every step, ``row`` the step's row (channel
-    order; read it, do not keep it): it costs 0.28 µs a step of ~6.7 (a progress bar's
-    callback, measured 2026-12-02), so a progress bar takes ``progress(steps)`` instead,
+    order; read it, do not keep it): it costs 0.28 µs a step of ~6.7 (measured with a
+    progress bar's callback), so a progress bar takes ``progress(steps)`` instead,
     called after every block with the steps flown so far; ``recorder`` (a log) is handed
     the rows a block at a time (:class:`StepRecorder`). A run that leaves the valid range
     stops: the returned history holds the steps up to then and its ``stopped`` field says

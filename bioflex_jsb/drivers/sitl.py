@@ -551,10 +551,10 @@ def run_paced(
     # link: 73 000-143 000 objects the collector tracks) is kept out of the cyclic
     # collector's generations while it runs (gc.freeze), so a full collection in flight
     # scans only the session's own objects: one over all of them took 25-34 ms on a quiet
-    # machine (143 000 tracked, as in the bench's process) and a 2x run of the bench's
-    # sitl_speedup once stalled 75-81 ms (p99 75 ms against the 5 ms bar; 0.1-0.5 ms in
-    # every other run), 2026-12-03. They go back to the collector when the loop ends, unless
-    # the caller had frozen some itself (``bioflex-jsb ardupilot``): its choice stands.
+    # machine (143 000 tracked, as in the bench's process), and without the freeze a 2x run
+    # of the bench's sitl_speedup stalled 75-81 ms (p99 75 ms against the 5 ms bar; 0.1-0.5
+    # ms in every other run). They go back to the collector when the loop ends, unless
+    # the caller has frozen some itself (``bioflex-jsb ardupilot``): its choice stands.
     thawed = gc.get_freeze_count() == 0
     gc.freeze()
     try:

@@ -182,7 +182,7 @@ def mode_labels_of_roots(lam: np.ndarray) -> tuple[str, ...]:
     the factor of the larger ω_n: of the ways to share the roots so, the one with the largest
     ratio of the short period's ω_n to the phugoid's. With two pairs this is the pair of the
     larger modulus; with four real roots, the two largest. Ranking single roots by modulus
-    instead called the phugoid pair "short_period" when one real short-period root was
+    instead would call the phugoid pair "short_period" when one real short-period root is
     slower than the phugoid.
     """
     lam = np.asarray(lam, dtype=complex)

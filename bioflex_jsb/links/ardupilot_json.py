@@ -128,8 +128,8 @@ FRAME_WRAP_WINDOW = 2 ** 16
 # about 0.4 ms of reads and comparisons (1.4 us a datagram on the project's machine).
 MAX_BATCH = 256
 # The receive buffer asked for [bytes] (net.core.rmem_max caps it for a user; Linux counts
-# each small datagram at about 830 bytes of buffer, so the default 212 992 held 256 of them,
-# 2.6 ms of a 100k/s flood, and a frame arriving behind a full buffer was lost): 4 MiB hold
+# each small datagram at about 830 bytes of buffer, so the default 212 992 holds 256 of them,
+# 2.6 ms of a 100k/s flood, and a frame arriving behind a full buffer is lost): 4 MiB hold
 # about 5000, 50 ms of such a flood, longer than a scheduler's time slice.
 RECV_BUFFER_BYTES = 4 * 1024 * 1024
 

@@ -160,7 +160,7 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
     """The loads of ``run`` at ``lm``'s stations by both methods (MD absent for ``rigid``).
     Refused (InputError, one line): the native model's run (its wing is in JSBSim's XML,
     with no modal loads model), and a run flown with another wing than ``lm``'s, as its own
-    loads say (``meta["loads"]["wing"]``: another variant's or aircraft's wing gave root
+    loads say (``meta["loads"]["wing"]``: another variant's or aircraft's wing gives root
     bending moments off by up to four orders of magnitude, silently)."""
     if run.model == "native":
         raise InputError("the native wing (in the aircraft's XML) has no section loads "

@@ -59,7 +59,7 @@ from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matr
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import prototype as P
 
-# root, 25, 50, 75 % semispan (issue 24): a definition's default [loads] stations
+# root, 25, 50, 75 % semispan: a definition's default [loads] stations
 DEFAULT_STATION_FRACTIONS = DEFAULT_MONITORING_STATIONS
 QUANTITIES = ("shear_n", "bending_n_m", "torque_n_m")
 QUANTITY_UNITS = {"shear_n": "N", "bending_n_m": "N*m", "torque_n_m": "N*m"}

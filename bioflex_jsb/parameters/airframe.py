@@ -201,10 +201,10 @@ class PostStall:
 
 
 POST_STALL = PostStall(
-    alpha_negative_stall_rad=math.radians(-10.0),  # ESTIMATE: the issue's linear range −10°..11°
+    alpha_negative_stall_rad=math.radians(-10.0),  # ESTIMATE: the spec's linear range −10°..11°
     normal_force_90deg=1.25,  # ESTIMATE: flat plate of aspect ratio ≈ 9 broadside (Hoerner)
     decay_rad=math.radians(4.0),  # ESTIMATE: abrupt thin-aerofoil leading-edge stall
-    alpha_table_min_rad=math.radians(-30.0),  # the issue asks for at least −20°..+30°
+    alpha_table_min_rad=math.radians(-30.0),  # the specification asks for at least −20°..+30°
     alpha_table_max_rad=math.radians(30.0),
     alpha_table_step_rad=math.radians(1.0),  # resolution of the stall region
 )

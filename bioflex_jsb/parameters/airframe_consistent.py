@@ -1,5 +1,5 @@
 """A second rigid-airframe parameter set: one aircraft whose rigid derivatives follow from a
-stated tail, fuselage and centre of gravity (issue 15, item 5). NOT the default.
+stated tail, fuselage and centre of gravity. NOT the default.
 
 The default set (:mod:`bioflex_jsb.parameters.airframe`) calibrates C_mα, C_mq and C_mα̇
 to Table 3's rigid short period with C_Lα = 5.3 /rad and the CG at 0.30 c̄: those values do

@@ -14,7 +14,7 @@ Sources (cited below by short name):
 
 The wing's data were published in ft/slug units (20 ft semi-span, 6 ft chord); the SI
 values below are the rounded conversions of Patil, Hodges & Cesnik (2001), which the
-literature has used since. The issue (``issues show 15``) gives the same numbers.
+literature has used since. The project's specification gives the same numbers.
 
 Frames and signs as :mod:`bioflex_jsb.structures.beam`: the beam runs along y from the
 clamped root (y = 0) to the tip; bending w positive down, twist positive leading edge up;
@@ -28,7 +28,7 @@ CHORD_M = 1.8288  # Patil, Hodges & Cesnik (2001); 6 ft, Goland (1945)
 X_ELASTIC_FRAC = 0.33  # elastic axis, chord fraction aft of LE; Goland (1945)
 X_INERTIAL_FRAC = 0.43  # centre of mass, chord fraction aft of LE; Goland (1945)
 MASS_PER_LENGTH_KG_M = 35.71  # Patil, Hodges & Cesnik (2001)
-# Mass moment of inertia per unit span [kg·m], Patil, Hodges & Cesnik (2001). The issue
+# Mass moment of inertia per unit span [kg·m], Patil, Hodges & Cesnik (2001). The spec
 # states it "about the centre of mass". DECISION (measured in tests/test_goland.py): read
 # about the elastic axis, the beam gives 48.15, 95.71, 243.84 rad/s against the published
 # 49.5, 97.0, 248.9 (−2.7, −1.3, −2.0 %); read about the centre of mass (I_EA = 9.83 kg·m)
@@ -40,7 +40,7 @@ MASS_MOMENT_OF_INERTIA_KG_M = 8.64
 DEFAULT_INERTIA_AXIS = "elastic-axis"
 BENDING_STIFFNESS_N_M2 = 9.77e6  # EI, Patil, Hodges & Cesnik (2001)
 TORSIONAL_STIFFNESS_N_M2 = 0.987e6  # GJ, Patil, Hodges & Cesnik (2001)
-AIR_DENSITY_KG_M3 = 1.02  # as the issue gives it (attributed to Patil, Hodges & Cesnik 2001)
+AIR_DENSITY_KG_M3 = 1.02  # as the spec gives it (attributed to Patil, Hodges & Cesnik 2001)
 # Sea-level density, 0.002378 slug/ft³ (ISA). DECISION (measured in tests/test_goland.py):
 # with the elastic-axis inertia reading, Goland's exact strip-theory flutter point
 # (137.2 m/s, 70.7 rad/s) is reproduced at this density (137.0 m/s, 70.0 rad/s), not at
@@ -54,7 +54,7 @@ FLUTTER_DENSITY_KG_M3 = 1.225
 # --------------------------------------------------------------------------------------
 # Natural frequencies of the first three coupled modes [rad/s]: first bending, first
 # torsion, second bending; the exact (continuous-beam) values Patil, Hodges & Cesnik (2001)
-# tabulate, as the issue's brief quotes them (the paper itself is not in the reference
+# tabulate, as the specification quotes them (the paper itself is not in the reference
 # folder; not re-checked against it).
 PUBLISHED_NATURAL_FREQUENCIES_RAD_S = (49.5, 97.0, 248.9)
 # Flutter point of the exact strip-theory solution (Theodorsen's 2-D aerodynamics, lift

@@ -31,7 +31,7 @@ reference flow for any step, so the structural dynamics up to the third mode (10
 in the change of the aerodynamic stiffness and damping since the reference (a few per cent
 of ω²). The reference is renewed when Q or V moves by more than ``refresh_rel`` (default
 5 %): at the co-simulation's step that changes η₁ by < 0.05 % against a step exact at every
-step's flow (holding Ψ_r ΔA x_k over the step instead, a first-order treatment, was 2 % off
+step's flow (holding Ψ_r ΔA x_k over the step instead, a first-order treatment, is 2 % off
 in the Fig. 21 case; tests/test_gusts_and_modal_wing.py).
 
 Timing in the co-simulation (``drivers/gust.py``): the wing advances with the flow of t_k
@@ -71,7 +71,7 @@ def _one_blas_thread():
 # leaves 4 samples per period.
 DEFAULT_DT_S = 1.0 / 960.0
 # The co-simulation step's range [s]. Finest: below ~6e-5 s JSBSim's trim of the prototype
-# fails, reported as a motor short of thrust (measured 2026-12-03: 5e-5 and 3e-5 s fail,
+# fails, reported as a motor short of thrust (measured: 5e-5 and 3e-5 s fail,
 # 6e-5 and 1e-4 trim at 15 m/s), so 1e-4 s (10 kHz, 90 steps a period of the wing's 110 Hz
 # third mode) with margin; coarsest 0.02 s (50 Hz: at 0.04-0.1 s the propeller's RPM does
 # not settle in the trim, and the wing's modes are unresolved).
@@ -175,7 +175,7 @@ class ModalWing:
         first-order change of Φ per unit change of Q and of Q/V (Fréchet derivatives of the
         exponential along ∂A/∂Q and ∂A/∂(Q/V)). BLAS runs on one thread here: on these
         12×12 matrices OpenBLAS's default threads only add hand-over costs (a refresh took
-        5-39 ms instead of about 1 ms on a loaded 2-core machine, issue 13)."""
+        5-39 ms instead of about 1 ms on a loaded 2-core machine)."""
         with _one_blas_thread():
             self._compute_reference(q_pa, v_m_s)
 

@@ -220,8 +220,8 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
 # ---------------------------------------------------------------------------------------
 # A damaged cache heals itself. numba keeps a kernel's machine code in two pickles in its
 # cache directory (``<module>.<function>-<line>.pyXY.nbi``, the index, and ``….N.nbc``, the
-# code); a truncated, empty or overwritten file made every run fail in numba's loader
-# (UnpicklingError, EOFError, MemoryError, ...) until it was deleted by hand. The guard wraps
+# code); a truncated, empty or overwritten file makes every run fail in numba's loader
+# (UnpicklingError, EOFError, MemoryError, ...) until it is deleted by hand. The guard wraps
 # the kernel's cache loader: a file that cannot be read is discarded (this kernel's files
 # only), one line says so on stderr, and numba compiles the kernel and caches it anew.
 # ---------------------------------------------------------------------------------------
@@ -278,7 +278,7 @@ guard_cache(step_kernel)
 # A call through the dispatcher types every argument first (the 20-tuple element by element,
 # the four arrays, the scalars) to pick the compiled overload: 0.67 µs of a 10.1 µs
 # co-simulation step (least of 60 interleaved blocks of 200 steps, 2-core KVM machine,
-# load 2.2; kernel alone 1.10 -> 0.77 µs). The overload's entry point, found once for the
+# load 2.2; kernel alone 1.10 µs, 0.77 µs direct). The overload's entry point, found once for the
 # run's types, skips that; it converts what it is given to those types without checking
 # them (a table of another layout is written in the wrong places, tested), so a caller
 # checks each new table once with the ``accepts`` it comes with.

@@ -28,14 +28,14 @@ The diagonal rows of strips of one chord are the same numbers (two groups of 40 
 their states, equal from rest, stay equal, and the dense rows and the loads are taken on
 one state per group (:func:`state_groups`; 88 columns instead of 166), the whole state only
 when a group's states differ (set from outside, or NaN).
-Measured: the kernel's call (same state, the three versions interleaved, 15 rounds of
+Measured: the kernel's call (same state, the three variants interleaved, 15 rounds of
 20 000 calls, load 0.1-0.15) 3.6-4.1 µs with the inputs as three 8-term dot products per
 row and the diagonal rows read off the matrices, 3.4-3.6 µs with the inputs and diagonal
-rows as now, 2.7-3.0 µs with the groups; the step (``bioflex-jsb bench``'s estimator, bare,
-cosim and unsteady interleaved, 12 repeats, CPU clock) 10.0-10.3 µs against 10.2-10.8 µs
-before for the first change (load 1.0-1.5), 9.6-10.9 µs with the groups (unsteady_ratio
-1.80-1.90, load 0.2-2.0; the same minutes' runs of the first version were too noisy to
-pair).
+rows as in :func:`_advance` without the groups, 2.7-3.0 µs with the groups; the step
+(``bioflex-jsb bench``'s estimator, bare, cosim and unsteady interleaved, 12 repeats, CPU
+clock) 10.0-10.3 µs with those inputs and rows against 10.2-10.8 µs with the dot products
+(load 1.0-1.5), 9.6-10.9 µs with the groups (unsteady_ratio 1.80-1.90, load 0.2-2.0; runs
+without the groups in the same minutes were too noisy to pair).
 """
 
 from __future__ import annotations
@@ -221,12 +221,12 @@ def _advance(params, x, f, vt, n):
     1.3-1.6 µs (the grouped state: 0.4-0.9 µs less per kernel call, module docstring; Φ x and
     ∂Φ/∂V x as two passes 4.3 µs, loaded machine); Σ_p V^p Ψ B_p f as 24 column updates
     of the dense rows (the inputs and their products with V and V² side by side, SIMD over
-    the rows) 0.23 µs where three 8-term dot products per row took 0.77 µs; the diagonal
-    rows from packed vectors 0.07 µs where they were read off the matrices' diagonals with
-    their Ψ rows 0.2 µs. Blocking rows two or four at a time (2.1 µs), column-major Φ
-    (2.4 µs) and Φ, ∂Φ/∂V interleaved row by row (2.2 µs) were slower. On flat offsets into
-    the parameter array instead of 2-D views numba checked every index for wrap-around and
-    the loops lost their SIMD (12.6 µs)."""
+    the rows) 0.23 µs where three 8-term dot products per row take 0.77 µs; the diagonal
+    rows from packed vectors 0.07 µs where reading them off the matrices' diagonals with
+    their Ψ rows takes 0.2 µs. Blocking rows two or four at a time (2.1 µs), column-major Φ
+    (2.4 µs) and Φ, ∂Φ/∂V interleaved row by row (2.2 µs) are slower. On flat offsets into
+    the parameter array instead of 2-D views numba checks every index for wrap-around and
+    the loops lose their SIMD (12.6 µs)."""
     nx = x.shape[0]
     o_psi, o_diag, o_y = int(params[H_PSI]), int(params[H_DIAG]), int(params[H_SCRATCH])
     o_key, o_grp = int(params[H_KEY]), int(params[H_GROUPS])

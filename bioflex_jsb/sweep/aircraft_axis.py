@@ -1,4 +1,4 @@
-"""The ``aircraft`` axis of a campaign (issue 23): aircraft definitions (docs/aircraft.md) as
+"""The ``aircraft`` axis of a campaign: aircraft definitions (docs/aircraft.md) as
 the wings of a sweep (pure: parsing, checks, identity).
 
 ``[axes] aircraft = ["bioflex_original", "my_aircraft.toml"]`` names shipped aircraft
@@ -94,8 +94,8 @@ _DIGESTS: dict[str, str] = {}
 def aircraft_identity(aircraft) -> dict[str, Any]:
     """What of ``aircraft`` enters its cases' ids: its name and the SHA-256 of its
     definition file's bytes (read once per process and file); for an aircraft on another
-    airframe also that its default flutter range is derived from its wing (before, it was
-    the prototype's 5-40 m/s: ids made then are not reused)."""
+    airframe also that its default flutter range is derived from its wing (a stored case
+    computed on the prototype's 5-40 m/s range keeps another id and is not reused)."""
     path = str(aircraft.definition.path)
     if path not in _DIGESTS:
         from bioflex_jsb.definition.loader import DefinitionError

@@ -105,14 +105,14 @@ class RunSettings:
     aero: str = DEFAULT_AERO
 
 
-# the range a case id records for "none given": the prototype's, once the fixed default (its
-# ids stay; another airframe's ids record "derived": aircraft_axis.aircraft_identity)
+# the range a case id records for "none given": the prototype's (its stored ids stay valid;
+# another airframe's ids record "derived": aircraft_axis.aircraft_identity)
 DEFAULT_FLUTTER_RANGE_ID = (5.0, 40.0)
 
 
 def settings_identity(settings: RunSettings) -> dict[str, Any]:
     """The settings as hashed into case ids: ``aero`` only when it is not the default, so
-    every quasi-steady case keeps the id it had before the option existed."""
+    a quasi-steady case has the id it has in a store written without ``aero``."""
     d = dataclasses.asdict(settings)
     if d["aero"] == DEFAULT_AERO:
         del d["aero"]
@@ -316,7 +316,7 @@ def _unknown(table: dict, allowed: set[str], where: str) -> None:
         raise CampaignError(f"{key}: unknown key; accepted: {', '.join(sorted(allowed))}")
 
 
-MIN_SPEED_M_S = 1.0  # DECISION: a case's lowest airspeed [m/s] (1e-300 was a failed row)
+MIN_SPEED_M_S = 1.0  # DECISION: a case's lowest airspeed [m/s] (1e-300 would be a failed row)
 
 
 def _number(v: Any, key: str, unit: str, positive: bool = False, minimum: float | None = None,

@@ -89,8 +89,8 @@ def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
     of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``, one with
     an ``aircraft`` axis an ``aircraft`` column after ``wing`` (the definition's name, empty
     for the wings of ``axes.wings``), one with a ``turbulence`` gust and the gust metrics the
-    :data:`TURBULENCE_COLUMNS` after them; other tables are the ones they always were (their
-    files resume as before)."""
+    :data:`TURBULENCE_COLUMNS` after them; other tables keep the columns of a store written
+    without these options (so its files resume)."""
     cols = {}
     for name, kind in INPUT_COLUMNS.items():
         cols[name] = kind

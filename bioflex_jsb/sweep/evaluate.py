@@ -178,7 +178,7 @@ def _evaluate(case: Case, log_dir: str | None) -> dict[str, Any]:
     if "flutter" in case.metrics:
         f = _flutter(case, build)
         # empty means none in the range: an instability at and below the range's lower end
-        # (the result has no speed then) is written as that end, as the column always had it
+        # (the result has no speed then) is written as that end, as in every stored table
         row["flutter_speed_m_s"] = f.flutter_speed_m_s if not f.present_at_lower_end \
             else f.unstable_at_and_below_m_s
         row["flutter_mode"] = f.mode

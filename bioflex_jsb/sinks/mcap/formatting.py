@@ -154,12 +154,12 @@ def _fill_steps(flat, code, lut, templates, tpl_at, float_at, fa_at, head_at, re
     doubles as bytes, a row a step, the first ones for a layout of fewer records); the
     timestamp's varints; and each record's index entry (log time, offset in ``flat``) as
     entry ``counts[j]`` of ``entries[j]`` (records × steps × 2), counted. One pass over each
-    step's bytes in memory order: the structured numpy copies this replaces wrote one field
-    across the whole chunk at a time (a pass over ~0.6 MB per field) and cost 1.5-2× as much
-    inside a run as alone, the run's own data evicted (measured 2026-12-02); and one call per
+    step's bytes in memory order: structured numpy copies, writing one field across the
+    whole chunk at a time (a pass over ~0.6 MB per field), cost 1.5-2× as much inside a run
+    as alone, the run's own data evicted (measured in a gust run); and one call per
     chunk, whatever its layouts. The template and the step's doubles are read through views
     of their own (``tpl``, ``fb``): indexed ``templates[t0 + i]`` instead, the kernel took
-    0.27-0.28 µs a step of the gust log's chunks against 0.14 (measured 2026-12-02)."""
+    0.27-0.28 µs a step of the gust log's chunks against 0.14."""
     base = 0
     for r in range(code.shape[0]):
         c = code[r]

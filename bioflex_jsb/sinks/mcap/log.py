@@ -231,8 +231,8 @@ class RunLog:
         :meth:`sample` steps (and events); autopilot frames are not counted."""
         scene = sum(len(block) for block, _ in self._scene_blocks)  # not yet in the writer
         # the scene's samples go in a chunk of their own (flush): its overhead too (with the
-        # 3.0 kB wing messages of 17 stations a file came out 188 bytes over its limit
-        # without it; the 7.2 kB ones had hidden it in the per-step margin)
+        # 3.0 kB wing messages of 17 stations a file comes out 188 bytes over its limit
+        # without it; 7.2 kB ones would hide it in the per-step margin)
         own_chunk = self._writer.chunk_overhead_bound() if self.scene is not None else 0
         return self._writer.size_bound((len(self._rows) + more_steps) * self._row_bytes
                                        + scene) + own_chunk

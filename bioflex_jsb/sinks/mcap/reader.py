@@ -172,7 +172,7 @@ def _numbers(msg: dict, field: str, topic: str, ns: int, optional: bool = False)
     return list(value)
 
 
-iter_json = iter_messages  # the name from when every log was JSON
+iter_json = iter_messages  # the JSON-log name of iter_messages, kept for its callers
 
 
 def read_events(reader, summary) -> list[dict]:

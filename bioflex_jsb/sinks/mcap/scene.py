@@ -71,7 +71,7 @@ _ARROW_AHEAD_OF_NOSE_M = 0.1
 # the tip, where the cosine-spaced strips crowd and the shapes turn, keeps its density), not
 # at all 42: the shapes drawn linearly between them are within 0.7, 1.9 and 4.2 % of each
 # mode's peak (modes 1-3) of the 42-station mesh, and a scene message is 3.0 kB instead of
-# 7.2 kB (measured 2026-12-02). The mode sheet and the mode animation draw every station.
+# 7.2 kB. The mode sheet and the mode animation draw every station.
 SCENE_MESH_STATIONS = 17
 # NUMERICAL (drawing only): the fuselage's spheroid in rings along x and sides around
 _FUSELAGE_RINGS, _FUSELAGE_SIDES = 16, 12
@@ -413,9 +413,8 @@ def _sample_floats(v, cols, twist, heave, ea_x, chord_fwd, z0, arrow_head, m_per
     the columns of w_g, φ, θ) and their stations' ``twist`` and ``heave`` (m, K:
     :meth:`AircraftMesh.twist_heave`), in one pass, operation for operation as
     :meth:`AircraftMesh.gust_arrow` and :meth:`AircraftMesh.wing_xz` (the same doubles,
-    tests/test_scene.py). Their ~50 small numpy operations on a chunk's 54 samples took
-    ~0.2 ms in a run, its caches cold, this (with :meth:`AircraftMesh.twist_heave`) ~0.08 ms
-    (measured 2026-12-02)."""
+    tests/test_scene.py). Their ~50 small numpy operations on a chunk's 54 samples take
+    ~0.2 ms in a run, its caches cold, this (with :meth:`AircraftMesh.twist_heave`) ~0.08 ms."""
     m, k_n = twist.shape
     out = np.empty((m, 9 + 8 * k_n))
     for i in range(m):

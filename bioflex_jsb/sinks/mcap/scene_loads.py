@@ -168,7 +168,7 @@ def _marker_floats(values, cols, one_g, twist, heave, ea_x, minus_y, le_ahead, z
     then the port ones (y mirrored), each position, size (x, y, z), colour (r, g, b):
     operation for operation :func:`marker_floats` (the same doubles, tests/test_scene_loads.py;
     its numpy and the ratios' on a chunk's 54 samples took ~0.25 ms in a run, its caches
-    cold, this ~0.05 ms: measured 2026-12-02)."""
+    cold, this ~0.05 ms)."""
     m, s = twist.shape
     n = 2 * s  # spheres a half
     out = np.empty((m, 2 * n * FLOATS_PER_SPHERE))

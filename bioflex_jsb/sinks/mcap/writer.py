@@ -41,7 +41,7 @@ CHUNK_SPAN_S = 0.9
 CHUNK_WALL_S = 0.9  # wall time per chunk [s] (runs slower than real time, SITL sessions)
 # DECISION: wall time per chunk [s] while a live client is subscribed (the tee's
 # ``subscribed``): a message reaches it at most this long after its step (plus the send),
-# within the ~50 ms a live plot looks immediate at (issue 26); a chunk's fixed cost (≈ 0.7
+# within the ~50 ms a live plot looks immediate at; a chunk's fixed cost (≈ 0.7
 # ms, see above) every 20 ms of a real-time session is ≈ 3 % of a core, only while watched
 LIVE_CHUNK_WALL_S = 0.02
 CHUNK_MAX_BYTES = 4 * 1024 * 1024  # uncompressed chunk size limit [bytes]
@@ -50,7 +50,7 @@ ZSTD_LEVEL = -3  # zstd's fast level: see McapFileWriter
 # DECISION: a kind of chunk (the set of its channels) that zstd shrinks by less than
 # RAW_BELOW is stored uncompressed for its next RAW_CHUNKS chunks of that kind, then tried
 # again. The section loads' own chunk (24 doubles a step: mantissas that look like noise)
-# compressed 1.12:1 (measured 2026-12-02 on a gust run's chunks) at 0.59 ns a byte: 0.14 µs
+# compresses 1.12:1 (measured on a gust run's chunks) at 0.59 ns a byte: 0.14 µs
 # a step alone, for 12 % of its bytes; the steps' chunk compresses 2.07:1, the scene's 4.4:1
 # and the load markers' 5.7:1, so they stay compressed.
 RAW_BELOW = 0.15  # [-] of the chunk's size
@@ -123,7 +123,7 @@ class McapFileWriter:
         # Integrity: each zstd frame carries its content checksum (XXH64, 4 bytes, checked
         # by every zstd decoder: a damaged chunk fails to decompress), so its MCAP chunk CRC
         # is 0 ("not computed", as the MCAP specification allows): XXH64 cost 0.05 ns a byte
-        # against CRC-32's 0.15 (measured on a gust run's chunks, 2026-12-02), ~0.13 µs a
+        # against CRC-32's 0.15 (measured on a gust run's chunks), ~0.13 µs a
         # step less. A chunk stored uncompressed (RAW_BELOW) has its CRC-32; the data
         # section's CRC covers every byte written either way.
         self._compress = zstandard.ZstdCompressor(
@@ -296,8 +296,8 @@ class McapFileWriter:
         if len(parts) > 1:
             entries = entries[np.argsort(entries[:, 1], kind="stable")]
         # in offset order (a block's entries are, and so are single messages'): the ones
-        # within the chunk's bytes are a prefix; a mask over every entry instead cost ~10 µs
-        # a channel a chunk (0.08 µs a step of a gust log's steps' chunk, 2026-12-03)
+        # within the chunk's bytes are a prefix; a mask over every entry instead costs ~10 µs
+        # a channel a chunk (0.08 µs a step of a gust log's steps' chunk)
         if len(entries) and entries[-1, 1] >= n:
             entries = entries[:int(np.searchsorted(entries[:, 1], n))]
         return entries if len(entries) else None
