@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None) -> int:
     from bioflex_jsb.cli import common
-    from bioflex_jsb.cli.case import check_speed
+    from bioflex_jsb.cli.speed_option import check_speed
 
     parser = build_parser()
     try:

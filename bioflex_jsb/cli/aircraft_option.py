@@ -38,7 +38,7 @@ class CruiseSpeed(float):
 
 def cruise_speed_default() -> CruiseSpeed:
     """The marked default of ``--speed`` (:class:`CruiseSpeed`)."""
-    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S
+    from bioflex_jsb.cli.speed_option import DEFAULT_SPEED_M_S
 
     return CruiseSpeed(DEFAULT_SPEED_M_S)
 
@@ -140,8 +140,8 @@ def resolve_flight(args: argparse.Namespace) -> None:
     a 1-cos length or turbulence scale
     must be at least the aircraft's mean chord (simulation/gusts.py). One line (a
     UsageError, exit 2) otherwise."""
-    from bioflex_jsb.cli.case import DEFAULT_SPEED_M_S, check_speed
-    from bioflex_jsb.cli.common import UsageError
+    from bioflex_jsb.cli.speed_option import DEFAULT_SPEED_M_S, check_speed
+    from bioflex_jsb.cli.usage import UsageError
     from bioflex_jsb.definition.flying import flight_speeds
 
     aircraft = getattr(args, "aircraft_definition", None)

@@ -33,6 +33,7 @@ import sys
 import threading
 from typing import Any, NoReturn
 
+from bioflex_jsb.cli.usage import UsageError  # noqa: F401  (every command's, re-exported)
 from bioflex_jsb.interrupts import STOP, unsafe_frame
 
 EXIT_USAGE = 2
@@ -40,10 +41,6 @@ EXIT_DIVERGED = 3
 EXIT_ENVIRONMENT = 4
 EXIT_INTERRUPTED = 130
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
-class UsageError(Exception):
-    """A problem with what the user asked for; reported as one line, exit status 2."""
 
 
 class EnvironmentFault(Exception):
