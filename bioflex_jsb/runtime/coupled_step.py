@@ -184,32 +184,8 @@ class CoupledStep:
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
                  trim_mode: str = "rigid") -> None:
-        if trim_mode not in TRIM_MODES:
-            raise InputError(f"unknown trim {trim_mode!r}; accepted: {', '.join(TRIM_MODES)}")
-        if trim_mode == "elastic" and (not isinstance(wing, WingBuild)
-                                       or model not in ("coupled", "qsd") or trim is not None):
-            raise InputError("the elastic trim needs the wing's build (its modes) and the "
-                             f"coupled or qsd wing, trimmed here (got {model!r})")
-        if aero not in AERO_MODELS:
-            raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
-        if model not in STEP_MODELS:
-            raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
-        unsteady = aero == "unsteady"
-        if unsteady and model != "coupled":
-            raise InputError(f"aero='unsteady' is for the coupled wing, not {model!r} (the "
-                             "rigid, qsd and native wings are quasi-steady)")
-        if unsteady and not isinstance(wing, WingBuild):
-            raise InputError("aero='unsteady' needs the wing's build (its strips), not only "
-                             "its ElasticWingModel")
-        if unsteady and trim_mode == "elastic":
-            raise InputError("aero='unsteady' flies from the rigid trim (its lag states are "
-                             "linearised about it); accepted with it: trim_mode='rigid'")
-        build = wing if isinstance(wing, WingBuild) else None
-        if build is not None:
-            wing = build.model
+        build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
-        if wing is None and not native:
-            raise InputError(f"the {model} model needs a wing")
         self.airframe = airframe
         self.native = native
         configure_airframe(airframe, dt_s, modal_hooks=not native)
@@ -228,8 +204,9 @@ class CoupledStep:
                  if not (k == "throttle" and airframe.glider)}
         if airframe.glider:  # no engine, no throttle property: the throttle channel is 0
             nodes["throttle"] = _NO_THROTTLE
-        # the aircraft's own data (S, c̄, derivatives): its wing model's AirframeData
-        self.airframe_data = PROTOTYPE_AIRFRAME if wing is None else wing.airframe
+        # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's
+        self.airframe_data = (PROTOTYPE_AIRFRAME if wing is None
+                              else wing.airframe.at_speed(speed_m_s))
         _check_pair(airframe, self.airframe_data)
         self.alpha_range_rad = airframe.alpha_table_range_rad
         self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
@@ -241,30 +218,7 @@ class CoupledStep:
         # takes it; a glide's W cos γ/(Q S) differs by 1 − cos γ (γ −2.3°: 0.08 %)
         cl_trim = level_flight_condition(speed_m_s, airframe=self.airframe_data).cl_trim
         self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
-        if native:
-            self.wing = None
-            self.n_modes = _native_mode_count(airframe)
-            get_node = airframe.property_node
-            self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
-                                for i in range(self.n_modes)]
-            self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
-                                   for i in range(self.n_modes)]
-            self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
-        elif unsteady:
-            # imported here: the unsteady strips pull in scipy's integrators and optimisers,
-            # ~15 MB a quasi-steady run does not need
-            from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
-
-            self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s,
-                                                     aero=self.airframe_data.aero)
-            self.n_modes = wing.n_modes
-            self._write_reactions = airframe.external_reaction_writer()
-        else:
-            static = None if self.elastic_trim is None else self.elastic_trim.eta_rad
-            self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s,
-                                  static_eta=static, aero=self.airframe_data.aero)
-            self.n_modes = wing.n_modes
-            self._write_reactions = airframe.external_reaction_writer()
+        self._make_wing(model, aero, build, wing, airframe)
         self.model = model
         self.aero = aero
         self.units = channel_units(self.n_modes)
@@ -281,6 +235,33 @@ class CoupledStep:
         self.stopped: str | None = None
         self.sensed: Sensed | None = None  # the snapshot of the last step's start
         self.w_g_m_s = 0.0
+
+    def _make_wing(self, model: str, aero: str, build, wing, airframe: Airframe) -> None:
+        """The wing of the step: the native wing's properties, the unsteady strips or the
+        quasi-steady modal wing (``self.wing``, ``self.n_modes``, the reactions' writer)."""
+        if model == "native":
+            self.wing = None
+            self.n_modes = _native_mode_count(airframe)
+            get_node = airframe.property_node
+            self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
+                                for i in range(self.n_modes)]
+            self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
+                                   for i in range(self.n_modes)]
+            self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
+            return
+        if aero == "unsteady":
+            # imported here: the unsteady strips pull in scipy's integrators and optimisers,
+            # ~15 MB a quasi-steady run does not need
+            from bioflex_jsb.simulation.unsteady_wing import UnsteadyModalWing
+
+            self.wing = UnsteadyModalWing.from_build(build, self.reference, dt_s=self.dt_s,
+                                                     aero=self.airframe_data.aero)
+        else:
+            static = None if self.elastic_trim is None else self.elastic_trim.eta_rad
+            self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s,
+                                  static_eta=static, aero=self.airframe_data.aero)
+        self.n_modes = wing.n_modes
+        self._write_reactions = airframe.external_reaction_writer()
 
     # -- the wing ---------------------------------------------------------------------------
     @property
@@ -538,6 +519,40 @@ class CoupledStep:
         """Leave no modal loads behind in the airframe for its next user."""
         if not self.native:
             self.airframe.set_external_reactions()
+
+
+def _step_options(wing, model: str, aero: str, trim_mode: str, trim) -> tuple:
+    """(the wing's build or None, its ElasticWingModel or None) of a step's options, each
+    combination it cannot fly refused in one line (InputError): the unsteady strips are the
+    coupled wing's and need its build (its strips), from the rigid trim; the elastic trim
+    needs the build of a coupled or qsd wing and is made here; the native model has its wing
+    in the aircraft's XML. A run's configuration gives each model options that pass
+    (simulation/run_config.py RunConfig.settings_for)."""
+    if trim_mode not in TRIM_MODES:
+        raise InputError(f"unknown trim {trim_mode!r}; accepted: {', '.join(TRIM_MODES)}")
+    if trim_mode == "elastic" and (not isinstance(wing, WingBuild)
+                                   or model not in ("coupled", "qsd") or trim is not None):
+        raise InputError("the elastic trim needs the wing's build (its modes) and the "
+                         f"coupled or qsd wing, trimmed here (got {model!r})")
+    if aero not in AERO_MODELS:
+        raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
+    if model not in STEP_MODELS:
+        raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(STEP_MODELS)}")
+    if aero == "unsteady":
+        if model != "coupled":
+            raise InputError(f"aero='unsteady' is for the coupled wing, not {model!r} (the "
+                             "rigid, qsd and native wings are quasi-steady)")
+        if not isinstance(wing, WingBuild):
+            raise InputError("aero='unsteady' needs the wing's build (its strips), not only "
+                             "its ElasticWingModel")
+        if trim_mode == "elastic":
+            raise InputError("aero='unsteady' flies from the rigid trim (its lag states are "
+                             "linearised about it); accepted with it: trim_mode='rigid'")
+    build = wing if isinstance(wing, WingBuild) else None
+    model_ = build.model if build is not None else wing
+    if model_ is None and model != "native":
+        raise InputError(f"the {model} model needs a wing")
+    return build, model_
 
 
 def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitude_m: float):
