@@ -197,10 +197,6 @@ def run_gust(
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
                        trim_mode=trim_mode)
-    dt = step.dt_s
-    gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s, setup.duration_s, dt)
-    n_steps = int(round(setup.duration_s / dt))
-    names = step.names
     refused = True
     try:
         stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
@@ -209,168 +205,197 @@ def run_gust(
         if refused:  # a loads model refused (InputError): the step's hold goes with it
             step.release()
     keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
-    stopped = None
-    interrupted = False
-    block = max(1, int(round(WINDOW_S / dt)))
-    loads_out = None  # the recorder's loads topic
-    if recorder is not None:
-        block = max(1, int(recorder.start(names, dt)))
-        if stream is not None and hasattr(recorder, "loads"):
-            loads_out = recorder.loads(loads_meta["loads"])
-    block = min(block, max(n_steps, 1))
-    load_names = stream.names if stream is not None else ()
-    loads_table = None
-    if keep_all:  # row k: step k, columns in names' order
-        table = np.full((n_steps, len(names)), np.nan)
-        if stream is not None:
-            loads_table = np.full((n_steps, len(load_names)), np.nan)
-        envelope = None
-    else:  # one block of rows, refilled block after block
-        table = np.full((block, len(names)), np.nan)
-        both = names + load_names
-        pairs = tuple((both.index(c), both.index(c.replace("loads_fs_", "loads_md_")))
-                      for c in load_names if c.startswith("loads_fs_")
-                      and c.replace("loads_fs_", "loads_md_") in load_names)
-        envelope = _Envelope(both, dt, load_names, pairs)
-    k_loads = 0  # rows whose loads are out
+    run = _GustRun(step, setup, stream, loads_meta, recorder, keep_all)
+    run.fly(airframe, on_sample, progress)
+    # what each η_i does at the tip (twist or deflection), for figures: from the build
+    build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
+        else None
+    return run.history(model, trim_mode, build)
 
-    def hand_loads(time_s: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
+
+class _GustRun:
+    """One run's rows on their way: the table (every step, or one block refilled), the
+    envelope of a long run, the section loads one step behind, the recorder and its loads
+    topic; :meth:`fly` flies the blocks, :meth:`history` gives the TimeHistory."""
+
+    def __init__(self, step: CoupledStep, setup: RunConfig, stream, loads_meta: dict,
+                 recorder, keep_all: bool) -> None:
+        self.step, self.setup, self.stream, self.loads_meta = step, setup, stream, loads_meta
+        self.recorder, self.keep_all = recorder, keep_all
+        dt = self.dt = step.dt_s
+        self.gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s,
+                              setup.duration_s, dt)
+        self.n_steps = int(round(setup.duration_s / dt))
+        names = self.names = step.names
+        block = max(1, int(round(WINDOW_S / dt)))
+        self.loads_out = None  # the recorder's loads topic
+        if recorder is not None:
+            block = max(1, int(recorder.start(names, dt)))
+            if stream is not None and hasattr(recorder, "loads"):
+                self.loads_out = recorder.loads(loads_meta["loads"])
+        self.block = min(block, max(self.n_steps, 1))
+        load_names = self.load_names = stream.names if stream is not None else ()
+        self.loads_table = None
+        if keep_all:  # row k: step k, columns in names' order
+            self.table = np.full((self.n_steps, len(names)), np.nan)
+            if stream is not None:
+                self.loads_table = np.full((self.n_steps, len(load_names)), np.nan)
+            self.envelope = None
+        else:  # one block of rows, refilled block after block
+            self.table = np.full((self.block, len(names)), np.nan)
+            both = names + load_names
+            pairs = tuple((both.index(c), both.index(c.replace("loads_fs_", "loads_md_")))
+                          for c in load_names if c.startswith("loads_fs_")
+                          and c.replace("loads_fs_", "loads_md_") in load_names)
+            self.envelope = _Envelope(both, dt, load_names, pairs)
+        self.k_loads = 0  # rows whose loads are out
+        self.k = 0  # steps handed over
+        self.stopped: str | None = None
+        self.interrupted = False
+
+    def hand_loads(self, time_s: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
         """Rows whose loads are known (one behind the steps): to the loads topic, the
         loads table or the envelope."""
-        nonlocal k_loads
         if not len(time_s):
             return
-        if loads_out is not None:
-            loads_out.rows(time_s, values)
-        if loads_table is not None:
-            loads_table[k_loads:k_loads + len(time_s)] = values
-        if envelope is not None:
-            envelope.add(time_s, np.hstack([rows, values]))
-        k_loads += len(time_s)
+        if self.loads_out is not None:
+            self.loads_out.rows(time_s, values)
+        if self.loads_table is not None:
+            self.loads_table[self.k_loads:self.k_loads + len(time_s)] = values
+        if self.envelope is not None:
+            self.envelope.add(time_s, np.hstack([rows, values]))
+        self.k_loads += len(time_s)
 
-    def hand(k0: int, m: int, j0: int, last: bool = False) -> None:
+    def hand(self, k0: int, m: int, j0: int, last: bool = False) -> None:
         """Rows [k0, k0 + m) of the run, complete in the table from row j0: to the
         recorder and the envelope (and their loads, those known, to theirs; with the
         ``last`` block, every one: the loads topic gets no chunk of a single step)."""
         if m <= 0:
             return
-        rows = table[j0:j0 + m]
-        time_s = (k0 + np.arange(m)) * dt
-        if recorder is not None:
-            recorder.rows(time_s, rows)
-        if stream is not None:
-            known = stream.add(time_s, rows)
+        rows = self.table[j0:j0 + m]
+        time_s = (k0 + np.arange(m)) * self.dt
+        if self.recorder is not None:
+            self.recorder.rows(time_s, rows)
+        if self.stream is not None:
+            known = self.stream.add(time_s, rows)
             if last:
-                end = stream.finish()
+                end = self.stream.finish()
                 known = tuple(np.concatenate([a, b]) for a, b in zip(known, end, strict=True))
-            hand_loads(*known)
-        elif envelope is not None:
-            envelope.add(time_s, rows)
+            self.hand_loads(*known)
+        elif self.envelope is not None:
+            self.envelope.add(time_s, rows)
 
-    advance_into = step.stepper()  # the step, bound once (compiled or Python)
-    k = 0  # steps handed over
-    i = 0  # complete steps of the block in progress
-    j0 = 0  # its first row in the table
-    try:
-        with airframe.capturing():  # JSBSim's output captured once for the loop
-            while k < n_steps:
-                j0 = k if keep_all else 0
-                # the gust by step number [m/s, up], one block at a time
-                ws = gust.samples(min(block, n_steps - k), k).tolist()
-                stop = None
-                i = 0
-                # between steps: a stop signal deferred inside JSBSim's calls (STOP.pending,
-                # bioflex_jsb.interrupts) ends the block, and is raised once it is handed on
-                if on_sample is None:
-                    for w in ws:
-                        stop = advance_into(w, table, j0 + i)
-                        i += 1
-                        if stop or STOP.pending:
-                            break
-                else:
-                    for w in ws:
-                        stop = advance_into(w, table, j0 + i)
-                        i += 1
-                        on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
-                        if stop or STOP.pending:
-                            break
-                m, i = i, 0
-                k += m
-                hand(k - m, m, j0, last=bool(stop) or k >= n_steps)
-                if progress is not None:
-                    progress(k)
-                if stop:
-                    stopped = stop
-                    break
-                raise_if_stopped()
-    except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
-        interrupted = True
-    finally:
-        step.release()
+    def _block(self, advance_into, j0: int, on_sample) -> tuple[int, str | None]:
+        """Fly one block from row ``j0``: (the steps flown, why the run stopped or None).
+        Between steps a stop signal deferred inside JSBSim's calls (STOP.pending,
+        bioflex_jsb.interrupts) ends the block, raised once it is handed on."""
+        k, table, dt = self.k, self.table, self.dt
+        # the gust by step number [m/s, up], one block at a time
+        ws = self.gust.samples(min(self.block, self.n_steps - k), k).tolist()
+        stop, i = None, 0
+        self._in_block = (j0, 0)
+        for w in ws:
+            stop = advance_into(w, table, j0 + i)
+            i += 1
+            self._in_block = (j0, i)
+            if on_sample is not None:
+                on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
+            if stop or STOP.pending:
+                break
+        self._in_block = (j0, 0)
+        return i, stop
+
+    def fly(self, airframe: Airframe, on_sample, progress) -> None:
+        """Fly every block, handing each on; a stop (out of range) ends the run, Ctrl-C or
+        SIGTERM keeps what was flown; every complete step reaches the recorder however the
+        run ends."""
+        advance_into = self.step.stepper()  # the step, bound once (compiled or Python)
+        self._in_block = (0, 0)
         try:
+            with airframe.capturing():  # JSBSim's output captured once for the loop
+                while self.k < self.n_steps:
+                    j0 = self.k if self.keep_all else 0
+                    m, stop = self._block(advance_into, j0, on_sample)
+                    self.k += m
+                    self.hand(self.k - m, m, j0, last=bool(stop) or self.k >= self.n_steps)
+                    if progress is not None:
+                        progress(self.k)
+                    if stop:
+                        self.stopped = stop
+                        break
+                    raise_if_stopped()
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
+            self.interrupted = True
+        finally:
+            self._finish()
+
+    def _finish(self) -> None:
+        self.step.release()
+        try:
+            j0, i = self._in_block
             if i:  # the block in progress when the loop failed or was interrupted
-                m, i = i, 0
-                k += m
-                hand(k - m, m, j0, last=True)
-            if stream is not None and stream.holding:  # interrupted between blocks
-                hand_loads(*stream.finish())
+                self._in_block = (j0, 0)
+                self.k += i
+                self.hand(self.k - i, i, j0, last=True)
+            if self.stream is not None and self.stream.holding:  # interrupted between blocks
+                self.hand_loads(*self.stream.finish())
         finally:
             try:
-                if loads_out is not None:
-                    loads_out.stop()
+                if self.loads_out is not None:
+                    self.loads_out.stop()
             finally:
-                if recorder is not None:
-                    recorder.stop(k)  # also when the loop failed: every complete step kept
-    n = k
-    if interrupted:
-        stopped = f"interrupted at t = {n * dt:.3f} s"
-    trim = step.trim
-    units = dict(step.units)
-    if envelope is None:
-        time_s = np.arange(n) * dt
-        channels = {name: table[:n, c].copy() for c, name in enumerate(names)}
-        if loads_table is not None:
-            channels.update({name: loads_table[:n, c].copy()
-                             for c, name in enumerate(load_names)})
-        history = "all"
-    else:
-        time_s, rows = envelope.history(len(names) + len(load_names))
-        channels = {name: rows[:, c].copy() for c, name in enumerate(names + load_names)}
-        history = "envelope"
-    if stream is not None:
-        units.update(stream.units)
-    # what each η_i does at the tip (twist or deflection), for figures: from the build
-    build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
-        else None
-    return TimeHistory(
-        model=model,
-        time_s=time_s,
-        channels=channels,
-        units=units,
-        meta={
-            "source": "jsbsim-native" if model == "native" else "jsbsim-cosim",
-            "speed_m_s": setup.speed_m_s,
-            "dt_s": dt,
-            "gust": setup.gust.text(),
-            "gust_start_s": setup.gust_start_s,
-            "trim_alpha_rad": trim.alpha_rad,
-            "trim_theta_rad": trim.theta_rad,
-            "trim_elevator_rad": trim.elevator_rad,
-            "trim_throttle": trim.throttle,
-            "alpha_peak_rad": step.alpha_peak_rad,
-            "time_beyond_stall_s": step.stall_steps * dt,
-            "interrupted": interrupted,
-            "history": history,
-            "trim_mode": trim_mode,
-            "static_eta_rad": (None if step.elastic_trim is None
-                               else [float(e) for e in step.elastic_trim.eta_rad]),
-            "steps": n,
-            "envelope_s": envelope.span_s if envelope is not None else None,
-            "mode_tips": None if build is None else mode_tips(build.modes),
-            **loads_meta,
-        },
-        stopped=stopped,
-    )
+                if self.recorder is not None:
+                    self.recorder.stop(self.k)  # also when the loop failed: every step kept
+
+    def history(self, model: str, trim_mode: str, build) -> TimeHistory:
+        """The run as a TimeHistory: every step, or the envelope (``meta["history"]``)."""
+        n, dt, step, setup = self.k, self.dt, self.step, self.setup
+        stopped = f"interrupted at t = {n * dt:.3f} s" if self.interrupted else self.stopped
+        trim = step.trim
+        units = dict(step.units)
+        names, load_names = self.names, self.load_names
+        if self.envelope is None:
+            time_s = np.arange(n) * dt
+            channels = {name: self.table[:n, c].copy() for c, name in enumerate(names)}
+            if self.loads_table is not None:
+                channels.update({name: self.loads_table[:n, c].copy()
+                                 for c, name in enumerate(load_names)})
+            history = "all"
+        else:
+            time_s, rows = self.envelope.history(len(names) + len(load_names))
+            channels = {name: rows[:, c].copy() for c, name in enumerate(names + load_names)}
+            history = "envelope"
+        if self.stream is not None:
+            units.update(self.stream.units)
+        return TimeHistory(
+            model=model,
+            time_s=time_s,
+            channels=channels,
+            units=units,
+            meta={
+                "source": "jsbsim-native" if model == "native" else "jsbsim-cosim",
+                "speed_m_s": setup.speed_m_s,
+                "dt_s": dt,
+                "gust": setup.gust.text(),
+                "gust_start_s": setup.gust_start_s,
+                "trim_alpha_rad": trim.alpha_rad,
+                "trim_theta_rad": trim.theta_rad,
+                "trim_elevator_rad": trim.elevator_rad,
+                "trim_throttle": trim.throttle,
+                "alpha_peak_rad": step.alpha_peak_rad,
+                "time_beyond_stall_s": step.stall_steps * dt,
+                "interrupted": self.interrupted,
+                "history": history,
+                "trim_mode": trim_mode,
+                "static_eta_rad": (None if step.elastic_trim is None
+                                   else [float(e) for e in step.elastic_trim.eta_rad]),
+                "steps": n,
+                "envelope_s": self.envelope.span_s if self.envelope is not None else None,
+                "mode_tips": None if build is None else mode_tips(build.modes),
+                **self.loads_meta,
+            },
+            stopped=stopped,
+        )
 
 
 def _load_stream(loads, step: CoupledStep, model: str, speed_m_s: float, aero: str
