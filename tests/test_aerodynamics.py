@@ -107,13 +107,13 @@ def test_semi_infinite_filament_is_the_limit_of_a_long_segment():
 def test_horseshoe_sign_lift_up_gives_downwash_behind_it():
     a = np.array([[0.0, -1.0, 0.0]])
     b = np.array([[0.0, 1.0, 0.0]])
-    w = ll._horseshoe_normalwash(np.array([[0.5, 0.0, 0.0], [-0.05, 0.0, 0.0]]), a, b)
+    w = ll.horseshoe_normalwash(np.array([[0.5, 0.0, 0.0], [-0.05, 0.0, 0.0]]), a, b)
     assert w[0, 0] < 0.0  # downwash behind a lifting (Γ > 0) bound vortex
     assert w[1, 0] > 0.0  # upwash just ahead of it
     # far behind, on the centre line, the trailing legs at y = ±1 look like two infinite
     # lines, each inducing Γ/(2π·1) downward: w → −1/π for Γ = 1 (1e-6: the finite bound
     # segment and the legs' starting ends contribute O(1/x²) = 1e-12 at x = 1e6)
-    far = ll._horseshoe_normalwash(np.array([[1e6, 0.0, 0.0]]), a, b)
+    far = ll.horseshoe_normalwash(np.array([[1e6, 0.0, 0.0]]), a, b)
     assert far[0, 0] == pytest.approx(-1.0 / math.pi, rel=1e-6)
 
 
@@ -344,7 +344,7 @@ def _full_span_strip_loads(planform, alpha_starboard, antisymmetric, n_spanwise=
     """Both halves as explicit unknowns, no mirror images: starboard l'/q and l'·x/q."""
     r = ll.control_point_fraction(TWO_PI)
     edges = ll.spanwise_nodes(planform, n_spanwise)
-    lat = ll._lattice(planform, edges, n_chord, r, "cosine")[0]
+    lat = ll.build_lattice(planform, edges, n_chord, r, "cosine")[0]
     m = np.array([1.0, -1.0, 1.0])
     a = np.vstack([lat.a_m, lat.b_m * m])  # port panels: bound segment still along +y
     b = np.vstack([lat.b_m, lat.a_m * m])
@@ -353,7 +353,7 @@ def _full_span_strip_loads(planform, alpha_starboard, antisymmetric, n_spanwise=
     alpha_panels = np.concatenate(
         [alpha_starboard[lat.strip_index], sign * alpha_starboard[lat.strip_index]]
     )
-    gamma = np.linalg.solve(ll._horseshoe_normalwash(ctrl, a, b), -alpha_panels)
+    gamma = np.linalg.solve(ll.horseshoe_normalwash(ctrl, a, b), -alpha_panels)
     g_star = gamma[: lat.strip_index.size]
     x_mid = 0.5 * (lat.a_m[:, 0] + lat.b_m[:, 0])
     lift = 2.0 * np.bincount(lat.strip_index, weights=g_star)

@@ -543,15 +543,15 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
 
 def test_varints_are_canonical_protobuf():
     """The timestamp varints: every length 1 … 5 bytes, equal to the shortest encoding."""
-    from bioflex_jsb.sinks.mcap import formatting, protobuf
+    from bioflex_jsb.sinks.mcap import protobuf, records
 
     v = np.array([0, 1, 127, 128, 16383, 16384, 2**21 - 1, 2**21, 2**28 - 1, 2**28,
                   999_999_999], dtype=np.int64)
-    lengths = [formatting._varint_length(x) for x in v.tolist()]  # the records' lengths
+    lengths = [records._varint_length(x) for x in v.tolist()]  # the records' lengths
     assert lengths == [len(protobuf.varint(int(x))) for x in v]
     for x, n in zip(v.tolist(), lengths, strict=True):
         row = np.zeros(n + 2, dtype=np.uint8)
-        formatting._write_varint(row, 1, x, n)  # the records' writer, one byte in
+        records._write_varint(row, 1, x, n)  # the records' writer, one byte in
         assert row[0] == 0 and row[-1] == 0  # nothing outside its n bytes
         got = row[1:1 + n].tobytes()
         assert got == protobuf.varint(x) and protobuf.read_varint(got, 0) == (x, n)
@@ -564,18 +564,18 @@ def test_records_write_the_sampled_records_at_their_steps_only():
     index entries point at its records."""
     import struct
 
-    from bioflex_jsb.sinks.mcap import formatting, protobuf
+    from bioflex_jsb.sinks.mcap import protobuf, records
 
     def pieces(ls, ln):
-        return [formatting._doubles((1,)),
-                formatting._timestamp(1, ls, ln) + formatting._doubles((2,))]
+        return [records.doubles((1,)),
+                records.timestamp(1, ls, ln) + records.doubles((2,))]
 
-    records = formatting.Records([7, 9], pieces, timestamped=True, every=1)
+    recs = records.Records([7, 9], pieces, timestamped=True, every=1)
     ns = np.array([127_999_999_000, 127_999_999_500, 128_000_000_000, 128_000_000_250,
                    128_000_001_000, 128_000_002_000], dtype=np.int64)  # 1 → 2-byte seconds
     floats = np.column_stack([np.arange(6.0), 100.0 + np.arange(6.0)])
     sampled = np.array([0, 2, 3, 5])
-    block, index = records.build(ns, floats, 40, sampled, 11)
+    block, index = recs.build(ns, floats, 40, sampled, 11)
     data, pos, got = bytes(block), 0, []
     while pos < len(data):
         op, length, cid, seq, log_ns, pub_ns = struct.unpack_from("<BQHIQQ", data, pos)

@@ -182,7 +182,7 @@ def test_dihedral_symmetry_image_against_the_full_span_lattice():
     pf = _tapered(3.0, 1.0, 0.6, dihedral_rad=math.radians(8.0))
     aero = solve_spanwise_aerodynamics(pf, n_spanwise=12, n_chordwise=2)
     edges = ll.spanwise_nodes(pf, 12)
-    lat = ll._lattice(pf, edges, 2, ll.control_point_fraction(ll.TWO_PI), "cosine")[0]
+    lat = ll.build_lattice(pf, edges, 2, ll.control_point_fraction(ll.TWO_PI), "cosine")[0]
     normals = ll._strip_normals(pf, edges)[lat.strip_index]
     mirror = np.array([1.0, -1.0, 1.0])
     a = np.vstack([lat.a_m, lat.b_m * mirror])

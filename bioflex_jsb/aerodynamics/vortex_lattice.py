@@ -323,7 +323,8 @@ class _Lattice:
     strip_index: np.ndarray  # (n,) strip of each panel
 
 
-def _lattice(planform: PlanformLike, edges_m: np.ndarray, n_chordwise: int, r: float, spacing: str):
+def build_lattice(planform: PlanformLike, edges_m: np.ndarray, n_chordwise: int, r: float,
+                  spacing: str):
     x_le = np.asarray(planform.leading_edge_x_at(edges_m), dtype=float)
     chord = np.asarray(planform.chord_at(edges_m), dtype=float)
     height = _heights(planform, edges_m)
@@ -417,7 +418,7 @@ def _semi_infinite_velocity(p: np.ndarray, a: np.ndarray, length_m: np.ndarray) 
     return factor[..., None] * uxr
 
 
-def _horseshoe_normalwash(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def horseshoe_normalwash(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Upward velocity w at ``points`` (n, 3) due to unit-Γ horseshoes a → b (m, 3) [1/m].
 
     Horseshoe: trailing leg from +∞ to a, bound segment a → b, trailing leg b → +∞. With
@@ -428,7 +429,7 @@ def _horseshoe_normalwash(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> n
 
 def _horseshoe_velocity(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(n, m, 3) velocity at ``points`` (n, 3) due to unit-Γ horseshoes a → b (m, 3) [1/m]
-    (:func:`_horseshoe_normalwash`'s horseshoes)."""
+    (:func:`horseshoe_normalwash`'s horseshoes)."""
     p = points[:, None, :]
     aa = a[None, :, :]
     bb = b[None, :, :]
@@ -465,17 +466,17 @@ def solve_spanwise_aerodynamics(
         raise ValueError("n_chordwise must be at least 1")
     r = control_point_fraction(section_lift_slope_per_rad)
     edges = spanwise_nodes(planform, n_spanwise, spacing)
-    lat, x_le_nodes, chord_nodes, stations, chord = _lattice(
+    lat, x_le_nodes, chord_nodes, stations, chord = build_lattice(
         planform, edges, n_chordwise, r, spacing
     )
 
     mirror = np.array([1.0, -1.0, 1.0])
     normals = _strip_normals(planform, edges)
     if normals is None:
-        w_self = _horseshoe_normalwash(lat.control_m, lat.a_m, lat.b_m)
+        w_self = horseshoe_normalwash(lat.control_m, lat.a_m, lat.b_m)
         # the port image of a starboard horseshoe a → b is the horseshoe b' → a' (bound
         # segment still pointing to +y), which carries the same Γ in symmetric flight
-        w_image = _horseshoe_normalwash(lat.control_m, lat.b_m * mirror, lat.a_m * mirror)
+        w_image = horseshoe_normalwash(lat.control_m, lat.b_m * mirror, lat.a_m * mirror)
     else:  # dihedral: the velocity normal to each control point's strip
         n_panel = normals[lat.strip_index][:, None, :]
         w_self = np.sum(_horseshoe_velocity(lat.control_m, lat.a_m, lat.b_m) * n_panel,

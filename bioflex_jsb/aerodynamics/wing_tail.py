@@ -43,9 +43,9 @@ from bioflex_jsb.aerodynamics.vortex_lattice import (
     DEFAULT_N_SPANWISE,
     TWO_PI,
     PlanformLike,
-    _horseshoe_normalwash,
-    _lattice,
+    build_lattice,
     control_point_fraction,
+    horseshoe_normalwash,
     spanwise_nodes,
 )
 
@@ -71,7 +71,7 @@ def _surface(planform: PlanformLike, z_m: float, n_spanwise: int, n_chordwise: i
              section_lift_slope_per_rad: float) -> _Surface:
     r = control_point_fraction(section_lift_slope_per_rad)
     edges = spanwise_nodes(planform, n_spanwise, "cosine")
-    lat, _, chord_nodes, _, _ = _lattice(planform, edges, n_chordwise, r, "cosine")
+    lat, _, chord_nodes, _, _ = build_lattice(planform, edges, n_chordwise, r, "cosine")
     lift_z = np.array([0.0, 0.0, z_m])
     m = np.arange(n_chordwise)
     widths = np.diff(edges)
@@ -88,8 +88,8 @@ def _influence(targets: _Surface, sources: _Surface) -> np.ndarray:
     """Upward velocity at the targets' control points per unit Γ of the sources' horseshoes
     (symmetric flight: each starboard horseshoe with its port image) [1/m]."""
     mirror = np.array([1.0, -1.0, 1.0])
-    return (_horseshoe_normalwash(targets.control_m, sources.a_m, sources.b_m)
-            + _horseshoe_normalwash(targets.control_m, sources.b_m * mirror,
+    return (horseshoe_normalwash(targets.control_m, sources.a_m, sources.b_m)
+            + horseshoe_normalwash(targets.control_m, sources.b_m * mirror,
                                     sources.a_m * mirror))
 
 

@@ -163,7 +163,7 @@ class PkFamily(engine.RootFamily):
         self.natural_frequencies_rad_s = tuple(float(w) for w in
                                                model.natural_frequencies_rad_s)
         self.reference_semichord_m = float(np.mean(model.semichord_m))
-        self.divergence_speed_m_s = _finite_or_none(divergence_speed_m_s(
+        self.divergence_speed_m_s = finite_or_none(divergence_speed_m_s(
             model, self.density_kg_m3))
         self.divergence_is_instability = True
         self.name = name
@@ -184,7 +184,7 @@ class PkFamily(engine.RootFamily):
         return self._at(speed_m_s, predicted)
 
 
-def _finite_or_none(v: float) -> float | None:
+def finite_or_none(v: float) -> float | None:
     return v if math.isfinite(v) else None
 
 

@@ -28,7 +28,7 @@ from bioflex_jsb.aeroelasticity.clamped_wing import (
     ClampedWingModel,
     structural_damping_matrix,
 )
-from bioflex_jsb.aeroelasticity.pk import _finite_or_none, clamped_search
+from bioflex_jsb.aeroelasticity.pk import clamped_search, finite_or_none
 from bioflex_jsb.aeroelasticity.strip_aero import (
     check_aero,
     divergence_speed_m_s,
@@ -116,7 +116,7 @@ def state_space_family(model: ClampedWingModel, *, density_kg_m3: float,
         extrapolate=True, method="state-space", aero=aero, name=name, mode_labels=labels,
         natural_frequencies_rad_s=tuple(float(w) for w in w0),
         reference_semichord_m=float(np.mean(model.semichord_m)),
-        divergence_speed_m_s=_finite_or_none(divergence_speed_m_s(model, density_kg_m3)),
+        divergence_speed_m_s=finite_or_none(divergence_speed_m_s(model, density_kg_m3)),
         divergence_is_instability=True)
     fam.zeta, fam.density_kg_m3 = zeta, float(density_kg_m3)
     return fam

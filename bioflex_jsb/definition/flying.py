@@ -27,6 +27,7 @@ from bioflex_jsb.definition.model import (
     ModalStructure,
     WingStation,
 )
+from bioflex_jsb.definition.ranges import DAMPING_RANGE
 from bioflex_jsb.definition.reader import Reader
 from bioflex_jsb.errors import InputError
 
@@ -87,8 +88,6 @@ def flying_structure(r: Reader, stations: tuple[WingStation, ...], base_dir: Pat
                      ) -> MembraneStructure | ModalStructure | None:
     """The ``[structure]`` of a wing on an airframe (module docstring); ``None`` for beam
     sections (the loader reads them as a clamped wing's)."""
-    from bioflex_jsb.definition.loader import DAMPING_RANGE
-
     t = r.table("structure", None)
     if t.get("kind", "beam") == "beam":
         return None  # beam sections, read as for a clamped wing (and flown as its modes)

@@ -31,6 +31,35 @@ from bioflex_jsb.definition.model import (
     Definition,
     WingStation,
 )
+from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cli)
+    AERO_MODELS,
+    CHORD_RANGE_M,
+    DAMPING_RANGE,
+    DENSITY_RANGE_KG_M3,
+    DIHEDRAL_LIMIT_RAD,
+    INERTIA_AXES,
+    INERTIA_RANGE_KG_M,
+    LEADING_EDGE_RANGE_M,
+    LIFT_SLOPE_RANGE_PER_RAD,
+    LIFT_SLOPES,
+    MASS_PER_LENGTH_RANGE_KG_M,
+    MAX_MONITORING_STATIONS,
+    MAX_POINT_MASSES,
+    MAX_STRUTS,
+    METHODS,
+    N_ELEMENTS_RANGE,
+    N_MODES_RANGE,
+    POINT_MASS_CHORD_RANGE,
+    POINT_MASS_INERTIA_RANGE_KG_M2,
+    POINT_MASS_RANGE_KG,
+    SEMISPAN_RANGE_M,
+    SPEED_LIMIT_M_S,
+    STIFFNESS_RANGE_N_M2,
+    STRIPS_RANGE,
+    STRUT_STIFFNESS_RANGE_N_M,
+    TWIST_LIMIT_RAD,
+    TWIST_UNITS,
+)
 from bioflex_jsb.definition.reader import DefinitionError, Reader
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 from bioflex_jsb.tomlfile import read_toml
@@ -45,57 +74,6 @@ OTHER_SHIPPED = ("sgs_wing", "sgs_elastic", "c172_elastic")
 ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT + OTHER_SHIPPED
 FORMAT_VERSION = 1
 
-# Valid ranges [unit], each with its reason.
-# Semispan b/2 [m]: 0.05 m (a wind-tunnel model) to 100 m (the largest wings built are
-# about 40 m per side: A380 39.8 m, Helios 37.7 m); a file in mm (6096 for 6.096 m) is
-# outside.
-SEMISPAN_RANGE_M = (0.05, 100.0)
-CHORD_RANGE_M = (0.005, 30.0)  # a 5 mm model chord to a 30 m root chord
-LEADING_EDGE_RANGE_M = (-100.0, 100.0)
-TWIST_LIMIT_RAD = math.radians(30.0)  # beyond 30° the strip's attached flow is gone
-# Dihedral of a panel, |atan(Δz/Δy)| [rad]: up to 30°. The beam runs along y and the strips
-# lie in planes through it: at 30° the real spar is 1/cos 30° = 15 % longer than the beam,
-# and beyond it the wing is no longer a wing with some dihedral (docs/aircraft.md).
-DIHEDRAL_LIMIT_RAD = math.radians(30.0)
-# Point masses on the wing [kg]: 1e-6 (a milligram-scale balance weight of a model) to 1e6
-# (a transport's fuel per wing is ~1e5 kg); at most 100 of them (engines, tanks, pods).
-POINT_MASS_RANGE_KG = (1e-6, 1e6)
-POINT_MASS_INERTIA_RANGE_KG_M2 = (0.0, 1e7)  # its own pitch inertia; 0: a point
-# Chordwise position of a point mass's centre of mass [chord fraction aft of the LE]: a
-# wing-mounted engine or a pod sits ahead of the leading edge (negative), a tip tank or a
-# balance weight up to a few chords ahead or behind; -3..3 catches a value in metres or %.
-POINT_MASS_CHORD_RANGE = (-3.0, 3.0)
-MAX_POINT_MASSES = 100
-# A strut's vertical stiffness at its attachment [N/m] (k = (EA/L) sin² γ): a C172's
-# aluminium strut is ~2e6 N/m; the range is the beam stiffnesses' 1e-3..1e12.
-STRUT_STIFFNESS_RANGE_N_M = (1e-3, 1e12)
-MAX_STRUTS = 4
-# Stiffnesses [N·m²]: 1e-3 (a foam-and-film model wing) to 1e12 (a transport's root
-# bending is about 1e10).
-STIFFNESS_RANGE_N_M2 = (1e-3, 1e12)
-MASS_PER_LENGTH_RANGE_KG_M = (1e-4, 1e5)  # 0.1 g/m (a model) to 100 t/m
-INERTIA_RANGE_KG_M = (1e-9, 1e6)
-# Structural damping ratio ζ [-]: built-up wings measure 0.005-0.05; 0.3 leaves room for a
-# heavily damped test article; 5 is a percentage or a typo (2 % is 0.02).
-DAMPING_RANGE = (0.0, 0.3)
-# Air density [kg/m³]: 0.01 (about 33 km, ISA; above it the atmosphere is no place for a
-# wing, and the strip models' dynamic pressure vanishes) to 2 (denser than any air at the
-# surface: -50 °C sea level is 1.58).
-DENSITY_RANGE_KG_M3 = (0.01, 2.0)
-LIFT_SLOPE_RANGE_PER_RAD = (1.0, 7.0)  # thin aerofoil 2π = 6.283; real sections 5.5-6.9
-STRIPS_RANGE = (4, 200)
-N_MODES_RANGE = (2, 20)
-N_ELEMENTS_RANGE = (4, 400)
-SPEED_LIMIT_M_S = 400.0  # the strip models are incompressible: above ~0.3 Mach, caution
-AERO_MODELS = ("unsteady", "quasi-steady")
-LIFT_SLOPES = ("strip", "vlm")
-METHODS = ("pk", "state-space")
-INERTIA_AXES = ("elastic-axis", "centre-of-mass")
-TWIST_UNITS = ("deg", "rad")
-# Monitoring stations of the section loads [fraction of the semispan]: model.py's
-# DEFAULT_MONITORING_STATIONS, the root and the quarter points (the tip, s = 1, carries no
-# load and is refused).
-MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distribution
 
 
 def _per_station(r: Reader, t: dict, key: str, n: int, lo: float, hi: float, unit: str,

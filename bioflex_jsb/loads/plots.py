@@ -9,7 +9,7 @@ LABELS = {"shear_n": "shear V [N]", "bending_n_m": "bending moment M [N·m]",
 SIGNS = {"shear_n": "up +", "bending_n_m": "tip up +", "torque_n_m": "leading edge up +"}
 
 
-def _figure(rows: int, cols: int, size):
+def new_figure(rows: int, cols: int, size):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -59,7 +59,7 @@ def plot_section_loads(loads, path=None, gust_start_s: float | None = None):
     """Shear, bending and torque against time at every station: force summation solid,
     mode displacement dashed, the 1 g value dotted; the difference FS − MD in a second
     column; below, what share of the root loads MD carries (:func:`md_caveat`)."""
-    fig, ax = _figure(3, 2, (11.0, 9.2))
+    fig, ax = new_figure(3, 2, (11.0, 9.2))
     colours = ["C0", "C1", "C2", "C3", "C4", "C5", "C6", "C7"]
     t = loads.time_s
     diff = loads.difference()

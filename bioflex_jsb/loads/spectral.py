@@ -164,11 +164,11 @@ def compare_spectra(ss: StateSpace, outputs, units, series: np.ndarray, dt_s: fl
 
 def plot_bode(ss: StateSpace, outputs, units, path=None, f_max_hz: float = DEFAULT_F_MAX_HZ):
     """Magnitude and phase of H_y(f) per output (per m/s of upward gust)."""
-    from bioflex_jsb.loads.plots import _figure, save
+    from bioflex_jsb.loads.plots import new_figure, save
 
     f = frequency_grid_hz(f_max_hz, 2000)
     h = frequency_response(ss, outputs, f)
-    fig, ax = _figure(2, len(outputs), (4.2 * len(outputs), 6.0))
+    fig, ax = new_figure(2, len(outputs), (4.2 * len(outputs), 6.0))
     for i, (o, u) in enumerate(zip(outputs, units, strict=True)):
         ax[0, i].loglog(f, np.abs(h[i]), color="C0")
         ax[0, i].set_title(OUTPUT_LABELS.get(o, o), fontsize=10)
@@ -190,10 +190,10 @@ def plot_bode(ss: StateSpace, outputs, units, path=None, f_max_hz: float = DEFAU
 def plot_psd(cases: list[SpectralComparison], path=None):
     """Output PSDs: the LTI's (line) against the nonlinear run's Welch estimate with its
     95 % band (shaded), one row per turbulence case, one column per output."""
-    from bioflex_jsb.loads.plots import _figure, save
+    from bioflex_jsb.loads.plots import new_figure, save
 
     n_out = len(cases[0].outputs)
-    fig, ax = _figure(len(cases), n_out, (4.2 * n_out, 3.4 * len(cases)))
+    fig, ax = new_figure(len(cases), n_out, (4.2 * n_out, 3.4 * len(cases)))
     for r, c in enumerate(cases):
         for i, (o, u) in enumerate(zip(c.outputs, c.units, strict=True)):
             a = ax[r, i]

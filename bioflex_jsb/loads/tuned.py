@@ -183,12 +183,12 @@ def plot_envelopes(result: TunedGustResult, path=None, method: str = "force_summ
     torque (up and down) marked and labelled with their gradient and sign."""
     from scipy.spatial import ConvexHull
 
-    from bioflex_jsb.loads.plots import _figure, save
+    from bioflex_jsb.loads.plots import new_figure, save
 
     stations = result.stations_m
     cols = min(len(stations), 2)
     rows = math.ceil(len(stations) / cols)
-    fig, ax = _figure(rows, cols, (5.6 * cols, 4.6 * rows))
+    fig, ax = new_figure(rows, cols, (5.6 * cols, 4.6 * rows))
     qb, qt = QUANTITIES.index("bending_n_m"), QUANTITIES.index("torque_n_m")
     h_all = np.array([c["gradient_m"] for c in result.cases])
     import matplotlib.pyplot as plt

@@ -34,8 +34,8 @@ from __future__ import annotations
 import numpy as np
 
 from bioflex_jsb.aeroelasticity.strip_increments import strip_load_rows
-from bioflex_jsb.simulation.modal_wing import TrimReference, _one_blas_thread
-from bioflex_jsb.simulation.unsteady_wing import _NODES, UnsteadyModalWing
+from bioflex_jsb.simulation.modal_wing import TrimReference, one_blas_thread
+from bioflex_jsb.simulation.unsteady_wing import FIT_SPEED_NODES, UnsteadyModalWing
 
 NEEDED = ("alpha", "alpha_rad", "q", "airspeed_m_s", "w_g")
 
@@ -79,7 +79,7 @@ class UnsteadyStripLoads:
             build, TrimReference(0.0, lm.dynamic_pressure_pa, cl_trim), dt_s=self._dt,
             aero=build.airframe.aero)
         g = wing.geometry
-        nodes = [c * lm.speed_m_s for c in _NODES]
+        nodes = [c * lm.speed_m_s for c in FIT_SPEED_NODES]
         inv = np.linalg.inv(np.vander(nodes, 3, increasing=True))
         mats = [wing.continuous(v, rho)[:2] for v in nodes]
         rows = [strip_load_rows(g, n, v, rho) for v in nodes]
@@ -148,7 +148,7 @@ class UnsteadyStripLoads:
         # BLAS on one thread: these products are small (a block of 864 rows by 8-170
         # columns), and OpenBLAS's threads on the shared 2-core machine made them 2-3 ×
         # slower (measured 130-160 against ~40 µs a row)
-        with _one_blas_thread():
+        with one_blas_thread():
             return self._block(np.asarray(rows, dtype=float))
 
     def _block(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

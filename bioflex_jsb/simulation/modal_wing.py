@@ -62,7 +62,7 @@ def _blas_controller() -> ThreadpoolController:
     return ThreadpoolController()
 
 
-def _one_blas_thread():
+def one_blas_thread():
     """A context in which BLAS uses one thread (about 10 µs to enter and leave)."""
     return _blas_controller().limit(limits=1, user_api="blas")
 # Default co-simulation step [s]: 31 samples per period of the first wing mode (in vacuo), 9
@@ -176,7 +176,7 @@ class ModalWing:
         exponential along ∂A/∂Q and ∂A/∂(Q/V)). BLAS runs on one thread here: on these
         12×12 matrices OpenBLAS's default threads only add hand-over costs (a refresh took
         5-39 ms instead of about 1 ms on a loaded 2-core machine)."""
-        with _one_blas_thread():
+        with one_blas_thread():
             self._compute_reference(q_pa, v_m_s)
 
     def _compute_reference(self, q_pa: float, v_m_s: float) -> None:

@@ -56,12 +56,12 @@ from bioflex_jsb.simulation.modal_wing import (
     FlowState,
     TrimReference,
     WingLoads,
-    _one_blas_thread,
+    one_blas_thread,
 )
 
 INPUTS = ("Q*dalpha", "Q*q/V", "dQ", "alpha_i", "q", "alpha_i_dot", "q_dot", "w_g")
 INPUT_UNITS = ("Pa*rad", "Pa*rad/m", "Pa", "rad", "rad/s", "rad/s^2", "rad/s^2", "m/s")
-_NODES = (0.5, 1.0, 1.5)  # speeds of the quadratic's fit, × V_r
+FIT_SPEED_NODES = (0.5, 1.0, 1.5)  # speeds of the quadratic's fit, × V_r
 
 
 class UnsteadyModalWing:
@@ -161,12 +161,12 @@ class UnsteadyModalWing:
         """Exact step at (Q_r, V_r) and the quadratics in V at ρ_r (module docstring), BLAS
         on one thread (as ModalWing's: on a loaded 2-core machine OpenBLAS's threads made a
         refresh of these 166-state matrices take 335-1550 ms instead of 54-113 ms)."""
-        with _one_blas_thread():
+        with one_blas_thread():
             self._compute_reference(q_pa, v_m_s)
 
     def _compute_reference(self, q_pa: float, v_m_s: float) -> None:
         rho = 2.0 * q_pa / (v_m_s * v_m_s)
-        nodes = [c * v_m_s for c in _NODES]
+        nodes = [c * v_m_s for c in FIT_SPEED_NODES]
         mats = [self.continuous(v, rho) for v in nodes]
         vander = np.vander(nodes, 3, increasing=True)  # rows [1, V, V²]
         inv = np.linalg.inv(vander)

@@ -27,12 +27,12 @@ import hashlib
 from pathlib import Path
 from typing import Any
 
+from bioflex_jsb.sweep.errors import CampaignError
+
 AXIS_KEY = "aircraft"
 
 
 def _fail(message: str):
-    from bioflex_jsb.sweep.campaign import CampaignError
-
     return CampaignError(message)
 
 

@@ -34,7 +34,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import MODELS
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
@@ -48,6 +47,7 @@ from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.sweep.columns import DEFAULT_AERO, result_columns
 from bioflex_jsb.sweep.columns import RUN_INFO_COLUMNS as RUN_INFO_COLUMNS  # re-exported
+from bioflex_jsb.sweep.errors import CampaignError as CampaignError  # re-exported
 from bioflex_jsb.tomlfile import read_toml
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
@@ -65,10 +65,6 @@ AXIS_KEYS = {"wings", "aircraft", "x_inertial_frac", "x_elastic_frac", "speeds_m
              "seeds", "models"}
 RANGE_KEYS = {"start", "stop", "step", "num"}
 TURBULENCE = ("dryden", "vonkarman")
-
-
-class CampaignError(InputError):
-    """A campaign file that cannot be used; the one-line message names the key."""
 
 
 class RecordingError(Exception):

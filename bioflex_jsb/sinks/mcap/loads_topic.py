@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bioflex_jsb.sinks.mcap.formatting import Records, _packed
-from bioflex_jsb.sinks.mcap.schemas import PROTO_FIELDS, PROTO_SCHEMAS, topic
-from bioflex_jsb.sinks.mcap.writer import _signals_deferred
+from bioflex_jsb.sinks.mcap.records import Records, packed
+from bioflex_jsb.sinks.mcap.schemas import PROTO_FIELDS, topic
+from bioflex_jsb.sinks.mcap.writer import signals_deferred
 
 if TYPE_CHECKING:
-    from bioflex_jsb.sinks.mcap.log import RunLog
+    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
 
 GROUP = "loads"
 TAGS = {"force_summation": "fs", "mode_displacement": "md"}
@@ -86,13 +86,10 @@ class LoadsTopic:
     """The loads of one run on ``/bioflex/<model>/loads`` (module docstring): ``layout`` is
     the run's ``meta["loads"]`` (names in column order: method, quantity, station)."""
 
-    def __init__(self, log: RunLog, model: str, layout: dict) -> None:
-        self._log = log
-        w = log._writer
-        if GROUP not in log._schema_ids:
-            name, data = PROTO_SCHEMAS[GROUP]
-            log._schema_ids[GROUP] = w.add_schema(name, "protobuf", data)
-        self.channel_id = w.add_channel(topic(model, GROUP), log._schema_ids[GROUP],
+    def __init__(self, writer: McapFileWriter, schema_id: int, model: str, layout: dict
+                 ) -> None:
+        self._writer = w = writer
+        self.channel_id = w.add_channel(topic(model, GROUP), schema_id,
                                         channel_metadata(model, layout))
         w.flush()  # the channel on disk before its first message
         s = len(layout["stations_m"])
@@ -103,7 +100,7 @@ class LoadsTopic:
                              "topic's order (method, quantity, station)")
         pieces = []
         for f in fields:
-            pieces += _packed(number[f], s)
+            pieces += packed(number[f], s)
         self._records = Records([self.channel_id], lambda ls, ln: [pieces], timestamped=False)
         self.n_columns = len(expected)
         self.seq = 0
@@ -118,8 +115,8 @@ class LoadsTopic:
             raise ValueError(f"loads of shape {values.shape}, expected "
                              f"({len(time_s)}, {self.n_columns})")
         ns = np.rint(np.asarray(time_s, dtype=float) * 1e9).astype(np.int64)
-        w = self._log._writer
-        with _signals_deferred():
+        w = self._writer
+        with signals_deferred():
             block, index = self._records.build(ns, values, self.seq)
             self.seq += len(ns)
             w.append_block(block, index)

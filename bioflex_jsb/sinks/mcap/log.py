@@ -26,12 +26,14 @@ from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogWriteError
 from bioflex_jsb.sinks.mcap.formatting import (
     AutopilotRecords,
-    _ModelChannels,
+    ModelChannels,
     log_message,
     lti_records,
 )
+from bioflex_jsb.sinks.mcap.loads_topic import GROUP as LOADS_GROUP
+from bioflex_jsb.sinks.mcap.loads_topic import LoadsTopic, prediction_loads
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
-from bioflex_jsb.sinks.mcap.scene import _BIN_EPS, SCENE_RATE_HZ
+from bioflex_jsb.sinks.mcap.scene import SAMPLE_BIN_EPS, SCENE_RATE_HZ
 from bioflex_jsb.sinks.mcap.schemas import (
     EVENT_LEVELS,
     EVENTS_PROTO_SCHEMA,
@@ -45,7 +47,7 @@ from bioflex_jsb.sinks.mcap.schemas import (
 from bioflex_jsb.sinks.mcap.writer import (
     CHUNK_SPAN_S,
     McapFileWriter,
-    _signals_deferred,
+    signals_deferred,
 )
 
 if TYPE_CHECKING:
@@ -63,12 +65,12 @@ class RunLog:
         self._stream = stream
         self._writer = writer
         self._schema_ids: dict[str, int] = {}
-        self._models: dict[str, _ModelChannels] = {}
+        self._models: dict[str, ModelChannels] = {}
         self._origin: tuple[float, float, float, float, float] | None = None
         # the steps of the chunk in progress: one model's, times [s] and value tuples
         self._ts: list[float] = []
         self._rows: list[tuple] = []
-        self._pending: _ModelChannels | None = None
+        self._pending: ModelChannels | None = None
         self._streams: list[AutopilotRecorder] = []  # their frames go into the same chunks
         self._events_id: int | None = None  # the events channel, made at the first event
         self.events = 0  # events logged
@@ -129,21 +131,27 @@ class RunLog:
         return log
 
     # -- channels -----------------------------------------------------------------------
-    def _channel_id(self, model: str, group: str, metadata: dict[str, str] | None = None
-                    ) -> int:
+    def schema_id(self, group: str) -> int:
+        """The id of ``group``'s protobuf schema in this log, written at its first use."""
         if group not in self._schema_ids:
             name, data = PROTO_SCHEMAS[group]
             self._schema_ids[group] = self._writer.add_schema(name, "protobuf", data)
-        return self._writer.add_channel(topic(model, group), self._schema_ids[group],
+        return self._schema_ids[group]
+
+    def channel_id(self, model: str, group: str, metadata: dict[str, str] | None = None
+                   ) -> int:
+        """A new channel of ``model``'s ``group`` topic (its schema written first if new)."""
+        return self._writer.add_channel(topic(model, group), self.schema_id(group),
                                         {"model": model, **(metadata or {})})
 
-    def _model(self, model: str, names) -> _ModelChannels:
+    def _model(self, model: str, names) -> ModelChannels:
         ch = self._models.get(model)
         if ch is None:
             # pose and location at the 3-D scene's samples (the scene's rate and rule, so
             # the body pose and the wing drawn agree), with or without a scene in the log
             rate = SCENE_RATE_HZ if self.scene is None else self.scene.rate_hz
-            ch = self._models[model] = _ModelChannels(self, model, names, rate, _BIN_EPS)
+            ch = self._models[model] = ModelChannels(self.channel_id, model, names, rate,
+                                                     SAMPLE_BIN_EPS)
         elif ch.names != tuple(names):
             raise ValueError(f"the {model} samples changed their channels")
         return ch
@@ -164,7 +172,7 @@ class RunLog:
     def recorder(self, model: str) -> TableRecorder:
         """A recorder of the run of ``model`` for ``run_gust(..., recorder=)``: it logs every
         step (a message on each run topic; pose and location at the 3-D scene's samples,
-        :class:`~.formatting._ModelChannels`), handed a chunk of rows at a time, so a step
+        :class:`~.formatting.ModelChannels`), handed a chunk of rows at a time, so a step
         costs the run nothing beyond its share of one call per chunk."""
         return TableRecorder(self, model)
 
@@ -186,7 +194,7 @@ class RunLog:
         self._ts.append(t_s)
         self._rows.append(tuple([row[k] for k in ch.names]))
 
-    def _next_chunk(self, ch: _ModelChannels, t_s: float) -> None:
+    def _next_chunk(self, ch: ModelChannels, t_s: float) -> None:
         """Close the chunk in progress (if any) and start one for ``ch`` at ``t_s``."""
         if self._rows or any(s._frames for s in self._streams):
             self.flush()
@@ -199,7 +207,7 @@ class RunLog:
         self._due_wall = time.monotonic() + self._writer.chunk_wall_s  # short when live
 
     def _format_pending(self) -> None:
-        """Serialise the kept steps into the chunk in progress (see _ModelChannels.format)."""
+        """Serialise the kept steps into the chunk in progress (see ModelChannels.format)."""
         ch, rows, ts = self._pending, self._rows, self._ts
         n = len(rows)  # an interrupt between the two appends leaves one time more
         if ch is None or not n:
@@ -259,7 +267,7 @@ class RunLog:
             schema_name, data = EVENTS_PROTO_SCHEMA
             sid = self._writer.add_schema(schema_name, "protobuf", data)
             self._events_id = w.add_channel(EVENTS_TOPIC, sid, {})
-        with _signals_deferred():
+        with signals_deferred():
             self._format_pending()  # the steps before the event go first
             for stream in self._streams:
                 stream._format()
@@ -283,10 +291,8 @@ class RunLog:
         """Log the LTI prediction ``history`` (a ``TimeHistory`` of the linear model of
         ``model``) on ``/bioflex/<model>/lti_prediction``, one message per sample, with its
         section loads where it has them (:func:`~.loads_topic.prediction_loads`)."""
-        from bioflex_jsb.sinks.mcap.loads_topic import prediction_loads
-
         fields, load_cols, metadata = prediction_loads(history)
-        cid = self._channel_id(model, "lti_prediction", metadata)
+        cid = self.channel_id(model, "lti_prediction", metadata)
         etas = sorted((k for k in history.channels if k.startswith("eta") and k[3:].isdigit()),
                       key=lambda k: int(k[3:]))
         t = np.asarray(history.time_s, dtype=float)
@@ -298,7 +304,7 @@ class RunLog:
         ns = np.rint(t * 1e9).astype(np.int64)
         w = self._writer
         self.flush()
-        with _signals_deferred():
+        with signals_deferred():
             for k0 in range(0, len(t), _MAX_PENDING_STEPS):
                 k1 = min(len(t), k0 + _MAX_PENDING_STEPS)
                 block, index = records.build(ns[k0:k1], values[k0:k1], k0)
@@ -307,7 +313,7 @@ class RunLog:
 
     def flush(self) -> None:
         """Write the kept steps as a chunk and hand it to the operating system."""
-        with _signals_deferred():
+        with signals_deferred():
             self._format_pending()
             for stream in self._streams:
                 stream._format()
@@ -355,7 +361,7 @@ class TableRecorder:
     def __init__(self, log: RunLog, model: str) -> None:
         self._log = log
         self._model = model
-        self._ch: _ModelChannels | None = None
+        self._ch: ModelChannels | None = None
         self.steps = 0  # rows logged
 
     def start(self, names, dt_s: float) -> int:
@@ -373,7 +379,7 @@ class TableRecorder:
         log, ch = self._log, self._ch
         if ch is None or not len(rows):
             return
-        with _signals_deferred():
+        with signals_deferred():
             if log._origin is None:
                 log._set_origin(*rows[0, [ch.i_lat, ch.i_lon, ch.i_alt]].tolist())
             block, index = ch.format(time_s, rows, log._origin)
@@ -392,9 +398,7 @@ class TableRecorder:
     def loads(self, layout: dict):
         """The run's section loads on ``/bioflex/<model>/loads`` (``layout``: the run's
         ``meta["loads"]``), a chunk per block after the steps' (:mod:`.loads_topic`)."""
-        from bioflex_jsb.sinks.mcap.loads_topic import LoadsTopic
-
-        out = LoadsTopic(self._log, self._model, layout)
+        out = LoadsTopic(self._log._writer, self._log.schema_id(LOADS_GROUP), self._model, layout)
         scene = self._log.scene  # with the scene: also drawn as markers (scene_loads.py)
         return out if scene is None else scene.with_loads(out, self._model, layout)
 
@@ -407,7 +411,7 @@ class AutopilotRecorder:
     def __init__(self, log: RunLog, model: str) -> None:
         self._log = log
         self.model = model
-        self._records = AutopilotRecords(log._channel_id(model, "autopilot"))
+        self._records = AutopilotRecords(log.channel_id(model, "autopilot"))
         self._frames: list[tuple] = []  # the frames of the chunk in progress
         self.seq = 0
         self.frames = 0  # frames logged

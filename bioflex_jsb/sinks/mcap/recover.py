@@ -31,7 +31,7 @@ from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError, bad_data_errors
 from bioflex_jsb.sinks.mcap.writer import MAGIC, McapFileWriter
 
-_OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
+_OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
 _OP_METADATA, _OP_DATA_END = 0x0C, 0x0F
 _KNOWN_OPS = set(range(0x01, 0x10))
 _COMPRESSIONS = (b"", b"zstd", b"lz4")
@@ -206,7 +206,7 @@ class _Copier:
             name, at = _string(b, 0)
             meta, _ = _string_map(b, at)
             self.w.add_metadata(name, meta)
-        elif op == _OP_MESSAGE:
+        elif op == OP_MESSAGE:
             cid, seq, log_ns, _pub = struct.unpack_from("<HIQQ", b, 0)
             if cid not in self.channels:
                 raise ValueError(f"message on channel {cid} before its channel record")

@@ -29,7 +29,6 @@ of a chunk's samples come from one compiled pass (:func:`_sample_floats`, the ar
 from __future__ import annotations
 
 import math
-import struct
 from dataclasses import astuple, dataclass
 from typing import TYPE_CHECKING
 
@@ -37,8 +36,17 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp, sample_steps
 from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
+from bioflex_jsb.sinks.mcap.records import (
+    F,
+    Records,
+    consts,
+    dbl,
+    entity_head,
+    sample_steps,
+    sub,
+    timestamp,
+)
 from bioflex_jsb.sinks.mcap.schemas import (
     AIRFRAME_GROUP,
     SCENE_GROUP,
@@ -56,7 +64,7 @@ if TYPE_CHECKING:
 SCENE_RATE_HZ = 60.0
 # NUMERICAL: a step's sample bin is floor(t·rate + this): 1e-6 of a bin (17 ns at 60 Hz)
 # absorbs the rounding of t = k·dt, far below any step
-_BIN_EPS = 1e-6
+SAMPLE_BIN_EPS = 1e-6
 DEFAULT_EXAGGERATION = 1.0  # true scale: the logged twist is degrees already (η₁ ~ 0.3 rad)
 # DECISION (drawing only): the gust arrow is 0.1 m long per m/s (a 3 m/s gust: 0.3 m, a
 # third of the fuselage), its head 30 % of it, 15 mm shaft and 40 mm head diameters, ahead
@@ -310,25 +318,7 @@ class AircraftMesh:
                                 _ARROW_HEAD_FRACTION * length])
 
 
-# -- the protobuf layout of one message ----------------------------------------------------
-def _size(parts) -> int:
-    return sum(8 if p == F else (p[1] if isinstance(p, tuple) else len(p)) for p in parts)
-
-
-def _sub(number: int, parts: list) -> list:
-    """A length-delimited sub-message of ``parts``."""
-    return [tag(number, LEN) + varint(_size(parts))] + parts
-
-
-def _dbl(number: int, value: float) -> bytes:
-    return tag(number, I64) + struct.pack("<d", value)
-
-
-def _consts(number: int, values) -> list:
-    return _sub(number, [b"".join(_dbl(i + 1, v) for i, v in enumerate(values))])
-
-
-_POSE = _sub(1, _consts(1, (0.0, 0.0, 0.0)) + _consts(2, (0.0, 0.0, 0.0, 1.0)))
+_POSE = sub(1, consts(1, (0.0, 0.0, 0.0)) + consts(2, (0.0, 0.0, 0.0, 1.0)))
 
 
 def _indices(number: int, idx: np.ndarray) -> bytes:
@@ -337,8 +327,8 @@ def _indices(number: int, idx: np.ndarray) -> bytes:
 
 
 def _rigid_list(points: np.ndarray, idx: np.ndarray, colour) -> list:
-    body = [b"".join(b"".join(_consts(2, p)) for p in points)]
-    return _sub(12, _POSE + body + _consts(3, colour) + [_indices(5, idx)])
+    body = [b"".join(b"".join(consts(2, p)) for p in points)]
+    return sub(12, _POSE + body + consts(3, colour) + [_indices(5, idx)])
 
 
 def _wing_list(y_m: np.ndarray, idx: np.ndarray, colour) -> list:
@@ -346,27 +336,23 @@ def _wing_list(y_m: np.ndarray, idx: np.ndarray, colour) -> list:
     points: list = []
     for y in y_m:
         for _ in range(2):
-            points += _sub(2, [tag(1, I64), F, _dbl(2, float(y)) + tag(3, I64), F])
-    return _sub(12, _POSE + points + _consts(3, colour) + [_indices(5, idx)])
+            points += sub(2, [tag(1, I64), F, dbl(2, float(y)) + tag(3, I64), F])
+    return sub(12, _POSE + points + consts(3, colour) + [_indices(5, idx)])
 
 
 def _arrow(colour) -> list:
-    pose = _sub(1, _sub(1, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
-                + _sub(2, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F, tag(4, I64), F]))
-    return _sub(7, pose + [tag(2, I64), F, _dbl(3, _ARROW_SHAFT_DIAMETER_M) + tag(4, I64), F,
-                           _dbl(5, _ARROW_HEAD_DIAMETER_M)] + _consts(6, colour))
+    pose = sub(1, sub(1, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
+                + sub(2, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F, tag(4, I64), F]))
+    return sub(7, pose + [tag(2, I64), F, dbl(3, _ARROW_SHAFT_DIAMETER_M) + tag(4, I64), F,
+                           dbl(5, _ARROW_HEAD_DIAMETER_M)] + consts(6, colour))
 
 
 def text_primitive(text: str, position_m, size: float = 0.06) -> list:
     """A ``TextPrimitive`` (field 13 of SceneEntity): ``text`` at ``position_m`` (body frame),
     billboarded, ``size`` [m] high."""
-    pose = _sub(1, _consts(1, position_m) + _consts(2, (0.0, 0.0, 0.0, 1.0)))
-    return _sub(13, pose + [tag(2, VARINT) + b"\x01", _dbl(3, size)] + _consts(5, (1, 1, 1, 1))
+    pose = sub(1, consts(1, position_m) + consts(2, (0.0, 0.0, 0.0, 1.0)))
+    return sub(13, pose + [tag(2, VARINT) + b"\x01", dbl(3, size)] + consts(5, (1, 1, 1, 1))
                 + [string_field(6, text)])
-
-
-def _head(frame: str, entity_id: str) -> list:
-    return [string_field(2, frame) + string_field(3, entity_id) + tag(5, VARINT) + b"\x01"]
 
 
 def scene_pieces(mesh: AircraftMesh, frame: str, texts: list | None = None):
@@ -376,12 +362,12 @@ def scene_pieces(mesh: AircraftMesh, frame: str, texts: list | None = None):
     (:func:`text_primitive`)."""
     wings = [part for sign in (-1.0, 1.0)
              for part in _wing_list(sign * mesh.y_m, mesh.wing_indices, COLOURS["wing"])]
-    head = _head(frame, ENTITY_ID)
+    head = entity_head(frame, ENTITY_ID)
     arrow = _arrow(COLOURS["gust"])
     extra = [part for text in texts or [] for part in text]
 
     def pieces(ls: int, ln: int) -> list[list]:
-        return [_sub(2, _timestamp(1, ls, ln) + head + arrow + wings + extra)]
+        return [sub(2, timestamp(1, ls, ln) + head + arrow + wings + extra)]
 
     return pieces
 
@@ -391,10 +377,10 @@ def airframe_pieces(mesh: AircraftMesh, frame: str):
     constant)."""
     rigid = [part for name in AIRFRAME_PARTS
              for part in _rigid_list(*mesh.rigid[name], COLOURS[name])]
-    head = _head(frame, AIRFRAME_ENTITY_ID)
+    head = entity_head(frame, AIRFRAME_ENTITY_ID)
 
     def pieces(ls: int, ln: int) -> list[list]:
-        return [_sub(2, _timestamp(1, ls, ln) + head + rigid)]
+        return [sub(2, timestamp(1, ls, ln) + head + rigid)]
 
     return pieces
 
@@ -593,7 +579,7 @@ class SceneLog:
             return []
         ch = self._channel(model)
         # the samples: the steps entering a new 1/rate bin (the rule pose and location use)
-        pick, ch.last_bin = sample_steps(t, self.rate_hz, _BIN_EPS, ch.last_bin)
+        pick, ch.last_bin = sample_steps(t, self.rate_hz, SAMPLE_BIN_EPS, ch.last_bin)
         t0 = np.rint(t[:1] * 1e9).astype(np.int64)
         parts = []
         if ch.last_airframe_ns is None or t0[0] - ch.last_airframe_ns >= AIRFRAME_PERIOD_NS:

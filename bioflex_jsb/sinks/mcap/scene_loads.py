@@ -30,11 +30,10 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.formatting import F, Records, _timestamp
 from bioflex_jsb.sinks.mcap.protobuf import I64, tag
-from bioflex_jsb.sinks.mcap.scene import _consts, _dbl, _head, _sub
+from bioflex_jsb.sinks.mcap.records import F, Records, consts, dbl, entity_head, sub, timestamp
 from bioflex_jsb.sinks.mcap.schemas import body_frame, topic
-from bioflex_jsb.sinks.mcap.writer import _signals_deferred
+from bioflex_jsb.sinks.mcap.writer import signals_deferred
 
 GROUP = "scene_loads"  # /bioflex/<model>/scene_loads
 ENTITY_ID = "section_loads"
@@ -79,11 +78,11 @@ def diameter_m(ratio: np.ndarray) -> np.ndarray:
 def _sphere() -> list:
     """A SpherePrimitive (field 9 of SceneEntity): pose (position variable, no rotation),
     size (x, y, z) and colour (r, g, b variable, alpha 1)."""
-    pose = _sub(1, _sub(1, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
-                + _consts(2, (0.0, 0.0, 0.0, 1.0)))
-    size = _sub(2, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
-    rgba = _sub(3, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F, _dbl(4, 1.0)])
-    return _sub(9, pose + size + rgba)
+    pose = sub(1, sub(1, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
+                + consts(2, (0.0, 0.0, 0.0, 1.0)))
+    size = sub(2, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F])
+    rgba = sub(3, [tag(1, I64), F, tag(2, I64), F, tag(3, I64), F, dbl(4, 1.0)])
+    return sub(9, pose + size + rgba)
 
 
 class _Stations:
@@ -227,10 +226,10 @@ class LoadMarkers:
                                                {"model": model, **legend(self.method)})
         frame = body_frame(model)
         spheres = [p for _ in range(2 * len(QUANTITIES) * s) for p in _sphere()]
-        head = _head(frame, ENTITY_ID)
+        head = entity_head(frame, ENTITY_ID)
 
         def pieces(ls: int, ln: int) -> list[list]:
-            return [_sub(2, _timestamp(1, ls, ln) + head + spheres)]
+            return [sub(2, timestamp(1, ls, ln) + head + spheres)]
 
         self._records = Records([self.marker_channel_id], pieces, True)
         self.marker_seq = 0
@@ -260,7 +259,7 @@ class LoadMarkers:
         got = self.build(time_s, values)
         if got is not None:
             w = self._scene._writer
-            with _signals_deferred():
+            with signals_deferred():
                 w.append_block(*got)
                 w.close_chunk()
 

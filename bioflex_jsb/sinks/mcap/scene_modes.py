@@ -27,8 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb import __version__
-from bioflex_jsb.sinks.mcap.formatting import Records, log_message
+from bioflex_jsb.sinks.mcap.formatting import log_message
 from bioflex_jsb.sinks.mcap.protobuf import length_delimited, string_field, varint
+from bioflex_jsb.sinks.mcap.records import Records
 from bioflex_jsb.sinks.mcap.scene import (
     AircraftMesh,
     airframe_outline,

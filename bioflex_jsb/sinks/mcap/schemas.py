@@ -56,7 +56,7 @@ _TIME = {
 }
 
 # Fields of rigid_body, in message order: (field, row key, description).
-_RIGID_FIELDS = (
+RIGID_FIELDS = (
     ("du_m_s", "u", "airspeed perturbation from trim [m/s]"),
     ("dalpha_rad", "alpha", "angle-of-attack perturbation from trim, against the air [rad]"),
     ("dtheta_rad", "theta", "pitch-angle perturbation from trim [rad]"),
@@ -71,7 +71,7 @@ _RIGID_FIELDS = (
     ("altitude_m", "altitude_m", "altitude above sea level [m]"),
 )
 # Fields logged only when the run provides them (row key = field name).
-_RIGID_OPTIONAL = (
+RIGID_OPTIONAL = (
     ("alpha_rad", "angle of attack against the air [rad]"),
     ("beta_rad", "sideslip angle, wind from starboard positive [rad]"),
     ("v_north_m_s", "inertial velocity, north [m/s]"),
@@ -81,7 +81,7 @@ _RIGID_OPTIONAL = (
 
 # rigid_body's field → the run's channel it holds (what a reader rebuilds the run with)
 RIGID_BODY_CHANNELS: dict[str, str] = {
-    **{f: k for f, k, _ in _RIGID_FIELDS}, **{f: f for f, _ in _RIGID_OPTIONAL}}
+    **{f: k for f, k, _ in RIGID_FIELDS}, **{f: f for f, _ in RIGID_OPTIONAL}}
 
 SCHEMAS: dict[str, dict] = {
     "rigid_body": {
@@ -91,8 +91,8 @@ SCHEMAS: dict[str, dict] = {
         "the location topic (WGS-84); the time is the message's log time.",
         "type": "object",
         "properties": {
-            **{f: _num(d) for f, _, d in _RIGID_FIELDS},
-            **{f: _num(d) for f, d in _RIGID_OPTIONAL},
+            **{f: _num(d) for f, _, d in RIGID_FIELDS},
+            **{f: _num(d) for f, d in RIGID_OPTIONAL},
         },
     },
     "modal": {

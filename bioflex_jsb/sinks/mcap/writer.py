@@ -55,7 +55,7 @@ ZSTD_LEVEL = -3  # zstd's fast level: see McapFileWriter
 # and the load markers' 5.7:1, so they stay compressed.
 RAW_BELOW = 0.15  # [-] of the chunk's size
 RAW_CHUNKS = 15
-_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 0x03, 0x04, 0x05, 0x06
+_OP_SCHEMA, _OP_CHANNEL, OP_MESSAGE, _OP_CHUNK = 0x03, 0x04, 0x05, 0x06
 _OP_CHUNK_INDEX, _OP_STATISTICS, _OP_METADATA_INDEX = 0x08, 0x0B, 0x0D
 _MSG_HEADER = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
 # Upper bounds for McapFileWriter.size_bound [bytes]: a Message record is ≥ 31 bytes (its
@@ -71,7 +71,7 @@ _FINISH_FIXED_BYTES = 13 + 37 + 58 + 5 * 26
 
 
 @contextmanager
-def _signals_deferred():
+def signals_deferred():
     """Hold SIGINT/SIGTERM while a chunk or the summary is written (no half-written record):
     blocked at the operating system, and a handler already due deferred
     (:func:`~bioflex_jsb.interrupts.critical_section`)."""
@@ -230,7 +230,7 @@ class McapFileWriter:
 
     def append(self, channel_id: int, log_ns: int, sequence: int, data: bytes) -> None:
         """One message into the chunk in progress (log time = publish time = ``log_ns``)."""
-        record = _MSG_HEADER.pack(_OP_MESSAGE, 22 + len(data), channel_id, sequence, log_ns,
+        record = _MSG_HEADER.pack(OP_MESSAGE, 22 + len(data), channel_id, sequence, log_ns,
                                   log_ns) + data
         self._index[channel_id].append((log_ns, self._size))
         self._dirty.add(channel_id)
@@ -281,7 +281,7 @@ class McapFileWriter:
 
     def close_chunk(self) -> None:
         """Compress and write the chunk in progress with its message indexes; flush."""
-        with _signals_deferred():
+        with signals_deferred():
             self._close_chunk()
 
     def _entries(self, cid: int, n: int) -> np.ndarray | None:
@@ -372,7 +372,7 @@ class McapFileWriter:
         """Close the last chunk, write the summary and the footer, flush."""
         if self.finished:
             return
-        with _signals_deferred():
+        with signals_deferred():
             self._close_chunk()
             self._wait()  # the data section's CRC and length include the last chunk
             self._write(_record_bytes(DataEnd(data_section_crc=self._crc)))
