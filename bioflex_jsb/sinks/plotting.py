@@ -8,6 +8,7 @@ user's file (which needs ``--force``): :func:`~bioflex_jsb.plot_files.is_our_plo
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -368,6 +369,117 @@ def _gust_onset(runs: Sequence[TimeHistory]) -> float:
     return 0.0
 
 
+@dataclass
+class _Panels:
+    """What every panel of :func:`time_histories` shares: the runs, their styles, the mode
+    shown for η₁, the gust onset and the η₁ zoom's centre [s], the NRMSE labels."""
+
+    runs: Sequence[TimeHistory]
+    shown: ModeDisplay
+    styles: dict[int, dict]
+    t_gust: float
+    t_zoom: float
+    t_end: float
+    nrmse: Mapping[str, float] | None
+
+    @classmethod
+    def of(cls, runs: Sequence[TimeHistory], nrmse: Mapping[str, float] | None) -> _Panels:
+        t_gust = _gust_onset(runs)
+        elastic = [r for r in runs if r.model != "rigid" and "eta1" in r.channels]
+        t_zoom = t_gust  # the η₁ zoom: the gust onset, or where the wing diverged before it
+        if elastic and all(r.stopped is not None and r.stop_time_s < t_gust for r in elastic):
+            t_zoom = max(r.stop_time_s for r in elastic) - ZOOM_AFTER_S + ZOOM_BEFORE_S
+        t_end = max((float(r.time_s[-1]) for r in runs if len(r.time_s)), default=1.0)
+        return cls(runs, ModeDisplay([r for r in runs if r.model != "rigid"]),
+                   _distinct_styles(runs), t_gust, t_zoom, t_end, nrmse)
+
+    def draw(self, ax, name: str, ylabel: str, scale: float | None) -> None:
+        """One panel: every run's ``name`` channel, the diverged runs' ×, limits and labels."""
+        channel = "eta1" if name == "eta1_zoom" else name
+        zoom = ((self.t_zoom - ZOOM_BEFORE_S, self.t_zoom + ZOOM_AFTER_S)
+                if name == "eta1_zoom" else None)
+        limits: list[float] = []
+        stops: list[tuple[float, float]] = []  # (t [s], value) where a diverged run ends
+        for run in self._runs_on(name, channel):
+            self._line(ax, run, name, channel, scale, zoom, limits, stops)
+        if limits and any(r.stopped is not None and channel in r.channels for r in self.runs):
+            lo, hi = min(limits), max(limits)
+            pad = 0.15 * max(hi - lo, 1e-9)
+            ax.set_ylim(lo - pad, hi + pad)  # diverged runs are clipped, their × at the edge
+            stops = [(t, float(np.clip(y, lo - pad, hi + pad))) for t, y in stops]
+        for t_stop, y_stop in stops:
+            ax.plot([t_stop], [y_stop], marker="X", color="tab:red", ms=9, ls="none",
+                    zorder=6, clip_on=False)
+        ax.set_xlim(*(zoom if zoom is not None else (0.0, self.t_end)))
+        if self.t_gust > 0.0 and (zoom is None or zoom[0] <= self.t_gust <= zoom[1]):
+            ax.axvline(self.t_gust, color="0.6", lw=0.7, ls=":")
+        ax.set_ylabel(ylabel.format(label=self.shown.label))
+        ax.grid(True, alpha=0.3)
+        if self.nrmse is not None or name == "w_g":
+            ax.legend(fontsize=7, loc="best")  # NRMSE differs by panel: a legend in each
+
+    def _runs_on(self, name: str, channel: str) -> list[TimeHistory]:
+        """The runs drawn on a panel: those with the channel and samples; η₁ of elastic runs
+        only (the rigid wing does not deform); the gust input once (every run flies the
+        same samples)."""
+        out = [r for r in self.runs if channel in r.channels and len(r.time_s)
+               and not (channel == "eta1" and r.model == "rigid")]
+        return out[:1] if name == "w_g" else out
+
+    def _label(self, run: TimeHistory, name: str, channel: str) -> str:
+        if name == "w_g":
+            gust_text = str(run.meta.get("gust", "") or "")
+            return f"w_g, gust {gust_text}" if gust_text else "w_g"
+        label = str(run.meta.get("label", run.model))
+        if (self.nrmse is not None and run.meta.get("source") == "lti"
+                and channel in self.nrmse):
+            label += f", NRMSE {self.nrmse[channel]:.3f}"
+        if run.stopped is not None:
+            label += f" (diverged at t = {run.stop_time_s:.2f} s)"
+        return label
+
+    def _line(self, ax, run: TimeHistory, name: str, channel: str, scale: float | None,
+              zoom: tuple[float, float] | None, limits: list[float],
+              stops: list[tuple[float, float]]) -> None:
+        """One run's line on a panel (η₁ as its running envelope and mean); the finished
+        runs' extremes go to ``limits``, a diverged run's last point to ``stops``."""
+        style = (dict(color="black", ls="-", lw=1.2, zorder=2) if name == "w_g"
+                 else dict(self.styles[id(run)]))
+        t, y = run.time_s, run[channel] * (self.shown.scale(run) if scale is None else scale)
+        label = self._label(run, name, channel)
+        if zoom is not None:
+            keep = (t >= zoom[0]) & (t <= zoom[1])
+            t, y = t[keep], y[keep]
+            if not len(t):
+                return
+        if name == "eta1" and len(t) > 2:
+            tc, lo, hi, mean = running_envelope(t, y, ENVELOPE_WINDOW_S)
+            ax.fill_between(tc, lo, hi, color=style["color"], alpha=0.18, lw=0,
+                            zorder=style["zorder"] - 1)
+            ax.plot(tc, mean, label=label, **style)
+            extremes = [float(lo.min()), float(hi.max())]
+        else:
+            ax.plot(t, y, label=label, **style)
+            extremes = [float(y.min()), float(y.max())]
+        if run.stopped is None:
+            limits += extremes
+        elif name != "w_g" and (zoom is None or run.time_s[-1] <= zoom[1]):
+            stops.append((float(t[-1]), float(y[-1])))
+
+
+def _figure_legend(fig, axes) -> None:
+    """One legend for the figure (the same lines in every panel; not the gust input's)."""
+    handles: dict[str, object] = {}
+    for ax in axes.flat:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if not label.startswith("w_g"):
+                handles.setdefault(label, handle)
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="upper center",
+                   ncol=min(len(handles), 4), fontsize=9, frameon=False,
+                   bbox_to_anchor=(0.5, 0.975))
+
+
 def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
                    nrmse: Mapping[str, float] | None = None) -> Path:
     """Gust time histories of several runs on shared axes (like Figs. 21 and 22).
@@ -382,93 +494,17 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
     NRMSE [-]) labels the LTI prediction's line in every panel (``compare``).
     """
     fig, axes = plt.subplots(4, 2, figsize=(12, 12.6), sharex=False)
-    shown = ModeDisplay([r for r in runs if r.model != "rigid"])
-    t_gust = _gust_onset(runs)
-    styles = _distinct_styles(runs)
-    elastic = [r for r in runs if r.model != "rigid" and "eta1" in r.channels]
-    t_zoom = t_gust  # the η₁ zoom: the gust onset, or where the wing diverged before it
-    if elastic and all(r.stopped is not None and r.stop_time_s < t_gust for r in elastic):
-        t_zoom = max(r.stop_time_s for r in elastic) - ZOOM_AFTER_S + ZOOM_BEFORE_S
-    t_end = max((float(r.time_s[-1]) for r in runs if len(r.time_s)), default=1.0)
+    panels = _Panels.of(runs, nrmse)
     for ax, (name, ylabel, scale) in zip(axes.flat, TIME_PANELS, strict=True):
-        channel = "eta1" if name == "eta1_zoom" else name
-        zoom = (t_zoom - ZOOM_BEFORE_S, t_zoom + ZOOM_AFTER_S) if name == "eta1_zoom" else None
-        drawn_gust = False
-        limits: list[float] = []
-        stops: list[tuple[float, float]] = []  # (t [s], value) where a diverged run ends
-        for run in runs:
-            if channel not in run.channels or not len(run.time_s):
-                continue
-            if channel == "eta1" and run.model == "rigid":
-                continue  # the rigid wing does not deform: η₁ ≡ 0
-            if name == "w_g":
-                if drawn_gust:
-                    continue  # one gust input: every run flies the same samples
-                drawn_gust = True
-            style = dict(styles[id(run)])
-            t, y = run.time_s, run[channel] * (shown.scale(run) if scale is None else scale)
-            label = str(run.meta.get("label", run.model))
-            if nrmse is not None and run.meta.get("source") == "lti" and channel in nrmse:
-                label += f", NRMSE {nrmse[channel]:.3f}"
-            if run.stopped is not None:
-                label += f" (diverged at t = {run.stop_time_s:.2f} s)"
-            if name == "w_g":
-                style = dict(color="black", ls="-", lw=1.2, zorder=2)
-                gust_text = str(run.meta.get("gust", "") or "")
-                label = f"w_g, gust {gust_text}" if gust_text else "w_g"
-            if zoom is not None:
-                keep = (t >= zoom[0]) & (t <= zoom[1])
-                t, y = t[keep], y[keep]
-                if not len(t):
-                    continue
-            if name == "eta1" and len(t) > 2:
-                tc, lo, hi, mean = running_envelope(t, y, ENVELOPE_WINDOW_S)
-                ax.fill_between(tc, lo, hi, color=style["color"], alpha=0.18, lw=0,
-                                zorder=style["zorder"] - 1)
-                ax.plot(tc, mean, label=label, **style)
-                if run.stopped is None:
-                    limits += [float(lo.min()), float(hi.max())]
-            else:
-                ax.plot(t, y, label=label, **style)
-                if run.stopped is None:
-                    limits += [float(y.min()), float(y.max())]
-            if run.stopped is not None and name != "w_g" and (
-                    zoom is None or run.time_s[-1] <= zoom[1]):
-                stops.append((float(t[-1]), float(y[-1])))
-        if limits and any(r.stopped is not None and channel in r.channels for r in runs):
-            lo, hi = min(limits), max(limits)
-            pad = 0.15 * max(hi - lo, 1e-9)
-            ax.set_ylim(lo - pad, hi + pad)  # diverged runs are clipped, their × at the edge
-            stops = [(t, float(np.clip(y, lo - pad, hi + pad))) for t, y in stops]
-        for t_stop, y_stop in stops:
-            ax.plot([t_stop], [y_stop], marker="X", color="tab:red", ms=9, ls="none",
-                    zorder=6, clip_on=False)
-        if zoom is not None:
-            ax.set_xlim(*zoom)
-        else:
-            ax.set_xlim(0.0, t_end)
-        if t_gust > 0.0 and (zoom is None or zoom[0] <= t_gust <= zoom[1]):
-            ax.axvline(t_gust, color="0.6", lw=0.7, ls=":")
-        ax.set_ylabel(ylabel.format(label=shown.label))
-        ax.grid(True, alpha=0.3)
-        if nrmse is not None or name == "w_g":
-            ax.legend(fontsize=7, loc="best")  # NRMSE differs by panel: a legend in each
+        panels.draw(ax, name, ylabel, scale)
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     fig.suptitle(title, y=0.995)
-    if nrmse is None:  # one legend for the figure: the same lines in every panel
-        handles: dict[str, object] = {}
-        for ax in axes.flat:
-            for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-                if not label.startswith("w_g"):
-                    handles.setdefault(label, handle)
-        if handles:
-            fig.legend(list(handles.values()), list(handles), loc="upper center",
-                       ncol=min(len(handles), 4), fontsize=9, frameon=False,
-                       bbox_to_anchor=(0.5, 0.975))
+    if nrmse is None:
+        _figure_legend(fig, axes)
     if any("eta1" in r.channels and r.model != "rigid" for r in runs):
-        fig.text(0.5, 0.004, f"{shown.note}. {ENVELOPE_NOTE}", ha="center", va="bottom",
-                 fontsize=8, color="0.25", wrap=True)
+        fig.text(0.5, 0.004, f"{panels.shown.note}. {ENVELOPE_NOTE}", ha="center",
+                 va="bottom", fontsize=8, color="0.25", wrap=True)
     fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955 if nrmse is None else 0.98))
     return save_figure(fig, path)
 
