@@ -18,6 +18,7 @@ from bioflex_jsb.sinks.plotting import ModeDisplay, running_envelope
 # ---------------------------------------------------------------------------------------
 FLIGHT_POINTS = 4000  # samples drawn per line: a 600 s session at 960 Hz is 576 000 steps
 MAX_EVENT_LABELS = 14  # events written on the figure; the rest are counted in the note
+_DEG = 180.0 / np.pi  # rad to deg
 
 
 def _thinned(t: np.ndarray, x: np.ndarray):
@@ -100,7 +101,6 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
 
     run, spans = _one_flight([runs] if isinstance(runs, TimeHistory) else list(runs))
     t = np.asarray(run.time_s, dtype=float)
-    deg = 180.0 / np.pi
     fig = plt.figure(figsize=(15, 12.5))
     grid = GridSpec(5, 2, figure=fig, width_ratios=(1.35, 1.0), hspace=0.12, wspace=0.22)
     left = [fig.add_subplot(grid[0, 0])]
@@ -108,22 +108,49 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
     ax_track = fig.add_subplot(grid[0:3, 1])
     ax_nz = fig.add_subplot(grid[3, 1], sharex=left[0])
     ax_alpha = fig.add_subplot(grid[4, 1], sharex=left[0])
-    ax_alt, ax_v, ax_att, ax_psi, ax_eta = left
+    _state_panels(left[:4], run, t)
+    notes = _mode_panel(left[4], run, t)
+    _load_panels(ax_nz, ax_alpha, run, t)
+    for ax in left + [ax_nz, ax_alpha]:
+        ax.grid(True, alpha=0.3)
+    for ax in left[:-1] + [ax_nz]:
+        ax.tick_params(labelbottom=False)
+    left[4].set_xlabel("time [s]")
+    ax_alpha.set_xlabel("time [s]")
+    left[0].set_xlim(float(t[0]), float(t[-1]))
+    track = _track(ax_track, run, t)
+    merged = _events_merged(events, float(t[-1]) if len(t) else 0.0)
+    shown_events = merged[:MAX_EVENT_LABELS]
+    _mark_events(shown_events, left + [ax_nz, ax_alpha], left[0], ax_track, t, track)
+    ax_track.legend(fontsize=8, loc="best")
+    fig.suptitle(title, y=0.995)
+    fig.text(0.5, 0.005, _footnote(merged, shown_events, spans, notes), ha="center",
+             va="bottom", fontsize=8, color="0.2", wrap=True)
+    fig.subplots_adjust(left=0.06, right=0.95, top=0.955, bottom=0.1)
+    return plotting.save_figure(fig, path)
 
-    def line(ax, name, scale=1.0, **kw):
-        if name in run.channels:
-            ax.plot(*_thinned(t, run[name] * scale), **kw)
 
-    line(ax_alt, "altitude_m", color="tab:blue", lw=1.3)
+def _line(ax, run: TimeHistory, t: np.ndarray, name: str, scale: float = 1.0, **kw) -> None:
+    """``run``'s channel ``name`` × ``scale`` against ``t`` [s] (thinned), if it has it."""
+    if name in run.channels:
+        ax.plot(*_thinned(t, run[name] * scale), **kw)
+
+
+def _state_panels(axes, run: TimeHistory, t: np.ndarray) -> None:
+    """Altitude [m], airspeed [m/s], bank and pitch [deg], heading [deg] (compass ticks)."""
+    ax_alt, ax_v, ax_att, ax_psi = axes
+    _line(ax_alt, run, t, "altitude_m", color="tab:blue", lw=1.3)
     ax_alt.set_ylabel("altitude [m] (MSL)")
-    line(ax_v, "airspeed_m_s", color="tab:blue", lw=1.3)
+    _line(ax_v, run, t, "airspeed_m_s", color="tab:blue", lw=1.3)
     ax_v.set_ylabel("airspeed [m/s]")
-    line(ax_att, "phi_rad", deg, color="tab:red", lw=1.3, label="bank φ (right wing down +)")
-    line(ax_att, "theta_rad", deg, color="tab:green", lw=1.3, label="pitch θ (nose up +)")
+    _line(ax_att, run, t, "phi_rad", _DEG, color="tab:red", lw=1.3,
+          label="bank φ (right wing down +)")
+    _line(ax_att, run, t, "theta_rad", _DEG, color="tab:green", lw=1.3,
+          label="pitch θ (nose up +)")
     ax_att.set_ylabel("attitude [deg]")
     ax_att.legend(fontsize=8, loc="best")
     if "psi_rad" in run.channels:
-        tt, psi = _thinned(t, run["psi_rad"] * deg)
+        tt, psi = _thinned(t, run["psi_rad"] * _DEG)
         tt, psi, low = _heading(tt, psi)
         ax_psi.plot(tt, psi, color="tab:purple", lw=1.3)
         ticks = np.arange(low, low + 361.0, 90.0)
@@ -131,8 +158,12 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
         ax_psi.set_yticks(ticks, [f"{v:g} {'NESW'[int(v // 90) % 4]}" for v in ticks])
     ax_psi.set_ylabel("heading ψ [deg]")
 
+
+def _mode_panel(ax_eta, run: TimeHistory, t: np.ndarray) -> dict[str, list[str]]:
+    """Each wing mode as the quantity it makes (a twin axis per unit); the modes drawn by
+    quantity, for the footnote."""
     modes = sorted(int(n[3:]) for n in run.channels if n.startswith("eta")
-                    and n[3:].isdigit())
+                   and n[3:].isdigit())
     notes: dict[str, list[str]] = {}  # quantity drawn -> the modes drawn so
     axes_by_unit: dict[str, object] = {}
     colours = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
@@ -155,26 +186,29 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
     else:
         ax_eta.text(0.5, 0.5, "no wing modes in this log (rigid wing)", ha="center",
                     va="center", transform=ax_eta.transAxes)
+    return notes
 
+
+def _load_panels(ax_nz, ax_alpha, run: TimeHistory, t: np.ndarray) -> None:
+    """Load factor n_z [-] (band) and angle of attack [deg], the gust [m/s] on a twin axis."""
     if "n_z" in run.channels:
         _band(ax_nz, t, run["n_z"], "tab:blue", "n_z")
     ax_nz.axhline(1.0, color="0.5", lw=0.7)
     ax_nz.set_ylabel("load factor n_z [-]")
-    line(ax_alpha, "alpha_rad", deg, color="tab:blue", lw=1.3, label="α")
+    _line(ax_alpha, run, t, "alpha_rad", _DEG, color="tab:blue", lw=1.3, label="α")
     ax_alpha.set_ylabel("angle of attack α [deg]")
     gust = run.channels.get("w_g")
     if gust is not None and np.any(gust != 0.0):
         ax_w = ax_alpha.twinx()
         ax_w.plot(*_thinned(t, gust), color="black", lw=0.9)
         ax_w.set_ylabel("gust w_g [m/s] (up)")
-    for ax in left + [ax_nz, ax_alpha]:
-        ax.grid(True, alpha=0.3)
-    for ax in left[:-1] + [ax_nz]:
-        ax.tick_params(labelbottom=False)
-    ax_eta.set_xlabel("time [s]")
-    ax_alpha.set_xlabel("time [s]")
-    ax_alt.set_xlim(float(t[0]), float(t[-1]))
 
+
+def _track(ax_track, run: TimeHistory, t: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The track north against east [m] (the NED velocity integrated by trapezoids from the
+    start), with time marks; (east, north) or None without the velocity."""
+    track = None
     if "v_north_m_s" in run.channels and "v_east_m_s" in run.channels and len(t) > 1:
         dt = np.diff(t)
         north = np.concatenate([[0.0], np.cumsum(
@@ -190,8 +224,8 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
             ax_track.plot(east[k], north[k], ".", color="tab:blue", ms=6)
             ax_track.annotate(f"{tk:g} s", (east[k], north[k]), textcoords="offset points",
                               xytext=(4, -9), fontsize=7, color="tab:blue")
+        track = east, north
     else:
-        east = north = None
         ax_track.text(0.5, 0.5, "no NED velocity in this log", ha="center",
                       transform=ax_track.transAxes)
     ax_track.set_aspect("equal", adjustable="datalim")
@@ -199,21 +233,29 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
     ax_track.set_ylabel("north [m]")
     ax_track.set_title("track (logged NED velocity integrated from the start)", fontsize=10)
     ax_track.grid(True, alpha=0.3)
+    return track
 
-    merged = _events_merged(events, float(t[-1]) if len(t) else 0.0)
-    shown_events = merged[:MAX_EVENT_LABELS]
+
+def _mark_events(shown_events, time_axes, ax_top, ax_track, t: np.ndarray,
+                 track: tuple[np.ndarray, np.ndarray] | None) -> None:
+    """The events numbered: a dotted line on every time axis, the number above the top one
+    and a numbered circle on the track."""
     for n, (te, _text) in enumerate(shown_events, 1):
-        for ax in left + [ax_nz, ax_alpha]:
+        for ax in time_axes:
             ax.axvline(te, color="0.55", lw=0.7, ls=":")
-        ax_alt.annotate(str(n), (te, 1.0), xycoords=("data", "axes fraction"),
+        ax_top.annotate(str(n), (te, 1.0), xycoords=("data", "axes fraction"),
                         xytext=(0, 2), textcoords="offset points", ha="center",
                         va="bottom", fontsize=8, color="0.2")
-        if east is not None:
+        if track is not None:
+            east, north = track
             k = min(int(np.searchsorted(t, te)), len(t) - 1)
             ax_track.plot(east[k], north[k], "o", mfc="white", mec="0.2", ms=11, zorder=5)
             ax_track.annotate(str(n), (east[k], north[k]), ha="center", va="center",
                               fontsize=7, zorder=6)
-    ax_track.legend(fontsize=8, loc="best")
+
+
+def _footnote(merged, shown_events, spans: list[str], notes: dict[str, list[str]]) -> str:
+    """The events listed, the wing models flown and what each mode is drawn as."""
     lines = [f"{n}: t = {te:.1f} s {text}" for n, (te, text) in enumerate(shown_events, 1)]
     if len(merged) > len(shown_events):
         lines.append(f"(+{len(merged) - len(shown_events)} more events: bioflex-jsb info "
@@ -228,10 +270,7 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
         foot += "\nwing modes: " + "; ".join(
             f"mode{'s' if len(m) > 1 else ''} {', '.join(m)} drawn as {what[q]}"
             for q, m in notes.items()) + "; running mean, min/max shaded"
-    fig.suptitle(title, y=0.995)
-    fig.text(0.5, 0.005, foot, ha="center", va="bottom", fontsize=8, color="0.2", wrap=True)
-    fig.subplots_adjust(left=0.06, right=0.95, top=0.955, bottom=0.1)
-    return plotting.save_figure(fig, path)
+    return foot
 
 
 def _nice_step(x: float) -> float:
