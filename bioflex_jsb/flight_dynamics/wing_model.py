@@ -208,6 +208,27 @@ def _text(value, what: str, source: str) -> str:
 
 def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) -> WingVariant:
     """Build a variant from a parsed variant file (see docs/wing_variants.md)."""
+    _check_variant_keys(data, source)
+    base = _variant_base(data, source)
+    values: dict[str, object] = {"name": data.get("name", Path(source).stem)}
+    if not isinstance(values["name"], str) or not values["name"]:
+        raise VariantError(f"{source}: 'name' must be a non-empty string")
+    _text(values["name"], "'name'", source)
+    values.update(_structure_values(data, source, base_dir))
+    if "overrides" in data:
+        values["overrides"] = _overrides(data["overrides"], source)
+    modes = _variant_modes(data, values, source)
+    values["pinned_c_eta1_q1"] = _variant_pin(data, base, values, source, modes)
+    if "description" in data:
+        if not isinstance(data["description"], str):
+            raise VariantError(f"{source}: 'description' must be a string")
+        values["description"] = data["description"]
+    return replace(base, published_c_eta1_q1=None, **values)
+
+
+def _check_variant_keys(data: dict, source: str) -> None:
+    """A variant file's keys: some, all known; an aircraft or clamped-wing definition named
+    as what it is."""
     if not data:
         raise VariantError(f"{source}: the variant file sets nothing (empty, or comments "
                            f"only); give at least one of {', '.join(sorted(_VARIANT_KEYS))} "
@@ -224,17 +245,23 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
         raise VariantError(
             f"{source}: unknown key {unknown[0]!r}; accepted: {', '.join(sorted(_VARIANT_KEYS))}"
         )
+
+
+def _variant_base(data: dict, source: str) -> WingVariant:
+    """The named wing a variant starts from (``base``; a file's base is not a file)."""
     base_name = data.get("base", "original")
     if not isinstance(base_name, str):
         raise VariantError(f"{source}: 'base' must be a variant name")
-    if base_name not in VARIANTS:  # a base is a named wing only (a file's base is not a file)
+    if base_name not in VARIANTS:
         raise VariantError(f"{source}: base {base_name!r} is not a named wing; accepted: "
                            f"{', '.join(VARIANTS)}")
-    base = get_variant(base_name)
-    values: dict[str, object] = {"name": data.get("name", Path(source).stem)}
-    if not isinstance(values["name"], str) or not values["name"]:
-        raise VariantError(f"{source}: 'name' must be a non-empty string")
-    _text(values["name"], "'name'", source)
+    return get_variant(base_name)
+
+
+def _structure_values(data: dict, source: str, base_dir: Path | None) -> dict[str, object]:
+    """The axes [chord fraction], ribs, structural damping [ratio] and modes file (relative
+    to ``base_dir``) a variant file gives."""
+    values: dict[str, object] = {}
     for key in ("x_inertial_frac", "x_elastic_frac"):
         if key in data:
             v = data[key]
@@ -260,49 +287,56 @@ def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) 
         if base_dir is not None and not path.is_absolute():
             path = base_dir / path
         values["modes_file"] = str(path)
-    if "overrides" in data:
-        ov = data["overrides"]
-        if not isinstance(ov, dict):
-            raise VariantError(f"{source}: 'overrides' must be a table of coefficient = value")
-        checked = {}
-        for k, v in ov.items():
-            try:
-                parse_override_key(k, DEFAULT_N_MODES)
-            except ValueError as exc:
-                raise VariantError(f"{source}: overrides: {exc}") from None
-            checked[k] = _coefficient(v, f"overrides.{k}", source)
-        values["overrides"] = checked
-    if "modes_file" in data:
-        moved = [k for k in ("x_inertial_frac", "x_elastic_frac", "ribs") if k in data]
-        if moved:
-            raise VariantError(
-                f"{source}: {moved[0]!r} has no effect with 'modes_file': the modes file "
-                "gives the structure, its [axes] table the axis positions; move it there "
-                "or remove it")
-        from bioflex_jsb.structures.modal_file import read_modal_file
+    return values
 
-        modes = read_modal_file(values["modes_file"])
-        # the axes the wing has: the modes file's (their mean where it gives one per station)
-        values["x_inertial_frac"] = float(np.mean(modes.x_inertial_frac))
-        values["x_elastic_frac"] = float(np.mean(modes.x_elastic_frac))
-    else:
-        modes = None
-    if "pin_c_eta1_q1" in data:
-        pin = data["pin_c_eta1_q1"]
-        if pin == PHYSICAL_PIN:
-            values["pinned_c_eta1_q1"] = None
-        elif isinstance(pin, bool) or not isinstance(pin, int | float) or not math.isfinite(pin):
-            raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
-                               f"{PHYSICAL_PIN!r} (the strip model's own value)")
-        else:
-            values["pinned_c_eta1_q1"] = _coefficient(pin, "'pin_c_eta1_q1'", source)
-    else:
-        values["pinned_c_eta1_q1"] = _inherited_pin(base, values, source, modes)
-    if "description" in data:
-        if not isinstance(data["description"], str):
-            raise VariantError(f"{source}: 'description' must be a string")
-        values["description"] = data["description"]
-    return replace(base, published_c_eta1_q1=None, **values)
+
+def _overrides(ov, source: str) -> dict[str, float]:
+    """``overrides``: a table of coefficient name (docs/wing_variants.md) = value."""
+    if not isinstance(ov, dict):
+        raise VariantError(f"{source}: 'overrides' must be a table of coefficient = value")
+    checked = {}
+    for k, v in ov.items():
+        try:
+            parse_override_key(k, DEFAULT_N_MODES)
+        except ValueError as exc:
+            raise VariantError(f"{source}: overrides: {exc}") from None
+        checked[k] = _coefficient(v, f"overrides.{k}", source)
+    return checked
+
+
+def _variant_modes(data: dict, values: dict, source: str):
+    """The modes file's modes (None without one); its axes become the variant's, and the
+    keys a modes file decides are refused beside it."""
+    if "modes_file" not in data:
+        return None
+    moved = [k for k in ("x_inertial_frac", "x_elastic_frac", "ribs") if k in data]
+    if moved:
+        raise VariantError(
+            f"{source}: {moved[0]!r} has no effect with 'modes_file': the modes file "
+            "gives the structure, its [axes] table the axis positions; move it there "
+            "or remove it")
+    from bioflex_jsb.structures.modal_file import read_modal_file
+
+    modes = read_modal_file(values["modes_file"])
+    # the axes the wing has: the modes file's (their mean where it gives one per station)
+    values["x_inertial_frac"] = float(np.mean(modes.x_inertial_frac))
+    values["x_elastic_frac"] = float(np.mean(modes.x_elastic_frac))
+    return modes
+
+
+def _variant_pin(data: dict, base: WingVariant, values: dict, source: str, modes
+                 ) -> float | None:
+    """C_η1^Q1 pinned by the file (``pin_c_eta1_q1``: a number, or PHYSICAL_PIN for the
+    strip model's own value) or inherited from the base (:func:`_inherited_pin`)."""
+    if "pin_c_eta1_q1" not in data:
+        return _inherited_pin(base, values, source, modes)
+    pin = data["pin_c_eta1_q1"]
+    if pin == PHYSICAL_PIN:
+        return None
+    if isinstance(pin, bool) or not isinstance(pin, int | float) or not math.isfinite(pin):
+        raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
+                           f"{PHYSICAL_PIN!r} (the strip model's own value)")
+    return _coefficient(pin, "'pin_c_eta1_q1'", source)
 
 
 def _differs(a, b) -> bool:
