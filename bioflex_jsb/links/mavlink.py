@@ -530,79 +530,99 @@ class MavlinkLink:
         return ts in (0, SYSTEM_ID) and tc in (0, COMPONENT_ID)
 
     def _handle(self, msg, state: VehicleState) -> None:
+        """One message from a peer, dispatched by type (:data:`_HANDLERS`; MISSION_* to the
+        mission protocol); a type the vehicle does not serve is ignored."""
         t = msg.get_type()
-        if t in ("COMMAND_LONG", "COMMAND_INT"):
-            if self._for_us(msg):
-                self.commands.handle(msg, state)
-        elif t == "PARAM_REQUEST_LIST":
-            if self._for_us(msg):
-                self._param_queue.clear()
-                self._param_queue.extend(range(len(self.params.names)))
-        elif t == "PARAM_REQUEST_READ":
-            if self._for_us(msg):
-                names = self.params.names
-                name = _param_name(msg.param_id)
-                if msg.param_index >= 0:
-                    if msg.param_index < len(names):
-                        self._send_param(msg.param_index)
-                    else:
-                        self._param_error(msg, b"", msg.param_index,
-                                          M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
-                elif name in names:
-                    self._send_param(names.index(name))
-                else:
-                    self._param_error(msg, name.encode()[:16], -1,
-                                      M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
-        elif t == "PARAM_SET":
-            if self._for_us(msg):
-                name = _param_name(msg.param_id)
-                if name in self.params.names:
-                    try:
-                        self.params.set(name, float(msg.param_value))
-                    except ValueError as exc:  # the PARAM_VALUE reports the value in force
-                        self._param_error(msg, name.encode()[:16], -1,
-                                          M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)
-                        self.commands.refuse(f"PARAM_SET {exc}")
-                    self._send_param(self.params.names.index(name))
-                else:
-                    self._param_error(msg, name.encode()[:16], -1,
-                                      M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
-        elif t.startswith("MISSION_"):
-            if self.mission is not None and self._for_us(msg):
-                self.mission.handle(msg, t)
-            elif self._for_us(msg) and t in ("MISSION_REQUEST_LIST", "MISSION_COUNT",
-                                             "MISSION_CLEAR_ALL"):
-                self._send(self._mav.mission_ack_encode(
-                    msg.get_srcSystem(), msg.get_srcComponent(), M.MAV_MISSION_UNSUPPORTED,
-                    getattr(msg, "mission_type", 0)))
-        elif t == "SET_MODE":
-            if msg.target_system == SYSTEM_ID and self.vehicle is not None:
-                if msg.base_mode & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
-                    reason = self.vehicle.set_mode(int(msg.custom_mode))
-                    if reason:
-                        self.commands.refuse(f"SET_MODE: {reason}")
-        elif t == "TIMESYNC":
-            if msg.tc1 == 0:  # a request: answer with the vehicle's (simulated) clock [ns]
-                self._send(self._mav.timesync_encode(max(1, int(state.time_s * 1e9)),
-                                                     msg.ts1))
-        elif t == "FILE_TRANSFER_PROTOCOL":
-            if msg.target_system == SYSTEM_ID and msg.target_component in (0, COMPONENT_ID):
-                self._ftp_reply(msg)
-        elif t == "PING":
-            if msg.target_system == 0 and msg.target_component == 0:
-                self._send(self._mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(),
-                                                 msg.get_srcComponent()))
-        elif t == "REQUEST_DATA_STREAM":
-            if self._for_us(msg):
-                hz = float(msg.req_message_rate) if msg.start_stop else 0.0
-                for mid in STREAMS.get(msg.req_stream_id, ()):
-                    self.set_rate(mid, hz)
-        elif t == "MANUAL_CONTROL":
-            if msg.target in (0, SYSTEM_ID) and self.vehicle is not None:
-                self.sticks.manual_control(msg)
-        elif t == "RC_CHANNELS_OVERRIDE":
-            if self._for_us(msg) and self.vehicle is not None:
-                self.sticks.rc_override(msg)
+        if t.startswith("MISSION_"):
+            self._on_mission(msg, t)
+            return
+        handler = _HANDLERS.get(t)
+        if handler is not None:
+            getattr(self, handler)(msg, state)
+
+    def _on_command(self, msg, state: VehicleState) -> None:
+        if self._for_us(msg):
+            self.commands.handle(msg, state)
+
+    def _on_param_request_list(self, msg, state: VehicleState) -> None:
+        if self._for_us(msg):
+            self._param_queue.clear()
+            self._param_queue.extend(range(len(self.params.names)))
+
+    def _on_param_request_read(self, msg, state: VehicleState) -> None:
+        if not self._for_us(msg):
+            return
+        names = self.params.names
+        name = _param_name(msg.param_id)
+        if msg.param_index >= 0:
+            if msg.param_index < len(names):
+                self._send_param(msg.param_index)
+            else:
+                self._param_error(msg, b"", msg.param_index, M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
+        elif name in names:
+            self._send_param(names.index(name))
+        else:
+            self._param_error(msg, name.encode()[:16], -1, M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
+
+    def _on_param_set(self, msg, state: VehicleState) -> None:
+        if not self._for_us(msg):
+            return
+        name = _param_name(msg.param_id)
+        if name not in self.params.names:
+            self._param_error(msg, name.encode()[:16], -1, M.MAV_PARAM_ERROR_DOES_NOT_EXIST)
+            return
+        try:
+            self.params.set(name, float(msg.param_value))
+        except ValueError as exc:  # the PARAM_VALUE reports the value in force
+            self._param_error(msg, name.encode()[:16], -1,
+                              M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)
+            self.commands.refuse(f"PARAM_SET {exc}")
+        self._send_param(self.params.names.index(name))
+
+    def _on_mission(self, msg, t: str) -> None:
+        """The mission protocol's messages; without a mission, a list, count or clear is
+        answered "unsupported"."""
+        if self.mission is not None and self._for_us(msg):
+            self.mission.handle(msg, t)
+        elif self._for_us(msg) and t in ("MISSION_REQUEST_LIST", "MISSION_COUNT",
+                                         "MISSION_CLEAR_ALL"):
+            self._send(self._mav.mission_ack_encode(
+                msg.get_srcSystem(), msg.get_srcComponent(), M.MAV_MISSION_UNSUPPORTED,
+                getattr(msg, "mission_type", 0)))
+
+    def _on_set_mode(self, msg, state: VehicleState) -> None:
+        if (msg.target_system == SYSTEM_ID and self.vehicle is not None
+                and msg.base_mode & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED):
+            reason = self.vehicle.set_mode(int(msg.custom_mode))
+            if reason:
+                self.commands.refuse(f"SET_MODE: {reason}")
+
+    def _on_timesync(self, msg, state: VehicleState) -> None:
+        if msg.tc1 == 0:  # a request: answer with the vehicle's (simulated) clock [ns]
+            self._send(self._mav.timesync_encode(max(1, int(state.time_s * 1e9)), msg.ts1))
+
+    def _on_ftp(self, msg, state: VehicleState) -> None:
+        if msg.target_system == SYSTEM_ID and msg.target_component in (0, COMPONENT_ID):
+            self._ftp_reply(msg)
+
+    def _on_ping(self, msg, state: VehicleState) -> None:
+        if msg.target_system == 0 and msg.target_component == 0:
+            self._send(self._mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(),
+                                             msg.get_srcComponent()))
+
+    def _on_request_data_stream(self, msg, state: VehicleState) -> None:
+        if self._for_us(msg):
+            hz = float(msg.req_message_rate) if msg.start_stop else 0.0
+            for mid in STREAMS.get(msg.req_stream_id, ()):
+                self.set_rate(mid, hz)
+
+    def _on_manual_control(self, msg, state: VehicleState) -> None:
+        if msg.target in (0, SYSTEM_ID) and self.vehicle is not None:
+            self.sticks.manual_control(msg)
+
+    def _on_rc_override(self, msg, state: VehicleState) -> None:
+        if self._for_us(msg) and self.vehicle is not None:
+            self.sticks.rc_override(msg)
 
     def _param_error(self, msg, name: bytes, index: int, error: int) -> None:
         self._send(self._mav.param_error_encode(msg.get_srcSystem(), msg.get_srcComponent(),
@@ -674,3 +694,21 @@ def _param_name(raw) -> str:
 MSG_IDS = {name: getattr(M, f"MAVLINK_MSG_ID_{name}") for name in (
     "HEARTBEAT", "SYS_STATUS", "ATTITUDE", "GLOBAL_POSITION_INT", "GPS_RAW_INT", "VFR_HUD",
     "NAMED_VALUE_FLOAT", "AUTOPILOT_VERSION", "HOME_POSITION", "BATTERY_STATUS")}
+
+
+# The message types the vehicle serves and the MavlinkLink method that handles each
+# (MISSION_* go to the mission protocol).
+_HANDLERS = {
+    "COMMAND_LONG": "_on_command",
+    "COMMAND_INT": "_on_command",
+    "PARAM_REQUEST_LIST": "_on_param_request_list",
+    "PARAM_REQUEST_READ": "_on_param_request_read",
+    "PARAM_SET": "_on_param_set",
+    "SET_MODE": "_on_set_mode",
+    "TIMESYNC": "_on_timesync",
+    "FILE_TRANSFER_PROTOCOL": "_on_ftp",
+    "PING": "_on_ping",
+    "REQUEST_DATA_STREAM": "_on_request_data_stream",
+    "MANUAL_CONTROL": "_on_manual_control",
+    "RC_CHANNELS_OVERRIDE": "_on_rc_override",
+}
