@@ -19,7 +19,7 @@ from bioflex_jsb.loads.model import (
     LoadsModel,
     build_loads_model,
 )
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters import constants as C
 
 __all__ = ["DEFAULT_STATION_FRACTIONS", "METHODS", "QUANTITIES", "LoadsModel", "SectionLoads",
            "build_loads_model", "loads_metrics", "monitoring_stations", "section_loads",
@@ -57,7 +57,7 @@ def section_loads(build, run, stations=None, *, static: str | None = None,
         if alt is not None and len(alt) and float(alt[0]) > SEA_LEVEL_ALTITUDE_MAX_M:
             raise InputError(f"the run starts at {float(alt[0]):.0f} m; give density_kg_m3 "
                              "(sea level is assumed up to 100 m)")
-        density_kg_m3 = P.SEA_LEVEL_DENSITY_KG_M3
+        density_kg_m3 = C.SEA_LEVEL_DENSITY_KG_M3
     if static is None:
         static = "rigid" if run.model == "rigid" else "elastic"
     if run.model == "rigid" and static != "rigid":

@@ -57,7 +57,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters import constants as C
 
 # root, 25, 50, 75 % semispan: a definition's default [loads] stations
 DEFAULT_STATION_FRACTIONS = DEFAULT_MONITORING_STATIONS
@@ -142,7 +142,7 @@ class LoadsModel:
         z[0] = q0 * (self.alpha_wing_rad + self.static_alpha_rad)
         z[2:2 + n] = q0 * self.static_eta_rad
         z[2 + 2 * n] = q0
-        z[3 + 2 * n] = P.STANDARD_GRAVITY_M_S2
+        z[3 + 2 * n] = C.STANDARD_GRAVITY_M_S2
         return z
 
     def force_summation(self, z: np.ndarray, part: str = "total") -> np.ndarray:
@@ -433,7 +433,7 @@ def _elements_at(nodes: np.ndarray, y: float) -> list[int]:
 
 
 def build_loads_model(build, speed_m_s: float, stations=None, *,
-                      density_kg_m3: float = P.SEA_LEVEL_DENSITY_KG_M3,
+                      density_kg_m3: float = C.SEA_LEVEL_DENSITY_KG_M3,
                       static: str = "elastic") -> LoadsModel:
     """The :class:`LoadsModel` of ``build`` (a :class:`~bioflex_jsb.flight_dynamics.
     wing_model.WingBuild`: the prototype's or a definition's wing, on its own planform,

@@ -31,10 +31,10 @@ import numpy as np
 
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.loads.model import METHODS, QUANTITIES, QUANTITY_UNITS, LoadsModel
-from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters import constants as C
 from bioflex_jsb.simulation.step_kernel import guard_cache
 
-G = P.STANDARD_GRAVITY_M_S2
+G = C.STANDARD_GRAVITY_M_S2
 TAGS = {"force_summation": "fs", "mode_displacement": "md"}
 
 
