@@ -3,9 +3,8 @@ problem (:class:`DefinitionError`, an :class:`~bioflex_jsb.errors.InputError`: e
 
 from __future__ import annotations
 
-import math
-
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.values import is_finite_real, is_whole
 
 
 class DefinitionError(InputError):
@@ -45,7 +44,7 @@ class Reader:
         v = t.get(key, default)
         if v is None:
             raise self.fail(f"{where}.{key}", f"missing (a number in {unit})")
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        if not is_finite_real(v):
             raise self.fail(f"{where}.{key}", f"must be a finite number in {unit}, got {v!r}")
         if not lo <= v <= hi:
             raise self.fail(f"{where}.{key}", f"{v:g} {unit} is outside the valid range "
@@ -54,7 +53,7 @@ class Reader:
 
     def integer(self, t: dict, where: str, key: str, lo: int, hi: int, default: int) -> int:
         v = t.get(key, default)
-        if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+        if not is_whole(v) or not lo <= v <= hi:
             raise self.fail(f"{where}.{key}", f"must be an integer {lo}..{hi}, got {v!r}")
         return int(v)
 

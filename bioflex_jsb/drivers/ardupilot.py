@@ -134,6 +134,7 @@ from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.values import is_whole
 
 G0_M_S2 = 9.80665  # standard gravity: JSBSim's at the airframe's 45° latitude
 # WGS-84, for north/east from latitude/longitude near the launch point
@@ -264,8 +265,7 @@ class ArduPilotPhysics:
                  aero: str = "quasi-steady", compiled: bool = True) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
             raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
-        if isinstance(record_every, bool) or not isinstance(record_every, int) \
-                or record_every < 0:
+        if not is_whole(record_every) or record_every < 0:
             raise InputError(f"record_every must be an integer >= 0, got {record_every!r}")
         self.airframe = airframe
         self.wing_model = wing

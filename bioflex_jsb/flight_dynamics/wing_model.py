@@ -46,6 +46,7 @@ from bioflex_jsb.parameters.wing import (
 from bioflex_jsb.structures.beam_wing import BeamWing
 from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.tomlfile import read_toml
+from bioflex_jsb.values import is_finite_real, is_real
 
 MASS_BASES = ("paper", "consistent")
 DEFAULT_MASS_BASIS = "consistent"
@@ -185,7 +186,7 @@ MAX_PINNED_COEFFICIENT = 100.0
 
 def _coefficient(value, what: str, source: str) -> float:
     """A pinned coefficient: a finite number with |value| <= MAX_PINNED_COEFFICIENT."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if not is_finite_real(value):
         raise VariantError(f"{source}: {what} must be a finite number, got {value!r}")
     if abs(value) > MAX_PINNED_COEFFICIENT:
         raise VariantError(f"{source}: {what} = {value!r} is outside "
@@ -265,7 +266,7 @@ def _structure_values(data: dict, source: str, base_dir: Path | None) -> dict[st
     for key in ("x_inertial_frac", "x_elastic_frac"):
         if key in data:
             v = data[key]
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            if not is_finite_real(v):
                 raise VariantError(f"{source}: {key!r} must be a number, got {v!r}")
             if not 0.0 <= float(v) <= 1.0:
                 raise VariantError(f"{source}: {key!r} must be a chord fraction 0..1, got {v!r}")
@@ -276,7 +277,7 @@ def _structure_values(data: dict, source: str, base_dir: Path | None) -> dict[st
         values["ribs"] = data["ribs"]
     if "structural_damping" in data:
         z = data["structural_damping"]
-        if isinstance(z, bool) or not isinstance(z, int | float) or not 0.0 <= z < 1.0:
+        if not is_real(z) or not 0.0 <= z < 1.0:
             raise VariantError(f"{source}: 'structural_damping' must be a ratio in [0, 1)")
         values["structural_damping"] = float(z)
     if "modes_file" in data:
@@ -333,7 +334,7 @@ def _variant_pin(data: dict, base: WingVariant, values: dict, source: str, modes
     pin = data["pin_c_eta1_q1"]
     if pin == PHYSICAL_PIN:
         return None
-    if isinstance(pin, bool) or not isinstance(pin, int | float) or not math.isfinite(pin):
+    if not is_finite_real(pin):
         raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
                            f"{PHYSICAL_PIN!r} (the strip model's own value)")
     return _coefficient(pin, "'pin_c_eta1_q1'", source)

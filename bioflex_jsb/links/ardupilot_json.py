@@ -101,6 +101,7 @@ from bioflex_jsb.links.ardupilot_reply import (  # noqa: F401  (the reply's name
     encode_reply_json,
 )
 from bioflex_jsb.links.udp_guard import BLOCK_S, FLOOD_RATE_PER_S, FloodGuard
+from bioflex_jsb.values import is_whole
 
 # SIM_JSON.h, servo_packet_16 / servo_packet_32: magic, frame_rate, frame_count, pwm[]
 MAGIC_16 = 18458
@@ -161,7 +162,7 @@ class ServoPacket(NamedTuple):
 
 def instance_port(instance: int = 0) -> int:
     """The UDP port ArduPilot SITL instance ``instance`` (its ``-I``) sends servos to."""
-    if isinstance(instance, bool) or not isinstance(instance, int) or instance < 0:
+    if not is_whole(instance) or instance < 0:
         raise ValueError(f"SITL instance must be an integer >= 0, got {instance!r}")
     port = BASE_PORT + PORT_STEP_PER_INSTANCE * instance
     if port > 65535:

@@ -7,12 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.values import is_real
 
 
 def finite_number(value, what: str) -> float:
     """``value`` as a finite float (InputError, one line, for anything else); ``what``
     names it, with its unit."""
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+    if not is_real(value):
         raise InputError(f"{what} must be a number, got {value!r}")
     if not np.isfinite(value):
         raise InputError(f"{what} must be finite, got {value!r}")

@@ -33,7 +33,6 @@ is known, ``cli/case.py check_speed``, ``api``).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from enum import Enum, StrEnum
 
@@ -41,6 +40,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.simulation.gusts import GustSpec, check_gust_resolution
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.simulation.run import check_run_length
+from bioflex_jsb.values import is_real
 
 
 class WingModel(StrEnum):
@@ -80,7 +80,7 @@ def _enum(kind: type[Enum], value, what: str):
 
 
 def _number(value, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not is_real(value):
         raise InputError(f"{what} must be a number, got {value!r}")
     if not math.isfinite(value):
         raise InputError(f"{what} must be finite, got {value!r}")

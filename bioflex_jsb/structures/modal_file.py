@@ -48,6 +48,7 @@ import numpy as np
 
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
+from bioflex_jsb.values import is_real
 
 FORMAT_NAME = "bioflex-jsb-modes"
 FORMAT_VERSION = 1
@@ -145,7 +146,7 @@ class _Reader:
 
     # --------------------------------------------------------------------------------------
     def number(self, value, what, table, key, index=0) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if not is_real(value):
             self.fail(what, f"expected a number, got {type(value).__name__}", table, key, index)
         x = float(value)
         if not math.isfinite(x):
@@ -158,7 +159,7 @@ class _Reader:
                       table, key, index)
         out = np.empty(len(value))
         for j, item in enumerate(value):
-            if isinstance(item, bool) or not isinstance(item, (int, float)):
+            if not is_real(item):
                 self.fail(what, f"element {j} is not a number ({item!r})", table, key, index)
             if not math.isfinite(float(item)):
                 self.fail(what, f"element {j} is non-finite ({float(item)})", table, key, index)

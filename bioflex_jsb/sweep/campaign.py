@@ -49,6 +49,7 @@ from bioflex_jsb.sweep.columns import DEFAULT_AERO, result_columns
 from bioflex_jsb.sweep.columns import RUN_INFO_COLUMNS as RUN_INFO_COLUMNS  # re-exported
 from bioflex_jsb.sweep.errors import CampaignError as CampaignError  # re-exported
 from bioflex_jsb.tomlfile import read_toml
+from bioflex_jsb.values import is_whole
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
 MAX_CASES = 1_000_000
@@ -345,7 +346,7 @@ def _values(v: Any, key: str, integer: bool = False) -> list:
             raise CampaignError(f"{key}: give step or num, not both")
         if "num" in v:
             num = v["num"]
-            if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            if not is_whole(num) or num < 1:
                 raise CampaignError(f"{key}.num: must be a whole number ≥ 1, got {num!r}")
             n, step = num, (stop - start) / max(num - 1, 1)
         else:
@@ -589,7 +590,7 @@ def _gusts(axes: dict, metrics: tuple[str, ...]) -> list[str]:
     if "seeds" in axes:
         seeds = _values(axes["seeds"], "axes.seeds", integer=True)
         for i, s in enumerate(seeds):
-            if isinstance(s, bool) or not isinstance(s, int) or s < 0:
+            if not is_whole(s) or s < 0:
                 raise CampaignError(f"axes.seeds[{i}]: must be a whole number ≥ 0, got {s!r}")
         seeds = _unique(seeds, "axes.seeds")
         if not any(spec.kind in TURBULENCE for _, _, spec in specs):

@@ -31,6 +31,7 @@ from bioflex_jsb.simulation.results import TimeHistory
 from bioflex_jsb.sinks.mcap.errors import LogError
 from bioflex_jsb.sinks.mcap.reader import NotOurs, iter_messages, open_reader, read_metadata
 from bioflex_jsb.sinks.mcap.schemas import EVENTS_TOPIC, RIGID_BODY_CHANNELS, RUN_METADATA
+from bioflex_jsb.values import is_finite_real, is_real
 
 # At most this many steps (messages of rigid_body and lti_prediction topics) per read: 17
 # minutes of one model at 960 Hz; every channel of a gust run with its loads is 55 doubles,
@@ -51,7 +52,7 @@ def _number(msg: dict, field: str, topic: str, ns: int, required: bool = False) 
     value = msg.get(field)
     if value is None and not required:
         return math.nan
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if not is_real(value):
         raise NotOurs(topic, ns, f"field {field!r} is {type(value).__name__}, not a number")
     return float(value)
 
@@ -183,8 +184,7 @@ def _window_ns(start_s, end_s) -> tuple[int | None, int | None]:
     """The window [start_s, end_s) [s] as log times [ns]; LogError for a bad one."""
     out = []
     for what, v in (("start_s", start_s), ("end_s", end_s)):
-        if v is not None and (isinstance(v, bool) or not isinstance(v, int | float)
-                              or not math.isfinite(v) or v < 0.0):
+        if v is not None and (not is_finite_real(v) or v < 0.0):
             raise LogError(f"{what} must be a finite time >= 0 s, got {v!r}")
         out.append(None if v is None else int(round(v * 1e9)))
     if None not in out and out[1] <= out[0]:

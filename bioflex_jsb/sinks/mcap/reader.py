@@ -15,6 +15,7 @@ from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
 from bioflex_jsb.sinks.mcap.protobuf import decoder
 from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC
 from bioflex_jsb.sinks.mcap.writer import MAGIC
+from bioflex_jsb.values import is_real
 
 
 def check_file(path: str | Path) -> Path:
@@ -156,7 +157,7 @@ def _number(msg: dict, field: str, topic: str, ns: int, optional: bool = False):
     value = msg.get(field)
     if value is None and optional:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if not is_real(value):
         raise NotOurs(topic, ns, f"field {field!r} is {type(value).__name__}, not a number")
     return value
 
