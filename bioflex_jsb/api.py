@@ -24,7 +24,7 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -118,75 +118,101 @@ def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
     return complete_aircraft(_load_aircraft(name_or_file))
 
 
-def _wing(wing):
-    """The :class:`WingBuild` of an :class:`Aircraft` (the wing itself otherwise): its
-    model carries the aircraft's :class:`~bioflex_jsb.parameters.airframe.AirframeData`,
-    which every linear analysis below takes. Anything else (a name, a path, a Definition)
-    is refused in one line saying what to pass."""
-    if isinstance(wing, Aircraft):
-        return wing.wing()
-    if wing is not None and not isinstance(wing, WingBuild):
+@dataclass(frozen=True)
+class _Subject:
+    """What an analysis below is given, read once (:meth:`of`): an :class:`Aircraft` (its
+    wing, JSBSim airframe, speeds and air) or a bare :class:`WingBuild` (flown on the
+    prototype's airframe, at the prototype's speeds), or None (the prototype's rigid
+    aircraft, linear analyses only). Every analysis asks it, not the argument's type."""
+
+    aircraft: Aircraft | None
+    build: WingBuild | None
+
+    @classmethod
+    def of(cls, wing) -> _Subject:
+        """``wing`` read: anything else than an Aircraft, a WingBuild or None is refused in
+        one line saying what to pass."""
+        if isinstance(wing, Aircraft):
+            return cls(wing, wing.wing())
+        if wing is None or isinstance(wing, WingBuild):
+            return cls(None, wing)
         hint = ("; a name or file is loaded first (api.load_wing, api.load_aircraft), and a "
                 "clamped wing's definition is analysed with clamped=True"
                 if isinstance(wing, str | Path | Definition) else "")
         raise InputError(f"give a wing (a WingBuild) or an Aircraft, not {wing!r}{hint}")
-    return wing
 
+    def flying_build(self) -> WingBuild:
+        """The wing of a nonlinear JSBSim run (docs/aircraft.md, "What runs with another
+        airframe"): an Aircraft flies on its own JSBSim airframe when
+        :func:`~bioflex_jsb.definition.flying.flight_refusal` has no objection (else one
+        line); a bare WingBuild only on the prototype's (another airframe's wing needs its
+        Aircraft: the JSBSim aircraft is in the definition), never with the prototype's
+        numbers."""
+        if self.aircraft is not None:
+            problem = flight_refusal(self.aircraft)
+            if problem:
+                raise InputError(problem)
+        build = self.build
+        if build is None:
+            raise InputError("give a wing (a WingBuild: api.load_wing) or an Aircraft "
+                             "(api.load_aircraft) to fly, not None")
+        if self.aircraft is None and build.model.airframe is not PROTOTYPE_AIRFRAME:
+            raise InputError(f"wing {build.variant.name!r} is built for airframe "
+                             f"{build.model.airframe.name!r}: a bare wing flies on the "
+                             "prototype's airframe only; pass its Aircraft "
+                             "(api.load_aircraft), whose definition names the JSBSim "
+                             "aircraft")
+        return build
 
-def _flying_wing(wing):
-    """:func:`_wing` for the nonlinear JSBSim runs (docs/aircraft.md, "What runs with
-    another airframe"): an :class:`Aircraft` flies on its own JSBSim airframe when
-    :func:`~bioflex_jsb.definition.flying.flight_refusal` has no objection (else one line);
-    a bare WingBuild only on the prototype's (another airframe's wing needs its Aircraft:
-    the JSBSim aircraft is in the definition), never with the prototype's numbers."""
-    if isinstance(wing, Aircraft):
-        problem = flight_refusal(wing)
-        if problem:
-            raise InputError(problem)
-    build = _wing(wing)
-    if build is None:
-        raise InputError("give a wing (a WingBuild: api.load_wing) or an Aircraft "
-                         "(api.load_aircraft) to fly, not None")
-    if (not isinstance(wing, Aircraft)
-            and build.model.airframe is not PROTOTYPE_AIRFRAME):
-        raise InputError(f"wing {build.variant.name!r} is built for airframe "
-                         f"{build.model.airframe.name!r}: a bare wing flies on the "
-                         "prototype's airframe only; pass its Aircraft (api.load_aircraft), "
-                         "whose definition names the JSBSim aircraft")
-    return build
-
-
-def _flight_speed(wing, speed_m_s: float | None) -> float:
-    """The trim speed [m/s] of a nonlinear run of ``wing``: ``speed_m_s``, within an
-    :class:`Aircraft`'s flight speeds, default its cruise speed; the prototype's 15 m/s
-    (Table 1) for a bare wing."""
-    if isinstance(wing, Aircraft):
-        cruise, (lo, hi) = flight_speeds(wing)
+    def flight_speed(self, speed_m_s: float | None) -> float:
+        """The trim speed [m/s] of a nonlinear run: ``speed_m_s``, within an Aircraft's
+        flight speeds, default its cruise speed; the prototype's 15 m/s (Table 1) for a bare
+        wing."""
+        if self.aircraft is None:
+            return CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
+        cruise, (lo, hi) = flight_speeds(self.aircraft)
         v = cruise if speed_m_s is None else _real(speed_m_s, "speed_m_s [m/s]")
         if not lo <= v <= hi:
-            raise InputError(f"speed {v:g} m/s is outside aircraft {wing.name!r}'s flight "
-                             f"speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
+            raise InputError(f"speed {v:g} m/s is outside aircraft {self.aircraft.name!r}'s "
+                             f"flight speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
         return v
-    return CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
 
+    def jsbsim_airframe(self) -> Airframe:
+        """The JSBSim airframe a nonlinear run flies: the Aircraft's own, else the
+        prototype's."""
+        return Airframe() if self.aircraft is None else airframe_for(self.aircraft)
 
-def _flight(wing, speed_m_s: float | None):
-    """(the WingBuild, the JSBSim airframe, the trim speed [m/s]) of a nonlinear run of
-    ``wing``: an :class:`Aircraft`'s own airframe and cruise speed (the default of
-    ``speed_m_s``), else the prototype's (15 m/s, Table 1)."""
-    build = _flying_wing(wing)
-    v = _flight_speed(wing, speed_m_s)
-    return build, airframe_for(wing) if isinstance(wing, Aircraft) else Airframe(), v
+    def density(self, density_kg_m3: float | None) -> dict:
+        """The air density [kg/m^3] of an analysis as keyword arguments: given, else an
+        Aircraft definition's [air], else none (the analyses' sea-level default)."""
+        if density_kg_m3 is not None:
+            return {"density_kg_m3": _check_density(density_kg_m3)}
+        if self.aircraft is not None:
+            return {"density_kg_m3": float(self.aircraft.definition.air.density_kg_m3)}
+        return {}
 
-
-def _density(wing, density_kg_m3: float | None) -> dict:
-    """The air density of an analysis: given, else an :class:`Aircraft` definition's
-    [air], else none (the analyses' sea-level default)."""
-    if density_kg_m3 is not None:
-        return {"density_kg_m3": _check_density(density_kg_m3)}
-    if isinstance(wing, Aircraft):
-        return {"density_kg_m3": float(wing.definition.air.density_kg_m3)}
-    return {}
+    def analysis_speed(self, speed_m_s: float | None) -> float:
+        """The speed [m/s] of a linear analysis: ``speed_m_s`` when given, else an
+        Aircraft's cruise speed (the prototype's 15 m/s on its airframe, Table 1; the
+        file's ``airframe.cruise_speed_m_s`` on another), or the prototype's for a bare wing
+        built on the prototype's airframe (or None, the rigid prototype); one line when no
+        cruise speed is known (a wing of another airframe without its Aircraft, an aircraft
+        without the field)."""
+        if speed_m_s is not None:
+            return _linear_speed(speed_m_s)
+        if self.aircraft is not None:
+            a = self.aircraft
+            cruise = (CRUISE_SPEED_M_S if a.flight_problem() is None
+                      else a.airframe.cruise_speed_m_s)
+            if cruise is None:
+                raise InputError(f"aircraft {a.name!r} has no airframe.cruise_speed_m_s: "
+                                 "give speed_m_s [m/s]")
+            return float(cruise)
+        if self.build is None or self.build.model.airframe is PROTOTYPE_AIRFRAME:
+            return CRUISE_SPEED_M_S
+        raise InputError(f"wing {self.build.variant.name!r} is built for airframe "
+                         f"{self.build.model.airframe.name!r}: give speed_m_s [m/s] (or pass "
+                         "its Aircraft, whose cruise speed is the default)")
 
 
 # The lowest speed of a linear analysis [m/s]: its dynamic pressure at sea level is 6 mPa,
@@ -207,29 +233,6 @@ def _linear_speed(speed_m_s) -> float:
                          f"{SPEED_LIMIT_M_S:g} m/s (the strip aerodynamics are "
                          "incompressible)")
     return v
-
-
-def _analysis_speed(wing, speed_m_s: float | None) -> float:
-    """The speed [m/s] of a linear analysis: ``speed_m_s`` when given, else an
-    :class:`Aircraft`'s cruise speed (the prototype's 15 m/s on its airframe, Table 1; the
-    file's ``airframe.cruise_speed_m_s`` on another), or the prototype's for a bare wing
-    built on the prototype's airframe (or None, the rigid prototype); one line when no
-    cruise speed is known (a wing of another airframe without its Aircraft, an aircraft
-    without the field)."""
-    if speed_m_s is not None:
-        return _linear_speed(speed_m_s)
-    if isinstance(wing, Aircraft):
-        cruise = (CRUISE_SPEED_M_S if wing.flight_problem() is None
-                  else wing.airframe.cruise_speed_m_s)
-        if cruise is None:
-            raise InputError(f"aircraft {wing.name!r} has no airframe.cruise_speed_m_s: give "
-                             "speed_m_s [m/s]")
-        return float(cruise)
-    if wing is None or wing.model.airframe is PROTOTYPE_AIRFRAME:
-        return CRUISE_SPEED_M_S
-    raise InputError(f"wing {wing.variant.name!r} is built for airframe "
-                     f"{wing.model.airframe.name!r}: give speed_m_s [m/s] (or pass its "
-                     "Aircraft, whose cruise speed is the default)")
 
 
 def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:3",
@@ -277,16 +280,17 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
     configuration made (and so checked) before the airframe loads."""
     if models is None:
         models = ("rigid", "coupled", "qsd") if aero == "quasi-steady" else ("coupled",)
-    build = _flying_wing(wing)  # what the aircraft cannot fly first: the more basic refusal
+    subject = _Subject.of(wing)
+    build = subject.flying_build()  # what the aircraft cannot fly first: the more basic refusal
     if not isinstance(models, str) and "native" in tuple(models):
         raise InputError(f"unknown model 'native'; give one or more of {', '.join(MODELS)} "
                          "(the native wing is an exported aircraft's: docs/native.md)")
     chord = build.airframe.reference.mean_chord_m  # the shortest gust: one mean chord
-    config = RunConfig(_flight_speed(wing, speed_m_s), parse_gust(_gust_text(gust), chord),
+    config = RunConfig(subject.flight_speed(speed_m_s), parse_gust(_gust_text(gust), chord),
                        duration_s, gust_start_s, altitude_m, dt_s, models=models, aero=aero,
                        trim=trim)
     check_recorders(recorders, config.models)
-    airframe = airframe_for(wing) if isinstance(wing, Aircraft) else Airframe()
+    airframe = subject.jsbsim_airframe()
     out = {}
     for model in map(str, config.models):
         recorder = (recorders or {}).get(model)
@@ -419,9 +423,10 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     ``wing`` an :class:`Aircraft` (or its wing): the model is its own (S, c̄, mass, I_yy, the
     derivatives of its file, its planform; the air of its [air]); ``None`` the prototype's
     rigid aircraft."""
-    air = _density(wing, None)
-    speed_m_s = _analysis_speed(wing, speed_m_s)
-    wing = _wing(wing)
+    subject = _Subject.of(wing)
+    air = subject.density(None)
+    speed_m_s = subject.analysis_speed(speed_m_s)
+    wing = subject.build
     if trim not in ("rigid", "elastic"):
         raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
     if trim == "elastic":
@@ -535,9 +540,10 @@ def modes(wing, speed_m_s: float | Iterable[float] | None = None, model: str = "
             raise InputError("a clamped wing's modes need speed_m_s [m/s]")
         speed_m_s = _linear_speed(speed_m_s)
         return _clamped_modes(wing, speed_m_s, aero, method, structural_damping)
-    air = _density(wing, None)
-    speed_m_s = _analysis_speed(wing, speed_m_s)
-    wing = _wing(wing)
+    subject = _Subject.of(wing)
+    air = subject.density(None)
+    speed_m_s = subject.analysis_speed(speed_m_s)
+    wing = subject.build
     if aero == "unsteady":
         if model != "coupled":
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
@@ -613,8 +619,9 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     if clamped:
         return _clamped_flutter(wing, range_m_s, aero, method, structural_damping,
                                 density_kg_m3, lift_slope, scan)
-    air = _density(wing, density_kg_m3)
-    wing = _wing(wing)
+    subject = _Subject.of(wing)
+    air = subject.density(density_kg_m3)
+    wing = subject.build
     aero = aero or FREE_DEFAULT_AERO
     _check_choice("aerodynamics", aero, AERO_MODELS)
     if method not in (None, "state-space"):
@@ -642,11 +649,9 @@ def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[flo
     5-40 m/s told the SGS sailplane "no instability" while it flutters at 59 m/s).
     ``build``: a :class:`WingBuild` or an :class:`Aircraft` (its wing); ``density_kg_m3``
     [kg/m^3]: the air's (None: an Aircraft's [air], else sea level)."""
-    if density_kg_m3 is None:
-        density_kg_m3 = _density(build, None).get("density_kg_m3")
-    else:
-        density_kg_m3 = _check_density(density_kg_m3)
-    return _free_speed_range_m_s(_wing(build), density_kg_m3)
+    subject = _Subject.of(build)
+    return _free_speed_range_m_s(subject.build,
+                                 subject.density(density_kg_m3).get("density_kg_m3"))
 
 
 def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope, scan):
@@ -685,7 +690,7 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
     ``density_kg_m3`` [kg/m^3]: the air's (None: the run's own)."""
     from bioflex_jsb.loads import section_loads as _section_loads
 
-    build = _wing(wing)
+    build = _Subject.of(wing).build
     if build is None:
         raise InputError("section loads need the wing the run flew (a WingBuild or an "
                          "Aircraft), not None")
