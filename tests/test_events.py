@@ -55,7 +55,7 @@ def test_the_log_schema_is_foxglove_published_one_and_its_runtime_reads_our_even
     pytest.importorskip("foxglove_schemas_protobuf")
     from foxglove_schemas_protobuf import Log_pb2
 
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
 
     published = Log_pb2.DESCRIPTOR
     assert fox.LOG_FILE == published.serialized_pb

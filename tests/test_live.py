@@ -29,7 +29,7 @@ import time
 import pytest
 
 from bioflex_jsb.sinks.mcap import summarise
-from bioflex_jsb.sinks.mcap.protobuf import decoder
+from bioflex_jsb.sinks.mcap_io.protobuf import decoder
 from tests.cli_helpers import assert_one_line_error, run_cli
 from tests.tools import protobuf_class
 
@@ -623,7 +623,7 @@ def test_chunks_close_within_the_live_span_only_while_a_client_listens(
     from bioflex_jsb.simulation.channels import channel_units
     from bioflex_jsb.simulation.run import RunDescription
     from bioflex_jsb.sinks import mcap as sink
-    from bioflex_jsb.sinks.mcap.writer import CHUNK_WALL_S, LIVE_CHUNK_WALL_S
+    from bioflex_jsb.sinks.mcap_io.writer import CHUNK_WALL_S, LIVE_CHUNK_WALL_S
 
     clock = _Clock()
     monkeypatch.setattr(log_module, "time", clock)

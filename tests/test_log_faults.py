@@ -215,8 +215,8 @@ def test_a_channel_whose_schema_is_lost_is_not_copied_without_it():
     import io
     import struct
 
-    from bioflex_jsb.sinks.mcap.recover import _Copier
-    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+    from bioflex_jsb.sinks.mcap_io.recover import _Copier
+    from bioflex_jsb.sinks.mcap_io.writer import McapFileWriter
 
     copier = _Copier(McapFileWriter(io.BytesIO(), library="test"))
 
@@ -250,7 +250,7 @@ def test_embedded_foxglove_schemas_are_the_published_ones():
     pb = pytest.importorskip("foxglove_schemas_protobuf")
     from foxglove_schemas_protobuf import FrameTransform_pb2, LocationFix_pb2
 
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
 
     published = published_files(FrameTransform_pb2.DESCRIPTOR, LocationFix_pb2.DESCRIPTOR)
     assert fox.FILES == published, pb.__name__

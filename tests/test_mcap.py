@@ -543,7 +543,7 @@ def test_sigkill_loses_at_most_one_chunk_and_recovers(tmp_path, node_check, caps
 
 def test_varints_are_canonical_protobuf():
     """The timestamp varints: every length 1 … 5 bytes, equal to the shortest encoding."""
-    from bioflex_jsb.sinks.mcap import protobuf, records
+    from bioflex_jsb.sinks.mcap_io import protobuf, records
 
     v = np.array([0, 1, 127, 128, 16383, 16384, 2**21 - 1, 2**21, 2**28 - 1, 2**28,
                   999_999_999], dtype=np.int64)
@@ -564,7 +564,7 @@ def test_records_write_the_sampled_records_at_their_steps_only():
     index entries point at its records."""
     import struct
 
-    from bioflex_jsb.sinks.mcap import protobuf, records
+    from bioflex_jsb.sinks.mcap_io import protobuf, records
 
     def pieces(ls, ln):
         return [records.doubles((1,)),

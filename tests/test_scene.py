@@ -56,7 +56,7 @@ def gust_log(tmp_path_factory, build):
 def test_embedded_scene_schemas_are_the_published_ones():
     from foxglove_schemas_protobuf import SceneUpdate_pb2
 
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
 
     published = published_files(SceneUpdate_pb2.DESCRIPTOR)
     assert list(published) == list(fox.SCENE_UPDATE_FILES)

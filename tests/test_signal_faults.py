@@ -122,7 +122,7 @@ def test_signal_inside_a_jsbsim_callback_during_a_sitl_session(tmp_path):
 # signals. It raised KeyboardInterrupt there, and 5 of 22 logs of SIGINT-ed `gust` runs had
 # their footer and data CRC wrong (the review of 2026-12-03).
 IN_CHUNK_WRITE = """
-from bioflex_jsb.sinks.mcap import writer as _w
+from bioflex_jsb.sinks.mcap_io import writer as _w
 _orig = _w.McapFileWriter._write_now
 _n = [0]
 def _wrapped(self, data):

@@ -159,7 +159,7 @@ def _escape_unencodable_output() -> None:
 
 def _is_log_write_error(exc: OSError) -> bool:
     """A log that could not be written (the MCAP sink's own OSError, one line)."""
-    mcap_errors = sys.modules.get("bioflex_jsb.sinks.mcap.errors")
+    mcap_errors = sys.modules.get("bioflex_jsb.sinks.mcap_io.errors")
     return mcap_errors is not None and isinstance(exc, mcap_errors.LogWriteError)
 
 

@@ -3,7 +3,7 @@
 One :class:`LiveServer` per command (a SITL session's files come and go, the server stays):
 the Foxglove SDK's WebSocket server (``foxglove-sdk``, the optional extra ``live``) on its
 own SDK context. Each MCAP log the run writes is *teed* (:meth:`LiveServer.attach`: the
-writer's ``on_chunk`` hook, :class:`~bioflex_jsb.sinks.mcap.writer.McapFileWriter`): every
+writer's ``on_chunk`` hook, :class:`~bioflex_jsb.sinks.mcap_io.writer.McapFileWriter`): every
 chunk's message records, the bytes the file gets, are forwarded with the topic, schema
 (name, encoding, the embedded ``FileDescriptorSet``), channel metadata and log time of the
 file's channel, so a live client decodes exactly what Foxglove would read from the file.

@@ -68,7 +68,6 @@ data, never command-line arguments, and raises its own one-line errors
 """
 
 from bioflex_jsb.sinks.mcap.compare import compare_logs
-from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError
 from bioflex_jsb.sinks.mcap.formatting import enu_quaternion
 from bioflex_jsb.sinks.mcap.history import READ_MAX_STEPS, histories
 from bioflex_jsb.sinks.mcap.log import AutopilotRecorder, RunLog, TableRecorder
@@ -80,7 +79,6 @@ from bioflex_jsb.sinks.mcap.reader import (
     read_metadata,
     summarise,
 )
-from bioflex_jsb.sinks.mcap.recover import check_chunks, recover
 from bioflex_jsb.sinks.mcap.schemas import (
     AUTOPILOT_ACTIONS,
     AUTOPILOT_PHASES,
@@ -95,7 +93,10 @@ from bioflex_jsb.sinks.mcap.schemas import (
     body_frame,
     topic,
 )
-from bioflex_jsb.sinks.mcap.writer import (
+from bioflex_jsb.sinks.mcap.writers import recover
+from bioflex_jsb.sinks.mcap_io.errors import LogError, LogWriteError
+from bioflex_jsb.sinks.mcap_io.recover import check_chunks
+from bioflex_jsb.sinks.mcap_io.writer import (
     CHUNK_MAX_BYTES,
     CHUNK_SPAN_S,
     CHUNK_WALL_S,

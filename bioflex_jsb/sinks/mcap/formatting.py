@@ -19,7 +19,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from bioflex_jsb.sinks.mcap.protobuf import (
+from bioflex_jsb.sinks.mcap.schemas import (
+    PROTO_FIELDS,
+    RIGID_FIELDS,
+    RIGID_OPTIONAL,
+    WORLD_FRAME,
+    body_frame,
+)
+from bioflex_jsb.sinks.mcap_io.protobuf import (
     I64,
     LEN,
     VARINT,
@@ -28,15 +35,8 @@ from bioflex_jsb.sinks.mcap.protobuf import (
     tag,
     varint,
 )
-from bioflex_jsb.sinks.mcap.records import Records, doubles, packed, sample_steps, timestamp
-from bioflex_jsb.sinks.mcap.schemas import (
-    PROTO_FIELDS,
-    RIGID_FIELDS,
-    RIGID_OPTIONAL,
-    WORLD_FRAME,
-    body_frame,
-)
-from bioflex_jsb.sinks.mcap.writer import OP_MESSAGE
+from bioflex_jsb.sinks.mcap_io.records import Records, doubles, packed, sample_steps, timestamp
+from bioflex_jsb.sinks.mcap_io.writer import OP_MESSAGE
 
 STEP_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location")
 
@@ -160,7 +160,7 @@ class AutopilotRecords:
         got = self._dtypes.get(n_pwm)
         if got is not None:
             return got
-        from bioflex_jsb.sinks.mcap.protobuf import I32, VARINT
+        from bioflex_jsb.sinks.mcap_io.protobuf import I32, VARINT
 
         num = self._number
         names, formats, offsets, consts = [], [], [], {}

@@ -28,9 +28,9 @@ import numpy as np
 
 from bioflex_jsb.simulation.channels import CHANNELS, describe
 from bioflex_jsb.simulation.results import TimeHistory
-from bioflex_jsb.sinks.mcap.errors import LogError
 from bioflex_jsb.sinks.mcap.reader import NotOurs, iter_messages, open_reader, read_metadata
 from bioflex_jsb.sinks.mcap.schemas import EVENTS_TOPIC, RIGID_BODY_CHANNELS, RUN_METADATA
+from bioflex_jsb.sinks.mcap_io.errors import LogError
 from bioflex_jsb.values import is_finite_real, is_real
 
 # At most this many steps (messages of rigid_body and lti_prediction topics) per read: 17

@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from bioflex_jsb.sinks.mcap.records import Records, packed
 from bioflex_jsb.sinks.mcap.schemas import PROTO_FIELDS, topic
-from bioflex_jsb.sinks.mcap.writer import signals_deferred
+from bioflex_jsb.sinks.mcap_io.records import Records, packed
+from bioflex_jsb.sinks.mcap_io.writer import signals_deferred
 
 if TYPE_CHECKING:
-    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+    from bioflex_jsb.sinks.mcap_io.writer import McapFileWriter
 
 GROUP = "loads"
 TAGS = {"force_summation": "fs", "mode_displacement": "md"}

@@ -23,7 +23,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from bioflex_jsb import __version__
-from bioflex_jsb.sinks.mcap.errors import LogWriteError
 from bioflex_jsb.sinks.mcap.formatting import (
     AutopilotRecords,
     ModelChannels,
@@ -44,7 +43,8 @@ from bioflex_jsb.sinks.mcap.schemas import (
     WORLD_FRAME,
     topic,
 )
-from bioflex_jsb.sinks.mcap.writer import (
+from bioflex_jsb.sinks.mcap_io.errors import LogWriteError
+from bioflex_jsb.sinks.mcap_io.writer import (
     CHUNK_SPAN_S,
     McapFileWriter,
     signals_deferred,

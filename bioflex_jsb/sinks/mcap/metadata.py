@@ -18,7 +18,7 @@ from typing import Any
 from bioflex_jsb import __version__
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.run import RunDescription, RunDescriptionError
-from bioflex_jsb.sinks.mcap.errors import LogError
+from bioflex_jsb.sinks.mcap_io.errors import LogError
 
 DESCRIPTION_KEY = "description"
 TIME_BASE = "log and publish times are simulation time [ns from the run start]"

@@ -11,10 +11,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
-from bioflex_jsb.sinks.mcap.protobuf import decoder
 from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC
-from bioflex_jsb.sinks.mcap.writer import MAGIC
+from bioflex_jsb.sinks.mcap_io.errors import LogError, bad_data_errors
+from bioflex_jsb.sinks.mcap_io.protobuf import decoder
+from bioflex_jsb.sinks.mcap_io.writer import MAGIC
 from bioflex_jsb.values import is_real
 
 
@@ -42,8 +42,8 @@ def verify(path: str | Path) -> dict:
     """Every CRC and record of the log checked (:func:`.recover.check_chunks`); LogError,
     one line, for a file that is unfinished (being written, or its writer killed:
     :mod:`.writers`) or damaged anywhere (header, chunks, metadata, summary, footer)."""
-    from bioflex_jsb.sinks.mcap.recover import check_chunks
     from bioflex_jsb.sinks.mcap.writers import unfinished_message
+    from bioflex_jsb.sinks.mcap_io.recover import check_chunks
 
     p = check_file(path)
     result = check_chunks(p)

@@ -36,8 +36,16 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
-from bioflex_jsb.sinks.mcap.records import (
+from bioflex_jsb.sinks.mcap.schemas import (
+    AIRFRAME_GROUP,
+    SCENE_GROUP,
+    SCENE_METADATA,
+    SCENE_PROTO_SCHEMA,
+    body_frame,
+    topic,
+)
+from bioflex_jsb.sinks.mcap_io.protobuf import I64, LEN, VARINT, string_field, tag, varint
+from bioflex_jsb.sinks.mcap_io.records import (
     F,
     Records,
     consts,
@@ -47,17 +55,9 @@ from bioflex_jsb.sinks.mcap.records import (
     sub,
     timestamp,
 )
-from bioflex_jsb.sinks.mcap.schemas import (
-    AIRFRAME_GROUP,
-    SCENE_GROUP,
-    SCENE_METADATA,
-    SCENE_PROTO_SCHEMA,
-    body_frame,
-    topic,
-)
 
 if TYPE_CHECKING:
-    from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+    from bioflex_jsb.sinks.mcap_io.writer import McapFileWriter
 
 # DECISION: a display's frame rate. The 3-D panel draws at most this often; the wing modes
 # (31-107 Hz) are sampled, not resolved (the modal topic has every step).

@@ -30,10 +30,10 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.protobuf import I64, tag
-from bioflex_jsb.sinks.mcap.records import F, Records, consts, dbl, entity_head, sub, timestamp
 from bioflex_jsb.sinks.mcap.schemas import body_frame, topic
-from bioflex_jsb.sinks.mcap.writer import signals_deferred
+from bioflex_jsb.sinks.mcap_io.protobuf import I64, tag
+from bioflex_jsb.sinks.mcap_io.records import F, Records, consts, dbl, entity_head, sub, timestamp
+from bioflex_jsb.sinks.mcap_io.writer import signals_deferred
 
 GROUP = "scene_loads"  # /bioflex/<model>/scene_loads
 ENTITY_ID = "section_loads"

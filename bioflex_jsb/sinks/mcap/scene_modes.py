@@ -28,8 +28,6 @@ import numpy as np
 
 from bioflex_jsb import __version__
 from bioflex_jsb.sinks.mcap.formatting import log_message
-from bioflex_jsb.sinks.mcap.protobuf import length_delimited, string_field, varint
-from bioflex_jsb.sinks.mcap.records import Records
 from bioflex_jsb.sinks.mcap.scene import (
     AircraftMesh,
     airframe_outline,
@@ -53,7 +51,9 @@ from bioflex_jsb.sinks.mcap.schemas import (
     body_frame,
     topic,
 )
-from bioflex_jsb.sinks.mcap.writer import McapFileWriter
+from bioflex_jsb.sinks.mcap_io.protobuf import length_delimited, string_field, varint
+from bioflex_jsb.sinks.mcap_io.records import Records
+from bioflex_jsb.sinks.mcap_io.writer import McapFileWriter
 
 MODEL = "modes"
 MODES_METADATA = "bioflex.modes"

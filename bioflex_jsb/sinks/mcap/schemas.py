@@ -287,7 +287,7 @@ def _typed_fields(group: str) -> tuple[tuple[str, int, bool, int, str | None], .
     """(field, number, repeated, protobuf type, enum) of a message with integer or enum
     fields: a JSON ``integer`` (or an array of them) is ``fixed32``, a ``string`` with an
     ``enum`` the protobuf enum named by its ``title``, anything else a double."""
-    from bioflex_jsb.sinks.mcap.protobuf import TYPE_DOUBLE, TYPE_ENUM, TYPE_FIXED32
+    from bioflex_jsb.sinks.mcap_io.protobuf import TYPE_DOUBLE, TYPE_ENUM, TYPE_FIXED32
 
     props = SCHEMAS[group]["properties"]
     out = []
@@ -304,8 +304,8 @@ def _typed_fields(group: str) -> tuple[tuple[str, int, bool, int, str | None], .
 
 
 def _proto_schemas() -> dict[str, tuple[str, bytes]]:
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
-    from bioflex_jsb.sinks.mcap.protobuf import (
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io.protobuf import (
         file_descriptor,
         file_descriptor_set,
         typed_file_descriptor,
@@ -335,8 +335,8 @@ PROTO_SCHEMAS: dict[str, tuple[str, bytes]] = _proto_schemas()
 
 
 def _event_schema() -> tuple[str, bytes]:
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
-    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor_set
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io.protobuf import file_descriptor_set
 
     return EVENT_SCHEMA, file_descriptor_set(fox.files(fox.LOG_FILES))
 
@@ -346,8 +346,8 @@ EVENTS_PROTO_SCHEMA: tuple[str, bytes] = _event_schema()
 
 
 def _scene_schema() -> tuple[str, bytes]:
-    from bioflex_jsb.sinks.mcap import foxglove_descriptors as fox
-    from bioflex_jsb.sinks.mcap.protobuf import file_descriptor_set
+    from bioflex_jsb.sinks.mcap_io import foxglove_descriptors as fox
+    from bioflex_jsb.sinks.mcap_io.protobuf import file_descriptor_set
 
     return SCENE_SCHEMA, file_descriptor_set(fox.files(fox.SCENE_UPDATE_FILES))
 

@@ -85,3 +85,13 @@ def unfinished_message(path: str | Path, missing: str = "no summary or footer") 
                 f"was killed, {recover} repairs it")
     return (f"{name!r} is unfinished ({missing}): its writer was killed before closing it; "
             f"{recover} repairs it (every complete chunk)")
+
+
+def recover(path: str | Path, out: str | Path) -> dict:
+    """A killed or damaged log's intact chunks copied into the finished log ``out``
+    (:func:`bioflex_jsb.sinks.mcap_io.recover.recover`), its library marked as bioflex-jsb's
+    recovered copy."""
+    from bioflex_jsb import __version__
+    from bioflex_jsb.sinks.mcap_io.recover import recover as copy_intact
+
+    return copy_intact(path, out, library=f"bioflex-jsb {__version__} (recovered)")

@@ -27,9 +27,8 @@ import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
-from bioflex_jsb import __version__
-from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError, bad_data_errors
-from bioflex_jsb.sinks.mcap.writer import MAGIC, McapFileWriter
+from bioflex_jsb.sinks.mcap_io.errors import LogError, LogWriteError, bad_data_errors
+from bioflex_jsb.sinks.mcap_io.writer import MAGIC, McapFileWriter
 
 _OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
 _OP_METADATA, _OP_DATA_END = 0x0C, 0x0F
@@ -219,7 +218,7 @@ class _Copier:
             self.last_ns = log_ns if self.last_ns is None else max(self.last_ns, log_ns)
 
 
-def recover(path: str | Path, out: str | Path) -> dict:
+def recover(path: str | Path, out: str | Path, library: str) -> dict:
     """Copy every intact record of a (killed or damaged) log into a finished, indexed file
     ``out``: every chunk that checks (module docstring), also those after a damaged one
     (each skipped chunk is listed in ``skipped``: its byte offset and why). Returns counts,
@@ -238,7 +237,7 @@ def recover(path: str | Path, out: str | Path) -> dict:
     except OSError as exc:
         raise LogWriteError(f"cannot write {str(dst)!r}: {exc.strerror}") from None
     with fout:
-        writer = McapFileWriter(fout, library=f"bioflex-jsb {__version__} (recovered)",
+        writer = McapFileWriter(fout, library=library,
                                 background=False)
         copier = _Copier(writer)
         skipped: list[str] = []

@@ -21,8 +21,8 @@ import numba
 import numpy as np
 
 from bioflex_jsb.simulation.step_kernel import guard_cache
-from bioflex_jsb.sinks.mcap.protobuf import I64, LEN, VARINT, string_field, tag, varint
-from bioflex_jsb.sinks.mcap.writer import OP_MESSAGE
+from bioflex_jsb.sinks.mcap_io.protobuf import I64, LEN, VARINT, string_field, tag, varint
+from bioflex_jsb.sinks.mcap_io.writer import OP_MESSAGE
 
 # A record's pieces: bytes (constant), F (a double, the next column of the chunk's float
 # matrix), SEC / NSEC (the timestamp's seconds / nanoseconds varint).

@@ -3,7 +3,7 @@
 The header (and whatever the caller writes before the first chunk: metadata, schemas,
 channels) is handed to the operating system when the writer is created and by
 :meth:`McapFileWriter.flush`, so a process killed before its first step leaves a file that
-:func:`~bioflex_jsb.sinks.mcap.recover.recover` turns into a finished, empty log.
+:func:`~bioflex_jsb.sinks.mcap_io.recover.recover` turns into a finished, empty log.
 
 Every record other than the messages in a chunk is serialised with the ``mcap`` package's
 record classes; the messages themselves are written here (the package's ``Writer`` costs
