@@ -365,3 +365,44 @@ def air_velocity_body(airspeed_m_s: float, alpha_rad: float, beta_rad: float
     cb = math.cos(beta_rad)
     return (airspeed_m_s * math.cos(alpha_rad) * cb, airspeed_m_s * math.sin(beta_rad),
             airspeed_m_s * math.sin(alpha_rad) * cb)
+
+
+class SensorRows:
+    """The sensor channels of each step of a run, for the coupled step
+    (:mod:`bioflex_jsb.runtime.coupled_step`): :meth:`before` with the wing's state at t_k
+    before its step, :meth:`row` with the rigid body's :data:`KINEMATICS` at t_k and the
+    wing's η_{k+1} after it (module docstring: central differences, η_{−1} = η_0 − Δt η̇_0,
+    a wing at rest before the run). ``rate_state``: the wing's η̇ is a state (the coupled,
+    unsteady and native wings; not the quasi-static one)."""
+
+    def __init__(self, sensor_set: SensorSet, dt_s: float, rate_state: bool) -> None:
+        self.set = sensor_set
+        self.dt_s = float(dt_s)
+        self.rate_state = bool(rate_state)
+        n = sensor_set.n_modes
+        self.n_modes = n
+        self.eta_prev: np.ndarray | None = None
+        self.eta_k = np.zeros(n)
+        self.eta_dot_k = np.zeros(n)
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        return self.set.channels
+
+    def before(self, eta, eta_dot) -> None:
+        """The wing's η_k [rad], η̇_k [rad/s] (before its step k)."""
+        n = self.n_modes
+        self.eta_k[:] = np.asarray(eta, dtype=float)[:n]
+        self.eta_dot_k[:] = np.asarray(eta_dot, dtype=float)[:n]
+        if self.eta_prev is None:
+            self.eta_prev = self.eta_k - self.dt_s * self.eta_dot_k
+
+    def row(self, kin, eta_next, t_s: float) -> np.ndarray:
+        """The channels at t_k (``t_s`` [s]) from the rigid body's ``kin`` then and the
+        wing's η_{k+1} [rad] (reused array)."""
+        dot, ddot = central_modal_kinematics(self.eta_prev, self.eta_k,
+                                             np.asarray(eta_next, dtype=float)[:self.n_modes],
+                                             self.eta_dot_k, self.dt_s, self.rate_state)
+        values = self.set.read(kin, self.eta_k, dot, ddot, t_s)
+        self.eta_prev[:] = self.eta_k
+        return values
