@@ -230,7 +230,8 @@ class CoupledStep:
         self.model = model
         self.aero = aero
         self.units = channel_units(self.n_modes)
-        self._sensors = self._sensor_rows(sensors, airframe)
+        self._kin_get = None  # the readers of _kinematics, bound at its first call
+        self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
             self.units.update(sensors.units)
         self.names = tuple(self.units)
@@ -275,23 +276,20 @@ class CoupledStep:
         self._write_reactions = airframe.external_reaction_writer()
 
     # -- the sensors ------------------------------------------------------------------------
-    def _sensor_rows(self, sensors: SensorSet | None, airframe: Airframe) -> SensorRows | None:
-        """The rows' sensor channels (None without sensors) and the readers of the rigid
-        body's kinematics they need (:meth:`_kinematics`)."""
+    def _sensor_rows(self, sensors: SensorSet | None) -> SensorRows | None:
+        """The rows' sensor channels (None without sensors)."""
         if sensors is None or not len(sensors):
             return None
         if sensors.n_modes not in (0, self.n_modes):
             raise InputError(f"the sensors carry {sensors.n_modes} modes, the wing flies "
                              f"{self.n_modes}")
-        node = airframe.property_node
-        self._kin_get = tuple(node(p).get_double_value for p in (
-            JP.FORCES_FBX_TOTAL_LBS, JP.FORCES_FBY_TOTAL_LBS, JP.FORCES_FBZ_TOTAL_LBS,
-            JP.INERTIA_MASS_SLUGS, JP.ACCELERATIONS_PDOT_RAD_SEC2,
-            JP.ACCELERATIONS_QDOT_RAD_SEC2, JP.ACCELERATIONS_RDOT_RAD_SEC2))
-        self._kin = np.zeros(len(SENSOR_KINEMATICS))
-        rows = SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state)
-        self._sensor_cols = None  # their columns of the table (set with the names)
-        return rows
+        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state)
+
+    def rigid_kinematics(self, wind_down_fps: float) -> np.ndarray:
+        """The rigid body's kinematics now, as the sensor channels take them
+        (:meth:`_kinematics`; a reused array): for a driver that reads a sensor at the
+        state a step reached (the ArduPilot backend)."""
+        return self._kinematics(wind_down_fps)
 
     @property
     def model_rate_state(self) -> bool:
@@ -300,10 +298,17 @@ class CoupledStep:
 
     def _kinematics(self, wind_down_fps: float) -> np.ndarray:
         """The rigid body's :data:`~bioflex_jsb.simulation.sensors.KINEMATICS` now (SI,
-        body axes): the specific force at the CG (JSBSim's total forces over its mass, as
-        the ArduPilot backend's IMU), the rates and their rates, the CG's velocity against
-        the air with the wind ``wind_down_fps`` [ft/s, down] (FGAuxiliary's, as
-        :func:`state_reader`)."""
+        body axes; a reused array): the specific force at the CG (JSBSim's total forces
+        over its mass, as the ArduPilot backend's IMU), the rates and their rates, the CG's
+        velocity against the air with the wind ``wind_down_fps`` [ft/s, down]
+        (FGAuxiliary's, as :func:`state_reader`)."""
+        if self._kin_get is None:
+            node = self.airframe.property_node
+            self._kin_get = tuple(node(p).get_double_value for p in (
+                JP.FORCES_FBX_TOTAL_LBS, JP.FORCES_FBY_TOTAL_LBS, JP.FORCES_FBZ_TOTAL_LBS,
+                JP.INERTIA_MASS_SLUGS, JP.ACCELERATIONS_PDOT_RAD_SEC2,
+                JP.ACCELERATIONS_QDOT_RAD_SEC2, JP.ACCELERATIONS_RDOT_RAD_SEC2))
+            self._kin = np.zeros(len(SENSOR_KINEMATICS))
         g = self.get
         fx, fy, fz, mass, pd, qd, rd = (f() for f in self._kin_get)
         theta, phi = g["theta"](), g["phi"]()
