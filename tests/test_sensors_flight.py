@@ -151,3 +151,45 @@ def test_the_tip_imu_rings_at_the_first_wing_mode_of_modes(build):
     mode = api.modes(build, 15.0).get("aeroelastic_1")
     expected = abs(mode.eigenvalue.imag) / (2 * math.pi)
     assert measured == pytest.approx(expected, rel=0.01)
+
+
+def test_every_sensor_is_an_mcap_topic_holding_its_channels(build, tmp_path):
+    """A gust run's log: one topic per IMU and per airspeed probe
+    (/bioflex/<model>/imu_<name>, airspeed_<name>), a message per step holding exactly the
+    history's channels; the file passes pymcap-cli's doctor."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from bioflex_jsb.parameters.sensors import AirspeedSpec
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks import mcap as sink
+    from bioflex_jsb.sinks.mcap.reader import messages_by_topic
+
+    sensors = Sensors(imus=(_tip(build), CG_IMU),
+                      airspeeds=(AirspeedSpec("pitot", (0.3, 0.0, 0.0)),))
+    cfg = RunConfig(15.0, parse_gust("sharp:1"), 0.3, 0.1, 0.0, DT, models=("coupled",))
+    path = tmp_path / "sensors.mcap"
+    log = sink.RunLog.open(path, RunDescription(kind="gust", wing="optimised", speed_m_s=15.0,
+                                                gust="sharp:1", models=("coupled",),
+                                                duration_s=0.3))
+    try:
+        run = run_gust(Airframe(), build.model, "coupled", cfg, sensors=sensors, loads=build,
+                       recorder=log.recorder("coupled"))
+    finally:
+        log.close()
+    msgs = messages_by_topic(path)
+    tip = msgs[sink.topic("coupled", "imu_tip")]
+    assert len(tip) == len(run.time_s)
+    for field in ("ax_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s"):
+        np.testing.assert_array_equal([m[field] for _, m in tip], run[f"imu_tip_{field}"])
+    cg = msgs[sink.topic("coupled", "imu_cg")]
+    np.testing.assert_array_equal([m["az_m_s2"] for _, m in cg], run["imu_cg_az_m_s2"])
+    pitot = msgs[sink.topic("coupled", "airspeed_pitot")]
+    np.testing.assert_array_equal([m["airspeed_m_s"] for _, m in pitot],
+                                  run["airspeed_pitot_m_s"])
+    exe = Path(sys.executable).with_name("pymcap-cli")
+    if exe.exists():
+        out = subprocess.run([str(exe), "doctor", str(path)], capture_output=True, text=True,
+                             timeout=120)
+        assert out.returncode == 0 and "error" not in out.stdout.lower(), out.stdout

@@ -40,6 +40,7 @@ from bioflex_jsb.sinks.mcap.schemas import (
     PROTO_SCHEMAS,
     RUN_METADATA,
     WORLD_FRAME,
+    sensor_group,
     topic,
 )
 from bioflex_jsb.sinks.mcap.writer import (
@@ -136,6 +137,20 @@ class RunLog:
             self._schema_ids[group] = self._writer.add_schema(name, "protobuf", data)
         return self._writer.add_channel(topic(model, group), self._schema_ids[group],
                                         {"model": model, **(metadata or {})})
+
+    def _sensor_channel_id(self, model: str, kind: str, name: str, columns) -> int:
+        """The topic of the sensor ``name`` (``imu`` or ``airspeed``) of the run ``model``:
+        ``/bioflex/<model>/<kind>_<name>`` (its metadata: the sensor, the run's channels
+        it holds)."""
+        group = "imu" if kind == "imu" else "airspeed_probe"
+        if group not in self._schema_ids:
+            schema, data = PROTO_SCHEMAS[group]
+            self._schema_ids[group] = self._writer.add_schema(schema, "protobuf", data)
+        return self._writer.add_channel(
+            topic(model, sensor_group(kind, name)), self._schema_ids[group],
+            {"model": model, "sensor": name, "kind": kind, "channels": ",".join(columns),
+             "axes": "the sensor's own (its mounting from body axes x forward, y starboard, "
+                     "z down; docs/aircraft.md)"})
 
     def _model(self, model: str, names) -> _ModelChannels:
         ch = self._models.get(model)
