@@ -193,3 +193,37 @@ def test_every_sensor_is_an_mcap_topic_holding_its_channels(build, tmp_path):
         out = subprocess.run([str(exe), "doctor", str(path)], capture_output=True, text=True,
                              timeout=120)
         assert out.returncode == 0 and "error" not in out.stdout.lower(), out.stdout
+
+
+@pytest.mark.parametrize("with_tip", [False, True])
+def test_the_mavlink_vehicle_reports_its_autopilot_imu_as_highres_imu(build, with_tip):
+    """The SITL vehicle's HIGHRES_IMU: without sensors the CG's specific force and the body
+    rates (JSBSim's forces over the mass); with a wing-tip autopilot IMU its channels are in
+    the rows and the message carries the tip's reading."""
+    from pymavlink.dialects.v20 import common as mavlink
+
+    from bioflex_jsb.drivers.sitl import SitlSim
+    from bioflex_jsb.links.mavlink_telemetry import encode
+
+    sensors = Sensors(imus=(_tip(build, autopilot=True),)) if with_tip else None
+    sim = SitlSim(build, build.modes, sensors=sensors)
+    sim.trigger_gust()
+    for _ in range(300):
+        sim.step()
+    st = sim.vehicle_state()
+    get, k = sim.core.get, U.M_PER_FT / sim.core.airframe["inertia/mass-slugs"]
+    cg = tuple(sim.core.airframe[f"forces/fb{c}-total-lbs"] * k for c in "xyz")
+    if with_tip:
+        assert "imu_tip_az_m_s2" in sim.names
+        assert st.imu_accel_m_s2 != cg
+        assert abs(st.imu_accel_m_s2[2] - cg[2]) < 100.0  # the wing's modes, not nonsense
+    else:
+        assert st.imu_accel_m_s2 == cg
+        assert st.imu_gyro_rad_s == (get["p"](), get["q"](), get["r"]())
+        assert not any(n.startswith("imu_") for n in sim.names)
+    mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+    (msg,) = encode(mav, mavlink.MAVLINK_MSG_ID_HIGHRES_IMU, st)
+    back = mav.decode(bytearray(msg.pack(mav)))
+    assert back.get_type() == "HIGHRES_IMU" and back.fields_updated == 0b111111
+    assert back.zacc == pytest.approx(st.imu_accel_m_s2[2], rel=1e-6)  # a float32 field
+    assert back.ygyro == pytest.approx(st.imu_gyro_rad_s[1], rel=1e-6, abs=1e-9)

@@ -142,7 +142,7 @@ from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
-from bioflex_jsb.simulation.sensors import SensorSet, latest_modal_kinematics
+from bioflex_jsb.simulation.sensors import AutopilotImu, SensorSet
 
 G0_M_S2 = 9.80665  # standard gravity: JSBSim's at the airframe's 45° latitude
 # WGS-84, for north/east from latitude/longitude near the launch point
@@ -317,8 +317,7 @@ class ArduPilotPhysics:
         self._sensor_set = SensorSet(sensors, modes, _flown_modes(wing)) if sensors else None
         # the autopilot's IMU alone (its own noise stream: read once per reply)
         self.autopilot_imu = sensors.autopilot_imu
-        self._autopilot_set = SensorSet(Sensors(imus=(self.autopilot_imu,)), modes,
-                                        _flown_modes(wing))
+        self._autopilot = AutopilotImu(self.autopilot_imu, modes, _flown_modes(wing), dt_s)
         self._imu_sent: tuple[int, tuple, tuple] | None = None  # (frame, accel, gyro)
         self.core: CoupledStep = None  # type: ignore[assignment]
         self._new_core(dt_s)
@@ -345,10 +344,8 @@ class ArduPilotPhysics:
                            self.altitude_m, dt_s, compiled=self.compiled, aero=self.aero,
                            sensors=self._sensor_set)
         self.core = core
-        # the wing's states before the last step, for the autopilot IMU's modal rates
-        # (latest_modal_kinematics): η_{k-1}, η_k, η̇_k; at rest before the flight
-        n = core.n_modes
-        self._eta_hist = (np.zeros(n), np.zeros(n), np.zeros(n))
+        self._autopilot.dt_s = core.dt_s
+        self._autopilot.reset(core.n_modes)  # the wing at rest before the flight
         a = self.airframe
         node = a.property_node
         self._h_launch_m = core.get["h"]() * U.M_PER_FT
@@ -514,10 +511,7 @@ class ArduPilotPhysics:
             self._written_pwm = pwm_us
         k = core.k
         w_g = self.gust.at_step(k) if self.gust is not None else 0.0
-        eta_prev, _, _ = self._eta_hist
-        self._eta_hist = (self._eta_hist[1], np.array(core.eta, dtype=float),
-                          np.array(core.eta_dot, dtype=float))
-        del eta_prev
+        self._autopilot.before_step(core.eta, core.eta_dot)
         self._last_row = row = core.advance(w_g)
         if self._log is not None:
             self._step_rows.append((self.frame_k - 1, row))
@@ -614,13 +608,9 @@ class ArduPilotPhysics:
         if self._imu_sent is not None and self._imu_sent[0] == key:
             return self._imu_sent[1], self._imu_sent[2]
         core = self.core
-        kin = core.rigid_kinematics(-self._last_w_g * U.FT_PER_M)
-        eta_prev, eta_k, eta_dot_k = self._eta_hist
-        eta, eta_dot = np.asarray(core.eta, dtype=float), np.asarray(core.eta_dot, dtype=float)
-        dot, ddot = latest_modal_kinematics(eta_prev, eta_k, eta, eta_dot_k, eta_dot,
-                                            core.dt_s, core.model_rate_state)
-        v = self._autopilot_set.read(kin, eta, dot, ddot, self.t_s).tolist()
-        accel, gyro = (v[0], v[1], v[2]), (v[3], v[4], v[5])
+        accel, gyro = self._autopilot.read(core.rigid_kinematics(-self._last_w_g * U.FT_PER_M),
+                                           core.eta, core.eta_dot, self.t_s,
+                                           core.model_rate_state)
         self._imu_sent = (key, accel, gyro)
         return accel, gyro
 

@@ -406,3 +406,38 @@ class SensorRows:
         values = self.set.read(kin, self.eta_k, dot, ddot, t_s)
         self.eta_prev[:] = self.eta_k
         return values
+
+
+class AutopilotImu:
+    """The IMU an autopilot reads, at the state a step reached (ArduPilot's JSON backend,
+    the MAVLink vehicle's HIGHRES_IMU): its own :class:`SensorSet` (its own noise stream,
+    read once per sample) and the wing's states before the last step, for
+    :func:`latest_modal_kinematics`. Call :meth:`before_step` with the wing's η, η̇ before
+    each step, :meth:`read` after it."""
+
+    def __init__(self, spec: ImuSpec, modes=None, n_modes: int | None = None,
+                 dt_s: float = 1.0) -> None:
+        self.spec = spec
+        self.set = SensorSet(Sensors(imus=(spec,)), modes, n_modes)
+        self.dt_s = float(dt_s)
+        self.reset(self.set.n_modes)
+
+    def reset(self, n_modes: int) -> None:
+        """A new flight: the wing at rest before it (η_{k−1} = η_k = 0, η̇_k = 0)."""
+        self._hist = (np.zeros(n_modes), np.zeros(n_modes), np.zeros(n_modes))
+
+    def before_step(self, eta, eta_dot) -> None:
+        """The wing's η [rad], η̇ [rad/s] before the step about to be flown."""
+        self._hist = (self._hist[1], np.array(eta, dtype=float),
+                      np.array(eta_dot, dtype=float))
+
+    def read(self, kin, eta, eta_dot, t_s: float, rate_state: bool
+             ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """(specific force [m/s²], rates [rad/s]) in the IMU's axes at the newest state: the
+        rigid body's :data:`KINEMATICS` ``kin`` and the wing's η, η̇ now, at ``t_s`` [s]."""
+        eta_prev, eta_k, eta_dot_k = self._hist
+        eta, eta_dot = np.asarray(eta, dtype=float), np.asarray(eta_dot, dtype=float)
+        dot, ddot = latest_modal_kinematics(eta_prev, eta_k, eta, eta_dot_k, eta_dot,
+                                            self.dt_s, rate_state)
+        v = self.set.read(kin, eta, dot, ddot, t_s).tolist()
+        return (v[0], v[1], v[2]), (v[3], v[4], v[5])
