@@ -138,19 +138,21 @@ def _peak_hz(signal: np.ndarray, dt_s: float) -> float:
 
 
 def test_the_tip_imu_rings_at_the_first_wing_mode_of_modes(build):
-    """After a sharp gust the tip accelerometer rings at the coupled model's first
-    aeroelastic mode: its damped frequency from `modes` (api.modes, 15 m/s), within 1 %
-    (the spectral peak of a 2.5 s decay, ζ = 0.018, resolves it to ~0.1 Hz of 42 Hz)."""
+    """After a sharp gust in the linear regime (0.1 m/s) the tip accelerometer rings at the
+    coupled model's first aeroelastic mode: its damped frequency from `modes` (api.modes,
+    15 m/s, 42.02 Hz), measured +0.10 % (the spectral peak of a 2.5 s decay, ζ = 0.018);
+    bar 0.5 %. (At 1 m/s the nonlinear run itself, η₁ as much as the sensor, rings 0.8 %
+    higher.)"""
     from bioflex_jsb import api
 
     sensors = Sensors(imus=(_tip(build),))
-    cfg = RunConfig(15.0, parse_gust("sharp:1"), 3.0, 0.5, 0.0, DT, models=("coupled",))
+    cfg = RunConfig(15.0, parse_gust("sharp:0.1"), 3.0, 0.5, 0.0, DT, models=("coupled",))
     run = run_gust(Airframe(), build.model, "coupled", cfg, sensors=sensors, loads=build)
     t = run.time_s
     measured = _peak_hz(run["imu_tip_az_m_s2"][t > 0.5], DT)
     mode = api.modes(build, 15.0).get("aeroelastic_1")
     expected = abs(mode.eigenvalue.imag) / (2 * math.pi)
-    assert measured == pytest.approx(expected, rel=0.01)
+    assert measured == pytest.approx(expected, rel=0.005)
 
 
 def test_every_sensor_is_an_mcap_topic_holding_its_channels(build, tmp_path):
