@@ -229,3 +229,11 @@ def test_the_mavlink_vehicle_reports_its_autopilot_imu_as_highres_imu(build, wit
     assert back.get_type() == "HIGHRES_IMU" and back.fields_updated == 0b111111
     assert back.zacc == pytest.approx(st.imu_accel_m_s2[2], rel=1e-6)  # a float32 field
     assert back.ygyro == pytest.approx(st.imu_gyro_rad_s[1], rel=1e-6, abs=1e-9)
+
+
+def test_a_wing_sensor_without_the_mode_shapes_is_refused(build):
+    from bioflex_jsb.errors import InputError
+
+    cfg = RunConfig(15.0, parse_gust("sharp:1"), 0.1, 0.05, 0.0, DT, models=("coupled",))
+    with pytest.raises(InputError, match="mode shapes"):
+        run_gust(Airframe(), build.model, "coupled", cfg, sensors=Sensors(imus=(_tip(build),)))

@@ -155,7 +155,7 @@ def run_gust(
     keep: str = "auto",
     loads: WingBuild | LoadsModel | None = None,
     progress: Callable[[int], None] | None = None,
-    sensors: Sensors | None = None,
+    sensors: Sensors | SensorSet | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
     with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
@@ -194,8 +194,10 @@ def run_gust(
     (:mod:`bioflex_jsb.loads.stream`).
 
     ``sensors``: the aircraft's IMUs and airspeed probes
-    (:class:`~bioflex_jsb.parameters.sensors.Sensors`, in body axes from the CG); None: the
-    wing build's (``wing`` or ``loads``: an aircraft definition's ``[sensors]``). Each is
+    (:class:`~bioflex_jsb.parameters.sensors.Sensors`, in body axes from the CG, their mode
+    shapes from the build, ``wing`` or ``loads``; or a ready
+    :class:`~bioflex_jsb.simulation.sensors.SensorSet`); None: the wing build's (an
+    aircraft definition's ``[sensors]``). Each is
     channels of the history (``imu_<name>_ax_m_s2`` … ``gz_rad_s``, ``airspeed_<name>_m_s``;
     :mod:`bioflex_jsb.simulation.sensors`), ``meta["sensors"]`` says where they sit.
     """
@@ -226,9 +228,12 @@ def run_gust(
     return history
 
 
-def _sensor_set(sensors: Sensors | None, build: WingBuild | None, wing) -> SensorSet | None:
+def _sensor_set(sensors, build: WingBuild | None, wing) -> SensorSet | None:
     """The run's :class:`SensorSet` (None: no sensors): ``sensors`` or the build's, with the
-    build's modes (the wing model's first ``n_modes``)."""
+    build's modes (the wing model's first ``n_modes``); a sensor on the wing without the
+    build (its mode shapes) is refused in one line."""
+    if isinstance(sensors, SensorSet):
+        return sensors if len(sensors) else None
     if sensors is None:
         sensors = build.sensors if build is not None else None
     if not sensors:
@@ -236,6 +241,9 @@ def _sensor_set(sensors: Sensors | None, build: WingBuild | None, wing) -> Senso
     n_modes = getattr(wing, "n_modes", None)
     if isinstance(wing, WingBuild):
         n_modes = wing.model.n_modes
+    if build is None and any(s.wing is not None for s in (*sensors.imus, *sensors.airspeeds)):
+        raise InputError("a sensor on the wing needs the wing's mode shapes: give the "
+                         "WingBuild as wing or loads, or a SensorSet")
     return SensorSet(sensors, None if build is None else build.modes, n_modes)
 
 
