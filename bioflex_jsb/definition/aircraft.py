@@ -50,6 +50,7 @@ from bioflex_jsb.definition.model import (
     ModalStructure,
 )
 from bioflex_jsb.definition.reader import DefinitionError, Reader
+from bioflex_jsb.definition.sensors import resolve_sensors
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
     WingBuild,
@@ -68,6 +69,7 @@ from bioflex_jsb.parameters.airframe import (
     RigidAerodynamics,
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
+from bioflex_jsb.parameters.sensors import Sensors
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM, Planform
 
 # DECISION: the definition's [airframe] numbers and the JSBSim aircraft they describe must
@@ -392,11 +394,21 @@ class Aircraft:
             build = build_wing(self.variant(), FLYING_N_MODES, mass_basis, self.planform(),
                                self.airframe_data())
         stations = tuple(float(s) for s in self.definition.monitoring_stations)
-        if stations == DEFAULT_MONITORING_STATIONS:
+        sensors = self.sensors()
+        if stations == DEFAULT_MONITORING_STATIONS and not sensors:
             return build  # the cached build itself
         # the definition's [loads] stations go with its wing into every analysis that
-        # reports section loads (gust, compare, api.fly_gust, sweeps)
-        return dataclasses.replace(build, monitoring_stations=stations)
+        # reports section loads (gust, compare, api.fly_gust, sweeps), its [sensors] into
+        # every run that flies it
+        if stations != DEFAULT_MONITORING_STATIONS:
+            build = dataclasses.replace(build, monitoring_stations=stations)
+        return dataclasses.replace(build, sensors=sensors) if sensors else build
+
+    def sensors(self) -> Sensors:
+        """The definition's ``[sensors]`` in body axes from the CG
+        (:func:`~bioflex_jsb.definition.sensors.resolve_sensors`); none: an empty
+        :class:`~bioflex_jsb.parameters.sensors.Sensors` (the autopilot's IMU at the CG)."""
+        return resolve_sensors(self.definition.sensor_stations, self.definition)
 
     def summary(self) -> dict[str, object]:
         """The definition's airframe and wing as plain data (for logs and --json)."""

@@ -61,6 +61,7 @@ from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cl
     TWIST_UNITS,
 )
 from bioflex_jsb.definition.reader import DefinitionError, Reader
+from bioflex_jsb.definition.sensors import parse_sensors
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 from bioflex_jsb.tomlfile import read_toml
 
@@ -242,7 +243,7 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     r = Reader(data, where)
     r.keys(data, "(top level)", ("format", "name", "description", "source", "wing",
                                  "structure", "aero", "air", "analysis", "airframe",
-                                 "loads"))
+                                 "loads", "sensors"))
     fmt = data.get("format", FORMAT_VERSION)
     if fmt != FORMAT_VERSION:
         raise r.fail("format", f"must be {FORMAT_VERSION}, got {fmt!r}")
@@ -284,7 +285,9 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
                       source=r.text(data, "", "source", ""), stations=stations,
                       structure=structure, aero=aero, air=air, analysis=analysis,
                       airframe=airframe, path=path, flying=flying,
-                      monitoring_stations=_monitoring_stations(r))
+                      monitoring_stations=_monitoring_stations(r),
+                      sensor_stations=parse_sensors(r, data, stations[-1].y_m,
+                                                    airframe is not None))
 
 
 def shipped_path(name: str) -> Path:

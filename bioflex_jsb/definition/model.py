@@ -245,6 +245,9 @@ class Definition:
     # the semispan from the root [-], sorted, distinct, each 0 <= s < 1 (the tip carries no
     # load); default DEFAULT_MONITORING_STATIONS.
     monitoring_stations: tuple[float, ...] = DEFAULT_MONITORING_STATIONS
+    # [sensors]: the IMUs and airspeed probes as the file places them
+    # (definition/sensors.py SensorStation; Aircraft.sensors() in body axes from the CG)
+    sensor_stations: tuple = ()
 
     @property
     def clamped(self) -> bool:

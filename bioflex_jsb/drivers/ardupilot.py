@@ -67,11 +67,18 @@ launcher armed again: a re-launch needs ArduPilot's restart.
 
 The state sent (:meth:`ArduPilotPhysics.state`), in flight:
 
-* ``imu.gyro``: ``velocities/p-rad_sec``, ``q-``, ``r-`` (body FRD, against the Earth);
-* ``imu.accel_body``: the specific force at the CG, the non-gravitational forces
-  ``forces/fbx-total-lbs`` … (aerodynamics, propulsion, the elastic wing's
-  ``external_reactions``, ground) over ``inertia/mass-slugs``, in m/s², body FRD; JSBSim
-  computes them during the step for the state the step reached, the one sent;
+* ``imu.gyro`` and ``imu.accel_body``: the autopilot's IMU
+  (:attr:`~bioflex_jsb.parameters.sensors.Sensors.autopilot_imu`: the aircraft
+  definition's ``[sensors]`` IMU marked ``autopilot``, else its first; without sensors an
+  ideal IMU at the CG) at its station, in its axes (:mod:`bioflex_jsb.simulation.sensors`):
+  the specific force at the CG, the non-gravitational forces ``forces/fbx-total-lbs`` …
+  (aerodynamics, propulsion, the elastic wing's ``external_reactions``, ground) over
+  ``inertia/mass-slugs`` [m/s²], and the rates ``velocities/p-rad_sec``, ``q-``, ``r-``
+  (body FRD, against the Earth), carried to its point by ω̇ × r + ω × (ω × r) and, on the
+  wing, by the modes (their η̈ the mean over the last step, half a step old:
+  :func:`~bioflex_jsb.simulation.sensors.latest_modal_kinematics`); JSBSim computes the
+  forces during the step for the state the step reached, the one sent. At the CG without
+  noise this is the CG's specific force and the body rates to the bit;
 * ``position``: north/east from the launch point on the local ellipsoid radii, down =
   −(h − h_launch) [m];
 * ``velocity``: ``velocities/v-north-fps``, ``v-east-fps``, ``v-down-fps`` [m/s];
@@ -130,10 +137,12 @@ from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.links.ardupilot_json import RESEND, RESET, FrameRecord, JsonState
 from bioflex_jsb.links.ardupilot_rate import FrameRate
+from bioflex_jsb.parameters.sensors import NO_SENSORS, Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpec
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.simulation.sensors import AutopilotImu, SensorSet
 from bioflex_jsb.values import is_whole
 
 G0_M_S2 = 9.80665  # standard gravity: JSBSim's at the airframe's 45° latitude
@@ -255,6 +264,9 @@ class ArduPilotPhysics:
             WingBuild); compiled: the coupled step's compiled kernel (False: its Python step);
             both go to :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep` as they are,
             and :meth:`summary` says which step runs (:attr:`step_kind`).
+        sensors: the aircraft's sensor stations (None: the wing build's, an aircraft
+            definition's ``[sensors]``): every one is logged (its channels in the run
+            topics' rows, its own topic), the autopilot's IMU is sent (module docstring).
     """
 
     def __init__(self, airframe: Airframe, wing: ElasticWingModel | WingBuild | None,
@@ -262,7 +274,8 @@ class ArduPilotPhysics:
                  dt_s: float = DEFAULT_DT_S, gust: GustSpec | None = None,
                  gust_at_s: float = 60.0, launcher: Launcher | None = None,
                  record_every: int = 8, gust_repeat: bool = False,
-                 aero: str = "quasi-steady", compiled: bool = True) -> None:
+                 aero: str = "quasi-steady", compiled: bool = True,
+                 sensors: Sensors | None = None) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
             raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
         if not is_whole(record_every) or record_every < 0:
@@ -297,6 +310,15 @@ class ArduPilotPhysics:
         self._t_offset_s = 0.0  # session time at ArduPilot's last restart [s]
         self._frames_seen = 0
         self._flown_before_s = 0.0  # flight time of the flights before this one [s]
+        if sensors is None:
+            sensors = wing.sensors if isinstance(wing, WingBuild) else NO_SENSORS
+        modes = wing.modes if isinstance(wing, WingBuild) else None
+        self.sensors = sensors
+        self._sensor_set = SensorSet(sensors, modes, _flown_modes(wing)) if sensors else None
+        # the autopilot's IMU alone (its own noise stream: read once per reply)
+        self.autopilot_imu = sensors.autopilot_imu
+        self._autopilot = AutopilotImu(self.autopilot_imu, modes, _flown_modes(wing), dt_s)
+        self._imu_sent: tuple[int, tuple, tuple] | None = None  # (frame, accel, gyro)
         self.core: CoupledStep = None  # type: ignore[assignment]
         self._new_core(dt_s)
         self.dt_s = self.core.dt_s
@@ -319,8 +341,11 @@ class ArduPilotPhysics:
             self._flown_before_s += self.core.k * self.core.dt_s
             self.core.release()
         core = CoupledStep(self.airframe, self.wing_model, self.model, self.speed_m_s,
-                           self.altitude_m, dt_s, compiled=self.compiled, aero=self.aero)
+                           self.altitude_m, dt_s, compiled=self.compiled, aero=self.aero,
+                           sensors=self._sensor_set)
         self.core = core
+        self._autopilot.dt_s = core.dt_s
+        self._autopilot.reset(core.n_modes)  # the wing at rest before the flight
         a = self.airframe
         node = a.property_node
         self._h_launch_m = core.get["h"]() * U.M_PER_FT
@@ -486,6 +511,7 @@ class ArduPilotPhysics:
             self._written_pwm = pwm_us
         k = core.k
         w_g = self.gust.at_step(k) if self.gust is not None else 0.0
+        self._autopilot.before_step(core.eta, core.eta_dot)
         self._last_row = row = core.advance(w_g)
         if self._log is not None:
             self._step_rows.append((self.frame_k - 1, row))
@@ -558,8 +584,6 @@ class ArduPilotPhysics:
 
     def _flight_state(self) -> JsonState:
         get = self.core.get
-        m = self._mass()
-        k = U.M_PER_FT / m
         phi, theta = get["phi"](), get["theta"]()
         psi = math.remainder(get["psi"](), 2.0 * math.pi)
         s_n, s_e, s_d = self._stroke_ned_m
@@ -567,13 +591,28 @@ class ArduPilotPhysics:
         east = math.remainder(get["lon"]() - self._lon0, 2.0 * math.pi) * self._m_per_rad_e + s_e
         down = self._h_launch_m - get["h"]() * U.M_PER_FT + s_d
         f = U.M_PER_FT
+        accel, gyro = self.autopilot_imu_now()
         return JsonState(
-            timestamp_s=self.t_s, gyro_rad_s=(get["p"](), get["q"](), get["r"]()),
-            accel_body_m_s2=(self._fx() * k, self._fy() * k, self._fz() * k),
+            timestamp_s=self.t_s, gyro_rad_s=gyro, accel_body_m_s2=accel,
             position_ned_m=(north, east, down),
             velocity_ned_m_s=(get["vn"]() * f, get["ve"]() * f, get["vd"]() * f),
             quaternion=quaternion_from_euler(phi, theta, psi), attitude_rad=(phi, theta, psi),
             airspeed_m_s=self._vt() * f)
+
+    def autopilot_imu_now(self) -> tuple[tuple[float, float, float],
+                                         tuple[float, float, float]]:
+        """(specific force [m/s²], rates [rad/s]) of the autopilot's IMU at the state the
+        last step reached, in its axes (module docstring); read once per physics time (a
+        resend repeats the sample, its noise too)."""
+        key = (self.restarts, self.frame_k)
+        if self._imu_sent is not None and self._imu_sent[0] == key:
+            return self._imu_sent[1], self._imu_sent[2]
+        core = self.core
+        accel, gyro = self._autopilot.read(core.rigid_kinematics(-self._last_w_g * U.FT_PER_M),
+                                           core.eta, core.eta_dot, self.t_s,
+                                           core.model_rate_state)
+        self._imu_sent = (key, accel, gyro)
+        return accel, gyro
 
     # -- recording --------------------------------------------------------------------------
     def log_to(self, log) -> None:
@@ -653,3 +692,10 @@ class ArduPilotPhysics:
             "gust_report": {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                             for k, v in self.gust_report.items()},
         }
+
+
+def _flown_modes(wing) -> int | None:
+    """The modes the wing flies (its model's), None for the native wing (its own count)."""
+    if isinstance(wing, WingBuild):
+        return wing.model.n_modes
+    return None if wing is None else wing.n_modes

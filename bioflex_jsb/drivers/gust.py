@@ -29,12 +29,14 @@ from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.interrupts import STOP, raise_if_stopped
 from bioflex_jsb.loads.model import LoadsModel, build_loads_model
 from bioflex_jsb.loads.stream import LoadStream
+from bioflex_jsb.parameters.sensors import Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.channels import mode_tips
 from bioflex_jsb.simulation.gusts import GustField
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
 from bioflex_jsb.simulation.run_config import RunConfig
+from bioflex_jsb.simulation.sensors import SensorSet
 
 # The envelope: per this span of simulated time [s], the first and last step and the steps
 # where each summary channel reaches its minimum and maximum.
@@ -153,6 +155,7 @@ def run_gust(
     keep: str = "auto",
     loads: WingBuild | LoadsModel | None = None,
     progress: Callable[[int], None] | None = None,
+    sensors: Sensors | SensorSet | None = None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
     with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
@@ -189,14 +192,26 @@ def run_gust(
     Küssner increments recovered after the steps: :mod:`bioflex_jsb.loads.unsteady`), force
     summation for the rigid model; a modes-file wing without EI, GJ has force summation only
     (:mod:`bioflex_jsb.loads.stream`).
+
+    ``sensors``: the aircraft's IMUs and airspeed probes
+    (:class:`~bioflex_jsb.parameters.sensors.Sensors`, in body axes from the CG, their mode
+    shapes from the build, ``wing`` or ``loads``; or a ready
+    :class:`~bioflex_jsb.simulation.sensors.SensorSet`); None: the wing build's (an
+    aircraft definition's ``[sensors]``). Each is
+    channels of the history (``imu_<name>_ax_m_s2`` … ``gz_rad_s``, ``airspeed_<name>_m_s``;
+    :mod:`bioflex_jsb.simulation.sensors`), ``meta["sensors"]`` says where they sit.
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
     aero, trim_mode = (v.value for v in setup.settings_for(model))  # the run's rules
     model = str(model)  # its name, as the history, the logs and the tables carry it
+    # what each η_i does at the tip (twist or deflection), for figures: from the build
+    build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
+        else None
+    sensor_set = _sensor_set(sensors, build, wing)
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
-                       trim_mode=trim_mode)
+                       trim_mode=trim_mode, sensors=sensor_set)
     refused = True
     try:
         stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
@@ -207,10 +222,29 @@ def run_gust(
     keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
     run = _GustRun(step, setup, stream, loads_meta, recorder, keep_all)
     run.fly(airframe, on_sample, progress)
-    # what each η_i does at the tip (twist or deflection), for figures: from the build
-    build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
-        else None
-    return run.history(model, trim_mode, build)
+    history = run.history(model, trim_mode, build)
+    if sensor_set is not None:
+        history.meta["sensors"] = sensor_set.describe()
+    return history
+
+
+def _sensor_set(sensors, build: WingBuild | None, wing) -> SensorSet | None:
+    """The run's :class:`SensorSet` (None: no sensors): ``sensors`` or the build's, with the
+    build's modes (the wing model's first ``n_modes``); a sensor on the wing without the
+    build (its mode shapes) is refused in one line."""
+    if isinstance(sensors, SensorSet):
+        return sensors if len(sensors) else None
+    if sensors is None:
+        sensors = build.sensors if build is not None else None
+    if not sensors:
+        return None
+    n_modes = getattr(wing, "n_modes", None)
+    if isinstance(wing, WingBuild):
+        n_modes = wing.model.n_modes
+    if build is None and any(s.wing is not None for s in (*sensors.imus, *sensors.airspeeds)):
+        raise InputError("a sensor on the wing needs the wing's mode shapes: give the "
+                         "WingBuild as wing or loads, or a SensorSet")
+    return SensorSet(sensors, None if build is None else build.modes, n_modes)
 
 
 class _GustRun:

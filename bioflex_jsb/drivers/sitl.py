@@ -73,10 +73,12 @@ from bioflex_jsb.generators.autopilot import (
 )
 from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink import VehicleState
+from bioflex_jsb.parameters.sensors import NO_SENSORS, Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
+from bioflex_jsb.simulation.sensors import AutopilotImu, SensorSet
 
 LINK_PERIOD_S = 1.0 / 200.0  # simulated time between link services [s]
 RESYNC_S = 0.25  # a loop this far behind its schedule starts a new one [s]
@@ -269,7 +271,8 @@ class SitlSim:
                  start_height_m: float = DEFAULT_START_HEIGHT_M, dt_s: float = DEFAULT_DT_S,
                  speedup: float = 1.0, airframe: Airframe | None = None,
                  trim_mode: str = "rigid", aero: str = "quasi-steady",
-                 airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S) -> None:
+                 airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S,
+                 sensors: Sensors | None = None) -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
         :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
@@ -280,7 +283,10 @@ class SitlSim:
         SITL aircraft by default, or an aircraft without an engine with the glider's
         autopilot (:func:`glider_airframe`): the vehicle then flies as a glider (its speed
         held with pitch, no altitude hold; ``glider``). ``airspeed_range_m_s``: the
-        speed targets accepted [m/s] (AIRSPEED_MS, DO_CHANGE_SPEED)."""
+        speed targets accepted [m/s] (AIRSPEED_MS, DO_CHANGE_SPEED). ``sensors``: the
+        aircraft's sensor stations (None: the WingBuild's, an aircraft definition's
+        ``[sensors]``): each is channels of the rows (and a log topic), and the autopilot's
+        IMU is reported as HIGHRES_IMU (without sensors: an ideal IMU at the CG)."""
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
         self.aero = aero
@@ -302,6 +308,11 @@ class SitlSim:
         self._k_base = 0  # steps flown by the cores before the present one
         self._reset_walls: list[float] = []
         self._dt0 = dt_s
+        if sensors is None:
+            sensors = getattr(wing_model, "sensors", None) or NO_SENSORS
+        n_flown = getattr(getattr(wing_model, "model", wing_model), "n_modes", None)
+        self._sensor_set = SensorSet(sensors, modes, n_flown) if sensors else None
+        self._autopilot_imu = AutopilotImu(sensors.autopilot_imu, modes, n_flown, dt_s)
         self._new_core(model)
         self.dt_s = self.core.dt_s
         self.n_modes = self.core.n_modes
@@ -350,7 +361,10 @@ class SitlSim:
             wing = wing.model  # a WingBuild: the model is enough for the quasi-steady strips
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
-                                trim_mode="elastic" if elastic else "rigid", aero=self.aero)
+                                trim_mode="elastic" if elastic else "rigid", aero=self.aero,
+                                sensors=self._sensor_set)
+        self._autopilot_imu.dt_s = self.core.dt_s
+        self._autopilot_imu.reset(self.core.n_modes)
         self.trim = self.core.trim
         self._relocate()
         self._get = self.core.get
@@ -432,6 +446,7 @@ class SitlSim:
         (in ``self.names`` order). A run that leaves its valid range is reset (module
         docstring); ``self.stopped`` then says why until the next step."""
         core = self.core
+        self._autopilot_imu.before_step(core.eta, core.eta_dot)
         values = core.advance(self._w_g(self.k))
         self._state = None  # the snapshot of t_k+1 is read when asked for (vehicle_state)
         if core.stopped:
@@ -509,7 +524,12 @@ class SitlSim:
         named["tip_twist"] = float(np.asarray(self._tip_twist_per_mode) @ eta)
         b = v.battery
         home = v.home
+        core = self.core
+        accel, gyro = self._autopilot_imu.read(
+            core.rigid_kinematics(-self._w_g(self.k) * U.FT_PER_M), eta,
+            core.eta_dot, self.t_s, core.model_rate_state)
         return VehicleState(
+            imu_accel_m_s2=accel, imu_gyro_rad_s=gyro,
             time_s=self.t_s, roll_rad=self._state.phi_rad, pitch_rad=self._state.theta_rad,
             yaw_rad=math.remainder(get["psi"](), 2.0 * math.pi),
             p_rad_s=get["p"](), q_rad_s=get["q"](), r_rad_s=get["r"](),

@@ -37,6 +37,7 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
     spanwise_geometry,
 )
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME, AirframeData
+from bioflex_jsb.parameters.sensors import NO_SENSORS, Sensors
 from bioflex_jsb.parameters.wing import (
     DEFAULT_PLANFORM,
     MODAL_DAMPING_RATIO,
@@ -406,6 +407,9 @@ class WingBuild:
     # the section loads' monitoring stations [fractions of the semispan, root 0]: an aircraft
     # definition's [loads] stations (Aircraft.wing), None: the loads' default stations
     monitoring_stations: tuple[float, ...] | None = None
+    # the aircraft's sensor stations in body axes from the CG (an aircraft definition's
+    # [sensors], Aircraft.wing; none: the autopilot's IMU at the CG)
+    sensors: Sensors = NO_SENSORS
 
     @property
     def airframe(self) -> AirframeData:

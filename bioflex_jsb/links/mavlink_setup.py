@@ -135,6 +135,9 @@ class VehicleState:
     battery_energy_j: float = 0.0
     battery_remaining_pct: int = 100
     battery_time_remaining_s: float = 0.0
+    # the autopilot's IMU (HIGHRES_IMU): specific force [m/s²] and rates [rad/s] in its axes
+    imu_accel_m_s2: tuple[float, float, float] = (0.0, 0.0, -9.80665)
+    imu_gyro_rad_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 class Parameters(Protocol):

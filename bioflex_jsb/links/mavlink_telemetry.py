@@ -33,14 +33,17 @@ DEFAULT_RATES_HZ = {
     M.MAVLINK_MSG_ID_EXTENDED_SYS_STATE: 1.0,
     M.MAVLINK_MSG_ID_BATTERY_STATUS: 1.0,
     M.MAVLINK_MSG_ID_MISSION_CURRENT: 1.0,
+    M.MAVLINK_MSG_ID_HIGHRES_IMU: 25.0,
 }
+HIGHRES_IMU_FIELDS = 0b111111  # fields_updated: x/y/z acceleration and x/y/z gyro
 PROTOCOL_VERSION_ID = 300  # not in pymavlink's common dialect: encoded here
 # Messages sent once on request (MAV_CMD_REQUEST_MESSAGE) but not streamed.
 ON_REQUEST = frozenset({M.MAVLINK_MSG_ID_AUTOPILOT_VERSION, PROTOCOL_VERSION_ID})
 # REQUEST_DATA_STREAM (deprecated, still sent by MAVProxy and QGC for ArduPilot): stream ids
 # → the messages they rate.
 STREAMS = {
-    M.MAV_DATA_STREAM_RAW_SENSORS: (M.MAVLINK_MSG_ID_GPS_RAW_INT,),
+    M.MAV_DATA_STREAM_RAW_SENSORS: (M.MAVLINK_MSG_ID_GPS_RAW_INT,
+                                    M.MAVLINK_MSG_ID_HIGHRES_IMU),
     M.MAV_DATA_STREAM_EXTENDED_STATUS: (M.MAVLINK_MSG_ID_SYS_STATUS,
                                         M.MAVLINK_MSG_ID_MISSION_CURRENT),
     M.MAV_DATA_STREAM_POSITION: (M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,),
@@ -149,6 +152,15 @@ def encode(mav, mid: int, s: VehicleState) -> list:
                  else M.MISSION_STATE_PAUSED)
         return [mav.mission_current_encode(s.mission_seq, total, state,
                                            1 if s.custom_mode == MODES.AUTO else 2)]
+    if mid == M.MAVLINK_MSG_ID_HIGHRES_IMU:
+        # the autopilot's IMU at its station (docs/aircraft.md, "Sensors"): specific force
+        # and rates in its axes; no magnetometer, barometer or temperature (NaN, not
+        # flagged in fields_updated: bits 0-5, the accelerometer and gyro)
+        ax, ay, az = s.imu_accel_m_s2
+        gx, gy, gz = s.imu_gyro_rad_s
+        nan = math.nan
+        return [mav.highres_imu_encode(int(s.time_s * 1e6 + 1e-3), ax, ay, az, gx, gy, gz,
+                                       nan, nan, nan, nan, nan, nan, nan, HIGHRES_IMU_FIELDS)]
     if mid == M.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
         return [mav.autopilot_version_encode(CAPABILITIES, 0, 0, 0, 0, [0] * 8, [0] * 8,
                                              [0] * 8, 0, 0, 0)]

@@ -56,6 +56,8 @@ from bioflex_jsb.simulation.modal_wing import (
     TrimReference,
     WingLoads,
 )
+from bioflex_jsb.simulation.sensors import KINEMATICS as SENSOR_KINEMATICS
+from bioflex_jsb.simulation.sensors import SensorRows, SensorSet
 
 STEP_MODELS = (*WING_MODELS, "native")
 TRIM_MODES = ("rigid", "elastic")  # the trim a run starts from (``trim_mode``)
@@ -173,6 +175,12 @@ class CoupledStep:
             ``wing`` then a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`; its
             compiled step: :mod:`bioflex_jsb.simulation.unsteady_kernel`). ``wing`` may be a
             WingBuild for either (its ``model`` is used).
+        sensors: the aircraft's IMUs and airspeed probes
+            (:class:`~bioflex_jsb.simulation.sensors.SensorSet`, the wing's modes in it):
+            each row then also holds their channels at t_k (``imu_<name>_…``,
+            ``airspeed_<name>_m_s``; :class:`~bioflex_jsb.simulation.sensors.SensorRows`
+            from JSBSim's forces, rates and their rates of the snapshot and η_{k−1}, η_k,
+            η_{k+1}); None: no sensor channels (and no cost).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -183,7 +191,7 @@ class CoupledStep:
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
-                 trim_mode: str = "rigid") -> None:
+                 trim_mode: str = "rigid", sensors: SensorSet | None = None) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
         self.airframe = airframe
@@ -222,6 +230,10 @@ class CoupledStep:
         self.model = model
         self.aero = aero
         self.units = channel_units(self.n_modes)
+        self._kin_get = None  # the readers of _kinematics, bound at its first call
+        self._sensors = self._sensor_rows(sensors)
+        if self._sensors is not None:
+            self.units.update(sensors.units)
         self.names = tuple(self.units)
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
         self._row = row_getter(self.names)
@@ -263,6 +275,53 @@ class CoupledStep:
         self.n_modes = wing.n_modes
         self._write_reactions = airframe.external_reaction_writer()
 
+    # -- the sensors ------------------------------------------------------------------------
+    def _sensor_rows(self, sensors: SensorSet | None) -> SensorRows | None:
+        """The rows' sensor channels (None without sensors)."""
+        if sensors is None or not len(sensors):
+            return None
+        if sensors.n_modes not in (0, self.n_modes):
+            raise InputError(f"the sensors carry {sensors.n_modes} modes, the wing flies "
+                             f"{self.n_modes}")
+        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state)
+
+    def rigid_kinematics(self, wind_down_fps: float) -> np.ndarray:
+        """The rigid body's kinematics now, as the sensor channels take them
+        (:meth:`_kinematics`; a reused array): for a driver that reads a sensor at the
+        state a step reached (the ArduPilot backend)."""
+        return self._kinematics(wind_down_fps)
+
+    @property
+    def model_rate_state(self) -> bool:
+        """Whether the wing's η̇ is a state (not the quasi-static wing's, which is 0)."""
+        return getattr(self.wing, "model", "native") != "qsd"
+
+    def _kinematics(self, wind_down_fps: float) -> np.ndarray:
+        """The rigid body's :data:`~bioflex_jsb.simulation.sensors.KINEMATICS` now (SI,
+        body axes; a reused array): the specific force at the CG (JSBSim's total forces
+        over its mass, as the ArduPilot backend's IMU), the rates and their rates, the CG's
+        velocity against the air with the wind ``wind_down_fps`` [ft/s, down]
+        (FGAuxiliary's, as :func:`state_reader`)."""
+        if self._kin_get is None:
+            node = self.airframe.property_node
+            self._kin_get = tuple(node(p).get_double_value for p in (
+                JP.FORCES_FBX_TOTAL_LBS, JP.FORCES_FBY_TOTAL_LBS, JP.FORCES_FBZ_TOTAL_LBS,
+                JP.INERTIA_MASS_SLUGS, JP.ACCELERATIONS_PDOT_RAD_SEC2,
+                JP.ACCELERATIONS_QDOT_RAD_SEC2, JP.ACCELERATIONS_RDOT_RAD_SEC2))
+            self._kin = np.zeros(len(SENSOR_KINEMATICS))
+        g = self.get
+        fx, fy, fz, mass, pd, qd, rd = (f() for f in self._kin_get)
+        theta, phi = g["theta"](), g["phi"]()
+        m_per_ft = U.M_PER_FT
+        k = m_per_ft / mass
+        ua = g["u"]() + wind_down_fps * math.sin(theta)
+        va = g["v"]() - wind_down_fps * math.sin(phi) * math.cos(theta)
+        wa = g["w"]() - wind_down_fps * math.cos(phi) * math.cos(theta)
+        kin = self._kin
+        kin[:] = (fx * k, fy * k, fz * k, g["p"](), g["q"](), g["r"](), pd, qd, rd,
+                  ua * m_per_ft, va * m_per_ft, wa * m_per_ft)
+        return kin
+
     # -- the wing ---------------------------------------------------------------------------
     @property
     def eta(self) -> np.ndarray:
@@ -290,6 +349,8 @@ class CoupledStep:
             self.wing.eta = np.zeros(self.n_modes)
             self.wing.eta_dot = np.zeros(self.n_modes)
             self.model = model
+            if self._sensors is not None:
+                self._sensors.rate_state = self.model_rate_state
             if self.compiled:
                 self._views["model"][0] = K.MODEL_CODES[model]
                 self.wing.prepare_arrays()
@@ -321,6 +382,10 @@ class CoupledStep:
         t = self.k * self.dt_s
         state = self.sense(w_g_m_s)
         flow = state.flow
+        sensors = self._sensors
+        if sensors is not None:  # the rigid body and the wing at t_k, before the step
+            kin = self._kinematics(-w_g_m_s * U.FT_PER_M).copy()
+            sensors.before(self.eta, self.eta_dot)
         if self.native:
             eta, eta_dot = self.eta, self.eta_dot
             lift_lbf, drag_lbf, moment_lbf_ft = (g() for g in self._native_loads)
@@ -344,7 +409,11 @@ class CoupledStep:
                                   loads.pitch_moment_n_m)
             self.airframe.step()
             new_eta = mw.eta
-        values = self._row(self._row_dict(state, w_g_m_s, loads, eta, eta_dot))
+        row = self._row_dict(state, w_g_m_s, loads, eta, eta_dot)
+        if sensors is not None:
+            row.update(zip(sensors.channels, sensors.row(kin, new_eta, t).tolist(),
+                           strict=True))
+        values = self._row(row)
         self.sensed, self.w_g_m_s = state, w_g_m_s
         self.k += 1
         alpha = flow.alpha_rad
@@ -448,7 +517,7 @@ class CoupledStep:
             table[k] = self.advance(w_g_m_s)
             return self.stopped
         if self._fast is None:
-            self._fast = self._bind_fast_step()
+            self._fast = self._bind_sensing(self._bind_fast_step())
         return self._fast(w_g_m_s, table, k)
 
     def stepper(self):
@@ -457,8 +526,30 @@ class CoupledStep:
         if not self.compiled:
             return self.advance_into
         if self._fast is None:
-            self._fast = self._bind_fast_step()
+            self._fast = self._bind_sensing(self._bind_fast_step())
         return self._fast
+
+    def _bind_sensing(self, fast):
+        """``fast`` with the sensor channels of the row (:meth:`_sensor_rows`): the rigid
+        body and the wing read before the step, the channels written after it; ``fast``
+        itself without sensors (a run without them pays nothing)."""
+        sensors = self._sensors
+        if sensors is None:
+            return fast
+        x, n, dt = self.wing._x, self.n_modes, self.dt_s  # x: updated in place by the kernel
+        kinematics, before, sensor_row = self._kinematics, sensors.before, sensors.row
+        cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.intp)
+        ft_per_m = U.FT_PER_M
+
+        def fast_sensing(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+            kin = kinematics(-w_g_m_s * ft_per_m)
+            before(x[:n], x[n:2 * n])
+            t_s = self.k * dt
+            stopped = fast(w_g_m_s, table, k)
+            table[k, cols] = sensor_row(kin, x[:n], t_s)
+            return stopped
+
+        return fast_sensing
 
     def _bind_fast_step(self):
         """The compiled path of :meth:`advance_into` as a closure over everything it uses,

@@ -57,6 +57,9 @@ FLIGHT_PATH_GAMMA_RAD = "flight-path/gamma-rad"
 
 # forces/
 FORCES_FBX_PROP_LBS = "forces/fbx-prop-lbs"
+FORCES_FBX_TOTAL_LBS = "forces/fbx-total-lbs"
+FORCES_FBY_TOTAL_LBS = "forces/fby-total-lbs"
+FORCES_FBZ_TOTAL_LBS = "forces/fbz-total-lbs"
 FORCES_FBY_AERO_LBS = "forces/fby-aero-lbs"
 FORCES_FBZ_PROP_LBS = "forces/fbz-prop-lbs"
 FORCES_FWX_AERO_LBS = "forces/fwx-aero-lbs"

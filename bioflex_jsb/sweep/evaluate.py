@@ -235,6 +235,7 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     from bioflex_jsb.drivers.gust import RunConfig, run_gust
     from bioflex_jsb.simulation.gusts import parse_gust
     from bioflex_jsb.simulation.results import gust_metrics, stop_event_text
+    from bioflex_jsb.simulation.sensors import SensorSet
 
     s = case.settings
     chord_m = build.model.airframe.reference.mean_chord_m  # the shortest gust: one chord
@@ -264,7 +265,11 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     try:
         # the unsteady strips need the wing's build (its strips); the quasi-steady its model
         wing = build if setup.needs_build(case.model) else build.model
-        run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder)
+        # the aircraft's [sensors] with the build's mode shapes (none: no sensor channels)
+        sensors = (SensorSet(build.sensors, build.modes, build.model.n_modes)
+                   if build.sensors else None)
+        run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
+                       sensors=sensors)
         if log is not None and run.stopped:  # as a gust log says it: read_log's stopped
             log.event(run.stop_time_s, "ERROR", stop_event_text(case.model, run.stopped),
                       name=case.model)

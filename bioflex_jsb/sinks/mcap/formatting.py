@@ -48,6 +48,24 @@ EVERY_STEP_GROUPS = STEP_GROUPS[:5]
 SAMPLED_GROUPS = STEP_GROUPS[5:]
 
 
+def sensor_columns(names) -> list[tuple[str, str, tuple[str, ...]]]:
+    """The sensor stations among a run's channel ``names``: (kind ``imu`` or ``airspeed``,
+    name, its channels in the topic's field order), in the names' order."""
+    from bioflex_jsb.simulation.sensors import IMU_AXES
+
+    have = set(names)
+    out = []
+    for c in names:
+        if c.startswith("imu_") and c.endswith("_" + IMU_AXES[0]):
+            name = c[len("imu_"):-len(IMU_AXES[0]) - 1]
+            cols = tuple(f"imu_{name}_{a}" for a in IMU_AXES)
+            if name and all(x in have for x in cols):
+                out.append(("imu", name, cols))
+        elif c.startswith("airspeed_") and c.endswith("_m_s") and len(c) > len("airspeed__m_s"):
+            out.append(("airspeed", c[len("airspeed_"):-len("_m_s")], (c,)))
+    return out
+
+
 class ModelChannels:
     """Channel ids and the protobuf records of one step of one wing model: seven messages
     (rigid_body … location), the last two (:data:`SAMPLED_GROUPS`) only at the steps
@@ -56,7 +74,8 @@ class ModelChannels:
     :meth:`format` builds a chunk of steps at once."""
 
     def __init__(self, channel_id: Callable[[str, str, dict[str, str] | None], int], model: str,
-                 names, rate_hz: float, bin_eps: float) -> None:
+                 names, rate_hz: float, bin_eps: float,
+                 sensor_channel_id: Callable[[str, str, str, tuple[str, ...]], int]) -> None:
         self.names = tuple(names)
         self.rate_hz, self.bin_eps = float(rate_hz), float(bin_eps)
         col = {name: i for i, name in enumerate(self.names)}
@@ -66,6 +85,11 @@ class ModelChannels:
                             "step too); every step: rigid_body"}
         self.ids = {g: channel_id(model, g, rate if g in SAMPLED_GROUPS else None)
                     for g in STEP_GROUPS}
+        # the sensor stations' topics (every step, after the other every-step ones)
+        sensors = sensor_columns(self.names)
+        sensor_ids = [sensor_channel_id(model, kind, name, cols)
+                      for kind, name, cols in sensors]
+        sensor_pieces = [doubles(range(1, len(cols) + 1)) for _, _, cols in sensors]
         self.seq = 0  # messages on each every-step topic so far (their sequence numbers)
         self.sampled_seq = 0  # messages on each sampled topic so far
         self.last_bin: int | None = None  # the sample bin of the last step formatted
@@ -75,7 +99,8 @@ class ModelChannels:
         # the raw columns copied as they are, in message order
         self.copy_cols = np.array([col[k] for k in (
             *rigid_keys, *modal_keys, "lift_n", "drag_n", "pitch_moment_n_m", "w_g",
-            "elevator_rad", "throttle")], dtype=np.intp)
+            "elevator_rad", "throttle", *(c for _, _, cols in sensors for c in cols))],
+            dtype=np.intp)
         self.i_lat, self.i_lon = col["latitude_rad"], col["longitude_rad"]
         self.i_alt = col["altitude_m"]
         self.i_att = [col["phi_rad"], col["theta_rad"], col["psi_rad"]]
@@ -92,14 +117,17 @@ class ModelChannels:
                 doubles((1, 2, 3)),
                 doubles((1,)),
                 doubles((1, 2)),
+                *sensor_pieces,
                 ts_pose + [string_field(2, WORLD_FRAME) + string_field(3, frame)
                            + tag(4, LEN) + varint(27)] + doubles((1, 2, 3))
                 + [tag(5, LEN) + varint(36)] + doubles((1, 2, 3, 4)),
                 ts_loc + [string_field(7, frame)] + doubles((1, 2, 3)) + [covariance],
             ]
 
-        self.records = Records([self.ids[g] for g in STEP_GROUPS], pieces, timestamped=True,
-                               every=len(EVERY_STEP_GROUPS))
+        ids = ([self.ids[g] for g in EVERY_STEP_GROUPS] + sensor_ids
+               + [self.ids[g] for g in SAMPLED_GROUPS])
+        self.records = Records(ids, pieces, timestamped=True,
+                               every=len(EVERY_STEP_GROUPS) + len(sensor_ids))
 
     def floats(self, v: np.ndarray, origin, sampled: np.ndarray | None = None) -> np.ndarray:
         """The doubles of each step (rows of the raw values ``v``), in record order; those of

@@ -41,6 +41,7 @@ from bioflex_jsb.sinks.mcap.schemas import (
     PROTO_SCHEMAS,
     RUN_METADATA,
     WORLD_FRAME,
+    sensor_group,
     topic,
 )
 from bioflex_jsb.sinks.mcap_io.errors import LogWriteError
@@ -144,6 +145,17 @@ class RunLog:
         return self._writer.add_channel(topic(model, group), self.schema_id(group),
                                         {"model": model, **(metadata or {})})
 
+    def sensor_channel_id(self, model: str, kind: str, name: str, columns) -> int:
+        """The topic of the sensor ``name`` (``imu`` or ``airspeed``) of the run ``model``:
+        ``/bioflex/<model>/<kind>_<name>`` (its metadata: the sensor, the run's channels
+        it holds)."""
+        group = "imu" if kind == "imu" else "airspeed_probe"
+        return self._writer.add_channel(
+            topic(model, sensor_group(kind, name)), self.schema_id(group),
+            {"model": model, "sensor": name, "kind": kind, "channels": ",".join(columns),
+             "axes": "the sensor's own (its mounting from body axes x forward, y starboard, "
+                     "z down; docs/aircraft.md)"})
+
     def _model(self, model: str, names) -> ModelChannels:
         ch = self._models.get(model)
         if ch is None:
@@ -151,7 +163,7 @@ class RunLog:
             # the body pose and the wing drawn agree), with or without a scene in the log
             rate = SCENE_RATE_HZ if self.scene is None else self.scene.rate_hz
             ch = self._models[model] = ModelChannels(self.channel_id, model, names, rate,
-                                                     SAMPLE_BIN_EPS)
+                                                     SAMPLE_BIN_EPS, self.sensor_channel_id)
         elif ch.names != tuple(names):
             raise ValueError(f"the {model} samples changed their channels")
         return ch

@@ -12,7 +12,9 @@ RUN_METADATA = "bioflex.run"
 FRAME_METADATA = "bioflex.world_frame"
 WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
-          "lti_prediction", "autopilot", "loads")
+          "lti_prediction", "autopilot", "loads", "imu", "airspeed_probe")
+# The sensor stations' topics (docs/aircraft.md, "Sensors"): one per IMU, one per airspeed
+# probe, named by the sensor (topic(model, sensor_group(kind, name)))
 # The autopilot topic's enums: (JSON schema / protobuf enum name, value names from 0); the
 # values are the drivers' codes (bioflex_jsb.drivers.ardupilot ACTIONS and PHASES)
 AUTOPILOT_ACTIONS = ("ACTION_STEP", "ACTION_RESEND", "ACTION_RESET")
@@ -36,6 +38,12 @@ SCENE_METADATA = "bioflex.scene"
 def topic(model: str, group: str) -> str:
     """The topic of ``group`` (one of :data:`GROUPS`) for the wing ``model``."""
     return f"/bioflex/{model}/{group}"
+
+
+def sensor_group(kind: str, name: str) -> str:
+    """The topic group of the sensor ``name`` of ``kind`` (``imu``, ``airspeed``):
+    ``/bioflex/<model>/imu_<name>``, ``/bioflex/<model>/airspeed_<name>``."""
+    return f"{kind}_{name}"
 
 
 def body_frame(model: str) -> str:
@@ -229,6 +237,34 @@ SCHEMAS: dict[str, dict] = {
                                 "start and restarts)"),
         },
     },
+}
+
+
+# The sensor stations (bioflex_jsb.simulation.sensors; docs/aircraft.md "Sensors"): one
+# message per step on each sensor's topic, the run's channels imu_<name>_<field>
+SCHEMAS["imu"] = {
+    "title": "bioflex.Imu",
+    "description": "An IMU at its station (the channel's metadata: sensor, and the run's "
+    "meta['sensors'] its position and axes): the specific force and the rates in its own "
+    "axes, the rigid body's at its point plus the elastic wing's modes for a wing station, "
+    "with its bias and noise (ArduPilot's SIM_ACC*/SIM_GYR* meanings). Log time: the step's.",
+    "type": "object",
+    "properties": {
+        "ax_m_s2": _num("specific force along the sensor's x axis (body x forward when "
+                        "mounted straight) [m/s^2]; at rest level, z reads -g"),
+        "ay_m_s2": _num("specific force along the sensor's y axis (starboard) [m/s^2]"),
+        "az_m_s2": _num("specific force along the sensor's z axis (down) [m/s^2]"),
+        "gx_rad_s": _num("rate about the sensor's x axis [rad/s]"),
+        "gy_rad_s": _num("rate about the sensor's y axis [rad/s]"),
+        "gz_rad_s": _num("rate about the sensor's z axis [rad/s]"),
+    },
+}
+SCHEMAS["airspeed_probe"] = {
+    "title": "bioflex.AirspeedProbe",
+    "description": "An airspeed probe at its station: the true airspeed of the air at its "
+    "point (the CG's, the rotation's and the wing's modal velocity), with its noise.",
+    "type": "object",
+    "properties": {"airspeed_m_s": _num("true airspeed at the probe [m/s]")},
 }
 
 
