@@ -180,104 +180,18 @@ class _Reader:
 
     # --------------------------------------------------------------------------------------
     def parse(self, data: dict, normalise: bool) -> ModalData:
-        unknown = sorted(set(data) - _TOP_KEYS)
-        if unknown:
-            self.fail(unknown[0], f"unknown key (accepted: {', '.join(sorted(_TOP_KEYS))})",
-                      None, unknown[0])
-        if data.get("format") != FORMAT_NAME:
-            self.fail("format", f"missing or not {FORMAT_NAME!r}", None, "format")
-        if data.get("format_version") != FORMAT_VERSION:
-            self.fail("format_version", f"missing or not {FORMAT_VERSION}", None,
-                      "format_version")
-        for key in ("source", "notes"):
-            if key in data and not isinstance(data[key], str):
-                self.fail(key, "expected a string", None, key)
-
-        units = data.get("units")
-        if not isinstance(units, dict):
-            self.fail("units", "missing [units] table (length, angle, frequency, "
-                      "generalised_mass)")
-        for key in sorted(set(units) - set(_UNIT_TABLES)):
-            self.fail(f"units.{key}", "unknown key", "units", key)
-        factor = {}
-        for key, table in _UNIT_TABLES.items():
-            if key not in units:
-                self.fail(f"units.{key}", "missing", "units")
-            if units[key] not in table:
-                self.fail(f"units.{key}",
-                          f"unknown unit {units[key]!r} (accepted: {', '.join(table)})",
-                          "units", key)
-            factor[key] = table[units[key]]
-
-        stations = data.get("stations")
-        if not isinstance(stations, dict) or "y" not in stations:
-            self.fail("stations.y", "missing [stations] table with y = [...]")
-        for key in sorted(set(stations) - {"y"}):
-            self.fail(f"stations.{key}", "unknown key", "stations", key)
-        y = self.array(stations["y"], "stations.y", "stations", "y") * factor["length"]
-        if y.size < 2:
-            self.fail("stations.y", "need at least two stations", "stations", "y")
-        if np.any(np.diff(y) <= 0.0):
-            j = int(np.argmax(np.diff(y) <= 0.0)) + 1
-            self.fail("stations.y", f"not strictly increasing at element {j}", "stations", "y")
-        if y[0] < 0.0:
-            self.fail("stations.y", "stations are on the starboard half (y ≥ 0)",
-                      "stations", "y")
+        """The file's tables read in order (header, units, stations, axes, modes), each
+        problem one line naming the key; the modal data in SI, normalised if asked."""
+        self._header(data)
+        units, factor = self._units(data)
+        y = self._stations(data, factor)
         k = y.size
-
-        axes = data.get("axes", {})
-        if not isinstance(axes, dict):
-            self.fail("axes", "expected a table")
-        for key in sorted(set(axes) - {"x_elastic_frac", "x_inertial_frac"}):
-            self.fail(f"axes.{key}", "unknown key", "axes", key)
-        x_e = self.axis(axes.get("x_elastic_frac", DEFAULT_AXIS_FRAC), "axes.x_elastic_frac",
-                        "x_elastic_frac", k)
-        x_i = self.axis(axes.get("x_inertial_frac", DEFAULT_AXIS_FRAC),
-                        "axes.x_inertial_frac", "x_inertial_frac", k)
-
+        x_e, x_i = self._axes(data, k)
         modes = data.get("mode")
         if not isinstance(modes, list) or not modes:
             self.fail("mode", "no [[mode]] table: at least one mode is needed")
-        freq, damp, mass, bend, twist = [], [], [], [], []
-        for i, mode in enumerate(modes):
-            tag = f"mode[{i + 1}]"
-            if not isinstance(mode, dict):
-                self.fail(tag, "expected a [[mode]] table")
-            for key in sorted(set(mode) - _MODE_KEYS):
-                accepted = ", ".join(sorted(_MODE_KEYS))
-                self.fail(f"{tag}.{key}", f"unknown key (accepted: {accepted})",
-                          "mode", key, i)
-            for key in ("frequency", "generalised_mass", "bending", "twist"):
-                if key not in mode:
-                    self.fail(f"{tag}.{key}", "missing", "mode", None, i)
-            f = self.number(mode["frequency"], f"{tag}.frequency", "mode", "frequency", i)
-            if f <= 0.0:
-                self.fail(f"{tag}.frequency", "must be positive", "mode", "frequency", i)
-            if not MIN_FREQUENCY_RAD_S <= f * factor["frequency"] <= MAX_FREQUENCY_RAD_S:
-                self.fail(f"{tag}.frequency", f"{f:g} {units['frequency']} is outside "
-                          f"{MIN_FREQUENCY_RAD_S:g}..{MAX_FREQUENCY_RAD_S:g} rad/s (the range "
-                          "a structural mode of the model may have)", "mode", "frequency", i)
-            z = self.number(mode.get("damping_ratio", 0.0), f"{tag}.damping_ratio", "mode",
-                            "damping_ratio", i)
-            if not 0.0 <= z < MAX_DAMPING_RATIO:
-                self.fail(f"{tag}.damping_ratio", f"must satisfy 0 <= damping_ratio < "
-                          f"{MAX_DAMPING_RATIO:g} (an under-damped mode), got {z:g}", "mode",
-                          "damping_ratio", i)
-            m = self.number(mode["generalised_mass"], f"{tag}.generalised_mass", "mode",
-                            "generalised_mass", i)
-            if m <= 0.0:
-                self.fail(f"{tag}.generalised_mass", "must be positive", "mode",
-                          "generalised_mass", i)
-            b = self.array(mode["bending"], f"{tag}.bending", "mode", "bending", i, k)
-            t = self.array(mode["twist"], f"{tag}.twist", "mode", "twist", i, k)
-            if not np.any(b) and not np.any(t):
-                self.fail(f"{tag}.twist", "bending and twist are both all zero", "mode",
-                          "twist", i)
-            freq.append(f * factor["frequency"])
-            damp.append(z)
-            mass.append(m * factor["generalised_mass"])
-            bend.append(b * factor["length"])
-            twist.append(t * factor["angle"])
+        read = [self._mode(mode, i, k, units, factor) for i, mode in enumerate(modes)]
+        freq, damp, mass, bend, twist = (list(c) for c in zip(*read, strict=True))
         if np.any(np.diff(freq) < 0.0):
             j = int(np.argmax(np.diff(freq) < 0.0)) + 1
             self.fail(f"mode[{j + 1}].frequency",
@@ -307,6 +221,110 @@ class _Reader:
                           "mode", "generalised_mass", i)
         return scaled if normalise else modal
 
+
+    def _header(self, data: dict) -> None:
+        """Known top-level keys, the format's name and version, text source and notes."""
+        unknown = sorted(set(data) - _TOP_KEYS)
+        if unknown:
+            self.fail(unknown[0], f"unknown key (accepted: {', '.join(sorted(_TOP_KEYS))})",
+                      None, unknown[0])
+        if data.get("format") != FORMAT_NAME:
+            self.fail("format", f"missing or not {FORMAT_NAME!r}", None, "format")
+        if data.get("format_version") != FORMAT_VERSION:
+            self.fail("format_version", f"missing or not {FORMAT_VERSION}", None,
+                      "format_version")
+        for key in ("source", "notes"):
+            if key in data and not isinstance(data[key], str):
+                self.fail(key, "expected a string", None, key)
+
+    def _units(self, data: dict) -> tuple[dict, dict[str, float]]:
+        """The [units] table and each quantity's factor to SI."""
+        units = data.get("units")
+        if not isinstance(units, dict):
+            self.fail("units", "missing [units] table (length, angle, frequency, "
+                      "generalised_mass)")
+        for key in sorted(set(units) - set(_UNIT_TABLES)):
+            self.fail(f"units.{key}", "unknown key", "units", key)
+        factor = {}
+        for key, table in _UNIT_TABLES.items():
+            if key not in units:
+                self.fail(f"units.{key}", "missing", "units")
+            if units[key] not in table:
+                self.fail(f"units.{key}",
+                          f"unknown unit {units[key]!r} (accepted: {', '.join(table)})",
+                          "units", key)
+            factor[key] = table[units[key]]
+        return units, factor
+
+    def _stations(self, data: dict, factor: dict[str, float]) -> np.ndarray:
+        """The spanwise stations y [m]: at least two, strictly increasing, on the
+        starboard half."""
+        stations = data.get("stations")
+        if not isinstance(stations, dict) or "y" not in stations:
+            self.fail("stations.y", "missing [stations] table with y = [...]")
+        for key in sorted(set(stations) - {"y"}):
+            self.fail(f"stations.{key}", "unknown key", "stations", key)
+        y = self.array(stations["y"], "stations.y", "stations", "y") * factor["length"]
+        if y.size < 2:
+            self.fail("stations.y", "need at least two stations", "stations", "y")
+        if np.any(np.diff(y) <= 0.0):
+            j = int(np.argmax(np.diff(y) <= 0.0)) + 1
+            self.fail("stations.y", f"not strictly increasing at element {j}", "stations", "y")
+        if y[0] < 0.0:
+            self.fail("stations.y", "stations are on the starboard half (y ≥ 0)",
+                      "stations", "y")
+        return y
+
+    def _axes(self, data: dict, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The elastic and inertial axes [chord fractions] at the ``k`` stations."""
+        axes = data.get("axes", {})
+        if not isinstance(axes, dict):
+            self.fail("axes", "expected a table")
+        for key in sorted(set(axes) - {"x_elastic_frac", "x_inertial_frac"}):
+            self.fail(f"axes.{key}", "unknown key", "axes", key)
+        x_e = self.axis(axes.get("x_elastic_frac", DEFAULT_AXIS_FRAC), "axes.x_elastic_frac",
+                        "x_elastic_frac", k)
+        x_i = self.axis(axes.get("x_inertial_frac", DEFAULT_AXIS_FRAC),
+                        "axes.x_inertial_frac", "x_inertial_frac", k)
+        return x_e, x_i
+
+    def _mode(self, mode, i: int, k: int, units: dict, factor: dict[str, float]) -> tuple:
+        """One [[mode]] in SI: (frequency [rad/s], damping ratio, generalised mass, bending
+        [m] and twist [rad] at the ``k`` stations)."""
+        tag = f"mode[{i + 1}]"
+        if not isinstance(mode, dict):
+            self.fail(tag, "expected a [[mode]] table")
+        for key in sorted(set(mode) - _MODE_KEYS):
+            accepted = ", ".join(sorted(_MODE_KEYS))
+            self.fail(f"{tag}.{key}", f"unknown key (accepted: {accepted})", "mode", key, i)
+        for key in ("frequency", "generalised_mass", "bending", "twist"):
+            if key not in mode:
+                self.fail(f"{tag}.{key}", "missing", "mode", None, i)
+        f = self.number(mode["frequency"], f"{tag}.frequency", "mode", "frequency", i)
+        if f <= 0.0:
+            self.fail(f"{tag}.frequency", "must be positive", "mode", "frequency", i)
+        if not MIN_FREQUENCY_RAD_S <= f * factor["frequency"] <= MAX_FREQUENCY_RAD_S:
+            self.fail(f"{tag}.frequency", f"{f:g} {units['frequency']} is outside "
+                      f"{MIN_FREQUENCY_RAD_S:g}..{MAX_FREQUENCY_RAD_S:g} rad/s (the range "
+                      "a structural mode of the model may have)", "mode", "frequency", i)
+        z = self.number(mode.get("damping_ratio", 0.0), f"{tag}.damping_ratio", "mode",
+                        "damping_ratio", i)
+        if not 0.0 <= z < MAX_DAMPING_RATIO:
+            self.fail(f"{tag}.damping_ratio", f"must satisfy 0 <= damping_ratio < "
+                      f"{MAX_DAMPING_RATIO:g} (an under-damped mode), got {z:g}", "mode",
+                      "damping_ratio", i)
+        m = self.number(mode["generalised_mass"], f"{tag}.generalised_mass", "mode",
+                        "generalised_mass", i)
+        if m <= 0.0:
+            self.fail(f"{tag}.generalised_mass", "must be positive", "mode",
+                      "generalised_mass", i)
+        b = self.array(mode["bending"], f"{tag}.bending", "mode", "bending", i, k)
+        t = self.array(mode["twist"], f"{tag}.twist", "mode", "twist", i, k)
+        if not np.any(b) and not np.any(t):
+            self.fail(f"{tag}.twist", "bending and twist are both all zero", "mode",
+                      "twist", i)
+        return (f * factor["frequency"], z, m * factor["generalised_mass"],
+                b * factor["length"], t * factor["angle"])
 
 def parse_modal_text(text: str, *, name: str = "<modal text>", normalise: bool = True) -> ModalData:
     """Parse modal-file ``text``; ``name`` is used in error messages."""
