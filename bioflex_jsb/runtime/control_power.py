@@ -13,9 +13,11 @@ aircraft:
 * pitch, roll and yaw accelerations per unit elevator, aileron and rudder command
   [rad/s²]; the roll damping L_p [1/s] (∂ṗ/∂p) and the weathercock stiffness N_β [1/s²]
   (∂ṙ/∂β);
+* the pitch stiffness M_α [1/s²] (∂q̇/∂α) and damping M_q [1/s] (∂q̇/∂q), and the lift
+  slope over the momentum, L_α/(m V) [1/s] (the α a pull-up at q needs is q/(L_α/(m V)));
 * the forward acceleration per unit throttle at the trim [m/s²] (thrust along the trim's
-  stability x axis over the mass) and the steady climb angle the thrust left at full
-  throttle would give, (T(1) − T_trim)/W [rad] (a glider: 0).
+  stability x axis over the mass) and the steady climb angles the thrust left at full
+  throttle and at idle would give, (T(δ) − T_trim)/W [rad] (a glider: 0).
 
 Products of inertia are left out (c172p's I_xz is 0, as most of the package's aircraft).
 """
@@ -28,6 +30,7 @@ from dataclasses import dataclass
 from bioflex_jsb import units as U
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.runtime.identification import (
+    ALPHA_STEP_RAD,
     BETA_STEP_RAD,
     CONTROL_STEP,
     RATE_STEP,
@@ -44,8 +47,9 @@ class ControlPower:
     """Measured at a trim at ``speed_m_s`` [m/s], ``altitude_m`` [m] (module docstring):
     accelerations per unit command [rad/s²], ``roll_damping_1_s`` L_p [1/s, negative: it
     damps], ``yaw_stiffness_1_s2`` N_β [1/s², positive: weathercock stable],
-    ``throttle_m_s2`` [m/s² per unit throttle], ``climb_angle_full_rad`` [rad], the trim's
-    θ [rad] and throttle [-]."""
+    ``throttle_m_s2`` [m/s² per unit throttle], ``climb_angle_full_rad`` and
+    ``climb_angle_idle_rad`` [rad], the trim's θ [rad] and throttle [-], M_α [1/s²], M_q
+    [1/s], L_α/(m V) [1/s] and the mass [kg] JSBSim flies."""
 
     speed_m_s: float
     altitude_m: float
@@ -58,6 +62,11 @@ class ControlPower:
     climb_angle_full_rad: float
     theta_trim_rad: float
     throttle_trim: float
+    climb_angle_idle_rad: float = 0.0
+    pitch_alpha_1_s2: float = 0.0
+    pitch_rate_1_s: float = 0.0
+    lift_alpha_1_s: float = 0.0
+    mass_kg: float = 0.0
 
     def as_dict(self) -> dict[str, float]:
         return dict(self.__dict__)
@@ -105,17 +114,26 @@ def measure_control_power(airframe, speed_m_s: float, altitude_m: float = 0.0
     def thrust(r) -> float:  # along the trim's stability x axis [N]
         return r.thrust_x * cos0 + r.thrust_z * sin0
 
-    per_throttle = climb = 0.0
+    m_alpha = diff("alpha_rad", ALPHA_STEP_RAD, lambda r: r.pitch) / iyy
+    q_step = RATE_STEP * 2.0 * base.speed_m_s / (float(fdm["metrics/cbarw-ft"]) * U.M_PER_FT)
+    m_q = diff("q_rad_s", q_step, lambda r: r.pitch) / iyy
+    l_alpha = diff("alpha_rad", ALPHA_STEP_RAD, lambda r: r.lift) / (mass_kg * base.speed_m_s)
+    per_throttle = climb = idle = 0.0
     if powered:
         t_lo, t_hi = max(0.0, throttle - CONTROL_STEP), min(1.0, throttle + CONTROL_STEP)
         per_throttle = (thrust(ev(at(throttle=t_hi))) - thrust(ev(at(throttle=t_lo)))) / (
             (t_hi - t_lo) * mass_kg)
-        climb = math.asin(max(-1.0, min(1.0, (thrust(ev(at(throttle=1.0)))
-                                              - thrust(ev(base))) /
-                                        (mass_kg * STANDARD_GRAVITY_M_S2))))
+        weight = mass_kg * STANDARD_GRAVITY_M_S2
+        t_trim = thrust(ev(base))
+
+        def angle(delta: float) -> float:
+            return math.asin(max(-1.0, min(1.0, (thrust(ev(at(throttle=delta))) - t_trim)
+                                           / weight)))
+        climb, idle = angle(1.0), angle(0.0)
     ev(base)  # leave the airframe at the trim state
     return ControlPower(trim.speed_m_s, trim.altitude_m, pitch, roll, yaw, lp, nb,
-                        per_throttle, climb, trim.theta_rad, throttle)
+                        per_throttle, climb, trim.theta_rad, throttle, idle, m_alpha, m_q,
+                        l_alpha, mass_kg)
 
 
 def airframe_span_m(fdm) -> float:
