@@ -149,7 +149,8 @@ def _add_modal_loads(aero: ET.Element, axes: dict[str, ET.Element], k: int,
     parts = modal_wing_aerodynamics(nums, spec.leapfrog(nums), spec.reference)
     aero.insert(k, ET.Comment(f" modal wing '{spec.variant}': its loads "
                               "(bioflex_jsb.generators.native_wing) "))
-    aero.insert(k + 1, parts["functions"])
+    aero.insert(k + 1, parts["speed"])
+    aero.insert(k + 2, parts["functions"])
     for axis in ("LIFT", "DRAG", "PITCH"):
         axes[axis].insert(0, parts[axis])
 

@@ -669,8 +669,8 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
                             reference: ReferenceGeometry = REFERENCE_GEOMETRY,
                             ) -> dict[str, ET.Element]:
     """The native modal wing's loads as JSBSim aerodynamics of the airframe: ``<function>``
-    elements keyed by where they go (``functions``: before the first axis; ``LIFT``, ``DRAG``,
-    ``PITCH``: into those axes).
+    elements keyed by where they go (``speed``, then ``functions``: before the first axis, in
+    that order; ``LIFT``, ``DRAG``, ``PITCH``: into those axes).
 
     Loads of the stored state y = Φ_h x after this step's update, the structural state half
     a step into the interval over which JSBSim applies the forces it computes (module
@@ -696,10 +696,16 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
     # aerodynamics' own functions have run, so it would be the previous step's
     half_chord_ft = 0.5 * reference.mean_chord_m * U.FT_PER_M
 
-    def airspeed(parent: ET.Element) -> None:  # V [ft/s], at least MIN_AIRSPEED_FPS
-        m = el(parent, "max")
-        W.prop(m, "velocities/vt-fps")
-        W.value(m, MIN_AIRSPEED_FPS)
+    # V [ft/s], at least MIN_AIRSPEED_FPS: one function a step, read by the lift and pitch
+    speed_fn = "aero/bioflex/vt-guarded-fps"
+    speed = ET.Element("function", name=speed_fn)
+    el(speed, "description", f"airspeed [ft/s], at least {MIN_AIRSPEED_FPS:g} (no 0/0 at rest)")
+    m = el(speed, "max")
+    W.prop(m, "velocities/vt-fps")
+    W.value(m, MIN_AIRSPEED_FPS)
+
+    def airspeed(parent: ET.Element) -> None:
+        W.prop(parent, speed_fn)
 
     def loads(fn: ET.Element, r: int, gain: float) -> None:
         c = gain * U.PA_PER_PSF * s_ref
@@ -724,7 +730,8 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
     el(pitch, "description", "modal wing pitching moment about the CG, nose up [lbs ft]")
     loads(pitch, 2, U.LBF_FT_PER_N_M)
     out = {}
-    for key, e in (("functions", lift), ("LIFT", in_lift), ("DRAG", in_drag), ("PITCH", pitch)):
+    for key, e in (("speed", speed), ("functions", lift), ("LIFT", in_lift), ("DRAG", in_drag),
+                   ("PITCH", pitch)):
         collapse(e)
         out[key] = e
     return out
