@@ -218,5 +218,8 @@ def test_the_definitions_stations_reach_every_run(tmp_path, capsys):
     data = json.loads(out)
     assert data["speed_m_s"] == SPEED_M_S  # the aircraft's cruise speed, not 15 m/s
     assert data["loads"]["station_fractions"] == [0.0, 0.1, 0.2]
-    code, _, err = run_cli(capsys, "loads", "--aircraft", str(path), "--tuned")
-    assert code == 2 and "--tuned takes the prototype's airframe only" in err
+    # --tuned takes this airframe (tests/test_loads_aircraft.py) and its own chord: a
+    # gradient whose gust is shorter than it is refused in one line
+    code, _, err = run_cli(capsys, "loads", "--aircraft", str(path), "--tuned",
+                           "--gradients", "0.1")
+    assert code == 2 and "shorter than the aircraft's mean chord" in err

@@ -310,11 +310,20 @@ def test_an_aircraft_file_that_cannot_take_the_wing_is_refused(tmp_path, edit, w
 
 
 def test_a_speed_the_glider_cannot_glide_at_is_refused_in_one_line(tmp_path):
-    """12 m/s: C_L 2.75 needed, beyond the CLwbh table's 1.26 peak (stall 17.7 m/s)."""
+    """12 m/s: outside the definition's flight speeds (20-28 m/s), refused with the spec;
+    given a range that holds it, the trim says why: C_L 2.75 needed, beyond the CLwbh
+    table's 1.26 peak (stall 17.7 m/s)."""
+    import dataclasses
+
     from bioflex_jsb.runtime.results import TrimError
 
     aircraft = load_aircraft("sgs_elastic")
-    spec = N.aircraft_spec(aircraft, aircraft.wing(), speed_m_s=12.0)
+    with pytest.raises(J.ExportError) as exc:
+        N.aircraft_spec(aircraft, aircraft.wing(), speed_m_s=12.0)
+    assert "outside 20..28 m/s, the flight speeds of aircraft 'sgs_elastic'" in \
+        _one_line(exc)
+    spec = N.aircraft_spec(aircraft, aircraft.wing(), speed_m_s=SPEED_M_S)
+    spec = dataclasses.replace(spec, speed_m_s=12.0, speed_range_m_s=(5.0, 40.0))
     with pytest.raises(TrimError) as exc:
         N.export_flight(spec, 0.0)
     assert "glide" in _one_line(exc)

@@ -181,9 +181,12 @@ def test_another_airframe_flies_its_gust_runs_as_the_gust_command(folder, monkey
 
     (folder / "sgs_gust.toml").write_text(SGS_GUST, encoding="utf-8")
     out = folder / "sgs_gust.csv"
-    code, _ = _sweep([folder / "sgs_gust.toml", "--out", out, "--workers", "1"], monkeypatch,
-                     capsys)
-    assert code == 0
+    code, said = _sweep([folder / "sgs_gust.toml", "--out", out, "--workers", "1"],
+                        monkeypatch, capsys)
+    assert code == 0  # one case of two has a result: the table is the sweep's result
+    err = said.err.strip().splitlines()  # and the failed one is counted, in one line
+    assert len(err) == 1 and "1 of the 2 cases run now failed" in err[0] and \
+        "outside aircraft 'sgs_elastic'" in err[0]
     rows = {float(r["speed_m_s"]): r for r in csv.DictReader(out.open(encoding="utf-8"))}
     assert rows[15.0]["status"] == "failed" and "outside aircraft 'sgs_elastic'" in \
         rows[15.0]["error"] and "20..28" in rows[15.0]["error"]
@@ -194,6 +197,30 @@ def test_another_airframe_flies_its_gust_runs_as_the_gust_command(folder, monkey
     summary = json.loads(capsys.readouterr().out)["summary"]["coupled"]
     for col in GUST_COLUMNS:
         assert float(rows[25.0][col]) == summary[col], col
+
+
+def test_a_campaign_whose_every_case_failed_exits_1_in_one_line(folder, monkeypatch,
+                                                                  capsys):
+    """Every case outside the SGS's 20-28 m/s: each is a failed row, and the sweep, which
+    has no result, says so in one line with the first error and exits 1 (not 0); a
+    --resume that runs the missing case at 25 m/s gives the table a result: exit 0."""
+    (folder / "sgs_low.toml").write_text(SGS_GUST.replace("[15.0, 25.0]", "[15.0, 16.0]"),
+                                         encoding="utf-8")
+    out = folder / "low.csv"
+    code, said = _sweep([folder / "sgs_low.toml", "--out", out, "--workers", "1"],
+                        monkeypatch, capsys)
+    assert code == 1
+    err = said.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("bioflex-jsb sweep: every case failed (2 run ")
+    assert "outside aircraft 'sgs_elastic'" in err[0] and "15 m/s" in err[0]
+    rows = list(csv.DictReader(out.open(encoding="utf-8")))
+    assert [r["status"] for r in rows] == ["failed", "failed"]  # recorded all the same
+    # a resume that adds a case with a result: the table has one, the failed rows stay
+    (folder / "sgs_low.toml").write_text(
+        SGS_GUST.replace("[15.0, 25.0]", "[15.0, 16.0, 25.0]"), encoding="utf-8")
+    code, said = _sweep([folder / "sgs_low.toml", "--out", out, "--workers", "1",
+                         "--resume"], monkeypatch, capsys)
+    assert code == 0 and said.err.strip() == ""
 
 
 def test_an_aircraft_that_cannot_fly_is_refused_for_gust_runs(folder, monkeypatch, capsys):

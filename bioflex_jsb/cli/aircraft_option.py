@@ -21,13 +21,13 @@ AIRCRAFT_PREFIX = "aircraft:"
 # (definition/aircraft.py: Aircraft.linear_problem); the others fly JSBSim's prototype
 # airframe and refuse another one (Aircraft.flight_problem).
 LINEAR_COMMANDS = ("modes", "flutter", "export")
-# The commands of the nonlinear co-simulation that fly any airframe (definition/flying.py:
-# flight_refusal: its own JSBSim aircraft, a glider in its steady glide; trim reads its own
-# --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's copy with the wing:
-# docs/native.md; sitl flies a glider with the glider's autopilot: cli/sitl.py; loads flies
-# one gust on it, its --tuned and --frequency studies refuse it: cli/loads.py); the others
-# (ardupilot) refuse an airframe other than the prototype's in one line.
-FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl", "loads")
+# The commands of the nonlinear co-simulation, each flying any airframe
+# (definition/flying.py: flight_refusal: its own JSBSim aircraft, a glider in its steady
+# glide; trim reads its own --aircraft: cli/trim.py; export-jsbsim writes the aircraft file's
+# copy with the wing and the files it names: docs/native.md; sitl flies a glider's or a
+# powered aircraft's own autopilot: cli/sitl.py; loads: cli/loads.py; ardupilot maps the
+# servos by what the aircraft's commands do: cli/sitl_ardupilot.py).
+FLIGHT_COMMANDS = ("gust", "compare", "export-jsbsim", "sitl", "loads", "ardupilot")
 
 
 class CruiseSpeed(float):
@@ -84,19 +84,12 @@ class _AircraftAction(argparse._StoreAction):
                          "(the aircraft's definition holds its wing)")
         try:
             aircraft = complete(load_aircraft(values))  # JSBSim's numbers where it has none
-            # the linear analyses take any airframe; the flight commands the prototype's
+            # the linear analyses take any airframe; the flight commands one that flies
             command = parser.prog.rsplit(" ", 1)[-1]
             if command in LINEAR_COMMANDS:
                 problem = aircraft.linear_problem()
-            elif command in FLIGHT_COMMANDS:
+            else:  # every other command flies it (FLIGHT_COMMANDS)
                 problem = flight_refusal(aircraft)
-            elif aircraft.flight_problem() and aircraft.airframe.jsbsim_path:
-                problem = (f"aircraft {aircraft.name!r}: {command} takes the prototype's "
-                           "airframe only in this version (airframe.jsbsim = "
-                           f"{aircraft.airframe.jsbsim!r}; gust, compare, trim, export-jsbsim, "
-                           "sitl, modes, flutter and export take this one: docs/aircraft.md)")
-            else:
-                problem = aircraft.flight_problem()
             variant = aircraft.variant()
         except InputError as exc:  # the definition's one line, naming the field
             parser.error(f"--aircraft: {exc}")

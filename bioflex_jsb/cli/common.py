@@ -4,6 +4,9 @@ JSON output, log names.
 Exit statuses (every command; docs/reliability.md):
 
 * 0: done.
+* 1 (:data:`EXIT_NO_RESULT`): the work ran and gave no result: every case of a sweep failed,
+  a repeated run differs from its log, ``info --check`` found a damaged log; one line says
+  why.
 * 2 (:data:`EXIT_USAGE`): what was asked cannot be done as given (bad input, an unusable
   path, an existing output without ``--force``): one line, nothing ran.
 * 3 (:data:`EXIT_DIVERGED`): a simulation left the model's valid range (a result).
@@ -36,6 +39,7 @@ from typing import Any, NoReturn
 from bioflex_jsb.cli.usage import UsageError  # noqa: F401  (every command's, re-exported)
 from bioflex_jsb.interrupts import STOP, unsafe_frame
 
+EXIT_NO_RESULT = 1
 EXIT_USAGE = 2
 EXIT_DIVERGED = 3
 EXIT_ENVIRONMENT = 4

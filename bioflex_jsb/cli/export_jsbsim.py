@@ -46,8 +46,12 @@ refuses with the trim's reason). For `--model qsd` the names end in _qsd. --airc
 exports a definition's wing with its values (S, c-bar, mass, derivatives, modes): on the
 generated airframe as --wing does; on a JSBSim aircraft file (e.g. sgs_elastic: the jsbsim
 package's SGS glider) as aircraft/<definition name>/, a copy of that file with the wing added
-(the original is never written), its glide trim as the initial condition, flown from t = 0
-(no engine to spin up; coupled model only). See docs/native.md."""
+(the original is never written) and the files it names (engines, propellers, systems: e.g.
+c172_elastic's c172p engine and propeller from the jsbsim root's engine/) copied beside it,
+its trim as the initial condition (a glider's glide, flown after 0.1 s; a powered
+aircraft's level flight, its engines started by the script and held 8 s while the
+propellers settle), at --speed within the aircraft's own speeds (coupled model only). See
+docs/native.md."""
 
 
 def register(sub) -> None:
@@ -213,7 +217,7 @@ def run(args: argparse.Namespace) -> int:
     }
     if spec.model == "coupled":
         nums = J.modal_matrices(spec.wing, spec.cl_trim)
-        err, at = J.leapfrog_eigen_error(nums, spec.leapfrog(nums))
+        err, at = spec.eigen_error(nums)
         info["eigenvalue_error_max"] = err
         info["eigenvalue_error_at_speed_m_s"] = at
     if args.json:

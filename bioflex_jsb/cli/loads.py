@@ -49,14 +49,16 @@ force summation (FS: the strips' aerodynamic loads, the gust's included, less th
 of the wing outboard) and by mode displacement (MD: EI phi'' eta, GJ theta' eta of the beam
 modes), with their difference: largest and smallest value after the gust start with its time,
 the 1 g value and the increments over it. With --tuned: 1-cos gusts over a range of gradient
-lengths H, up and down (default {{h_min:.2g}}..{{h_max:g}} m, {{n}} lengths; amplitude
+lengths H, up and down (default {{h_min:.2g}}..{{h_max:g}} m, {{n}} lengths; another
+--aircraft: 1.5 of its chords to V T_sp, T_sp its rigid short period's 2 pi/omega_n; amplitude
 U_ref (H/H_max)^(1/6), U_ref = --amplitude, the airworthiness codes' shape; docs/loads.md
 for the rationale), the critical gradient per station, quantity and method (--csv FILE
 writes the table), and the correlated-load envelopes (bending vs torque per station) in
 --plot (default loads_envelope.png). With --frequency: the LTI model's frequency response
 from the gust to q, n_z and the root bending moment (--bode), the output PSDs under the
 --spectrum turbulence, their RMS and N0, against Welch estimates (95 % bands) from nonlinear
-runs of --record seconds at each of --sigmas (--plot, default loads_psd.png). The tuned gusts
+runs of --record seconds at each of --sigmas (--plot, default loads_psd.png), on the
+--aircraft's own JSBSim model linearised at its trim. The tuned gusts
 run in parallel on the sweep's executors (--workers local processes, default one per core, or
 --scheduler a Dask cluster; a progress bar on a terminal), the table the same whatever the
 number of workers; the --frequency runs are sequential. No MCAP log
@@ -176,7 +178,9 @@ def register(sub) -> None:
     p.add_argument("--frequency", action="store_true",
                    help="continuous turbulence in the frequency domain (above)")
     p.add_argument("--sigmas", type=sigma_list, default=None,
-                   help="--frequency: turbulence intensities sigma_w [m/s] (default 0.1,2.5)")
+                   help="--frequency: turbulence intensities sigma_w [m/s] (default 0.1,2.5; "
+                   "another airframe: 0.1 and the largest whose 4-sigma gust angle stays in "
+                   "its aerodynamic tables, at most 2.5)")
     p.add_argument("--scale", type=positive_float("turbulence scale", "m"), default=None,
                    help="--frequency: turbulence length scale L_w [m] (default 30: "
                    "MIL-F-8785C's L_w = h at 30 m above ground)")
@@ -235,19 +239,13 @@ def _fly(args, build, gust_text: str, duration_s: float, gust_start_s: float):
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.loads import monitoring_stations
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
     resolve_flight(args)  # --speed: the aircraft's cruise speed, within its speeds
     check_time_step(args.dt)
     build = wing_from_args(args)
     aircraft = getattr(args, "aircraft_definition", None)
-    if build.airframe is not PROTOTYPE_AIRFRAME and (args.tuned or args.frequency):
-        raise UsageError(f"--aircraft {aircraft.name}: --{'tuned' if args.tuned else 'frequency'}"
-                         " takes the prototype's airframe only in this version (its gust "
-                         "lengths and JSBSim rigid block are the prototype's); loads of one "
-                         "--gust take this aircraft")
     if args.stations is None:  # the aircraft definition's, else the default stations
-        args.stations = monitoring_stations(getattr(args, "aircraft_definition", None))
+        args.stations = monitoring_stations(aircraft)
     if args.model == "rigid" and args.static == "elastic":
         raise UsageError("--model rigid has no static deflection; drop --static elastic")
     if args.tuned and args.frequency:
@@ -255,6 +253,7 @@ def run(args: argparse.Namespace) -> int:
     for opt in ("workers", "scheduler"):
         if getattr(args, opt) is not None and not args.tuned:
             raise UsageError(f"--{opt} applies to --tuned (its gusts run in parallel)")
+    sigmas_given = args.sigmas is not None  # else the airframe's own (_default_sigmas)
     for study, options in (("tuned", TUNED_OPTIONS), ("frequency", FREQUENCY_OPTIONS)):
         for opt, default in options.items():  # never silently ignored
             if getattr(args, opt) is not None and not getattr(args, study):
@@ -271,7 +270,7 @@ def run(args: argparse.Namespace) -> int:
     if args.tuned:
         return _tuned(args, build)
     if args.frequency:
-        return _frequency(args, build)
+        return _frequency(args, build, sigmas_given)
     from bioflex_jsb.loads import loads_metrics
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 
@@ -340,8 +339,9 @@ def _tuned(args, build) -> int:
             raise UsageError(f"--csv {args.csv!r}: the file name must end in .csv")
         check_output(args.csv, args.force, "--csv")
     try:
+        scales = _gust_scales(args, build)
         cases = tuned_cases(args.speed, args.gradients, u_ref_m_s=args.amplitude,
-                            scaling=args.scaling)
+                            scaling=args.scaling, scales=scales)
     except InputError as exc:
         raise UsageError(str(exc)) from None
     rows = _fly_tuned(args, build, cases)
@@ -353,7 +353,7 @@ def _tuned(args, build) -> int:
         raise UsageError(f"{failed[0]['gust']}: {failed[0]['error']}")
     stopped = [f"{r['gust']}: {r['error']}" for r in rows if r["status"] == "diverged"]
     result = tuned_result(cases, [r["loads"] for r in rows], args.speed,
-                          u_ref_m_s=args.amplitude, scaling=args.scaling)
+                          u_ref_m_s=args.amplitude, scaling=args.scaling, scales=scales)
     if args.csv:
         with open(args.csv, "w", newline="", encoding="utf-8") as f:
             csv.writer(f).writerows(result.csv_rows())
@@ -383,6 +383,30 @@ def _tuned(args, build) -> int:
     for s in stopped:
         print(f"bioflex-jsb loads: diverged: {s}", file=sys.stderr)
     return EXIT_DIVERGED if stopped else 0
+
+
+def _gust_scales(args, build):
+    """The tuned gust's gradient range and settling time: the prototype's defaults on its
+    airframe, else the aircraft's own (its mean chord, its rigid short period at --speed:
+    loads.tuned.aircraft_gust_scales); given --gradients must be gusts of at least one of its
+    chords (2H >= c̄)."""
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.flight_dynamics.eigen import modes_at
+    from bioflex_jsb.loads.tuned import PROTOTYPE_SCALES, aircraft_gust_scales
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
+    chord_m = build.model.airframe.reference.mean_chord_m
+    if args.gradients is not None and min(args.gradients) * 2.0 < chord_m:
+        raise InputError(f"--gradients: H {min(args.gradients):g} m is a gust shorter than "
+                         f"the aircraft's mean chord {chord_m:.3g} m; each H must be at least "
+                         f"{chord_m / 2.0:.3g} m")
+    if build.airframe is PROTOTYPE_AIRFRAME:
+        return PROTOTYPE_SCALES
+    aircraft = getattr(args, "aircraft_definition", None)
+    density = {} if aircraft is None else {
+        "density_kg_m3": float(aircraft.definition.air.density_kg_m3)}
+    sp = modes_at("rigid", [args.speed], build.model, **density)[0].get("short_period")
+    return aircraft_gust_scales(chord_m, args.speed, sp.frequency_rad_s)
 
 
 def _fly_tuned(args, build, cases: list[dict]) -> list[dict]:
@@ -440,17 +464,41 @@ FREQUENCY_UNITS = ("rad/s", "-", "N*m")
 FREQUENCY_START_S = 1.0  # the record analysed starts here [s] (turbulence from 0.5 s)
 
 
-def _frequency(args, build) -> int:
+# The larger default intensity of another airframe: its 4-sigma gust angle w/V stays
+# inside its aerodynamic tables (a Gaussian record crosses 4 sigma about exp(-8) N0 T
+# times: 0.1 times in 120 s at N0 = 3 Hz), at most the prototype's 2.5 m/s.
+SIGMA_TABLE_MARGIN = 4.0
+
+
+def _default_sigmas(args, build, lin, airframe) -> tuple[float, ...]:
+    """--sigmas when not given: the prototype's (0.1, 2.5 m/s) on its airframe; on another
+    the small one and the largest whose SIGMA_TABLE_MARGIN-sigma angle of attack w/V from
+    the trim stays inside the airframe's tables (rounded down to 0.1 m/s; c172p at 57.8 m/s:
+    α -0.42 deg, tables from -5.16 deg: 1.1 m/s)."""
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
+    small, large = FREQUENCY_OPTIONS["sigmas"]
+    if build.airframe is PROTOTYPE_AIRFRAME:
+        return (small, large)
+    lo, hi = airframe.alpha_table_range_rad
+    margin_rad = min(lin.trim.alpha_rad - lo, hi - lin.trim.alpha_rad)
+    fit = math.floor(10.0 * args.speed * math.tan(max(margin_rad, 0.0))
+                     / SIGMA_TABLE_MARGIN) / 10.0
+    return (small, min(fit, large)) if fit > small else (small,)
+
+
+def _frequency(args, build, sigmas_given: bool = True) -> int:
     """The LTI model (Eq. 4 with JSBSim's rigid block, as `compare`) in the frequency domain
     against long nonlinear turbulence runs (bioflex_jsb.loads.spectral)."""
     import numpy as np
 
+    from bioflex_jsb.cli.aircraft_option import airframe_from_args
     from bioflex_jsb.flight_dynamics.lti import build_state_space
     from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
     from bioflex_jsb.loads.lti import with_load_outputs
     from bioflex_jsb.loads.model import build_loads_model
     from bioflex_jsb.loads.spectral import compare_spectra, plot_bode, plot_psd
-    from bioflex_jsb.runtime.fdm import Airframe, FdmError
+    from bioflex_jsb.runtime.fdm import FdmError
 
     if args.model != "coupled":
         raise UsageError("--frequency compares the coupled model (give --model coupled)")
@@ -462,12 +510,17 @@ def _frequency(args, build) -> int:
     check_distinct_outputs(("--plot", plot), ("--bode", bode))
     check_plot_path(plot, args.force)
     check_plot_path(bode, args.force)
-    try:
-        a_rr = Airframe().linearize(args.speed).a
+    try:  # JSBSim's rigid block of the airframe the runs fly (the aircraft's own, as compare)
+        airframe = airframe_from_args(args)
+        lin = airframe.linearize(args.speed)
     except FdmError as exc:
         raise UsageError(str(exc)) from None
-    ss = build_state_space("coupled", level_flight_condition(args.speed), build.model,
-                           a_rr=a_rr, controls=True)
+    a_rr = lin.a
+    if not sigmas_given:
+        args.sigmas = _default_sigmas(args, build, lin, airframe)
+    ss = build_state_space("coupled", level_flight_condition(args.speed,
+                                                             airframe=build.airframe),
+                           build.model, a_rr=a_rr, controls=True)
     ss = with_load_outputs(ss, build_loads_model(build, args.speed, (0.0,)))
     cases, stopped = [], []
     args.stations = (0.0,)

@@ -52,7 +52,14 @@ states, apparent mass, Kuessner gust) on the compiled step: the backward-axis wi
 unstable with quasi-steady strips at their cruise, fly that way. Before the session the
 chosen model's stability at the trim speed is checked (eigenvalues of the linear model, the
 phugoid left out, as the ardupilot command does): an unstable one is refused (exit 2, one
-line) unless --allow-unstable."""
+line) unless --allow-unstable. --aircraft flies another JSBSim aircraft: a glider (no engine)
+holds its speed with pitch and glides down; a powered one (e.g. c172_elastic, JSBSim's
+c172p) flies its own autopilot laws (altitude and pitch, bank and heading, sideslip to the
+rudder, a PI autothrottle) with gains scaled from its rigid short period and the control
+power and thrust its JSBSim model gives at the trim (docs/sitl.md, "A powered aircraft").
+Speeds: --speed and the airspeed targets (AIRSPEED_MS, DO_CHANGE_SPEED) within the
+aircraft's flight speeds: the prototype 12..22 m/s, a definition its
+airframe.speed_range_m_s (c172_elastic 31.1..68.9 m/s, cruise 57.8 m/s)."""
 
 
 def register(sub) -> None:
@@ -140,7 +147,10 @@ def run(args: argparse.Namespace) -> int:
                          "linearised about the rigid trim; the rigid wing is quasi-steady)")
     build = wing_from_args(args)
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
-    airframe, speeds = _airframe(args)
+    try:
+        airframe, speeds = _airframe(args, home[2] + args.start_height)
+    except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing
+        raise UsageError(str(exc)) from None
     try:
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
@@ -245,24 +255,20 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _airframe(args: argparse.Namespace):
+def _airframe(args: argparse.Namespace, start_altitude_m: float):
     """(the JSBSim airframe, the accepted speed targets [m/s]) of ``--aircraft`` when it
     is another JSBSim aircraft than the prototype's: an aircraft without an engine with the
-    glider's autopilot (drivers/sitl.py glider_airframe; its speeds: its definition's
-    speed_range_m_s); (None, None): the prototype's SITL aircraft. An aircraft with an
-    engine is refused in one line (the SITL autopilot of an engine is the prototype's)."""
+    glider's autopilot (drivers/sitl.py glider_airframe), one with engines with the powered
+    aircraft's autopilot, its gains scaled for it at --speed and ``start_altitude_m`` [m]
+    (drivers/sitl.py powered_airframe); its speeds: its definition's flight speeds.
+    (None, None): the prototype's SITL aircraft."""
     from bioflex_jsb.definition.flying import flight_speeds
-    from bioflex_jsb.drivers.sitl import glider_airframe
+    from bioflex_jsb.drivers.sitl import sitl_airframe
 
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is None or aircraft.flight_problem() is None:
         return None, None
-    airframe = glider_airframe(aircraft)
-    if not airframe.glider:
-        raise UsageError(f"--aircraft {aircraft.name}: sitl flies another JSBSim aircraft as "
-                         f"a glider (no engine); airframe.jsbsim = {aircraft.airframe.jsbsim!r}"
-                         f" has {airframe.engine_count} engine(s), whose autopilot is the "
-                         "prototype's only (docs/sitl.md)")
+    airframe, _gains = sitl_airframe(aircraft, args.speed, start_altitude_m)
     return airframe, tuple(flight_speeds(aircraft)[1])
 
 

@@ -64,7 +64,10 @@ frame is logged to the MCAP log as for any run (--out, --no-log; docs/logging.md
 ArduPilot's frame count, rate and servo PWM, the mapped controls, the lock-step action and
 the launcher phase on /bioflex/<model>/autopilot, every coupled step in flight on the run
 topics, and the session's events (binding, ignored packets, restarts, launches, stops, the
-summary at the end) on /bioflex/events. --table FILE.npz also keeps every --record-every-th
+summary at the end) on /bioflex/events. --aircraft flies another JSBSim aircraft (its
+cruise speed by default; its servos mapped by what its own commands do) and --write-parm
+FILE.parm writes its ArduPlane parameter file (docs/ardupilot.md, "Another aircraft").
+--table FILE.npz also keeps every --record-every-th
 frame (servos 1-4, ArduPilot's frame count, the step's channels) as a numpy table. Never
 expose ArduPlane's TCP ports: run both inside a loopback-only network namespace
 (scripts/ardupilot_sitl.py fly)."""
@@ -88,8 +91,17 @@ def register(sub) -> None:
     add_wing_arguments(p, default="optimised")
     p.add_argument("--model", choices=("coupled", "rigid", "qsd", NATIVE), default="coupled",
                    help="wing model (default coupled; native: the exported JSBSim wing)")
-    p.add_argument("--speed", type=airspeed, default=15.0,
-                   help="trim and launcher exit " + speed_help())
+    from bioflex_jsb.cli.aircraft_option import cruise_speed_default
+
+    p.add_argument("--speed", type=airspeed, default=cruise_speed_default(),
+                   help="trim and launcher exit " + speed_help(
+                       extra="; with --aircraft: its cruise_speed_m_s, within its flight "
+                       "speeds"))
+    p.add_argument("--write-parm", metavar="FILE.parm", default=None,
+                   help="write the ArduPlane parameter file of the aircraft (--aircraft: its "
+                   "airspeeds from its flight speeds, trim throttle, rate feed-forwards, L1 "
+                   "and TECS from its JSBSim model; else the prototype's "
+                   "bioflex_plane.parm) and exit; start ArduPlane with --defaults FILE")
     p.add_argument("--altitude", type=finite_float("altitude", "m"), default=0.0,
                    help="launch altitude [m above sea level, ISA], -500 to 11000 (default 0)")
     p.add_argument("--launch-accel", type=positive_float("launch acceleration", "m/s^2"),
@@ -132,6 +144,48 @@ def register(sub) -> None:
     add_log_arguments(p)
     add_live_arguments(p)
     p.set_defaults(run=run)
+
+
+def _other_aircraft(args: argparse.Namespace):
+    """The definition of ``--aircraft`` when it flies another JSBSim aircraft than the
+    prototype's generated one, else None."""
+    aircraft = getattr(args, "aircraft_definition", None)
+    return aircraft if aircraft is not None and aircraft.flight_problem() else None
+
+
+def _write_parm(args: argparse.Namespace) -> int:
+    """``--write-parm``: the aircraft's ArduPlane parameter file (the prototype's shipped
+    one without another --aircraft), never over a file of the user's without --force."""
+    from pathlib import Path
+
+    from bioflex_jsb.drivers.ardupilot import plane_numbers
+    from bioflex_jsb.generators.ardupilot_params import render_plane_parm
+    from bioflex_jsb.runtime.fdm import FdmError
+
+    check_new_file(args.write_parm, args.force, "--write-parm", (".parm",))
+    aircraft = _other_aircraft(args)
+    if aircraft is None:
+        text = (Path(__file__).resolve().parents[1] / "data" / "ardupilot"
+                / "bioflex_plane.parm").read_text(encoding="utf-8")
+        what = "the prototype's bioflex_plane.parm"
+    else:
+        try:
+            numbers, _power = plane_numbers(aircraft, args.speed, args.altitude)
+        except FdmError as exc:
+            raise UsageError(str(exc)) from None
+        text = render_plane_parm(numbers)
+        what = f"the parameters of aircraft {aircraft.name!r}"
+    try:
+        Path(args.write_parm).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise UsageError(f"cannot write --write-parm {args.write_parm!r}: "
+                         f"{exc.strerror}") from None
+    if args.json:
+        print_json({"parm": args.write_parm, "what": what})
+    else:
+        print(f"{what} written to {args.write_parm}: arduplane --model JSON:127.0.0.1 "
+              f"--defaults {args.write_parm}")
+    return 0
 
 
 def _build(args: argparse.Namespace):
@@ -183,13 +237,26 @@ def _build(args: argparse.Namespace):
     # both strip models have a compiled step (CoupledStep(compiled=True); the unsteady one
     # since simulation/unsteady_kernel.py); the summary's "step" says which one flew
     compiled = True
+    other = _other_aircraft(args)
     try:
-        airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
+        extra = {}
+        if other is not None:  # its own JSBSim aircraft, the servos by what its commands do
+            from bioflex_jsb.drivers.ardupilot import aircraft_channels
+            from bioflex_jsb.runtime.control_power import measure_control_power
+            from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+
+            probe = airframe_for(other)
+            extra["channels"] = aircraft_channels(
+                measure_control_power(probe, args.speed, args.altitude))
+            del probe
+            airframe = airframe_for(other)
+        else:
+            airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
         physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
                                    altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
                                    launcher=launcher, record_every=args.record_every,
                                    gust_repeat=args.gust_repeat, aero=args.aero,
-                                   compiled=compiled)
+                                   compiled=compiled, **extra)
     except FdmError as exc:  # the airframe cannot load or trim (InputErrors reach the CLI)
         raise UsageError(str(exc)) from None
     return physics, variant, overrides, check
@@ -273,9 +340,14 @@ def _text_report(s: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
     from bioflex_jsb.links.ardupilot_json import LockstepServer
 
     wall0 = time.monotonic()
+    resolve_flight(args)  # --speed of the aircraft (its cruise speed by default)
+    args.speed = float(args.speed)
+    if args.write_parm is not None:
+        return _write_parm(args)
     check_live(args)  # its refusals before the UDP port is taken
     physics, variant, overrides, check = _build(args)
     try:

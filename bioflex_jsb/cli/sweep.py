@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bioflex_jsb.cli.common import (
     EXIT_ENVIRONMENT,
+    EXIT_NO_RESULT,
     EnvironmentFault,
     UsageError,
     closing,
@@ -25,8 +26,11 @@ recorded with its error; a worker process that dies has its case retried once. A
 machine could not run or record (no space for its log, an unwritable --logs directory, a
 lost Dask scheduler or workers, the results table itself unwritable) is not recorded: the
 sweep stops with exit status 4 and one line, and --resume runs it and the rest once the
-cause is fixed (docs/reliability.md). One sweep at a time may write an --out. By default
-the cases run on local processes, one per core; --scheduler sends them to a Dask cluster."""
+cause is fixed (docs/reliability.md). The sweep exits 0 when every case has a row and one
+has a result (failed cases are counted on stderr, their errors are in the table); when
+every case of the table failed it exits 1 with one line and the first error. One sweep at
+a time may write an --out. By default the cases run on local processes, one per core;
+--scheduler sends them to a Dask cluster."""
 
 _SCHEDULER = re.compile(r"^(tcp|tls|ucx|inproc)://[^\s/]+(:\d+)?/?$")
 
@@ -156,6 +160,9 @@ def _run_locked(args, campaign, out: Path) -> int:
                              f"cases are not cases of campaign {campaign.name!r} (another "
                              "campaign, or its settings or axes changed); give another --out")
     done = store.done_ids - store.failed_ids if args.retry_failed else store.done_ids
+    # rows of an earlier session with a result (ok or diverged): kept whatever runs now
+    earlier_results = len(store.done_ids - store.failed_ids)
+    first_error: list[str] = []  # the first failed case's error, for the closing line
     todo = MissingCases(campaign.iter_cases(), done)
     total = campaign.n_cases
 
@@ -165,6 +172,8 @@ def _run_locked(args, campaign, out: Path) -> int:
         todo.on_skip = lambda: bar.update(1)
 
     def on_row(summary, row):
+        if row.get("status") in (None, "failed") and not first_error:
+            first_error.append(str(row.get("error") or "no error recorded"))
         if bar is not None:
             bar.update(1)
             bar.set_postfix_str(f"done {summary.run + summary.skipped} failed "
@@ -176,7 +185,7 @@ def _run_locked(args, campaign, out: Path) -> int:
             with executor:
                 summary = run_sweep(todo, store, executor, total=total, on_row=on_row)
         else:
-            summary = run_sweep(todo, store, executor, total=total)
+            summary = run_sweep(todo, store, executor, total=total, on_row=on_row)
     except executor_errors() as exc:  # the cluster cannot be reached: nothing ran
         raise UsageError(str(exc)) from None
     finally:
@@ -210,6 +219,25 @@ def _run_locked(args, campaign, out: Path) -> int:
         print(f"bioflex-jsb sweep: interrupted with {summary.remaining} cases left; "
               f"{out} keeps the finished ones: rerun with --resume", file=sys.stderr)
         return 130
+    return _failures(summary, earlier_results, first_error, out)
+
+
+def _failures(summary, earlier_results: int, first_error: list[str], out: Path) -> int:
+    """The exit status of a finished sweep and its one stderr line about failed cases:
+    EXIT_NO_RESULT when no row of the table has a result (every case failed: an aircraft
+    that cannot fly these cases, a campaign outside its envelope), 0 otherwise (a line
+    counting the failed cases run now, if any)."""
+    failed = summary.counts["failed"]
+    if not failed:
+        return 0
+    results = earlier_results + summary.counts["ok"] + summary.counts["diverged"]
+    first = first_error[0] if first_error else "see the table's error column"
+    if results == 0:
+        print(f"bioflex-jsb sweep: every case failed ({failed} run now, no result in "
+              f"{out}); the first: {first}", file=sys.stderr)
+        return EXIT_NO_RESULT
+    print(f"bioflex-jsb sweep: {failed} of the {summary.run} cases run now failed (their "
+          f"errors are in {out}'s error column); the first: {first}", file=sys.stderr)
     return 0
 
 

@@ -186,6 +186,67 @@ CHANNEL_MAP: tuple[Channel, ...] = (
 )
 THROTTLE_CHANNEL = 2
 
+
+def aircraft_channels(power) -> tuple[Channel, ...]:
+    """The channel map of another JSBSim aircraft: the same servos and JSBSim commands as
+    :data:`CHANNEL_MAP` (every JSBSim aircraft's FCS reads ``fcs/aileron-cmd-norm``,
+    ``fcs/elevator-cmd-norm``, ``fcs/rudder-cmd-norm``, ``fcs/throttle-cmd-norm[i]``), each
+    surface's direction from what its command does in the aircraft's own model
+    (``power``: :class:`~bioflex_jsb.runtime.control_power.ControlPower`): PWM above trim
+    gives ArduPilot's roll right, nose up, nose right. c172p: aileron +1 (roll power +10.5
+    rad/s² per unit), elevator −1 (−14.2), rudder −1 (−1.54): the prototype's map. A rudder
+    that moves nothing keeps the prototype's direction."""
+    def sign(x: float, default: float) -> float:
+        return default if x == 0.0 else math.copysign(1.0, x)
+
+    proto = {c.index: c for c in CHANNEL_MAP}
+    signs = {0: sign(power.roll_rad_s2, 1.0), 1: sign(power.pitch_rad_s2, -1.0),
+             3: sign(power.yaw_rad_s2, -1.0)}
+    return tuple(Channel(c.index, c.prop, c.zero_us, c.us_per_unit,
+                         signs.get(c.index, c.sign), c.lo, c.hi) for c in proto.values())
+
+
+def plane_numbers(aircraft, speed_m_s: float, altitude_m: float):
+    """(:class:`~bioflex_jsb.generators.ardupilot_params.PlaneNumbers`, the control power)
+    of an aircraft definition on its own JSBSim aircraft at the cruise ``speed_m_s`` [m/s]
+    and ``altitude_m`` [m]: its flight speeds, its stall speed from its identified C_L,max,
+    the trim throttle, the steady rates of a full command and the climb angles at full
+    throttle and idle measured on its JSBSim model (runtime/control_power.py, a copy loaded
+    for that), and the idle dive at its highest speed from its drag polar (D V/W).
+    Raises FdmError (one line) where it cannot be trimmed."""
+    from bioflex_jsb.definition.flying import flight_speeds
+    from bioflex_jsb.generators.ardupilot_params import PlaneNumbers
+    from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
+    from bioflex_jsb.runtime.control_power import measure_control_power
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+
+    probe = airframe_for(aircraft)
+    power = measure_control_power(probe, speed_m_s, altitude_m)
+    rho = float(probe["atmosphere/rho-slugs_ft3"]) * U.KG_M3_PER_SLUG_FT3
+    engines = probe.engine_count
+    del probe
+    _cruise, (lo, hi) = flight_speeds(aircraft)
+    data = aircraft.wing().model.airframe
+    s_m2 = data.reference.area_m2
+    weight = power.mass_kg * STANDARD_GRAVITY_M_S2
+    stall = math.sqrt(2.0 * weight / (rho * s_m2 * data.at_speed(lo).aero.cl_max))
+    fast = data.at_speed(hi).aero
+    q_hi = 0.5 * rho * hi * hi
+    cl = weight / (q_hi * s_m2)
+    dive = (fast.cd0 + fast.k_induced * cl * cl) * q_hi * s_m2 * hi / weight
+    q_full = -power.pitch_rad_s2 / (power.pitch_alpha_1_s2 / power.lift_alpha_1_s
+                                    + power.pitch_rate_1_s)
+    p_full = power.roll_rad_s2 / abs(power.roll_damping_1_s)
+    channels = aircraft_channels(power)
+    signs = tuple(c.sign for c in channels if c.index in (0, 1, 3))
+    numbers = PlaneNumbers(
+        aircraft.name, f"its JSBSim model {aircraft.airframe.jsbsim!r} trimmed at "
+        f"{speed_m_s:g} m/s, {altitude_m:g} m (runtime/control_power.py); its flight speeds "
+        f"{lo:g}..{hi:g} m/s; its identified C_L,max and drag polar", float(speed_m_s),
+        float(lo), float(hi), stall, power.throttle_trim, p_full, q_full,
+        power.climb_angle_full_rad, power.climb_angle_idle_rad, dive, signs, engines)
+    return numbers, power
+
 # The launch fires when, for LAUNCH_HOLD_S [s], servo 3 has been above LAUNCH_THROTTLE_US
 # (ArduPlane in TAKEOFF mode holds TKOFF_THR_IDLE, 5 % = 1050 µs, while it waits; disarmed
 # it sends 1000) or servo 5 within LAUNCH_SWITCH_US (SERVO5_FUNCTION 55 passes RC input 5
@@ -275,7 +336,8 @@ class ArduPilotPhysics:
                  gust_at_s: float = 60.0, launcher: Launcher | None = None,
                  record_every: int = 8, gust_repeat: bool = False,
                  aero: str = "quasi-steady", compiled: bool = True,
-                 sensors: Sensors | None = None) -> None:
+                 sensors: Sensors | None = None,
+                 channels: tuple[Channel, ...] = CHANNEL_MAP) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
             raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
         if not is_whole(record_every) or record_every < 0:
@@ -292,6 +354,7 @@ class ArduPilotPhysics:
         self.gust_repeat = bool(gust_repeat)
         self.aero = aero
         self.compiled = bool(compiled)
+        self.channels = tuple(channels)  # the servo map (aircraft_channels: another's)
         self._gust_applied = False  # the gust has begun in a flight of this session
         self._controls: list[Callable[[float], None]] = []
         self.stops: list[dict] = []  # valid-range stops: reason, time [s]
@@ -373,7 +436,7 @@ class ArduPilotPhysics:
         self._mass = node("inertia/mass-slugs").get_double_value
         self._vt = node("velocities/vt-fps").get_double_value
         writers = []
-        for ch in CHANNEL_MAP:
+        for ch in self.channels:
             if ch.index == THROTTLE_CHANNEL:
                 engines = [node(f"{ch.prop}[{i}]").set_double_value
                            for i in range(a.engine_count)]
@@ -506,7 +569,7 @@ class ArduPilotPhysics:
         core = self.core
         if pwm_us != self._written_pwm:  # ArduPlane's outputs change at its loop rate
             # (50-400 Hz) against 960 frames a second: the same PWM is not written again
-            for ch, write in zip(CHANNEL_MAP, self._controls, strict=True):
+            for ch, write in zip(self.channels, self._controls, strict=True):
                 write(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0))
             self._written_pwm = pwm_us
         k = core.k
@@ -623,13 +686,13 @@ class ArduPilotPhysics:
 
     def commands(self, pwm_us: tuple[int, ...]) -> tuple[float, ...]:
         """The four normalised commands (aileron, elevator, throttle, rudder) the channel map
-        gives for ``pwm_us`` [µs] (:data:`CHANNEL_MAP`); the last PWM's kept (ArduPlane's
+        gives for ``pwm_us`` [µs] (:attr:`channels`); the last PWM's kept (ArduPlane's
         outputs change at its loop rate, 50-400 Hz, against 960 frames a second)."""
         last_pwm, last = self._commands_of
         if pwm_us == last_pwm:
             return last
         out = tuple(ch.value(pwm_us[ch.index]) if ch.index < len(pwm_us) else ch.value(0)
-                    for ch in CHANNEL_MAP)
+                    for ch in self.channels)
         self._commands_of = (pwm_us, out)
         return out
 

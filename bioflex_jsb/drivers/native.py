@@ -17,6 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from bioflex_jsb.definition.airframe import GENERATED
+from bioflex_jsb.definition.flying import flight_speeds
 from bioflex_jsb.definition.reader import DefinitionError
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.generators import native_aircraft as NA
@@ -25,7 +26,6 @@ from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.runtime.coupled_step import configure_airframe
 from bioflex_jsb.runtime.fdm import TRIM_CONTROLS, Airframe
-from bioflex_jsb.runtime.results import TrimError
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 # The exported flights start at ISA sea level (as the prototype's: TrimState): a definition's
@@ -54,25 +54,66 @@ def fig21_trim_state(dt_s: float = DEFAULT_DT_S) -> NA.TrimState:
     return trim_state(P.SECTION5_AIRSPEED_M_S, dt_s)
 
 
-def glide_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimState:
-    """Glide trim of an exported glider (``files``: its aircraft and system, written to a
-    temporary root and loaded there, never into the user's): the steady, straight,
-    wings-level glide at ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, by
-    :meth:`Airframe.trim` (an aircraft without an engine: α, the flight-path angle γ and the
-    pitch trim by Newton in JSBSim's initial-condition run, runtime/glide.py) with
-    the export's step and integrators, as :func:`trim_state` trims the prototype. The modal
-    loads are zero in it: the wing is held at its trim reference while JSBSim's step is 0.
-    Raises TrimError (one line)."""
-    with tempfile.TemporaryDirectory(prefix="bioflex-glide-trim-") as tmp:
+def aircraft_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimState:
+    """Trim of an exported aircraft file (``files``: its aircraft, the files it names and
+    the system, written to a temporary root and loaded there, never into the user's) at
+    ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, by :meth:`Airframe.trim` with the
+    export's step and integrators, as :func:`trim_state` trims the prototype: a glider's
+    steady, straight, wings-level glide (α, the flight-path angle γ and the pitch trim by
+    Newton in JSBSim's initial-condition run, runtime/glide.py); a powered aircraft's level
+    flight, its engines started as JSBSim expects (runtime/engines.py) and trimmed by
+    JSBSim. The controls kept are the trim's surfaces and each engine's levers JSBSim has
+    (throttle, mixture, propeller advance, turboprop condition) as the trim left them. The
+    modal loads are zero in it: the wing is held at its trim reference while JSBSim's step
+    is 0. Raises TrimError (one line)."""
+    with tempfile.TemporaryDirectory(prefix="bioflex-export-trim-") as tmp:
         write_export(files, Path(tmp))
         af = Airframe(tmp, spec.aircraft_name)
-        if not af.glider:
-            raise TrimError(f"aircraft {spec.aircraft_name!r} has {af.engine_count} engines: "
-                            "an aircraft file's export is trimmed to a glide")
         configure_airframe(af, spec.dt_s, modal_hooks=False)
         trim = af.trim(spec.speed_m_s)
-        return NA.TrimState(_state(af), {name: af[name] for name in TRIM_CONTROLS},
-                            trim.speed_m_s, 0.0, 0.0, gamma_rad=trim.flight_path_rad)
+        controls = {name: af[name] for name in TRIM_CONTROLS}
+        for i in range(af.engine_count):
+            for lever in ENGINE_LEVERS:
+                name = f"{lever}[{i}]"
+                if af.has_property(name):
+                    controls[name] = af[name]
+        return NA.TrimState(_state(af), controls, trim.speed_m_s, trim.propeller_rpm, 0.0,
+                            gamma_rad=trim.flight_path_rad)
+
+
+# An engine's levers, per engine (``<lever>[i]``), kept in an exported trim where JSBSim has
+# them: FGFCS's throttle, mixture and propeller-advance commands (a turboprop's condition
+# lever is its mixture command).
+ENGINE_LEVERS = ("fcs/throttle-cmd-norm", "fcs/mixture-cmd-norm", "fcs/advance-cmd-norm")
+
+
+def carried_files(spec: J.ExportSpec) -> dict[str, str]:
+    """The files the aircraft file ``spec.jsbsim_path`` names (engines, propellers,
+    systems, sections), found as JSBSim finds them (runtime/aircraft_files.py) and put in
+    the exported aircraft's folder where JSBSim looks first (``Engines/``, ``Systems/``, the
+    folder itself): path from the JSBSim root → text, each after a comment naming its
+    original (so a later export replaces it as its own). Read with the bounds of every
+    input file; ExportError (one line) for a file that is not UTF-8 text."""
+    from bioflex_jsb.runtime.aircraft_files import (
+        named_files,
+        read_aircraft_xml,
+        read_named_files,
+    )
+
+    src = Path(spec.jsbsim_path)
+    named = named_files(src, read_aircraft_xml(src))
+    sources = {f.target: f.source for f in named}
+    out = {}
+    for target, data in read_named_files(src, named).items():
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise J.ExportError(f"{str(sources[target])!r} is not UTF-8 text: the export "
+                                "copies the files an aircraft names as text") from None
+        note = (f"<!-- GENERATED by bioflex_jsb.drivers.native (bioflex-jsb export-jsbsim): "
+                f"a copy of {sources[target]}. Do not edit. -->")
+        out[f"aircraft/{spec.aircraft_name}/{target}"] = NA.with_note(text, note)
+    return out
 
 
 def _state(af: Airframe) -> dict[str, tuple[str, float]]:
@@ -117,8 +158,10 @@ def aircraft_spec(aircraft, build, model: str = "coupled", dt_s: float = DEFAULT
             raise DefinitionError(problem)
         return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho)
     craft = re.sub(r"[^A-Za-z0-9_-]+", "_", d.name)
+    _cruise, speeds = flight_speeds(aircraft)
     return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho, jsbsim_path=a.jsbsim_path,
-                        aircraft=craft, jsbsim_chord_m=NA.jsbsim_chord_m(a.jsbsim_path))
+                        aircraft=craft, jsbsim_chord_m=NA.jsbsim_chord_m(a.jsbsim_path),
+                        speed_range_m_s=(float(speeds[0]), float(speeds[1])))
 
 
 def export_flight(spec: J.ExportSpec, gust_up_m_s: float = P.SECTION5_GUST_AMPLITUDE_M_S,
@@ -129,14 +172,25 @@ def export_flight(spec: J.ExportSpec, gust_up_m_s: float = P.SECTION5_GUST_AMPLI
     (:func:`~bioflex_jsb.generators.native_aircraft.export_case`). Returns the case, the trim
     and the files (path from the JSBSim root → text; write them with
     :func:`write_export`). Raises TrimError (one line), ExportError."""
-    files = NA.render_aircraft_files(spec)
     if spec.jsbsim_path:
-        state = glide_trim_state(files, spec)
+        carried = carried_files(spec)
+        names = frozenset(f.name for f in _named(spec))
+        files = NA.render_aircraft_files(spec, carried=names)
+        files.update(carried)
+        state = aircraft_trim_state(files, spec)
     else:
+        files = NA.render_aircraft_files(spec)
         state = trim_state(spec.speed_m_s, spec.dt_s)
     case = NA.export_case(spec, state, gust_up_m_s)
     files.update(NA.flight_files(state, case))
     return case, state, files
+
+
+def _named(spec: J.ExportSpec):
+    from bioflex_jsb.runtime.aircraft_files import named_files, read_aircraft_xml
+
+    src = Path(spec.jsbsim_path)
+    return named_files(src, read_aircraft_xml(src))
 
 
 def write_export(files: dict[str, str], out_dir: Path) -> list[Path]:

@@ -5,7 +5,9 @@ The one coupled step (:class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`), o
 ``systems/bioflex_autothrottle.xml``, see :mod:`bioflex_jsb.generators.autopilot`) flies the
 modes of :mod:`bioflex_jsb.drivers.sitl_vehicle`, for as long as asked (or until stopped);
 or on another aircraft without an engine (a glider: :func:`glider_airframe`, its speed held
-with pitch by the glider's autopilot), whose arrival at the ground is a landing.
+with pitch by the glider's autopilot), whose arrival at the ground is a landing, or on
+another aircraft with engines (:func:`powered_airframe`: the powered aircraft's autopilot,
+its gains scaled for it).
 
 Where it flies: home is a point on the ground (latitude, longitude, ground altitude AMSL;
 default :data:`DEFAULT_HOME`, the Canberra model aircraft field ArduPilot's SITL also
@@ -38,7 +40,8 @@ WP_RADIUS_M     default waypoint acceptance radius [m], 5..500
 LOIT_RAD_M      loiter radius [m], 20..1000
 RTL_ALT_M       return altitude [m above home], 20..1000
 AIRSPEED_MS     airspeed held by the autothrottle [m/s], 12..22 (MAV_CMD_DO_CHANGE_SPEED);
-                a glider's: held with pitch, within its definition's speed range
+                another aircraft's: within its definition's flight speeds (a glider's held
+                with pitch)
 GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up], ±5
 GUST_LEN_M      length of that gust [m], 1..500
 GUST_TRIG       write 1: the gust starts now; reads 1 while it blows, then 0
@@ -68,8 +71,11 @@ from bioflex_jsb.drivers.sitl_vehicle import (
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators.autopilot import (
     GLIDER_SYSTEM_FILE,
+    POWERED_SYSTEM_FILE,
     SITL_AIRCRAFT,
+    powered_gains,
     render_glider_autopilot,
+    render_powered_autopilot,
 )
 from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink import VehicleState
@@ -99,6 +105,83 @@ MAX_RESETS_PER_MINUTE = 30  # a run that keeps diverging: each reset still costs
 # the centre; with 25 s it holds 144-146 m (tests/test_glider_sitl.py).
 GLIDER_LOITER_RADIUS_M = 150.0
 GLIDER_L1_PERIOD_S = 25.0
+
+
+def powered_airframe(aircraft, speed_m_s: float, altitude_m: float):
+    """The JSBSim airframe of an aircraft definition with engines (``--aircraft``: its own
+    JSBSim aircraft) with a powered aircraft's autopilot added
+    (:func:`~bioflex_jsb.generators.autopilot.render_powered_autopilot`), its gains scaled
+    for the aircraft (:func:`~bioflex_jsb.generators.autopilot.powered_gains`) from its
+    rigid short period at ``speed_m_s`` [m/s] (the definition's linear model at the air
+    density of ``altitude_m`` [m], the session's start) and the control power its JSBSim
+    model gives at the trim there (runtime/control_power.py, measured on a copy loaded for
+    that alone): (the airframe, the gains). Raises FdmError (one line) where it cannot be
+    trimmed or a control moves nothing; an aircraft without an engine is refused (the
+    glider's autopilot: :func:`glider_airframe`)."""
+    from bioflex_jsb.flight_dynamics.eigen import modes_at
+    from bioflex_jsb.runtime.control_power import measure_control_power
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+    from bioflex_jsb.runtime.results import TrimError
+
+    probe = airframe_for(aircraft)
+    if probe.glider:
+        raise TrimError(f"aircraft {aircraft.name!r} has no engine: it flies the glider's "
+                        "autopilot")
+    power = measure_control_power(probe, speed_m_s, altitude_m)
+    density = float(probe["atmosphere/rho-slugs_ft3"]) * U.KG_M3_PER_SLUG_FT3
+    sp = modes_at("rigid", [speed_m_s], aircraft.wing().model,
+                  density_kg_m3=density)[0].get("short_period")
+    try:
+        gains = powered_gains(speed_m_s, sp.frequency_rad_s, sp.damping, power)
+    except ValueError as exc:
+        raise TrimError(f"aircraft {aircraft.name!r}: {exc}") from None
+    engines = probe.engine_count
+    del probe
+    text = render_powered_autopilot(gains, engines)
+    return airframe_for(aircraft, systems={POWERED_SYSTEM_FILE: text}), gains
+
+
+def sitl_airframe(aircraft, speed_m_s: float, altitude_m: float):
+    """The SITL airframe of another JSBSim aircraft: without an engine the glider's
+    (:func:`glider_airframe`), with engines the powered aircraft's
+    (:func:`powered_airframe`): (the airframe, its gains, None for a glider)."""
+    from bioflex_jsb.runtime.engines import engines_of
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
+
+    if not engines_of(complete(aircraft).airframe.jsbsim_path):
+        return glider_airframe(aircraft), None
+    return powered_airframe(aircraft, speed_m_s, altitude_m)
+
+
+def loiter_radius_m(speed_m_s: float) -> float:
+    """A powered aircraft's LOIT_RAD_M default [m]: the circle flown at the CIRCLE mode's
+    20° bank (V²/(g tan 20°), within the guidance's 30° limit), in whole tens of metres,
+    within the parameter's range (c172 at 57.8 m/s: 940 m)."""
+    from bioflex_jsb.drivers.sitl_vehicle import LOITER_RADIUS_RANGE_M
+    from bioflex_jsb.generators.autopilot import LOITER_BANK_RAD
+    from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
+
+    r = speed_m_s**2 / (STANDARD_GRAVITY_M_S2 * math.tan(LOITER_BANK_RAD))
+    lo, hi = LOITER_RADIUS_RANGE_M
+    return float(min(hi, max(lo, 10.0 * math.ceil(r / 10.0))))
+
+
+# The L1 distance against the tightest turn the guidance may fly (V²/(g tan 30°)): the
+# prototype's 17 s period at 15 m/s gives 1.5 of it (61 m against 40 m), the glider's 25 s
+# at 25 m/s 1.35; shorter, the guidance saturates its bank and circles a waypoint it cannot
+# turn onto (measured on the c172 with the prototype's 17 s: 235 m against 590 m).
+L1_TURN_RATIO = 1.5
+
+
+def l1_period_s(speed_m_s: float, damping: float) -> float:
+    """A powered aircraft's L1 period [s]: its L1 distance ζ P V/π is L1_TURN_RATIO times
+    its tightest turn at the guidance's bank limit (c172 at 57.8 m/s: 64 s, L1 885 m;
+    the rule gives the prototype's 16.6 s and the glider's 27.7 s)."""
+    from bioflex_jsb.generators.autopilot import BANK_CMD_MAX_RAD
+    from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
+
+    turn_m = speed_m_s**2 / (STANDARD_GRAVITY_M_S2 * math.tan(BANK_CMD_MAX_RAD))
+    return math.pi * L1_TURN_RATIO * turn_m / (damping * speed_m_s)
 
 
 def glider_airframe(aircraft) -> Airframe:
@@ -292,6 +375,8 @@ class SitlSim:
         self.aero = aero
         self.airframe = airframe or Airframe(aircraft=SITL_AIRCRAFT)
         self.glider = bool(self.airframe.glider)
+        # another JSBSim aircraft with engines, flying the powered aircraft's autopilot
+        self.powered_file = self.airframe.has_property("ap/elevator-trim-norm")
         self.airspeed_range_m_s = tuple(float(v) for v in airspeed_range_m_s)
         self._wing_model, self._model0 = wing_model, model
         self.home_deg = tuple(float(x) for x in home)
@@ -326,8 +411,13 @@ class SitlSim:
         ground = self.home_deg[2]
         self.altitude_hold_range_m = (ground + ALT_HOLD_RANGE_ABOVE_HOME_M[0],
                                       ground + ALT_HOLD_RANGE_ABOVE_HOME_M[1])
+        # the battery feeds the motors of an electric aircraft (the prototype's); another
+        # aircraft's engines burn fuel: its battery feeds the avionics only (as a glider's)
+        electric = (not self.airframe.engines  # the generated prototype's: its motors
+                    or all(e.kind == "electric" for e in self.airframe.engines))
         self.power_properties = tuple(f"propulsion/engine[{i}]/power-hp"
-                                      for i in range(self.airframe.engine_count))
+                                      for i in range(self.airframe.engine_count)
+                                      if electric)
         self.gust_amplitude_m_s = 1.0
         self.gust_length_m = 30.0
         self._gust: GustField | None = None
@@ -342,6 +432,10 @@ class SitlSim:
         if self.glider:
             self.vehicle.settings.loiter_radius_m = GLIDER_LOITER_RADIUS_M
             self.vehicle.settings.l1_period_s = GLIDER_L1_PERIOD_S
+        elif self.powered_file:
+            self.vehicle.settings.loiter_radius_m = loiter_radius_m(speed_m_s)
+            self.vehicle.settings.l1_period_s = l1_period_s(
+                speed_m_s, self.vehicle.settings.l1_damping)
         self._guide_every = max(1, int(round(GUIDANCE_PERIOD_S / self.dt_s)))
 
     def _new_core(self, model: str) -> None:
@@ -369,6 +463,11 @@ class SitlSim:
         self._relocate()
         self._get = self.core.get
         self.wing = self.core.wing
+        if self.powered_file:  # the autopilot's increments are on the trim's commands
+            for surface in ("elevator", "aileron", "rudder"):
+                a[f"ap/{surface}-trim-norm"] = a[f"fcs/{surface}-cmd-norm"]
+            for i in range(a.engine_count):
+                a[f"ap/throttle-trim-norm[{i}]"] = a[f"fcs/throttle-cmd-norm[{i}]"]
         a["ap/theta-trim-rad"] = self.trim.theta_rad
         a["ap/altitude-hold-m"] = self.start_altitude_m
         a["ap/heading-hold-rad"] = math.remainder(self._get["psi"](), 2 * math.pi)

@@ -40,6 +40,20 @@ from the same pitch-attitude and roll laws (:func:`_pitch_loop`, :func:`_roll_ch
 its own gains, θ_cmd from the airspeed error (a PI loop: the speed is held with pitch, no
 altitude hold) instead of the altitude loop, and the sideslip fed to the rudder
 (docs/sitl.md, "A glider").
+
+**A powered aircraft's autopilot** (:func:`render_powered_autopilot`; another JSBSim aircraft
+with engines, such as JSBSim's c172p, added to the copy of its aircraft by
+:func:`bioflex_jsb.drivers.sitl.powered_airframe`) has the prototype's laws (altitude hold
+through the pitch attitude, the heading/roll hold, the stick modes, the autothrottle) and
+the glider's sideslip-to-rudder loop, with gains from the aircraft's own dynamics
+(:func:`powered_gains`: its rigid short period at the speed, the control power and thrust
+its JSBSim model gives per unit command, runtime/control_power.py), the airspeed held by a
+PI autothrottle, and the attitude command limited to the climb angle its engines allow.
+Its commands are increments on the trim's (``ap/<surface>-trim-norm``, set by the SITL
+after each trim) written to the normalised commands every JSBSim aircraft reads
+(``fcs/elevator-cmd-norm``, ``fcs/aileron-cmd-norm``, ``fcs/rudder-cmd-norm``,
+``fcs/throttle-cmd-norm[i]``); disengaged, each writes its command's own value back, so
+JSBSim's trim (which moves those commands) sees no autopilot.
 """
 
 from __future__ import annotations
@@ -48,12 +62,14 @@ import argparse
 import math
 import sys
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from pathlib import Path
 
 from bioflex_jsb import units as U
 from bioflex_jsb.generators import airframe as AX
 from bioflex_jsb.generators.xml_writer import XmlWriter, num_repr, serialise
 from bioflex_jsb.parameters.airframe import PROPULSION
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 
 SYSTEM_FILE = "bioflex_autopilot"
 THROTTLE_SYSTEM_FILE = "bioflex_autothrottle"
@@ -237,24 +253,25 @@ def render_glider_autopilot() -> str:
     writes them for every aircraft) and act on nothing."""
     root = ET.Element("system", name="bioflex-glider-autopilot")
     for prop, value in _AUTOPILOT_PROPERTIES + (
-            ("ap/airspeed-hold-mps", 0), ("ap/autothrottle", 0), ("ap/armed", 1)):
+            ("ap/airspeed-hold-mps", 0), ("ap/autothrottle", 0), ("ap/armed", 1),
+            ("ap/speed-integral-rad", 0)):
         el(root, "property", prop, value=repr(float(value)))
     pitch = el(root, "channel", name="AP pitch")
     speed = node("product", "velocities/vt-fps", U.M_PER_FT)
     _function(pitch, "ap/speed-error-mps", node("difference", speed, "ap/airspeed-hold-mps"))
-    # the integral runs while the speed loop flies the aircraft (trigger 0), held at 0 in
-    # MANUAL, the stick modes and disengaged (trigger < 0: JSBSim's FGPID resets it)
-    sw = el(pitch, "switch", name="ap/speed-integrator-trigger")
-    el(sw, "default", value="-1")
-    t = el(sw, "test", "ap/engage == 1\nap/manual == 0\nap/pitch-mode == 0", value="0")
+    # the integral runs while the speed loop flies the aircraft, held at 0 in MANUAL, the
+    # stick modes and disengaged; over JSBSim's own step (_integrator: JSBSim's <pid>
+    # integrated with the step the aircraft was loaded with, 1/120 s, 8 times too fast)
+    sw = el(pitch, "switch", name="ap/speed-integrating")
+    el(sw, "default", value="0")
+    t = el(sw, "test", "ap/engage == 1\nap/manual == 0\nap/pitch-mode == 0", value="1")
     t.set("logic", "AND")
-    pid = el(pitch, "pid", name="ap/theta-speed-incr-rad")
-    el(pid, "input", "ap/speed-error-mps")
-    el(pid, "kp", GLIDER_K_AIRSPEED_RAD_PER_M_S)
-    el(pid, "ki", GLIDER_KI_AIRSPEED_RAD_PER_M)
-    el(pid, "kd", 0.0)
-    el(pid, "trigger", "ap/speed-integrator-trigger")
-    _clip(pid, -GLIDER_THETA_SPAN_RAD, GLIDER_THETA_SPAN_RAD)
+    _integrator(pitch, "ap/speed-integral-rad", "ap/speed-error-mps",
+                GLIDER_KI_AIRSPEED_RAD_PER_M, "ap/speed-integrating",
+                (-GLIDER_THETA_SPAN_RAD, GLIDER_THETA_SPAN_RAD))
+    _function(pitch, "ap/theta-speed-incr-rad",
+              node("sum", node("product", GLIDER_K_AIRSPEED_RAD_PER_M_S, "ap/speed-error-mps"),
+                   "ap/speed-integral-rad"), (-GLIDER_THETA_SPAN_RAD, GLIDER_THETA_SPAN_RAD))
     _function(pitch, "ap/theta-speed-rad",
               node("sum", "ap/theta-trim-rad", "ap/theta-speed-incr-rad"))
     # the pitch rate a steady turn has (q = r tan φ, body axes) is not damped
@@ -269,6 +286,274 @@ def render_glider_autopilot() -> str:
               (-RUDDER_AUTHORITY, RUDDER_AUTHORITY))
     _engage_switch(yaw, "ap/rudder-out-norm", "ap/rudder-auto-norm", "0",
                    "fcs/rudder-cmd-norm")
+    return serialise(root, _HEADER)
+
+
+# -- a powered aircraft's autopilot ------------------------------------------------------
+POWERED_SYSTEM_FILE = "bioflex_powered_autopilot"
+# The closed pitch-attitude loop: its stiffness twice the airframe's short period's
+# (ω_c = √2 ω_sp), damped to ζ_c (the classical 0.7 of a second-order loop).
+PITCH_LOOP_DAMPING = 0.7
+# The altitude and airspeed loops' time constant [s]: ArduPlane's TECS_TIME_CONST default
+# (5 s); the prototype's own altitude loop, tuned by hand (K_h 0.03 rad/m, K_ḣ 0.06 rad per
+# m/s at 15 m/s), has 4.2 s. The airspeed integral's time constant is twice it.
+ENERGY_TIME_CONSTANT_S = 5.0
+# Climb-rate feedback: K_ḣ V = 1, a climb at γ is taken off θ_cmd as an equal angle (the
+# prototype's K_ḣ V is 0.9).
+CLIMB_DAMPING = 1.0
+# Share of the full-throttle climb angle the altitude loop may command above (and below) θ
+# at the trim, so that the autothrottle keeps a margin to hold the speed in a climb.
+CLIMB_ANGLE_SHARE = 0.8
+# The bank loop's time constant [s] (the glider's 1 s; ArduPlane's RLL2SRV_TCONST default
+# is 0.5 s), and the roll-rate feedback's share of the roll's own damping.
+ROLL_TIME_CONSTANT_S = 1.0
+ROLL_RATE_SHARE = 0.25
+
+
+@dataclass(frozen=True)
+class PoweredGains:
+    """A powered aircraft's autopilot gains (SI in, normalised command out) and the numbers
+    they were chosen from (:func:`powered_gains`)."""
+
+    theta_per_rad: float  # elevator per rad of pitch-attitude error (> 0)
+    q_per_rad_s: float  # elevator per rad/s of pitch rate (> 0: nose-down elevator)
+    altitude_rad_per_m: float  # θ_cmd per m of altitude error
+    altitude_i_rad_per_m_s: float  # θ_cmd per m·s of integrated altitude error
+    climb_rad_per_m_s: float  # θ_cmd per m/s of climb rate
+    theta_span_rad: float  # θ_cmd within θ_trim ± this
+    phi_per_rad: float  # aileron per rad of bank error
+    p_per_rad_s: float  # aileron per rad/s of roll rate
+    beta_per_rad: float  # rudder per rad of sideslip (signed)
+    airspeed_per_m_s: float  # throttle per m/s of airspeed error
+    airspeed_i_per_m: float  # throttle per m of integrated airspeed error
+    climb_throttle_per_m_s: float  # throttle per unit ḣ/V (the climb's thrust W ḣ/V)
+    source: dict  # what they were scaled from (the log, docs/sitl.md)
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def powered_gains(speed_m_s: float, short_period_rad_s: float, short_period_damping: float,
+                  power) -> PoweredGains:
+    """The gains of :func:`render_powered_autopilot` for an aircraft at ``speed_m_s`` [m/s]
+    whose rigid short period has the natural frequency ``short_period_rad_s`` ω_sp [rad/s]
+    and damping ``short_period_damping`` ζ_sp, with the control power ``power``
+    (:class:`bioflex_jsb.runtime.control_power.ControlPower`: m_δe, l_δa, n_δr [rad/s² per
+    unit], L_p [1/s], N_β [1/s²], a_δt [m/s² per unit], γ_full [rad]):
+
+    * pitch attitude: K_θ = ω_sp²/|m_δe| (the loop's stiffness twice the airframe's),
+      K_q = max(0, 2 ζ_c ω_c − 2 ζ_sp ω_sp)/|m_δe|, ω_c = √2 ω_sp, ζ_c = 0.7;
+    * altitude: K_ḣ = 1/V (CLIMB_DAMPING), K_h = (1 + K_ḣ V)/(V τ) with τ = 5 s
+      (θ ≈ θ_cmd and ḣ = V Δθ make the altitude error decay as e^(−t/τ)), an integral
+      K_h/(4 τ) for the trim's change of θ with speed; θ_cmd within θ_trim ± 0.8 γ_full (at
+      most 12°);
+    * bank: p_ss = |l_δa/L_p| (steady roll rate per unit aileron), K_p = 0.25/p_ss,
+      K_φ = (1 + p_ss K_p)/(p_ss τ_φ), τ_φ = 1 s (the bank's time constant with the roll
+      taken as first order);
+    * sideslip to rudder: N_β/n_δr (the rudder doubles the weathercock stiffness);
+    * airspeed: K_V = 1/(a_δt τ) and K_i = K_V/(2 τ), τ = 5 s, with the climb's thrust
+      fed forward: g/a_δt per unit ḣ/V (W sin γ over the thrust a unit of throttle adds).
+    Raises ValueError when a number it needs is not positive and finite."""
+    v, wn, zeta = float(speed_m_s), float(short_period_rad_s), float(short_period_damping)
+    m_de, l_da, lp = abs(power.pitch_rad_s2), abs(power.roll_rad_s2), power.roll_damping_1_s
+    a_dt = power.throttle_m_s2
+    for name, value in (("speed", v), ("short-period frequency", wn), ("elevator power", m_de),
+                        ("aileron power", l_da), ("roll damping", -lp),
+                        ("thrust per throttle", a_dt), ("climb angle at full throttle",
+                                                        power.climb_angle_full_rad)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"autopilot gains: the aircraft's {name} must be positive, got "
+                             f"{value!r}")
+    wc = math.sqrt(2.0) * wn
+    k_theta = wn * wn / m_de
+    k_q = max(0.0, 2.0 * PITCH_LOOP_DAMPING * wc - 2.0 * zeta * wn) / m_de
+    k_hdot = CLIMB_DAMPING / v
+    k_h = (1.0 + k_hdot * v) / (v * ENERGY_TIME_CONSTANT_S)
+    span = min(THETA_CMD_MAX_RAD, CLIMB_ANGLE_SHARE * power.climb_angle_full_rad)
+    p_ss = l_da / abs(lp)
+    k_p = ROLL_RATE_SHARE / p_ss
+    k_phi = (1.0 + p_ss * k_p) / (p_ss * ROLL_TIME_CONSTANT_S)
+    k_beta = (power.yaw_stiffness_1_s2 / power.yaw_rad_s2
+              if power.yaw_rad_s2 and power.yaw_stiffness_1_s2 > 0.0 else 0.0)
+    k_v = 1.0 / (a_dt * ENERGY_TIME_CONSTANT_S)
+    source = {"speed_m_s": v, "short_period_rad_s": wn, "short_period_damping": zeta,
+              **{f"power_{k}": float(x) for k, x in power.as_dict().items()}}
+    return PoweredGains(k_theta, k_q, k_h, k_h / (4.0 * ENERGY_TIME_CONSTANT_S), k_hdot,
+                        span, k_phi, k_p, k_beta, k_v,
+                        k_v / (2.0 * ENERGY_TIME_CONSTANT_S),
+                        STANDARD_GRAVITY_M_S2 / a_dt, source)
+
+
+def _integrator(channel, name: str, rate: str, gain: float, running: str,
+                clip: tuple[float, float]) -> None:
+    """``name`` = ∫ ``gain`` · ``rate`` dt over JSBSim's own step (``simulation/dt``) while
+    the property ``running`` is 1, else 0, clipped to ``clip`` (no wind-up past it). The
+    integral is a property declared by the caller's system (its previous value is read)."""
+    step = node("sum", name, node("product", gain, "simulation/dt", rate))
+    f = el(channel, "fcs_function", name=name + "-next")
+    fn = el(f, "function")
+    fn.append(node("ifthen", running, step, 0.0))
+    _clip(f, *clip)
+    el(f, "output", name)
+
+
+def _trimmed_switch(channel, name: str, auto: str, manual: str, output: str) -> None:
+    """The output switch of a powered aircraft's surface: engaged, ``auto``; in MANUAL,
+    ``manual``; disengaged, the command's own value (JSBSim's trim moves it)."""
+    sw = el(channel, "switch", name=name)
+    el(sw, "default", value=output)
+    t = el(sw, "test", "ap/manual == 1", value=manual)
+    t.set("logic", "AND")
+    t = el(sw, "test", "ap/engage == 1", value=auto)
+    t.set("logic", "AND")
+    el(sw, "output", output)
+
+
+def _plus_trim(channel, name: str, trim: str, increment: str) -> None:
+    _function(channel, name, node("sum", trim, increment), (-1.0, 1.0))
+
+
+def render_powered_autopilot(gains: PoweredGains, engines: int) -> str:
+    """Text of a powered aircraft's autopilot system (module docstring) with ``gains`` for
+    ``engines`` engines (``fcs/throttle-cmd-norm[i]``, each its own trim lever)."""
+    g = gains
+    root = ET.Element("system", name="bioflex-powered-autopilot")
+    trims = (("ap/elevator-trim-norm", 0), ("ap/aileron-trim-norm", 0),
+             ("ap/rudder-trim-norm", 0))
+    levers = tuple((f"ap/throttle-trim-norm[{i}]", 0) for i in range(engines))
+    for prop, value in _AUTOPILOT_PROPERTIES + trims + levers + (
+            ("ap/airspeed-hold-mps", 0), ("ap/autothrottle", 0), ("ap/armed", 1),
+            ("ap/throttle-integral-norm", 0), ("ap/altitude-integral-rad", 0)):
+        el(root, "property", prop, value=repr(float(value)))
+
+    pitch = el(root, "channel", name="AP pitch")
+    climb = node("product", "velocities/h-dot-fps", U.M_PER_FT)
+    _function(pitch, "ap/altitude-error-m",
+              node("difference", "ap/altitude-hold-m", "position/h-sl-meters"))
+    # the altitude's integral takes the trim's change of θ with the speed (the attitude at
+    # 50 m/s is not the cruise trim's: 5 m low without it, measured on the c172); it runs
+    # while the loop flies and its command is inside the span (no wind-up in a climb)
+    unclipped = node("sum", node("product", g.altitude_rad_per_m, "ap/altitude-error-m"),
+                     node("product", -g.climb_rad_per_m_s, climb), "ap/altitude-integral-rad")
+    _function(pitch, "ap/theta-alt-unclipped-rad", unclipped)
+    sw = el(pitch, "switch", name="ap/altitude-integrating")
+    el(sw, "default", value="0")
+    t = el(sw, "test", "ap/engage == 1\nap/manual == 0\nap/pitch-mode == 0\n"
+           f"ap/theta-alt-unclipped-rad lt {float(g.theta_span_rad)!r}\n"
+           f"ap/theta-alt-unclipped-rad gt {-float(g.theta_span_rad)!r}", value="1")
+    t.set("logic", "AND")
+    _integrator(pitch, "ap/altitude-integral-rad", "ap/altitude-error-m",
+                g.altitude_i_rad_per_m_s, "ap/altitude-integrating",
+                (-g.theta_span_rad, g.theta_span_rad))
+    _function(pitch, "ap/theta-alt-incr-rad", node("product", 1.0, "ap/theta-alt-unclipped-rad"),
+              (-g.theta_span_rad, g.theta_span_rad))
+    _function(pitch, "ap/theta-alt-rad", node("sum", "ap/theta-trim-rad",
+                                              "ap/theta-alt-incr-rad"))
+    sw = el(pitch, "switch", name="ap/theta-cmd-rad")
+    el(sw, "default", value="ap/theta-alt-rad")
+    t = el(sw, "test", "ap/pitch-mode == 1", value="ap/pitch-cmd-rad")
+    t.set("logic", "AND")
+    # the pitch rate a steady turn has (q = r tan φ, body axes) is not damped (as the glider)
+    _function(pitch, "ap/q-off-turn-rad_sec",
+              node("difference", "velocities/q-rad_sec",
+                   node("product", "velocities/r-rad_sec", node("tan", "attitude/phi-rad"))))
+    elevator = node(
+        "sum",
+        node("product", -g.theta_per_rad,
+             node("difference", "ap/theta-cmd-rad", "attitude/theta-rad")),
+        node("product", g.q_per_rad_s, "ap/q-off-turn-rad_sec"))
+    _function(pitch, "ap/elevator-auto-incr-norm", elevator,
+              (-ELEVATOR_AUTHORITY, ELEVATOR_AUTHORITY))
+    _plus_trim(pitch, "ap/elevator-auto-norm", "ap/elevator-trim-norm",
+               "ap/elevator-auto-incr-norm")
+    _plus_trim(pitch, "ap/elevator-manual-norm", "ap/elevator-trim-norm",
+               "ap/manual-elevator-norm")
+    _trimmed_switch(pitch, "ap/elevator-out-norm", "ap/elevator-auto-norm",
+                    "ap/elevator-manual-norm", "fcs/elevator-cmd-norm")
+
+    roll = el(root, "channel", name="AP roll")
+    err = node("difference", "ap/heading-hold-rad", "attitude/psi-rad")
+    _function(roll, "ap/heading-error-rad", node("atan2", node("sin", err), node("cos", err)))
+    _function(roll, "ap/phi-heading-rad",
+              node("product", K_HEADING_RAD_PER_RAD, "ap/heading-error-rad"),
+              (-PHI_CMD_MAX_RAD, PHI_CMD_MAX_RAD))
+    _function(roll, "ap/phi-bank-rad", node("product", 1.0, "ap/bank-cmd-rad"),
+              (-BANK_CMD_MAX_RAD, BANK_CMD_MAX_RAD))
+    sw = el(roll, "switch", name="ap/phi-cmd-rad")
+    el(sw, "default", value="ap/phi-heading-rad")
+    t = el(sw, "test", "ap/roll-mode == 1", value="ap/phi-bank-rad")
+    t.set("logic", "AND")
+    t = el(sw, "test", "ap/loiter == 1", value="ap/loiter-bank-rad")
+    t.set("logic", "AND")
+    aileron = node(
+        "sum",
+        node("product", g.phi_per_rad, node("difference", "ap/phi-cmd-rad", "attitude/phi-rad")),
+        node("product", -g.p_per_rad_s, "velocities/p-rad_sec"))
+    _function(roll, "ap/aileron-auto-incr-norm", aileron, (-AILERON_AUTHORITY, AILERON_AUTHORITY))
+    _plus_trim(roll, "ap/aileron-auto-norm", "ap/aileron-trim-norm", "ap/aileron-auto-incr-norm")
+    _plus_trim(roll, "ap/aileron-manual-norm", "ap/aileron-trim-norm", "ap/manual-aileron-norm")
+    _trimmed_switch(roll, "ap/aileron-out-norm", "ap/aileron-auto-norm",
+                    "ap/aileron-manual-norm", "fcs/aileron-cmd-norm")
+
+    yaw = el(root, "channel", name="AP yaw")
+    _function(yaw, "ap/rudder-auto-incr-norm", node("product", g.beta_per_rad, "aero/beta-rad"),
+              (-RUDDER_AUTHORITY, RUDDER_AUTHORITY))
+    _plus_trim(yaw, "ap/rudder-auto-norm", "ap/rudder-trim-norm", "ap/rudder-auto-incr-norm")
+    _trimmed_switch(yaw, "ap/rudder-out-norm", "ap/rudder-auto-norm", "ap/rudder-trim-norm",
+                    "fcs/rudder-cmd-norm")
+
+    thr = el(root, "channel", name="AP throttle")
+    speed = node("product", "velocities/vt-fps", U.M_PER_FT)
+    _function(thr, "ap/speed-error-mps", node("difference", "ap/airspeed-hold-mps", speed))
+    # the integral runs while the autothrottle flies, held at 0 otherwise; integrated with
+    # the step JSBSim runs at (simulation/dt): JSBSim's <pid> takes the step the aircraft
+    # was loaded with (1/120 s) and integrated 8 times too fast at the co-simulation's
+    # 1/960 s (measured)
+    sw = el(thr, "switch", name="ap/throttle-integrating")
+    el(sw, "default", value="0")
+    t = el(sw, "test", "ap/engage == 1\nap/autothrottle == 1\nap/armed == 1", value="1")
+    t.set("logic", "AND")
+    # the thrust a climb at ḣ needs, W ḣ/V, fed forward (the total energy's rate: the PI
+    # is left with the model's errors, not the climbs', so it does not wind up on them)
+    _function(thr, "ap/throttle-climb-norm",
+              node("product", g.climb_throttle_per_m_s,
+                   node("product", "velocities/h-dot-fps", U.M_PER_FT),
+                   node("quotient", 1.0,
+                        node("max", node("product", "velocities/vt-fps", U.M_PER_FT), 1.0))))
+    # the first engine's lever before its 0..1 limits: while it is past one and the error
+    # pushes further, the integral is held (no wind-up at full throttle or idle)
+    _function(thr, "ap/throttle-unclipped-norm",
+              node("sum", "ap/throttle-trim-norm[0]" if engines else 0.0,
+                   node("product", g.airspeed_per_m_s, "ap/speed-error-mps"),
+                   "ap/throttle-integral-norm", "ap/throttle-climb-norm"))
+    sw = el(thr, "switch", name="ap/throttle-integrand-gate")
+    el(sw, "default", value="1")
+    t = el(sw, "test", "ap/throttle-unclipped-norm ge 1\nap/speed-error-mps gt 0", value="0")
+    t.set("logic", "AND")
+    t = el(sw, "test", "ap/throttle-unclipped-norm le 0\nap/speed-error-mps lt 0", value="0")
+    t.set("logic", "AND")
+    _function(thr, "ap/speed-error-gated-mps",
+              node("product", "ap/speed-error-mps", "ap/throttle-integrand-gate"))
+    _integrator(thr, "ap/throttle-integral-norm", "ap/speed-error-gated-mps",
+                g.airspeed_i_per_m, "ap/throttle-integrating", (-1.0, 1.0))
+    _function(thr, "ap/throttle-auto-incr-norm",
+              node("sum", node("product", g.airspeed_per_m_s, "ap/speed-error-mps"),
+                   "ap/throttle-integral-norm"), (-1.0, 1.0))
+    for i in range(engines):
+        lever = f"ap/throttle-trim-norm[{i}]"
+        _function(thr, f"ap/throttle-auto-norm[{i}]",
+                  node("sum", lever, "ap/throttle-auto-incr-norm", "ap/throttle-climb-norm"),
+                  (0.0, 1.0))
+        sw = el(thr, "switch", name=f"ap/throttle-out-norm[{i}]")
+        el(sw, "default", value=f"fcs/throttle-cmd-norm[{i}]")
+        t = el(sw, "test", "ap/armed == 0", value="0")  # disarmed: the engine at idle
+        t.set("logic", "AND")
+        t = el(sw, "test", "ap/engage == 1\nap/autothrottle == 1",
+               value=f"ap/throttle-auto-norm[{i}]")
+        t.set("logic", "AND")
+        t = el(sw, "test", "ap/manual == 1", value=lever)
+        t.set("logic", "AND")
+        el(sw, "output", f"fcs/throttle-cmd-norm[{i}]")
     return serialise(root, _HEADER)
 
 

@@ -61,13 +61,15 @@ def _p(name: str) -> str:
 # ======================================================================================
 
 
-def render_aircraft_files(spec: ExportSpec, include_shared: bool = True) -> dict[str, str]:
+def render_aircraft_files(spec: ExportSpec, include_shared: bool = True,
+                          carried: frozenset[str] = frozenset()) -> dict[str, str]:
     """Files of ``aircraft/bioflex_<variant>/`` (the generated rigid airframe with the modal
     system included) and ``systems/``: path relative to the JSBSim root → text.
     ``include_shared``: also the airframe's own systems (flight controls), for a new root.
-    An aircraft file's wing (``spec.jsbsim_path``): :func:`render_jsbsim_aircraft_files`."""
+    An aircraft file's wing (``spec.jsbsim_path``): :func:`render_jsbsim_aircraft_files`
+    (``carried``: the file names it may include, which the caller copies along)."""
     if spec.jsbsim_path:
-        return render_jsbsim_aircraft_files(spec)
+        return render_jsbsim_aircraft_files(spec, carried)
     base = airframe_xml.AIRCRAFT_NAME
     craft = spec.aircraft_name
     sysname = system_name(spec.variant, spec.model)
@@ -147,21 +149,33 @@ def _add_modal_loads(aero: ET.Element, axes: dict[str, ET.Element], k: int,
     parts = modal_wing_aerodynamics(nums, spec.leapfrog(nums), spec.reference)
     aero.insert(k, ET.Comment(f" modal wing '{spec.variant}': its loads "
                               "(bioflex_jsb.generators.native_wing) "))
-    aero.insert(k + 1, parts["functions"])
+    aero.insert(k + 1, parts["speed"])
+    aero.insert(k + 2, parts["functions"])
     for axis in ("LIFT", "DRAG", "PITCH"):
         axes[axis].insert(0, parts[axis])
 
 
-def render_jsbsim_aircraft_files(spec: ExportSpec) -> dict[str, str]:
+# Top-level sections of an aircraft file left out of its exported copy: sockets and output
+# files JSBSim would open (c172p.xml writes JSBout172C.csv at 60 Hz); the script has its own
+# output.
+DROPPED_SECTIONS = ("input", "output")
+
+
+def render_jsbsim_aircraft_files(spec: ExportSpec,
+                                 carried: frozenset[str] = frozenset()) -> dict[str, str]:
     """Files of an aircraft file's wing (``spec.jsbsim_path``, e.g. the jsbsim package's
-    SGS.xml): ``aircraft/<aircraft>/<aircraft>.xml``, a COPY of that file renamed, with the
-    modal system included after its last flight-control section and the modal loads in its
-    aerodynamics, and ``systems/<system>.xml``. A copy, not a wrapper: JSBSim includes
-    sections from files (``<system file>``, ``<aerodynamics file>``), not a whole aircraft,
-    and the loads go into the file's own axes; the copy also keeps the aircraft the wing
-    was exported against when the original changes. Nothing is written to the original.
-    ExportError (one line) for a file that cannot take the wing: not readable XML, no
-    LIFT/DRAG/PITCH axes, or a reference to another file (the copy would lose it)."""
+    SGS.xml or c172p.xml): ``aircraft/<aircraft>/<aircraft>.xml``, a COPY of that file
+    renamed, with the modal system included after its last flight-control section and the
+    modal loads in its aerodynamics, and ``systems/<system>.xml``. A copy, not a wrapper:
+    JSBSim includes sections from files (``<system file>``, ``<aerodynamics file>``), not a
+    whole aircraft, and the loads go into the file's own axes; the copy also keeps the
+    aircraft the wing was exported against when the original changes. Nothing is written to
+    the original. The files it names (engines, propellers, systems, sections) must be in
+    ``carried`` (their ``file`` attributes as written): the caller copies them beside it
+    (:func:`bioflex_jsb.drivers.native.carried_files`). Its top-level ``<input>`` and
+    ``<output>`` are left out (:data:`DROPPED_SECTIONS`). ExportError (one line) for a file
+    that cannot take the wing: not readable XML, no LIFT/DRAG/PITCH axes, or a reference to
+    a file not carried (the copy would lose it)."""
     src = spec.jsbsim_path
     try:
         parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
@@ -172,10 +186,12 @@ def render_jsbsim_aircraft_files(spec: ExportSpec) -> dict[str, str]:
         raise ExportError(f"{src!r} is no JSBSim aircraft (its root is <{root.tag}>, "
                           "not <fdm_config>)")
     for e in root.iter():
-        if isinstance(e.tag, str) and e.get("file"):
+        if isinstance(e.tag, str) and e.get("file") and e.get("file") not in carried:
             raise ExportError(f"{src!r} includes the file {e.get('file')!r} (<{e.tag} "
-                              "file>): the export copies one aircraft file; accepted: an "
-                              "aircraft in one file (the jsbsim package's SGS)")
+                              "file>), which the export does not carry along: the copy "
+                              "would not load")
+    for section in [e for e in root if e.tag in DROPPED_SECTIONS]:
+        root.remove(section)
     sysname = system_name(spec.variant, spec.model)
     root.set("name", spec.aircraft_name)
     kids = list(root)
@@ -194,6 +210,17 @@ def render_jsbsim_aircraft_files(spec: ExportSpec) -> dict[str, str]:
             "LIFT, DRAG and PITCH axes). Do not edit. -->\n")
     return {f"aircraft/{spec.aircraft_name}/{spec.aircraft_name}.xml": serialise(root, note),
             f"systems/{sysname}.xml": render_system(spec)}
+
+
+def with_note(text: str, note: str) -> str:
+    """``text`` (an XML file) with the comment ``note`` after its XML declaration (before
+    everything when it has none): still the same XML."""
+    body = text.lstrip("\ufeff")
+    if body.startswith("<?xml"):
+        end = body.find("?>")
+        if end > 0:
+            return f"{body[:end + 2]}\n{note}{body[end + 2:]}"
+    return f"{note}\n{body}"
 
 
 def jsbsim_chord_m(path: str) -> float:
@@ -265,6 +292,12 @@ COLUMNS = (
 # zero); held, the history is the trim's (q then < 3e-5 rad/s over 2 s). 0.1 s: 96 steps at
 # the default step, where AB2 needs one.
 GLIDE_HOLD_S = 0.1
+# An aircraft file's engines, started by the script's first event (JSBSim's
+# propulsion/set-running, as the co-simulation starts them: runtime/engines.py), with the
+# airframe held at the trim this long [s] while their propellers settle on the trim RPM.
+# Measured, c172p at 57.8 m/s: from 2826 rev/min (JSBSim's start) to the trim's 2368.9,
+# 8.4 rev/min off at 4 s and 1.7 at 5 s (a factor 5 a second): 8 s leaves < 0.02 rev/min.
+ENGINE_SETTLE_S = 8.0
 # A glider's CSV: no propeller column.
 GLIDER_COLUMNS = tuple(c for c in COLUMNS if not c.prop.startswith("propulsion/"))
 
@@ -291,6 +324,9 @@ class FlightCase:
     duration_s: float = FIG21_DURATION_S
     craft: str = ""  # the aircraft's name (empty: aircraft_name of the variant)
     glider: bool = False  # no engine (an aircraft file's export): held GLIDE_HOLD_S only
+    # an aircraft file's engines: started by the script (JSBSim's propulsion/set-running)
+    engines_started: bool = False
+    propeller: bool = True  # engine 0 drives a propeller (its RPM is a column)
 
     @property
     def aircraft(self) -> str:
@@ -299,7 +335,7 @@ class FlightCase:
     @property
     def columns(self) -> tuple[Column, ...]:
         """The CSV's columns after ``Time``."""
-        return GLIDER_COLUMNS if self.glider else COLUMNS
+        return GLIDER_COLUMNS if self.glider or not self.propeller else COLUMNS
 
     @property
     def end_s(self) -> float:
@@ -329,6 +365,11 @@ def fig21_case() -> FlightCase:
                       FIG21_SCRIPT, FIG21_IC, FIG21_OUTPUT)
 
 
+def _has_engine(state: TrimState) -> bool:
+    """Whether the trim has an engine's throttle among its controls (not a glide)."""
+    return any(name.startswith("fcs/throttle-cmd-norm[") for name in state.controls)
+
+
 def export_case(spec: ExportSpec, state: TrimState,
                 gust_up_m_s: float = P.SECTION5_GUST_AMPLITUDE_M_S) -> FlightCase:
     """The case ``bioflex-jsb export-jsbsim`` writes for ``spec``: ``scripts/<aircraft>.xml``,
@@ -340,10 +381,15 @@ def export_case(spec: ExportSpec, state: TrimState,
         raise ExportError(f"the trim is at {state.speed_m_s:g} m/s, the export at "
                           f"{spec.speed_m_s:g} m/s")
     craft = spec.aircraft_name
-    if spec.jsbsim_path:
+    if spec.jsbsim_path and not _has_engine(state):
         return FlightCase(spec.variant, spec.model, spec.speed_m_s, spec.dt_s,
                           f"scripts/{craft}.xml", "trim", f"{craft}.csv", float(gust_up_m_s),
                           settle_s=GLIDE_HOLD_S, craft=craft, glider=True)
+    if spec.jsbsim_path:  # a powered aircraft file: its engines started in the script
+        return FlightCase(spec.variant, spec.model, spec.speed_m_s, spec.dt_s,
+                          f"scripts/{craft}.xml", "trim", f"{craft}.csv", float(gust_up_m_s),
+                          settle_s=ENGINE_SETTLE_S, craft=craft, engines_started=True,
+                          propeller=state.propeller_rpm > 0.0)
     settle = max(FIG21_SETTLE_S, float(math.ceil(state.rpm_settle_s + 0.5)))
     return FlightCase(spec.variant, spec.model, spec.speed_m_s, spec.dt_s,
                       f"scripts/{craft}.xml", "trim", f"{craft}.csv", float(gust_up_m_s),
@@ -415,6 +461,8 @@ def render_script(state: TrimState, case: FlightCase) -> str:
                            + ("integrators' history fills at the trim controls" if case.glider
                               else "propellers spin up to the trim RPM"))
     el(ev, "condition", "simulation/sim-time-sec ge 0")
+    if case.engines_started:  # JSBSim's start (magnetos, spools), then the trim's levers
+        el(ev, "set", name="propulsion/set-running", value="-1")
     for name, value in state.controls.items():
         el(ev, "set", name=name, value=_trim_num(value))
     for name in INTEGRATORS:

@@ -136,6 +136,12 @@ DT_MATCH_REL = 1e-6
 EIGEN_REL_TOL = 0.01
 
 
+# The airspeed [ft/s] the rate terms' c̄/(2V) divide by at least: at rest (an aircraft
+# loaded before its initial condition, or standing on the ground) V = 0 made them 0/0, NaN
+# forces that an α̇ term (c172p's CLadot) fed back for ever; no flight is near 1e-3 ft/s.
+MIN_AIRSPEED_FPS = 1e-3
+
+
 class ExportError(ValueError):
     """A request the exporter cannot honour (one line)."""
 
@@ -195,7 +201,10 @@ class ExportSpec:
     model, the step [s], the trim speed [m/s] of the trim C_L (C_0^Q, induced-drag slope), the
     reference density [kg/m³]; ``jsbsim_path``: the aircraft file it is attached to (empty:
     the generated prototype), ``aircraft``: the exported aircraft's name (empty:
-    :func:`aircraft_name`), ``jsbsim_chord_m``: c̄ [m] of the file's ``aero/ci2vel`` (0: c̄)."""
+    :func:`aircraft_name`), ``jsbsim_chord_m``: c̄ [m] of the file's ``aero/ci2vel`` (0: c̄);
+    ``speed_range_m_s``: the speeds [m/s] the aircraft flies (the prototype's 5-40 m/s, an
+    aircraft definition's flight speeds), where the trim speed must lie and over which, from
+    0, the step's eigenvalues are checked (:attr:`check_speed_max_m_s`)."""
 
     wing: ElasticWingModel
     variant: str
@@ -206,16 +215,20 @@ class ExportSpec:
     jsbsim_path: str = ""
     aircraft: str = ""
     jsbsim_chord_m: float = 0.0
+    speed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S
 
     def __post_init__(self) -> None:
         if self.model not in EXPORT_MODELS:
             raise ExportError(f"unknown model {self.model!r}; accepted: {', '.join(EXPORT_MODELS)}")
         if not (math.isfinite(self.dt_s) and 0.0 < self.dt_s <= 0.1):
             raise ExportError(f"time step must be in (0, 0.1] s, got {self.dt_s!r}")
-        lo, hi = AIRSPEED_RANGE_M_S
+        lo, hi = self.speed_range_m_s
         if not (math.isfinite(self.speed_m_s) and lo <= self.speed_m_s <= hi):
+            whose = ("the range every command accepts for the prototype"
+                     if self.speed_range_m_s == AIRSPEED_RANGE_M_S else
+                     f"the flight speeds of {self.airframe_label}")
             raise ExportError(f"speed {self.speed_m_s:g} m/s is outside {lo:g}..{hi:g} m/s, "
-                              "the range every command accepts")
+                              f"{whose}")
         if self.jsbsim_path and self.model != "coupled":
             raise ExportError(f"model {self.model!r} puts the wing's loads into the generated "
                               "airframe's external reactions; an aircraft file's wing exports "
@@ -225,22 +238,35 @@ class ExportSpec:
 
     def _check_step(self) -> None:
         """Refuse a step at which the coupled step is not within :data:`EIGEN_REL_TOL` of the
-        exact dynamics over 0..GRID_SPEED_MAX_M_S (module docstring)."""
+        exact dynamics over 0..check_speed_max_m_s (module docstring)."""
         nums = modal_matrices(self.wing, self.cl_trim)
-        err, at = leapfrog_eigen_error(nums, self.leapfrog(nums))
+        err, at = self.eigen_error(nums)
         if err <= EIGEN_REL_TOL:
             return
         ok = self.dt_s
         for _ in range(12):
             ok /= 2.0
-            if leapfrog_eigen_error(nums, self.leapfrog(nums, ok))[0] <= EIGEN_REL_TOL:
+            if self.eigen_error(nums, ok)[0] <= EIGEN_REL_TOL:
                 break
         raise ExportError(
             f"time step {self.dt_s:.6g} s is too coarse for wing {self.variant!r}: the "
             f"integration's eigenvalues are {err:.1%} off the exact ones at {at:g} m/s of the "
-            f"0..{GRID_SPEED_MAX_M_S:g} m/s the exported wing's tables cover (trimmed at "
+            f"0..{self.check_speed_max_m_s:g} m/s the exported wing flies (trimmed at "
             f"{self.speed_m_s:g} m/s; accepted: {EIGEN_REL_TOL:.0%}); --dt {ok:.6g} s is "
             "within it")
+
+    @property
+    def check_speed_max_m_s(self) -> float:
+        """The top of the speeds [m/s] the step's eigenvalues are checked over from 0: the
+        tables' GRID_SPEED_MAX_M_S, or the aircraft's fastest flight speed if higher."""
+        return max(GRID_SPEED_MAX_M_S, float(self.speed_range_m_s[1]))
+
+    def eigen_error(self, nums: ModalMatrices, dt_s: float | None = None
+                    ) -> tuple[float, float]:
+        """(largest relative error of the step's eigenvalues, its speed [m/s]) over
+        0..check_speed_max_m_s at the step ``dt_s`` (default the exported one)."""
+        return leapfrog_eigen_error(nums, self.leapfrog(nums, dt_s),
+                                    self.check_speed_max_m_s, self.rho_ref)
 
     @property
     def cl_trim(self) -> float:
@@ -643,8 +669,8 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
                             reference: ReferenceGeometry = REFERENCE_GEOMETRY,
                             ) -> dict[str, ET.Element]:
     """The native modal wing's loads as JSBSim aerodynamics of the airframe: ``<function>``
-    elements keyed by where they go (``functions``: before the first axis; ``LIFT``, ``DRAG``,
-    ``PITCH``: into those axes).
+    elements keyed by where they go (``speed``, then ``functions``: before the first axis, in
+    that order; ``LIFT``, ``DRAG``, ``PITCH``: into those axes).
 
     Loads of the stored state y = Φ_h x after this step's update, the structural state half
     a step into the interval over which JSBSim applies the forces it computes (module
@@ -670,11 +696,22 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
     # aerodynamics' own functions have run, so it would be the previous step's
     half_chord_ft = 0.5 * reference.mean_chord_m * U.FT_PER_M
 
+    # V [ft/s], at least MIN_AIRSPEED_FPS: one function a step, read by the lift and pitch
+    speed_fn = "aero/bioflex/vt-guarded-fps"
+    speed = ET.Element("function", name=speed_fn)
+    el(speed, "description", f"airspeed [ft/s], at least {MIN_AIRSPEED_FPS:g} (no 0/0 at rest)")
+    m = el(speed, "max")
+    W.prop(m, "velocities/vt-fps")
+    W.value(m, MIN_AIRSPEED_FPS)
+
+    def airspeed(parent: ET.Element) -> None:
+        W.prop(parent, speed_fn)
+
     def loads(fn: ET.Element, r: int, gain: float) -> None:
         c = gain * U.PA_PER_PSF * s_ref
         disp = [(c * nums.load_eta[r, i] * co.eta_rate[i], y_eta[i]) for i in range(n)]
         rate = [(c * half_chord_ft * nums.load_etadot[r, i], y_rate[i]) for i in range(n)]
-        lead = (W.over(lambda q: W.combination(q, rate), "velocities/vt-fps")
+        lead = (W.over(lambda q: W.combination(q, rate), airspeed)
                 if any(a for a, _ in rate) else None)
         total = lambda p: W.combination(p, disp, lead=lead)  # noqa: E731
         W.times(W.times(total, qbar), _p("enabled"))(fn)
@@ -693,7 +730,8 @@ def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
     el(pitch, "description", "modal wing pitching moment about the CG, nose up [lbs ft]")
     loads(pitch, 2, U.LBF_FT_PER_N_M)
     out = {}
-    for key, e in (("functions", lift), ("LIFT", in_lift), ("DRAG", in_drag), ("PITCH", pitch)):
+    for key, e in (("speed", speed), ("functions", lift), ("LIFT", in_lift), ("DRAG", in_drag),
+                   ("PITCH", pitch)):
         collapse(e)
         out[key] = e
     return out

@@ -14,6 +14,15 @@ short-period response to be quasi-static. For the 1.7 m span prototype at 15 m/s
   DEFAULT_H_MAX_M = 15 m, past which a gust is a slow change of angle of attack for this
   aircraft.
 
+Another aircraft (``--aircraft`` on its own JSBSim airframe) takes the same two ends from
+its own data, :func:`aircraft_gust_scales`: the shortest DEFAULT_H_MIN_CHORDS of its mean
+chord, the longest H = V T_sp with T_sp = 2π/ω_n its rigid short period's natural period at
+the speed (ω_n = |λ|, defined for real roots too: an over-damped short period's slower root),
+within the codes' 107 m; the run goes on 2 T_sp after the gust. For JSBSim's c172p at its
+57.8 m/s cruise (ω_n 7.91 rad/s): H 2.24..45.9 m, 1.59 s after the gust. The prototype keeps
+its defaults above, chosen by hand at the long end (its rule would give 15 × 0.594 = 8.9 m
+with ω_n 10.6 rad/s, shorter than the 15 m its tables were measured with).
+
 Amplitude: ``cs25`` scaling U = U_ref (H/H_max)^(1/6), the code's shape with the reference at
 the longest gradient (U_ref default 3 m/s, the paper's gust), or ``fixed`` (every gust U_ref).
 The 1-cos gust of ``simulation/gusts.py`` is given by its length L = 2H.
@@ -46,9 +55,57 @@ SETTLE_AFTER_S = 1.6
 GUST_START_S = 0.2  # time before the gust [s]: the trim (the loads are steady from t = 0)
 
 
+# The airworthiness codes' longest gradient [m]: CS/FAR 25.341(a)(2), 350 ft.
+CODE_H_MAX_M = 350.0 * 0.3048
+
+
 def default_gradients_m(n: int = DEFAULT_N_LENGTHS) -> np.ndarray:
     """Log-spaced gradients H [m] from DEFAULT_H_MIN_CHORDS c̄ to DEFAULT_H_MAX_M."""
     return np.geomspace(DEFAULT_H_MIN_CHORDS * P.MEAN_AERODYNAMIC_CHORD_M, DEFAULT_H_MAX_M, n)
+
+
+@dataclass(frozen=True)
+class GustScales:
+    """The tuned gust's lengths and times for one aircraft at one speed: the shortest and
+    longest gradient H [m] and how long each run goes on after its gust [s]."""
+
+    h_min_m: float
+    h_max_m: float
+    settle_after_s: float
+    source: str  # how they were found (the settings' record)
+
+    def gradients_m(self, n: int = DEFAULT_N_LENGTHS) -> np.ndarray:
+        """``n`` log-spaced gradients H [m] from h_min_m to h_max_m."""
+        return np.geomspace(self.h_min_m, self.h_max_m, n)
+
+
+PROTOTYPE_SCALES = GustScales(DEFAULT_H_MIN_CHORDS * P.MEAN_AERODYNAMIC_CHORD_M,
+                              DEFAULT_H_MAX_M, SETTLE_AFTER_S,
+                              "the prototype's defaults (loads/tuned.py)")
+
+
+def aircraft_gust_scales(mean_chord_m: float, speed_m_s: float,
+                         short_period_rad_s: float) -> GustScales:
+    """The tuned gust's scales of an aircraft of mean chord ``mean_chord_m`` [m] at
+    ``speed_m_s`` [m/s] whose rigid short period has the natural frequency
+    ``short_period_rad_s`` ω_n = |λ| [rad/s] (module docstring): H from
+    DEFAULT_H_MIN_CHORDS c̄ to V·2π/ω_n (at most CODE_H_MAX_M), 2·2π/ω_n after the gust."""
+    for name, value in (("mean chord [m]", mean_chord_m), ("speed [m/s]", speed_m_s),
+                        ("short-period frequency [rad/s]", short_period_rad_s)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise InputError(f"tuned gust: the aircraft's {name} must be positive, got "
+                             f"{value!r}")
+    period_s = 2.0 * math.pi / short_period_rad_s
+    h_min = DEFAULT_H_MIN_CHORDS * mean_chord_m
+    h_max = min(speed_m_s * period_s, CODE_H_MAX_M)
+    if h_max <= h_min:
+        raise InputError(f"tuned gust: the short period's {period_s:.3g} s at {speed_m_s:g} "
+                         f"m/s gives a longest gradient {h_max:.3g} m, not above the "
+                         f"shortest ({DEFAULT_H_MIN_CHORDS:g} chords, {h_min:.3g} m); give "
+                         "--gradients")
+    return GustScales(h_min, h_max, 2.0 * period_s,
+                      f"{DEFAULT_H_MIN_CHORDS:g} c̄ to V·T_sp, T_sp = 2π/ω_n = "
+                      f"{period_s:.3f} s (the rigid short period at {speed_m_s:g} m/s)")
 
 
 def gust_amplitude_m_s(h_m: float, u_ref_m_s: float, h_max_m: float, scaling: str) -> float:
@@ -89,11 +146,13 @@ class TunedGustResult:
 
 
 def tuned_cases(speed_m_s: float, gradients_m=None, *,
-                u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25") -> list[dict]:
+                u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
+                scales: GustScales = PROTOTYPE_SCALES) -> list[dict]:
     """The sweep's gusts, in order: every gradient of ``gradients_m`` [m] (default
-    :func:`default_gradients_m`) up then down, each a dict of its gradient [m], sign,
-    amplitude [m/s, up +], gust text (``1cos:U:L``, L = 2H), duration [s] and gust start [s]."""
-    h = default_gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
+    ``scales.gradients_m()``, the prototype's :func:`default_gradients_m`) up then down, each
+    a dict of its gradient [m], sign, amplitude [m/s, up +], gust text (``1cos:U:L``,
+    L = 2H), duration [s] (the gust, then ``scales.settle_after_s``) and gust start [s]."""
+    h = scales.gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
     if h.ndim != 1 or h.size == 0 or not np.all(np.isfinite(h)) or np.any(h <= 0.0):
         raise InputError("gust gradients must be positive lengths [m]")
     if not (math.isfinite(u_ref_m_s) and u_ref_m_s > 0.0):
@@ -106,30 +165,34 @@ def tuned_cases(speed_m_s: float, gradients_m=None, *,
             cases.append({"gradient_m": float(hm), "sign": "up" if sign > 0 else "down",
                           "amplitude_m_s": sign * u,
                           "gust": f"1cos:{sign * u:.6g}:{2.0 * hm:.6g}",
-                          "duration_s": GUST_START_S + 2.0 * hm / speed_m_s + SETTLE_AFTER_S,
+                          "duration_s": GUST_START_S + 2.0 * hm / speed_m_s
+                          + scales.settle_after_s,
                           "gust_start_s": GUST_START_S})
     return cases
 
 
 def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
                u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
-               progress=None) -> TunedGustResult:
+               progress=None, scales: GustScales = PROTOTYPE_SCALES) -> TunedGustResult:
     """Fly 1-cos gusts of every gradient in ``gradients_m`` [m] up and down through
     ``fly(gust_text, duration_s, gust_start_s)`` (returns a SectionLoads), one after the
     other, and find the critical cases (:func:`tuned_result`). The command flies the same
     cases on the sweep executors (:mod:`bioflex_jsb.sweep.tuned_loads`)."""
-    cases = tuned_cases(speed_m_s, gradients_m, u_ref_m_s=u_ref_m_s, scaling=scaling)
+    cases = tuned_cases(speed_m_s, gradients_m, u_ref_m_s=u_ref_m_s, scaling=scaling,
+                        scales=scales)
     loads = []
     for case in cases:
         loads.append(fly(case["gust"], case["duration_s"], case["gust_start_s"]))
         if progress is not None:
             progress(len(loads), len(cases), case["gust"])
-    return tuned_result(cases, loads, speed_m_s, u_ref_m_s=u_ref_m_s, scaling=scaling)
+    return tuned_result(cases, loads, speed_m_s, u_ref_m_s=u_ref_m_s, scaling=scaling,
+                        scales=scales)
 
 
 def tuned_result(cases: list[dict], loads: list, speed_m_s: float, *,
                  u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S,
-                 scaling: str = "cs25") -> TunedGustResult:
+                 scaling: str = "cs25", scales: GustScales = PROTOTYPE_SCALES
+                 ) -> TunedGustResult:
     """The critical case per station, quantity, method and direction (largest increment up,
     largest down, over the run after the gust start) of ``cases`` (:func:`tuned_cases`, in
     their order) and their SectionLoads ``loads`` (the same order)."""
@@ -169,7 +232,8 @@ def tuned_result(cases: list[dict], loads: list, speed_m_s: float, *,
     gradients = list(dict.fromkeys(c["gradient_m"] for c in cases))
     settings = {"speed_m_s": speed_m_s, "gradients_m": gradients, "u_ref_m_s": u_ref_m_s,
                 "scaling": scaling, "h_max_m": h_max, "gust_start_s": GUST_START_S,
-                "settle_after_s": SETTLE_AFTER_S, "model": first.model, "wing": first.wing,
+                "settle_after_s": scales.settle_after_s, "scales": scales.source,
+                "model": first.model, "wing": first.wing,
                 "static": first.meta.get("static")}
     for c in cases:
         del c["gust_start_s"]

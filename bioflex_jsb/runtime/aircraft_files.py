@@ -164,6 +164,26 @@ def named_files(aircraft_path: Path, tree: ET.ElementTree,
     return found
 
 
+def read_named_files(aircraft_path: Path, files: list[NamedFile]
+                     ) -> dict[PurePosixPath, bytes]:
+    """The content of each of ``files`` (:func:`named_files` of ``aircraft_path``) by its
+    target in a copy's aircraft directory, each read once (two engines of one file) with
+    the bound of one file, :data:`MAX_TOTAL_BYTES` in all; :class:`AircraftLoadError`
+    (one line) past a bound."""
+    total, out = 0, {}
+    for f in files:
+        if f.target in out:
+            continue
+        data = read_input_bytes(f.source, f"the file <{f.element} file={f.name!r}>",
+                                AircraftLoadError, MAX_FILE_BYTES)
+        total += len(data)
+        if total > MAX_TOTAL_BYTES:
+            raise AircraftLoadError(f"the files {str(aircraft_path)!r} names exceed "
+                                    f"{MAX_TOTAL_BYTES // (1024 * 1024)} MiB in all")
+        out[f.target] = data
+    return out
+
+
 def read_xml(path: str | os.PathLike, what: str = "the JSBSim aircraft") -> ET.ElementTree:
     """The XML file ``path`` (``what`` it is, for the message), read with the bound of every
     input file (:data:`MAX_FILE_BYTES`) and parsed; one line if it cannot be."""
@@ -232,19 +252,13 @@ def private_root(aircraft_path: str | os.PathLike, tree: ET.ElementTree,
     root = tree.getroot()
     for section in [el for el in root if el.tag in DROPPED_SECTIONS]:
         root.remove(section)
-    total, written = 0, set()
-    for f in files:
-        if f.target in written:  # two engines of one file: copied once
-            continue
-        written.add(f.target)
-        data = read_input_bytes(f.source, f"the file <{f.element} file={f.name!r}>",
-                                AircraftLoadError, MAX_FILE_BYTES)
-        total += len(data)
-        if total > MAX_TOTAL_BYTES:
-            work.cleanup()
-            raise AircraftLoadError(f"the files {str(src)!r} names exceed "
-                                    f"{MAX_TOTAL_BYTES // (1024 * 1024)} MiB in all")
-        out = target_dir.joinpath(*f.target.parts)
+    try:
+        contents = read_named_files(src, files)
+    except AircraftLoadError:
+        work.cleanup()
+        raise
+    for target, data in contents.items():
+        out = target_dir.joinpath(*target.parts)
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_bytes(data)
     for file, text in generated.items():

@@ -446,6 +446,11 @@ class Airframe:
     def _has(self, name: str) -> bool:
         return bool(self._fdm.get_property_manager().hasNode(name))
 
+    def has_property(self, name: str) -> bool:
+        """Whether the flying instance has the JSBSim property ``name`` (an engine's lever,
+        an FCS output)."""
+        return self._has(name)
+
     def _aileron_norm(self) -> float:
         """The aileron position −1..1 (+ roll right): the left surface's normalised
         position where the FCS writes one per side (c172p, the prototype), else the single

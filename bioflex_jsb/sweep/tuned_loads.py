@@ -95,7 +95,8 @@ def fly_tuned_case(case: TunedCase, log_dir: str | None = None) -> dict[str, Any
     row: dict[str, Any] = {"case_id": case.case_id, "index": case.index, "gust": case.gust}
     try:
         build = _build(case)
-        setup = RunConfig(case.speed_m_s, parse_gust(case.gust), case.duration_s,
+        chord_m = build.model.airframe.reference.mean_chord_m  # the shortest gust
+        setup = RunConfig(case.speed_m_s, parse_gust(case.gust, chord_m), case.duration_s,
                           case.gust_start_s, 0.0, case.dt_s, models=(case.model,),
                           trim=case.trim)
         # as api.fly_gust flies one model: the build for the elastic trim, else its model
