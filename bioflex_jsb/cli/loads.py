@@ -246,6 +246,18 @@ def run(args: argparse.Namespace) -> int:
     aircraft = getattr(args, "aircraft_definition", None)
     if args.stations is None:  # the aircraft definition's, else the default stations
         args.stations = monitoring_stations(aircraft)
+    sigmas_given = args.sigmas is not None  # else the airframe's own (_default_sigmas)
+    _check_study_options(args)
+    if args.tuned:
+        return _tuned(args, build)
+    if args.frequency:
+        return _frequency(args, build, sigmas_given)
+    return _single_gust(args, build)
+
+
+def _check_study_options(args: argparse.Namespace) -> None:
+    """One study (a gust, --tuned or --frequency) and only its options (never silently
+    ignored); the others' defaults filled in."""
     if args.model == "rigid" and args.static == "elastic":
         raise UsageError("--model rigid has no static deflection; drop --static elastic")
     if args.tuned and args.frequency:
@@ -253,9 +265,8 @@ def run(args: argparse.Namespace) -> int:
     for opt in ("workers", "scheduler"):
         if getattr(args, opt) is not None and not args.tuned:
             raise UsageError(f"--{opt} applies to --tuned (its gusts run in parallel)")
-    sigmas_given = args.sigmas is not None  # else the airframe's own (_default_sigmas)
     for study, options in (("tuned", TUNED_OPTIONS), ("frequency", FREQUENCY_OPTIONS)):
-        for opt, default in options.items():  # never silently ignored
+        for opt, default in options.items():
             if getattr(args, opt) is not None and not getattr(args, study):
                 raise UsageError(f"--{opt} applies to --{study}")
             if getattr(args, opt) is None:
@@ -267,10 +278,10 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler and args.scheduler != "local" and args.workers is not None:
         raise UsageError("--workers applies to local processes and --scheduler local; a "
                          "cluster's workers are started with it (dask worker)")
-    if args.tuned:
-        return _tuned(args, build)
-    if args.frequency:
-        return _frequency(args, build, sigmas_given)
+
+
+def _single_gust(args: argparse.Namespace, build) -> int:
+    """The section loads of one gust run: the metrics printed or as JSON, the figure."""
     from bioflex_jsb.loads import loads_metrics
     from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 
