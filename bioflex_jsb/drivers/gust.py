@@ -32,6 +32,7 @@ from bioflex_jsb.loads.stream import LoadStream
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.channels import mode_tips
+from bioflex_jsb.simulation.controller import controller_meta
 from bioflex_jsb.simulation.gusts import GustField
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
 from bioflex_jsb.simulation.run_config import RunConfig
@@ -153,6 +154,7 @@ def run_gust(
     keep: str = "auto",
     loads: WingBuild | LoadsModel | None = None,
     progress: Callable[[int], None] | None = None,
+    controller=None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
     with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
@@ -189,6 +191,13 @@ def run_gust(
     Küssner increments recovered after the steps: :mod:`bioflex_jsb.loads.unsteady`), force
     summation for the rigid model; a modes-file wing without EI, GJ has force summation only
     (:mod:`bioflex_jsb.loads.stream`).
+
+    ``controller``: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`: a
+    Python object with ``step(t_s, signals)`` or a
+    :class:`~bioflex_jsb.simulation.controller.LinearController`; a fresh one per run, its
+    state starts at the trim): every step it reads the row's signals and commands the
+    elevator and throttle over the trim; the history has its commands as channels
+    ``ctrl_<command>`` and ``meta["controller"]`` says what it was.
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
@@ -196,7 +205,7 @@ def run_gust(
     model = str(model)  # its name, as the history, the logs and the tables carry it
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
-                       trim_mode=trim_mode)
+                       trim_mode=trim_mode, controller=controller)
     refused = True
     try:
         stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
@@ -393,6 +402,7 @@ class _GustRun:
                 "envelope_s": self.envelope.span_s if self.envelope is not None else None,
                 "mode_tips": None if build is None else mode_tips(build.modes),
                 **self.loads_meta,
+                **({} if step.control is None else {"controller": controller_meta(step.control)}),
             },
             stopped=stopped,
         )

@@ -14,6 +14,11 @@ Per step k (time t_k = k Δt, airframe state x_k), :meth:`CoupledStep.advance`:
    :class:`~bioflex_jsb.simulation.modal_wing.ModalWing`) and writes the loads of η_{k+1}
    in that flow into ``external_reactions`` (lift and drag turned from wind to body axes
    with α_k);
+   With a controller in the loop (``controller=``, :mod:`bioflex_jsb.simulation.controller`)
+   the row of t_k (step 5's) is built here, the controller reads its signals and its
+   commands go into the row (``ctrl_<command>``) and to JSBSim's flight controls
+   (:mod:`bioflex_jsb.runtime.control_surfaces`), which move the surface in step 4: the
+   forces of x_{k+1} carry it, one step after the LTI model's zero-order hold would;
 4. runs JSBSim's step: it integrates x_k → x_{k+1} and computes the forces of x_{k+1},
    which it applies over the next step — with the wing's loads of η_{k+1}, the same time,
    so the elastic loads do not lag the rigid aerodynamics;
@@ -173,6 +178,10 @@ class CoupledStep:
             ``wing`` then a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`; its
             compiled step: :mod:`bioflex_jsb.simulation.unsteady_kernel`). ``wing`` may be a
             WingBuild for either (its ``model`` is used).
+        controller: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`: a
+            Python object or a LinearController), or None. Every step it reads the row of
+            t_k (its signals), its commands are logged in the row (channels ``ctrl_<command>``)
+            and written to JSBSim before its step (:meth:`_attach_controller`).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -183,7 +192,7 @@ class CoupledStep:
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
-                 trim_mode: str = "rigid") -> None:
+                 trim_mode: str = "rigid", controller=None) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
         self.airframe = airframe
@@ -224,10 +233,14 @@ class CoupledStep:
         self.units = channel_units(self.n_modes)
         self.names = tuple(self.units)
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
+        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
+        self.control = None  # the controller in the loop (_attach_controller)
+        self._control_step = None
+        if controller is not None:
+            self._attach_controller(controller)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
-        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         if self.compiled:
             self._setup_kernel(nodes)
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
@@ -262,6 +275,44 @@ class CoupledStep:
                                   static_eta=static, aero=self.airframe_data.aero)
         self.n_modes = wing.n_modes
         self._write_reactions = airframe.external_reaction_writer()
+
+    # -- the controller ---------------------------------------------------------------------
+    def _attach_controller(self, controller) -> None:
+        """Put ``controller`` in the loop: its command channels join the row, it is bound to
+        the row's channels with every channel's trim value (the row the step would log at
+        the trim in calm air) and its commands go to JSBSim through the writers of
+        :mod:`bioflex_jsb.runtime.control_surfaces` (the JSBSim boundary)."""
+        from bioflex_jsb.runtime.control_surfaces import command_writers
+        from bioflex_jsb.simulation.controller import (
+            COMMAND_CHANNELS,
+            CONTROL_OUTPUTS,
+            ControlLoop,
+            check_controller,
+        )
+
+        controller = check_controller(controller)
+        for o in controller.outputs:
+            self.units[COMMAND_CHANNELS[o]] = CONTROL_OUTPUTS[o]
+        self.names = tuple(self.units)
+        zeros = np.zeros(self.n_modes)
+        trim = self._row_dict(self._read(0.0), 0.0, WingLoads(0.0, 0.0, 0.0), zeros, zeros)
+        trim.update({COMMAND_CHANNELS[o]: 0.0 for o in controller.outputs})
+        loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
+        writers = command_writers(self.airframe, loop.outputs)
+        step = loop.step
+        if len(writers) == 1:
+            (write,) = writers
+
+            def control(table: np.ndarray, k: int) -> None:
+                write(step(table, k)[0])
+        else:
+            def control(table: np.ndarray, k: int) -> None:
+                for w, value in zip(writers, step(table, k), strict=False):
+                    w(value)
+
+        self.control = loop
+        self._control_step = control
+        self._scratch_py = np.zeros((1, len(self.names)))  # the Python step's row
 
     # -- the wing ---------------------------------------------------------------------------
     @property
@@ -326,6 +377,8 @@ class CoupledStep:
             lift_lbf, drag_lbf, moment_lbf_ft = (g() for g in self._native_loads)
             loads = WingLoads(lift_lbf * U.N_PER_LBF, drag_lbf * U.N_PER_LBF,
                               moment_lbf_ft * U.N_M_PER_LBF_FT)
+            if self.control is not None:
+                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot)
             self.airframe.step()
             new_eta = self.eta
         else:
@@ -342,9 +395,12 @@ class CoupledStep:
             self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
                                   loads.drag_n * ca - loads.lift_n * sa,
                                   loads.pitch_moment_n_m)
+            if self.control is not None:
+                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot)
             self.airframe.step()
             new_eta = mw.eta
-        values = self._row(self._row_dict(state, w_g_m_s, loads, eta, eta_dot))
+        if self.control is None:
+            values = self._row(self._row_dict(state, w_g_m_s, loads, eta, eta_dot))
         self.sensed, self.w_g_m_s = state, w_g_m_s
         self.k += 1
         alpha = flow.alpha_rad
@@ -352,6 +408,17 @@ class CoupledStep:
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
                                     self._agl_m() * U.M_PER_FT, self.alpha_range_rad)
         return values
+
+    def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot
+                        ) -> tuple[float, ...]:
+        """The row of the Python step with a controller: built before JSBSim's step, the
+        controller run on it (its commands into the row and into JSBSim)."""
+        row = self._row_dict(s, w_g, loads, eta, eta_dot)
+        row.update({c: 0.0 for c in self.control.command_names})
+        scratch = self._scratch_py
+        scratch[0] = self._row(row)
+        self._control_step(scratch, 0)
+        return tuple(scratch[0].tolist())
 
     def _row_dict(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot) -> dict:
         """The row of one step by channel name: the snapshot ``s`` at t_k, the gust then,
@@ -478,6 +545,7 @@ class CoupledStep:
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
+        control = self._control_step  # None without a controller
 
         def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
             nonlocal checked, call
@@ -497,6 +565,8 @@ class CoupledStep:
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
+            if control is not None:  # its commands from row k, before JSBSim's step
+                control(table, k)
             jsbsim_step()
             step_k = self.k  # steps flown (``k`` is the table row)
             self.k = step_k + 1
