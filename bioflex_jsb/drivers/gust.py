@@ -67,6 +67,12 @@ class StepRecorder(Protocol):
     however the run ends (finished, stopped, interrupted, failed), with the number of
     complete rows.
 
+    A recorder that also logs a controller in the loop has ``controller(names, meta)``
+    (optional): called once before the first step of a run with a controller (``meta``: the
+    run's ``meta["controller"]``), it returns an object whose ``rows(time_s, rows)`` is
+    handed the same rows as the recorder's, right after them, and whose ``stop()`` is called
+    once at the end, before the recorder's own.
+
     A recorder that also logs section loads has ``loads(layout)`` (optional): called once
     before the first step of a run with loads (``layout``: the run's ``meta["loads"]``,
     channel names, units, stations, 1 g values), it returns an object whose ``rows(time_s,
@@ -238,10 +244,13 @@ class _GustRun:
         names = self.names = step.names
         block = max(1, int(round(WINDOW_S / dt)))
         self.loads_out = None  # the recorder's loads topic
+        self.control_out = None  # the recorder's controller topic
         if recorder is not None:
             block = max(1, int(recorder.start(names, dt)))
             if stream is not None and hasattr(recorder, "loads"):
                 self.loads_out = recorder.loads(loads_meta["loads"])
+            if step.control is not None and hasattr(recorder, "controller"):
+                self.control_out = recorder.controller(names, controller_meta(step.control))
         self.block = min(block, max(self.n_steps, 1))
         load_names = self.load_names = stream.names if stream is not None else ()
         self.loads_table = None
@@ -285,6 +294,8 @@ class _GustRun:
         time_s = (k0 + np.arange(m)) * self.dt
         if self.recorder is not None:
             self.recorder.rows(time_s, rows)
+            if self.control_out is not None:
+                self.control_out.rows(time_s, rows)
         if self.stream is not None:
             known = self.stream.add(time_s, rows)
             if last:
@@ -352,6 +363,8 @@ class _GustRun:
             try:
                 if self.loads_out is not None:
                     self.loads_out.stop()
+                if self.control_out is not None:
+                    self.control_out.stop()
             finally:
                 if self.recorder is not None:
                     self.recorder.stop(self.k)  # also when the loop failed: every step kept

@@ -461,12 +461,35 @@ def _toml_text(controller: LinearController, dt_s: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+# The controllers shipped with the package (by name: ``--controller gla_optimised``), each
+# a .toml file here with its design in its notes (scripts/design_gla.py writes them).
+SHIPPED_DIR = Path(__file__).resolve().parent.parent / "data" / "controllers"
+
+
+def shipped_controllers() -> tuple[str, ...]:
+    """The names of the shipped controller files."""
+    return tuple(sorted(p.stem for p in SHIPPED_DIR.glob("*.toml")))
+
+
+def controller_path(source: str | Path) -> Path:
+    """The file of ``source``: a path, or the name of a shipped controller; InputError (one
+    line) for neither."""
+    p = Path(source)
+    if p.suffix or p.exists() or str(source) not in shipped_controllers():
+        if not p.suffix and not p.exists():
+            raise InputError(f"no controller {str(source)!r}: give a .npz or .toml file or a "
+                             f"shipped controller ({', '.join(shipped_controllers())})")
+        return p
+    return SHIPPED_DIR / f"{source}.toml"
+
+
 def load_controller(source) -> Controller:
-    """A controller from ``source``: a controller file's path (:meth:`LinearController.load`),
-    a :class:`LinearController`, the package's :class:`StateSpace`, python-control's
+    """A controller from ``source``: a controller file's path (:meth:`LinearController.load`)
+    or a shipped controller's name (:func:`shipped_controllers`), a
+    :class:`LinearController`, the package's :class:`StateSpace`, python-control's
     ``StateSpace`` or any object with ``inputs``, ``outputs`` and ``step`` (checked)."""
     if isinstance(source, str | Path):
-        return LinearController.load(source)
+        return LinearController.load(controller_path(source))
     if isinstance(source, StateSpace):
         return LinearController.from_state_space(source)
     module = type(source).__module__ or ""
