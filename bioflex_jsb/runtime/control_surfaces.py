@@ -89,47 +89,64 @@ def elevator_map(airframe: Airframe) -> ElevatorMap:
     return m
 
 
-def elevator_writer(airframe: Airframe) -> Callable[[float], None]:
-    """``write(delta_rad)``: the elevator δe [rad, + trailing edge down] over the trim,
-    written as ``fcs/elevator-cmd-norm`` (module docstring); ``airframe`` trimmed."""
+@dataclass(frozen=True)
+class Command:
+    """How one command δ (over the trim, SI) reaches JSBSim: the value
+    v = offset + (angle + δ)/(down if angle + δ ≥ 0 else up) (the map a compiled controller
+    applies itself: :class:`~bioflex_jsb.simulation.controller_kernel.LinearBinding`),
+    written by each of ``setters`` with its own ``adds`` added (the throttle's per-engine
+    trims)."""
+
+    offset: float
+    angle: float
+    down: float
+    up: float
+    setters: tuple[Callable[[float], None], ...]
+    adds: tuple[float, ...]
+
+    def value(self, delta: float) -> float:
+        angle = self.angle + delta
+        return self.offset + angle / (self.down if angle >= 0.0 else self.up)
+
+    def write_value(self, value: float) -> None:
+        """Write an already mapped ``value``."""
+        for set_value, add in zip(self.setters, self.adds, strict=True):
+            set_value(add + value)
+
+    def write(self, delta: float) -> None:
+        """Write the command ``delta`` (over the trim)."""
+        self.write_value(self.value(delta))
+
+
+def elevator_command(airframe: Airframe) -> Command:
+    """The elevator δe [rad, + trailing edge down] over the trim as ``fcs/elevator-cmd-norm``
+    (module docstring: c₀ + m⁻¹(δ₀ + δe) − m⁻¹(δ₀)); ``airframe`` trimmed."""
     m = elevator_map(airframe)
     command0 = airframe[JP.FCS_ELEVATOR_CMD_NORM]
     manager = airframe.jsbsim.get_property_manager()
     pitch_trim = (airframe[JP.FCS_PITCH_TRIM_CMD_NORM]
                   if manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM) else 0.0)
     angle0 = m.angle_rad(command0 + pitch_trim)
-    base = m.command(angle0)
-    set_command = airframe.property_node(JP.FCS_ELEVATOR_CMD_NORM).set_double_value
-    down, up = m.down_rad, m.up_rad
-
-    def write(delta_rad: float) -> None:
-        angle = angle0 + delta_rad
-        set_command(command0 + (angle / (down if angle >= 0.0 else up) - base))
-
-    return write
+    setter = airframe.property_node(JP.FCS_ELEVATOR_CMD_NORM).set_double_value
+    return Command(command0 - m.command(angle0), angle0, m.down_rad, m.up_rad, (setter,),
+                   (0.0,))
 
 
-def throttle_writer(airframe: Airframe) -> Callable[[float], None]:
-    """``write(delta)``: the throttle δt [-] over the trim on every engine's command."""
+def throttle_command(airframe: Airframe) -> Command:
+    """The throttle δt [-] over the trim on every engine's command (its trim added)."""
     if airframe.glider or not airframe.engines:
         raise InputError(f"aircraft {airframe.aircraft!r} has no engine: a controller cannot "
                          "command its throttle")
     names = [JP.throttle_cmd(e.index) for e in airframe.engines]
-    setters = [airframe.property_node(n).set_double_value for n in names]
-    trims = [airframe[n] for n in names]
-    pairs = tuple(zip(setters, trims, strict=True))
-
-    def write(delta: float) -> None:
-        for set_value, trim in pairs:
-            set_value(trim + delta)
-
-    return write
+    return Command(0.0, 0.0, 1.0, 1.0,
+                   tuple(airframe.property_node(n).set_double_value for n in names),
+                   tuple(airframe[n] for n in names))
 
 
-WRITERS = {"elevator": elevator_writer, "throttle": throttle_writer}
+COMMANDS = {"elevator": elevator_command, "throttle": throttle_command}
 
 
-def command_writers(airframe: Airframe, outputs: tuple[str, ...]
-                    ) -> tuple[Callable[[float], None], ...]:
-    """One writer per command of ``outputs`` (in that order), for the trimmed ``airframe``."""
-    return tuple(WRITERS[o](airframe) for o in outputs)
+def commands_for(airframe: Airframe, outputs: tuple[str, ...]) -> tuple[Command, ...]:
+    """One :class:`Command` per command of ``outputs`` (in that order), for the trimmed
+    ``airframe``."""
+    return tuple(COMMANDS[o](airframe) for o in outputs)

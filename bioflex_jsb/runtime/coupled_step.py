@@ -51,6 +51,7 @@ from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
+from bioflex_jsb.simulation.controller_kernel import linear_step
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
 from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
 from bioflex_jsb.simulation.modal_wing import (
@@ -236,6 +237,7 @@ class CoupledStep:
         self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         self.control = None  # the controller in the loop (_attach_controller)
         self._control_step = None
+        self._control_fast = None
         if controller is not None:
             self._attach_controller(controller)
         self._row = row_getter(self.names)
@@ -282,7 +284,7 @@ class CoupledStep:
         the row's channels with every channel's trim value (the row the step would log at
         the trim in calm air) and its commands go to JSBSim through the writers of
         :mod:`bioflex_jsb.runtime.control_surfaces` (the JSBSim boundary)."""
-        from bioflex_jsb.runtime.control_surfaces import command_writers
+        from bioflex_jsb.runtime.control_surfaces import commands_for
         from bioflex_jsb.simulation.controller import (
             COMMAND_CHANNELS,
             CONTROL_OUTPUTS,
@@ -298,17 +300,28 @@ class CoupledStep:
         trim = self._row_dict(self._read(0.0), 0.0, WingLoads(0.0, 0.0, 0.0), zeros, zeros)
         trim.update({COMMAND_CHANNELS[o]: 0.0 for o in controller.outputs})
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
-        writers = command_writers(self.airframe, loop.outputs)
+        commands = commands_for(self.airframe, loop.outputs)
+        binding = loop.binding
+        if binding is not None:  # the compiled update maps and returns the first command
+            for i, c in enumerate(commands):
+                binding.set_map(i, c.offset, c.angle, c.down, c.up)
+        self._control_fast = None
+        if binding is not None and len(commands) == 1 and len(commands[0].setters) == 1 \
+                and commands[0].adds == (0.0,):
+            # the fast path (_bind_fast_step): the update's machine code, then the setter
+            self._control_fast = (binding, commands[0].setters[0])
         step = loop.step
-        if len(writers) == 1:
-            (write,) = writers
+        if binding is not None:
+            values = binding.values
 
             def control(table: np.ndarray, k: int) -> None:
-                write(step(table, k)[0])
+                step(table, k)
+                for c, value in zip(commands, values(), strict=True):
+                    c.write_value(value)
         else:
             def control(table: np.ndarray, k: int) -> None:
-                for w, value in zip(writers, step(table, k), strict=False):
-                    w(value)
+                for c, delta in zip(commands, step(table, k), strict=True):
+                    c.write(delta)
 
         self.control = loop
         self._control_step = control
@@ -546,11 +559,20 @@ class CoupledStep:
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
         control = self._control_step  # None without a controller
+        # a compiled controller of one command: its machine code for the tables the step
+        # kernel's entry accepts (the same table type), then the command's setter
+        fast_control = self._control_fast
+        if fast_control is not None:
+            binding, set_command = fast_control
+            c_params, c_entry = binding.params, binding.entry
+        c_call = None
 
         def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
-            nonlocal checked, call
+            nonlocal checked, call, c_call
             if table is not checked:
                 checked, call = table, (entry if accepts(table) else kernel)
+                if fast_control is not None:
+                    c_call = c_entry if call is entry else linear_step
             wind_down_fps = -w_g_m_s * ft_per_m
             set_wind(wind_down_fps)
             reads = (g_u(), g_v(), g_w(), g_q(), g_p(), g_r(), g_theta(), g_phi(), g_psi(),
@@ -565,7 +587,9 @@ class CoupledStep:
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
-            if control is not None:  # its commands from row k, before JSBSim's step
+            if c_call is not None:  # its commands from row k, before JSBSim's step
+                set_command(c_call(table, k, c_params))
+            elif control is not None:
                 control(table, k)
             jsbsim_step()
             step_k = self.k  # steps flown (``k`` is the table row)

@@ -504,8 +504,10 @@ class ControlLoop:
     every channel's value at the trim. :meth:`step` ``(table, k)`` reads row k's signals,
     writes the commands into row k's command columns and returns them in the controller's
     output order. A :class:`LinearController` runs as one compiled call
-    (:mod:`bioflex_jsb.simulation.controller_kernel`; ``compiled=False``: its reference
-    :meth:`LinearController.step`)."""
+    (:mod:`bioflex_jsb.simulation.controller_kernel`; ``binding`` its
+    :class:`~bioflex_jsb.simulation.controller_kernel.LinearBinding`, which the runtime
+    calls directly; ``compiled=False``: its reference :meth:`LinearController.step`,
+    ``binding`` None)."""
 
     def __init__(self, controller, names: tuple[str, ...], dt_s: float,
                  trim: Mapping[str, float], compiled: bool = True) -> None:
@@ -522,13 +524,15 @@ class ControlLoop:
         self.out_cols = [names.index(c) for c in self.command_names]
         self.dt_s = float(dt_s)
         self.n_states = getattr(controller, "n_states", None)
+        self.binding = None
         linear = isinstance(controller, LinearController)
         if linear and compiled:
-            from bioflex_jsb.simulation.controller_kernel import bind_linear
+            from bioflex_jsb.simulation.controller_kernel import LinearBinding
 
             system, every = controller.at_step(dt_s)
             offsets = [float(trim[s]) for s in controller.inputs]
-            self.step = bind_linear(system, every, offsets, self.in_cols, self.out_cols)
+            self.binding = LinearBinding(system, every, offsets, self.in_cols, self.out_cols)
+            self.step = self.binding.step
             return
         reset = getattr(controller, "reset", None)
         if callable(reset):
