@@ -31,7 +31,7 @@ critical for the wing (docs/tutorials/gust_load_alleviation.md).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.signal import fftconvolve
@@ -191,12 +191,16 @@ def open_loop(plant: StateSpace, dt_s: float) -> StateSpace:
 @dataclass(frozen=True)
 class Prediction:
     """The LTI model's prediction of a controller's alleviation: the tuned-gust peaks and
-    the turbulence RMS of ``output``, open and closed loop, and their ratios."""
+    the turbulence RMS of ``output``, open and closed loop, and their ratios; the two
+    discrete models (``open_model``, ``closed_model``: from ``w_g``, at the run's step) for
+    their responses and spectra (``frequency_response``)."""
 
     open_peaks: TunedPeaks
     closed_peaks: TunedPeaks
     open_rms: float
     closed_rms: float
+    open_model: StateSpace | None = field(default=None, repr=False)
+    closed_model: StateSpace | None = field(default=None, repr=False)
 
     @property
     def tuned_ratio(self) -> float:
@@ -228,7 +232,7 @@ def predict(plant: StateSpace, controller: LinearController, dt_s: float,
     ol, cl = open_loop(plant, dt_s), close_loop(plant, controller, dt_s)
     return Prediction(tuned_peaks(ol, v, output, gradients_m, u_ref_m_s),
                       tuned_peaks(cl, v, output, gradients_m, u_ref_m_s),
-                      turbulence_rms(ol, v, output), turbulence_rms(cl, v, output))
+                      turbulence_rms(ol, v, output), turbulence_rms(cl, v, output), ol, cl)
 
 
 def static_gain(gains, signals=DEFAULT_SIGNALS, dt_s: float | None = None,
