@@ -741,8 +741,9 @@ def load_controller(source):
 
 
 def linear_controller(source):
-    """:func:`load_controller`, refusing what is not linear (one line): the LTI model closes
-    the loop with the controller's state space."""
+    """The controller of ``source`` (:func:`load_controller`'s sources), refusing one that is
+    not linear (one line): the LTI model closes the loop with the controller's state
+    space."""
     from bioflex_jsb.simulation.controller import LinearController
 
     controller = load_controller(source)
