@@ -141,3 +141,25 @@ def test_the_log_holds_the_controller(wing, tmp_path):
     assert back.meta["controller"]["inputs"] == ["alpha", "q"]
     assert back.meta["controller"]["name"] == run.meta["controller"]["name"]
     doctor_strict(path)
+
+
+def test_cli_refuses_a_bad_controller_in_one_line(capsys, tmp_path):
+    from tests.cli_helpers import assert_one_line_error, run_cli
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[controller]\ndt_s = 0\ninputs = ["qq"]\noutputs = ["elevator"]\n'
+                   'd = [[1.0]]\n')
+    for command in ("gust", "compare"):
+        code, _, err = run_cli(capsys, command, "--controller", str(bad), "--no-log")
+        assert_one_line_error(code, err, "'qq' is not a signal of the run")
+    code, _, err = run_cli(capsys, "gust", "--controller", "no_such", "--no-log")
+    assert_one_line_error(code, err, "shipped controller (gla_optimised)")
+
+
+def test_rerun_flies_the_controller_again():
+    from bioflex_jsb.cli.rerun import argv_for
+    from bioflex_jsb.simulation.run import RunDescription
+
+    d = RunDescription("gust", "optimised", 15.0, extra={"controller": "/abs/gla.toml"})
+    argv = argv_for(d)
+    assert argv[argv.index("--controller") + 1] == "/abs/gla.toml"
