@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb import units as U
 from bioflex_jsb.aeroelasticity.free_aircraft import (
     AERO_MODELS,
     FREE_DEFAULT_AERO,
@@ -67,6 +68,7 @@ from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.runtime.jsbsim_aircraft import complete as complete_aircraft
+from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation.gusts import parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
@@ -78,7 +80,8 @@ __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
     "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
     "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "plot_runs",
-    "read_log", "section_loads", "to_python_control",
+    "read_log", "section_loads", "to_python_control", "load_controller",
+    "linear_controller", "predict_alleviation", "design_alleviation",
 ]
 
 
@@ -239,7 +242,8 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
              models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
-             aero: str = "quasi-steady", trim: str = "rigid") -> dict[str, TimeHistory]:
+             aero: str = "quasi-steady", trim: str = "rigid",
+             controller=None) -> dict[str, TimeHistory]:
     """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing`` (a WingBuild or an
     Aircraft), one per model of ``models`` (``rigid``, ``coupled``, ``qsd``; None: all
     three, or ``coupled`` alone with ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and
@@ -262,9 +266,16 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
     channels ``loads_<fs|md>_<quantity>_s<j>`` (:func:`bioflex_jsb.drivers.gust.run_gust`'s
     ``loads``; docs/loads.md), and :func:`metrics` their peaks. An :class:`Aircraft` flies
     on its own JSBSim airframe (an aircraft without an engine in its steady glide;
-    docs/aircraft.md)."""
+    docs/aircraft.md).
+
+    ``controller``: a controller in the loop of every run (:func:`load_controller`'s
+    sources: a controller file, a shipped controller's name, a LinearController,
+    python-control's StateSpace or an object with ``inputs``, ``outputs`` and ``step``;
+    :mod:`bioflex_jsb.simulation.controller`): it reads the run's signals every step and
+    commands the elevator [rad] and throttle [-] over the trim; each run has its commands
+    as channels ``ctrl_<command>`` and ``meta["controller"]``."""
     return _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m,
-                     dt_s, recorders, aero, trim)[0]
+                     dt_s, recorders, aero, trim, controller)[0]
 
 
 def _gust_text(gust) -> str:
@@ -275,7 +286,7 @@ def _gust_text(gust) -> str:
 
 
 def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
-              recorders, aero, trim):
+              recorders, aero, trim, controller=None):
     """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build: the run's
     configuration made (and so checked) before the airframe loads."""
     if models is None:
@@ -290,12 +301,15 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
                        duration_s, gust_start_s, altitude_m, dt_s, models=models, aero=aero,
                        trim=trim)
     check_recorders(recorders, config.models)
+    if controller is not None:
+        controller = load_controller(controller)
     airframe = subject.jsbsim_airframe()
     out = {}
     for model in map(str, config.models):
         recorder = (recorders or {}).get(model)
         flown = build if config.needs_build(model) else build.model
-        out[model] = run_gust(airframe, flown, model, config, recorder=recorder, loads=build)
+        out[model] = run_gust(airframe, flown, model, config, recorder=recorder, loads=build,
+                              controller=controller)
         # which wing flew, as the command's runs say (plot_runs' title, a user's table)
         out[model].meta.update(wing=build.variant.name, mass_basis=build.mass_basis)
     return out, airframe, build, config.speed_m_s
@@ -322,7 +336,7 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
 def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:0.3",
             model: str = "coupled", duration_s: float = 5.0, gust_start_s: float = 0.5,
             aero: str = "quasi-steady", trim: str = "rigid",
-            recorder: StepRecorder | None = None) -> Comparison:
+            recorder: StepRecorder | None = None, controller=None) -> Comparison:
     """The nonlinear gust run of ``model`` with ``wing`` (as :func:`fly_gust`: ``speed_m_s``
     [m/s], ``gust``, ``duration_s`` [s] from ``gust_start_s`` [s]) and the LTI model of Eq. (4)
     driven by the same gust samples at the same trim (its rigid block JSBSim's own
@@ -332,20 +346,28 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     ``aero``/``trim`` as for :func:`fly_gust` (unsteady: coupled only; elastic: coupled or
     qsd). ``wing`` an :class:`Aircraft`: its own airframe, linearised at its trim (a
     glider's steady glide), ``speed_m_s`` None its cruise speed. ``recorder``: a step
-    recorder (an MCAP log) of the nonlinear run."""
+    recorder (an MCAP log) of the nonlinear run.
+
+    ``controller``: a linear controller in the loop of both (:func:`load_controller`'s
+    sources but a Python object: the LTI model closes the loop with its state space, at the
+    run's step with the run's one step of delay, :mod:`bioflex_jsb.simulation.closed_loop`);
+    its commands are compared too (``ctrl_<command>``). The quasi-steady ``coupled``,
+    ``qsd`` or ``rigid`` model about the rigid trim."""
     if model not in MODELS:
         raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
-    check_comparable(model, aero, trim)  # before flying
+    check_comparable(model, aero, trim, controller is not None)  # before flying
     check_gust_excites(parse_gust(_gust_text(gust)))
+    if controller is not None:
+        controller = linear_controller(controller)
     runs, airframe, build, speed = _fly_gust(
         wing, speed_m_s, gust, (model,), duration_s, gust_start_s, 0.0, DEFAULT_DT_S,
-        {model: recorder} if recorder is not None else None, aero, trim)
+        {model: recorder} if recorder is not None else None, aero, trim, controller)
     drift = None
     if airframe.glider:  # the glide's own drift in calm air (drivers/compare.py)
         drift = _fly_gust(wing, speed, "none", (model,), duration_s, gust_start_s, 0.0,
-                          DEFAULT_DT_S, None, aero, trim)[0][model]
+                          DEFAULT_DT_S, None, aero, trim, controller)[0][model]
     return compare_run(build, runs[model], model, speed, aero, trim, airframe=airframe,
-                       drift=drift)
+                       drift=drift, controller=controller)
 
 
 def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
@@ -707,3 +729,95 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
     if density_kg_m3 is not None:
         density_kg_m3 = _check_density(density_kg_m3)
     return _section_loads(build, run, stations, static=static, density_kg_m3=density_kg_m3)
+
+
+def load_controller(source):
+    """A controller for :func:`fly_gust` and :func:`compare` (docs/api.md, "Controllers in
+    the loop"): ``source`` a controller file's path (``.npz`` or ``.toml``: A, B, C, D,
+    ``dt_s`` [s] (0: continuous), the signals it reads and the commands it writes), a
+    shipped controller's name (``gla_optimised``), a
+    :class:`~bioflex_jsb.simulation.controller.LinearController`, the package's or
+    python-control's ``StateSpace`` (its input names the signals, its output names the
+    commands), or any object with ``inputs``, ``outputs`` and ``step(t_s, signals)``.
+    Unknown signal or command names are one line (InputError)."""
+    from bioflex_jsb.simulation.controller import load_controller as _load
+
+    return _load(source)
+
+
+def linear_controller(source):
+    """The controller of ``source`` (:func:`load_controller`'s sources), refusing one that is
+    not linear (one line): the LTI model closes the loop with the controller's state
+    space."""
+    from bioflex_jsb.simulation.controller import LinearController
+
+    controller = load_controller(source)
+    if not isinstance(controller, LinearController):
+        raise InputError(f"the LTI model needs a linear controller (a state space), not "
+                         f"{type(controller).__name__}")
+    return controller
+
+
+def _gla_plant(wing, speed_m_s):
+    """(the WingBuild, the trim speed [m/s], the GLA plant of loads/alleviation.py with
+    JSBSim's rigid block at the trim and the loads at the trim's density)."""
+    from bioflex_jsb.loads.alleviation import gla_plant
+    from bioflex_jsb.loads.model import build_loads_model
+
+    subject = _Subject.of(wing)
+    build = subject.flying_build()
+    v = subject.flight_speed(speed_m_s)
+    airframe = subject.jsbsim_airframe()
+    lin = airframe.linearize(v)
+    rho = airframe[JP.ATMOSPHERE_RHO_SLUGS_FT3] * U.KG_M3_PER_SLUG_FT3  # the trim's air
+    lm = build_loads_model(build, v, density_kg_m3=rho, static="elastic")
+    return build, v, gla_plant(build, v, lm, a_rr=lin.a)
+
+
+def predict_alleviation(wing, controller, speed_m_s: float | None = None,
+                        u_ref_m_s: float = 3.0, dt_s: float = DEFAULT_DT_S):
+    """What ``controller`` (a linear one, :func:`linear_controller`) does to the root bending
+    moment of ``wing`` (a WingBuild or an Aircraft) at ``speed_m_s`` [m/s] (None: the
+    cruise speed) by the LTI model (:mod:`bioflex_jsb.loads.alleviation`: Eq. 4 with its
+    controls and JSBSim's rigid block, the loop closed at the step ``dt_s`` [s] with the
+    run's one step of delay): the tuned 1-cosine gust's peak increment over the gradients
+    of ``loads --tuned`` (``u_ref_m_s`` [m/s] at the longest) and the von Kármán
+    turbulence RMS, open and closed loop (a
+    :class:`~bioflex_jsb.loads.alleviation.Prediction`: ``tuned_ratio``, ``rms_ratio``,
+    ``peak_ratios``, ``as_dict()``)."""
+    from bioflex_jsb.loads.alleviation import predict
+
+    controller = linear_controller(controller)
+    u_ref = _real(u_ref_m_s, "u_ref_m_s [m/s]")
+    if u_ref <= 0.0:
+        raise InputError(f"u_ref_m_s must be > 0 m/s, got {u_ref:g}")
+    _, _, plant = _gla_plant(wing, speed_m_s)
+    return predict(plant, controller, _real(dt_s, "dt_s [s]"), u_ref_m_s=u_ref)
+
+
+def design_alleviation(wing, speed_m_s: float | None = None,
+                       signals: tuple[str, ...] = ("alpha", "q"),
+                       elevator_limit_rad: float = 0.17453292519943295,
+                       u_ref_m_s: float = 3.0, dt_s: float = DEFAULT_DT_S):
+    """A gust load alleviation controller for ``wing`` (a WingBuild or an Aircraft) at
+    ``speed_m_s`` [m/s] (None: the cruise speed), designed on the LTI model
+    (:func:`bioflex_jsb.loads.alleviation.design_output_feedback`): a static feedback from
+    ``signals`` (the run's channels; default the angle of attack [rad] and the pitch rate
+    [rad/s]) to the elevator [rad] minimising the root bending moment's tuned-gust peak
+    (``u_ref_m_s`` [m/s]) with the elevator's increment within ``elevator_limit_rad`` [rad]
+    (default 10°), at the step ``dt_s`` [s]. Returns (the LinearController, continuous so
+    that it flies at any step; the design's record: gains, cost, iterations)."""
+    from bioflex_jsb.loads.alleviation import design_output_feedback, static_gain
+    from bioflex_jsb.simulation.controller import check_signals
+
+    signals = check_signals(signals)
+    limit = _real(elevator_limit_rad, "elevator_limit_rad [rad]")
+    if not 0.0 < limit <= 0.5:
+        raise InputError(f"elevator_limit_rad must be in (0, 0.5] rad, got {limit:g}")
+    _, v, plant = _gla_plant(wing, speed_m_s)
+    ctrl, record = design_output_feedback(plant, _real(dt_s, "dt_s [s]"), signals,
+                                          u_ref_m_s=_real(u_ref_m_s, "u_ref_m_s [m/s]"),
+                                          elevator_limit_rad=limit)
+    record["speed_m_s"] = v
+    gains = [record["gains"][s] for s in signals]
+    return static_gain(gains, signals, None, name="gla"), record

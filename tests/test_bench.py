@@ -306,6 +306,11 @@ def test_bench_json_has_every_figure(capsys):
         assert key in data["wall"]["us_per_step"]
     assert set(data["cosim_us_per_step_by_gust"]) == {"sharp:0.3", "sharp:3",
                                                       "dryden:1.5:100:7"}
+    assert "controlled" in data["us_per_step"]
+    assert "value" in data["controller_in_loop_us_per_step"]
+    c = data["controller_us"]
+    assert c["n_states"] == 10 and c["bar_us"] == 1.0 and c["meets_bar"] in (True, False)
+    assert 0.0 < c["update"]["least"] <= c["in_step"]["median"]
     c = data["kernel_compile_s"]
     assert c["cold"] > 0.0 and c["cached"] > 0.0
     assert set(c["cold_by_kernel"]) == {"step_kernel", "unsteady_kernel"}
@@ -381,3 +386,18 @@ def test_bench_bad_input_is_one_line_and_exit_2(capsys):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert word in err and err.count("\n") == 1, (argv, err)
+
+
+def test_controller_cost_is_the_step_s_own_calls():
+    """The controller's figure times what the compiled step calls (its update's machine
+    code and the setter of JSBSim's elevator command) for a 10-state controller; the
+    readable Python update beside it is tens of times slower (18 µs against 0.5 µs a step
+    measured at load 9 on the 2-core machine)."""
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+
+    c = bench.controller_cost_us(build_wing(VARIANTS["optimised"]), calls=500, repeat=3)
+    assert c["n_states"] == bench.CONTROLLER_STATES == 10
+    assert c["signals"] == ["q", "alpha", "n_z"]
+    assert 0.0 < c["update"]["least"] <= c["update"]["median"]
+    assert c["python_reference"]["least"] > 5.0 * c["update"]["least"]
+    assert c["meets_bar"] == (c["in_step"]["least"] <= c["bar_us"])

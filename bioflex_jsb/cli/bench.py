@@ -35,7 +35,11 @@ figure and its groups': ratio = co-simulation / bare, logged_ratio = logged co-s
 bare, log_ratio = logged / unlogged, unsteady_ratio = unsteady co-simulation / bare,
 native_ratio = native / bare, python_ratio = Python step / bare; each ratio with a bar (on a
 quiet 2-core machine) printed against it; the logging costs [µs/step]: the rows, the section
-loads, the scene. Also: µs per step through sharp:0.3, sharp:3 and Dryden gusts (a large gust
+loads, the scene. A controller in the loop: the co-simulation with a 10-state linear
+controller (q, alpha, n_z to the elevator) and its difference from the co-simulation, and
+the controller's own per-step cost (its compiled update and the command written to JSBSim,
+the least of 15 timings of 20000 calls; bar 1 µs). Also: µs per step through sharp:0.3,
+sharp:3 and Dryden gusts (a large gust
 renews the wing's reference step more often), the cost of one reference renewal [ms] of
 both wings, the step kernels' cold compile and cached load [s], the load average, and the
 SITL pacing error (step start against the wall clock, p50/p99 [ms] and resyncs) over
@@ -147,7 +151,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     finally:
         sb.close()
-    payload = {**figures, "refresh_ms": bench.refresh_cost_ms(build),
+    payload = {**figures, "controller_us": bench.controller_cost_us(build, args.speed),
+               "refresh_ms": bench.refresh_cost_ms(build),
                "unsteady_refresh_ms": bench.unsteady_refresh_cost_ms(build),
                "kernel_compile_s": compile_s, "dt_s": bench.DEFAULT_DT_S, "steps": args.steps,
                "repeat": args.repeat}
@@ -210,6 +215,10 @@ def _against_bar(d: dict) -> str:
     return f"   bar <= {d['bar']:g}: {'meets it' if d['meets_bar'] else 'ABOVE IT'}"
 
 
+def _against_bar_us(c: dict) -> str:
+    return f"   bar <= {c['bar_us']:g} µs: {'meets it' if c['meets_bar'] else 'ABOVE IT'}"
+
+
 def _print(p: dict) -> None:
     us = p["us_per_step"]
     load = ", ".join(f"{x:.2f}" for x in p["load_average"])
@@ -233,6 +242,14 @@ def _print(p: dict) -> None:
         print(f"  logging cost, {label:15s} {_spread(p['log_costs_us_per_step'][key], ' µs/step')}")
     for gust, d in p["cosim_us_per_step_by_gust"].items():
         print(f"co-simulation, {gust:18s} {_spread(d, ' µs/step')}")
+    print(f"{'  with a controller':20s} {_spread(us['controlled'], ' µs/step')}")
+    print(f"  controller in the loop (with - without) "
+          f"{_spread(p['controller_in_loop_us_per_step'], ' µs/step')}")
+    c = p["controller_us"]
+    print(f"controller of {c['n_states']} states ({', '.join(c['signals'])} -> elevator), per "
+          f"step: {c['in_step']['least']:.3f} µs (median {c['in_step']['median']:.3f}; the "
+          f"update alone {c['update']['least']:.3f}, in Python "
+          f"{c['python_reference']['least']:.2f}){_against_bar_us(c)}")
     fixed = ", ".join(f"{k} {us[k]['fixed_ms']:.2f} ms" for k in ("cosim", "logged", "unsteady")
                       if us[k]["fixed_ms"] is not None)
     print(f"fixed cost per run (fit): {fixed}")

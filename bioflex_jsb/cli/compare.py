@@ -27,7 +27,10 @@ from bioflex_jsb.cli.common import (
 from bioflex_jsb.cli.gust import (
     Interrupted,
     add_aero_arguments,
+    add_controller_argument,
     add_run_arguments,
+    controller_from_args,
+    controller_line,
     fly,
     open_log,
     run_config,
@@ -46,7 +49,9 @@ case, as for gust); small gusts (--gust sharp:0.3) agree to a few per cent, larg
 where the linear model leaves the nonlinear one. A nonlinear run that diverges has no NRMSE
 (null in --json) and the command exits with status 3. Valid ranges: as for gust. The MCAP log
 holds every step of the nonlinear run and the linear model's response on
-/bioflex/<model>/lti_prediction (docs/logging.md; --out, --no-log)."""
+/bioflex/<model>/lti_prediction (docs/logging.md; --out, --no-log). With --controller the
+same linear controller flies in both: the LTI model with its controls closes the loop at the
+run's step, with the run's one step of delay, and the commands are compared too."""
 
 # The table's unit of each channel's largest difference, and its factor from SI.
 DISPLAY_UNITS = {"u": ("m/s", 1.0), "alpha": ("deg", 57.29577951308232),
@@ -62,6 +67,7 @@ def register(sub) -> None:
     p.add_argument("--model", choices=("coupled", "qsd", "rigid"), default="coupled",
                    help="wing model of both runs (default coupled)")
     add_aero_arguments(p)
+    add_controller_argument(p, linear=True)
     add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png",
                    help="overlay of both time histories, NRMSE in the legends (.png, .pdf, "
@@ -86,10 +92,16 @@ def run(args: argparse.Namespace) -> int:
     resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
     try:
-        check_comparable(args.model, args.aero, args.trim)
+        check_comparable(args.model, args.aero, args.trim, args.controller is not None)
     except InputError as exc:
         raise UsageError(f"--model {args.model} --aero {args.aero} --trim {args.trim}: "
                          f"{exc}") from None
+    controller = controller_from_args(args)
+    if controller is not None:
+        from bioflex_jsb.simulation.controller import LinearController
+
+        if not isinstance(controller, LinearController):  # a file is always linear
+            raise UsageError("--controller: the LTI model needs a linear controller")
     try:
         check_gust_excites(args.gust)
     except InputError as exc:
@@ -119,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
         nonlinear = runs[0]
         try:
             linear = linear_prediction(build, nonlinear, args.model, args.speed, args.aero,
-                                       args.trim, airframe)
+                                       args.trim, airframe, controller)
         except FdmError as exc:
             raise UsageError(str(exc)) from None
         if log is not None:
@@ -145,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
         "overrides": dict(build.model.coefficients.overrides),
         "nrmse": errors, "worst": worst, "stopped": stops, "diverged": diverged,
         "divergence_time_s": nonlinear.stop_time_s,
+        "controller": nonlinear.meta.get("controller"),
         "duration_s": float(nonlinear.time_s[-1]) if len(nonlinear.time_s) else 0.0,
         "plot": args.plot, "out": args.out,
     }
@@ -157,12 +170,19 @@ def run(args: argparse.Namespace) -> int:
             print(f"the nonlinear run diverged at t = {nonlinear.stop_time_s:.3f} s: no "
                   "comparison (NRMSE null); see the reason below")
         else:
-            print(f"{'channel':<8} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} {'at t [s]':>9}")
+            width = max(8, *(len(c) for c in channels))  # a controller's command is longer
+            print(f"{'channel':<{width}} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} "
+                  f"{'at t [s]':>9}")
             for c in channels:
                 unit, scale = DISPLAY_UNITS.get(c, (worst[c]["unit"], 1.0))
-                print(f"{c:<8} {errors[c]:9.4f} {worst[c]['max_abs_difference'] * scale:11.5f} "
+                print(f"{c:<{width}} {errors[c]:9.4f} "
+                      f"{worst[c]['max_abs_difference'] * scale:11.5f} "
                       f"{unit:<6} {worst[c]['at_time_s']:9.3f}")
             print(result.loads_table(), end="")  # section loads (drivers/compare.py)
+            line = controller_line(nonlinear)
+            if line:
+                print(f"{line}; the LTI model closes the loop at the run's step, with its "
+                      "one step of delay")
             print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
                   "largest difference and when it occurs")
         if args.plot:

@@ -93,6 +93,7 @@ def register(sub) -> None:
                    help="comma-separated subset of rigid,coupled,qsd (default: all three; "
                    "with --aero unsteady: rigid,coupled)")
     add_aero_arguments(p)
+    add_controller_argument(p)
     add_log_arguments(p)
     add_live_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
@@ -119,6 +120,48 @@ def add_aero_arguments(p: argparse.ArgumentParser) -> None:
                    "wing's static deflection and its loads carried by JSBSim's trim; "
                    "`bioflex-jsb trim --wing W` shows it; docs/decisions.md); the rigid "
                    "model has no elastic wing and starts from the rigid trim either way")
+
+
+def add_controller_argument(p: argparse.ArgumentParser, linear: bool = False) -> None:
+    """--controller FILE (gust, compare)."""
+    what = ("a linear controller (the LTI model closes the loop with it)" if linear
+            else "a controller")
+    p.add_argument("--controller", metavar="FILE", default=None,
+                   help=f"fly with {what} in the loop: a .npz or .toml file (A, B, C, D, "
+                   "dt_s [s], the signals it reads: the run's channels such as alpha, q, "
+                   "n_z, eta1; the commands it writes: elevator [rad], throttle [-] over the "
+                   "trim) or a shipped one by name (gla_optimised); its commands are logged "
+                   "as ctrl_elevator_rad, ctrl_throttle (docs/api.md)")
+
+
+def controller_from_args(args, linear: bool = False):
+    """The --controller of ``args`` loaded (None without one), one line (exit 2) for a
+    file that cannot be read or names an unknown signal; kept as
+    ``args.controller_object`` for :func:`fly`."""
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.simulation.controller import load_controller
+
+    args.controller_object = None
+    if getattr(args, "controller", None) is None:
+        return None
+    try:
+        args.controller_object = load_controller(args.controller)
+    except InputError as exc:
+        raise UsageError(f"--controller: {exc}") from None
+    return args.controller_object
+
+
+def controller_line(run) -> str | None:
+    """One line on the controller a run flew with (None without one)."""
+    c = run.meta.get("controller")
+    if not c:
+        return None
+    peaks = ", ".join(
+        f"{ch} peak {abs(run[ch]).max() * (57.29577951308232 if ch.endswith('_rad') else 1):.3g}"
+        f" {'deg' if ch.endswith('_rad') else '-'}" for ch in c["channels"] if len(run[ch]))
+    states = "" if c["n_states"] is None else f", {c['n_states']} states"
+    return (f"controller {c['name']} ({c['kind']}{states}) reads {', '.join(c['inputs'])}, "
+            f"commands {', '.join(c['outputs'])} over the trim: {peaks}")
 
 
 damping_ratio = number_type("damping ratio", low=0.0, high=1.0, high_open=True, symbol="Z")
@@ -211,6 +254,9 @@ def run_description(args, kind: str, models):
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
         extra["aircraft"] = aircraft.source
+    if getattr(args, "controller", None) is not None:  # a file by its absolute path
+        c = args.controller
+        extra["controller"] = os.path.abspath(c) if os.path.isfile(c) else c
     wing = args.wing  # a variant file by its absolute path: rerun reads it from anywhere
     if wing.lower().endswith(".toml") and os.path.isfile(wing):
         wing = os.path.abspath(wing)
@@ -261,7 +307,8 @@ def fly(args, build, config, log=None, airframe=None):
             try:
                 run = run_gust(airframe, build if config.needs_build(model) else build.model,
                                model, config, progress=progress, recorder=recorder,
-                               loads=build)
+                               loads=build,
+                               controller=getattr(args, "controller_object", None))
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -289,6 +336,7 @@ def run(args: argparse.Namespace) -> int:
     build = wing_for_run(wing_from_args(args), args)
     args.models = resolve_models(args)
     config = run_config(args, args.models)
+    controller_from_args(args)
     plot = args.plot if args.plot is not None else (None if args.json else "gust.png")
     check_plot_path(plot, args.force)
     log = None
@@ -334,12 +382,17 @@ def run(args: argparse.Namespace) -> int:
             "overrides": dict(build.model.coefficients.overrides),
             "summary": summary,
             "diverged": [r.model for r in runs if r.stopped is not None],
+            "controller": runs[0].meta.get("controller") if runs else None,
             "stopped": stops,
             "plot": plot,
             "out": args.out,
         })
     else:
         print_summary(build, args, summary)
+        for r in runs:
+            line = controller_line(r)
+            if line:
+                print(f"{r.model}: {line}")
         if plot:
             print(f"time histories written to {plot}")
         if args.out:

@@ -59,6 +59,8 @@ def argv_for(description) -> list[str]:
         common += ["--structural-damping", repr(float(d.extra["structural_damping"]))]
     if d.extra.get("trim", "rigid") != "rigid":
         common += ["--trim", str(d.extra["trim"])]
+    if d.extra.get("controller"):
+        common += ["--controller", str(d.extra["controller"])]
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")

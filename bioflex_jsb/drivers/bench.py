@@ -101,6 +101,14 @@ RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
+# A controller in the loop (simulation/controller.py): the issue's figure is a linear
+# controller of 10 states, here reading q, α and n_z and commanding the elevator, within
+# CONTROLLER_BAR_US a step (its update and the command written to JSBSim).
+CONTROLLER_STATES = 10
+CONTROLLER_SIGNALS = ("q", "alpha", "n_z")
+CONTROLLER_BAR_US = 1.0
+CONTROLLER_CALLS = 20_000  # calls of one timing (~15 ms: shorter than the speed states)
+CONTROLLER_REPEAT = 15
 # The 3-D scene of a gust log: the scene's default, true scale, as cli.gust.SCENE_EXAGGERATION
 # (the CLI is above this layer; tests/test_bench.py holds the two equal).
 GUST_SCENE_EXAGGERATION = DEFAULT_EXAGGERATION
@@ -371,7 +379,8 @@ class StepBench:
         return c1 - c0, w1 - w0
 
     def cosim(self, n: int, gust: str = "sharp:0.3", log: str | None = None,
-              compiled: bool = True, aero: str = "quasi-steady") -> tuple[float, float]:
+              compiled: bool = True, aero: str = "quasi-steady",
+              controller=None) -> tuple[float, float]:
         """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
         at half the shortest run; ``aero`` the strips; ``log``: None (no log, no section
         loads), ``"rows"`` (an MCAP log of the run's rows), ``"loads"`` (and the section
@@ -400,7 +409,8 @@ class StepBench:
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=run_log.recorder("coupled") if run_log else None,
                            compiled=compiled,
-                           loads=self.build if log in ("loads", "gust") else None)
+                           loads=self.build if log in ("loads", "gust") else None,
+                           controller=controller)
             if run_log is not None:  # closing writes the last chunks: part of the log's cost
                 run_log.close()
                 run_log = None
@@ -423,6 +433,7 @@ class StepBench:
             "unsteady": lambda n: self.cosim(n, aero="unsteady"),
             "native": self.native_run,
             "python": lambda n: self.cosim(n, compiled=False),
+            "controlled": lambda n: self.cosim(n, controller=bench_controller()),
         }
         for g in gusts:
             if g != "sharp:0.3":  # that one is "cosim"
@@ -473,6 +484,7 @@ class StepBench:
             "us_per_step": {k: cpu[k].as_dict() for k in plain},
             "log_costs_us_per_step": {k: difference(cpu[a], cpu[b])
                                       for k, (a, b) in LOG_COSTS.items()},
+            "controller_in_loop_us_per_step": difference(cpu["controlled"], cpu["cosim"]),
             "wall": {"us_per_step": {k: est["wall"][k].as_dict() for k in plain},
                      **{key: ratio(est["wall"][a], est["wall"][b])
                         for key, (a, b) in RATIOS.items()}},
@@ -484,6 +496,87 @@ class StepBench:
             "load_average_before": load0,
             "load_average": list(os.getloadavg()),
         }
+
+
+def bench_controller(n_states: int = CONTROLLER_STATES, seed: int = 0):
+    """A discrete linear controller of ``n_states`` states at the run's step, reading
+    :data:`CONTROLLER_SIGNALS` and commanding the elevator: A random with its spectral
+    radius 0.9 (stable), B, C, D random and scaled so that a gust run's signals move the
+    elevator by well under a degree (the run stays the cosim's); seeded, the same every
+    time."""
+    from bioflex_jsb.simulation.controller import LinearController
+
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(n_states, n_states))
+    a *= 0.9 / max(abs(np.linalg.eigvals(a)))
+    m = len(CONTROLLER_SIGNALS)
+    return LinearController.from_arrays(
+        a, 1e-3 * rng.normal(size=(n_states, m)), 1e-2 * rng.normal(size=(1, n_states)),
+        1e-3 * rng.normal(size=(1, m)), DEFAULT_DT_S, CONTROLLER_SIGNALS, ["elevator"],
+        f"bench{n_states}")
+
+
+def controller_cost_us(build: WingBuild, speed_m_s: float = 15.0,
+                       calls: int = CONTROLLER_CALLS,
+                       repeat: int = CONTROLLER_REPEAT) -> dict[str, object]:
+    """The per-step cost [µs] of a 10-state linear controller in the coupled step
+    (:func:`bench_controller`), measured on a trimmed step's own objects: ``update`` the
+    compiled update alone (its machine code on a row of the run's table, the elevator's
+    map to JSBSim's command included), ``in_step`` what the step calls between its kernel
+    and JSBSim's step (the update and the command written to JSBSim's property: the whole
+    per-step cost),
+    ``python_reference`` the readable Python update for comparison. Each the least time per
+    call of ``repeat`` timings of ``calls`` calls (noise only adds time) and their median,
+    on the process's CPU clock as the other figures (a timing preempted is not charged for
+    the wait; the least on the wall clock beside it);
+    ``bar_us`` and ``meets_bar`` for ``in_step``; the load average."""
+    from bioflex_jsb.runtime.coupled_step import CoupledStep
+    from bioflex_jsb.simulation.controller import ControlLoop
+
+    airframe = Airframe()
+    controller = bench_controller()
+    step = CoupledStep(airframe, build.model, "coupled", speed_m_s, controller=controller)
+    try:
+        table = np.zeros((4, len(step.names)))
+        table[:, step.names.index("n_z")] = 1.0
+        reference = ControlLoop(controller, step.names, step.dt_s,
+                                dict(zip(step.names, table[0].tolist(), strict=True)),
+                                compiled=False)
+        binding, set_command = step._control_fast  # what the step's fast path calls
+        entry, params = binding.entry, binding.params
+
+        def update(n: int) -> None:
+            for _ in range(n):
+                entry(table, 1, params)
+
+        def in_step(n: int) -> None:  # as CoupledStep's compiled step does it
+            for _ in range(n):
+                set_command(entry(table, 1, params))
+
+        def python_reference(n: int) -> None:
+            for _ in range(n):
+                reference.step(table, 1)
+
+        out = {}
+        for key, run in (("update", update), ("in_step", in_step),
+                         ("python_reference", python_reference)):
+            n = calls if key != "python_reference" else max(1, calls // 20)
+            cpu, wall = [], []
+            for _ in range(repeat):
+                c0, w0 = _clocks()
+                run(n)
+                c1, w1 = _clocks()
+                cpu.append((c1 - c0) / n * 1e6)
+                wall.append((w1 - w0) / n * 1e6)
+            out[key] = {"least": min(cpu), "median": statistics.median(cpu),
+                        "wall_least": min(wall)}
+    finally:
+        step.release()
+    value = out["in_step"]["least"]
+    return {**out, "n_states": controller.n_states, "signals": list(CONTROLLER_SIGNALS),
+            "calls": calls, "repeat": repeat, "clock": "process CPU time (time.process_time)",
+            "bar_us": CONTROLLER_BAR_US, "meets_bar": bool(value <= CONTROLLER_BAR_US),
+            "load_average": list(os.getloadavg())}
 
 
 def refresh_cost_ms(build: WingBuild, n: int = 50) -> dict[str, float]:

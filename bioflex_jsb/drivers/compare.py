@@ -48,6 +48,7 @@ from bioflex_jsb.simulation.lti_response import simulate
 from bioflex_jsb.simulation.results import TimeHistory, nrmse
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
+COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle")  # a controller's, when one flew
 LOADS_PREFIX = "loads_"
 
 
@@ -121,8 +122,12 @@ def check_gust_excites(gust) -> None:
                          "aircraft (its errors are relative to the response to it)")
 
 
-def check_comparable(model: str, aero: str, trim: str) -> None:
-    """Raise InputError (one line) for a model, aerodynamics and trim with no linear model."""
+def check_comparable(model: str, aero: str, trim: str, controller: bool = False) -> None:
+    """Raise InputError (one line) for a model, aerodynamics and trim with no linear model
+    (with a ``controller``: one with the controls, quasi-steady about the rigid trim)."""
+    if controller and (aero != "quasi-steady" or trim != "rigid"):
+        raise InputError("a controller is compared on the quasi-steady model about the rigid "
+                         "trim (the unsteady and elastic-trim LTI models have no controls)")
     if trim == "elastic" and (aero == "unsteady" or model == "rigid"):
         raise InputError("the elastic trim is compared for the quasi-steady coupled or qsd "
                          "model (the rigid model has no wing; the unsteady one is "
@@ -134,14 +139,19 @@ def check_comparable(model: str, aero: str, trim: str) -> None:
 
 def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
                       aero: str = "quasi-steady", trim: str = "rigid",
-                      airframe: Airframe | None = None) -> TimeHistory:
+                      airframe: Airframe | None = None, controller=None) -> TimeHistory:
     """The LTI model's response to the gust samples ``nonlinear["w_g"]`` [m/s] at its times.
 
     ``model``: ``rigid``, ``coupled`` or ``qsd``; ``aero="unsteady"`` (coupled only): Eq. (4)
     on unsteady strips with Küssner's gust; ``trim="elastic"`` (coupled, qsd; quasi-steady):
     linearised about the static aeroelastic equilibrium. Raises InputError for a combination
-    that has no linear model (:func:`check_comparable`)."""
-    check_comparable(model, aero, trim)
+    that has no linear model (:func:`check_comparable`).
+
+    ``controller``: the linear controller the run flew with
+    (:class:`~bioflex_jsb.simulation.controller.LinearController`): the model with its
+    controls closes the loop at the run's step with its one step of delay
+    (:mod:`bioflex_jsb.simulation.closed_loop`); the prediction has its commands too."""
+    check_comparable(model, aero, trim, controller is not None)
     # the JSBSim airframe the run flew (the prototype's by default): A_RR at its trim (an
     # aircraft without an engine: its steady glide, runtime/glide.py)
     lin = (airframe or Airframe()).linearize(speed_m_s)
@@ -163,11 +173,35 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
                                build.model, a_rr=lin.a)
     layout = nonlinear.meta.get("loads")
     lm = None if layout is None else _loads_model(build, nonlinear, model, speed_m_s)
+    if controller is not None:
+        ss = build_state_space(model, level_flight_condition(speed_m_s,
+                                                             airframe=build.airframe),
+                               build.model, a_rr=lin.a, controls=True)
     if lm is not None and aero != "unsteady":
         ss = with_load_outputs(ss, lm)
-    linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
+    if controller is not None:
+        linear = _closed_loop_response(ss, controller, nonlinear)
+    else:
+        linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
+    return linear
+
+
+def _closed_loop_response(ss, controller, nonlinear: TimeHistory) -> TimeHistory:
+    """The closed loop's response to the run's gust samples, on the run's channels (the
+    LTI's own extra signals left out: its airspeed and absolute angles would be
+    perturbations under an absolute channel's name)."""
+    from bioflex_jsb.simulation.closed_loop import close_loop, respond, signal_outputs
+
+    dt = float(nonlinear.meta.get("dt_s") or nonlinear.time_s[1] - nonlinear.time_s[0])
+    cl = close_loop(signal_outputs(ss), controller, dt)
+    linear = respond(cl, nonlinear["w_g"])
+    for extra in ("airspeed_m_s", "theta_rad", "alpha_rad"):
+        linear.channels.pop(extra, None)
+        linear.units.pop(extra, None)
+    linear.time_s = np.asarray(nonlinear.time_s, dtype=float)
+    linear.channels["w_g"] = np.asarray(nonlinear["w_g"], dtype=float)
     return linear
 
 
@@ -226,16 +260,20 @@ def _add_drift(linear: TimeHistory, nonlinear: TimeHistory, drift: TimeHistory) 
 def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
                 aero: str = "quasi-steady", trim: str = "rigid",
                 linear: TimeHistory | None = None, airframe: Airframe | None = None,
-                drift: TimeHistory | None = None) -> Comparison:
+                drift: TimeHistory | None = None, controller=None) -> Comparison:
     """Compare ``nonlinear`` (a gust run of ``model``) with the LTI prediction (``linear``,
     computed by :func:`linear_prediction` on ``airframe``, the JSBSim airframe flown, when
     not given); ``drift``: the calm-air run of the same trim and steps, added to the
-    prediction (a glide's drift: module docstring); see the module docstring."""
+    prediction (a glide's drift: module docstring); ``controller``: the linear controller
+    the run flew with (:func:`linear_prediction`), whose commands are compared too; see
+    the module docstring."""
     if linear is None:
-        linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim, airframe)
+        linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim, airframe,
+                                   controller)
     if drift is not None:
         _add_drift(linear, nonlinear, drift)
-    channels = tuple(c for c in CHANNELS if c in linear.channels and c in nonlinear.channels)
+    channels = tuple(c for c in CHANNELS + COMMANDS
+                     if c in linear.channels and c in nonlinear.channels)
     load_channels = tuple(c for c in nonlinear.channels
                           if c.startswith(LOADS_PREFIX) and c in linear.channels)
     static = (nonlinear.meta.get("loads") or {}).get("static_1g", {})

@@ -33,6 +33,7 @@ from bioflex_jsb.parameters.sensors import Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation.channels import mode_tips
+from bioflex_jsb.simulation.controller import controller_meta
 from bioflex_jsb.simulation.gusts import GustField
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
 from bioflex_jsb.simulation.run_config import RunConfig
@@ -67,6 +68,12 @@ class StepRecorder(Protocol):
     returns), and with the rows left when the run stops; ``stop(n)`` once at the end,
     however the run ends (finished, stopped, interrupted, failed), with the number of
     complete rows.
+
+    A recorder that also logs a controller in the loop has ``controller(names, meta)``
+    (optional): called once before the first step of a run with a controller (``meta``: the
+    run's ``meta["controller"]``), it returns an object whose ``rows(time_s, rows)`` is
+    handed the same rows as the recorder's, right after them, and whose ``stop()`` is called
+    once at the end, before the recorder's own.
 
     A recorder that also logs section loads has ``loads(layout)`` (optional): called once
     before the first step of a run with loads (``layout``: the run's ``meta["loads"]``,
@@ -156,6 +163,7 @@ def run_gust(
     loads: WingBuild | LoadsModel | None = None,
     progress: Callable[[int], None] | None = None,
     sensors: Sensors | SensorSet | None = None,
+    controller=None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
     with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
@@ -200,6 +208,12 @@ def run_gust(
     aircraft definition's ``[sensors]``). Each is
     channels of the history (``imu_<name>_ax_m_s2`` … ``gz_rad_s``, ``airspeed_<name>_m_s``;
     :mod:`bioflex_jsb.simulation.sensors`), ``meta["sensors"]`` says where they sit.
+    ``controller``: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`: a
+    Python object with ``step(t_s, signals)`` or a
+    :class:`~bioflex_jsb.simulation.controller.LinearController`; a fresh one per run, its
+    state starts at the trim): every step it reads the row's signals and commands the
+    elevator and throttle over the trim; the history has its commands as channels
+    ``ctrl_<command>`` and ``meta["controller"]`` says what it was.
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
@@ -211,7 +225,7 @@ def run_gust(
     sensor_set = _sensor_set(sensors, build, wing)
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
-                       trim_mode=trim_mode, sensors=sensor_set)
+                       trim_mode=trim_mode, sensors=sensor_set, controller=controller)
     refused = True
     try:
         stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
@@ -263,10 +277,13 @@ class _GustRun:
         names = self.names = step.names
         block = max(1, int(round(WINDOW_S / dt)))
         self.loads_out = None  # the recorder's loads topic
+        self.control_out = None  # the recorder's controller topic
         if recorder is not None:
             block = max(1, int(recorder.start(names, dt)))
             if stream is not None and hasattr(recorder, "loads"):
                 self.loads_out = recorder.loads(loads_meta["loads"])
+            if step.control is not None and hasattr(recorder, "controller"):
+                self.control_out = recorder.controller(names, controller_meta(step.control))
         self.block = min(block, max(self.n_steps, 1))
         load_names = self.load_names = stream.names if stream is not None else ()
         self.loads_table = None
@@ -310,6 +327,8 @@ class _GustRun:
         time_s = (k0 + np.arange(m)) * self.dt
         if self.recorder is not None:
             self.recorder.rows(time_s, rows)
+            if self.control_out is not None:
+                self.control_out.rows(time_s, rows)
         if self.stream is not None:
             known = self.stream.add(time_s, rows)
             if last:
@@ -377,6 +396,8 @@ class _GustRun:
             try:
                 if self.loads_out is not None:
                     self.loads_out.stop()
+                if self.control_out is not None:
+                    self.control_out.stop()
             finally:
                 if self.recorder is not None:
                     self.recorder.stop(self.k)  # also when the loop failed: every step kept
@@ -427,6 +448,7 @@ class _GustRun:
                 "envelope_s": self.envelope.span_s if self.envelope is not None else None,
                 "mode_tips": None if build is None else mode_tips(build.modes),
                 **self.loads_meta,
+                **({} if step.control is None else {"controller": controller_meta(step.control)}),
             },
             stopped=stopped,
         )

@@ -26,7 +26,7 @@ from bioflex_jsb.loads.model import QUANTITIES, QUANTITY_UNITS, LoadsModel
 @dataclass(frozen=True)
 class LoadOutputs:
     """Loads output matrices of a :class:`StateSpace`: ``c`` (rows, states), ``d`` (rows,
-    inputs: the gust's column only is non-zero) per method; row names
+    inputs: the gust's column, and the controls' of a model with them) per method; row names
     ``<fs|md>_<quantity>_s<j>`` and units; ``static`` the 1 g loads of the rows."""
 
     names: tuple[str, ...]
@@ -38,7 +38,9 @@ class LoadOutputs:
 
 def _signal_rows(ss: StateSpace, lm: LoadsModel) -> tuple[np.ndarray, ...]:
     """(Z_x, Z_w, E_x, E_w): the signals' perturbation z = Z_x x + Z_w w_g and the modal
-    deflection Δη = E_x x + E_w w_g (module docstring)."""
+    deflection Δη = E_x x + E_w w_g (module docstring). The other inputs' columns (the
+    elevator, the throttle: they reach the wing's loads through n_z and q̇ alone, the tail
+    and the thrust line being off the wing): :func:`_input_signal_column`."""
     n = lm.n_modes
     nx = ss.n_states
     u0, q0, rho = lm.speed_m_s, lm.dynamic_pressure_pa, lm.density_kg_m3
@@ -85,10 +87,32 @@ def _signal_rows(ss: StateSpace, lm: LoadsModel) -> tuple[np.ndarray, ...]:
     return zx, zw, eta_x, eta_w
 
 
+def _input_signal_column(ss: StateSpace, lm: LoadsModel, j: int) -> tuple[np.ndarray, ...]:
+    """(Z_u, E_u) of the input ``j`` that is not the gust (an elevator [rad], a throttle
+    [-]): it enters the force summation through the state derivative alone, g n_z (−u₀ of
+    the α row's B), q̇ and η̈ (their rows of B), and the QSD model's η through its D."""
+    n = lm.n_modes
+    st = ss.states
+    ia, iq = st.index("alpha"), st.index("q")
+    b = ss.b[:, j]
+    zu = np.zeros(5 + 3 * n)
+    eta_u = np.zeros(n)
+    if ss.model == "qsd":
+        eta_u = ss.d[[ss.outputs.index(f"eta{i + 1}") for i in range(n)], j]
+        zu[2:2 + n] = lm.dynamic_pressure_pa * eta_u
+    elif ss.model == "coupled":
+        zu[5 + 2 * n:] = b[[st.index(f"eta{i + 1}_dot") for i in range(n)]]
+    zu[3 + 2 * n] = -lm.speed_m_s * b[ia]
+    zu[4 + 2 * n] = b[iq]
+    return zu, eta_u
+
+
 def load_outputs(ss: StateSpace, lm: LoadsModel) -> LoadOutputs:
     """C_loads, D_loads of ``ss`` (rigid, coupled or qsd) for ``lm``'s stations: force
     summation rows first, then mode displacement (not for ``rigid``, nor for a wing without
-    EI, GJ: ``lm.md_matrix`` None)."""
+    EI, GJ: ``lm.md_matrix`` None). D has a column per input of ``ss``: the gust's, and
+    for a model with controls (the elevator, the throttle) theirs, which reach the loads
+    through n_z, q̇ and η̈ (:func:`_input_signal_column`)."""
     zx, zw, eta_x, eta_w = _signal_rows(ss, lm)
     ig = ss.inputs.index("w_g")
     s = lm.n_stations
@@ -96,14 +120,21 @@ def load_outputs(ss: StateSpace, lm: LoadsModel) -> LoadOutputs:
     static_all = lm.static_loads()
     c = [lm.fs_matrix @ zx]
     dw = [lm.fs_matrix @ zw]
+    others = [j for j in range(ss.b.shape[1]) if j != ig]
+    columns = {j: _input_signal_column(ss, lm, j) for j in others}
+    du = {j: [lm.fs_matrix @ columns[j][0]] for j in others}
     static = [static_all["force_summation"].reshape(-1)]
     if ss.model != "rigid" and lm.md_matrix is not None:
         names += [f"md_{q}_s{j}" for q in QUANTITIES for j in range(s)]
         c.append(lm.md_matrix @ eta_x)
         dw.append(lm.md_matrix @ eta_w)
+        for j in others:
+            du[j].append(lm.md_matrix @ columns[j][1])
         static.append(static_all["mode_displacement"].reshape(-1))
     d = np.zeros((len(names), ss.b.shape[1]))
     d[:, ig] = np.concatenate(dw)
+    for j in others:
+        d[:, j] = np.concatenate(du[j])
     units = tuple(QUANTITY_UNITS[nm.split("_", 1)[1].rsplit("_s", 1)[0]] for nm in names)
     return LoadOutputs(tuple(names), units, np.vstack(c), d, np.concatenate(static))
 

@@ -14,6 +14,11 @@ Per step k (time t_k = k Δt, airframe state x_k), :meth:`CoupledStep.advance`:
    :class:`~bioflex_jsb.simulation.modal_wing.ModalWing`) and writes the loads of η_{k+1}
    in that flow into ``external_reactions`` (lift and drag turned from wind to body axes
    with α_k);
+   With a controller in the loop (``controller=``, :mod:`bioflex_jsb.simulation.controller`)
+   the row of t_k (step 5's) is built here, the controller reads its signals and its
+   commands go into the row (``ctrl_<command>``) and to JSBSim's flight controls
+   (:mod:`bioflex_jsb.runtime.control_surfaces`), which move the surface in step 4: the
+   forces of x_{k+1} carry it, one step after the LTI model's zero-order hold would;
 4. runs JSBSim's step: it integrates x_k → x_{k+1} and computes the forces of x_{k+1},
    which it applies over the next step — with the wing's loads of η_{k+1}, the same time,
    so the elastic loads do not lag the rigid aerodynamics;
@@ -46,6 +51,7 @@ from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
+from bioflex_jsb.simulation.controller_kernel import linear_step
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
 from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
 from bioflex_jsb.simulation.modal_wing import (
@@ -181,6 +187,10 @@ class CoupledStep:
             ``airspeed_<name>_m_s``; :class:`~bioflex_jsb.simulation.sensors.SensorRows`
             from JSBSim's forces, rates and their rates of the snapshot and η_{k−1}, η_k,
             η_{k+1}); None: no sensor channels (and no cost).
+        controller: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`: a
+            Python object or a LinearController), or None. Every step it reads the row of
+            t_k (its signals), its commands are logged in the row (channels ``ctrl_<command>``)
+            and written to JSBSim before its step (:meth:`_attach_controller`).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -191,7 +201,8 @@ class CoupledStep:
                  trim: TrimResult | None = None,
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
-                 trim_mode: str = "rigid", sensors: SensorSet | None = None) -> None:
+                 trim_mode: str = "rigid", sensors: SensorSet | None = None,
+                 controller=None) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
         self.airframe = airframe
@@ -236,10 +247,20 @@ class CoupledStep:
             self.units.update(sensors.units)
         self.names = tuple(self.units)
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
+        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
+        self.control = None  # the controller in the loop (_attach_controller)
+        self._control_step = None
+        self._control_fast = None
+        if controller is not None and self._sensors is not None:
+            # the sensors' channels need eta_{k+1} (after JSBSim's step); the controller reads
+            # the row of t_k before it: the two orders are not reconciled yet
+            raise InputError("a controller in the loop and sensor stations ([sensors]) in one "
+                             "run are not supported yet: fly without one of them")
+        if controller is not None:
+            self._attach_controller(controller)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
-        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         if self.compiled:
             self._setup_kernel(nodes)
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
@@ -322,6 +343,55 @@ class CoupledStep:
                   ua * m_per_ft, va * m_per_ft, wa * m_per_ft)
         return kin
 
+    # -- the controller ---------------------------------------------------------------------
+    def _attach_controller(self, controller) -> None:
+        """Put ``controller`` in the loop: its command channels join the row, it is bound to
+        the row's channels with every channel's trim value (the row the step would log at
+        the trim in calm air) and its commands go to JSBSim through the writers of
+        :mod:`bioflex_jsb.runtime.control_surfaces` (the JSBSim boundary)."""
+        from bioflex_jsb.runtime.control_surfaces import commands_for
+        from bioflex_jsb.simulation.controller import (
+            COMMAND_CHANNELS,
+            CONTROL_OUTPUTS,
+            ControlLoop,
+            check_controller,
+        )
+
+        controller = check_controller(controller)
+        for o in controller.outputs:
+            self.units[COMMAND_CHANNELS[o]] = CONTROL_OUTPUTS[o]
+        self.names = tuple(self.units)
+        zeros = np.zeros(self.n_modes)
+        trim = self._row_dict(self._read(0.0), 0.0, WingLoads(0.0, 0.0, 0.0), zeros, zeros)
+        trim.update({COMMAND_CHANNELS[o]: 0.0 for o in controller.outputs})
+        loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
+        commands = commands_for(self.airframe, loop.outputs)
+        binding = loop.binding
+        if binding is not None:  # the compiled update maps and returns the first command
+            for i, c in enumerate(commands):
+                binding.set_map(i, c.offset, c.angle, c.down, c.up)
+        self._control_fast = None
+        if binding is not None and len(commands) == 1 and len(commands[0].setters) == 1 \
+                and commands[0].adds == (0.0,):
+            # the fast path (_bind_fast_step): the update's machine code, then the setter
+            self._control_fast = (binding, commands[0].setters[0])
+        step = loop.step
+        if binding is not None:
+            values = binding.values
+
+            def control(table: np.ndarray, k: int) -> None:
+                step(table, k)
+                for c, value in zip(commands, values(), strict=True):
+                    c.write_value(value)
+        else:
+            def control(table: np.ndarray, k: int) -> None:
+                for c, delta in zip(commands, step(table, k), strict=True):
+                    c.write(delta)
+
+        self.control = loop
+        self._control_step = control
+        self._scratch_py = np.zeros((1, len(self.names)))  # the Python step's row
+
     # -- the wing ---------------------------------------------------------------------------
     @property
     def eta(self) -> np.ndarray:
@@ -391,6 +461,8 @@ class CoupledStep:
             lift_lbf, drag_lbf, moment_lbf_ft = (g() for g in self._native_loads)
             loads = WingLoads(lift_lbf * U.N_PER_LBF, drag_lbf * U.N_PER_LBF,
                               moment_lbf_ft * U.N_M_PER_LBF_FT)
+            if self.control is not None:
+                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot)
             self.airframe.step()
             new_eta = self.eta
         else:
@@ -407,13 +479,16 @@ class CoupledStep:
             self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
                                   loads.drag_n * ca - loads.lift_n * sa,
                                   loads.pitch_moment_n_m)
+            if self.control is not None:
+                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot)
             self.airframe.step()
             new_eta = mw.eta
-        row = self._row_dict(state, w_g_m_s, loads, eta, eta_dot)
-        if sensors is not None:
-            row.update(zip(sensors.channels, sensors.row(kin, new_eta, t).tolist(),
-                           strict=True))
-        values = self._row(row)
+        if self.control is None:
+            row = self._row_dict(state, w_g_m_s, loads, eta, eta_dot)
+            if sensors is not None:
+                row.update(zip(sensors.channels, sensors.row(kin, new_eta, t).tolist(),
+                               strict=True))
+            values = self._row(row)
         self.sensed, self.w_g_m_s = state, w_g_m_s
         self.k += 1
         alpha = flow.alpha_rad
@@ -421,6 +496,17 @@ class CoupledStep:
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
                                     self._agl_m() * U.M_PER_FT, self.alpha_range_rad)
         return values
+
+    def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot
+                        ) -> tuple[float, ...]:
+        """The row of the Python step with a controller: built before JSBSim's step, the
+        controller run on it (its commands into the row and into JSBSim)."""
+        row = self._row_dict(s, w_g, loads, eta, eta_dot)
+        row.update({c: 0.0 for c in self.control.command_names})
+        scratch = self._scratch_py
+        scratch[0] = self._row(row)
+        self._control_step(scratch, 0)
+        return tuple(scratch[0].tolist())
 
     def _row_dict(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot) -> dict:
         """The row of one step by channel name: the snapshot ``s`` at t_k, the gust then,
@@ -569,11 +655,21 @@ class CoupledStep:
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
+        control = self._control_step  # None without a controller
+        # a compiled controller of one command: its machine code for the tables the step
+        # kernel's entry accepts (the same table type), then the command's setter
+        fast_control = self._control_fast
+        if fast_control is not None:
+            binding, set_command = fast_control
+            c_params, c_entry = binding.params, binding.entry
+        c_call = None
 
         def fast(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
-            nonlocal checked, call
+            nonlocal checked, call, c_call
             if table is not checked:
                 checked, call = table, (entry if accepts(table) else kernel)
+                if fast_control is not None:
+                    c_call = c_entry if call is entry else linear_step
             wind_down_fps = -w_g_m_s * ft_per_m
             set_wind(wind_down_fps)
             reads = (g_u(), g_v(), g_w(), g_q(), g_p(), g_r(), g_theta(), g_phi(), g_psi(),
@@ -588,6 +684,10 @@ class CoupledStep:
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
+            if c_call is not None:  # its commands from row k, before JSBSim's step
+                set_command(c_call(table, k, c_params))
+            elif control is not None:
+                control(table, k)
             jsbsim_step()
             step_k = self.k  # steps flown (``k`` is the table row)
             self.k = step_k + 1

@@ -81,6 +81,14 @@ CHANNELS: dict[str, Channel] = {
     "v_east_m_s": Channel("m/s", _A, "inertial velocity, east (NED)"),
     "v_down_m_s": Channel("m/s", _A, "inertial velocity, down (NED)"),
 }
+# A controller's commands, when one is in the loop (bioflex_jsb.simulation.controller)
+COMMAND_CHANNELS: dict[str, Channel] = {
+    "ctrl_elevator_rad": Channel("rad", _P, "elevator commanded by the controller in the loop, "
+                                 "added to the trim's, trailing edge down positive (the "
+                                 "surface's angle, within its travel: elevator_rad)"),
+    "ctrl_throttle": Channel("-", _P, "throttle commanded by the controller in the loop, added "
+                             "to the trim's (the total clipped to 0..1: throttle)"),
+}
 BASE_UNITS: dict[str, str] = {name: c.unit for name, c in CHANNELS.items()}
 # the self-describing name → the channel's own (``TimeHistory`` answers to both)
 ALIASES: dict[str, str] = {c.alias: name for name, c in CHANNELS.items() if c.alias}
@@ -103,6 +111,8 @@ def describe(name: str, unit: str | None = None) -> Channel:
     ``unknown``)."""
     if name in CHANNELS:
         return CHANNELS[name]
+    if name in COMMAND_CHANNELS:
+        return COMMAND_CHANNELS[name]
     if m := _ETA.fullmatch(name):
         return Channel("rad", _P, f"modal coordinate of wing mode {m.group(1)} (twist-"
                        "normalised: its largest section twist per unit η is 1 rad, tip twist "

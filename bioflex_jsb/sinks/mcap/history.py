@@ -38,7 +38,8 @@ from bioflex_jsb.values import is_finite_real, is_real
 # so 0.44 GB of arrays at the bound (and the decoding, ~15 µs a message, 6 messages a step,
 # about 90 s).
 READ_MAX_STEPS = 1_000_000
-STEP_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "location")
+STEP_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "location",
+               "controller")
 REFERENCE_GROUPS = ("rigid_body", "lti_prediction")  # their messages are the run's steps
 LOADS_GROUP = "loads"
 RESAMPLED = "linear in time between the 60 Hz location samples (docs/logging.md)"
@@ -88,6 +89,10 @@ def _values(group: str, msg: dict, topic: str, ns: int) -> dict[str, float]:
                 for f in ("latitude", "longitude") if f in msg}
     if group == LOADS_GROUP:
         return _loads(msg, topic, ns)
+    if group == "controller":  # its commands (a command it does not write is NaN: left out)
+        values = {c: _number(msg, f, topic, ns) for c, f in (
+            ("ctrl_elevator_rad", "elevator_cmd_rad"), ("ctrl_throttle", "throttle_cmd"))}
+        return {c: v for c, v in values.items() if not math.isnan(v)}
     fields = {"modal_loads": ("lift_n", "drag_n", "pitch_moment_n_m"),
               "controls": ("elevator_rad", "throttle")}[group]
     return {f: _number(msg, f, topic, ns) for f in fields if f in msg}
@@ -172,6 +177,9 @@ def histories(path: str | Path, *, loads: bool = False, start_s: float | None = 
         run = TimeHistory(model, t_ns * 1e-9, channels,
                           {n: describe(n).unit for n in channels},
                           _run_meta(meta, path, layout, channels))
+        control = channel_meta.get(f"/bioflex/{model}/controller")
+        if control and not prediction:
+            run.meta["controller"] = _controller_meta(control)
         if prediction:
             run.meta.update(label=f"LTI {model}", linestyle="--")
         else:
@@ -298,6 +306,19 @@ def _loads_layout(metadata: dict[str, str] | None, channels) -> dict | None:
     except (TypeError, ValueError, AttributeError) as exc:
         raise LogError(f"the log's loads metadata is not one bioflex-jsb writes ({exc})"
                        ) from None
+
+
+def _controller_meta(metadata: dict[str, str]) -> dict:
+    """A run's ``meta["controller"]`` from its controller channel's metadata
+    (:func:`.controller_topic.channel_metadata`)."""
+    outputs = [o for o in metadata.get("commands", "").split(",") if o]
+    return {"name": metadata.get("name"), "kind": metadata.get("kind"),
+            "inputs": _json(metadata.get("signals"), "controller signals") or [],
+            "outputs": outputs,
+            "channels": [{"elevator": "ctrl_elevator_rad", "throttle": "ctrl_throttle"}.get(o, o)
+                         for o in outputs],
+            "n_states": _json(metadata.get("n_states"), "controller n_states"),
+            "dt_s": _json(metadata.get("dt_s"), "controller dt_s")}
 
 
 _FLOAT_META = ("speed_m_s", "duration_s", "gust_start_s", "dt_s")

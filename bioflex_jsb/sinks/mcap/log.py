@@ -407,6 +407,15 @@ class TableRecorder:
         """The run is over (``n`` complete rows): nothing is pending, every chunk was
         written by :meth:`rows`."""
 
+    def controller(self, names, meta: dict):
+        """The run's controller on ``/bioflex/<model>/controller`` (``names``: the run's
+        channels, ``meta``: the controller's, ``simulation.controller.controller_meta``), a
+        chunk per block after the steps' (:mod:`.controller_topic`)."""
+        from bioflex_jsb.sinks.mcap.controller_topic import GROUP, ControllerTopic
+
+        return ControllerTopic(self._log._writer, self._log.schema_id(GROUP), self._model,
+                               names, meta)
+
     def loads(self, layout: dict):
         """The run's section loads on ``/bioflex/<model>/loads`` (``layout``: the run's
         ``meta["loads"]``), a chunk per block after the steps' (:mod:`.loads_topic`)."""

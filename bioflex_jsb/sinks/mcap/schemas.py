@@ -12,7 +12,8 @@ RUN_METADATA = "bioflex.run"
 FRAME_METADATA = "bioflex.world_frame"
 WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
-          "lti_prediction", "autopilot", "loads", "imu", "airspeed_probe")
+          "lti_prediction", "autopilot", "loads", "imu", "airspeed_probe",
+          "controller")
 # The sensor stations' topics (docs/aircraft.md, "Sensors"): one per IMU, one per airspeed
 # probe, named by the sensor (topic(model, sensor_group(kind, name)))
 # The autopilot topic's enums: (JSON schema / protobuf enum name, value names from 0); the
@@ -296,6 +297,27 @@ SCHEMAS["loads"] = {
              "tip up positive (upper surface in compression)"),
             ("torque_n_m", "torque about the elastic axis", "N*m",
              "leading edge up positive"))
+    },
+}
+# A controller in the loop of a gust run (bioflex_jsb.sinks.mcap.controller_topic;
+# bioflex_jsb.simulation.controller): what it read and what it commanded, every step
+SCHEMAS["controller"] = {
+    "title": "bioflex.Controller",
+    "description": "The controller in the loop (bioflex_jsb.simulation.controller), one "
+    "message per step at the step's log time, in chunks of their own after the steps': the "
+    "commands it wrote from the step's row (JSBSim's flight controls move the surface in "
+    "that step, so the controls topic shows it at the next step) and the signals it read. "
+    "The channel's metadata: its name, kind, signals, commands, states, sample time.",
+    "type": "object",
+    "properties": {
+        "elevator_cmd_rad": _num("elevator commanded over the trim, trailing edge down "
+                                 "positive; NaN when it does not command the elevator [rad]"),
+        "throttle_cmd": _num("throttle commanded over the trim; NaN when it does not "
+                             "command the throttle [-]"),
+        "signals": {"type": "array", "items": {"type": "number"},
+                    "description": "the signals it read at the step, element i the channel "
+                    "metadata's signals[i], as the run's channels (SI; a linear controller "
+                    "reads their perturbations from the trim values in the metadata)"},
     },
 }
 # The LTI model's section loads on its prediction topic, under the loads topic's field names

@@ -1,0 +1,152 @@
+"""A controller's commands into JSBSim: the elevator [rad] and the throttle [-] as the
+aircraft's flight controls take them, converted here, once, at the JSBSim boundary.
+
+The elevator. An aircraft's flight controls map the normalised command
+``fcs/elevator-cmd-norm`` (plus ``fcs/pitch-trim-cmd-norm``, clipped to −1..1) to the
+surface's angle ``fcs/elevator-pos-rad``: the prototype's generated controls by one gain
+(±20°, ``parameters.airframe.CONTROL_LIMITS``), JSBSim's c172p and SGS by an
+``aerosurface_scale`` with a different travel up and down (c172p: −28°/+23°). The map is
+measured, not assumed: :func:`elevator_map` loads a fresh JSBSim instance of the same
+aircraft (its flight controls only matter; a 7 ms load) and runs its initial condition at
+commands from −1 to 1 (:data:`PROBE_COMMANDS`); the map must be linear on each side of 0
+(two slopes, rad per unit command, :class:`ElevatorMap`) to within
+:data:`LINEARITY_TOL_RAD`, else a controller cannot command that elevator in rad (one line,
+InputError). The flying instance is never touched (a trimmed airframe stays trimmed).
+
+A command δe [rad] over the trim is then written as the normalised command
+c = c₀ + (m⁻¹(δ₀ + δe) − m⁻¹(δ₀)), c₀ the trim's command and δ₀ its angle, m⁻¹ the inverse
+map: exactly c₀ at δe = 0, and the surface at δ₀ + δe within its travel (the flight
+controls clip beyond it).
+
+The throttle: ``fcs/throttle-cmd-norm[i]`` of every engine, the trim's plus δt (the flight
+controls clip the total to 0..1). A glider has no throttle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from bioflex_jsb.errors import InputError
+from bioflex_jsb.runtime.fdm import Airframe, load_fdm
+from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, captured
+from bioflex_jsb.simulation import jsbsim_properties as JP
+
+# The normalised commands the elevator map is measured at (0 and both ends included).
+PROBE_COMMANDS = (-1.0, -0.75, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0)
+# The map is linear on each side of 0 when every probe lies on its side's line within this
+# [rad] (JSBSim's aerosurface_scale and pure_gain are exact to rounding: ~1e-16 measured on
+# the prototype, the c172p and the SGS).
+LINEARITY_TOL_RAD = 1e-9
+
+
+@dataclass(frozen=True)
+class ElevatorMap:
+    """The elevator's angle against its normalised command (module docstring): ``down``
+    and ``up`` [rad per unit command] the slopes for a positive and a negative command
+    (+ trailing edge down)."""
+
+    down_rad: float
+    up_rad: float
+
+    def angle_rad(self, command: float) -> float:
+        """The angle [rad] of the (summed) command within −1..1."""
+        return command * (self.down_rad if command >= 0.0 else self.up_rad)
+
+    def command(self, angle_rad: float) -> float:
+        """The (summed) command of the angle [rad] (beyond the travel: beyond ±1)."""
+        return angle_rad / (self.down_rad if angle_rad >= 0.0 else self.up_rad)
+
+
+def elevator_map(airframe: Airframe) -> ElevatorMap:
+    """The elevator map of ``airframe``'s aircraft, measured on a fresh instance of it."""
+    log = CapturingLogger()
+    fdm = load_fdm(airframe.root, airframe.aircraft, airframe.aircraft_path, log)
+    manager = fdm.get_property_manager()
+    for name in (JP.FCS_ELEVATOR_CMD_NORM, JP.FCS_ELEVATOR_POS_RAD):
+        if not manager.hasNode(name):
+            raise InputError(f"aircraft {airframe.aircraft!r} has no {name}: a controller's "
+                             "elevator cannot be commanded")
+    has_trim = manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM)
+    angles = []
+    with captured(log):
+        for c in PROBE_COMMANDS:
+            fdm[JP.FCS_ELEVATOR_CMD_NORM] = c
+            if has_trim:
+                fdm[JP.FCS_PITCH_TRIM_CMD_NORM] = 0.0
+            fdm.run_ic()
+            angles.append(float(fdm[JP.FCS_ELEVATOR_POS_RAD]))
+    zero = angles[PROBE_COMMANDS.index(0.0)]
+    down, up = angles[-1], -angles[0]
+    m = ElevatorMap(down, up)
+    worst = max(abs(m.angle_rad(c) - a) for c, a in zip(PROBE_COMMANDS, angles, strict=True))
+    if not (down > 0.0 and up > 0.0) or abs(zero) > LINEARITY_TOL_RAD \
+            or worst > LINEARITY_TOL_RAD:
+        raise InputError(f"aircraft {airframe.aircraft!r}: its elevator angle is not linear "
+                         "on each side of zero command (fcs/elevator-pos-rad at commands "
+                         f"{PROBE_COMMANDS}: {[round(a, 6) for a in angles]} rad), so a "
+                         "controller's elevator in rad cannot be converted")
+    return m
+
+
+@dataclass(frozen=True)
+class Command:
+    """How one command δ (over the trim, SI) reaches JSBSim: the value
+    v = offset + (angle + δ)/(down if angle + δ ≥ 0 else up) (the map a compiled controller
+    applies itself: :class:`~bioflex_jsb.simulation.controller_kernel.LinearBinding`),
+    written by each of ``setters`` with its own ``adds`` added (the throttle's per-engine
+    trims)."""
+
+    offset: float
+    angle: float
+    down: float
+    up: float
+    setters: tuple[Callable[[float], None], ...]
+    adds: tuple[float, ...]
+
+    def value(self, delta: float) -> float:
+        angle = self.angle + delta
+        return self.offset + angle / (self.down if angle >= 0.0 else self.up)
+
+    def write_value(self, value: float) -> None:
+        """Write an already mapped ``value``."""
+        for set_value, add in zip(self.setters, self.adds, strict=True):
+            set_value(add + value)
+
+    def write(self, delta: float) -> None:
+        """Write the command ``delta`` (over the trim)."""
+        self.write_value(self.value(delta))
+
+
+def elevator_command(airframe: Airframe) -> Command:
+    """The elevator δe [rad, + trailing edge down] over the trim as ``fcs/elevator-cmd-norm``
+    (module docstring: c₀ + m⁻¹(δ₀ + δe) − m⁻¹(δ₀)); ``airframe`` trimmed."""
+    m = elevator_map(airframe)
+    command0 = airframe[JP.FCS_ELEVATOR_CMD_NORM]
+    manager = airframe.jsbsim.get_property_manager()
+    pitch_trim = (airframe[JP.FCS_PITCH_TRIM_CMD_NORM]
+                  if manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM) else 0.0)
+    angle0 = m.angle_rad(command0 + pitch_trim)
+    setter = airframe.property_node(JP.FCS_ELEVATOR_CMD_NORM).set_double_value
+    return Command(command0 - m.command(angle0), angle0, m.down_rad, m.up_rad, (setter,),
+                   (0.0,))
+
+
+def throttle_command(airframe: Airframe) -> Command:
+    """The throttle δt [-] over the trim on every engine's command (its trim added)."""
+    if airframe.glider or not airframe.engines:
+        raise InputError(f"aircraft {airframe.aircraft!r} has no engine: a controller cannot "
+                         "command its throttle")
+    names = [JP.throttle_cmd(e.index) for e in airframe.engines]
+    return Command(0.0, 0.0, 1.0, 1.0,
+                   tuple(airframe.property_node(n).set_double_value for n in names),
+                   tuple(airframe[n] for n in names))
+
+
+COMMANDS = {"elevator": elevator_command, "throttle": throttle_command}
+
+
+def commands_for(airframe: Airframe, outputs: tuple[str, ...]) -> tuple[Command, ...]:
+    """One :class:`Command` per command of ``outputs`` (in that order), for the trimmed
+    ``airframe``."""
+    return tuple(COMMANDS[o](airframe) for o in outputs)
