@@ -464,17 +464,23 @@ def load_definition(name_or_file: str = "goland") -> Definition:
     return _load_definition(name_or_file)
 
 
+def _definition(definition, what: str = "clamped=True analyses") -> Definition:
+    """A definition, a shipped name or a TOML file as a :class:`Definition` (``what`` begins
+    the refusal of anything else)."""
+    if isinstance(definition, str | Path):
+        return load_definition(str(definition))
+    if isinstance(definition, Definition):
+        return definition
+    # a WingBuild, an Aircraft, None: an AttributeError deep in the model before
+    raise InputError(f"{what} a clamped wing's definition (a name such as "
+                     f"'goland', a TOML file or api.load_definition's result), not "
+                     f"{type(definition).__name__}")
+
+
 def _clamped(definition, lift_slope: str | None):
     from bioflex_jsb.definition.clamped import clamped_model
 
-    if isinstance(definition, str | Path):
-        d = load_definition(str(definition))
-    elif isinstance(definition, Definition):
-        d = definition
-    else:  # a WingBuild, an Aircraft, None: an AttributeError deep in the model before
-        raise InputError(f"clamped=True analyses a clamped wing's definition (a name such as "
-                         f"'goland', a TOML file or api.load_definition's result), not "
-                         f"{type(definition).__name__}")
+    d = _definition(definition)
     if lift_slope is not None:
         _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
     return d, clamped_model(d, lift_slope)
@@ -670,6 +676,75 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope,
     return replace(res, settings=dict(res.settings, definition=d.path or d.name,
                                       range_derived=range_m_s is None
                                       and d.analysis.speed_range_m_s is None))
+
+
+def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] | None = None,
+                          *, aileron=None, density_kg_m3: float | None = None,
+                          lift_slope: str | None = None):
+    """Aileron effectiveness and reversal of a clamped elastic wing
+    (:class:`bioflex_jsb.aeroelasticity.aileron.AileronResult`: ``.as_dict()``,
+    ``.plot(path)``; docs/aeroelasticity.md, "Aileron effectiveness and reversal"): against
+    airspeed, the rolling moment per aileron angle elastic over rigid (root held), the
+    steady roll rate p b/(2V) per radian of aileron and its ratio to the rigid wing's; the
+    reversal speed [m/s] (None: none), the clamped divergence speed, the rigid C_lδ, C_lp.
+
+    ``wing``: a definition (``api.load_definition``'s), a shipped name or a TOML file with
+    a beam wing (an aircraft definition's wing is analysed clamped, as ``flutter --clamped``
+    does). ``aileron``: the definition's ``[aileron]`` (None), or (start, end, hinge): the
+    span range as fractions of the semispan and the hinge line's chord fraction (checked as
+    a file's), or a :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`.
+    ``range_m_s`` (low, high) [m/s], 0 <= low < high <= 400 (default 0 to 1.5 × the reversal
+    speed); ``density_kg_m3`` [kg/m^3] and ``lift_slope`` (``strip``, ``vlm``) default to
+    the definition's."""
+    from bioflex_jsb.aeroelasticity import aileron as A
+    from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+    from bioflex_jsb.definition.clamped import clamped_model
+    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S, parse_aileron
+
+    d = _definition(wing.definition if isinstance(wing, Aircraft) else wing,
+                    "aileron_effectiveness analyses")
+    if lift_slope is not None:
+        _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
+    surface = _surface(d, aileron, parse_aileron, ControlSurface)
+    if range_m_s is not None:
+        if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
+                or len(tuple(range_m_s)) != 2:
+            raise InputError(f"range must be (low, high) [m/s], got {range_m_s!r}")
+        lo, hi = (_real(x, "range [m/s]") for x in range_m_s)
+        if not 0.0 <= lo < hi <= SPEED_LIMIT_M_S:
+            raise InputError(f"range must satisfy 0 <= low < high <= {SPEED_LIMIT_M_S:g} m/s, "
+                             f"got {lo:g}:{hi:g}")
+        range_m_s = (lo, hi)
+    rho = d.air.density_kg_m3 if density_kg_m3 is None else _check_density(density_kg_m3)
+    model = clamped_model(d, lift_slope, breaks_m=(surface.start_m, surface.end_m))
+    return A.aileron_effectiveness(
+        A.clamped_roll_strips(model, surface), density_kg_m3=rho, range_m_s=range_m_s,
+        name=d.name, settings={"definition": d.path or d.name, "clamped": True,
+                               "semispan_m": d.semispan_m,
+                               "lift_slope": model.lift_slope, "aero": "steady strips",
+                               "range_derived": range_m_s is None})
+
+
+def _surface(d: Definition, aileron, parse, surface_type):
+    """The control surface of ``aileron_effectiveness`` (its docstring)."""
+    if aileron is None:
+        if d.aileron is None:
+            raise InputError(f"definition {d.name!r} has no [aileron]: add one to the file "
+                             "(docs/aircraft.md) or give one (aileron=(start, end, hinge); "
+                             "the command's --aileron START:END:HINGE): the span as fractions "
+                             "of the semispan and the hinge's chord fraction")
+        return d.aileron
+    if isinstance(aileron, surface_type):
+        if aileron.end_m > d.semispan_m * (1.0 + 1e-12):
+            raise InputError(f"aileron ends at {aileron.end_m:g} m, beyond the semispan "
+                             f"{d.semispan_m:g} m")
+        return aileron
+    if isinstance(aileron, str) or not isinstance(aileron, Iterable) \
+            or len(tuple(aileron)) != 3:
+        raise InputError(f"aileron must be (start, end, hinge): the span as fractions of the "
+                         f"semispan and the hinge's chord fraction, got {aileron!r}")
+    start, end, hinge = tuple(aileron)
+    return parse({"span": [start, end], "hinge": hinge}, d.semispan_m, "aileron argument")
 
 
 def section_loads(wing, run: TimeHistory, stations=None, *,

@@ -61,10 +61,13 @@ from bioflex_jsb.aeroelasticity.control_surface import (
 # The eigenvalues 1/q of a bordered pencil: real when |Im| is below this share of the
 # largest |μ| (round-off of a real eigenvalue of a real pencil is ~1e-15 of it).
 REAL_TOLERANCE = 1e-9
-# The derived speed range [m/s]: from 0 to TOP_OVER_REVERSAL × the reversal speed (or,
-# without a reversal, TOP_OVER_REVERSAL × the divergence speed), at most SPEED_LIMIT_M_S
-# (the strips are incompressible), in N_SPEEDS points.
+# The derived speed range [m/s] (derived_range_m_s), in N_SPEEDS points: its top is
+# TOP_OVER_REVERSAL × the reversal speed, or TOP_OVER_DIVERGENCE × the divergence speed when
+# that lies within DIVERGENCE_SHOWN × the reversal speed, at most SPEED_LIMIT_M_S (the strips
+# are incompressible).
 TOP_OVER_REVERSAL = 1.5
+TOP_OVER_DIVERGENCE = 1.1
+DIVERGENCE_SHOWN = 2.0
 SPEED_LIMIT_M_S = 400.0
 N_SPEEDS = 241
 
@@ -370,11 +373,17 @@ class AileronResult:
 
 def derived_range_m_s(reversal_m_s: float | None, divergence_m_s: float | None
                       ) -> tuple[float, float]:
-    """The default range [m/s]: 0 to 1.5 × the reversal speed (or the divergence speed
-    without one), at most 400 m/s (the strips are incompressible)."""
-    ref = reversal_m_s if reversal_m_s is not None else divergence_m_s
-    top = SPEED_LIMIT_M_S if ref is None else min(SPEED_LIMIT_M_S, TOP_OVER_REVERSAL * ref)
-    return 0.0, top
+    """The default range [m/s]: from 0 to 1.5 × the reversal speed, or to 1.1 × the
+    divergence speed when that lies within 2 × the reversal speed (so that the figure shows
+    both; Goland with its aileron: 1.1 × 252.3 m/s); without a reversal 1.5 × the
+    divergence speed; at most 400 m/s (the strips are incompressible)."""
+    if reversal_m_s is None:
+        top = SPEED_LIMIT_M_S if divergence_m_s is None else TOP_OVER_REVERSAL * divergence_m_s
+    else:
+        top = TOP_OVER_REVERSAL * reversal_m_s
+        if divergence_m_s is not None and divergence_m_s <= DIVERGENCE_SHOWN * reversal_m_s:
+            top = max(top, TOP_OVER_DIVERGENCE * divergence_m_s)
+    return 0.0, min(SPEED_LIMIT_M_S, top)
 
 
 def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
@@ -425,6 +434,14 @@ DPI = 110
 EFFECTIVENESS_AXIS = (-1.5, 2.0)  # [-]: near divergence the curves leave it (said on it)
 
 
+def _broken_at(speeds: np.ndarray, values: np.ndarray, pole_m_s: float | None) -> np.ndarray:
+    """``values`` with a gap (NaN) at the grid point nearest the pole: no line across it."""
+    out = np.array(values, dtype=float)
+    if pole_m_s is not None and speeds[0] < pole_m_s < speeds[-1]:
+        out[int(np.searchsorted(speeds, pole_m_s))] = np.nan
+    return out
+
+
 def plot_aileron(result: AileronResult, path=None):
     """The figure of :meth:`AileronResult.plot` (written to ``path`` when given; a PNG
     carries the package's Software tag)."""
@@ -439,16 +456,18 @@ def plot_aileron(result: AileronResult, path=None):
     FigureCanvasAgg(fig)
     ax_e, ax_p = fig.subplots(2, 1, sharex=True)
     v = result.speeds_m_s
-    ax_e.plot(v, result.effectiveness, lw=1.8, label="rolling moment, root held: R/R_rigid")
-    ax_e.plot(v, result.roll_effectiveness, lw=1.8, ls="--",
-              label="steady roll rate: p/p_rigid")
+    held = _broken_at(v, result.effectiveness, result.divergence_speed_m_s)
+    rolling = _broken_at(v, result.roll_effectiveness, result.roll_divergence_speed_m_s)
+    ax_e.plot(v, held, lw=1.8, label="rolling moment, root held: R/R_rigid")
+    ax_e.plot(v, rolling, lw=1.8, ls="--", label="steady roll rate: p/p_rigid")
     ax_e.axhline(1.0, color="0.5", lw=0.8)
     ax_e.axhline(0.0, color="k", lw=0.9)
     ax_e.axhspan(EFFECTIVENESS_AXIS[0], 0.0, color="tab:red", alpha=0.07, lw=0)
     ax_e.set_ylim(*EFFECTIVENESS_AXIS)
     ax_e.set_ylabel(f"aileron effectiveness, elastic/rigid [-]\n(< 0: reversed; axis "
                     f"{EFFECTIVENESS_AXIS[0]:g}..{EFFECTIVENESS_AXIS[1]:g})")
-    ax_p.plot(v, result.roll_rate_per_rad, lw=1.8, label="elastic")
+    ax_p.plot(v, _broken_at(v, result.roll_rate_per_rad, result.roll_divergence_speed_m_s),
+              lw=1.8, label="elastic")
     ax_p.axhline(result.rigid_roll_rate_per_rad, color="0.4", ls="-.", lw=1.2,
                  label=f"rigid: {result.rigid_roll_rate_per_rad:.3f} /rad")
     ax_p.axhline(0.0, color="k", lw=0.9)

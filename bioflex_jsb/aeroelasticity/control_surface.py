@@ -72,7 +72,7 @@ class ControlSurface:
     def as_dict(self) -> dict:
         return {"name": self.name, "start_m": self.start_m, "end_m": self.end_m,
                 "hinge_chord_fraction": self.hinge,
-                "flap_chord_ratio": self.flap_chord_ratio}
+                "flap_chord_ratio": round(self.flap_chord_ratio, 12)}
 
 
 def hinge_angle_rad(hinge: float) -> float:

@@ -271,6 +271,15 @@ def _aileron(r: Reader, semispan_m: float) -> ControlSurface | None:
     return ControlSurface(lo_v * scale, hi_v * scale, hinge, "aileron")
 
 
+def parse_aileron(table: dict, semispan_m: float, where: str) -> ControlSurface:
+    """An ``[aileron]`` table given outside a file (the API's and the CLI's override),
+    checked as a file's is (``where`` names it in the one-line error)."""
+    surface = _aileron(Reader({"aileron": table}, where), semispan_m)
+    if surface is None:
+        raise DefinitionError(f"{where}: aileron: give span = [start, end] and hinge")
+    return surface
+
+
 def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     """A :class:`Definition` from the parsed TOML ``data`` (``where`` names it in errors)."""
     r = Reader(data, where)
