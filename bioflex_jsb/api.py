@@ -681,31 +681,29 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope,
 def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] | None = None,
                           *, aileron=None, density_kg_m3: float | None = None,
                           lift_slope: str | None = None):
-    """Aileron effectiveness and reversal of a clamped elastic wing
+    """Aileron effectiveness and reversal of an elastic wing
     (:class:`bioflex_jsb.aeroelasticity.aileron.AileronResult`: ``.as_dict()``,
     ``.plot(path)``; docs/aeroelasticity.md, "Aileron effectiveness and reversal"): against
     airspeed, the rolling moment per aileron angle elastic over rigid (root held), the
     steady roll rate p b/(2V) per radian of aileron and its ratio to the rigid wing's; the
-    reversal speed [m/s] (None: none), the clamped divergence speed, the rigid C_lδ, C_lp.
+    reversal speed [m/s] (None: none), the divergence speeds, the rigid C_lδ, C_lp.
 
-    ``wing``: a definition (``api.load_definition``'s), a shipped name or a TOML file with
-    a beam wing (an aircraft definition's wing is analysed clamped, as ``flutter --clamped``
-    does). ``aileron``: the definition's ``[aileron]`` (None), or (start, end, hinge): the
-    span range as fractions of the semispan and the hinge line's chord fraction (checked as
-    a file's), or a :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`.
-    ``range_m_s`` (low, high) [m/s], 0 <= low < high <= 400 (default 0 to 1.5 × the reversal
-    speed); ``density_kg_m3`` [kg/m^3] and ``lift_slope`` (``strip``, ``vlm``) default to
-    the definition's."""
+    ``wing``: a clamped wing, i.e. a definition (``api.load_definition``'s), a shipped name
+    or a TOML file with a beam wing (an aircraft definition's wing is analysed clamped, as
+    ``flutter --clamped`` does: the beam's modes on Gauss strips); or an aircraft, i.e. an
+    :class:`Aircraft` or a :class:`WingBuild`: the flight model's wing (its flown modes on
+    the vortex lattice's strips, the aircraft's rigid C_lδa and C_lp reported beside).
+    ``aileron``: the definition's ``[aileron]`` (None; a WingBuild has none), or (start, end,
+    hinge): the span range as fractions of the semispan and the hinge line's chord fraction
+    (checked as a file's), or a
+    :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`. ``range_m_s``
+    (low, high) [m/s], 0 <= low < high <= 400 (default 0 to 1.5 × the reversal speed);
+    ``density_kg_m3`` [kg/m^3] defaults to the definition's (a WingBuild's: sea level);
+    ``lift_slope`` (``strip``, ``vlm``: a clamped wing's; an aircraft's is the lattice's)
+    to the definition's."""
     from bioflex_jsb.aeroelasticity import aileron as A
-    from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
-    from bioflex_jsb.definition.clamped import clamped_model
-    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S, parse_aileron
+    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
-    d = _definition(wing.definition if isinstance(wing, Aircraft) else wing,
-                    "aileron_effectiveness analyses")
-    if lift_slope is not None:
-        _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
-    surface = _surface(d, aileron, parse_aileron, ControlSurface)
     if range_m_s is not None:
         if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
                 or len(tuple(range_m_s)) != 2:
@@ -715,36 +713,89 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
             raise InputError(f"range must satisfy 0 <= low < high <= {SPEED_LIMIT_M_S:g} m/s, "
                              f"got {lo:g}:{hi:g}")
         range_m_s = (lo, hi)
+    if lift_slope is not None:
+        _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
+    cruise = None
+    if isinstance(wing, Aircraft | WingBuild):
+        strips, rho, name, settings = _aircraft_roll_strips(wing, aileron, density_kg_m3,
+                                                            lift_slope)
+        if isinstance(wing, Aircraft) or wing.airframe is PROTOTYPE_AIRFRAME:
+            cruise = _flight_speed(wing, None)  # the aircraft's cruise speed [m/s]
+    else:
+        strips, rho, name, settings = _clamped_roll_strips(wing, aileron, density_kg_m3,
+                                                           lift_slope)
+    return A.aileron_effectiveness(strips, density_kg_m3=rho, range_m_s=range_m_s, name=name,
+                                   settings=dict(settings, aero="steady strips",
+                                                 range_derived=range_m_s is None),
+                                   reference_speed_m_s=cruise)
+
+
+def _clamped_roll_strips(wing, aileron, density_kg_m3, lift_slope):
+    """(RollStrips, ρ, name, settings) of a clamped wing's definition (its beam's modes on
+    Gauss strips with edges at the surface's ends)."""
+    from bioflex_jsb.aeroelasticity.aileron import clamped_roll_strips
+    from bioflex_jsb.definition.clamped import clamped_model
+
+    d = _definition(wing, "aileron_effectiveness analyses an Aircraft, a WingBuild or")
+    surface = _surface(d.name, d.aileron, d.semispan_m, aileron)
     rho = d.air.density_kg_m3 if density_kg_m3 is None else _check_density(density_kg_m3)
     model = clamped_model(d, lift_slope, breaks_m=(surface.start_m, surface.end_m))
-    return A.aileron_effectiveness(
-        A.clamped_roll_strips(model, surface), density_kg_m3=rho, range_m_s=range_m_s,
-        name=d.name, settings={"definition": d.path or d.name, "clamped": True,
-                               "semispan_m": d.semispan_m,
-                               "lift_slope": model.lift_slope, "aero": "steady strips",
-                               "range_derived": range_m_s is None})
+    return clamped_roll_strips(model, surface), rho, d.name, {
+        "definition": d.path or d.name, "clamped": True, "semispan_m": d.semispan_m,
+        "lift_slope": model.lift_slope}
 
 
-def _surface(d: Definition, aileron, parse, surface_type):
-    """The control surface of ``aileron_effectiveness`` (its docstring)."""
+def _aircraft_roll_strips(wing, aileron, density_kg_m3, lift_slope):
+    """(RollStrips, ρ, name, settings) of an aircraft's flight model of its wing, with the
+    aircraft's own rigid C_lδa and C_lp for comparison."""
+    from bioflex_jsb.aeroelasticity.aileron import flight_roll_strips
+
+    if lift_slope is not None:
+        raise InputError("lift_slope is for clamped wings; an aircraft's wing takes the "
+                         "vortex lattice's span loading (its flight model's)")
+    own = wing.definition.aileron if isinstance(wing, Aircraft) else None
+    build = _wing(wing)
+    semispan = float(build.aero.semispan_m)
+    surface = _surface(build.variant.name, own, semispan, aileron)
+    from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
+
+    rho = _density(wing, density_kg_m3).get("density_kg_m3", SEA_LEVEL_DENSITY_KG_M3)
+    rigid = build.airframe.aero
+    return flight_roll_strips(build, surface), rho, build.variant.name, {
+        "definition": (wing.definition.path or wing.name) if isinstance(wing, Aircraft)
+        else build.variant.name, "clamped": False, "semispan_m": semispan,
+        "lift_slope": "vlm", "n_flown_modes": build.model.n_modes,
+        "e_shift_frac": float(build.e_shift_frac),
+        "aircraft": {"name": build.airframe.name,
+                     "cl_delta_a_per_rad": float(rigid.cl_delta_a_per_rad),
+                     "cl_p_per_rad": float(rigid.cl_p_per_rad)}}
+
+
+def _surface(name: str, own, semispan_m: float, aileron):
+    """The control surface of ``aileron_effectiveness`` (its docstring): ``aileron`` over
+    the wing's ``own`` (None: none) on a semispan of ``semispan_m`` [m]."""
+    from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+    from bioflex_jsb.definition.loader import parse_aileron
+
     if aileron is None:
-        if d.aileron is None:
-            raise InputError(f"definition {d.name!r} has no [aileron]: add one to the file "
+        if own is None:
+            raise InputError(f"wing {name!r} has no [aileron]: add one to its definition "
                              "(docs/aircraft.md) or give one (aileron=(start, end, hinge); "
                              "the command's --aileron START:END:HINGE): the span as fractions "
                              "of the semispan and the hinge's chord fraction")
-        return d.aileron
-    if isinstance(aileron, surface_type):
-        if aileron.end_m > d.semispan_m * (1.0 + 1e-12):
+        return own
+    if isinstance(aileron, ControlSurface):
+        if aileron.end_m > semispan_m * (1.0 + 1e-12):
             raise InputError(f"aileron ends at {aileron.end_m:g} m, beyond the semispan "
-                             f"{d.semispan_m:g} m")
+                             f"{semispan_m:g} m")
         return aileron
     if isinstance(aileron, str) or not isinstance(aileron, Iterable) \
             or len(tuple(aileron)) != 3:
         raise InputError(f"aileron must be (start, end, hinge): the span as fractions of the "
                          f"semispan and the hinge's chord fraction, got {aileron!r}")
     start, end, hinge = tuple(aileron)
-    return parse({"span": [start, end], "hinge": hinge}, d.semispan_m, "aileron argument")
+    return parse_aileron({"span": [start, end], "hinge": hinge}, semispan_m,
+                         "aileron argument")
 
 
 def section_loads(wing, run: TimeHistory, stations=None, *,

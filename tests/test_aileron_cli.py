@@ -54,7 +54,7 @@ def test_command_reports_the_reversal_within_2_percent_of_the_closed_form(capsys
     assert d["effectiveness"][0] == 1.0 and d["plot"] == str(plot) and is_our_plot(plot)
     code, out, _ = run_cli(capsys, "aileron")
     assert code == 0 and "aileron reversal at 168.1 m/s (q_R/q_D 0.444" in out
-    assert "divergence: clamped 252.3 m/s" in out and "V [m/s]   R/R_rigid" in out
+    assert "divergence: root held 252.3 m/s" in out and "V [m/s]   R/R_rigid" in out
 
 
 def test_the_api_takes_a_surface_a_tuple_or_the_definitions():
@@ -87,7 +87,7 @@ def test_the_api_takes_a_surface_a_tuple_or_the_definitions():
     (dict(range_m_s=200.0), "range must be (low, high)"),
     (dict(density_kg_m3=50.0), "outside 0.01..2"),
     (dict(lift_slope="panel"), "unknown lift_slope"),
-    (dict(wing=3.0), "aileron_effectiveness analyses a clamped wing's definition"),
+    (dict(wing=3.0), "analyses an Aircraft, a WingBuild or a clamped wing's definition"),
     (dict(wing="sgs_elastic", aileron=(0.6, 1.0, 0.8)), "a clamped analysis needs beam"),
 ])
 def test_api_refusals_are_one_line(kwargs, needle):

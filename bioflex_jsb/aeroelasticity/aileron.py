@@ -118,6 +118,38 @@ def clamped_roll_strips(model: ClampedWingModel, surface: ControlSurface) -> Rol
         stiffness=model.stiffness, semispan_m=float(model.weights_m.sum()), surface=surface)
 
 
+def flight_roll_strips(build, surface: ControlSurface) -> RollStrips:
+    """The :class:`RollStrips` of an aircraft's flight model of the wing (a
+    :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild`): its flown modes (half-wing
+    generalised masses, K_ii = ω_i² m_i) on the vortex lattice's starboard strips, each with
+    the lattice's C_lα c and the arm of Table B1 (x_E − x_ac, after a C_η1^Q1 pin's shift:
+    the flight model's), the surface's coverage of each strip a fraction where an end falls
+    inside one. The antisymmetric problem on the modes of the clamped half wing: what the
+    body frame sees of a wing rolling steadily (module docstring)."""
+    from bioflex_jsb.aeroelasticity.free_aircraft import strip_geometry
+
+    semispan = float(build.aero.semispan_m)
+    if surface.end_m > semispan * (1.0 + 1e-12):
+        raise ValueError(f"the surface ends at {surface.end_m:g} m, beyond the semispan "
+                         f"{semispan:g} m")
+    g = strip_geometry(build)
+    n = build.model.n_modes
+    w = np.asarray(build.aero.weights_m, dtype=float)
+    chord = np.asarray(g.chord_m, dtype=float)
+    a0 = np.asarray(g.cl_alpha_c_m, dtype=float) / chord
+    modes = build.modes
+    stiffness = np.diag(np.asarray(modes.frequencies_rad_s[:n], float) ** 2
+                        * np.asarray(modes.generalised_masses_kg_m2[:n], float))
+    return RollStrips(
+        stations_m=np.asarray(build.aero.stations_m, float), weights_m=w, chord_m=chord,
+        lift_slope_per_rad=a0, arm_m=np.asarray(g.e_m, float),
+        coverage=strip_coverage(w, surface),
+        flap_lift_per_rad=flap_lift_slope_per_rad(surface.hinge) * a0 / TWO_PI,
+        flap_moment_per_rad=np.full(w.size, flap_moment_slope_per_rad(surface.hinge)),
+        heave_m=np.asarray(g.phi[:n], float), twist_rad=np.asarray(g.theta[:n], float),
+        stiffness=stiffness, semispan_m=semispan, surface=surface)
+
+
 @dataclass(frozen=True, eq=False)
 class StaticRollMatrices:
     """The per-Pa matrices of the module docstring: ``stiffness`` K, ``aero`` G (n, n),
@@ -317,6 +349,9 @@ class AileronResult:
     range_m_s: tuple[float, float]
     surface: dict
     settings: dict = field(default_factory=dict)
+    # the four curves at one named speed (an aircraft's cruise), computed there: {"speed_m_s",
+    # "effectiveness", "roll_effectiveness", "rolling_moment_per_rad", "roll_rate_per_rad"}
+    reference: dict | None = None
 
     @property
     def reversal_above_divergence(self) -> bool:
@@ -346,6 +381,7 @@ class AileronResult:
             "roll_effectiveness": [float(v) for v in self.roll_effectiveness],
             "rolling_moment_n_m_per_rad": [float(v) for v in self.rolling_moment_per_rad],
             "roll_rate_pb_2v_per_rad": [float(v) for v in self.roll_rate_per_rad],
+            "at_reference_speed": None if self.reference is None else dict(self.reference),
             **self.settings,
         }
 
@@ -389,10 +425,12 @@ def derived_range_m_s(reversal_m_s: float | None, divergence_m_s: float | None
 def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
                           range_m_s: tuple[float, float] | None = None,
                           n_speeds: int = N_SPEEDS, name: str = "",
-                          settings: dict | None = None) -> AileronResult:
+                          settings: dict | None = None,
+                          reference_speed_m_s: float | None = None) -> AileronResult:
     """Effectiveness, steady roll and reversal of ``strips`` (:class:`RollStrips`) at
     ``density_kg_m3`` [kg/m³] over ``range_m_s`` [m/s] (default :func:`derived_range_m_s`)
-    in ``n_speeds`` points (module docstring)."""
+    in ``n_speeds`` points (module docstring); the curves also at ``reference_speed_m_s``
+    [m/s] (an aircraft's cruise) when given."""
     rho = float(density_kg_m3)
     mats = static_roll_matrices(strips)
     v_r = _speed(mats.reversal_dynamic_pressure_pa(), rho)
@@ -412,6 +450,14 @@ def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
     mean = {k: float(np.sum(chi * getattr(strips, k)) / np.sum(chi))
             for k in ("chord_m", "arm_m", "flap_lift_per_rad", "flap_moment_per_rad")}
     q_r = None if v_r is None else 0.5 * rho * v_r**2
+    reference = None
+    if reference_speed_m_s is not None:
+        q_ref = 0.5 * rho * float(reference_speed_m_s) ** 2
+        reference = {"speed_m_s": float(reference_speed_m_s),
+                     "effectiveness": mats.effectiveness(q_ref),
+                     "roll_effectiveness": mats.roll_rate_per_rad(q_ref) / rigid_rate,
+                     "rolling_moment_per_rad": mats.rolling_moment_per_rad(q_ref),
+                     "roll_rate_per_rad": mats.roll_rate_per_rad(q_ref)}
     surface = strips.surface.as_dict() if strips.surface is not None else {}
     surface.update(flap_lift_per_rad=mean["flap_lift_per_rad"],
                    flap_moment_quarter_chord_per_rad=mean["flap_moment_per_rad"])
@@ -426,7 +472,7 @@ def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
         density_kg_m3=rho, range_m_s=rng, surface=surface,
         settings={"rigid_moment_per_pa_rad": mats.moment_delta, "n_strips":
                   int(strips.stations_m.size), "n_modes": int(strips.stiffness.shape[0]),
-                  **(settings or {})})
+                  **(settings or {})}, reference=reference)
 
 
 FIGSIZE_IN = (9.0, 7.5)
@@ -489,13 +535,16 @@ def plot_aileron(result: AileronResult, path=None):
     if vd is not None and lo <= vd <= hi:
         for ax in (ax_e, ax_p):
             ax.axvline(vd, color="0.4", ls=":", lw=1.4)
-        ax_e.plot([], [], color="0.4", ls=":", label=f"divergence (clamped): {vd:.1f} m/s")
+        ax_e.plot([], [], color="0.4", ls=":", label=f"divergence, root held: {vd:.1f} m/s")
     ax_e.legend(loc="best", fontsize=9)
     ax_p.legend(loc="best", fontsize=9)
     s = result.surface
-    fig.suptitle(f"{result.name}: {s.get('name', 'aileron')} {s.get('start_m', 0):.3g}-"
-                 f"{s.get('end_m', 0):.3g} m, hinge {s.get('hinge_chord_fraction', 0):.3g} c; "
-                 f"steady strips, ρ {result.density_kg_m3:g} kg/m³", fontsize=11)
+    what = ("clamped" if result.settings.get("clamped", True) else
+            "the aircraft's flight model of the wing")
+    fig.suptitle(f"{result.name} ({what}): {s.get('name', 'aileron')} "
+                 f"{s.get('start_m', 0):.3g}-{s.get('end_m', 0):.3g} m, hinge "
+                 f"{s.get('hinge_chord_fraction', 0):.3g} c; steady strips, "
+                 f"ρ {result.density_kg_m3:g} kg/m³", fontsize=11)
     if path is not None:
         out = Path(path)
         suffix = out.suffix.lower().lstrip(".")

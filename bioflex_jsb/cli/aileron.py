@@ -1,4 +1,5 @@
-"""``bioflex-jsb aileron``: aileron effectiveness and reversal of a clamped elastic wing.
+"""``bioflex-jsb aileron``: aileron effectiveness and reversal of an elastic wing, clamped
+(``--clamped``) or the aircraft's flight model of its wing (``--aircraft``).
 
 :func:`bioflex_jsb.api.aileron_effectiveness` (this module only reads the arguments and
 formats its :class:`~bioflex_jsb.aeroelasticity.aileron.AileronResult`); the physics in
@@ -19,9 +20,9 @@ DEFAULT_WING = "goland_aileron"
 LIFT_SLOPE_CHOICES = ("strip", "vlm")
 TABLE_ROWS = 9  # speeds printed, evenly over the range
 
-HELP = """Aileron effectiveness and reversal of a clamped elastic wing (steady strips on the
-beam's modes, one half wing under antisymmetric ailerons; docs/aeroelasticity.md, "Aileron
-effectiveness and reversal"). Reports against airspeed [m/s]: the rolling moment per aileron
+HELP = """Aileron effectiveness and reversal of an elastic wing (steady strips on its modes, one
+half wing under antisymmetric ailerons; docs/aeroelasticity.md, "Aileron effectiveness and
+reversal"). Reports against airspeed [m/s]: the rolling moment per aileron
 angle of the wing held at its root, elastic over rigid [-]; the steady roll rate
 p b/(2V) per radian of aileron [1/rad] (the wing's roll damping balancing the aileron) and
 its ratio to the rigid wing's; the aileron reversal speed [m/s] (where both reach zero), its
@@ -30,9 +31,13 @@ dynamic pressure over the divergence's (q_R/q_D) beside the typical section's
 C_lp [1/rad] (both halves, on S and b). The aileron's section: thin aerofoil (Glauert 1927:
 c_l_delta = 2(pi - theta_h + sin theta_h), cos theta_h = 1 - 2 hinge).
 
---clamped NAME|FILE.toml: a definition with a beam wing (docs/aircraft.md), its [aileron]
-(span range, hinge) or --aileron; default goland_aileron (the Goland wing with a 20 %-chord
-aileron on its outer 40 %: reversal 168.1 m/s, divergence 252.3 m/s). --plot FILE.png
+--clamped NAME|FILE.toml: a definition with a beam wing (docs/aircraft.md) clamped at its
+root, the beam's modes on Gauss strips; default goland_aileron (the Goland wing with a
+20 %-chord aileron on its outer 40 %: reversal 168.1 m/s, divergence 252.3 m/s).
+--aircraft NAME|FILE.toml: an aircraft's flight model of its wing (its flown modes on the
+vortex lattice's strips, the aircraft's own C_l_delta_a and C_lp beside; bioflex_optimised's
+estimated outboard aileron reverses at 12.8 m/s). The aileron: the definition's [aileron]
+(span range, hinge) or --aileron. --plot FILE.png
 (.pdf, .svg): effectiveness and roll rate against airspeed, the reversal marked."""
 
 
@@ -65,9 +70,12 @@ def speed_range(text: str) -> tuple[float, float]:
 def register(sub) -> None:
     p = sub.add_parser("aileron", help="aileron effectiveness and reversal speed of a clamped "
                        "elastic wing", description=HELP)
-    p.add_argument("--clamped", default=DEFAULT_WING, metavar="NAME|FILE",
-                   help="a definition with a beam wing: a shipped name or a .toml file "
-                   f"(docs/aircraft.md); default {DEFAULT_WING}")
+    p.add_argument("--clamped", default=None, metavar="NAME|FILE",
+                   help="a definition with a beam wing, clamped: a shipped name or a .toml "
+                   f"file (docs/aircraft.md); default {DEFAULT_WING}")
+    p.add_argument("--aircraft", default=None, metavar="NAME|FILE",
+                   help="an aircraft definition (a shipped name such as bioflex_optimised, or "
+                   "a .toml file): its flight model's wing instead of a clamped one")
     p.add_argument("--aileron", type=aileron_spec, default=None, metavar="START:END:HINGE",
                    help="the aileron instead of the definition's [aileron]: span START to END "
                    "as fractions of the semispan (0 <= START < END <= 1, at least 0.01 "
@@ -97,7 +105,17 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb import api
 
     check_plot_path(args.plot, args.force)
-    res = api.aileron_effectiveness(args.clamped, args.range, aileron=args.aileron,
+    if args.aircraft is not None:
+        if args.clamped is not None:
+            raise UsageError("--clamped analyses a clamped wing, --aircraft an aircraft's "
+                             "flight model of its wing: give one of them")
+        if args.lift_slope is not None:
+            raise UsageError("--lift-slope is for --clamped; an aircraft's wing takes the "
+                             "vortex lattice's span loading (its flight model's)")
+        wing = api.load_aircraft(args.aircraft)
+    else:
+        wing = args.clamped or DEFAULT_WING
+    res = api.aileron_effectiveness(wing, args.range, aileron=args.aileron,
                                     density_kg_m3=args.density, lift_slope=args.lift_slope)
     payload = res.as_dict()
     payload["plot"] = None
@@ -124,8 +142,11 @@ def text_report(res, p: dict) -> str:
     s = p["surface"]
     semispan = s["end_m"] if res.settings.get("semispan_m") is None else \
         res.settings["semispan_m"]
+    what = "clamped" if p["clamped"] else (
+        f"the aircraft {p['aircraft']['name']}'s flight model: {p['n_flown_modes']} modes on "
+        f"the lattice's {p['n_strips']} strips")
     lines = [
-        f"wing {p['wing']} (clamped): {s['name']} {s['start_m']:.4g}-{s['end_m']:.4g} m "
+        f"wing {p['wing']} ({what}): {s['name']} {s['start_m']:.4g}-{s['end_m']:.4g} m "
         f"({s['start_m'] / semispan:.3g}-{s['end_m'] / semispan:.3g} of the semispan), hinge "
         f"{s['hinge_chord_fraction']:g} c ({100 * s['flap_chord_ratio']:.3g} % chord); steady "
         f"strips, lift slope {p['lift_slope']}, rho {p['density_kg_m3']:g} kg/m^3",
@@ -135,6 +156,10 @@ def text_report(res, p: dict) -> str:
         f"{p['rigid']['cl_p_per_rad']:.4g} /rad, steady roll p b/(2V) "
         f"{p['rigid']['roll_rate_pb_2v_per_rad']:.4g} per rad of aileron",
     ]
+    if not p["clamped"]:
+        air = p["aircraft"]
+        lines.append(f"  the aircraft's own (rigid, its tail and fuselage included): C_l_delta_a "
+                     f"{air['cl_delta_a_per_rad']:.4g} /rad, C_lp {air['cl_p_per_rad']:.4g} /rad")
     top = p["range_m_s"][1]
     vr, vd = p["reversal_speed_m_s"], p["divergence_speed_m_s"]
     if vr is None:
@@ -145,8 +170,14 @@ def text_report(res, p: dict) -> str:
                                         f"{p['typical_section_ratio']:.3f})")
         lines.append(f"  aileron reversal at {_speed_text(vr, top)}{rel}"
                      + ("; the wing diverges first" if p["reversal_above_divergence"] else ""))
-    lines.append(f"  divergence: clamped {_speed_text(vd, top)}, free to roll "
+    lines.append(f"  divergence: root held {_speed_text(vd, top)}, free to roll "
                  f"{_speed_text(p['roll_divergence_speed_m_s'], top)}")
+    ref = p.get("at_reference_speed")
+    if ref is not None:
+        lines.append(f"  at the aircraft's cruise speed {ref['speed_m_s']:g} m/s: R/R_rigid "
+                     f"{ref['effectiveness']:.4g}, p/p_rigid {ref['roll_effectiveness']:.4g}, "
+                     f"p b/(2V) {ref['roll_rate_per_rad']:.4g} per rad"
+                     + (" (reversed)" if ref["effectiveness"] < 0.0 else ""))
     lines.append("  V [m/s]   R/R_rigid   p/p_rigid   p b/(2V) per rad")
     lo = p["range_m_s"][0]
     for v in [lo + (top - lo) * i / (TABLE_ROWS - 1) for i in range(TABLE_ROWS)]:
