@@ -27,9 +27,9 @@ angle of the wing held at its root, elastic over rigid [-]; the steady roll rate
 p b/(2V) per radian of aileron [1/rad] (the wing's roll damping balancing the aileron) and
 its ratio to the rigid wing's; the aileron reversal speed [m/s] (where both reach zero), its
 dynamic pressure over the divergence's (q_R/q_D) beside the typical section's
--e c_l_delta/(c c_m_delta); the clamped divergence speed and the rigid wing's C_l_delta and
-C_lp [1/rad] (both halves, on S and b). The aileron's section: thin aerofoil (Glauert 1927:
-c_l_delta = 2(pi - theta_h + sin theta_h), cos theta_h = 1 - 2 hinge).
+-e c_l_delta/(c c_m_delta); the divergence speed (root held, and free to roll) and the rigid
+wing's C_l_delta and C_lp [1/rad] (both halves, on S and b). The aileron's section: thin
+aerofoil (Glauert 1927: c_l_delta = 2(pi - theta_h + sin theta_h), cos theta_h = 1 - 2 hinge).
 
 --clamped NAME|FILE.toml: a definition with a beam wing (docs/aircraft.md) clamped at its
 root, the beam's modes on Gauss strips; default goland_aileron (the Goland wing with a
