@@ -135,6 +135,8 @@ def run(args: argparse.Namespace) -> int:
 def _speed_text(v: float | None, top: float) -> str:
     if v is None:
         return "none"
+    if v > SPEED_LIMIT_M_S:  # a number the incompressible strips cannot vouch for
+        return f"none below {SPEED_LIMIT_M_S:g} m/s"
     return f"{v:.1f} m/s" + (" (above the range)" if v > top else "")
 
 
