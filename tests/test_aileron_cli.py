@@ -126,3 +126,16 @@ def test_help_states_units_and_ranges(capsys):
                  "0.5..0.95", "fractions of the semispan", "goland_aileron", "Glauert 1927",
                  "docs/aeroelasticity.md"):
         assert text in flat, text
+
+
+def test_thin_air_puts_reversal_beyond_the_strips_range(capsys):
+    # ρ 0.01 kg/m³ (about 33 km): the full-span reversal q_R = 18 088 Pa needs 1902 m/s,
+    # beyond the incompressible strips' 400 m/s: said so, the number kept in the JSON
+    code, out, _ = run_cli(capsys, "aileron", "--clamped", "goland", "--aileron", "0:1:0.75",
+                           "--density", "0.01")
+    assert code == 0 and "no aileron reversal below 400 m/s" in out
+    code, out, _ = run_cli(capsys, "aileron", "--clamped", "goland", "--aileron", "0:1:0.75",
+                           "--density", "0.01", "--json")
+    d = json.loads(out)
+    assert d["reversal_speed_m_s"] == pytest.approx(math.sqrt(2 * 18088.26 / 0.01), rel=1e-5)
+    assert d["range_m_s"] == [0.0, 400.0]

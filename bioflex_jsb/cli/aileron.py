@@ -164,8 +164,8 @@ def text_report(res, p: dict) -> str:
                      f"{air['cl_delta_a_per_rad']:.4g} /rad, C_lp {air['cl_p_per_rad']:.4g} /rad")
     top = p["range_m_s"][1]
     vr, vd = p["reversal_speed_m_s"], p["divergence_speed_m_s"]
-    if vr is None:
-        lines.append("  no aileron reversal")
+    if vr is None or vr > SPEED_LIMIT_M_S:
+        lines.append(f"  no aileron reversal below {SPEED_LIMIT_M_S:g} m/s")
     else:
         ratio = p["reversal_over_divergence"]
         rel = "" if ratio is None else (f" (q_R/q_D {ratio:.3f}; the typical section's "
