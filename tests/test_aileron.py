@@ -116,6 +116,26 @@ def test_partial_coverage_of_strips_without_edges():
 
 # --- the clamped wing against its closed forms --------------------------------------------
 
+def test_modal_loads_of_a_unit_aileron_angle_deflect_the_beam_as_its_closed_forms():
+    # The generalised forces F_δ of a full-span aileron on the wind-off wing (η = K⁻¹ F_δ
+    # per Pa per rad): the twist of a uniform torsion rod under the uniform moment
+    # m_δ = c (e c_lδ + c c_mδ), θ = (m_δ/GJ)(l y − y²/2), and the deflection of a
+    # cantilever under the uniform lift c c_lδ (up), w = −c c_lδ y²(6l² − 4ly + y²)/(24 EI).
+    # Measured with six modes (two of them torsion): twist 0.55 %, deflection 0.07 % of their
+    # largest values; twelve modes 0.09 %, 0.02 % (modal truncation). Tolerance 1 %, 0.2 %.
+    _, closed, model = _case(x_inertial=G.X_INERTIAL_FRAC)
+    s = ControlSurface(0.0, L_M, 0.75)
+    mats = static_roll_matrices(clamped_roll_strips(model, s))
+    eta = np.linalg.solve(mats.stiffness, mats.force_delta)
+    y = model.stations_m
+    cl, cm = closed["flap_lift_per_rad"], closed["flap_moment_per_rad"]
+    twist = (C_M * (closed["arm_m"] * cl + C_M * cm) / GJ) * (L_M * y - 0.5 * y * y)
+    heave = -C_M * cl * y**2 * (6 * L_M**2 - 4 * L_M * y + y * y) / (
+        24.0 * G.BENDING_STIFFNESS_N_M2)
+    assert np.abs(model.pitch_rad.T @ eta - twist).max() < 1e-2 * np.abs(twist).max()
+    assert np.abs(model.heave_m.T @ eta - heave).max() < 2e-3 * np.abs(heave).max()
+
+
 def test_divergence_is_the_strip_models():
     # the same steady problem as strip_aero's divergence speed (different assembly)
     mats, closed, model = _case()

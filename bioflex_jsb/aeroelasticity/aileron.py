@@ -354,6 +354,9 @@ class AileronResult:
     # the four curves at one named speed (an aircraft's cruise), computed there: {"speed_m_s",
     # "effectiveness", "roll_effectiveness", "rolling_moment_per_rad", "roll_rate_per_rad"}
     reference: dict | None = None
+    # F_δ: the generalised force on each mode of a unit aileron angle per unit dynamic
+    # pressure [the modal stiffness's units per Pa per rad] (module docstring)
+    modal_force_per_rad_per_pa: tuple[float, ...] = ()
 
     @property
     def reversal_above_divergence(self) -> bool:
@@ -384,6 +387,7 @@ class AileronResult:
             "rolling_moment_n_m_per_rad": [float(v) for v in self.rolling_moment_per_rad],
             "roll_rate_pb_2v_per_rad": [float(v) for v in self.roll_rate_per_rad],
             "at_reference_speed": None if self.reference is None else dict(self.reference),
+            "modal_force_per_rad_per_pa": list(self.modal_force_per_rad_per_pa),
             **self.settings,
         }
 
@@ -475,4 +479,5 @@ def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
         density_kg_m3=rho, range_m_s=rng, surface=surface,
         settings={"rigid_moment_per_pa_rad": mats.moment_delta, "n_strips":
                   int(strips.stations_m.size), "n_modes": int(strips.stiffness.shape[0]),
-                  **(settings or {})}, reference=reference)
+                  **(settings or {})}, reference=reference,
+        modal_force_per_rad_per_pa=tuple(float(f) for f in mats.force_delta))
