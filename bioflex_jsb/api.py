@@ -491,17 +491,23 @@ def load_definition(name_or_file: str = "goland") -> Definition:
     return _load_definition(name_or_file)
 
 
+def _definition(definition, what: str = "clamped=True analyses") -> Definition:
+    """A definition, a shipped name or a TOML file as a :class:`Definition` (``what`` begins
+    the refusal of anything else)."""
+    if isinstance(definition, str | Path):
+        return load_definition(str(definition))
+    if isinstance(definition, Definition):
+        return definition
+    # a WingBuild, an Aircraft, None: an AttributeError deep in the model before
+    raise InputError(f"{what} a clamped wing's definition (a name such as "
+                     f"'goland', a TOML file or api.load_definition's result), not "
+                     f"{type(definition).__name__}")
+
+
 def _clamped(definition, lift_slope: str | None):
     from bioflex_jsb.definition.clamped import clamped_model
 
-    if isinstance(definition, str | Path):
-        d = load_definition(str(definition))
-    elif isinstance(definition, Definition):
-        d = definition
-    else:  # a WingBuild, an Aircraft, None: an AttributeError deep in the model before
-        raise InputError(f"clamped=True analyses a clamped wing's definition (a name such as "
-                         f"'goland', a TOML file or api.load_definition's result), not "
-                         f"{type(definition).__name__}")
+    d = _definition(definition)
     if lift_slope is not None:
         _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
     return d, clamped_model(d, lift_slope)
@@ -697,6 +703,127 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope,
     return replace(res, settings=dict(res.settings, definition=d.path or d.name,
                                       range_derived=range_m_s is None
                                       and d.analysis.speed_range_m_s is None))
+
+
+def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] | None = None,
+                          *, aileron=None, density_kg_m3: float | None = None,
+                          lift_slope: str | None = None):
+    """Aileron effectiveness and reversal of an elastic wing
+    (:class:`bioflex_jsb.aeroelasticity.aileron.AileronResult`: ``.as_dict()``,
+    ``.plot(path)``; docs/aeroelasticity.md, "Aileron effectiveness and reversal"): against
+    airspeed, the rolling moment per aileron angle elastic over rigid (root held), the
+    steady roll rate p b/(2V) per radian of aileron and its ratio to the rigid wing's; the
+    reversal speed [m/s] (None: none), the divergence speeds, the rigid C_lδ, C_lp.
+
+    ``wing``: a clamped wing, i.e. a definition (``api.load_definition``'s), a shipped name
+    or a TOML file with a beam wing (an aircraft definition's wing is analysed clamped, as
+    ``flutter --clamped`` does: the beam's modes on Gauss strips); or an aircraft, i.e. an
+    :class:`Aircraft` or a :class:`WingBuild`: the flight model's wing (its flown modes on
+    the vortex lattice's strips, the aircraft's rigid C_lδa and C_lp reported beside).
+    ``aileron``: the definition's ``[aileron]`` (None; a WingBuild has none), or (start, end,
+    hinge): the span range as fractions of the semispan and the hinge line's chord fraction
+    (checked as a file's), or a
+    :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`. ``range_m_s``
+    (low, high) [m/s], 0 <= low < high <= 400 (default 0 to 1.5 × the reversal speed);
+    ``density_kg_m3`` [kg/m^3] defaults to the definition's (a WingBuild's: sea level);
+    ``lift_slope`` (``strip``, ``vlm``: a clamped wing's; an aircraft's is the lattice's)
+    to the definition's."""
+    from bioflex_jsb.aeroelasticity import aileron as A
+    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
+
+    if range_m_s is not None:
+        if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
+                or len(tuple(range_m_s)) != 2:
+            raise InputError(f"range must be (low, high) [m/s], got {range_m_s!r}")
+        lo, hi = (_real(x, "range [m/s]") for x in range_m_s)
+        if not 0.0 <= lo < hi <= SPEED_LIMIT_M_S:
+            raise InputError(f"range must satisfy 0 <= low < high <= {SPEED_LIMIT_M_S:g} m/s, "
+                             f"got {lo:g}:{hi:g}")
+        range_m_s = (lo, hi)
+    if lift_slope is not None:
+        _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
+    cruise = None
+    if isinstance(wing, Aircraft | WingBuild):
+        strips, rho, name, settings = _aircraft_roll_strips(wing, aileron, density_kg_m3,
+                                                            lift_slope)
+        if isinstance(wing, Aircraft) or wing.airframe is PROTOTYPE_AIRFRAME:
+            cruise = _Subject.of(wing).flight_speed(None)  # its cruise speed [m/s]
+    else:
+        strips, rho, name, settings = _clamped_roll_strips(wing, aileron, density_kg_m3,
+                                                           lift_slope)
+    return A.aileron_effectiveness(strips, density_kg_m3=rho, range_m_s=range_m_s, name=name,
+                                   settings=dict(settings, aero="steady strips",
+                                                 range_derived=range_m_s is None),
+                                   reference_speed_m_s=cruise)
+
+
+def _clamped_roll_strips(wing, aileron, density_kg_m3, lift_slope):
+    """(RollStrips, ρ, name, settings) of a clamped wing's definition (its beam's modes on
+    Gauss strips with edges at the surface's ends)."""
+    from bioflex_jsb.aeroelasticity.aileron import clamped_roll_strips
+    from bioflex_jsb.definition.clamped import clamped_model
+
+    d = _definition(wing, "aileron_effectiveness analyses an Aircraft, a WingBuild or")
+    surface = _surface(d.name, d.aileron, d.semispan_m, aileron)
+    rho = d.air.density_kg_m3 if density_kg_m3 is None else _check_density(density_kg_m3)
+    model = clamped_model(d, lift_slope, breaks_m=(surface.start_m, surface.end_m))
+    return clamped_roll_strips(model, surface), rho, d.name, {
+        "definition": d.path or d.name, "clamped": True, "semispan_m": d.semispan_m,
+        "lift_slope": model.lift_slope}
+
+
+def _aircraft_roll_strips(wing, aileron, density_kg_m3, lift_slope):
+    """(RollStrips, ρ, name, settings) of an aircraft's flight model of its wing, with the
+    aircraft's own rigid C_lδa and C_lp for comparison."""
+    from bioflex_jsb.aeroelasticity.aileron import flight_roll_strips
+
+    if lift_slope is not None:
+        raise InputError("lift_slope is for clamped wings; an aircraft's wing takes the "
+                         "vortex lattice's span loading (its flight model's)")
+    subject = _Subject.of(wing)
+    own = None if subject.aircraft is None else subject.aircraft.definition.aileron
+    build = subject.build
+    semispan = float(build.aero.semispan_m)
+    surface = _surface(build.variant.name, own, semispan, aileron)
+    from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
+
+    rho = subject.density(density_kg_m3).get("density_kg_m3", SEA_LEVEL_DENSITY_KG_M3)
+    rigid = build.airframe.aero
+    return flight_roll_strips(build, surface), rho, build.variant.name, {
+        "definition": (wing.definition.path or wing.name) if isinstance(wing, Aircraft)
+        else build.variant.name, "clamped": False, "semispan_m": semispan,
+        "lift_slope": "vlm", "n_flown_modes": build.model.n_modes,
+        "e_shift_frac": float(build.e_shift_frac),
+        "aircraft": {"name": build.airframe.name,
+                     "cl_delta_a_per_rad": float(rigid.cl_delta_a_per_rad),
+                     "cl_p_per_rad": float(rigid.cl_p_per_rad)}}
+
+
+def _surface(name: str, own, semispan_m: float, aileron):
+    """The control surface of ``aileron_effectiveness`` (its docstring): ``aileron`` over
+    the wing's ``own`` (None: none) on a semispan of ``semispan_m`` [m]."""
+    from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+    from bioflex_jsb.definition.loader import parse_aileron
+
+    if aileron is None:
+        if own is None:
+            raise InputError(f"wing {name!r} has no [aileron]: add one to its definition "
+                             "(docs/aircraft.md) or give one (aileron=(start, end, hinge); "
+                             "the command's --aileron START:END:HINGE): the span as fractions "
+                             "of the semispan and the hinge's chord fraction")
+        return own
+    if isinstance(aileron, ControlSurface):
+        if aileron.end_m > semispan_m * (1.0 + 1e-12):
+            raise InputError(f"aileron ends at {aileron.end_m:g} m, beyond the semispan "
+                             f"{semispan_m:g} m")
+        return aileron
+    if isinstance(aileron, str) or not isinstance(aileron, Iterable) \
+            or len(tuple(aileron)) != 3:
+        raise InputError(f"aileron must be (start, end, hinge): the span as fractions of the "
+                         f"semispan and the hinge's chord fraction, got {aileron!r}")
+    start, end, hinge = tuple(aileron)
+    return parse_aileron({"span": [start, end], "hinge": hinge}, semispan_m,
+                         "aileron argument")
 
 
 def section_loads(wing, run: TimeHistory, stations=None, *,

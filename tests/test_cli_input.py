@@ -127,7 +127,8 @@ def _value_candidates(action) -> list[str]:
     if isinstance(action.default, (int, float, str)) and not isinstance(action.default, bool):
         out.append(str(action.default))
     # "15": a speed every command accepts (export-jsbsim's --speed has no default to try)
-    return out + ["1", "0.5", "15", "x.mcap", "rigid", "sharp:1", "5:40", "local", "0.02"]
+    return out + ["1", "0.5", "15", "x.mcap", "rigid", "sharp:1", "5:40", "local", "0.02",
+                  "0.6:1:0.8"]
 
 
 def test_every_single_valued_option_given_twice_is_refused_naming_it():

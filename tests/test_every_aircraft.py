@@ -28,6 +28,8 @@ LINEAR = {
     "modes": ["modes", "--json"],
     "flutter": ["flutter", "--json"],
     "linearize": ["linearize", "--json"],
+    # an aileron on the outer 35 % for the aircraft that have none in their definition
+    "aileron": ["aileron", "--aileron", "0.6:0.95:0.75", "--json"],
 }
 
 

@@ -13,7 +13,11 @@
 * :mod:`~bioflex_jsb.aeroelasticity.free_aircraft`: the paper's free aircraft, Eq. (4) with
   unsteady strips (named Jones lag states), its flutter and the six-wing table;
 * :mod:`~bioflex_jsb.aeroelasticity.strip_increments`: the unsteady strips' loads beyond the
-  quasi-steady ones as rows on the state (for the LTI model and the co-simulation's wing).
+  quasi-steady ones as rows on the state (for the LTI model and the co-simulation's wing);
+* :mod:`~bioflex_jsb.aeroelasticity.control_surface`: a trailing-edge surface (aileron) on
+  the strips, its thin-aerofoil section; :mod:`~bioflex_jsb.aeroelasticity.aileron`: aileron
+  effectiveness, steady roll and reversal of a clamped wing or an aircraft's wing (the
+  figure: :mod:`~bioflex_jsb.aeroelasticity.aileron_plot`).
 """
 
 from bioflex_jsb.aeroelasticity.flutter import FlutterResult, goland_flutter

@@ -40,6 +40,9 @@ DEFAULT_N_STRIPS = 24
 DEFAULT_VLM_SPANWISE = 40
 DEFAULT_VLM_CHORDWISE = 4
 LIFT_SLOPES = ("strip", "vlm")
+# Gauss-Legendre strips on each piece of the span between breaks (a control surface's ends):
+# at least this many (a 4-point rule is exact for polynomials to degree 7 on the piece)
+MIN_PIECE_STRIPS = 4
 
 
 @dataclass(frozen=True)
@@ -138,9 +141,23 @@ def goland_sections(*, inertia_about: str = G.DEFAULT_INERTIA_AXIS) -> BeamSecti
     )
 
 
-def _gauss_strips(semispan_m: float, n: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = np.polynomial.legendre.leggauss(n)
-    return 0.5 * semispan_m * (x + 1.0), 0.5 * semispan_m * w
+def _gauss_strips(semispan_m: float, n: int, breaks_m=()) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre strips on [0, semispan]; with ``breaks_m`` [m] inside the span, on
+    each piece between them (the piece's share of ``n``, at least MIN_PIECE_STRIPS), so
+    that a strip edge (the cumulative weights: the Gauss nodes lie between them) falls on
+    every break."""
+    inner = sorted({float(b) for b in breaks_m if 0.0 < float(b) < semispan_m})
+    if not inner:
+        x, w = np.polynomial.legendre.leggauss(n)
+        return 0.5 * semispan_m * (x + 1.0), 0.5 * semispan_m * w
+    ends = [0.0, *inner, float(semispan_m)]
+    ys, ws = [], []
+    for lo, hi in zip(ends[:-1], ends[1:], strict=True):
+        k = max(MIN_PIECE_STRIPS, math.ceil(n * (hi - lo) / semispan_m))
+        x, w = np.polynomial.legendre.leggauss(k)
+        ys.append(lo + 0.5 * (hi - lo) * (x + 1.0))
+        ws.append(0.5 * (hi - lo) * w)
+    return np.concatenate(ys), np.concatenate(ws)
 
 
 def clamped_wing_model(
@@ -153,11 +170,15 @@ def clamped_wing_model(
     section_lift_slope_per_rad: float = TWO_PI,
     vlm_spanwise: int = DEFAULT_VLM_SPANWISE,
     vlm_chordwise: int = DEFAULT_VLM_CHORDWISE,
+    breaks_m: tuple[float, ...] = (),
 ) -> ClampedWingModel:
     """Modal model of the clamped beam ``sections`` with aerodynamic strips.
 
     ``lift_slope="strip"``: ``n_strips`` Gauss-Legendre strips, each with the 2-D lift
-    slope ``section_lift_slope_per_rad``. ``lift_slope="vlm"``: the strips of the vortex
+    slope ``section_lift_slope_per_rad``; with ``breaks_m`` [m] (a control surface's ends)
+    Gauss-Legendre strips on each piece of the span between them, each piece its share of
+    ``n_strips`` (at least 4), so that strip edges fall on the breaks (none: the strips of
+    before, bit for bit). ``lift_slope="vlm"``: the strips of the vortex
     lattice (``vlm_spanwise`` × ``vlm_chordwise`` panels on the half wing, tuned to the same
     2-D slope) with its local C_lα(y); this needs a constant chord (a rectangular planform).
     """
@@ -166,9 +187,9 @@ def clamped_wing_model(
     sol = solve_beam(sections, n_modes, n_elements)
     semispan = sections.semispan_m
     if lift_slope == "strip":
-        y, w = _gauss_strips(semispan, n_strips)
+        y, w = _gauss_strips(semispan, n_strips, breaks_m)
         a0 = np.full(y.size, float(section_lift_slope_per_rad))
-        text = f"strip theory, a0 = {section_lift_slope_per_rad:.4f}/rad, {n_strips} strips"
+        text = f"strip theory, a0 = {section_lift_slope_per_rad:.4f}/rad, {y.size} strips"
     else:
         chord = sections.chord_m
         if np.ptp(chord) > 1e-12 * chord[0]:

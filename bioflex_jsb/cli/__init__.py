@@ -41,6 +41,7 @@ COMMAND_MODULES = (
     "linearize",
     "modes",
     "flutter",
+    "aileron",
     "export",
     "gust",
     "sitl",

@@ -72,9 +72,11 @@ def beam_wing(d: Definition) -> BeamWing:
     return BeamWing(beam_sections(d), n_elements=s.n_elements, damping_ratio=s.damping_ratio)
 
 
-def clamped_model(d: Definition, lift_slope: str | None = None) -> ClampedWingModel:
+def clamped_model(d: Definition, lift_slope: str | None = None,
+                  breaks_m: tuple[float, ...] = ()) -> ClampedWingModel:
     """The modal model with strips of the clamped wing ``d``; refuses what the clamped
-    strip analysis does not model (a swept leading edge, no torsion mode)."""
+    strip analysis does not model (a swept leading edge, no torsion mode). ``breaks_m``
+    [m]: strip edges there (a control surface's ends; the flutter analyses take none)."""
     where = f"definition {d.name!r}" + (f" ({d.path})" if d.path else "")
     if not isinstance(d.structure, BeamStructure):
         raise DefinitionError(f"{where}: structure.kind: a clamped analysis needs beam "
@@ -92,7 +94,8 @@ def clamped_model(d: Definition, lift_slope: str | None = None) -> ClampedWingMo
     model = clamped_wing_model(beam_sections(d), lift_slope=slope,
                                n_modes=d.structure.n_modes, n_elements=d.structure.n_elements,
                                n_strips=d.aero.strips,
-                               section_lift_slope_per_rad=d.aero.section_lift_slope_per_rad)
+                               section_lift_slope_per_rad=d.aero.section_lift_slope_per_rad,
+                               breaks_m=tuple(breaks_m))
     if not np.any(model.torsion_energy_fraction > 0.5):
         raise DefinitionError(f"{where}: structure.n_modes: the {model.n_modes} lowest modes "
                               "are all bending (no torsion mode): raise n_modes, or check "

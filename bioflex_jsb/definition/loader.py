@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
 from bioflex_jsb.definition.airframe import parse_airframe
 from bioflex_jsb.definition.flying import (
     FLYING_AERO_FIELDS,
@@ -37,6 +38,7 @@ from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cl
     DAMPING_RANGE,
     DENSITY_RANGE_KG_M3,
     DIHEDRAL_LIMIT_RAD,
+    HINGE_RANGE,
     INERTIA_AXES,
     INERTIA_RANGE_KG_M,
     LEADING_EDGE_RANGE_M,
@@ -47,6 +49,7 @@ from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cl
     MAX_POINT_MASSES,
     MAX_STRUTS,
     METHODS,
+    MIN_CONTROL_SPAN_FRACTION,
     N_ELEMENTS_RANGE,
     N_MODES_RANGE,
     POINT_MASS_CHORD_RANGE,
@@ -69,9 +72,10 @@ from bioflex_jsb.tomlfile import read_toml
 # the aircraft (definition.flying.SHIPPED_AIRCRAFT: the prototype's six variants).
 SHIPPED = ("goland",)
 # The second aircraft (JSBSim's SGS glider with an estimated elastic wing: docs/aircraft.md)
-# and its wing clamped: loaded by name too (load_aircraft("sgs_elastic"),
-# load_definition("sgs_wing")); not benchmark wings.
-OTHER_SHIPPED = ("sgs_wing", "sgs_elastic", "c172_elastic")
+# and its wing clamped, the powered example (c172_elastic), and the Goland wing with an
+# illustrative aileron (the aileron command's case): loaded by name too
+# (load_aircraft("sgs_elastic"), load_definition("sgs_wing")); not benchmark wings.
+OTHER_SHIPPED = ("sgs_wing", "sgs_elastic", "c172_elastic", "goland_aileron")
 ALL_SHIPPED = SHIPPED + SHIPPED_AIRCRAFT + OTHER_SHIPPED
 FORMAT_VERSION = 1
 
@@ -238,12 +242,51 @@ def _monitoring_stations(r: Reader) -> tuple[float, ...]:
     return out
 
 
+def _aileron(r: Reader, semispan_m: float) -> ControlSurface | None:
+    """``[aileron]`` (optional): ``span = [start, end]`` as fractions of the semispan or
+    ``y_m = [start, end]`` in metres (one of them), ``hinge`` the hinge line's chord
+    fraction aft of the leading edge (docs/aircraft.md)."""
+    t = r.table("aileron", ("span", "y_m", "hinge"), required=False)
+    if not t:
+        return None
+    given = [k for k in ("span", "y_m") if k in t]
+    if len(given) != 1:
+        raise r.fail("aileron", "give its span range once: span = [start, end] as fractions "
+                     "of the semispan, or y_m = [start, end] in metres"
+                     + (" (not both)" if given else ""))
+    key = given[0]
+    hi, unit = (1.0, "(fraction of the semispan)") if key == "span" else (semispan_m, "m")
+    v = t[key]
+    if not isinstance(v, list) or len(v) != 2:
+        raise r.fail(f"aileron.{key}", f"must be [start, end] {unit}, got {v!r}")
+    hint = " (a fraction: 60 % is 0.6)" if key == "span" else ""
+    lo_v, hi_v = (r.number({key: x}, "aileron", key, 0.0, hi, unit, hint=hint) for x in v)
+    scale = semispan_m if key == "span" else 1.0
+    if hi_v - lo_v < MIN_CONTROL_SPAN_FRACTION * hi:
+        raise r.fail(f"aileron.{key}", f"[{lo_v:g}, {hi_v:g}]: start must be below end by at "
+                     f"least {MIN_CONTROL_SPAN_FRACTION:g} of the semispan (a narrower surface "
+                     "is a tab)")
+    hinge = r.number(t, "aileron", "hinge", *HINGE_RANGE, "chord fraction",
+                     hint=" (the hinge line aft of the leading edge: a 25 %-chord aileron "
+                     "is 0.75)")
+    return ControlSurface(lo_v * scale, hi_v * scale, hinge, "aileron")
+
+
+def parse_aileron(table: dict, semispan_m: float, where: str) -> ControlSurface:
+    """An ``[aileron]`` table given outside a file (the API's and the CLI's override),
+    checked as a file's is (``where`` names it in the one-line error)."""
+    surface = _aileron(Reader({"aileron": table}, where), semispan_m)
+    if surface is None:
+        raise DefinitionError(f"{where}: aileron: give span = [start, end] and hinge")
+    return surface
+
+
 def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     """A :class:`Definition` from the parsed TOML ``data`` (``where`` names it in errors)."""
     r = Reader(data, where)
     r.keys(data, "(top level)", ("format", "name", "description", "source", "wing",
                                  "structure", "aero", "air", "analysis", "airframe",
-                                 "loads", "sensors"))
+                                 "loads", "sensors", "aileron"))
     fmt = data.get("format", FORMAT_VERSION)
     if fmt != FORMAT_VERSION:
         raise r.fail("format", f"must be {FORMAT_VERSION}, got {fmt!r}")
@@ -287,7 +330,8 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
                       airframe=airframe, path=path, flying=flying,
                       monitoring_stations=_monitoring_stations(r),
                       sensor_stations=parse_sensors(r, data, stations[-1].y_m,
-                                                    airframe is not None))
+                                                    airframe is not None),
+                      aileron=_aileron(r, stations[-1].y_m))
 
 
 def shipped_path(name: str) -> Path:

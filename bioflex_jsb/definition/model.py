@@ -3,9 +3,11 @@
 A definition has a wing (planform by span stations, :class:`WingStation`), its structure
 (:class:`BeamStructure`: sections per station), the aerodynamic settings
 (:class:`AeroSettings`), the air (:class:`Air`) and the analysis settings
-(:class:`AnalysisSettings`). ``airframe`` (:class:`Airframe`: the JSBSim aircraft,
-reference geometry, mass properties, the wing's attachment, the rigid derivatives) is
-``None`` for a clamped wing: "a clamped wing is the same definition without an airframe".
+(:class:`AnalysisSettings`), and optionally the wing's aileron
+(:class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`). ``airframe``
+(:class:`Airframe`: the JSBSim aircraft, reference geometry, mass properties, the wing's
+attachment, the rigid derivatives) is ``None`` for a clamped wing: "a clamped wing is the
+same definition without an airframe".
 The wing on an airframe has one more structure kind than a clamped wing
 (:class:`MembraneStructure`: the prototype's calibrated membrane; :class:`ModalStructure`: a
 modal file) and its flight-dynamics settings (:class:`FlyingWing`).
@@ -24,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
 from bioflex_jsb.parameters.airframe import DerivativeSchedule
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 
@@ -248,6 +251,8 @@ class Definition:
     # [sensors]: the IMUs and airspeed probes as the file places them
     # (definition/sensors.py SensorStation; Aircraft.sensors() in body axes from the CG)
     sensor_stations: tuple = ()
+    # [aileron]: the wing's aileron (span range in metres, hinge line), or None: no surface
+    aileron: ControlSurface | None = None
 
     @property
     def clamped(self) -> bool:

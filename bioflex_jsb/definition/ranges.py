@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import math
 
+# an aileron's hinge line [chord fraction]: the control-surface module's range and reason
+from bioflex_jsb.aeroelasticity.control_surface import HINGE_RANGE  # noqa: F401
+
 # Valid ranges [unit], each with its reason.
 # Semispan b/2 [m]: 0.05 m (a wind-tunnel model) to 100 m (the largest wings built are
 # about 40 m per side: A380 39.8 m, Helios 37.7 m); a file in mm (6096 for 6.096 m) is
@@ -56,3 +59,6 @@ TWIST_UNITS = ("deg", "rad")
 # DEFAULT_MONITORING_STATIONS, the root and the quarter points (the tip, s = 1, carries no
 # load and is refused).
 MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distribution
+# [aileron]: its span [fraction of the semispan] is at least this wide: narrower is a tab,
+# not an aileron, and no strip analysis resolves it (200 strips are 0.5 % of the semispan).
+MIN_CONTROL_SPAN_FRACTION = 0.01
