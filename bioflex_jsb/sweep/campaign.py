@@ -195,11 +195,11 @@ _MODES_DIGESTS: dict[str, str | None] = {}
 
 def _modes_digest(path: str) -> str | None:
     if path not in _MODES_DIGESTS:
+        from bioflex_jsb.files import read_input_bytes
         from bioflex_jsb.structures.modal_file import MAX_MODAL_BYTES, ModalFileError
-        from bioflex_jsb.tomlfile import read_input_bytes
 
         try:
-            data = read_input_bytes(path, "modal-data file", ModalFileError, MAX_MODAL_BYTES)
+            data = read_input_bytes(path, "modal-data file", MAX_MODAL_BYTES, ModalFileError)
             _MODES_DIGESTS[path] = hashlib.sha256(data).hexdigest()
         except ModalFileError:
             _MODES_DIGESTS[path] = None

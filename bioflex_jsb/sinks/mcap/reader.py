@@ -6,25 +6,23 @@ truncated or damaged is a :class:`LogError` with one line for the user.
 
 from __future__ import annotations
 
+import io
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors
+from bioflex_jsb.sinks.mcap.errors import LogError, bad_data_errors, open_log
 from bioflex_jsb.sinks.mcap.protobuf import decoder
 from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC
 from bioflex_jsb.sinks.mcap.writer import MAGIC
 
 
 def check_file(path: str | Path) -> Path:
-    """``path`` as a Path if it is an existing file starting with the MCAP magic."""
+    """``path`` as a Path if it is a regular file (:func:`open_log`) starting with the MCAP
+    magic."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
-    with open(p, "rb") as f:
+    with open_log(p) as f:
         head = f.read(len(MAGIC))
     if head != MAGIC:
         raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
@@ -62,7 +60,7 @@ def open_reader(path: str | Path, verified: bool = False):
     from mcap.reader import make_reader
 
     p = verify(path) and Path(path) if verified else check_file(path)
-    with open(p, "rb") as f:
+    with open_log(p) as raw, io.BufferedReader(raw) as f:
         f.seek(0, 2)
         size = f.tell()
         if size < 2 * len(MAGIC) + 29:

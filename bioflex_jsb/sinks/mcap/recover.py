@@ -22,13 +22,14 @@ indexed like any log (the tests run ``pymcap-cli doctor`` on it).
 from __future__ import annotations
 
 import mmap
+import os
 import struct
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
 from bioflex_jsb import __version__
-from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError, bad_data_errors
+from bioflex_jsb.sinks.mcap.errors import LogError, LogWriteError, bad_data_errors, open_log
 from bioflex_jsb.sinks.mcap.writer import MAGIC, McapFileWriter
 
 _OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
@@ -39,11 +40,10 @@ _MAX_RESYNC_TRIES = 100_000  # candidate chunk starts tried after a damaged reco
 
 
 def _open_data(p: Path):
-    size = p.stat().st_size
-    if size == 0:
-        raise LogError(f"{str(p)!r} is empty: its writer was killed before writing the MCAP "
-                       "header; there is nothing to recover")
-    with open(p, "rb") as f:  # the map outlives the file object; freed with its last view
+    with open_log(p) as f:  # the map outlives the file object; freed with its last view
+        if os.fstat(f.fileno()).st_size == 0:
+            raise LogError(f"{str(p)!r} is empty: its writer was killed before writing the "
+                           "MCAP header; there is nothing to recover")
         data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     if data[:len(MAGIC)] != MAGIC:
         raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
@@ -225,10 +225,6 @@ def recover(path: str | Path, out: str | Path) -> dict:
     (each skipped chunk is listed in ``skipped``: its byte offset and why). Returns counts,
     the last log time kept [s] and where and why the read stopped."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
     dst = Path(out)
     if dst.exists() and dst.resolve() == p.resolve():
         raise LogError("--recover must name a new file, not the log itself")
@@ -359,10 +355,6 @@ def check_chunks(path: str | Path) -> dict:
     present), ``missing`` (what an unfinished file lacks) and ``problems`` (one phrase each
     for everything that does not check; empty for a sound, finished file)."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
     data = _open_data(p)
     chunks, bad, data_crc, stop, data_end = 0, [], "unfinished", None, None
     problems: list[str] = []
