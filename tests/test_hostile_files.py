@@ -344,3 +344,65 @@ def test_the_chunk_bound_names_the_chunk_and_keeps_the_projects_own_logs(bombs):
     assert decompress_chunk(b"lz4", lz4.frame.compress(data), len(data)) == data
     with pytest.raises(ValueError, match="cut short"):
         decompress_chunk(b"lz4", lz4.frame.compress(data)[:-8], len(data))
+
+
+# ---------------------------------------------------------------------------------------
+# A log must not steer the program: rerun takes only a run description's options
+# ---------------------------------------------------------------------------------------
+def _old_style_log(path: Path, argv: list[str]) -> Path:
+    """A finished log of before run descriptions whose bioflex.run record holds ``argv``."""
+    import json
+
+    from mcap.writer import Writer
+
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="bioflex-jsb 0.old")
+        sid = w.register_schema(name="Other", encoding="jsonschema", data=b"{}")
+        cid = w.register_channel(topic="/x", message_encoding="json", schema_id=sid)
+        w.add_metadata("bioflex.run", {"command": "gust", "argv": json.dumps(argv)})
+        w.add_message(cid, log_time=0, publish_time=0, data=b"{}")
+        w.finish()
+    return path
+
+
+SHORT = ["--duration", "0.1", "--gust-start", "0.05", "--models", "rigid"]
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["gust", "--live", "0.0.0.0:0", "--live-any-host", *SHORT], "'--live'"),
+    (["gust", *SHORT, "--live=0.0.0.0:0"], "'--live=0.0.0.0:0'"),
+    (["gust", *SHORT, "--plot", "/tmp/elsewhere.png"], "'--plot'"),
+    (["gust", *SHORT, "--no-log"], "'--no-log'"),
+    (["sweep", "campaign.toml", "--out", "x.csv"], "the command 'sweep'"),
+    (["gust", "--wing", "--live", "0.0.0.0:0"], "'0.0.0.0:0'"),
+    (["gust", "--speed"], "without its value"),
+], ids=["live", "live=", "plot", "no-log", "sweep", "value-then-option", "no-value"])
+def test_rerun_takes_no_network_output_or_command_from_a_log(tmp_path, capsys, monkeypatch,
+                                                             argv, needle):
+    """The fault-injection pass: an old-style log whose argv held ``--live 0.0.0.0:0
+    --live-any-host`` was flown as it said (with the live extra: an unauthenticated server
+    on every interface, opened by someone rerunning a log they were sent)."""
+    import bioflex_jsb.cli.live_option as live
+
+    monkeypatch.chdir(tmp_path)
+    opened = []
+    monkeypatch.setattr(live, "start_live", lambda *a, **k: opened.append(a))
+    log = _old_style_log(tmp_path / "sent.mcap", argv)
+    code, _out, err = run_cli(capsys, "rerun", str(log), "--out", str(tmp_path / "again.mcap"))
+    assert needle in one_line(code, err)
+    assert not opened and not (tmp_path / "again.mcap").exists()
+    assert not Path("/tmp/elsewhere.png").exists()
+
+
+def test_a_description_value_is_never_read_as_an_option():
+    from bioflex_jsb.cli.rerun import argv_for
+    from bioflex_jsb.simulation.run import RunDescription
+
+    d = RunDescription("gust", "--live=0.0.0.0:0", 15.0, gust="--plot=/tmp/x.png",
+                       models=("rigid",))
+    argv = argv_for(d)
+    assert "--wing=--live=0.0.0.0:0" in argv and "--gust=--plot=/tmp/x.png" in argv
+    assert all(a.split("=", 1)[0] in {"--wing", "--mass-basis", "--speed", "--gust",
+                                      "--duration", "--gust-start", "--dt", "--models"}
+               for a in argv[1:]), argv
