@@ -406,3 +406,43 @@ def test_a_description_value_is_never_read_as_an_option():
     assert all(a.split("=", 1)[0] in {"--wing", "--mass-basis", "--speed", "--gust",
                                       "--duration", "--gust-start", "--dt", "--models"}
                for a in argv[1:]), argv
+
+
+# ---------------------------------------------------------------------------------------
+# info prints a log's names escaped: no terminal escape sequences from a file
+# ---------------------------------------------------------------------------------------
+ESC_CLEAR, ESC_TITLE = "\x1b[2J\x1b[H", "\x1b]0;pwned\x07"
+
+
+def test_info_prints_a_logs_names_escaped(tmp_path, capsys):
+    """A hostile log's topic, schema, library, metadata and event texts held escape
+    sequences: printed raw they cleared the screen, set the terminal's title and faked
+    lines. Printed escaped, as repr writes them."""
+    import json
+
+    from mcap.writer import Writer
+
+    path = tmp_path / "hostile.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library=f"evil{ESC_TITLE}")
+        sid = w.register_schema(name=f"S{ESC_CLEAR}", encoding="jsonschema", data=b"{}")
+        cid = w.register_channel(topic=f"/t{ESC_CLEAR}\nfake line\r\u202eeman",
+                                 message_encoding="json", schema_id=sid)
+        w.add_metadata(f"m{ESC_TITLE}", {f"k\x1b[31m": f"v\n\x9b31m\u2028x"})
+        ev = w.register_channel(topic="/bioflex/events", message_encoding="json",
+                                schema_id=sid)
+        w.add_message(cid, log_time=0, publish_time=0, data=b"{}")
+        w.add_message(ev, log_time=1, publish_time=1, data=json.dumps(
+            {"level": 2, "message": f"crash{ESC_CLEAR}", "name": "x"}).encode())
+        w.finish()
+    code, out, err = run_cli(capsys, "info", str(path))
+    assert code == 0, err
+    assert not any(c in out for c in "\x1b\x07\x9b\r\u202e\u2028"), repr(out)
+    for shown in (r"\x1b[2J\x1b[H", r"\x1b]0;pwned\x07", r"\nfake line\r\u202eeman",
+                  r"k\x1b[31m: v\n\x9b31m\u2028x", r"crash\x1b[2J"):
+        assert shown in out, (shown, out)
+    assert "fake line" not in out.replace(r"\nfake line", "")  # never a line of its own
+    from bioflex_jsb.cli.common import escaped
+
+    assert escaped("α é Δ ≤ µ °") == "α é Δ ≤ µ °"  # letters and signs as they are

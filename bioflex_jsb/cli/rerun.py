@@ -6,7 +6,13 @@ import argparse
 import json
 import sys
 
-from bioflex_jsb.cli.common import UsageError, check_new_file, number_type, print_json
+from bioflex_jsb.cli.common import (
+    UsageError,
+    check_new_file,
+    escaped,
+    number_type,
+    print_json,
+)
 
 HELP = """Repeat the gust run, sweep case or comparison recorded in FILE.mcap from its metadata
 record bioflex.run (wing, mass basis, speed, gust and seed, duration, gust start, time step,
@@ -198,7 +204,7 @@ def run(args: argparse.Namespace) -> int:
               f"({result['messages']} messages on {result['topics']} topics agree)")
     else:
         print(f"rerun of {args.file} written to {args.out}: DIFFERENT result: "
-              f"{result['first_difference']}")
+              f"{escaped(result['first_difference'])}")  # names of the log's topics
     if not result["equal"]:
         print("bioflex-jsb rerun: the repeated run differs from the log", file=sys.stderr)
         return 1
