@@ -429,7 +429,7 @@ def test_info_prints_a_logs_names_escaped(tmp_path, capsys):
         sid = w.register_schema(name=f"S{ESC_CLEAR}", encoding="jsonschema", data=b"{}")
         cid = w.register_channel(topic=f"/t{ESC_CLEAR}\nfake line\r\u202eeman",
                                  message_encoding="json", schema_id=sid)
-        w.add_metadata(f"m{ESC_TITLE}", {f"k\x1b[31m": f"v\n\x9b31m\u2028x"})
+        w.add_metadata(f"m{ESC_TITLE}", {"k\x1b[31m": "v\n\x9b31m\u2028x"})
         ev = w.register_channel(topic="/bioflex/events", message_encoding="json",
                                 schema_id=sid)
         w.add_message(cid, log_time=0, publish_time=0, data=b"{}")
