@@ -446,3 +446,68 @@ def test_info_prints_a_logs_names_escaped(tmp_path, capsys):
     from bioflex_jsb.cli.common import escaped
 
     assert escaped("α é Δ ≤ µ °") == "α é Δ ≤ µ °"  # letters and signs as they are
+
+
+# ---------------------------------------------------------------------------------------
+# Names that hide what they are; outputs behind dangling links
+# ---------------------------------------------------------------------------------------
+BIDI = ["\u202a", "\u202b", "\u202c", "\u202d", "\u202e", "\u2066", "\u2067", "\u2068",
+        "\u2069"]
+
+
+@pytest.mark.parametrize("char", BIDI, ids=[f"U+{ord(c):04X}" for c in BIDI])
+def test_bidi_controls_are_refused_in_definition_variant_and_campaign_names(tmp_path, char):
+    """U+202E in a name displays ``optimised\u202edesab`` as ``optimisedbased``: a name
+    shown as another (it was accepted in definition and variant names)."""
+    from bioflex_jsb.definition.loader import DefinitionError, load_definition, shipped_path
+    from bioflex_jsb.flight_dynamics.wing_model import VariantError, load_variant_file
+    from bioflex_jsb.sweep.campaign import CampaignError, load_campaign
+
+    name = f"wing{char}gnp.evil"
+    text = shipped_path("bioflex_optimised").read_text(encoding="utf-8")
+    definition = tmp_path / "d.toml"
+    definition.write_text(text.replace('name = "bioflex_optimised"', f'name = "{name}"'),
+                          encoding="utf-8")
+    with pytest.raises(DefinitionError, match=f"U\\+{ord(char):04X}"):
+        load_definition(definition)
+    variant = tmp_path / "v.toml"
+    variant.write_text(f'name = "{name}"\nx_elastic_frac = 0.3\n', encoding="utf-8")
+    with pytest.raises(VariantError, match=f"U\\+{ord(char):04X}"):
+        load_variant_file(variant)
+    campaign = tmp_path / "c.toml"
+    campaign.write_text(f'name = "{name}"\nmetrics = ["gust"]\n[axes]\nspeeds_m_s = [15.0]\n',
+                        encoding="utf-8")
+    with pytest.raises(CampaignError, match=f"U\\+{ord(char):04X}"):
+        load_campaign(campaign)
+
+
+def test_printable_names_still_load(tmp_path):
+    from bioflex_jsb.errors import unprintable
+    from bioflex_jsb.flight_dynamics.wing_model import load_variant_file
+
+    assert unprintable("Flügel α-2 (Δx = 0,3 c) — שלום") is None  # right-to-left letters
+    variant = tmp_path / "v.toml"
+    variant.write_text('name = "Flügel α"\nstructural_damping = 0.02\n', encoding="utf-8")
+    assert load_variant_file(variant).name == "Flügel α"
+
+
+def test_sweep_out_as_a_dangling_link_is_refused(tmp_path, capsys, monkeypatch):
+    """The table was created at the link's target, outside the path named."""
+    from bioflex_jsb.sweep.store import StoreError, open_store
+
+    monkeypatch.chdir(tmp_path)
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    for suffix in (".csv", ".parquet"):
+        link = tmp_path / f"results{suffix}"
+        link.symlink_to(outside / f"target{suffix}")
+        with pytest.raises(StoreError, match="symbolic link"):
+            open_store(link, {"case_id": "text"}, resume=False)
+        campaign = tmp_path / "c.toml"
+        campaign.write_text('name = "c"\nmetrics = ["gust"]\n[run]\nduration_s = 0.2\n'
+                            'gust_start_s = 0.1\n[axes]\nwings = ["optimised"]\n'
+                            'speeds_m_s = [15.0]\ngusts = ["sharp:3"]\n'
+                            'models = ["rigid"]\n', encoding="utf-8")
+        code, _out, err = run_cli(capsys, "sweep", str(campaign), "--out", str(link))
+        assert "symbolic link" in one_line(code, err)
+        assert list(outside.iterdir()) == []

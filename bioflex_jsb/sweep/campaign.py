@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bioflex_jsb.errors import InputError
+from bioflex_jsb.errors import InputError, unprintable
 from bioflex_jsb.flight_dynamics.lti import MODELS
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
@@ -397,6 +397,9 @@ def _check_plain_name(name: str) -> None:
     """A campaign's ``name`` is the default output's file name (``<name>.parquet``): a plain
     file-name component, so that it cannot point outside the current folder."""
     bad = next((c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127), None)
+    if bad is None and unprintable(name):  # a bidirectional override, a line separator
+        raise CampaignError(f"name: {ascii(name[:60])} holds {unprintable(name)}; accepted: "
+                            "printable text")
     if (bad is not None or name.strip() in (".", "..") or name.startswith(".")
             or len(name) > MAX_NAME_CHARS):
         why = (f"contains {bad!r}" if bad is not None else

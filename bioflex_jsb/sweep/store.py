@@ -135,6 +135,9 @@ def open_store(path: str | Path, columns: dict[str, str], resume: bool):
     ``done_ids`` (every case with a row) and ``failed_ids`` (those whose last row is
     ``failed``, run again with ``--retry-failed``)."""
     p = Path(path)
+    if p.is_symlink() and not p.exists():  # the table would be created at its target
+        raise StoreError(f"--out {str(p)!r} is a symbolic link to {os.readlink(p)!r}, which "
+                         "does not exist; name the table's own path")
     suffix = p.suffix.lower()
     if suffix == ".csv":
         return CsvStore(p, columns, resume)
