@@ -511,3 +511,43 @@ def test_sweep_out_as_a_dangling_link_is_refused(tmp_path, capsys, monkeypatch):
         code, _out, err = run_cli(capsys, "sweep", str(campaign), "--out", str(link))
         assert "symbolic link" in one_line(code, err)
         assert list(outside.iterdir()) == []
+
+
+# ---------------------------------------------------------------------------------------
+# Every locale; names longer than the file system takes
+# ---------------------------------------------------------------------------------------
+def test_the_c_locale_without_utf8_mode_gets_no_traceback(tmp_path):
+    """``LC_ALL=C PYTHONUTF8=0 PYTHONCOERCECLOCALE=0 bioflex-jsb modes`` ended in a
+    UnicodeEncodeError (the C locale's stdout is ASCII with ``surrogateescape``, which the
+    adaptation of ``strict`` streams left alone). Now ω and α are written ``\\u03c9``; an
+    undecodable byte of a file name is written back as that byte."""
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("LC_", "LANG",
+                                                                     "PYTHONIO"))}
+    env.update(LC_ALL="C", PYTHONUTF8="0", PYTHONCOERCECLOCALE="0", PYTHONPATH=str(ROOT))
+    for argv in (["modes"], ["modes", "--help"]):
+        run = subprocess.run([sys.executable, "-m", "bioflex_jsb", *argv], env=env,
+                             capture_output=True, timeout=300, cwd=tmp_path)
+        assert run.returncode == 0 and b"Traceback" not in run.stderr, run.stderr[-2000:]
+        assert b"\\u" in run.stdout, run.stdout[:500]  # ω, α, η, ... escaped
+    name = os.fsencode(tmp_path) + b"/caf\xe9.mcap"  # Latin-1: not text in the C locale
+    run = subprocess.run([sys.executable, "-m", "bioflex_jsb", "info", name], env=env,
+                         capture_output=True, timeout=300, cwd=tmp_path)
+    assert run.returncode == 2 and b"Traceback" not in run.stderr, run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1, run.stderr
+
+
+def test_a_5000_character_airframe_path_is_one_line(tmp_path, capsys):
+    """A definition's ``airframe.jsbsim`` of 5000 characters: an ``OSError: File name too
+    long`` traceback from inside argument parsing (definition/airframe.py)."""
+    from bioflex_jsb.definition.loader import shipped_path
+
+    text = shipped_path("sgs_elastic").read_text(encoding="utf-8")
+    long = tmp_path / "long.toml"
+    long.write_text(text.replace('jsbsim = "SGS"', f'jsbsim = "./{"a" * 5000}"'),
+                    encoding="utf-8")
+    code, _out, err = run_cli(capsys, "modes", "--aircraft", str(long))
+    line = one_line(code, err)
+    assert "airframe.jsbsim" in line and "too long" in line and len(line) < 500, line
