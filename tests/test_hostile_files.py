@@ -551,3 +551,46 @@ def test_a_5000_character_airframe_path_is_one_line(tmp_path, capsys):
     code, _out, err = run_cli(capsys, "modes", "--aircraft", str(long))
     line = one_line(code, err)
     assert "airframe.jsbsim" in line and "too long" in line and len(line) < 500, line
+
+
+# ---------------------------------------------------------------------------------------
+# Small lies: a full numba cache, the pacing of a stopped session, speeds as a list
+# ---------------------------------------------------------------------------------------
+_FULL_CACHE = """
+import errno, sys
+import numba
+from numba.core import caching
+sys.path.insert(0, sys.argv[1])
+from bioflex_jsb.simulation.step_kernel import guard_cache
+
+def full(self, path):  # every write into the cache: a full disk
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+caching.IndexDataCacheFile._open_for_write = full
+import kernels
+guard_cache(kernels.twice)
+guard_cache(kernels.thrice)
+print(kernels.twice(21.0), kernels.thrice(2.0))
+"""
+
+
+def test_a_full_numba_cache_runs_uncached_and_says_where_once(tmp_path):
+    """A full NUMBA_CACHE_DIR made a --no-log run exit 4, "No space left on device", naming
+    no path (numba's save of the compiled code raised). The code compiled in memory runs;
+    one line says where the cache is and why."""
+    import subprocess
+    import sys
+
+    (tmp_path / "kernels.py").write_text(
+        "import numba\n\n\n@numba.njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n\n\n"
+        "@numba.njit(cache=True)\ndef thrice(x):\n    return 3.0 * x\n")
+    cache = tmp_path / "numba-cache"
+    run = subprocess.run([sys.executable, "-c", _FULL_CACHE, str(tmp_path)],
+                         capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "NUMBA_CACHE_DIR": str(cache),
+                              "PYTHONPATH": str(ROOT)})
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.split() == ["42.0", "6.0"]
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1, run.stderr
+    assert str(cache) in lines[0] and "No space left" in lines[0] and "uncached" in lines[0]
