@@ -594,3 +594,50 @@ def test_a_full_numba_cache_runs_uncached_and_says_where_once(tmp_path):
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1, run.stderr
     assert str(cache) in lines[0] and "No space left" in lines[0] and "uncached" in lines[0]
+
+
+def _wait_for_telemetry(port: int, timeout_s: float = 120.0) -> None:
+    """Be a ground station of the udpin vehicle on ``port`` until it sends something."""
+    from pymavlink.dialects.v20 import common as M
+
+    mav = M.MAVLink(None, srcSystem=255, srcComponent=190)
+    heartbeat = mav.heartbeat_encode(M.MAV_TYPE_GCS, M.MAV_AUTOPILOT_INVALID, 0, 0, 0).pack(mav)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.settimeout(0.5)
+        end = time.monotonic() + timeout_s
+        while time.monotonic() < end:
+            sock.sendto(heartbeat, ("127.0.0.1", port))
+            try:
+                if sock.recv(4096):
+                    return
+            except TimeoutError:
+                continue
+    raise AssertionError(f"no telemetry from the vehicle on port {port} in {timeout_s} s")
+
+
+def test_a_sitl_session_ended_by_ctrl_c_reports_its_pacing(tmp_path):
+    """Ctrl-C, a session's documented end, gave ``"pacing": null`` and printed no pacing
+    although --help promises it: the statistics were lost with run_paced's frame."""
+    import signal
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "bioflex_jsb", "sitl", "--mavlink",
+                             "udpin:127.0.0.1:0", "--no-log"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    try:
+        line = proc.stderr.readline()  # "... (local 127.0.0.1:PORT ...; Ctrl-C stops"
+        assert "Ctrl-C stops" in line, line + proc.stderr.read()
+        port = int(line.split("(local 127.0.0.1:")[1].split(",")[0].split(")")[0])
+        _wait_for_telemetry(port)  # the paced loop runs (a cold numba cache compiles first)
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err, err
+    assert "flew" in out and "pacing error p50" in out and "resyncs" in out, out

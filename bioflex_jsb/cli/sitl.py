@@ -120,6 +120,7 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.sitl import (
         DEFAULT_HOME,
         SPEEDUP_RANGE,
+        PacingStats,
         SitlParameters,
         SitlSim,
         run_paced,
@@ -219,11 +220,11 @@ def run(args: argparse.Namespace) -> int:
               f"(--allow-unstable): largest growth {check['max_growth_1_s']:+.3g} 1/s",
               file=sys.stderr)
     interrupted = False
+    stats = PacingStats()  # filled as the session flies: Ctrl-C, its usual end, keeps it
     try:
-        stats = run_paced(sim, args.duration, link, on_sample, idle=idle)
+        run_paced(sim, args.duration, link, on_sample, idle=idle, stats=stats)
     except KeyboardInterrupt:
         interrupted = True
-        stats = None
     finally:
         link.close()
         if log is not None:
@@ -241,7 +242,7 @@ def run(args: argparse.Namespace) -> int:
         "steps": sim.k,
         "aero": args.aero,
         "preflight": check,
-        "pacing": stats.summary() if stats else None,
+        "pacing": stats.summary() if stats.steps else None,
         "link": {"received": link.stats.received, "bad": link.stats.bad,
                  "rejected_signature": link.stats.rejected_signature,
                  "sent": link.stats.sent, "datagrams": link.stats.datagrams,
