@@ -641,3 +641,23 @@ def test_a_sitl_session_ended_by_ctrl_c_reports_its_pacing(tmp_path):
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err, err
     assert "flew" in out and "pacing error p50" in out and "resyncs" in out, out
+
+
+def test_campaign_speeds_given_as_a_list_are_rounded_as_ranges_are(tmp_path):
+    """15.0 and 15.0000000000001 in a list were two cases (two ids flying one speed); a
+    range's values were rounded to 12 decimals, a list's not."""
+    from bioflex_jsb.sweep.campaign import CampaignError, parse_campaign
+
+    def campaign(speeds, fracs=(0.3,)):
+        return {"name": "c", "metrics": ["gust"],
+                "axes": {"x_inertial_frac": list(fracs), "x_elastic_frac": [0.4],
+                         "speeds_m_s": speeds, "gusts": ["sharp:3"], "models": ["rigid"]}}
+
+    with pytest.raises(CampaignError, match="appears twice"):
+        parse_campaign(campaign([15.0, 15.0000000000001]))
+    with pytest.raises(CampaignError, match="appears twice"):
+        parse_campaign(campaign([15.0], fracs=(0.3, 0.30000000000000004)))
+    listed = parse_campaign(campaign([15.1 + 3 * 0.3, 15.4]))
+    ranged = parse_campaign(campaign({"start": 15.1, "stop": 16.0, "step": 0.3}))
+    assert listed.speeds_m_s[0] == ranged.speeds_m_s[-1] == 16.0
+    assert {c.case_id for c in listed.cases()} & {c.case_id for c in ranged.cases()}
