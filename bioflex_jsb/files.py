@@ -83,7 +83,7 @@ def open_input(path: str | Path, what: str, limit: int,
     try:
         fd = os.open(path, flags)
     except FileNotFoundError:
-        raise error(f"{where}: no such file") from None
+        raise error(f"{where}: not found") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
         if isinstance(exc, OSError) and exc.errno == errno.ENXIO:  # a socket
             raise error(f"{where}: not a regular file") from None

@@ -388,7 +388,7 @@ def test_bad_files_exit_2_with_one_line(command, gust_log, tmp_path, capsys):
     text = tmp_path / "text.mcap"
     text.write_text("not a log\n")
     extra = ["--out", str(tmp_path / "x.mcap")] if command == "rerun" else []
-    for bad, words in ((tmp_path / "missing.mcap", "no such file"),
+    for bad, words in ((tmp_path / "missing.mcap", "not found"),
                        (text, "not an MCAP file"), (truncated, "--recover")):
         assert main([command, str(bad), *extra]) == 2
         err = capsys.readouterr().err
