@@ -7,6 +7,7 @@ exit status 2. Any other exception is a bug and shows its traceback.
 
 :func:`plain_number` and :func:`plain_integer` are the one rule for a number a user types
 (command-line options, gust specifications): plain ASCII decimals, finite.
+:func:`unprintable` is the one rule for a name or description read from a file.
 """
 
 from __future__ import annotations
@@ -65,3 +66,29 @@ def plain_integer(text: str, what: str) -> int:
     if len(text) > MAX_NUMBER_CHARS or _PLAIN_INTEGER.match(text) is None:
         raise InputError(f"{what} must be a whole number ({PLAIN_INTEGER_HELP}), got {text!r}")
     return int(text)
+
+
+# ---------------------------------------------------------------------------------------
+# Names and descriptions read from files: printed and logged, so printable text only.
+# ---------------------------------------------------------------------------------------
+# The bidirectional embedding, override and isolate controls make a name display as another
+# ("Trojan Source", CVE-2021-42574: U+202E shows "wing\u202egnp.evil" as "winglive.png");
+# the Unicode categories: control characters (a newline splits a one-line message, an ESC
+# drives the terminal) and line or paragraph separators.
+BIDI_CONTROLS = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+_UNPRINTABLE_CATEGORIES = {"Cc": "a control character", "Zl": "a line separator",
+                           "Zp": "a paragraph separator", "Cs": "a byte that is not text"}
+
+
+def unprintable(text: str) -> str | None:
+    """What the first character of ``text`` that a name may not hold is (e.g. "a
+    bidirectional override (U+202E)"), or None when every character is printable text."""
+    import unicodedata
+
+    for ch in text:
+        if ch in BIDI_CONTROLS:
+            return f"a bidirectional control character (U+{ord(ch):04X})"
+        kind = _UNPRINTABLE_CATEGORIES.get(unicodedata.category(ch))
+        if kind:
+            return f"{kind} ({ascii(ch)})"
+    return None

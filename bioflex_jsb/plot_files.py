@@ -1,8 +1,8 @@
 """Figure files: which ones bioflex-jsb wrote, and where a figure may be written.
 
-The base of the layers (it imports nothing of the project but errors; matplotlib and PIL
-only when called): the sinks' figures, the section loads' and the results' ``.plot()``
-methods check their files here.
+Near the base of the layers (it imports nothing of the project but errors and files;
+matplotlib and PIL only when called): the sinks' figures, the section loads' and the
+results' ``.plot()`` methods check their files here.
 """
 
 from __future__ import annotations
@@ -10,6 +10,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.files import open_input
+
+# Largest file looked into as a possible figure of ours [bytes]: our PNGs are < 1 MB.
+MAX_PLOT_FILE_BYTES = 64 * 1024 * 1024
 
 
 def is_our_plot(path: str | Path) -> bool:
@@ -18,13 +22,14 @@ def is_our_plot(path: str | Path) -> bool:
     from PIL import Image
 
     try:
-        with Image.open(path) as image:
+        with open_input(path, "plot file", MAX_PLOT_FILE_BYTES) as f, Image.open(f) as image:
             if image.format != "PNG":
                 return False
             return str(image.info.get("Software", "")).startswith("bioflex-jsb")
     # not an image PIL can read (PIL.UnidentifiedImageError is an OSError); a header that
     # claims more pixels than PIL opens (DecompressionBombError); a broken chunk (PIL raises
     # SyntaxError or ValueError for some): none of them is a plot of ours
+    # a FIFO, a device or a file larger than a figure of ours (InputError, a ValueError)
     except (OSError, ValueError, SyntaxError, Image.DecompressionBombError):
         return False
 

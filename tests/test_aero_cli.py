@@ -82,6 +82,6 @@ def test_rerun_flies_an_unsteady_damped_run_as_it_was():
 
     d = RunDescription("gust", "optimised", 15.0, models=("rigid", "coupled"),
                        extra={"aero": "unsteady", "structural_damping": 0.02})
-    argv = argv_for(d)
-    assert argv[argv.index("--aero") + 1] == "unsteady"
-    assert float(argv[argv.index("--structural-damping") + 1]) == 0.02
+    argv = dict(a.split("=", 1) for a in argv_for(d)[1:])
+    assert argv["--aero"] == "unsteady"
+    assert float(argv["--structural-damping"]) == 0.02

@@ -119,7 +119,7 @@ def test_a_read_is_bounded_and_bad_files_are_one_line(logged, tmp_path, monkeypa
     text.write_text("not a log")
     with pytest.raises(InputError, match="not an MCAP file"):
         api.read_log(text)
-    with pytest.raises(InputError, match="no such file"):
+    with pytest.raises(InputError, match="not found"):
         api.read_log(tmp_path / "missing.mcap")
 
 

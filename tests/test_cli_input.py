@@ -234,13 +234,13 @@ LONG = "x" * 300
     ["export-jsbsim", "--out", LONG],
     ["rerun", "x.mcap", "--out", LONG + ".mcap"],
     ["plot", "x.mcap", "--out", LONG + ".png"],
-    ["info", LONG + ".mcap"],  # an input: the OSError itself, one line
+    ["info", LONG + ".mcap"],  # an input: the reader's one line (bioflex_jsb.files)
 ])
 def test_a_300_character_name_is_one_line(capsys, tmp_path, monkeypatch, argv):
     monkeypatch.chdir(tmp_path)
     code, _, err = run_cli(capsys, *argv)
     assert_one_line_error(code, err, "bytes per file or directory name" if argv[0] != "info"
-                          else "File name too long: 'xxxxx")
+                          else "File name too long (")
     assert not list(tmp_path.iterdir())
 
 

@@ -347,8 +347,9 @@ def test_rerun_flies_the_gliders_log_from_its_definition(tmp_path, capsys):
     assert code == 0, err
     report = json.loads(out)
     argv = report["command"]
-    assert argv[1:3] == ["gust", "--aircraft"] and argv[3].endswith("sgs_elastic.toml")
-    assert "--wing" not in argv
+    assert argv[1] == "gust" and argv[2].startswith("--aircraft=")
+    assert argv[2].endswith("sgs_elastic.toml")
+    assert not any(a.startswith("--wing") for a in argv)
     assert report["equal"] is True and report["messages"] > 0
 
 
@@ -373,5 +374,5 @@ def test_rerun_finds_a_relative_definition_from_another_directory(tmp_path, caps
     code, out, err = run_cli(capsys, "rerun", "work/run.mcap", "--out", "again.mcap", "--json")
     assert code == 0, err
     report = json.loads(out)
-    assert report["command"][3] == str((work / "my_glider.toml").resolve())
+    assert report["command"][2] == "--aircraft=" + str((work / "my_glider.toml").resolve())
     assert report["equal"] is True

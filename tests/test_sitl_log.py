@@ -143,3 +143,53 @@ def test_refusals_are_events_of_the_session_log(build, tmp_path):  # noqa: F811
     assert any(lvl == "WARNING" and t.startswith("Sticks ignored in CRUISE")
                for lvl, t in events), events
     assert sim.vehicle.refusals == 3
+
+
+def test_a_session_keeps_at_most_its_total_log_bound(steps, build, tmp_path):  # noqa: F811
+    """``--log-max-total-mb``: a session "until Ctrl-C" wrote 2.0 GB in 11 min with 50 MB
+    files and no total bound. With one, the files on disk (the one being written included)
+    never exceed it: the oldest finished files are removed as new ones start, listed in
+    ``removed`` and in the next file's run description."""
+    import json
+
+    _, rows = steps
+    max_mb, total_mb = 0.3, 1.0
+    log = SplitLog(str(tmp_path / "s.mcap"), _description(), build, max_mb, open_log,
+                   max_total_mb=total_mb)
+    on_disk = []
+    for rep in range(10):  # 20 s of simulated time: ≈ 8 MB without the bound
+        for k, (t, row) in enumerate(rows):
+            log.sample("coupled", t + 2.0 * rep, row)
+            if k % 240 == 0:
+                on_disk.append(sum(p.stat().st_size for p in tmp_path.glob("*.mcap")))
+    log.close()
+    on_disk.append(sum(p.stat().st_size for p in tmp_path.glob("*.mcap")))
+    assert max(on_disk) <= total_mb * 1e6, on_disk
+    assert len(log.removed) >= 8 and len(log.paths) >= 2, (log.removed, log.paths)
+    assert not any(os.path.exists(p) for p in log.removed)
+    assert sorted(p.name for p in tmp_path.glob("*.mcap")) == sorted(
+        os.path.basename(p) for p in log.paths)
+    described = json.loads(summarise(log.paths[-1])["metadata"]["bioflex.run"]["description"])
+    described = described["extra"]
+    assert described["removed_before"], described
+    for p in log.paths:
+        summarise(p)  # what is kept is finished and readable
+
+
+def test_the_total_bound_and_the_file_bound_are_checked_and_the_help_says_the_rate(capsys):
+    from bioflex_jsb.cli import main
+    from bioflex_jsb.cli.sitl import LOG_MB_PER_SIMULATED_S
+
+    # the help's rate within the bytes a step the growth test measures (960 steps/s; a
+    # session's chunks are larger than that test's 24 steps, so a little smaller a step)
+    lo, hi = BYTES_PER_STEP
+    assert 0.9 * lo * 960 / 1e6 <= LOG_MB_PER_SIMULATED_S <= hi * 960 / 1e6
+    for argv, needle in ((["--log-max-mb", "10", "--log-max-total-mb", "5"], "below"),
+                         (["--log-max-mb", "100000"], "above")):
+        assert main(["sitl", "--duration", "1", "--no-log", *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and needle in err, err
+    assert main(["sitl", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "0.4 MB per simulated second" in text and "1.4 GB an hour" in text, text
+    assert "--log-max-total-mb" in text

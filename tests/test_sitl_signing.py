@@ -64,7 +64,7 @@ def test_cli_bad_signing_key_exit_2_one_line(content, tmp_path, monkeypatch, cap
                   "--mavlink", "udpin:127.0.0.1:0"], monkeypatch)
     err = capsys.readouterr().err.strip()
     assert rc == 2
-    assert len(err.splitlines()) == 1 and "sitl: error: signing key" in err, err
+    assert len(err.splitlines()) == 1 and "sitl: error:" in err and "signing key" in err, err
 
 
 class Gcs:

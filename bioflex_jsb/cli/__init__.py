@@ -148,14 +148,41 @@ def _main(argv: list[str] | None) -> int:
     return status
 
 
+OUTPUT_ERRORS = "bioflex-jsb-output"  # the error handler of stdout and stderr (below)
+
+
+def _escape_or_pass_bytes(exc: UnicodeError):
+    """The encoding error handler of our output: an undecodable byte of a file name (a
+    surrogate U+DC80-U+DCFF, as ``surrogateescape`` made it) is written back as that byte;
+    any other character the encoding cannot hold as ``\\u03b1`` (``backslashreplace``)."""
+    import codecs
+
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    part = exc.object[exc.start:exc.end]
+    if all(0xDC80 <= ord(c) <= 0xDCFF for c in part):
+        return bytes(ord(c) - 0xDC00 for c in part), exc.end
+    return codecs.backslashreplace_errors(exc)
+
+
 def _escape_unencodable_output() -> None:
     """stdout and stderr write ``\\u03b1`` for a character their encoding cannot hold
     (``PYTHONIOENCODING=ascii``, a C locale, a Latin-1 terminal) instead of failing: our
-    tables and help texts use α, η, Δ, °, µ, ≤. Only for the program itself (``argv=None``);
-    an in-process caller keeps its own streams."""
+    tables and help texts use α, η, Δ, °, µ, ≤. A stream that fails on them is one whose
+    errors are ``strict`` or, in the C/POSIX locale without UTF-8 mode, ``surrogateescape``
+    (which passes undecodable bytes of file names and nothing else): both take
+    :func:`_escape_or_pass_bytes`, which keeps what ``surrogateescape`` did. Only for the
+    program itself (``argv=None``); an in-process caller keeps its own streams."""
+    import codecs
+
+    try:
+        codecs.lookup_error(OUTPUT_ERRORS)
+    except LookupError:
+        codecs.register_error(OUTPUT_ERRORS, _escape_or_pass_bytes)
     for stream in (sys.stdout, sys.stderr):
-        if getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure"):
-            stream.reconfigure(errors="backslashreplace")
+        if getattr(stream, "errors", None) in ("strict", "surrogateescape") and \
+                hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors=OUTPUT_ERRORS)
 
 
 def _is_log_write_error(exc: OSError) -> bool:

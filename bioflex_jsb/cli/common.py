@@ -615,3 +615,24 @@ def check_file_name(path: str, what: str) -> None:
             raise UsageError(f"{what} {name[:40]!r}...: a name of {len(part)} bytes; accepted: "
                              f"up to {limit} bytes per file or directory name (the file "
                              "system's limit)")
+
+
+# Characters a log's text may not put on the terminal as they are: control characters (an
+# ESC starts the terminal's escape sequences: clear the screen, set the title, move the
+# cursor; CR and LF fake lines), format characters (the bidirectional overrides U+202A-E,
+# U+2066-9 reorder what is shown), surrogates (undecodable bytes) and line or paragraph
+# separators. Printed escaped as Python writes them in a string: \x1b, \n, \u202e.
+UNPRINTED_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Zl", "Zp"})
+
+
+def escaped(text: object) -> str:
+    """``text`` with the characters of :data:`UNPRINTED_CATEGORIES` written as escapes
+    (``repr``'s, without the quotes); other text, accented and Greek letters included, as
+    it is."""
+    import unicodedata
+
+    text = str(text)
+    if all(unicodedata.category(ch) not in UNPRINTED_CATEGORIES for ch in text):
+        return text
+    return "".join(ascii(ch)[1:-1] if unicodedata.category(ch) in UNPRINTED_CATEGORIES
+                   else ch for ch in text)

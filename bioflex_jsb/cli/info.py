@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from bioflex_jsb.cli.common import UsageError, check_new_file, print_json
+from bioflex_jsb.cli.common import UsageError, check_new_file, escaped, print_json
 
 HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels
 (topic, schema, message count), the number of messages and chunks, the time span [s of
@@ -94,24 +94,28 @@ def _check_status(result: dict) -> str:
 
 
 def print_summary(s: dict) -> None:
-    print(f"{s['file']}: {s['messages']} messages in {s['chunks']} chunks, "
+    """The summary of a log as text; every name and value read from the log
+    :func:`escaped` (a hostile log cannot drive the terminal)."""
+    e = escaped
+    print(f"{e(s['file'])}: {s['messages']} messages in {s['chunks']} chunks, "
           f"t = {s['start_s']:.3f} … {s['end_s']:.3f} s ({s['duration_s']:.3f} s), "
-          f"written by {s['library']}")
-    width = max([len(c["topic"]) for c in s["channels"]] + [5])
+          f"written by {e(s['library'])}")
+    channels = [(e(c["topic"]), e(c["schema"]), c["messages"]) for c in s["channels"]]
+    width = max([len(topic) for topic, _, _ in channels] + [5])
     print(f"{'topic':<{width}}  {'schema':<24} {'messages':>8}")
-    for c in s["channels"]:
-        print(f"{c['topic']:<{width}}  {c['schema']:<24} {c['messages']:>8}")
+    for topic, schema, messages in channels:
+        print(f"{topic:<{width}}  {schema:<24} {messages:>8}")
     for name, record in s["metadata"].items():
-        print(f"metadata {name}:")
+        print(f"metadata {e(name)}:")
         for key, value in record.items():
             if value.startswith(("{", "[")):
                 try:
                     value = json.dumps(json.loads(value), separators=(", ", ": "))
                 except ValueError:
                     pass
-            print(f"  {key}: {value}")
+            print(f"  {e(key)}: {e(value)}")
     events = s.get("events") or []
     if events:
         print(f"events ({len(events)}):")
-    for e in events:
-        print(f"  t = {e['time_s']:.3f} s  {e['level']:<7}  {e['text']}")
+    for ev in events:
+        print(f"  t = {ev['time_s']:.3f} s  {e(ev['level']):<7}  {e(ev['text'])}")

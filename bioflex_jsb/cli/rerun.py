@@ -6,16 +6,33 @@ import argparse
 import json
 import sys
 
-from bioflex_jsb.cli.common import UsageError, check_new_file, number_type, print_json
+from bioflex_jsb.cli.common import (
+    UsageError,
+    check_new_file,
+    escaped,
+    number_type,
+    print_json,
+)
 
 HELP = """Repeat the gust run, sweep case or comparison recorded in FILE.mcap from its metadata
 record bioflex.run (wing, mass basis, speed, gust and seed, duration, gust start, time step,
 models), writing the new log to --out, and compare the two logs message by message (every
 topic, log time and number; numbers agree when within --rtol relative or 1e-12 absolute).
 Exit status 0 when they agree, 1 when they differ (the first difference is printed), 2 for a
-bad file."""
+bad file. Only what a run description holds is taken from the log: gust or compare, with
+--wing, --aircraft, --mass-basis, --speed, --gust, --duration, --gust-start, --dt, --models,
+--model, --aero, --structural-damping and --trim; a log asking for anything else (--live,
+an output, another command) is refused (docs/logging.md)."""
 
 LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold an argv
+# What a log may ask a rerun to do: fly ``gust`` or ``compare`` with the options of a run
+# description, each with its value. Nothing else a command line can hold: no network
+# (--live, --live-any-host), no output (--out, --plot, --force, --no-log: the rerun's own
+# --out is the one written), no other command. A log is a file someone may have sent.
+RUN_COMMANDS = ("gust", "compare")
+RUN_OPTIONS = ("--wing", "--aircraft", "--mass-basis", "--speed", "--gust", "--duration",
+               "--gust-start", "--dt", "--models", "--model", "--aero",
+               "--structural-damping", "--trim")
 
 
 tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
@@ -64,8 +81,32 @@ def argv_for(description) -> list[str]:
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")
-        return ["compare", *common, "--model", d.models[0]]
-    return ["gust", *common, "--models", ",".join(d.models)]
+        return run_argv(["compare", *common, "--model", d.models[0]], "the log")
+    return run_argv(["gust", *common, "--models", ",".join(d.models)], "the log")
+
+
+def run_argv(argv: list[str], source: str) -> list[str]:
+    """``argv`` as a run a log may ask for (:data:`RUN_COMMANDS` with :data:`RUN_OPTIONS`,
+    each with its value), every option written ``--option=value`` (a value can never be
+    read as another option); UsageError naming the first token that is not one
+    (``source``: where the list came from)."""
+    if not argv or argv[0] not in RUN_COMMANDS:
+        raise UsageError(f"{source} asks for the command {str(argv[:1])[1:-1] or 'none'}; a "
+                         f"rerun flies {' or '.join(RUN_COMMANDS)} only")
+    out, rest = [argv[0]], list(argv[1:])
+    while rest:
+        token = rest.pop(0)
+        name, eq, value = token.partition("=")
+        if name not in RUN_OPTIONS:
+            raise UsageError(f"{source} holds {token[:60]!r}, not an option of a run "
+                             f"description ({', '.join(RUN_OPTIONS)}); a rerun takes no "
+                             "network, output or other options from a log")
+        if not eq:
+            if not rest:
+                raise UsageError(f"{source} gives {name} without its value")
+            value = rest.pop(0)
+        out.append(f"{name}={value}")
+    return out
 
 
 def argv_from_log(path: str) -> list[str]:
@@ -107,7 +148,7 @@ def legacy_argv(path: str, meta: dict[str, str]) -> list[str]:
         raise UsageError(f"{path!r}: the run metadata has no usable argument list") from None
     if not isinstance(argv, list) or not all(isinstance(a, str) for a in argv):
         raise UsageError(f"{path!r}: the run metadata has no usable argument list")
-    return argv
+    return run_argv(argv, f"the argument list of {path!r}")
 
 
 def compare_logs(old: str, new: str, rtol: float) -> dict:
@@ -165,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
               f"({result['messages']} messages on {result['topics']} topics agree)")
     else:
         print(f"rerun of {args.file} written to {args.out}: DIFFERENT result: "
-              f"{result['first_difference']}")
+              f"{escaped(result['first_difference'])}")  # names of the log's topics
     if not result["equal"]:
         print("bioflex-jsb rerun: the repeated run differs from the log", file=sys.stderr)
         return 1

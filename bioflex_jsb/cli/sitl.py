@@ -29,6 +29,13 @@ EVENT_LEVEL = {0: "FATAL", 1: "FATAL", 2: "ERROR", 3: "ERROR", 4: "WARNING", 5: 
                6: "INFO", 7: "DEBUG"}
 EVENT_NAME = "vehicle"  # the events' reporter (foxglove.Log name)
 LOG_MAX_MB_MIN = 0.1  # the smallest --log-max-mb: a file's fixed part (≈ 20 kB) and a chunk
+# The largest --log-max-mb: a file info, plot and rerun still read (sinks/mcap/errors.py
+# MAX_LOG_BYTES, 64 GiB).
+LOG_MAX_MB_MAX = 65_536.0
+# What a session writes [MB per second of simulated time]: 11.92 MB for 30 s of the default
+# session (sitl --duration 30, optimised wing, 28 800 steps: 414 bytes a step at 960 steps/s;
+# tests/test_sitl_log.py holds the bytes per step), so ≈ 1.4 GB an hour at --speedup 1.
+LOG_MB_PER_SIMULATED_S = 0.40
 
 HELP = """Fly the JSBSim airframe with the elastic wing paced to the wall clock (--speedup N:
 N simulated seconds per second) and stream it as a MAVLink 2 vehicle (system 1, component 1,
@@ -40,7 +47,9 @@ WING_COUPLED, SIM_SPEEDUP); docs/sitl.md. A crash or divergence is reported and 
 is reset to trim over home; the session goes on. --mavlink:
 udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:14550),
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
-simulated seconds, or until Ctrl-C. Prints the pacing error (step start minus its wall-clock
+simulated seconds, or until Ctrl-C (the log grows ≈ 0.4 MB per simulated second, ≈ 1.4 GB
+an hour at --speedup 1 and N times that at --speedup N: --log-max-total-mb bounds what a
+session keeps). Prints the pacing error (step start minus its wall-clock
 due time: p50, p99 [ms]). The vehicle's MAVLink clock (time_boot_ms) is the simulated time
 since the start, the time axis of the MCAP log that every session writes (--out, --no-log).
 --signing-key FILE turns on MAVLink 2 signing: FILE holds the 32-byte secret as 64
@@ -98,7 +107,13 @@ def register(sub) -> None:
                    help="start (and reset) height above home [m], 20 to 3000 (default 100)")
     p.add_argument("--log-max-mb", type=positive_float("log size", "MB"), default=256.0,
                    help="start a new log file (NAME-001.mcap, ...) when one reaches this size "
-                   "[MB] (default 256); each file is a finished MCAP")
+                   f"[MB], {LOG_MAX_MB_MIN:g}..{LOG_MAX_MB_MAX:g} (default 256); each file is "
+                   "a finished MCAP")
+    p.add_argument("--log-max-total-mb", type=positive_float("log total", "MB"), default=None,
+                   help="keep at most this much of the session's log on disk [MB], at least "
+                   "--log-max-mb: when a new file starts, the session's oldest files are "
+                   "removed until the kept ones and the new file's limit fit (the summary "
+                   "lists them; default: keep every file, ≈ 1.4 GB an hour at --speedup 1)")
     p.add_argument("--signing-key", metavar="FILE",
                    help="MAVLink 2 signing key file: 64 hex digits (32 bytes); sign what is "
                    "sent, accept only signed messages")
@@ -112,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.sitl import (
         DEFAULT_HOME,
         SPEEDUP_RANGE,
+        PacingStats,
         SitlParameters,
         SitlSim,
         run_paced,
@@ -131,6 +147,12 @@ def run(args: argparse.Namespace) -> int:
     if args.log_max_mb < LOG_MAX_MB_MIN:
         raise UsageError(f"--log-max-mb {args.log_max_mb:g} is below {LOG_MAX_MB_MIN:g} MB "
                          "(a file holds its header, one chunk and its summary)")
+    if args.log_max_mb > LOG_MAX_MB_MAX:
+        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is above {LOG_MAX_MB_MAX:g} MB "
+                         "(the largest log info, plot and rerun read)")
+    if args.log_max_total_mb is not None and args.log_max_total_mb < args.log_max_mb:
+        raise UsageError(f"--log-max-total-mb {args.log_max_total_mb:g} is below --log-max-mb "
+                         f"{args.log_max_mb:g}: the file being written must fit")
     try:
         endpoint = parse_endpoint(args.mavlink)
         key = None if args.signing_key is None else read_signing_key(args.signing_key)
@@ -189,7 +211,8 @@ def run(args: argparse.Namespace) -> int:
                    **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
         try:
             log = SplitLog(args.out, description, build, args.log_max_mb,
-                           live_opener(args, open_log), replace=args.force)
+                           live_opener(args, open_log), replace=args.force,
+                           max_total_mb=args.log_max_total_mb)
         except UsageError:
             link.close()
             raise
@@ -207,11 +230,11 @@ def run(args: argparse.Namespace) -> int:
               f"(--allow-unstable): largest growth {check['max_growth_1_s']:+.3g} 1/s",
               file=sys.stderr)
     interrupted = False
+    stats = PacingStats()  # filled as the session flies: Ctrl-C, its usual end, keeps it
     try:
-        stats = run_paced(sim, args.duration, link, on_sample, idle=idle)
+        run_paced(sim, args.duration, link, on_sample, idle=idle, stats=stats)
     except KeyboardInterrupt:
         interrupted = True
-        stats = None
     finally:
         link.close()
         if log is not None:
@@ -224,11 +247,12 @@ def run(args: argparse.Namespace) -> int:
         "last_reset": sim.last_reset,
         "refusals": sim.vehicle.refusals,
         "log_files": log.paths if log is not None else [],
+        "log_files_removed": log.removed if log is not None else [],
         "simulated_s": sim.t_s,
         "steps": sim.k,
         "aero": args.aero,
         "preflight": check,
-        "pacing": stats.summary() if stats else None,
+        "pacing": stats.summary() if stats.steps else None,
         "link": {"received": link.stats.received, "bad": link.stats.bad,
                  "rejected_signature": link.stats.rejected_signature,
                  "sent": link.stats.sent, "datagrams": link.stats.datagrams,
@@ -247,7 +271,9 @@ def run(args: argparse.Namespace) -> int:
         if sim.resets:
             print(f"{sim.resets} resets (last: {sim.last_reset})")
         if args.out:
-            print(f"log written to {', '.join(log.paths)}")
+            print(f"log written to {', '.join(log.paths)}" + (
+                f" ({len(log.removed)} older files removed: --log-max-total-mb "
+                f"{args.log_max_total_mb:g})" if log.removed else ""))
     if interrupted:
         print("bioflex-jsb sitl: interrupted" + (f"; the log {args.out} holds every step flown"
                                                 if args.out else ""), file=sys.stderr)
@@ -311,10 +337,14 @@ class SplitLog:
     sample of the step it happened in (so a crash follows the last step flown); a reset
     (``reset``, called within that step after the vehicle's "Reset to trim" STATUSTEXT)
     starts the new file after that sample and the step's events: the reset's event is the
-    last record of the file that ends and the first of the new one."""
+    last record of the file that ends and the first of the new one.
+
+    With ``max_total_mb`` the files kept on disk stay within it: when a new file starts,
+    the session's oldest finished files are removed (listed in ``removed``; ``paths`` keeps
+    the rest) until their sizes and the new file's limit ``max_mb`` fit in it."""
 
     def __init__(self, path: str, description, build, max_mb: float, open_log,
-                 replace: bool = False) -> None:
+                 replace: bool = False, max_total_mb: float | None = None) -> None:
         import dataclasses
         from pathlib import Path
 
@@ -323,7 +353,10 @@ class SplitLog:
         self._description, self._build, self._open = description, build, open_log
         self._replace = dataclasses.replace
         self.max_bytes = int(max_mb * 1e6)
+        self.max_total_bytes = None if max_total_mb is None else int(max_total_mb * 1e6)
         self.paths: list[str] = []
+        self.removed: list[str] = []  # the oldest files, removed to keep max_total_mb
+        self._files = 0  # files opened (the next one's number)
         self._pending = 0
         self._steps = 0  # steps in the file being written
         self._events: list[tuple[float, int, str]] = []  # (t_s, MAV_SEVERITY, text)
@@ -331,15 +364,47 @@ class SplitLog:
         self._log = self._next(None)
 
     def _next(self, reason: str | None):
-        n = len(self.paths)
+        n = self._files
+        removed = self._keep_within_total()
         path = self._base if n == 0 else self._free_name(n)
         d = self._description
         if n:
-            extra = dict(d.extra, segment=n, **({"after_reset": reason} if reason else {}))
+            extra = dict(d.extra, segment=n, **({"after_reset": reason} if reason else {}),
+                         **({"removed_before": removed} if removed else {}))
             d = self._replace(d, extra=extra)
         log = self._open(str(path), d, self._build)
         self.paths.append(str(path))
+        self._files += 1
         return log
+
+    def _keep_within_total(self) -> list[str]:
+        """Remove the oldest finished files until they and a new file of ``max_bytes`` fit
+        in ``max_total_bytes``; returns their names (the new file's run description lists
+        them, ``extra.removed_before``; the first removal is said on stderr)."""
+        import os
+
+        if self.max_total_bytes is None:
+            return []
+        before = len(self.removed)
+        sizes = []
+        for p in self.paths:
+            try:
+                sizes.append(os.path.getsize(p))
+            except OSError:  # removed by someone else: it takes no room
+                sizes.append(0)
+        while self.paths and sum(sizes) + self.max_bytes > self.max_total_bytes:
+            oldest = self.paths.pop(0)
+            sizes.pop(0)
+            try:
+                os.unlink(oldest)
+            except FileNotFoundError:
+                pass
+            self.removed.append(oldest)
+        if before == 0 and self.removed:
+            print(f"bioflex-jsb sitl: the session's log reached --log-max-total-mb "
+                  f"{self.max_total_bytes / 1e6:g}: its oldest files are removed as new ones "
+                  "start", file=sys.stderr)
+        return [os.path.basename(p) for p in self.removed[before:]]
 
     def _free_name(self, n: int):
         """The name of the file after ``n`` others: ``<stem>-NNN<suffix>`` with the first

@@ -99,15 +99,20 @@ def _jsbsim_path(r: Reader, name: str, base_dir: Path | None) -> str:
         return ""
     field = "airframe.jsbsim"
     looks_like_path = "/" in name or name.startswith(".")
-    if not looks_like_path:
-        pkg = jsbsim_aircraft_dir()
-        if pkg is not None and (pkg / name / f"{name}.xml").is_file():
-            return str(pkg / name / f"{name}.xml")
-    path = Path(name)
-    if base_dir is not None and not path.is_absolute():
-        path = base_dir / path
-    if path.is_dir() and (path / f"{path.name}.xml").is_file():
-        return str((path / f"{path.name}.xml").resolve())
+    try:
+        if not looks_like_path:
+            pkg = jsbsim_aircraft_dir()
+            if pkg is not None and (pkg / name / f"{name}.xml").is_file():
+                return str(pkg / name / f"{name}.xml")
+        path = Path(name)
+        if base_dir is not None and not path.is_absolute():
+            path = base_dir / path
+        if path.is_dir() and (path / f"{path.name}.xml").is_file():
+            return str((path / f"{path.name}.xml").resolve())
+    except (OSError, ValueError) as exc:  # a name too long for the file system, a NUL
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise r.fail(field, f"{name[:60]!r}{'…' if len(name) > 60 else ''} "
+                     f"({len(name)} characters) cannot be looked up: {why}") from None
     raise r.fail(field, f"{name!r} is neither {GENERATED!r} (the generated prototype), an "
                  "aircraft of the jsbsim package's aircraft/ directory (e.g. c172x, SGS), nor "
                  "a directory holding <its name>.xml")

@@ -3,7 +3,7 @@ problem (:class:`DefinitionError`, an :class:`~bioflex_jsb.errors.InputError`: e
 
 from __future__ import annotations
 
-from bioflex_jsb.errors import InputError
+from bioflex_jsb.errors import InputError, unprintable
 from bioflex_jsb.values import is_finite_real, is_whole
 
 
@@ -65,17 +65,16 @@ class Reader:
         return str(v)
 
     def text(self, t: dict, where: str, key: str, default: str | None = None) -> str:
-        """A string; names and descriptions are printed and logged, so no control
-        characters (a newline would split a one-line message or a log field)."""
-        import unicodedata
-
+        """A string; names and descriptions are printed and logged, so printable text
+        only (:func:`bioflex_jsb.errors.unprintable`: no newline, which would split a
+        one-line message or a log field, no bidirectional override)."""
         v = t.get(key, default)
         field = f"{where}.{key}" if where else key
         if not isinstance(v, str) or (default is None and not v.strip()):
             raise self.fail(field, "must be a non-empty string")
-        if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in v):
-            raise self.fail(field, "holds a control character (a newline, ...); accepted: "
-                            "printable text")
+        bad = unprintable(v)
+        if bad:
+            raise self.fail(field, f"holds {bad}; accepted: printable text")
         return v
 
     def boolean(self, t: dict, where: str, key: str, default: bool | None = None) -> bool:

@@ -657,6 +657,7 @@ def run_paced(
     clock: Callable[[], float] = time.perf_counter,
     sleep: Callable[[float], None] = time.sleep,
     idle: Callable[[float], None] | None = None,
+    stats: PacingStats | None = None,
 ) -> PacingStats:
     """Fly ``sim`` paced to the wall clock for ``duration_s`` simulated seconds (None: until
     ``should_stop()``; Ctrl-C raises KeyboardInterrupt; a run that leaves its valid range is
@@ -664,7 +665,8 @@ def run_paced(
     :class:`~bioflex_jsb.links.mavlink.MavlinkLink`, serviced every LINK_PERIOD_S;
     ``on_sample(t_s, model, values)`` after every step (logging); ``idle(slack_s)`` when the
     next step is not due for ``slack_s`` [s] (a place for work that may wait, such as writing
-    a log chunk, without delaying a step)."""
+    a log chunk, without delaying a step). ``stats``: the pacing statistics to add the steps
+    to (returned; the caller's own holds them when Ctrl-C ends the session)."""
     n_end = None if duration_s is None else sim.k + int(round(duration_s / sim.dt_s))
     # DECISION: what is alive when the paced loop starts (modules, the airframe, the wing, the
     # link: 73 000-143 000 objects the collector tracks) is kept out of the cyclic
@@ -677,16 +679,16 @@ def run_paced(
     thawed = gc.get_freeze_count() == 0
     gc.freeze()
     try:
-        return _run_paced(sim, n_end, link, on_sample, should_stop, clock, sleep, idle)
+        return _run_paced(sim, n_end, link, on_sample, should_stop, clock, sleep, idle,
+                          PacingStats() if stats is None else stats)
     finally:
         if thawed:
             gc.unfreeze()
 
 
 def _run_paced(sim: SitlSim, n_end: int | None, link, on_sample, should_stop, clock, sleep,
-               idle) -> PacingStats:
+               idle, stats: PacingStats) -> PacingStats:
     """:func:`run_paced`'s loop, up to step ``n_end`` (None: until ``should_stop()``)."""
-    stats = PacingStats()
     add = stats.add
     dt = sim.dt_s
     link_every = max(1, int(round(LINK_PERIOD_S / dt)))

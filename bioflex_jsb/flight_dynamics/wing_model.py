@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.aerodynamics.vortex_lattice import SpanwiseAerodynamics
-from bioflex_jsb.errors import InputError
+from bioflex_jsb.errors import InputError, unprintable
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_coefficients import (
     modal_coefficients,
@@ -197,14 +197,13 @@ def _coefficient(value, what: str, source: str) -> float:
 
 
 def _text(value, what: str, source: str) -> str:
-    """A name or description: text without control characters (it is printed and logged)."""
-    import unicodedata
-
+    """A name or description: printable text (it is printed and logged;
+    :func:`bioflex_jsb.errors.unprintable`: no newline, no bidirectional override)."""
     if not isinstance(value, str):
         raise VariantError(f"{source}: {what} must be a string, got {type(value).__name__}")
-    if any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in value):
-        raise VariantError(f"{source}: {what} holds a control character (a newline, ...); "
-                           "accepted: printable text")
+    bad = unprintable(value)
+    if bad:
+        raise VariantError(f"{source}: {what} holds {bad}; accepted: printable text")
     return value
 
 

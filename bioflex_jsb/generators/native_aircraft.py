@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bioflex_jsb import units as U
+from bioflex_jsb.files import read_input_bytes
 from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.generators.native_wing import (
@@ -45,6 +46,9 @@ from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 W = XmlWriter(num_12g)
+# Largest aircraft file read [bytes]: the bound of every file JSBSim reads
+# (runtime/aircraft_files.py MAX_FILE_BYTES; the jsbsim package's largest is 1.6 MB).
+MAX_AIRCRAFT_FILE_BYTES = 16 * 1024 * 1024
 el, num = W.el, W.number
 
 # Header of the initial conditions and scripts (after the XML declaration).
@@ -177,10 +181,12 @@ def render_jsbsim_aircraft_files(spec: ExportSpec,
     that cannot take the wing: not readable XML, no LIFT/DRAG/PITCH axes, or a reference to
     a file not carried (the copy would lose it)."""
     src = spec.jsbsim_path
+    data = read_input_bytes(src, "the aircraft file", MAX_AIRCRAFT_FILE_BYTES, ExportError)
     try:
         parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
-        root = ET.parse(src, parser=parser).getroot()
-    except (OSError, ET.ParseError) as exc:
+        parser.feed(data)
+        root = parser.close()
+    except ET.ParseError as exc:
         raise ExportError(f"cannot read the aircraft file {src!r}: {exc}") from None
     if root.tag != "fdm_config":
         raise ExportError(f"{src!r} is no JSBSim aircraft (its root is <{root.tag}>, "
@@ -226,9 +232,10 @@ def with_note(text: str, note: str) -> str:
 def jsbsim_chord_m(path: str) -> float:
     """c̄ [m] of an aircraft file's ``<metrics><chord>`` (JSBSim's ``metrics/cbarw-ft``, from
     which it forms ``aero/ci2vel``); ExportError (one line) when it has none."""
+    data = read_input_bytes(path, "the aircraft file", MAX_AIRCRAFT_FILE_BYTES, ExportError)
     try:
-        chord = ET.parse(path).getroot().find("metrics/chord")
-    except (OSError, ET.ParseError) as exc:
+        chord = ET.fromstring(data).find("metrics/chord")
+    except ET.ParseError as exc:
         raise ExportError(f"cannot read the aircraft file {path!r}: {exc}") from None
     scale = {"FT": U.M_PER_FT, "IN": U.M_PER_FT / 12.0, "M": 1.0}
     unit = "FT" if chord is None else chord.get("unit", "FT").upper()

@@ -10,7 +10,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
+from bioflex_jsb.files import read_input_bytes
+
 SIGNING_KEY_BYTES = 32
+# Largest signing-key file read [bytes]: 64 hexadecimal digits and the white space around
+# them (a newline, CRLF, a few blanks) fit many times over.
+SIGNING_KEY_FILE_BYTES = 1024
 SIGNING_EPOCH_UNIX_S = 1420070400  # 2015-01-01T00:00:00Z: origin of signing timestamps
 
 
@@ -26,10 +31,9 @@ def read_signing_key(path: str | Path) -> bytes:
     when the file is missing, unreadable, or does not hold exactly 32 bytes of hex, or
     holds the all-zero key (which means "signing off" in MAVLink)."""
     where = f"signing key {str(path)!r}"
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise LinkError(f"{where}: cannot read it ({exc.strerror or exc})") from None
+    # a regular file of at most SIGNING_KEY_FILE_BYTES, read with that bound (a FIFO, a
+    # device such as /dev/zero or a large file: refused before reading it)
+    raw = read_input_bytes(path, "signing key", SIGNING_KEY_FILE_BYTES, LinkError)
     try:
         text = raw.decode("ascii").strip()
     except UnicodeDecodeError:

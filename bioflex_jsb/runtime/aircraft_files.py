@@ -43,10 +43,10 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
+from bioflex_jsb.files import read_input_bytes
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.results import AircraftLoadError
 from bioflex_jsb.simulation import jsbsim_properties as JP
-from bioflex_jsb.tomlfile import read_input_bytes
 
 # One file JSBSim reads [bytes]: the largest of the jsbsim package is 1.6 MB (an aircraft
 # with large aerodynamic tables); 16 MiB is 10 times that.
@@ -175,7 +175,7 @@ def read_named_files(aircraft_path: Path, files: list[NamedFile]
         if f.target in out:
             continue
         data = read_input_bytes(f.source, f"the file <{f.element} file={f.name!r}>",
-                                AircraftLoadError, MAX_FILE_BYTES)
+                                MAX_FILE_BYTES, AircraftLoadError)
         total += len(data)
         if total > MAX_TOTAL_BYTES:
             raise AircraftLoadError(f"the files {str(aircraft_path)!r} names exceed "
@@ -187,7 +187,7 @@ def read_named_files(aircraft_path: Path, files: list[NamedFile]
 def read_xml(path: str | os.PathLike, what: str = "the JSBSim aircraft") -> ET.ElementTree:
     """The XML file ``path`` (``what`` it is, for the message), read with the bound of every
     input file (:data:`MAX_FILE_BYTES`) and parsed; one line if it cannot be."""
-    data = read_input_bytes(path, what, AircraftLoadError, MAX_FILE_BYTES)
+    data = read_input_bytes(path, what, MAX_FILE_BYTES, AircraftLoadError)
     try:
         return ET.ElementTree(ET.fromstring(data))
     except ET.ParseError as exc:

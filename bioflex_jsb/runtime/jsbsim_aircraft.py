@@ -33,9 +33,15 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.definition.model import Inertia, JSBSimValues
+from bioflex_jsb.files import read_input_bytes
 from bioflex_jsb.parameters.airframe import DerivativeSchedule, ReferenceGeometry
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
-from bioflex_jsb.runtime.aircraft_files import derived_root, named_files, read_aircraft_xml
+from bioflex_jsb.runtime.aircraft_files import (
+    MAX_FILE_BYTES,
+    derived_root,
+    named_files,
+    read_aircraft_xml,
+)
 from bioflex_jsb.runtime.fdm import Airframe, load_fdm
 from bioflex_jsb.runtime.identification import identify_point
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, captured
@@ -77,9 +83,11 @@ def _fingerprint(jsbsim_path: str) -> str:
     """A hash of the aircraft file and every file it names (their bytes)."""
     path = Path(jsbsim_path)
     tree = read_aircraft_xml(path)
-    digest = hashlib.sha256(path.read_bytes())
+    digest = hashlib.sha256(read_input_bytes(path, "the JSBSim aircraft", MAX_FILE_BYTES,
+                                             AircraftLoadError))
     for f in named_files(path, tree):
-        digest.update(f.source.read_bytes())
+        digest.update(read_input_bytes(f.source, f"the file <{f.element} file={f.name!r}>",
+                                       MAX_FILE_BYTES, AircraftLoadError))
     return digest.hexdigest()
 
 

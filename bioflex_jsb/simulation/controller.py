@@ -68,9 +68,10 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.files import read_input_bytes
 from bioflex_jsb.simulation.channels import describe
 from bioflex_jsb.state_space import StateSpace
-from bioflex_jsb.tomlfile import loads_toml, read_input_bytes
+from bioflex_jsb.tomlfile import loads_toml
 
 # The commands a controller may write: name → unit (increments over the trim, module
 # docstring). The ailerons join once the lateral axis flies.
@@ -300,7 +301,7 @@ class LinearController:
         p = Path(path)
         if p.suffix.lower() not in FILE_SUFFIXES:
             raise InputError(f"controller file {str(p)!r}: give a .npz or .toml file")
-        data = read_input_bytes(p, "controller file", InputError, MAX_CONTROLLER_BYTES)
+        data = read_input_bytes(p, "controller file", MAX_CONTROLLER_BYTES, InputError)
         source = f"controller file {str(p)!r}"
         fields = _npz_fields(data, source) if p.suffix.lower() == ".npz" else \
             _toml_fields(data, source)

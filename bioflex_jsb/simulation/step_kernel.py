@@ -223,7 +223,10 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
 # code); a truncated, empty or overwritten file makes every run fail in numba's loader
 # (UnpicklingError, EOFError, MemoryError, ...) until it is deleted by hand. The guard wraps
 # the kernel's cache loader: a file that cannot be read is discarded (this kernel's files
-# only), one line says so on stderr, and numba compiles the kernel and caches it anew.
+# only), one line says so on stderr, and numba compiles the kernel and caches it anew. A
+# cache that cannot be written (a full disk: numba's save raised ENOSPC and the run ended
+# with status 4 naming no path) is skipped: the compiled code runs, one line on stderr says
+# where the cache is and why, once per process.
 # ---------------------------------------------------------------------------------------
 # What unpickling damaged bytes raises (pickle's own error, a stream cut short, a length or
 # an opcode argument out of range, an object built from nonsense): reading a file, nothing
@@ -234,9 +237,10 @@ DAMAGED_CACHE_ERRORS = (pickle.UnpicklingError, EOFError, ValueError, TypeError,
 
 def guard_cache(dispatcher) -> None:
     """Make ``dispatcher`` (an ``@numba.njit(cache=True)`` function) discard and rebuild a
-    damaged on-disk cache instead of failing: see the section's comment."""
+    damaged on-disk cache instead of failing, and run uncached when its cache cannot be
+    written: see the section's comment."""
     cache = dispatcher._cache
-    load = cache.load_overload
+    load, save = cache.load_overload, cache.save_overload
 
     def load_overload(sig, target_context):
         try:
@@ -245,7 +249,31 @@ def guard_cache(dispatcher) -> None:
             _discard_cache(dispatcher, cache, exc)
             return None  # numba compiles, then saves a fresh index and code
 
+    def save_overload(sig, data):
+        try:
+            save(sig, data)
+        except OSError as exc:  # a full disk, a read-only or vanished cache directory
+            _unwritable_cache(cache, exc)  # the compiled code is used all the same
+
     cache.load_overload = load_overload
+    cache.save_overload = save_overload
+
+
+UNWRITABLE_CACHE_SAID: list[str] = []  # the cache said to be unwritable (once a process)
+
+
+def _unwritable_cache(cache, exc: OSError) -> None:
+    """One line on stderr, once per process: the cache cannot be written, the run goes on
+    with the code compiled in memory, and where the cache is (NUMBA_CACHE_DIR when set,
+    else the kernel's own folder)."""
+    if UNWRITABLE_CACHE_SAID:
+        return
+    where = numba.config.CACHE_DIR or cache._cache_file._cache_path
+    UNWRITABLE_CACHE_SAID.append(where)
+    why = exc.strerror or type(exc).__name__
+    sys.stderr.write(f"bioflex-jsb: numba's cache in {where} cannot be written ({why}); "
+                     "running uncached (each run compiles its kernels again, 20-35 s) until "
+                     "there is room there, or NUMBA_CACHE_DIR names a writable folder\n")
 
 
 def cache_files(dispatcher) -> list[str]:

@@ -9,6 +9,7 @@ mass basis, aerodynamic model, overrides, …). :func:`read_state_space` reads i
 
 from __future__ import annotations
 
+import io
 import json
 import zipfile
 from collections.abc import Mapping
@@ -17,9 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.files import read_input_bytes
 from bioflex_jsb.flight_dynamics.lti import StateSpace
 
 FORMATS = (".npz", ".mat")
+# Largest model file read [bytes], and what its arrays may declare: a model of n states holds
+# about (n + inputs + outputs)^2 numbers; the project's have fewer than 40 states (< 20 kB).
+MAX_MODEL_FILE_BYTES = 64 * 1024 * 1024
 _NAME_KEYS = ("states", "state_units", "inputs", "input_units", "outputs", "output_units")
 
 
@@ -104,20 +109,33 @@ def state_space_from_arrays(data: Mapping[str, object], source: str = "model fil
     return StateSpace(model=model, speed_m_s=speed, a=a, b=b, c=c, d=d, notes=notes, **names)
 
 
+def _check_npz_sizes(raw: bytes, source: str) -> None:
+    """InputError unless the arrays of the .npz ``raw`` declare at most
+    :data:`MAX_MODEL_FILE_BYTES` in all (what ``numpy.load`` will decompress: the zip reader
+    stops at a member's declared size)."""
+    with zipfile.ZipFile(io.BytesIO(raw)) as z:
+        declared = sum(info.file_size for info in z.infolist())
+    if declared > MAX_MODEL_FILE_BYTES:
+        raise InputError(f"{source}: its arrays declare {declared} bytes, more than the "
+                         f"{MAX_MODEL_FILE_BYTES} a model file may hold")
+
+
 def read_state_space(path: str | Path) -> StateSpace:
     """Read a model file written by :func:`write_state_space` (``bioflex-jsb export``)."""
     p = Path(path)
     if p.suffix not in FORMATS:
         raise InputError(f"unknown model file type {p.suffix!r}; accepted: {', '.join(FORMATS)}")
+    raw = read_input_bytes(p, "model file", MAX_MODEL_FILE_BYTES)
     try:
         if p.suffix == ".npz":
-            with np.load(p, allow_pickle=False) as data:
+            _check_npz_sizes(raw, str(p))
+            with np.load(io.BytesIO(raw), allow_pickle=False) as data:
                 return state_space_from_arrays(dict(data), str(p))
         from scipy.io import loadmat
         from scipy.io.matlab import MatReadError
 
         try:
-            arrays = loadmat(p)
+            arrays = loadmat(io.BytesIO(raw))
         except MatReadError as exc:  # truncated, or not a .mat file at all
             raise InputError(f"{str(p)!r} is not a model file: {exc}") from None
         return state_space_from_arrays(arrays, str(p))

@@ -339,11 +339,11 @@ def parse_modal_text(text: str, *, name: str = "<modal text>", normalise: bool =
 
 def read_modal_file(path: str | Path, *, normalise: bool = True) -> ModalData:
     """Read a modal-data file into SI :class:`ModalData` (normalised unless told not to)."""
-    from bioflex_jsb.tomlfile import read_input_text
+    from bioflex_jsb.files import read_input_text
 
     p = Path(path)
     # a regular file of at most MAX_MODAL_BYTES, UTF-8 (a FIFO or a device: refused at once)
-    text = read_input_text(p, "modal-data file", ModalFileError, MAX_MODAL_BYTES)
+    text = read_input_text(p, "modal-data file", MAX_MODAL_BYTES, ModalFileError)
     return parse_modal_text(text, name=str(p), normalise=normalise)
 
 

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.files import open_input
 from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
 
 # The deck's units in SI. Length: the grids' coordinates and translations. Mass: the mass
@@ -48,6 +49,9 @@ AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 # semispan (two grids at one station, or out of order, are a mistake in the list).
 MIN_STATION_STEP_FRAC = 1e-9
 MAX_GRIDS = 10_000  # the stations of a modal file: a wing's reference line, not its mesh
+# Largest OP2 file read [bytes]: pyyeti reads it into memory; a SOL 103 deck of a wing's
+# beam or shell model with its first tens of modes is a few MB to a few hundred.
+MAX_OP2_BYTES = 2 * 1024**3
 
 
 class NastranError(InputError):
@@ -151,8 +155,10 @@ def read_op2_modes(path: str | Path, grids) -> FEModes:
         raise NastranError("reading an OP2 file needs pyyeti: pip install "
                            "\"bioflex-jsb[nastran]\" (or pip install pyyeti)") from None
     p = Path(path)
-    if not p.is_file():
-        raise NastranError(f"OP2 file {str(p)!r}: not a file")
+    # a regular file of at most MAX_OP2_BYTES (pyyeti reads it by name, into memory: a FIFO
+    # would hang it, a device fill the memory)
+    with open_input(p, "OP2 file", MAX_OP2_BYTES, NastranError):
+        pass
     ids = [int(g) for g in grids]
     if not 2 <= len(ids) <= MAX_GRIDS or len(set(ids)) != len(ids):
         raise NastranError(f"grids: give 2..{MAX_GRIDS} distinct grid ids, root to tip")

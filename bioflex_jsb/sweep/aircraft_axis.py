@@ -99,9 +99,10 @@ def aircraft_identity(aircraft) -> dict[str, Any]:
     path = str(aircraft.definition.path)
     if path not in _DIGESTS:
         from bioflex_jsb.definition.loader import DefinitionError
-        from bioflex_jsb.tomlfile import read_input_bytes
+        from bioflex_jsb.files import read_input_bytes
+        from bioflex_jsb.tomlfile import MAX_TOML_BYTES
 
-        data = read_input_bytes(path, "definition file", DefinitionError)
+        data = read_input_bytes(path, "definition file", MAX_TOML_BYTES, DefinitionError)
         _DIGESTS[path] = hashlib.sha256(data).hexdigest()
     out = {"name": aircraft.name, "definition_sha256": _DIGESTS[path]}
     if aircraft.flight_problem() is not None:

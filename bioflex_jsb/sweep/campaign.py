@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from bioflex_jsb.errors import unprintable
 from bioflex_jsb.flight_dynamics.lti import MODELS
 from bioflex_jsb.flight_dynamics.wing_model import (
     DEFAULT_MASS_BASIS,
@@ -192,11 +193,11 @@ _MODES_DIGESTS: dict[str, str | None] = {}
 
 def _modes_digest(path: str) -> str | None:
     if path not in _MODES_DIGESTS:
+        from bioflex_jsb.files import read_input_bytes
         from bioflex_jsb.structures.modal_file import MAX_MODAL_BYTES, ModalFileError
-        from bioflex_jsb.tomlfile import read_input_bytes
 
         try:
-            data = read_input_bytes(path, "modal-data file", ModalFileError, MAX_MODAL_BYTES)
+            data = read_input_bytes(path, "modal-data file", MAX_MODAL_BYTES, ModalFileError)
             _MODES_DIGESTS[path] = hashlib.sha256(data).hexdigest()
         except ModalFileError:
             _MODES_DIGESTS[path] = None
@@ -330,6 +331,18 @@ def _number(v: Any, key: str, unit: str, positive: bool = False, minimum: float 
     return x
 
 
+# The decimals an axis value keeps: a range's start + k * step carries the float error of
+# the product (15.1 + 3 * 0.3 = 16.000000000000004); a value given in a list is rounded
+# alike, so 15.0 and 15.0000000000001 are one speed (refused as given twice), not two cases
+# of two ids that fly the same.
+GRID_DECIMALS = 12
+
+
+def grid_values(values: list[float]) -> list[float]:
+    """``values`` rounded to :data:`GRID_DECIMALS` decimals, as every numeric axis is."""
+    return [round(x, GRID_DECIMALS) for x in values]
+
+
 def _values(v: Any, key: str, integer: bool = False) -> list:
     """An axis: a non-empty list, or a range table {start, stop, step | num} (stop included)."""
     if isinstance(v, dict):
@@ -357,8 +370,7 @@ def _values(v: Any, key: str, integer: bool = False) -> list:
             n = int(math.floor((stop - start) / step + 1e-9)) + 1
         if n > MAX_CASES:  # before the list is made (num = 1e8 hung the command)
             raise CampaignError(f"{key}: {n} values is too many; accepted: up to {MAX_CASES}")
-        values = [start + k * step for k in range(n)]
-        values = [round(x, 12) for x in values]
+        values = grid_values([start + k * step for k in range(n)])
         if integer:
             if not all(float(x).is_integer() for x in values):
                 raise CampaignError(f"{key}: must give whole numbers")
@@ -394,6 +406,9 @@ def _check_plain_name(name: str) -> None:
     """A campaign's ``name`` is the default output's file name (``<name>.parquet``): a plain
     file-name component, so that it cannot point outside the current folder."""
     bad = next((c for c in name if c in "/\\" or ord(c) < 32 or ord(c) == 127), None)
+    if bad is None and unprintable(name):  # a bidirectional override, a line separator
+        raise CampaignError(f"name: {ascii(name[:60])} holds {unprintable(name)}; accepted: "
+                            "printable text")
     if (bad is not None or name.strip() in (".", "..") or name.startswith(".")
             or len(name) > MAX_NAME_CHARS):
         why = (f"contains {bad!r}" if bad is not None else
@@ -447,7 +462,7 @@ def parse_campaign(
         raise CampaignError("axes.speeds_m_s: missing; give the airspeeds [m/s]")
     speeds = [_number(v, f"axes.speeds_m_s[{i}]", "m/s", minimum=MIN_SPEED_M_S, maximum=100.0)
               for i, v in enumerate(_values(axes["speeds_m_s"], "axes.speeds_m_s"))]
-    speeds = _unique(speeds, "axes.speeds_m_s")
+    speeds = _unique(grid_values(speeds), "axes.speeds_m_s")
 
     gusts = _gusts(axes, metrics)
 
@@ -536,9 +551,9 @@ def _wings(axes: dict, base_dir: Path | None, required: bool = True) -> list[Win
         grids = {}
         for key in ("x_inertial_frac", "x_elastic_frac"):
             values = _values(axes[key], f"axes.{key}")
-            grids[key] = _unique(
+            grids[key] = _unique(grid_values(
                 [_number(v, f"axes.{key}[{i}]", "(fraction of the chord)", minimum=0.0,
-                         maximum=1.0) for i, v in enumerate(values)], f"axes.{key}")
+                         maximum=1.0) for i, v in enumerate(values)]), f"axes.{key}")
         for xi in grids["x_inertial_frac"]:
             for xe in grids["x_elastic_frac"]:
                 wings.append(axis_variant(xi, xe))

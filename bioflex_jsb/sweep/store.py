@@ -44,6 +44,8 @@ from typing import Any
 SUFFIXES = (".csv", ".parquet")
 RESULT_NAME = "results.parquet"  # the one visible file of a .parquet output
 PARTS_DIR = ".parts"  # hidden: finished cases not merged yet
+# Largest results table read back [bytes]: a row is ≈ 0.5-1 kB, so 10^7 cases are ≈ 10 GB.
+MAX_TABLE_BYTES = 64 * 1024**3
 
 # Called with the name of each step of the merge (ParquetStore.close) as it is reached:
 # None in use; the fault tests kill the process at each step through it.
@@ -133,6 +135,9 @@ def open_store(path: str | Path, columns: dict[str, str], resume: bool):
     ``done_ids`` (every case with a row) and ``failed_ids`` (those whose last row is
     ``failed``, run again with ``--retry-failed``)."""
     p = Path(path)
+    if p.is_symlink() and not p.exists():  # the table would be created at its target
+        raise StoreError(f"--out {str(p)!r} is a symbolic link to {os.readlink(p)!r}, which "
+                         "does not exist; name the table's own path")
     suffix = p.suffix.lower()
     if suffix == ".csv":
         return CsvStore(p, columns, resume)
@@ -176,6 +181,28 @@ def _check_writable(path: Path) -> None:
     except OSError as exc:
         raise StoreError(f"--out {str(path)!r}: cannot write in {str(folder)!r}: "
                          f"{exc.strerror}") from None
+
+
+def _open_table(path: Path):
+    """A results table (or part) opened for reading: a regular file of at most
+    :data:`MAX_TABLE_BYTES` (:func:`bioflex_jsb.files.open_input`); StoreError otherwise."""
+    from bioflex_jsb.files import open_input
+
+    return open_input(path, "results table", MAX_TABLE_BYTES, StoreError)
+
+
+def _after_last_newline(fh, size: int) -> int:
+    """The offset just after the last newline of the open file ``fh`` of ``size`` bytes (0
+    without one), read backwards a block at a time."""
+    block, end = 64 * 1024, size
+    while end > 0:
+        start = max(0, end - block)
+        fh.seek(start)
+        at = fh.read(end - start).rfind(b"\n")
+        if at >= 0:
+            return start + at + 1
+        end = start
+    return 0
 
 
 def _text(value: Any) -> str:
@@ -244,11 +271,14 @@ class CsvStore:
             raise
 
     def _recover(self) -> None:
-        data = self.path.read_bytes()
-        if data and not data.endswith(b"\n"):  # a row cut off by a kill
+        with _open_table(self.path) as raw:
+            size = os.fstat(raw.fileno()).st_size
+            end = _after_last_newline(raw, size)
+        if end < size:  # a row cut off by a kill
             with open(self.path, "r+b") as fh:
-                fh.truncate(data.rfind(b"\n") + 1)
-        with open(self.path, newline="", encoding="utf-8", errors="replace") as fh:
+                fh.truncate(end)
+        with _open_table(self.path) as raw, io.TextIOWrapper(
+                raw, newline="", encoding="utf-8", errors="replace") as fh:
             reader = csv.reader(fh)
             header = next(reader, None)
             if header is None:
@@ -314,11 +344,13 @@ class ParquetStore:
 
         for part in self._sources():
             try:
-                schema = self._pq.read_schema(part)
-                if schema.names != self.schema.names:
-                    self.columns = _resumed_columns(self.path, schema.names, self.columns)
-                    self.schema = _schema(self.columns)
-                table = self._pq.read_table(part, columns=["case_id", "status"])
+                with _open_table(part) as fh:
+                    schema = self._pq.read_schema(fh)
+                    if schema.names != self.schema.names:
+                        self.columns = _resumed_columns(self.path, schema.names, self.columns)
+                        self.schema = _schema(self.columns)
+                    fh.seek(0)
+                    table = self._pq.read_table(fh, columns=["case_id", "status"])
             except (pa.ArrowException, OSError, ValueError) as exc:
                 if isinstance(exc, StoreError):
                     raise
@@ -410,7 +442,7 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
     p = Path(path)
     rows: list[dict[str, Any]]
     if p.suffix.lower() == ".csv":
-        with open(p, newline="", encoding="utf-8") as fh:
+        with _open_table(p) as raw, io.TextIOWrapper(raw, newline="", encoding="utf-8") as fh:
             reader = csv.DictReader(fh)
             raw = [r for r in reader if None not in r.values()]
         if columns is None:
@@ -429,7 +461,8 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
             files = [p]
         rows = []
         for f in files:
-            rows.extend(pq.read_table(f).to_pylist())
+            with _open_table(f) as fh:
+                rows.extend(pq.read_table(fh).to_pylist())
     by_id: dict[str, dict[str, Any]] = {}
     for r in rows:
         by_id[r["case_id"]] = r

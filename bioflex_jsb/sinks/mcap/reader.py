@@ -6,26 +6,24 @@ truncated or damaged is a :class:`LogError` with one line for the user.
 
 from __future__ import annotations
 
+import io
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from bioflex_jsb.sinks.mcap.schemas import EVENT_LEVELS, EVENTS_TOPIC
-from bioflex_jsb.sinks.mcap_io.errors import LogError, bad_data_errors
+from bioflex_jsb.sinks.mcap_io.errors import LogError, bad_data_errors, open_log
 from bioflex_jsb.sinks.mcap_io.protobuf import decoder
 from bioflex_jsb.sinks.mcap_io.writer import MAGIC
 from bioflex_jsb.values import is_real
 
 
 def check_file(path: str | Path) -> Path:
-    """``path`` as a Path if it is an existing file starting with the MCAP magic."""
+    """``path`` as a Path if it is a regular file (:func:`open_log`) starting with the MCAP
+    magic."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
-    with open(p, "rb") as f:
+    with open_log(p) as f:
         head = f.read(len(MAGIC))
     if head != MAGIC:
         raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
@@ -63,7 +61,7 @@ def open_reader(path: str | Path, verified: bool = False):
     from mcap.reader import make_reader
 
     p = verify(path) and Path(path) if verified else check_file(path)
-    with open(p, "rb") as f:
+    with open_log(p) as raw, io.BufferedReader(raw) as f:
         f.seek(0, 2)
         size = f.tell()
         if size < 2 * len(MAGIC) + 29:
@@ -82,7 +80,50 @@ def open_reader(path: str | Path, verified: bool = False):
                            "`--recover FIXED.mcap` copies its intact chunks") from None
         if summary is None:
             raise _truncated(p)
+        _check_chunk_sizes(f, summary, p)
+        f.seek(0)
         yield reader, summary
+
+
+def _check_chunk_sizes(f, summary, p: Path) -> None:
+    """The ``mcap`` reader decompresses a chunk to what its zstd frame declares (whatever
+    the chunk says) and an lz4 chunk without a bound: before it reads any, every chunk the
+    summary indexes is checked to decompress to at most what it declares, within
+    :data:`.recover.MAX_CHUNK_BYTES` (LogError, one line, otherwise): its Chunk record's
+    sizes, a zstd frame's declared size, an lz4 chunk decompressed with that bound."""
+    import struct
+
+    from bioflex_jsb.sinks.mcap_io.recover import (
+        ChunkTooLarge,
+        check_chunk_sizes,
+        check_zstd_frame,
+        decompress_chunk,
+    )
+
+    head = struct.Struct("<BQQQQII")  # opcode, length, start, end, uncompressed size, CRC, name
+    for index in summary.chunk_indexes:
+        f.seek(index.chunk_start_offset)
+        raw = f.read(head.size)
+        if len(raw) < head.size:
+            raise LogError(f"{str(p)!r}: its chunk index points past the end of the file")
+        _op, _length, _start, _end, size, _crc, name_len = head.unpack(raw)
+        name = f.read(min(name_len, 8))
+        if name_len > 8 or name not in (b"", b"zstd", b"lz4"):
+            raise LogError(f"{str(p)!r}: the chunk at byte {index.chunk_start_offset} is "
+                           "compressed in a way MCAP does not define (zstd, lz4 or none)")
+        (n_bytes,) = struct.unpack("<Q", f.read(8).ljust(8, b"\0"))
+        try:
+            check_chunk_sizes(max(size, index.uncompressed_size), n_bytes)
+            if name == b"lz4":  # decompressed by mcap without a bound: first by ours
+                decompress_chunk(name, f.read(n_bytes), size)
+            elif name == b"zstd":  # decompressed by mcap to what its frame's header says
+                check_zstd_frame(f.read(min(n_bytes, 18)), size)
+        except ChunkTooLarge as exc:
+            raise LogError(f"{str(p)!r}: {exc} (at byte {index.chunk_start_offset})") from None
+        except bad_data_errors() as exc:
+            raise LogError(f"{str(p)!r}: the chunk at byte {index.chunk_start_offset} is "
+                           f"damaged ({exc}); `bioflex-jsb info FILE --check` says where, "
+                           "`--recover FIXED.mcap` copies the intact chunks") from None
 
 
 def read_metadata(reader) -> dict[str, dict[str, str]]:

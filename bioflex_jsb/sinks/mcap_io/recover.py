@@ -22,27 +22,88 @@ indexed like any log (the tests run ``pymcap-cli doctor`` on it).
 from __future__ import annotations
 
 import mmap
+import os
 import struct
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
-from bioflex_jsb.sinks.mcap_io.errors import LogError, LogWriteError, bad_data_errors
-from bioflex_jsb.sinks.mcap_io.writer import MAGIC, McapFileWriter
+from bioflex_jsb.files import size_text
+from bioflex_jsb.sinks.mcap_io.errors import LogError, LogWriteError, bad_data_errors, open_log
+from bioflex_jsb.sinks.mcap_io.writer import CHUNK_MAX_BYTES, MAGIC, McapFileWriter
 
 _OP_HEADER, _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, OP_MESSAGE, _OP_CHUNK = 1, 2, 3, 4, 5, 6
 _OP_METADATA, _OP_DATA_END = 0x0C, 0x0F
 _KNOWN_OPS = set(range(0x01, 0x10))
 _COMPRESSIONS = (b"", b"zstd", b"lz4")
 _MAX_RESYNC_TRIES = 100_000  # candidate chunk starts tried after a damaged record length
+# Largest chunk read [bytes], uncompressed as it declares and compressed: 16 times the
+# project's own (writer.CHUNK_MAX_BYTES, 4 MiB); other MCAP writers' defaults are 1-8 MiB
+# (the mcap library's 1 MiB, ROS 2's 4 MiB). A chunk beyond it is refused before anything
+# is decompressed, and nothing decompresses to more than its chunk declares: a 65 kB file
+# holding a zstd chunk of 2 GiB of zeros took 4.2 GB to read before.
+MAX_CHUNK_BYTES = 64 * 1024 * 1024
+
+
+class ChunkTooLarge(LogError):
+    """A chunk larger than :data:`MAX_CHUNK_BYTES`: the file is refused (one line)."""
+
+
+def _too_large(what: str, n: int) -> ChunkTooLarge:
+    return ChunkTooLarge(f"a chunk {what} {size_text(n)}, more than the "
+                         f"{size_text(MAX_CHUNK_BYTES)} a chunk may hold here (bioflex-jsb "
+                         f"writes at most {size_text(CHUNK_MAX_BYTES)})")
+
+
+def check_chunk_sizes(size: int, n_bytes: int) -> None:
+    """ChunkTooLarge unless a chunk's declared uncompressed ``size`` and its compressed
+    ``n_bytes`` are both within :data:`MAX_CHUNK_BYTES`."""
+    if size > MAX_CHUNK_BYTES:
+        raise _too_large("declares", size)
+    if n_bytes > MAX_CHUNK_BYTES:
+        raise _too_large("holds", n_bytes)
+
+
+def check_zstd_frame(header: bytes, size: int) -> None:
+    """ValueError (a damaged chunk) when the zstd frame that starts with ``header`` declares
+    another size than its chunk's ``size`` (the decoder allocates what the frame says)."""
+    import zstandard
+
+    framed = zstandard.frame_content_size(header)  # -1: not in the frame's header
+    if framed not in (-1, size):
+        raise ValueError(f"its zstd frame declares {framed} bytes, the chunk {size}")
+
+
+def decompress_chunk(name: bytes, raw, size: int) -> bytes:
+    """The records of a chunk compressed with ``name`` (``zstd``, ``lz4`` or none) that
+    declares ``size`` bytes, never more than that decompressed: ChunkTooLarge beyond
+    :data:`MAX_CHUNK_BYTES`; ValueError (a damaged chunk) when a zstd frame declares
+    another size or an lz4 frame holds more; a zstd frame's checksum checked by the
+    decoder."""
+    check_chunk_sizes(size, len(raw))
+    if name == b"zstd":
+        import zstandard
+
+        check_zstd_frame(bytes(raw[:18]), size)
+        return zstandard.ZstdDecompressor().decompress(raw, max_output_size=size)
+    if name == b"lz4":
+        import lz4.frame
+
+        decoder = lz4.frame.LZ4FrameDecompressor()
+        data = decoder.decompress(raw, max_length=size + 1)
+        if len(data) > size:
+            raise ValueError(f"chunk decompresses to more than the {size} bytes it declares")
+        if not decoder.eof:
+            raise ValueError("chunk's lz4 frame is cut short")
+        return data
+    return bytes(raw)
 
 
 def _open_data(p: Path):
-    size = p.stat().st_size
-    if size == 0:
-        raise LogError(f"{str(p)!r} is empty: its writer was killed before writing the MCAP "
-                       "header; there is nothing to recover")
-    with open(p, "rb") as f:  # the map outlives the file object; freed with its last view
+    with open_log(p) as f:  # the map outlives the file object; freed with its last view
+        if os.fstat(f.fileno()).st_size == 0:
+            raise LogError(f"{str(p)!r} is empty: its writer was killed before writing the "
+                           "MCAP header; there is nothing to recover")
         data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     if data[:len(MAGIC)] != MAGIC:
         raise LogError(f"{str(p)!r} is not an MCAP file (no MCAP magic at the start)")
@@ -65,17 +126,7 @@ def _chunk_records(body) -> tuple[int, list[tuple[int, bytes]]]:
     at += 8
     if at + n_bytes != len(body):
         raise ValueError("chunk records length does not match the record length")
-    raw = body[at:at + n_bytes]
-    if name == b"zstd":
-        import zstandard
-
-        data = zstandard.ZstdDecompressor().decompress(raw, max_output_size=size)
-    elif name == b"lz4":
-        import lz4.frame
-
-        data = lz4.frame.decompress(raw)
-    else:
-        data = bytes(raw)
+    data = decompress_chunk(name, body[at:at + n_bytes], size)
     if len(data) != size:
         raise ValueError(f"chunk decompresses to {len(data)} bytes, not {size}")
     if crc and zlib.crc32(data) != crc:
@@ -139,6 +190,8 @@ def scan(data) -> Iterator[tuple[int, int, object]]:
         if op == _OP_CHUNK:
             try:
                 yield pos, op, _chunk_records(body)
+            except ChunkTooLarge as exc:
+                raise ChunkTooLarge(f"{exc} (at byte {pos})") from None
             except bad_data_errors() as exc:
                 yield pos, op, exc
         elif op in (_OP_DATA_END, _OP_FOOTER):
@@ -224,10 +277,6 @@ def recover(path: str | Path, out: str | Path, library: str) -> dict:
     (each skipped chunk is listed in ``skipped``: its byte offset and why). Returns counts,
     the last log time kept [s] and where and why the read stopped."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
     dst = Path(out)
     if dst.exists() and dst.resolve() == p.resolve():
         raise LogError("--recover must name a new file, not the log itself")
@@ -236,45 +285,49 @@ def recover(path: str | Path, out: str | Path, library: str) -> dict:
         fout = open(dst, "wb")  # noqa: SIM115 - closed below
     except OSError as exc:
         raise LogWriteError(f"cannot write {str(dst)!r}: {exc.strerror}") from None
-    with fout:
-        writer = McapFileWriter(fout, library=library,
-                                background=False)
-        copier = _Copier(writer)
-        skipped: list[str] = []
-        stop, chunks = "end of file", 0
-        # an intact summary (its CRC checks) gives the schemas, channels and metadata first:
-        # a damaged record before the first chunk (the header's length) loses them otherwise
-        taken, chunk_offsets = _from_summary(data, copier)
-        # with it, the chunks are read where its chunk index says they are (a damaged record
-        # length cannot make the scan skip an intact chunk); without it, the file is scanned
-        records = scan(data) if chunk_offsets is None else _indexed_chunks(data, chunk_offsets)
-        for offset, op, body in records:
-            if isinstance(body, BaseException):
+    try:
+        with fout:
+            writer = McapFileWriter(fout, library=library,
+                                    background=False)
+            copier = _Copier(writer)
+            skipped: list[str] = []
+            stop, chunks = "end of file", 0
+            # an intact summary (its CRC checks) gives the schemas, channels and metadata first:
+            # a damaged record before the first chunk (the header's length) loses them otherwise
+            taken, chunk_offsets = _from_summary(data, copier)
+            # with it, the chunks are read where its chunk index says they are (a damaged record
+            # length cannot make the scan skip an intact chunk); without it, the file is scanned
+            records = scan(data) if chunk_offsets is None else _indexed_chunks(data, chunk_offsets)
+            for offset, op, body in records:
+                if isinstance(body, BaseException):
+                    if op == _OP_CHUNK:
+                        skipped.append(f"chunk at byte {offset} ({body})")
+                        continue
+                    stop = str(body)
+                    break
+                if op in (_OP_DATA_END, _OP_FOOTER):
+                    stop = "the end of the data section (the file was finished)"
+                    break
                 if op == _OP_CHUNK:
-                    skipped.append(f"chunk at byte {offset} ({body})")
-                    continue
-                stop = str(body)
-                break
-            if op in (_OP_DATA_END, _OP_FOOTER):
-                stop = "the end of the data section (the file was finished)"
-                break
-            if op == _OP_CHUNK:
-                _crc, records = body
-                try:
-                    for inner_op, inner in records:
-                        copier.record(inner_op, inner)
-                except (ValueError, struct.error, UnicodeDecodeError) as exc:
-                    skipped.append(f"chunk at byte {offset} ({exc})")
-                    writer.close_chunk()
-                    continue
-                writer.close_chunk()  # one chunk out per chunk in
-                chunks += 1
-            elif op != _OP_HEADER and not (op == _OP_METADATA and offset in taken):
-                try:
-                    copier.record(op, body)
-                except (ValueError, struct.error, UnicodeDecodeError) as exc:
-                    skipped.append(f"record at byte {offset} ({exc})")
-        writer.finish()
+                    _crc, records = body
+                    try:
+                        for inner_op, inner in records:
+                            copier.record(inner_op, inner)
+                    except (ValueError, struct.error, UnicodeDecodeError) as exc:
+                        skipped.append(f"chunk at byte {offset} ({exc})")
+                        writer.close_chunk()
+                        continue
+                    writer.close_chunk()  # one chunk out per chunk in
+                    chunks += 1
+                elif op != _OP_HEADER and not (op == _OP_METADATA and offset in taken):
+                    try:
+                        copier.record(op, body)
+                    except (ValueError, struct.error, UnicodeDecodeError) as exc:
+                        skipped.append(f"record at byte {offset} ({exc})")
+            writer.finish()
+    except ChunkTooLarge as exc:  # refused whole: the partial copy is removed
+        dst.unlink(missing_ok=True)
+        raise ChunkTooLarge(f"{str(p)!r}: {exc}") from None
     skipped += [f"{n} messages of channel {cid} (its schema record is lost)"
                 for cid, n in copier.lost.items()]
     last = copier.last_ns
@@ -343,6 +396,8 @@ def _indexed_chunks(data, offsets: list[int]) -> Iterator[tuple[int, int, object
             continue
         try:
             yield at, _OP_CHUNK, _chunk_records(view[at + 9:end])
+        except ChunkTooLarge as exc:
+            raise ChunkTooLarge(f"{exc} (at byte {at})") from None
         except bad_data_errors() as exc:
             yield at, _OP_CHUNK, exc
     yield len(data), _OP_DATA_END, b""
@@ -358,11 +413,15 @@ def check_chunks(path: str | Path) -> dict:
     present), ``missing`` (what an unfinished file lacks) and ``problems`` (one phrase each
     for everything that does not check; empty for a sound, finished file)."""
     p = Path(path)
-    if not p.exists():
-        raise LogError(f"{str(p)!r}: no such file")
-    if not p.is_file():
-        raise LogError(f"{str(p)!r} is not a file")
     data = _open_data(p)
+    try:
+        return _check(p, data)
+    except ChunkTooLarge as exc:
+        raise ChunkTooLarge(f"{str(p)!r}: {exc}") from None
+
+
+def _check(p: Path, data) -> dict:
+    """:func:`check_chunks` of the mapped file ``data`` (of ``p``)."""
     chunks, bad, data_crc, stop, data_end = 0, [], "unfinished", None, None
     problems: list[str] = []
     for offset, op, body in scan(data):
