@@ -153,6 +153,10 @@ def _other_aircraft(args: argparse.Namespace):
     return aircraft if aircraft is not None and aircraft.flight_problem() else None
 
 
+# An ArduPlane parameter file is a few kB (the shipped one 4 kB); 1 MiB bounds the read.
+PARM_MAX_BYTES = 1 << 20
+
+
 def _write_parm(args: argparse.Namespace) -> int:
     """``--write-parm``: the aircraft's ArduPlane parameter file (the prototype's shipped
     one without another --aircraft), never over a file of the user's without --force."""
@@ -165,8 +169,10 @@ def _write_parm(args: argparse.Namespace) -> int:
     check_new_file(args.write_parm, args.force, "--write-parm", (".parm",))
     aircraft = _other_aircraft(args)
     if aircraft is None:
-        text = (Path(__file__).resolve().parents[1] / "data" / "ardupilot"
-                / "bioflex_plane.parm").read_text(encoding="utf-8")
+        from bioflex_jsb.files import read_input_text
+
+        shipped = Path(__file__).resolve().parents[1] / "data" / "ardupilot" / "bioflex_plane.parm"
+        text = read_input_text(shipped, "the shipped parameter file", PARM_MAX_BYTES, UsageError)
         what = "the prototype's bioflex_plane.parm"
     else:
         try:
