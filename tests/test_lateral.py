@@ -5,6 +5,8 @@ derivatives, closed forms and the classical approximations."""
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -161,7 +163,7 @@ def test_the_lateral_roots_agree_with_jsbsims_linearisation(name, speed, method)
     mine = lateral_mode_set(ss)
     lin = airframe.linearize_lateral(speed, method=method)
     assert lin.method == method
-    theirs = lateral_mode_set(ss.__class__(**{**ss.__dict__, "a": lin.a}))
+    theirs = lateral_mode_set(dataclasses.replace(ss, a=lin.a))
     for mode in ("roll", "spiral", "dutch_roll"):
         m, t = mine[mode].eigenvalue, theirs[mode].eigenvalue
         assert abs(m - t) <= 5e-3 * abs(t), (name, mode, m, t)
@@ -208,3 +210,53 @@ def test_the_classical_approximations_hold(name, speed, method):
     if abs(e) > 1e-6 * abs(d.l_prime["beta"] * d.n_prime["r"]):  # the prototype's E = 0
         assert (modes["spiral"].re < 0.0) == (e > 0.0), (name, modes["spiral"].re, e)
     assert math.isfinite(approx.spiral_rad_s)
+
+
+# -- the API and the command ----------------------------------------------------------------
+def test_the_api_model_is_the_identified_one_with_named_signals():
+    """api.lateral_model of the prototype at 15 m/s: its JSBSim airframe's derivatives, the
+    typed estimates of parameters/airframe.py (C_lp −0.45, C_nr −0.08, C_lδa 0.20; the
+    generated tables are linear in them: 1e-9), and python-control's model carries the
+    names."""
+    from bioflex_jsb import api
+    from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS as R
+
+    ss = api.lateral_model(None, 15.0)
+    d = ss.notes["derivatives"]
+    for mine, typed in (("cl_p", R.cl_p_per_rad), ("cn_r", R.cn_r_per_rad),
+                        ("cl_delta_a", R.cl_delta_a_per_rad), ("cn_beta", R.cn_beta_per_rad),
+                        ("cn_delta_r", R.cn_delta_r_per_rad)):
+        assert d[mine] == pytest.approx(typed, rel=1e-8), mine
+    assert "not the paper's" in ss.notes["source"]
+    sys_ctrl = ss.to_control()
+    assert list(sys_ctrl.input_labels) == ["v_g", "aileron", "rudder"]
+    assert list(sys_ctrl.output_labels) == ["beta", "p", "r", "phi", "n_y"]
+    assert [m.mode for m in api.lateral_modes(None, [15.0, 20.0])[1]] == [
+        "roll", "spiral", "dutch_roll"]
+
+
+def test_modes_axis_lateral_lists_roll_spiral_and_dutch_roll(capsys):
+    from tests.cli_helpers import run_cli
+
+    code, out, _ = run_cli(capsys, "modes", "--axis", "lateral", "--aircraft", "sgs_elastic",
+                           "--speed", "25", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["axis"] == "lateral" and data["aircraft"] == "sgs_elastic"
+    names = [m["mode"] for m in data["results"][0]["modes"]]
+    assert names == ["roll", "spiral", "dutch_roll"]
+    # SGS.xml's Clp −0.47 (measured −0.469986 on the sgs_elastic definition's airframe)
+    assert data["results"][0]["derivatives"]["cl_p"] == pytest.approx(-0.47, rel=1e-4)
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (("--plot", "x.png"), "--plot does not apply"),
+    (("--models", "coupled"), "--models coupled does not apply"),
+    (("--speed", "5"), "cannot trim at 5 m/s"),
+])
+def test_modes_axis_lateral_bad_input_is_one_line(capsys, tmp_path, monkeypatch, argv, needle):
+    from tests.cli_helpers import assert_one_line_error, run_cli
+
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli(capsys, "modes", "--axis", "lateral", *argv)
+    assert_one_line_error(code, err, needle)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 import numpy as np
 
@@ -49,7 +50,17 @@ speed). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization
 airframe), which includes the thrust's change with airspeed; see its --help (JSON:
 "rigid_block"). A mode is one conjugate pair or two real roots (an over-damped short period
 is listed as two real short_period roots); the short period is the one of the larger
-natural frequency at each speed."""
+natural frequency at each speed.
+
+--axis lateral: the rigid aircraft's lateral-directional modes instead (roll subsidence
+"roll", "spiral", "dutch_roll"; eigenvalues in rad/s), from sideslip, roll-rate, yaw-rate and
+bank equations whose derivatives are identified from the aircraft's JSBSim model at its trim
+at each --speed (the prototype's generated JSBSim airframe, whose lateral tables are
+estimates: the paper has no lateral data; docs/lateral.md). The aircraft must trim there
+(the prototype 9..32 m/s; an --aircraft its flight speeds, default its cruise speed); the
+elastic wing takes no part (its antisymmetric modes are not modelled yet), so --models,
+--aero, --structural-damping, --plot, --animate and --mode-sheet do not apply. JSON:
+"derivatives" (body axes, per rad; rates with b/2V) and "source" per speed."""
 
 
 def register(sub) -> None:
@@ -72,6 +83,10 @@ def register(sub) -> None:
     p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
                    help="structural damping ratio ζ of every wing mode, 0 <= Z < 1 (default: "
                    "the wing's own)")
+    p.add_argument("--axis", choices=("longitudinal", "lateral"), default="longitudinal",
+                   help="longitudinal (default: the paper's models) or lateral (the rigid "
+                   "aircraft's roll, spiral and Dutch roll from its JSBSim model's "
+                   "derivatives; eigenvalues in rad/s)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--plot", metavar="FILE.png",
@@ -114,6 +129,8 @@ def _check_shape_outputs(args, speeds) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.axis == "lateral":
+        return _run_lateral(args)
     default_speed, flight_top = aircraft_speeds(args)
     speeds = args.speed or [default_speed]
     if args.aero == "unsteady" and "coupled" not in args.models:  # it would change nothing
@@ -168,6 +185,56 @@ def run(args: argparse.Namespace) -> int:
               f"({', '.join(payload['animation']['modes'])})")
     if args.mode_sheet:
         print(f"mode sheet written to {args.mode_sheet}")
+    return 0
+
+
+LONGITUDINAL_ONLY = (("--aero unsteady", lambda a: a.aero != "quasi-steady"),
+                     ("--structural-damping", lambda a: a.structural_damping is not None),
+                     ("--plot", lambda a: a.plot is not None),
+                     ("--animate", lambda a: a.animate is not None),
+                     ("--mode-sheet", lambda a: a.mode_sheet is not None))
+
+
+def _run_lateral(args: argparse.Namespace) -> int:
+    """--axis lateral: the rigid lateral-directional modes at each --speed (HELP)."""
+    from bioflex_jsb import api
+    from bioflex_jsb.flight_dynamics.lateral import lateral_mode_set
+
+    given = [name for name, used in LONGITUDINAL_ONLY if used(args)]
+    if tuple(args.models) not in (("rigid", "coupled", "qsd"), ("rigid",)):
+        given.insert(0, f"--models {','.join(args.models)}")
+    if given:
+        raise UsageError(f"--axis lateral is the rigid aircraft's model: {', '.join(given)} "
+                         "does not apply")
+    aircraft = args.aircraft_definition  # None: the prototype
+    name = aircraft.name if aircraft is not None else "bioflex (the prototype)"
+    results = []
+    for v in args.speed or [None]:
+        ss = api.lateral_model(aircraft, v)
+        results.append((ss, lateral_mode_set(ss)))
+    payload = {
+        "axis": "lateral", "aircraft": name,
+        "results": [{**ms.as_dict(), "derivatives": ss.notes["derivatives"],
+                     "alpha_trim_rad": ss.notes["alpha_trim_rad"],
+                     "source": ss.notes["source"]} for ss, ms in results],
+        "unstable": [{"speed_m_s": ms.speed_m_s, "model": ms.model, "mode": m.mode,
+                      "re": m.re, "im": m.im}
+                     for _, ms in results for m in ms.modes if m.unstable],
+    }
+    if args.json:
+        print_json(payload)
+        return 0
+    print(f"aircraft {name}: rigid lateral-directional modes (derivatives from its JSBSim "
+          "model at each trim)")
+    print(f"{'V [m/s]':>8} {'mode':<12} {'re [rad/s]':>11} {'im [rad/s]':>11} {'damping':>8} "
+          f"{'ω_n [rad/s]':>12}  stability")
+    for _, ms in results:
+        for m in ms.modes:
+            note = "UNSTABLE" if m.unstable else "stable"
+            if m.mode == "spiral" and m.unstable:
+                note += f" (doubles in {math.log(2.0) / m.re:.0f} s)"
+            print(f"{ms.speed_m_s:8.2f} {m.mode:<12} {m.re:11.4f} {m.im:11.4f} "
+                  f"{m.damping:8.3f} {m.frequency_rad_s:12.4f}  {note}")
     return 0
 
 

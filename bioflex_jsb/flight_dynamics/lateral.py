@@ -266,11 +266,14 @@ def lateral_mode_labels(lam: np.ndarray, roll_estimate_rad_s: float | None = Non
     return tuple(labels)
 
 
-def lateral_mode_set(ss: StateSpace, roll_estimate_rad_s: float | None = None) -> ModeSet:
-    """The labelled modes of a lateral model ``ss`` (one entry per conjugate pair, im ≥ 0;
-    both roots of a real Dutch roll), in the order roll, spiral, Dutch roll."""
+def lateral_mode_set(ss: StateSpace) -> ModeSet:
+    """The labelled modes of a lateral model ``ss`` (states β, p, r, φ: one entry per
+    conjugate pair, im ≥ 0; both roots of a real Dutch roll), in the order roll, spiral,
+    Dutch roll; the roll root among four real ones is the one nearest L'_p = ∂ṗ/∂p."""
+    if ss.states != LATERAL_STATES:
+        raise ValueError(f"a lateral model has the states {LATERAL_STATES}, not {ss.states}")
     lam = np.linalg.eigvals(ss.a)
-    labels = lateral_mode_labels(lam, roll_estimate_rad_s)
+    labels = lateral_mode_labels(lam, float(ss.a[1, 1]))
     modes: list[Mode] = []
     for name in ("roll", "spiral", "dutch_roll", ROLL_SPIRAL_LABEL):
         roots = [lam[k] for k in range(4) if labels[k] == name]
