@@ -78,9 +78,9 @@ from bioflex_jsb.simulation.run_checks import finite_number as _real
 
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
-    "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "linear_model",
-    "load_aircraft", "load_definition", "load_wing", "metrics", "modes", "plot_runs",
-    "read_log", "section_loads", "to_python_control", "load_controller",
+    "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "lateral_model",
+    "lateral_modes", "linear_model", "load_aircraft", "load_definition", "load_wing", "metrics",
+    "modes", "plot_runs", "read_log", "section_loads", "to_python_control", "load_controller",
     "linear_controller", "predict_alleviation", "design_alleviation",
 ]
 
@@ -474,6 +474,99 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     return build_state_space(model, level_flight_condition(speed_m_s, airframe=airframe, **air),
                              None if wing is None else wing.model, controls=True)
 
+
+
+def _lateral_point(wing, speed_m_s: float | None):
+    """(the subject, the identified lateral point) of ``wing`` (an Aircraft, a bare
+    prototype wing or None): its JSBSim airframe trimmed at the speed [m/s]."""
+    from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
+    from bioflex_jsb.runtime.identification import identify_lateral
+    from bioflex_jsb.runtime.jsbsim_aircraft import isa_altitude_m
+
+    subject = _Subject.of(wing)
+    if subject.aircraft is not None:  # its speeds and mass as the JSBSim model says them
+        subject = _Subject(complete_aircraft(subject.aircraft), subject.build)
+        problem = flight_refusal(subject.aircraft)
+        if problem:
+            raise InputError(problem)
+        reference = subject.aircraft.airframe_data().reference
+        altitude = isa_altitude_m(subject.aircraft.definition.air.density_kg_m3)
+    elif subject.build is None or subject.build.model.airframe is PROTOTYPE_AIRFRAME:
+        reference, altitude = REFERENCE_GEOMETRY, 0.0
+    else:
+        raise InputError(f"wing {subject.build.variant.name!r} is built for airframe "
+                         f"{subject.build.model.airframe.name!r}: pass its Aircraft "
+                         "(api.load_aircraft), whose definition names the JSBSim aircraft")
+    speed = subject.flight_speed(speed_m_s)
+    airframe = subject.jsbsim_airframe()
+    name = subject.aircraft.name if subject.aircraft is not None else "bioflex"
+    source = (f"derivatives identified from the JSBSim airframe of {name!r} at its trim "
+              f"at {speed:g} m/s, {altitude:.0f} m (not the paper's: it has no lateral "
+              "data)")
+    return subject, identify_lateral(airframe, speed, reference, altitude, source)
+
+
+def _lateral(wing, speed_m_s, model: str):
+    """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`."""
+    from bioflex_jsb.flight_dynamics.lateral_elastic import (
+        LATERAL_MODELS,
+        antisymmetric_wing,
+        build_lateral_elastic,
+    )
+
+    _check_choice("model", model, LATERAL_MODELS)
+    subject, point = _lateral_point(wing, speed_m_s)
+    rigid = build_lateral_elastic("rigid", point.trim, point.aero, None)
+    if model == "rigid":
+        return rigid, rigid, None
+    if subject.build is None:
+        raise InputError(f"the lateral {model} model needs an elastic wing: pass a wing or "
+                         "an Aircraft, not None")
+    wing_a = antisymmetric_wing(subject.build, point.trim.ixx_kg_m2)
+    return build_lateral_elastic(model, point.trim, point.aero, wing_a), rigid, wing_a
+
+
+def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid"
+                  ) -> StateSpace:
+    """The linear lateral-directional model at ``speed_m_s`` [m/s] (None: the aircraft's
+    cruise speed, the prototype's 15 m/s), about its JSBSim trim there (docs/lateral.md):
+    states beta [rad] (sideslip, air from the right), p, r [rad/s] (roll right, yaw right,
+    body axes), phi [rad] (bank, right wing down); inputs v_g [m/s] (lateral gust, to
+    starboard), aileron [rad] (+ roll right) and rudder [rad] (+ trailing edge left, nose
+    left); outputs the states and n_y [-] (lateral load factor, to starboard). Its rigid
+    derivatives are identified from the aircraft's JSBSim model at the trim
+    (``notes["derivatives"]``, body axes; the prototype's are those of its generated JSBSim
+    airframe, estimates: the paper has no lateral data).
+
+    ``model``: ``rigid`` (default), ``coupled`` (with the wing's antisymmetric modes:
+    states eta1.. [rad] and eta1_dot.. [rad/s] after phi, quasi-steady strips;
+    :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`) or ``qsd`` (their static
+    deformation residualised; outputs also the quasi-static eta). ``wing`` an
+    :class:`Aircraft` (its JSBSim airframe and wing), the prototype's wing or None (the
+    prototype, rigid only). One line (InputError) when the aircraft cannot be trimmed at
+    that speed, or its wing has no beam (a modal-data file: no antisymmetric modes)."""
+    return _lateral(wing, speed_m_s, model)[0]
+
+
+def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
+                  model: str = "rigid") -> ModeSet | list[ModeSet]:
+    """The labelled lateral-directional modes of :func:`lateral_model` of ``wing`` (an
+    :class:`Aircraft`, the prototype's wing or None: the prototype) at ``speed_m_s``
+    [m/s] (or a list, one per speed of a sequence), ``model`` rigid, coupled or qsd:
+    ``roll`` (roll subsidence), ``spiral`` (unstable when its ``re`` > 0), ``dutch_roll``
+    and the coupled model's ``antisymmetric_k`` [rad/s]."""
+    from bioflex_jsb.flight_dynamics.lateral import lateral_mode_set
+    from bioflex_jsb.flight_dynamics.lateral_elastic import coupled_mode_set
+
+    if isinstance(speed_m_s, Iterable) and not isinstance(speed_m_s, str | bytes):
+        speeds = list(speed_m_s)
+        if not speeds:
+            raise InputError("speed_m_s: give a speed [m/s] or a non-empty sequence of them")
+        return [lateral_modes(wing, v, model) for v in speeds]
+    ss, rigid, wing_a = _lateral(wing, speed_m_s, model)
+    if model == "coupled":
+        return coupled_mode_set(ss, rigid, wing_a)
+    return lateral_mode_set(ss)
 
 def to_python_control(ss: StateSpace):
     """``ss`` (a :class:`StateSpace`, a model file's path or its arrays) as a

@@ -327,10 +327,9 @@ def test_mcap_decompression_bombs_are_refused_in_one_line_within_bounded_memory(
 
 
 def test_the_chunk_bound_names_the_chunk_and_keeps_the_projects_own_logs(bombs):
+    from bioflex_jsb.sinks.mcap import LogError, check_chunks
     from bioflex_jsb.sinks.mcap_io.recover import MAX_CHUNK_BYTES, decompress_chunk
     from bioflex_jsb.sinks.mcap_io.writer import CHUNK_MAX_BYTES
-
-    from bioflex_jsb.sinks.mcap import LogError, check_chunks
 
     assert MAX_CHUNK_BYTES >= 16 * CHUNK_MAX_BYTES
     with pytest.raises(LogError, match=r"declares 2 GiB, more than the 64 MiB.*at byte 99"):

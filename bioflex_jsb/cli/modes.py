@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import math
+import sys
 
 import numpy as np
 
@@ -49,7 +51,20 @@ speed). The phugoid differs from `bioflex-jsb linearize` (JSBSim's linearization
 airframe), which includes the thrust's change with airspeed; see its --help (JSON:
 "rigid_block"). A mode is one conjugate pair or two real roots (an over-damped short period
 is listed as two real short_period roots); the short period is the one of the larger
-natural frequency at each speed."""
+natural frequency at each speed.
+
+--axis lateral: the lateral-directional modes instead (roll subsidence "roll", "spiral",
+"dutch_roll" and, coupled, the wing's antisymmetric modes "antisymmetric_1..3";
+eigenvalues in rad/s): sideslip, roll-rate, yaw-rate and bank equations whose rigid
+derivatives are identified from the aircraft's JSBSim model at its trim at each --speed
+(the prototype's generated JSBSim airframe, whose lateral tables are estimates: the paper
+has no lateral data), --models rigid (the rigid aircraft), coupled (with the wing's
+antisymmetric modes on quasi-steady strips) and qsd (their static deformation); a wing given
+as a modal-data file has no antisymmetric modes (rigid only). The aircraft must trim there
+(the prototype 9..32 m/s; an --aircraft its flight speeds, default its cruise speed);
+--aero unsteady, --structural-damping, --plot, --animate and --mode-sheet do not apply.
+JSON: "derivatives" (body axes, per rad; rates with b/2V) and "source" per result;
+docs/lateral.md."""
 
 
 def register(sub) -> None:
@@ -62,7 +77,7 @@ def register(sub) -> None:
         f"speeds (default {DEFAULT_SPEED_M_S:g}; an --aircraft's own cruise speed)",
     )
     p.add_argument(
-        "--models", type=models_list, default=("rigid", "coupled", "qsd"),
+        "--models", type=models_list, default=DEFAULT_MODELS,
         help="comma-separated subset of rigid,coupled,qsd (default: all three)",
     )
     p.add_argument("--aero", choices=("quasi-steady", "unsteady"), default="quasi-steady",
@@ -72,6 +87,10 @@ def register(sub) -> None:
     p.add_argument("--structural-damping", type=damping_ratio, default=None, metavar="Z",
                    help="structural damping ratio ζ of every wing mode, 0 <= Z < 1 (default: "
                    "the wing's own)")
+    p.add_argument("--axis", choices=("longitudinal", "lateral"), default="longitudinal",
+                   help="longitudinal (default: the paper's models) or lateral (roll, "
+                   "spiral, Dutch roll from the JSBSim model's derivatives and the wing's "
+                   "antisymmetric modes; eigenvalues in rad/s)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--plot", metavar="FILE.png",
@@ -114,6 +133,8 @@ def _check_shape_outputs(args, speeds) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.axis == "lateral":
+        return _run_lateral(args)
     default_speed, flight_top = aircraft_speeds(args)
     speeds = args.speed or [default_speed]
     if args.aero == "unsteady" and "coupled" not in args.models:  # it would change nothing
@@ -168,6 +189,69 @@ def run(args: argparse.Namespace) -> int:
               f"({', '.join(payload['animation']['modes'])})")
     if args.mode_sheet:
         print(f"mode sheet written to {args.mode_sheet}")
+    return 0
+
+
+DEFAULT_MODELS = ("rigid", "coupled", "qsd")
+LONGITUDINAL_ONLY = (("--aero unsteady", lambda a: a.aero != "quasi-steady"),
+                     ("--structural-damping", lambda a: a.structural_damping is not None),
+                     ("--plot", lambda a: a.plot is not None),
+                     ("--animate", lambda a: a.animate is not None),
+                     ("--mode-sheet", lambda a: a.mode_sheet is not None))
+
+
+def _run_lateral(args: argparse.Namespace) -> int:
+    """--axis lateral: the lateral-directional modes at each --speed (HELP)."""
+    from bioflex_jsb import api
+
+    given = [name for name, used in LONGITUDINAL_ONLY if used(args)]
+    if given:
+        raise UsageError(f"--axis lateral takes the quasi-steady models without plots: "
+                         f"{', '.join(given)} does not apply")
+    aircraft = args.aircraft_definition
+    subject = aircraft if aircraft is not None else wing_from_args(args)
+    build = subject.wing() if aircraft is not None else subject
+    models = tuple(args.models)
+    if build.variant.beam is None and build.variant.modes_file:
+        if models != DEFAULT_MODELS:
+            if set(models) - {"rigid"}:
+                raise UsageError(f"wing {build.variant.name!r} is a modal-data file: no "
+                                 "antisymmetric modes (they need its beam); use --models "
+                                 "rigid")
+        else:
+            print(f"bioflex-jsb: note: wing {build.variant.name!r} is a modal-data file: "
+                  "the rigid lateral model only (the antisymmetric modes need its beam)",
+                  file=sys.stderr)
+            models = ("rigid",)
+    name = aircraft.name if aircraft is not None else f"bioflex (wing {build.variant.name})"
+    results = []
+    for model in models:
+        for v in args.speed or [None]:
+            ss = api.lateral_model(subject, v, model)
+            results.append((ss, api.lateral_modes(subject, ss.speed_m_s, model)))
+    payload = {
+        "axis": "lateral", "aircraft": name,
+        "results": [{**ms.as_dict(), "derivatives": ss.notes["derivatives"],
+                     "alpha_trim_rad": ss.notes["alpha_trim_rad"],
+                     "source": ss.notes["source"]} for ss, ms in results],
+        "unstable": [{"speed_m_s": ms.speed_m_s, "model": ms.model, "mode": m.mode,
+                      "re": m.re, "im": m.im}
+                     for _, ms in results for m in ms.modes if m.unstable],
+    }
+    if args.json:
+        print_json(payload)
+        return 0
+    print(f"aircraft {name}: lateral-directional modes (rigid derivatives from its JSBSim "
+          "model at each trim)")
+    print(f"{'V [m/s]':>8} {'model':<16} {'mode':<16} {'re [rad/s]':>11} {'im [rad/s]':>11} "
+          f"{'damping':>8} {'ω_n [rad/s]':>12}  stability")
+    for _, ms in results:
+        for m in ms.modes:
+            note = "UNSTABLE" if m.unstable else "stable"
+            if m.mode == "spiral" and m.unstable:
+                note += f" (doubles in {math.log(2.0) / m.re:.0f} s)"
+            print(f"{ms.speed_m_s:8.2f} {ms.model:<16} {m.mode:<16} {m.re:11.4f} {m.im:11.4f} "
+                  f"{m.damping:8.3f} {m.frequency_rad_s:12.4f}  {note}")
     return 0
 
 

@@ -81,12 +81,18 @@ from bioflex_jsb.runtime.engines import engines_of
 from bioflex_jsb.runtime.engines import start as start_engines
 from bioflex_jsb.runtime.glide import glide_elevator_norm, glide_trim
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, LogRecord, captured
-from bioflex_jsb.runtime.linearization import reduce_to_rigid, rigid_jacobian
+from bioflex_jsb.runtime.linearization import (
+    lateral_jacobian,
+    reduce_to_lateral,
+    reduce_to_rigid,
+    rigid_jacobian,
+)
 from bioflex_jsb.runtime.results import (  # noqa: F401  (the runtime's errors and results)
     RIGID_STATE_UNITS,
     RIGID_STATES,
     AircraftLoadError,
     FdmError,
+    LateralLinearization,
     LinearizationError,
     ModeEigenvalue,
     RigidLinearization,
@@ -516,6 +522,37 @@ class Airframe:
             jsbsim_states=names,
             residualised_states=residualised,
         )
+
+    def linearize_lateral(self, speed_m_s: float, altitude_m: float = 0.0,
+                          method: str = "FGLinearization") -> LateralLinearization:
+        """Trim at ``speed_m_s`` [m/s], then JSBSim's lateral-directional linear model
+        (states β, p, r, φ; SI): ``method`` ``FGLinearization`` (JSBSim's own, of the trim
+        companion at its trim) or ``central differences`` (of the flying instance's state
+        derivatives, :func:`~bioflex_jsb.runtime.linearization.lateral_jacobian`); a
+        glider always the latter (FGLinearization needs an engine).
+
+        Raises:
+            ValueError, TrimError: as :meth:`trim`.
+            LinearizationError: JSBSim's state list lacks a lateral state.
+        """
+        if method not in ("FGLinearization", "central differences"):
+            raise ValueError(f"unknown method {method!r}")
+        trim = self.trim(speed_m_s, altitude_m)
+        if self.glider or method == "central differences":
+            # the flying instance of an airframe with a trim companion keeps the trim's RPM
+            # (JSBSim's steady-state step diverges at its physical rotor inertia)
+            with captured(self._log):
+                a = lateral_jacobian(self._fdm,
+                                     powered=not (self.glider or self.has_companion))
+            method = "central differences"
+        else:
+            with captured(self._log):
+                lin = jsbsim.FGLinearization(self._trim_fdm)
+                a_full = np.array(lin.system_matrix, dtype=float)
+                names, units = tuple(lin.x_names), tuple(lin.x_units)
+            self._restore_time_step()
+            a = reduce_to_lateral(a_full, names, units)
+        return LateralLinearization(trim.speed_m_s, trim, a, method)
 
     # ---- modal-wing hooks -----------------------------------------------------------------
     def set_external_reactions(

@@ -48,6 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.flight_dynamics.lateral import LateralAerodynamics, LateralTrim
 from bioflex_jsb.parameters.airframe import ReferenceGeometry, RigidAerodynamics
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.runtime.results import LinearizationError, TrimError
@@ -138,10 +139,14 @@ class Evaluator:
     """Evaluates JSBSim's forces at states of ``airframe`` (a loaded
     :class:`~bioflex_jsb.runtime.fdm.Airframe` of an aircraft with the modal wing's hooks),
     held as the module docstring says. The airframe is left at the last state evaluated:
-    trim it again before flying it."""
+    trim it again before flying it. ``steady_rpm``: bring the propellers to their steady
+    RPM at each state (False: keep the trim's, for states at the trim's airspeed and
+    throttle on an airframe whose flying instance cannot take JSBSim's steady-state step:
+    the prototype, whose trim companion exists for that, runtime/fdm.py)."""
 
-    def __init__(self, airframe) -> None:
+    def __init__(self, airframe, steady_rpm: bool = True) -> None:
         self.airframe = airframe
+        self.steady_rpm = steady_rpm
         fdm = airframe.jsbsim
         self.fdm = fdm
         m = fdm.get_property_manager()
@@ -185,7 +190,7 @@ class Evaluator:
         for k in range(HOLD_PASSES):
             fdm[HOOK_LIFT], fdm[HOOK_DRAG] = lift_hook, drag_hook
             fdm.run_ic()
-            if k == 0 and self.engines:
+            if k == 0 and self.engines and self.steady_rpm:
                 fdm.get_propulsion().get_steady_state()
                 fdm.run_ic()
             u, w = fdm[JP.VELOCITIES_U_FPS], fdm[JP.VELOCITIES_W_FPS]
@@ -333,3 +338,91 @@ def _lift_peak(ev: Evaluator, at, alpha0: float, alpha_top: float, s_ref: float
         elif cl < best - 0.05:  # well past the peak
             break
     return best, best_alpha
+
+
+@dataclass(frozen=True)
+class LateralPoint:
+    """The lateral-directional derivatives at one trim (:func:`identify_lateral`):
+    ``trim`` (:class:`~bioflex_jsb.flight_dynamics.lateral.LateralTrim`: speed, density,
+    α_0, θ_0, the mass and inertia JSBSim flies with, S, b) and ``aero``
+    (:class:`~bioflex_jsb.flight_dynamics.lateral.LateralAerodynamics`, body axes), the
+    trim's drag coefficient ``cd_trim`` [-] (the body-axis C_Yβ holds −C_D of a SIDE axis
+    in wind axes: docs/lateral.md) and the surface positions at the trim [rad]."""
+
+    trim: LateralTrim
+    aero: LateralAerodynamics
+    cd_trim: float
+    aileron_rad: float
+    rudder_rad: float
+
+
+def identify_lateral(airframe, speed_m_s: float, reference: ReferenceGeometry,
+                     altitude_m: float = 0.0, source: str = "") -> LateralPoint:
+    """The lateral-directional derivatives of ``airframe`` at its trim at ``speed_m_s``
+    [m/s], ``altitude_m`` [m] (JSBSim's full trim; a glider's steady glide), by the
+    module's method: central differences of JSBSim's aerodynamic side force, rolling and
+    yawing moments (body axes, about the CG, ``forces/fby-aero-lbs``,
+    ``moments/l-aero-lbsft``, ``moments/n-aero-lbsft``) at β ± 1e-3 rad, p̂, r̂ ± 1e-3
+    (p̂ = p b/2V, body rates) and the aileron and rudder commands ± 0.01 (per radian of the
+    surfaces' own positions), each state with its u̇, ẇ held (:class:`Evaluator`),
+    non-dimensional on ``reference`` (S, b). The mass and inertia are JSBSim's at the trim
+    (``inertia/*``: the pilot's and the fuel's included). Raises :class:`TrimError` when
+    the aircraft cannot be trimmed there, :class:`LinearizationError` when a surface
+    command moves nothing."""
+    trim = airframe.trim(speed_m_s, altitude_m)
+    fdm = airframe.jsbsim
+    # every state has the trim's airspeed and throttle: the propellers stay at the trim's RPM
+    ev = Evaluator(airframe, steady_rpm=False)
+    v, a0 = trim.speed_m_s, trim.alpha_rad
+    theta0 = float(fdm[JP.ATTITUDE_THETA_RAD])
+    slug_ft2 = U.KG_PER_SLUG * U.M_PER_FT**2
+    mass = float(fdm[JP.INERTIA_MASS_SLUGS]) * U.KG_PER_SLUG
+    ixx, izz, j13 = (float(fdm[f"inertia/{k}-slugs_ft2"]) * slug_ft2
+                     for k in ("ixx", "izz", "ixz"))
+    rho = float(fdm[JP.ATMOSPHERE_RHO_SLUGS_FT3]) * U.KG_PER_SLUG / U.M_PER_FT**3
+    s_ref, b = reference.area_m2, reference.span_m
+    throttle = float(fdm[JP.FCS_THROTTLE_CMD_NORM_0]) if airframe.engines else 0.0
+    base = State(v, a0, elevator_cmd=float(fdm[JP.FCS_ELEVATOR_CMD_NORM]),
+                 aileron_cmd=float(fdm[JP.FCS_AILERON_CMD_NORM]),
+                 rudder_cmd=float(fdm[JP.FCS_RUDDER_CMD_NORM]), throttle=throttle)
+
+    def at(**changes) -> State:
+        return State(**{**base.__dict__, **changes})
+
+    def coeffs(r: Reading) -> np.ndarray:
+        qsr = r.q_pa * s_ref
+        return np.array([r.side / qsr, r.roll / (qsr * b), r.yaw / (qsr * b)])
+
+    def slope(lo: Reading, hi: Reading, step: float) -> np.ndarray:
+        return (coeffs(hi) - coeffs(lo)) / step
+
+    r0 = ev(base)
+    cd_trim = r0.drag / (r0.q_pa * s_ref)
+    d_beta = slope(ev(at(beta_rad=-BETA_STEP_RAD)), ev(at(beta_rad=BETA_STEP_RAD)),
+                   2 * BETA_STEP_RAD)
+    pr_step = RATE_STEP * 2.0 * v / b
+    d_p = slope(ev(at(p_rad_s=-pr_step)), ev(at(p_rad_s=pr_step)), 2 * RATE_STEP)
+    d_r = slope(ev(at(r_rad_s=-pr_step)), ev(at(r_rad_s=pr_step)), 2 * RATE_STEP)
+    surfaces = []
+    for field, angle in (("aileron_cmd", "aileron"), ("rudder_cmd", "rudder")):
+        cmd = getattr(base, field)
+        lo, hi = ev(at(**{field: cmd - CONTROL_STEP})), ev(at(**{field: cmd + CONTROL_STEP}))
+        travel = getattr(hi, angle) - getattr(lo, angle)
+        if not travel or not math.isfinite(travel):
+            raise LinearizationError(f"{airframe.aircraft!r}: the {angle} command does not "
+                                     f"move its surface at the trim at {v:g} m/s (at a "
+                                     "stop, or no fcs/*-pos-rad)")
+        surfaces.append(slope(lo, hi, travel))
+    d_da, d_dr = surfaces
+    aero = LateralAerodynamics(
+        cy_beta=d_beta[0], cy_p=d_p[0], cy_r=d_r[0], cy_delta_a=d_da[0], cy_delta_r=d_dr[0],
+        cl_beta=d_beta[1], cl_p=d_p[1], cl_r=d_r[1], cl_delta_a=d_da[1], cl_delta_r=d_dr[1],
+        cn_beta=d_beta[2], cn_p=d_p[2], cn_r=d_r[2], cn_delta_a=d_da[2], cn_delta_r=d_dr[2])
+    # I_xz = ∫ x z dm is the negative of the J₁₃ JSBSim integrates with (flight_dynamics/
+    # lateral.py; measured: tests/test_lateral.py)
+    lat_trim = LateralTrim(v, rho, a0, theta0, mass, ixx, izz, -j13, s_ref, b,
+                           source or f"JSBSim aircraft {airframe.aircraft!r} identified at "
+                           f"{v:g} m/s, {altitude_m:g} m")
+    ev(base)  # leave the airframe at the trim state, its hooks unloaded
+    airframe.set_external_reactions()
+    return LateralPoint(lat_trim, aero, cd_trim, r0.aileron, r0.rudder)

@@ -139,3 +139,84 @@ def rigid_jacobian(fdm, powered: bool = False) -> np.ndarray:
         a[:, j] = (derivatives(x0 + dx) - derivatives(x0 - dx)) / (2.0 * h)
     derivatives(x0)  # back at the trim state
     return a
+
+
+# JSBSim state names (FGStateSpace) of the lateral-directional model, in the order of
+# flight_dynamics/lateral.py's x = [β, p, r, φ], with their units.
+_LATERAL_JSBSIM = (("Beta", "rad"), ("P", "rad/s"), ("R", "rad/s"), ("Phi", "rad"))
+
+
+def reduce_to_lateral(a_full: np.ndarray, names: tuple[str, ...],
+                      units: tuple[str, ...]) -> np.ndarray:
+    """JSBSim's system matrix → the 4×4 lateral block in x = [β, p, r, φ] (rad, rad/s):
+    its rows and columns of Beta, P, R, Phi. The longitudinal states, the heading ψ (which
+    nothing depends on), the position and the engine states are dropped: at a wings-level
+    trim they are decoupled from the lateral ones but for a single propeller's gyroscopic
+    and torque terms (the c172p: its full matrix's lateral roots within 2.2 % of the
+    block's, the spiral's the farthest; docs/lateral.md)."""
+    index = {n: i for i, n in enumerate(names)}
+    keep = []
+    for name, unit in _LATERAL_JSBSIM:
+        if name not in index:
+            raise LinearizationError(f"JSBSim's linear model has no {name!r} state: {names}")
+        if units[index[name]] != unit:
+            raise LinearizationError(f"JSBSim's {name!r} state is in "
+                                     f"{units[index[name]]!r}, expected {unit!r}")
+        keep.append(index[name])
+    a = np.asarray(a_full, dtype=float)[np.ix_(keep, keep)]
+    if not np.all(np.isfinite(a)):
+        raise LinearizationError("JSBSim's linear model has non-finite entries")
+    return a
+
+
+# Central-difference steps of the lateral Jacobian (:func:`lateral_jacobian`): 1e-4 rad of
+# β and φ, 1e-4 rad/s of p and r, the longitudinal steps' sizes (JACOBIAN_STEPS).
+LATERAL_STEPS = (1e-4, 1e-4, 1e-4, 1e-4)
+
+
+def lateral_jacobian(fdm, powered: bool = False) -> np.ndarray:
+    """The lateral block A (4×4, x = [β [rad], p, r [rad/s], φ [rad]], body axes) of
+    ``fdm`` at its current state (a wings-level trim, no wind), by central differences of
+    JSBSim's own state derivatives: β̇ = (V v̇ − v V̇)/(V² cos β) with V̇ = (u u̇ + v v̇ +
+    w ẇ)/V, ṗ, ṙ, φ̇ = p + (q sin φ + r cos φ) tan θ, each state evaluated until its α̇ is
+    its own (:data:`ALPHADOT_PASSES`) and, ``powered``, with the propellers at their steady
+    RPM; α, θ, V and q held at the trim's. The glider's replacement for FGLinearization
+    (which needs an engine) and a second reference for the powered aircraft. The state is
+    put back at the end."""
+    m = 0.3048  # m per ft (exact)
+    u0, v0, w0 = (fdm[k] * m for k in (JP.VELOCITIES_U_FPS, JP.VELOCITIES_V_FPS,
+                                       JP.VELOCITIES_W_FPS))
+    speed = math.sqrt(u0 * u0 + v0 * v0 + w0 * w0)
+    alpha = math.atan2(w0, u0)
+    theta, q0 = fdm[JP.ATTITUDE_THETA_RAD], fdm[JP.VELOCITIES_Q_RAD_SEC]
+    x0 = np.array([math.asin(v0 / speed), fdm[JP.VELOCITIES_P_RAD_SEC],
+                   fdm[JP.VELOCITIES_R_RAD_SEC], fdm[JP.ATTITUDE_PHI_RAD]])
+
+    def derivatives(x: np.ndarray) -> np.ndarray:
+        beta, p, r, phi = x
+        u = speed * math.cos(alpha) * math.cos(beta)
+        v = speed * math.sin(beta)
+        w = speed * math.sin(alpha) * math.cos(beta)
+        fdm[JP.IC_U_FPS], fdm[JP.IC_V_FPS], fdm[JP.IC_W_FPS] = u / m, v / m, w / m
+        fdm[JP.IC_THETA_RAD], fdm[JP.IC_PHI_RAD] = theta, phi
+        fdm[JP.IC_P_RAD_SEC], fdm[JP.IC_Q_RAD_SEC], fdm[JP.IC_R_RAD_SEC] = p, q0, r
+        for _ in range(ALPHADOT_PASSES):
+            fdm.run_ic()
+            if powered:
+                fdm.get_propulsion().get_steady_state()
+        udot, vdot, wdot = (fdm[k] * m for k in (JP.ACCELERATIONS_UDOT_FT_SEC2,
+                                                 JP.ACCELERATIONS_VDOT_FT_SEC2,
+                                                 JP.ACCELERATIONS_WDOT_FT_SEC2))
+        vt_dot = (u * udot + v * vdot + w * wdot) / speed
+        return np.array([(speed * vdot - v * vt_dot) / (speed**2 * math.cos(beta)),
+                         fdm[JP.ACCELERATIONS_PDOT_RAD_SEC2],
+                         fdm[JP.ACCELERATIONS_RDOT_RAD_SEC2],
+                         p + (q0 * math.sin(phi) + r * math.cos(phi)) * math.tan(theta)])
+
+    a = np.empty((4, 4))
+    for j, h in enumerate(LATERAL_STEPS):
+        dx = np.zeros(4)
+        dx[j] = h
+        a[:, j] = (derivatives(x0 + dx) - derivatives(x0 - dx)) / (2.0 * h)
+    derivatives(x0)  # back at the trim state
+    return a

@@ -114,6 +114,31 @@ class RigidLinearization:
         raise KeyError(f"no {name!r} eigenvalue")
 
 
+@dataclass(frozen=True)
+class LateralLinearization:
+    """JSBSim's lateral-directional linear model at a trim (SI).
+
+    Attributes:
+        speed_m_s: trim airspeed [m/s]; trim: the trim it was taken at.
+        a: 4×4 system matrix, states [β, p, r, φ] in rad, rad/s (body axes; row i:
+            d x_i/dt), the lateral block of JSBSim's model
+            (:func:`~bioflex_jsb.runtime.linearization.reduce_to_lateral`).
+        method: ``FGLinearization`` (JSBSim's own) or ``central differences`` (of JSBSim's
+            state derivatives: a glider, which FGLinearization cannot take;
+            :func:`~bioflex_jsb.runtime.linearization.lateral_jacobian`).
+    """
+
+    speed_m_s: float
+    trim: TrimResult
+    a: np.ndarray
+    method: str
+
+    @property
+    def eigenvalues(self) -> np.ndarray:
+        """The four roots [rad/s]."""
+        return np.linalg.eigvals(self.a)
+
+
 def label_modes(eigenvalues: np.ndarray) -> tuple[ModeEigenvalue, ...]:
     """Label the 4 longitudinal eigenvalues and keep one per conjugate pair.
 

@@ -12,6 +12,7 @@ ACCELERATIONS_PDOT_RAD_SEC2 = "accelerations/pdot-rad_sec2"
 ACCELERATIONS_QDOT_RAD_SEC2 = "accelerations/qdot-rad_sec2"
 ACCELERATIONS_RDOT_RAD_SEC2 = "accelerations/rdot-rad_sec2"
 ACCELERATIONS_UDOT_FT_SEC2 = "accelerations/udot-ft_sec2"
+ACCELERATIONS_VDOT_FT_SEC2 = "accelerations/vdot-ft_sec2"
 ACCELERATIONS_WDOT_FT_SEC2 = "accelerations/wdot-ft_sec2"
 
 # aero/

@@ -309,6 +309,15 @@ def assemble(sections: BeamSections, n_elements: int = DEFAULT_N_ELEMENTS):
 
     Free dofs are ordered node by node, (w, w', θ) for nodes 1 … n_elements.
     """
+    k_glob, m_glob, nodes = assemble_unrestrained(sections, n_elements)
+    return k_glob[3:, 3:], m_glob[3:, 3:], nodes
+
+
+def assemble_unrestrained(sections: BeamSections, n_elements: int = DEFAULT_N_ELEMENTS):
+    """K and M of the beam with its root dofs kept (node by node, (w, w', θ) for nodes
+    0 … n_elements) and the node y [m]: what :func:`assemble` clamps, and what another root
+    condition (the antisymmetric modes' roll freedom, structures/antisymmetric.py)
+    restrains otherwise."""
     if n_elements < 1:
         raise BeamInputError(f"n_elements: need at least 1, got {n_elements}")
     nodes = np.linspace(0.0, sections.semispan_m, n_elements + 1)
@@ -329,7 +338,7 @@ def assemble(sections: BeamSections, n_elements: int = DEFAULT_N_ELEMENTS):
     for spring in sections.springs:
         idx, n_w, _ = _point_shape(nodes, spring.y_m)
         k_glob[np.ix_(idx, idx)] += spring.stiffness_n_m * np.outer(n_w, n_w)
-    return k_glob[3:, 3:], m_glob[3:, 3:], nodes
+    return k_glob, m_glob, nodes
 
 
 def _point_shape(nodes: np.ndarray, y_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
