@@ -522,6 +522,7 @@ def figure(path: Path, mode_hz: float, a: dict, b: dict,
                        label=f"ArduPlane FFT (FTN2 pitch, median) "
                              f"{res['fft_ftn2_pitch_peak_hz_median']:.2f} Hz")
         ax.set_xlim(0, 120)
+        ax.set_ylim(bottom=1e-5)
         ax.set_xlabel("frequency [Hz]")
         ax.set_title(title, fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
