@@ -279,8 +279,11 @@ def analyse(path: Path, from_s: float | None = None, mode_hz: float | None = Non
         result["band_hz"] = [peak_hz - half, peak_hz + half]
         result["band_filtered_over_raw_db"] = db(band_rms(fp, ap, peak_hz, half)
                                                  / band_rms(f, a, peak_hz, half))
-    late = [row for row in log["ftn2"] if row[0] >= from_s]
-    late1 = [row for row in log["ftn1"] if row[0] >= from_s]
+    # the FFT holds FFT_MINHZ while it sees no peak above FFT_SNR_REF: those frames left out
+    late = [row for row in log["ftn2"] if row[0] >= from_s and row[2] > FFT_MIN_HZ + 0.01]
+    late1 = [row for row in log["ftn1"] if row[0] >= from_s and row[1] > FFT_MIN_HZ + 0.01]
+    result["fft_frames_without_peak"] = sum(
+        1 for row in log["ftn2"] if row[0] >= from_s and row[2] <= FFT_MIN_HZ + 0.01)
     if late:
         result["fft_ftn2_pitch_peak_hz_median"] = float(np.median([r[2] for r in late]))
         result["fft_ftn2_roll_peak_hz_median"] = float(np.median([r[1] for r in late]))
