@@ -3,7 +3,7 @@
 
     python scripts/ardupilot_sitl.py build /path/to/ardupilot [--jobs 1] [--venv DIR]
     python scripts/ardupilot_sitl.py fly /path/to/ardupilot [--timeout-s 900] [--out DIR]
-        [--speedup 1] [--rate HZ]
+        [--speedup 1] [--rate HZ] [--defaults EXTRA.parm]
 
 ``build`` runs ``./waf configure --board sitl --no-submodule-update`` and ``./waf plane`` at
 ``nice 19`` (the checkout must have its submodules: waf, mavlink + pymavlink, DroneCAN
@@ -15,7 +15,8 @@ packages (empy==3.3.4, pexpect, future, dronecan, pymavlink); its ``bin`` goes f
 5760, 5762, 5763 listen on all interfaces): it re-executes itself under ``unshare -n`` (as
 root) or ``unshare -rn`` (as a user), brings ``lo`` up, starts the physics
 (``--physics-cmd``, default the bioflex JSON backend on UDP 9002), starts ArduPlane with
-``bioflex_jsb/data/ardupilot/bioflex_plane.parm``, and flies a takeoff + 4-waypoint + RTL
+``bioflex_jsb/data/ardupilot/bioflex_plane.parm`` (then each ``--defaults`` file, whose
+values win), and flies a takeoff + 4-waypoint + RTL
 mission over MAVLink (pymavlink, TCP 5760). ``--speedup N`` is ArduPlane's ``--speedup`` (it
 paces its frames to N times real time; lock-stepped, the backend sets the pace it reaches)
 and ``--rate HZ`` its ``--rate`` (``SIM_RATE_HZ``, ArduPilot's default 1200 when not given);
@@ -179,7 +180,7 @@ def _mission(mav, home_lat: float, home_lon: float):
 
 
 def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float = 1.0,
-        rate_hz: int | None = None) -> dict:
+        rate_hz: int | None = None, defaults: tuple[Path, ...] = ()) -> dict:
     if os.environ.get(NETNS_ENV) != "1":
         _in_private_netns()
     from pymavlink import mavutil
@@ -193,7 +194,8 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float 
                      "loadavg_start": list(os.getloadavg()),
                      "statustext": [], "reached": [], "xtrack_m": []}
     ap_cmd = [str(binary), "--model", "JSON:127.0.0.1", "--speedup", f"{speedup:g}",
-              "--slave", "0", "--defaults", str(PARAM_FILE), "-I0", "--wipe"]
+              "--slave", "0", "--defaults", ",".join(map(str, (PARAM_FILE, *defaults))),
+              "-I0", "--wipe"]
     if rate_hz is not None:
         ap_cmd += ["--rate", str(rate_hz)]
     summary["arduplane_cmd"] = shlex.join(ap_cmd)
@@ -494,6 +496,9 @@ def main(argv: list[str] | None = None) -> int:
                    help="ArduPlane's --speedup (default 1)")
     f.add_argument("--rate", type=int, default=None,
                    help="ArduPlane's --rate: SIM_RATE_HZ [Hz] (default ArduPilot's, 1200)")
+    f.add_argument("--defaults", type=Path, action="append", default=[],
+                   help="a parameter file loaded after bioflex_plane.parm (its values win; "
+                   "ArduPlane's --defaults takes them comma-separated); repeatable")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -505,8 +510,12 @@ def main(argv: list[str] | None = None) -> int:
                 raise ScriptError(f"--speedup must be > 0, got {args.speedup:g}")
             if args.rate is not None and args.rate < 1:
                 raise ScriptError(f"--rate must be >= 1 Hz, got {args.rate}")
+            for extra in args.defaults:
+                if not extra.is_file() or "," in str(extra.resolve()):
+                    raise ScriptError(f"--defaults {extra}: not a file (or a comma in its path)")
             summary = fly(args.ardupilot.resolve(), args.physics_cmd, args.timeout_s,
-                          args.out.resolve(), args.speedup, args.rate)
+                          args.out.resolve(), args.speedup, args.rate,
+                          tuple(p.resolve() for p in args.defaults))
             print(json.dumps(summary, indent=1))
             if summary["incomplete"]:
                 print(f"ardupilot_sitl: mission not completed: {'; '.join(summary['incomplete'])}",

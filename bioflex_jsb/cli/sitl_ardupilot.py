@@ -8,7 +8,7 @@ import json
 import sys
 import time
 
-from bioflex_jsb.cli.case import airspeed, speed_help
+from bioflex_jsb.cli.case import airspeed, check_time_step, speed_help
 from bioflex_jsb.cli.common import (
     UsageError,
     add_log_arguments,
@@ -32,6 +32,7 @@ from bioflex_jsb.cli.live_option import (
 )
 from bioflex_jsb.cli.preflight import NATIVE, add_allow_unstable, checked, preflight
 from bioflex_jsb.links.ardupilot_json import PEER_SILENCE_S
+from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 __all__ = ("preflight", "register", "run", "session_summary")
 
@@ -104,6 +105,12 @@ def register(sub) -> None:
                    "bioflex_plane.parm) and exit; start ArduPlane with --defaults FILE")
     p.add_argument("--altitude", type=finite_float("altitude", "m"), default=0.0,
                    help="launch altitude [m above sea level, ISA], -500 to 11000 (default 0)")
+    p.add_argument("--dt", type=positive_float("time step", "s"), default=DEFAULT_DT_S,
+                   help="the co-simulation step [s] (default 1/960): ArduPilot adopts 1/dt as "
+                   "its physics rate, and its SITL IMU (registered at 1 kHz) takes one sample "
+                   "a frame, so give 0.001 when ArduPilot's gyro spectrum, FFT or notch must "
+                   "read true frequencies (docs/ardupilot.md, \"The wing in ArduPlane's "
+                   "gyro\")")
     p.add_argument("--launch-accel", type=positive_float("launch acceleration", "m/s^2"),
                    default=40.0, help="launcher push [m/s^2] (default 40, 5..200)")
     p.add_argument("--launch-height", type=positive_float("launcher height", "m"),
@@ -205,6 +212,7 @@ def _build(args: argparse.Namespace):
         gust = parse_gust(args.gust)
     except GustSpecError as exc:
         raise UsageError(str(exc)) from None
+    check_time_step(args.dt)
     if args.gust_at < 0.0:
         raise UsageError(f"--gust-at must be >= 0 s, got {args.gust_at:g}")
     if args.record_every < 0:
@@ -259,7 +267,8 @@ def _build(args: argparse.Namespace):
         else:
             airframe = Airframe() if aircraft is None else Airframe(aircraft=aircraft)
         physics = ArduPilotPhysics(airframe, wing, args.model, speed_m_s=args.speed,
-                                   altitude_m=args.altitude, gust=gust, gust_at_s=args.gust_at,
+                                   altitude_m=args.altitude, dt_s=args.dt,
+                                   gust=gust, gust_at_s=args.gust_at,
                                    launcher=launcher, record_every=args.record_every,
                                    gust_repeat=args.gust_repeat, aero=args.aero,
                                    compiled=compiled, **extra)
