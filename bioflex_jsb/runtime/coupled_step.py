@@ -550,11 +550,13 @@ class CoupledStep:
             from bioflex_jsb.simulation import unsteady_kernel as UK
 
             self._kernel = UK.unsteady_kernel
+            K.say_if_compiling(self._kernel, "unsteady wing's step")
             self._params, v = UK.new_params(self.n_modes, mw.state.size)
             v["dt"][0] = mw.dt_s
             v["k_induced2"][0] = mw._k2
         else:
             self._kernel = K.step_kernel
+            K.say_if_compiling(self._kernel, "coupled step")
             lay = K.layout(self.n_modes)
             self._params = np.zeros(sum(size for _, size in lay.values()))
             v = {name: self._params[o:o + size] for name, (o, size) in lay.items()}

@@ -276,6 +276,23 @@ def _unwritable_cache(cache, exc: OSError) -> None:
                      "there is room there, or NUMBA_CACHE_DIR names a writable folder\n")
 
 
+COMPILING_SAID: list[str] = []  # the kernels said to be compiling (once a process each)
+
+
+def say_if_compiling(dispatcher, what: str) -> None:
+    """One line on a terminal's stderr, once a process, when ``dispatcher``'s machine code is
+    neither in memory nor in numba's cache on disk (a new installation, a cleared cache): the
+    first run then spends 10-40 s compiling ``what``, and says so and where it will be
+    cached. Not on a pipe or a file (a script's or a test's stderr holds its errors only)."""
+    if (what in COMPILING_SAID or not sys.stderr.isatty() or dispatcher.overloads
+            or cache_files(dispatcher)):
+        return
+    COMPILING_SAID.append(what)
+    where = numba.config.CACHE_DIR or dispatcher._cache._cache_file._cache_path
+    sys.stderr.write(f"bioflex-jsb: compiling the {what} for this machine (once per "
+                     f"installation, 10-40 s; cached in {where})\n")
+
+
 def cache_files(dispatcher) -> list[str]:
     """The on-disk cache files of ``dispatcher`` (its index and code files) that exist."""
     files = dispatcher._cache._cache_file
