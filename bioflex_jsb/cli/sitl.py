@@ -126,38 +126,16 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.drivers.sitl import (
         DEFAULT_HOME,
-        SPEEDUP_RANGE,
         PacingStats,
         SitlParameters,
         SitlSim,
         run_paced,
     )
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.links.mavlink import (
-        LinkError,
-        MavlinkLink,
-        parse_endpoint,
-        read_signing_key,
-    )
+    from bioflex_jsb.links.mavlink import LinkError, MavlinkLink
     from bioflex_jsb.runtime.fdm import FdmError
 
-    lo, hi = SPEEDUP_RANGE
-    if not lo <= args.speedup <= hi:
-        raise UsageError(f"--speedup {args.speedup:g} is outside {lo:g}..{hi:g}")
-    if args.log_max_mb < LOG_MAX_MB_MIN:
-        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is below {LOG_MAX_MB_MIN:g} MB "
-                         "(a file holds its header, one chunk and its summary)")
-    if args.log_max_mb > LOG_MAX_MB_MAX:
-        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is above {LOG_MAX_MB_MAX:g} MB "
-                         "(the largest log info, plot and rerun read)")
-    if args.log_max_total_mb is not None and args.log_max_total_mb < args.log_max_mb:
-        raise UsageError(f"--log-max-total-mb {args.log_max_total_mb:g} is below --log-max-mb "
-                         f"{args.log_max_mb:g}: the file being written must fit")
-    try:
-        endpoint = parse_endpoint(args.mavlink)
-        key = None if args.signing_key is None else read_signing_key(args.signing_key)
-    except LinkError as exc:
-        raise UsageError(str(exc)) from None
+    endpoint, key = _check_session_options(args)
     from bioflex_jsb.cli.aircraft_option import resolve_flight
 
     resolve_flight(args)  # --speed of the aircraft (its cruise speed by default)
@@ -171,54 +149,22 @@ def run(args: argparse.Namespace) -> int:
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     try:
         airframe, speeds = _airframe(args, home[2] + args.start_height)
-    except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing
-        raise UsageError(str(exc)) from None
-    try:
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
                       trim_mode=args.trim, aero=args.aero, airframe=airframe,
                       **({} if speeds is None else {"airspeed_range_m_s": speeds}))
-    except (FdmError, InputError) as exc:  # the airframe cannot trim, a home out of range
-        raise UsageError(str(exc)) from None
+    except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing,
+        raise UsageError(str(exc)) from None  # a home out of range
     try:
         link = MavlinkLink(endpoint, SitlParameters(sim), sim.vehicle, signing_key=key)
     except LinkError as exc:
         raise UsageError(str(exc)) from None
-    log = None
-    on_sample = idle = None
     try:
-        start_live(args, "sitl")  # before log_path creates the file: a refusal leaves none
-        args.out = log_path(args, "sitl", args.wing)
+        log = _session_log(args, build, sim, home, endpoint, key, check, airframe)
     except UsageError:
         link.close()
         raise
-    if args.out:
-        from bioflex_jsb.cli.gust import open_log
-        from bioflex_jsb.simulation.run import RunDescription
-
-        # a session follows its ground station: the description says how it began
-        description = RunDescription(
-            kind="sitl", wing=args.wing, speed_m_s=args.speed, gust="none",
-            models=(args.model,), mass_basis=args.mass_basis,
-            altitude_m=home[2] + args.start_height,  # where it starts, above sea level (it
-            # read 0 for a session flown 684 m up at the default home)
-            **({} if args.duration is None else {"duration_s": args.duration}),
-            extra={"until_stopped": args.duration is None, "speedup": args.speedup,
-                   "home": list(home), "start_height_m": args.start_height,
-                   "mavlink": endpoint.text(), "signed": key is not None,
-                   "trim": args.trim, "aero": args.aero,
-                   "preflight_stable": check["stable"], "glider": sim.glider,
-                   **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
-        try:
-            log = SplitLog(args.out, description, build, args.log_max_mb,
-                           live_opener(args, open_log), replace=args.force,
-                           max_total_mb=args.log_max_total_mb)
-        except UsageError:
-            link.close()
-            raise
-        on_sample = log.attach(sim)
-        idle = log.idle
-
+    on_sample, idle = (None, None) if log is None else (log.attach(sim), log.idle)
     host, port = link.local_address
     if not args.json:
         print(f"bioflex-jsb sitl: MAVLink 2 on {endpoint.text()} (local {host}:{port}"
@@ -240,7 +186,70 @@ def run(args: argparse.Namespace) -> int:
         if log is not None:
             log.close()
         stop_live(args)
-    summary = {
+    _report(args, _summary(args, sim, log, check, stats, link), sim, log)
+    if interrupted:
+        print("bioflex-jsb sitl: interrupted" + (f"; the log {args.out} holds every step flown"
+                                                if args.out else ""), file=sys.stderr)
+        return 130
+    return 0
+
+
+def _check_session_options(args: argparse.Namespace):
+    """--speedup and the log's size bounds in range; the MAVLink endpoint and the signing
+    key read: (endpoint, key or None); one line otherwise."""
+    from bioflex_jsb.drivers.sitl import SPEEDUP_RANGE
+    from bioflex_jsb.links.mavlink import LinkError, parse_endpoint, read_signing_key
+
+    lo, hi = SPEEDUP_RANGE
+    if not lo <= args.speedup <= hi:
+        raise UsageError(f"--speedup {args.speedup:g} is outside {lo:g}..{hi:g}")
+    if args.log_max_mb < LOG_MAX_MB_MIN:
+        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is below {LOG_MAX_MB_MIN:g} MB "
+                         "(a file holds its header, one chunk and its summary)")
+    if args.log_max_mb > LOG_MAX_MB_MAX:
+        raise UsageError(f"--log-max-mb {args.log_max_mb:g} is above {LOG_MAX_MB_MAX:g} MB "
+                         "(the largest log info, plot and rerun read)")
+    if args.log_max_total_mb is not None and args.log_max_total_mb < args.log_max_mb:
+        raise UsageError(f"--log-max-total-mb {args.log_max_total_mb:g} is below --log-max-mb "
+                         f"{args.log_max_mb:g}: the file being written must fit")
+    try:
+        endpoint = parse_endpoint(args.mavlink)
+        key = None if args.signing_key is None else read_signing_key(args.signing_key)
+    except LinkError as exc:
+        raise UsageError(str(exc)) from None
+    return endpoint, key
+
+
+def _session_log(args, build, sim, home, endpoint, key, check, airframe):
+    """The session's split log (None with --no-log): its description says how the session
+    began (a session follows its ground station); the live view started first, so that its
+    refusal leaves no file."""
+    start_live(args, "sitl")
+    args.out = log_path(args, "sitl", args.wing)
+    if not args.out:
+        return None
+    from bioflex_jsb.cli.gust import open_log
+    from bioflex_jsb.simulation.run import RunDescription
+
+    description = RunDescription(
+        kind="sitl", wing=args.wing, speed_m_s=args.speed, gust="none",
+        models=(args.model,), mass_basis=args.mass_basis,
+        altitude_m=home[2] + args.start_height,  # where it starts, above sea level
+        **({} if args.duration is None else {"duration_s": args.duration}),
+        extra={"until_stopped": args.duration is None, "speedup": args.speedup,
+               "home": list(home), "start_height_m": args.start_height,
+               "mavlink": endpoint.text(), "signed": key is not None,
+               "trim": args.trim, "aero": args.aero,
+               "preflight_stable": check["stable"], "glider": sim.glider,
+               **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
+    return SplitLog(args.out, description, build, args.log_max_mb,
+                    live_opener(args, open_log), replace=args.force,
+                    max_total_mb=args.log_max_total_mb)
+
+
+def _summary(args, sim, log, check, stats, link) -> dict:
+    """The session's summary (``--json``): resets, crashes, the files, pacing, the link."""
+    return {
         "resets": sim.resets,
         "crashes": sim.crashes,
         "landings": sim.landings,
@@ -259,26 +268,25 @@ def run(args: argparse.Namespace) -> int:
                  "signing": link.signing},
         "out": args.out,
     }
+
+
+def _report(args, summary: dict, sim, log) -> None:
+    """The summary as JSON, or its lines: time flown, pacing, resets, the files written."""
     if args.json:
         print_json(summary)
-    else:
-        pacing = summary["pacing"]
-        line = f"flew {sim.t_s:.2f} s simulated"
-        if pacing:
-            line += (f"; pacing error p50 {pacing['p50_ms']:.3f} ms, p99 {pacing['p99_ms']:.3f}"
-                     f" ms, {pacing['resyncs']} resyncs")
-        print(line)
-        if sim.resets:
-            print(f"{sim.resets} resets (last: {sim.last_reset})")
-        if args.out:
-            print(f"log written to {', '.join(log.paths)}" + (
-                f" ({len(log.removed)} older files removed: --log-max-total-mb "
-                f"{args.log_max_total_mb:g})" if log.removed else ""))
-    if interrupted:
-        print("bioflex-jsb sitl: interrupted" + (f"; the log {args.out} holds every step flown"
-                                                if args.out else ""), file=sys.stderr)
-        return 130
-    return 0
+        return
+    pacing = summary["pacing"]
+    line = f"flew {sim.t_s:.2f} s simulated"
+    if pacing:
+        line += (f"; pacing error p50 {pacing['p50_ms']:.3f} ms, p99 {pacing['p99_ms']:.3f}"
+                 f" ms, {pacing['resyncs']} resyncs")
+    print(line)
+    if sim.resets:
+        print(f"{sim.resets} resets (last: {sim.last_reset})")
+    if args.out:
+        print(f"log written to {', '.join(log.paths)}" + (
+            f" ({len(log.removed)} older files removed: --log-max-total-mb "
+            f"{args.log_max_total_mb:g})" if log.removed else ""))
 
 
 def _airframe(args: argparse.Namespace, start_altitude_m: float):
