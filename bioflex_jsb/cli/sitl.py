@@ -29,7 +29,7 @@ EVENT_LEVEL = {0: "FATAL", 1: "FATAL", 2: "ERROR", 3: "ERROR", 4: "WARNING", 5: 
                6: "INFO", 7: "DEBUG"}
 EVENT_NAME = "vehicle"  # the events' reporter (foxglove.Log name)
 LOG_MAX_MB_MIN = 0.1  # the smallest --log-max-mb: a file's fixed part (≈ 20 kB) and a chunk
-# The largest --log-max-mb: a file info, plot and rerun still read (sinks/mcap/errors.py
+# The largest --log-max-mb: a file info, plot and rerun still read (sinks/mcap_io/errors.py
 # MAX_LOG_BYTES, 64 GiB).
 LOG_MAX_MB_MAX = 65_536.0
 # What a session writes [MB per second of simulated time]: 11.92 MB for 30 s of the default
