@@ -99,9 +99,13 @@ def test_speedup_and_rate_reach_fly(script, monkeypatch, tmp_path):
     seen = []
     monkeypatch.setattr(script, "fly", lambda *a: seen.append(a) or {"incomplete": []})
     assert script.main(["fly", str(tmp_path), "--speedup", "12", "--rate", "240"]) == 0
-    assert seen[-1][4:] == (12.0, 240)
+    assert seen[-1][4:] == (12.0, 240, ())
     assert script.main(["fly", str(tmp_path)]) == 0
-    assert seen[-1][4:] == (1.0, None)  # ArduPilot's own SIM_RATE_HZ
+    assert seen[-1][4:] == (1.0, None, ())  # ArduPilot's own SIM_RATE_HZ
+    extra = tmp_path / "fft.parm"
+    extra.write_text("FFT_ENABLE 1\n")
+    assert script.main(["fly", str(tmp_path), "--defaults", str(extra)]) == 0
+    assert seen[-1][6] == (extra.resolve(),)  # loaded after bioflex_plane.parm
 
 
 @pytest.mark.parametrize("bad", [["--speedup", "0"], ["--speedup", "-2"],
