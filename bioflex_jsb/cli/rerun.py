@@ -32,7 +32,7 @@ LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold
 RUN_COMMANDS = ("gust", "compare")
 RUN_OPTIONS = ("--wing", "--aircraft", "--mass-basis", "--speed", "--gust", "--duration",
                "--gust-start", "--dt", "--models", "--model", "--aero",
-               "--structural-damping", "--trim")
+               "--structural-damping", "--trim", "--controller")
 
 
 tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
