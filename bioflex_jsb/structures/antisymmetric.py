@@ -38,9 +38,9 @@ from bioflex_jsb.structures.beam import (
     DEFAULT_N_ELEMENTS,
     BeamInputError,
     BeamSections,
-    _hermite,
     assemble,
     assemble_unrestrained,
+    hermite_shapes,
 )
 
 # The rigid roll's root is zero to the shifted solve's round-off, √(ε σ) at most: below
@@ -87,7 +87,7 @@ class AntisymmetricSolution:
         for i in range(n):
             q = self._full(i)
             for j in range(y.size):
-                nw = _hermite(np.array([xi[j]]), h[j])[0]
+                nw = hermite_shapes(np.array([xi[j]]), h[j])[0]
                 a, b = q[e[j]], q[e[j] + 1]
                 bend[i, j] = nw @ np.array([a[0], a[1], b[0], b[1]])
                 twist[i, j] = (1.0 - xi[j]) * a[2] + xi[j] * b[2]

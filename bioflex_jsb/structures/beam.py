@@ -261,7 +261,7 @@ def uniform_sections(
 # Element shape functions on ξ ∈ [0, 1], element length h. Element dofs: (w1, w1', θ1, w2,
 # w2', θ2).
 # ------------------------------------------------------------------------------------------
-def _hermite(xi: np.ndarray, h: float) -> np.ndarray:
+def hermite_shapes(xi: np.ndarray, h: float) -> np.ndarray:
     """(len(xi), 4) Hermite cubic shape functions for (w1, w1', w2, w2')."""
     xi = np.asarray(xi, dtype=float)
     return np.stack(
@@ -287,7 +287,7 @@ _T_DOFS = np.array([2, 5])  # positions of (θ1, θ2)
 def _element_matrices(y0: float, h: float, sections: BeamSections):
     """6×6 stiffness and mass matrices of the element [y0, y0 + h]."""
     props = sections.at(y0 + _GAUSS_X * h)
-    nw = _hermite(_GAUSS_X, h)  # (4 points, 4)
+    nw = hermite_shapes(_GAUSS_X, h)  # (4 points, 4)
     nwdd = _hermite_dd(_GAUSS_X, h)
     nt = np.stack([1 - _GAUSS_X, _GAUSS_X], axis=-1)  # (4, 2)
     ntd = np.array([-1.0 / h, 1.0 / h])
@@ -350,7 +350,7 @@ def _point_shape(nodes: np.ndarray, y_m: float) -> tuple[np.ndarray, np.ndarray,
     xi = (float(y_m) - float(nodes[e])) / h
     n_w = np.zeros(6)
     n_t = np.zeros(6)
-    n_w[_W_DOFS] = _hermite(np.array([xi]), h)[0]
+    n_w[_W_DOFS] = hermite_shapes(np.array([xi]), h)[0]
     n_t[_T_DOFS] = (1.0 - xi, xi)
     return np.arange(3 * e, 3 * e + 6), n_w, n_t
 
@@ -387,7 +387,7 @@ class BeamSolution:
         for i in range(n):
             q = self._full(i)
             for j in range(y.size):
-                nw = _hermite(np.array([xi[j]]), h[j])[0]
+                nw = hermite_shapes(np.array([xi[j]]), h[j])[0]
                 a, b = q[e[j]], q[e[j] + 1]
                 bend[i, j] = nw @ np.array([a[0], a[1], b[0], b[1]])
                 twist[i, j] = (1.0 - xi[j]) * a[2] + xi[j] * b[2]
