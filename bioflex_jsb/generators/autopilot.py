@@ -195,14 +195,13 @@ def _pitch_loop(pitch, theta_default: str, k_theta: float, k_q: float,
                    "ap/manual-elevator-norm", "fcs/elevator-cmd-norm")
 
 
-def _roll_channel(root, k_phi: float, k_p: float, output: str) -> None:
-    """The heading/roll hold (module docstring), one law for every aircraft: gains
-    ``k_phi`` [aileron per rad of bank error], ``k_p`` [aileron per rad/s of roll rate];
-    the aileron increment goes to ``output``."""
+def _bank_command(root):
+    """The roll channel (returned) with its bank command ``ap/phi-cmd-rad`` [rad]: the
+    heading hold's (the heading error wrapped to ±π), the commanded bank in roll mode 1, the
+    loiter's bank while loitering (module docstring)."""
     roll = el(root, "channel", name="AP roll")
     err = node("difference", "ap/heading-hold-rad", "attitude/psi-rad")
-    wrapped = node("atan2", node("sin", err), node("cos", err))
-    _function(roll, "ap/heading-error-rad", wrapped)
+    _function(roll, "ap/heading-error-rad", node("atan2", node("sin", err), node("cos", err)))
     _function(roll, "ap/phi-heading-rad",
               node("product", K_HEADING_RAD_PER_RAD, "ap/heading-error-rad"),
               (-PHI_CMD_MAX_RAD, PHI_CMD_MAX_RAD))
@@ -214,12 +213,26 @@ def _roll_channel(root, k_phi: float, k_p: float, output: str) -> None:
     t.set("logic", "AND")
     t = el(sw, "test", "ap/loiter == 1", value="ap/loiter-bank-rad")
     t.set("logic", "AND")
-    aileron = node(
+    return roll
+
+
+def _aileron_law(k_phi: float, k_p: float):
+    """The aileron [norm] of the bank hold: ``k_phi`` per rad of bank error, ``-k_p`` per
+    rad/s of roll rate."""
+    return node(
         "sum",
         node("product", k_phi, node("difference", "ap/phi-cmd-rad", "attitude/phi-rad")),
         node("product", -k_p, "velocities/p-rad_sec"),
     )
-    _function(roll, "ap/aileron-auto-norm", aileron, (-AILERON_AUTHORITY, AILERON_AUTHORITY))
+
+
+def _roll_channel(root, k_phi: float, k_p: float, output: str) -> None:
+    """The heading/roll hold (module docstring), one law for every aircraft: gains
+    ``k_phi`` [aileron per rad of bank error], ``k_p`` [aileron per rad/s of roll rate];
+    the aileron increment goes to ``output``."""
+    roll = _bank_command(root)
+    _function(roll, "ap/aileron-auto-norm", _aileron_law(k_phi, k_p),
+              (-AILERON_AUTHORITY, AILERON_AUTHORITY))
     _engage_switch(roll, "ap/aileron-out-norm", "ap/aileron-auto-norm",
                    "ap/manual-aileron-norm", output)
 
@@ -471,25 +484,9 @@ def render_powered_autopilot(gains: PoweredGains, engines: int) -> str:
     _trimmed_switch(pitch, "ap/elevator-out-norm", "ap/elevator-auto-norm",
                     "ap/elevator-manual-norm", "fcs/elevator-cmd-norm")
 
-    roll = el(root, "channel", name="AP roll")
-    err = node("difference", "ap/heading-hold-rad", "attitude/psi-rad")
-    _function(roll, "ap/heading-error-rad", node("atan2", node("sin", err), node("cos", err)))
-    _function(roll, "ap/phi-heading-rad",
-              node("product", K_HEADING_RAD_PER_RAD, "ap/heading-error-rad"),
-              (-PHI_CMD_MAX_RAD, PHI_CMD_MAX_RAD))
-    _function(roll, "ap/phi-bank-rad", node("product", 1.0, "ap/bank-cmd-rad"),
-              (-BANK_CMD_MAX_RAD, BANK_CMD_MAX_RAD))
-    sw = el(roll, "switch", name="ap/phi-cmd-rad")
-    el(sw, "default", value="ap/phi-heading-rad")
-    t = el(sw, "test", "ap/roll-mode == 1", value="ap/phi-bank-rad")
-    t.set("logic", "AND")
-    t = el(sw, "test", "ap/loiter == 1", value="ap/loiter-bank-rad")
-    t.set("logic", "AND")
-    aileron = node(
-        "sum",
-        node("product", g.phi_per_rad, node("difference", "ap/phi-cmd-rad", "attitude/phi-rad")),
-        node("product", -g.p_per_rad_s, "velocities/p-rad_sec"))
-    _function(roll, "ap/aileron-auto-incr-norm", aileron, (-AILERON_AUTHORITY, AILERON_AUTHORITY))
+    roll = _bank_command(root)
+    _function(roll, "ap/aileron-auto-incr-norm", _aileron_law(g.phi_per_rad, g.p_per_rad_s),
+              (-AILERON_AUTHORITY, AILERON_AUTHORITY))
     _plus_trim(roll, "ap/aileron-auto-norm", "ap/aileron-trim-norm", "ap/aileron-auto-incr-norm")
     _plus_trim(roll, "ap/aileron-manual-norm", "ap/aileron-trim-norm", "ap/manual-aileron-norm")
     _trimmed_switch(roll, "ap/aileron-out-norm", "ap/aileron-auto-norm",
