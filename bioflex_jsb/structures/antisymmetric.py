@@ -40,7 +40,7 @@ from bioflex_jsb.structures.beam import (
     BeamSections,
     assemble,
     assemble_unrestrained,
-    hermite_shapes,
+    sample_nodal_modes,
 )
 
 # The rigid roll's root is zero to the shifted solve's round-off, √(ε σ) at most: below
@@ -77,21 +77,9 @@ class AntisymmetricSolution:
         """(bending [m, down], twist [rad, leading edge up]) of every mode on the
         starboard half at ``stations_m`` [m], each (n, k); the port half is their negative
         at −y."""
-        y = np.asarray(stations_m, dtype=float)
-        nodes = self.nodes_m
-        e = np.clip(np.searchsorted(nodes, y, side="right") - 1, 0, nodes.size - 2)
-        h = nodes[e + 1] - nodes[e]
-        xi = (y - nodes[e]) / h
-        n = self.frequencies_rad_s.size
-        bend, twist = np.empty((n, y.size)), np.empty((n, y.size))
-        for i in range(n):
-            q = self._full(i)
-            for j in range(y.size):
-                nw = hermite_shapes(np.array([xi[j]]), h[j])[0]
-                a, b = q[e[j]], q[e[j] + 1]
-                bend[i, j] = nw @ np.array([a[0], a[1], b[0], b[1]])
-                twist[i, j] = (1.0 - xi[j]) * a[2] + xi[j] * b[2]
-        return bend, twist
+        return sample_nodal_modes(self.nodes_m, [self._full(i) for i in
+                                                 range(self.frequencies_rad_s.size)],
+                                  stations_m)
 
 
 def solve_antisymmetric(sections: BeamSections, fuselage_roll_inertia_kg_m2: float,

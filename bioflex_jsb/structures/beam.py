@@ -376,22 +376,9 @@ class BeamSolution:
 
     def sample(self, stations_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Raw (bending [m], twist [rad]) of all modes at ``stations_m``, each (n, k)."""
-        y = np.asarray(stations_m, dtype=float)
-        nodes = self.nodes_m
-        e = np.clip(np.searchsorted(nodes, y, side="right") - 1, 0, nodes.size - 2)
-        h = nodes[e + 1] - nodes[e]
-        xi = (y - nodes[e]) / h
-        n = self.frequencies_rad_s.size
-        bend = np.empty((n, y.size))
-        twist = np.empty((n, y.size))
-        for i in range(n):
-            q = self._full(i)
-            for j in range(y.size):
-                nw = hermite_shapes(np.array([xi[j]]), h[j])[0]
-                a, b = q[e[j]], q[e[j] + 1]
-                bend[i, j] = nw @ np.array([a[0], a[1], b[0], b[1]])
-                twist[i, j] = (1.0 - xi[j]) * a[2] + xi[j] * b[2]
-        return bend, twist
+        return sample_nodal_modes(self.nodes_m, [self._full(i) for i in
+                                                 range(self.frequencies_rad_s.size)],
+                                  stations_m)
 
 
 def _lowest_modes(k: np.ndarray, m: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -604,3 +591,24 @@ def wing_from_membrane(
         x_inertial_frac=np.full(n, x_i),
         description=f"{description}; x_I = {x_i:.3f} c, x_E = {x_e:.3f} c; {shape}",
     )
+
+
+def sample_nodal_modes(nodes_m: np.ndarray, modes: list[np.ndarray], stations_m
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """(bending [m], twist [rad]) of each mode at ``stations_m`` [m], each (n, k), from its
+    nodal (w, w', θ) rows (``modes[i]``: (len(nodes_m), 3)) as the elements interpolate
+    them: Hermite cubics for the bending, linear for the twist."""
+    y = np.asarray(stations_m, dtype=float)
+    nodes = nodes_m
+    e = np.clip(np.searchsorted(nodes, y, side="right") - 1, 0, nodes.size - 2)
+    h = nodes[e + 1] - nodes[e]
+    xi = (y - nodes[e]) / h
+    bend = np.empty((len(modes), y.size))
+    twist = np.empty((len(modes), y.size))
+    for i, q in enumerate(modes):
+        for j in range(y.size):
+            nw = hermite_shapes(np.array([xi[j]]), h[j])[0]
+            a, b = q[e[j]], q[e[j] + 1]
+            bend[i, j] = nw @ np.array([a[0], a[1], b[0], b[1]])
+            twist[i, j] = (1.0 - xi[j]) * a[2] + xi[j] * b[2]
+    return bend, twist
