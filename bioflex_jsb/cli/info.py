@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 
-from bioflex_jsb.cli.common import UsageError, check_new_file, escaped, print_json
+from bioflex_jsb.cli.common import (
+    EXIT_NO_RESULT,
+    UsageError,
+    check_new_file,
+    escaped,
+    print_json,
+)
 
 HELP = """Summarise an MCAP log written by bioflex-jsb (or any MCAP file): its channels
 (topic, schema, message count), the number of messages and chunks, the time span [s of
@@ -84,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
                 f"{args.file!r} is damaged: {'; '.join(result['problems'])}; "
                 "--recover FIXED.mcap copies the intact chunks")
         print(f"bioflex-jsb info: {line}", file=sys.stderr)
-        return 1
+        return EXIT_NO_RESULT
     return 0
 
 

@@ -7,6 +7,7 @@ import json
 import sys
 
 from bioflex_jsb.cli.common import (
+    EXIT_NO_RESULT,
     UsageError,
     check_new_file,
     escaped,
@@ -209,5 +210,5 @@ def run(args: argparse.Namespace) -> int:
               f"{escaped(result['first_difference'])}")  # names of the log's topics
     if not result["equal"]:
         print("bioflex-jsb rerun: the repeated run differs from the log", file=sys.stderr)
-        return 1
+        return EXIT_NO_RESULT
     return 0
