@@ -346,19 +346,27 @@ def exit_status(summary: dict) -> int:
 
 
 def _connect(mavutil, procs, timeout_s: float = 60.0):
+    """The MAVLink connection to ArduPlane's SERIAL0, once its first HEARTBEAT came.
+
+    One connection, kept: SITL's SERIAL0 accepts a single TCP client (ArduPlane waits for
+    it before it boots, then waits for the physics), so a second connection opened while
+    the first waits for a heartbeat is never served."""
     deadline = time.monotonic() + timeout_s
+    mav = None
     while time.monotonic() < deadline:
         if any(p.poll() is not None for p in procs):
             raise ScriptError("the physics or ArduPlane exited at start (see their logs)")
-        try:
-            # pymavlink prints "[Errno 111] Connection refused sleeping" on stdout while
-            # ArduPlane boots: stdout is the JSON summary's, so that goes to stderr
-            with contextlib.redirect_stdout(sys.stderr):
-                mav = mavutil.mavlink_connection(MAVLINK_URL, source_system=255)
-        except OSError:
-            time.sleep(1.0)
-            continue
-        if mav.wait_heartbeat(timeout=10) is not None:
+        if mav is None:
+            try:
+                # pymavlink prints "[Errno 111] Connection refused sleeping" on stdout while
+                # ArduPlane boots: stdout is the JSON summary's, so that goes to stderr
+                with contextlib.redirect_stdout(sys.stderr):
+                    mav = mavutil.mavlink_connection(MAVLINK_URL, source_system=255)
+            except OSError:
+                time.sleep(1.0)
+                continue
+        wait_s = min(1.0, max(0.0, deadline - time.monotonic()))
+        if mav.wait_heartbeat(timeout=wait_s) is not None:
             return mav
     raise ScriptError(f"no HEARTBEAT on {MAVLINK_URL} within {timeout_s:.0f} s")
 

@@ -264,6 +264,41 @@ def test_repeated_frame_is_answered_again_without_a_step(link):
     assert physics.steps[-1][0] == tuple(_pwm(99))
 
 
+def test_resends_that_crossed_the_reply_are_dropped_so_arduPilot_never_lags(link):
+    """A frame answered later than ArduPilot's 1 s re-send: its re-sends wait in the queue
+    behind it. Each one answered would be one more reply in ArduPilot's socket, which reads
+    one datagram per frame: it would read every later reply that many frames late, for the
+    rest of the flight (measured with ArduPlane at 240 Hz: 6 re-sends, 25 ms of lag)."""
+    physics, server, ap, records = link
+    for k in range(3):
+        _frame(server, ap, _pwm(k))
+    ap.send_servos(_pwm(3))
+    ap.resend()  # our step took over 1 s: ArduPilot sent frame 3 again, twice
+    ap.resend()
+    assert server.serve_once(5.0)  # frame 3 stepped and answered, its re-sends dropped
+    assert server.stats.crossed_resends == 2 and server.stats.resends == 0
+    assert ap.receive().values["timestamp"] == 4 * DT_S
+    for k in range(4, 10):  # every later reply is the one for the frame just sent
+        parsed = _frame(server, ap, _pwm(k))
+        assert parsed is not None and parsed.values["timestamp"] == (k + 1) * DT_S
+    assert not ap.pending()
+    assert ap.frame_counter == 10 and ap.time_now_us == pytest.approx(10 * DT_S * 1e6)
+    assert len(physics.steps) == 10 and [r.frame_count for r in records] == list(range(10))
+
+
+def test_a_datagram_queued_behind_the_answered_frame_is_handled_next(link):
+    physics, server, ap, _ = link
+    _frame(server, ap, _pwm(0))
+    ap.send_servos(_pwm(1))
+    ap.send_raw(b"hello")  # queued behind frame 1: read after the reply, held, then handled
+    assert server.serve_once(5.0)
+    assert ap.receive().values["timestamp"] == 2 * DT_S
+    assert server.stats.rejected == 0
+    assert server.serve_once(0.0)
+    assert server.stats.rejected == 1 and server.stats.crossed_resends == 0
+    assert _frame(server, ap, _pwm(2)).values["timestamp"] == 3 * DT_S
+
+
 def test_backward_frame_count_resets_the_physics(link):
     physics, server, ap, records = link
     for k in range(20):

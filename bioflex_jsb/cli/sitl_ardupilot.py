@@ -318,6 +318,7 @@ def session_summary(physics, server, wall_s: float) -> dict:
     connected = st.connected_wall_s
     summary.update(
         frames={"steps": st.steps, "resends": st.resends, "resets": st.resets,
+                "crossed_resends": st.crossed_resends,
                 "skipped": st.frames_skipped, "rejected": st.rejected,
                 "last_frame_count": server.last_frame_count},
         source_check={

@@ -66,6 +66,20 @@ flood that arrives while a frame is stepped then waits in the buffer, to be drop
 address, instead of pushing the peer's next frame out of it (a lost frame costs ArduPilot's
 1 s re-send).
 
+Re-sends that crossed the reply (:meth:`LockstepServer.serve_once`): a frame answered more
+than 1 s after ArduPilot sent it (a slow step: the compiled kernel's first step on a loaded
+machine, a stalled host) has ArduPilot's re-sends of it queued behind it. They arrived
+before the reply was sent, so ArduPilot gets that reply anyway; answering each again would
+put one more reply in ArduPilot's socket per re-send, and ArduPilot reads one datagram per
+frame (``JSON::recv_fdm``; a repeated timestamp advances its frame counter, not its clock),
+so it would read every later reply that many frames late for the rest of the session: a
+delay in the loop that depends on wall time (measured with ArduPlane at SIM_RATE_HZ 240: 6
+re-sends, 25 ms between its servo outputs and the physics they act on, and a different
+flight). So right after each reply the socket is read without waiting: the peer's re-sends
+of the frame just answered are counted (``crossed_resends``) and dropped, and the first
+other datagram is held for the next call. A re-send that arrives later (its reply lost) is
+answered as before.
+
 Wall time while connected (``ServerStats.connected_wall_s``, the denominator of the
 session's real-time factor): the sum of the wall-time intervals between consecutive frames
 of the peer, each counted when the peer's silence in it (from our reply to its next frame)
@@ -176,6 +190,14 @@ def _wrapped(last: int, count: int) -> bool:
     return last >= FRAME_COUNT_MODULUS - FRAME_WRAP_WINDOW and count < FRAME_WRAP_WINDOW
 
 
+def _frame_count(data: bytes) -> int | None:
+    """The frame count of a servo datagram, None if it is not one."""
+    try:
+        return parse_servo_packet(data).frame_count
+    except ServoPacketError:
+        return None
+
+
 def parse_servo_packet(data: bytes) -> ServoPacket:
     """Decode one servo datagram; ServoPacketError (one line) for anything else."""
     if len(data) == SERVO_16.size:
@@ -252,6 +274,9 @@ class ServerStats:
     recv_buffer_bytes: int = 0  # the socket's receive buffer the kernel granted [bytes]
     blocked: int = 0  # flooding sources blocked in the kernel (links/udp_guard.py)
     connected_wall_s: float = 0.0  # wall time while a peer was connected [s] (module doc)
+    # the peer's re-sends of a frame that were queued before its reply was sent (module
+    # docstring: Re-sends that crossed the reply): dropped, never answered
+    crossed_resends: int = 0
 
 
 class LockstepServer:
@@ -289,6 +314,7 @@ class LockstepServer:
         self.last_frame_count: int | None = None
         self._last_reply: bytes | None = None
         self._last_time_s = math.nan
+        self._held: tuple[bytes, tuple[str, int]] | None = None  # read, not yet handled
         bind_port = instance_port(instance) if port is None else port
         if not 0 <= bind_port <= 65535:
             raise ValueError(f"UDP port must be in 0..65535, got {bind_port}")
@@ -460,25 +486,32 @@ class LockstepServer:
 
     def serve_once(self, timeout_s: float | None = None) -> bool:
         """Wait up to ``timeout_s`` [s] (None: forever) for datagrams, then read at most
-        :data:`MAX_BATCH` of them, up to and including the first one answered.
+        :data:`MAX_BATCH` of them, up to and including the first one answered; after the
+        answer, the peer's re-sends of the answered frame already queued are dropped
+        (module docstring: Re-sends that crossed the reply).
 
         True if a datagram was read (answered, rejected or ignored), False on timeout.
         """
         if timeout_s is not None and timeout_s < 0:
             raise ValueError(f"timeout_s must be >= 0 or None, got {timeout_s}")
-        readable, _, _ = select.select([self._sock], [], [], timeout_s)
-        if not readable:
-            return False
+        held = self._held
+        if held is None:
+            readable, _, _ = select.select([self._sock], [], [], timeout_s)
+            if not readable:
+                return False
         sock, stats, clock, peer = self._sock, self.stats, self._clock, self.peer
         recvfrom, count = sock.recvfrom, self.guard.count
         # the peer's silence, once a batch: 3 s against a batch's 0.4 ms at most
         guarded = peer is not None and clock() - self._peer_reply_s < PEER_SILENCE_S
         for _ in range(MAX_BATCH):
-            try:
-                data, source = recvfrom(RECV_BYTES)
-            except BlockingIOError:
-                break
-            stats.received += 1
+            if held is not None:
+                (data, source), held, self._held = held, None, None
+            else:
+                try:
+                    data, source = recvfrom(RECV_BYTES)
+                except BlockingIOError:
+                    break
+                stats.received += 1
             if guarded and source != peer:  # handle's first test, inline: a flood's path
                 count(source)
                 stats.foreign += 1
@@ -493,9 +526,28 @@ class LockstepServer:
                     sock.sendto(reply, source)
                 except BlockingIOError:
                     pass  # ArduPilot re-sends the frame after 1 s; it is answered then
+                self._drop_crossed(source)
                 break
         self._guard_check()
         return True
+
+    def _drop_crossed(self, source: tuple[str, int]) -> None:
+        """Right after a reply to ``source``: read what is queued; the re-sends of the frame
+        just answered arrived before the reply was sent (ArduPilot sent them while it
+        waited for it), so they are counted and dropped; the first other datagram is held
+        for the next :meth:`serve_once`."""
+        last = self.last_frame_count
+        for _ in range(MAX_BATCH):
+            try:
+                data, src = self._sock.recvfrom(RECV_BYTES)
+            except BlockingIOError:
+                return
+            self.stats.received += 1
+            if src == source and last is not None and _frame_count(data) == last:
+                self.stats.crossed_resends += 1
+                continue
+            self._held = (data, src)
+            return
 
     def _guard_check(self) -> None:
         """Block the sources that flood (never the lock-stepping peer); say so."""
