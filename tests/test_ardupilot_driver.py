@@ -269,6 +269,32 @@ def test_gust_report(wing):
     json.dumps(ph.summary(), allow_nan=False)
 
 
+@pytest.mark.parametrize("pull_up", [False, True])
+def test_a_change_peak_at_the_end_of_its_search_is_flagged_as_no_peak(wing, pull_up):
+    """Trim servos: η₁'s largest change after a 1 s gust is inside the search (the gust's);
+    a pull-up that starts after the gust and grows until the search ends (as ArduPlane's
+    turn at a waypoint does) puts it at the search's last step: flagged, one WARNING."""
+    ph = _physics(wing, gust=parse_gust("1cos:2:15"), gust_at_s=0.1)
+    end_s = 0.1 + 1.0 + ad.GUST_DECAY_S  # flight time the search ends at [s]
+    for _ in range(ph.launch_hold_steps + ph.stroke_steps + int((end_s + 0.2) / ph.dt_s)):
+        t = ph.core.k * ph.core.dt_s if ph.phase == ad.FLIGHT else 0.0
+        elevator = 1500 + (int(200 * (t - 1.5)) if pull_up and t > 1.5 else 0)
+        ph.step((1500, elevator, 1130, 1500, 1000) + (0,) * 11, 1200)
+    ph.flush_events()
+    rep = ph.gust_report
+    warnings = [text for _, level, text in ph.events if level == "WARNING"]
+    assert rep["eta1_change_peak_at_window_end"] is pull_up
+    if pull_up:
+        assert rep["eta1_change_peak_time_s"] == pytest.approx(
+            rep["start_time_s"] + 1.0 + ad.GUST_DECAY_S, abs=2 * ph.dt_s)
+        assert len(warnings) == 1 and "end of its search" in warnings[0]
+        assert abs(rep["eta1_change_peak_rad"]) > abs(rep["eta1_change_peak_in_gust_rad"])
+    else:
+        assert rep["eta1_change_peak_time_s"] < rep["start_time_s"] + 1.0 + ad.GUST_DECAY_S
+        assert warnings == []
+    json.dumps(ph.summary(), allow_nan=False)
+
+
 def test_bad_inputs_are_one_line_errors(wing):
     with pytest.raises(ValueError, match="launch acceleration"):
         ad.Launcher(accel_m_s2=1.0)

@@ -92,7 +92,11 @@ first flight that reaches ``gust_at_s``), or after every launch with ``gust_repe
 first modal coordinate's range and largest change from the gust's start while the gust blows
 (``*_in_gust``, with n_z's range), and its peak and largest change until
 :data:`GUST_DECAY_S` after it (which may include a manoeuvre of the autopilot's), are
-measured on every step (:attr:`ArduPilotPhysics.gust_report`, [rad]).
+measured on every step (:attr:`ArduPilotPhysics.gust_report`, [rad]). A largest change
+still growing at the search's end (``eta1_change_peak_at_window_end``, a WARNING event) is
+a manoeuvre's (ArduPlane's turn at a waypoint, say), not the gust's: its value is where the
+search stopped, and it moves with the manoeuvre's timing, which varies from flight to flight
+(docs/ardupilot.md, "Flights differ").
 
 Events (:meth:`ArduPilotPhysics.event`): launches, valid-range stops and what the server
 reports (its source check, ArduPilot's restarts) are kept in :attr:`ArduPilotPhysics.events`
@@ -582,7 +586,7 @@ class ArduPilotPhysics:
         k0, k1 = self._gust_steps
         if k0 <= k <= k1:
             self._gust_applied = True
-            self._track_gust(k, k0)
+            self._track_gust(k, k0, k1)
         if core.stopped:
             flight_s = core.k * core.dt_s
             self.stops.append({"reason": core.stopped, "time_s": self.t_s,
@@ -595,7 +599,7 @@ class ArduPilotPhysics:
                        f"{core.stopped}; the aircraft is back on the launcher at rest and "
                        "stays there until ArduPilot restarts")
 
-    def _track_gust(self, k: int, k0: int) -> None:
+    def _track_gust(self, k: int, k0: int, k1: int) -> None:
         rep = self.gust_report
         eta1 = float(self.core.eta[0])
         if k == k0:
@@ -603,6 +607,7 @@ class ArduPilotPhysics:
             rep.update(start_time_s=self.t_s, start_flight_s=k * self.core.dt_s,
                        eta1_peak_rad=0.0, eta1_peak_time_s=math.nan,
                        eta1_at_start_rad=eta1, eta1_change_peak_rad=0.0,
+                       eta1_change_peak_time_s=math.nan, eta1_change_peak_at_window_end=False,
                        w_g_peak_m_s=0.0, eta1_min_in_gust_rad=eta1, eta1_max_in_gust_rad=eta1,
                        eta1_change_peak_in_gust_rad=0.0, n_z_min_in_gust=math.inf,
                        n_z_max_in_gust=-math.inf)
@@ -614,6 +619,15 @@ class ArduPilotPhysics:
         change = eta1 - rep["eta1_at_start_rad"]
         if abs(change) > abs(rep["eta1_change_peak_rad"]):
             rep["eta1_change_peak_rad"] = change
+            rep["eta1_change_peak_time_s"] = self.t_s
+            if k == k1:  # still growing when the search stops: no peak of the gust's
+                rep["eta1_change_peak_at_window_end"] = True
+                self.event("WARNING", (
+                    f"eta1's largest change after the gust, {change:.4g} rad, is at the end "
+                    f"of its search ({GUST_DECAY_S:g} s after the gust): a manoeuvre's, not "
+                    "the gust's peak, and it moves with the manoeuvre's timing; the gust's "
+                    f"own is eta1_change_peak_in_gust_rad "
+                    f"({rep['eta1_change_peak_in_gust_rad']:.4g} rad)"))
         if k <= self._gust_end_k:  # while the gust blows (1-cosine: its length)
             rep["eta1_min_in_gust_rad"] = min(rep["eta1_min_in_gust_rad"], eta1)
             rep["eta1_max_in_gust_rad"] = max(rep["eta1_max_in_gust_rad"], eta1)
