@@ -244,69 +244,93 @@ def split_batches(batches: list[dict], from_s: float):
     return pre, post
 
 
+def _analysis_start_s(path: Path, log: dict, from_s: float | None,
+                      turbulence_at_s: float) -> float:
+    """``from_s``, or SETTLE_S after the turbulence (``turbulence_at_s`` after the launch)."""
+    if from_s is not None:
+        return from_s
+    launch = launch_time_s(log["gps"])
+    if launch is None:
+        raise ScriptError(f"{path}: no launch (GPS speed never above "
+                          f"{LAUNCH_SPEED_M_S:g} m/s)")
+    return launch + turbulence_at_s + SETTLE_S
+
+
+def _airspeed_report(log: dict, from_s: float) -> dict:
+    """The airspeed's median and 5-95 % range [m/s] from ``from_s`` (None without ARSP)."""
+    arsp = np.array([v for t, v in log["arsp"] if t >= from_s])
+    return {"airspeed_m_s_median": float(np.median(arsp)) if arsp.size else None,
+            "airspeed_m_s_p5_p95": (np.percentile(arsp, [5, 95]).tolist()
+                                    if arsp.size else None)}
+
+
+def _filtered_report(pre_spectrum, post_spectrum, peak_hz: float, rate: float) -> dict:
+    """The filtered gyro against the raw at the raw peak and over its ±BAND_BINS bins."""
+    f, a = pre_spectrum
+    fp, ap = post_spectrum
+    at = amplitude_at(fp, ap, peak_hz)
+    half = BAND_BINS * rate / BATCH_COUNT
+    return {"filtered_at_peak_rad_s": at,
+            "filtered_over_raw_db": db(at / amplitude_at(f, a, peak_hz)),
+            "band_hz": [peak_hz - half, peak_hz + half],
+            "band_filtered_over_raw_db": db(band_rms(fp, ap, peak_hz, half)
+                                            / band_rms(f, a, peak_hz, half))}
+
+
+def _fft_report(log: dict, from_s: float) -> dict:
+    """ArduPlane's FFT peaks (FTN2 peak 0 per axis, FTN1's average), medians from
+    ``from_s``; the FFT holds FFT_MINHZ while it sees no peak above FFT_SNR_REF: those
+    frames are left out and counted."""
+    late = [row for row in log["ftn2"] if row[0] >= from_s and row[2] > FFT_MIN_HZ + 0.01]
+    late1 = [row for row in log["ftn1"] if row[0] >= from_s and row[1] > FFT_MIN_HZ + 0.01]
+    out: dict = {"fft_frames_without_peak": sum(
+        1 for row in log["ftn2"] if row[0] >= from_s and row[2] <= FFT_MIN_HZ + 0.01)}
+    if late:
+        out["fft_ftn2_pitch_peak_hz_median"] = float(np.median([r[2] for r in late]))
+        out["fft_ftn2_roll_peak_hz_median"] = float(np.median([r[1] for r in late]))
+        out["fft_ftn2_samples"] = len(late)
+    if late1:
+        out["fft_ftn1_pkavg_hz_median"] = float(np.median([r[1] for r in late1]))
+    return out
+
+
+def _errors_against_mode(result: dict, mode_hz: float) -> dict:
+    """The raw peak's and the FFT's errors [%] against the mode's frequency ``mode_hz``."""
+    out = {"mode_hz": mode_hz,
+           "raw_peak_error_pct": 100.0 * (result["raw_peak_hz"] / mode_hz - 1.0)}
+    if "fft_ftn2_pitch_peak_hz_median" in result:
+        out["fft_error_pct"] = 100.0 * (result["fft_ftn2_pitch_peak_hz_median"] / mode_hz - 1.0)
+    return out
+
+
 def analyse(path: Path, from_s: float | None = None, mode_hz: float | None = None,
             turbulence_at_s: float = TURBULENCE_AT_S) -> dict:
     """The FFT's peaks and the batch spectra of a log, from ``from_s`` [s, log time] (None:
     SETTLE_S after the turbulence, ``turbulence_at_s`` after the launch)."""
     log = read_log(path)
-    if from_s is None:
-        launch = launch_time_s(log["gps"])
-        if launch is None:
-            raise ScriptError(f"{path}: no launch (GPS speed never above "
-                              f"{LAUNCH_SPEED_M_S:g} m/s)")
-        from_s = launch + turbulence_at_s + SETTLE_S
+    from_s = _analysis_start_s(path, log, from_s, turbulence_at_s)
     pre, post = split_batches(log["batches"], from_s)
     if not pre:
         raise ScriptError(f"{path}: no complete raw gyro batch after {from_s:.1f} s "
                           "(INS_LOG_BAT_MASK, INS_LOG_BAT_OPT?)")
     rate = pre[0][0]
-    arsp = np.array([v for t, v in log["arsp"] if t >= from_s])
     result: dict = {"log": str(path), "from_s": from_s, "batch_rate_hz": rate,
-                    "airspeed_m_s_median": float(np.median(arsp)) if arsp.size else None,
-                    "airspeed_m_s_p5_p95": (np.percentile(arsp, [5, 95]).tolist()
-                                            if arsp.size else None),
+                    **_airspeed_report(log, from_s),
                     "batches_pre": len(pre), "batches_post": len(post),
                     "notch": {k: v for k, v in log["params"].items()
                               if k.startswith("INS_HNTCH_") or k == "INS_GYRO_FILTER"}}
-    spectra = {}
-    for name, group in (("pre", pre), ("post", post)):
-        if not group:
-            continue
-        f, a = amplitude_spectrum([arr[1] for _, arr in group], rate)  # pitch (y) gyro
-        spectra[name] = (f, a)
-    f, a = spectra["pre"]
-    peak_hz, peak_amp = spectral_peak(f, a, SEARCH_HZ)
+    spectra = {name: amplitude_spectrum([arr[1] for _, arr in group], rate)  # pitch (y)
+               for name, group in (("pre", pre), ("post", post)) if group}
+    peak_hz, peak_amp = spectral_peak(*spectra["pre"], SEARCH_HZ)
     result["raw_peak_hz"] = peak_hz
     result["raw_peak_rad_s"] = peak_amp
     if "post" in spectra:
-        fp, ap = spectra["post"]
-        at = amplitude_at(fp, ap, peak_hz)
-        half = BAND_BINS * rate / BATCH_COUNT
-        result["filtered_at_peak_rad_s"] = at
-        result["filtered_over_raw_db"] = db(at / amplitude_at(f, a, peak_hz))
-        result["band_hz"] = [peak_hz - half, peak_hz + half]
-        result["band_filtered_over_raw_db"] = db(band_rms(fp, ap, peak_hz, half)
-                                                 / band_rms(f, a, peak_hz, half))
-    # the FFT holds FFT_MINHZ while it sees no peak above FFT_SNR_REF: those frames left out
-    late = [row for row in log["ftn2"] if row[0] >= from_s and row[2] > FFT_MIN_HZ + 0.01]
-    late1 = [row for row in log["ftn1"] if row[0] >= from_s and row[1] > FFT_MIN_HZ + 0.01]
-    result["fft_frames_without_peak"] = sum(
-        1 for row in log["ftn2"] if row[0] >= from_s and row[2] <= FFT_MIN_HZ + 0.01)
-    if late:
-        result["fft_ftn2_pitch_peak_hz_median"] = float(np.median([r[2] for r in late]))
-        result["fft_ftn2_roll_peak_hz_median"] = float(np.median([r[1] for r in late]))
-        result["fft_ftn2_samples"] = len(late)
-    if late1:
-        result["fft_ftn1_pkavg_hz_median"] = float(np.median([r[1] for r in late1]))
+        result.update(_filtered_report(spectra["pre"], spectra["post"], peak_hz, rate))
+    result.update(_fft_report(log, from_s))
     if mode_hz is not None:
-        result["mode_hz"] = mode_hz
-        result["raw_peak_error_pct"] = 100.0 * (peak_hz / mode_hz - 1.0)
-        if late:
-            result["fft_error_pct"] = 100.0 * (
-                result["fft_ftn2_pitch_peak_hz_median"] / mode_hz - 1.0)
+        result.update(_errors_against_mode(result, mode_hz))
     result["_spectra"] = spectra
     return result
-
 
 
 # ---------------------------------------------------------------- ArduPilot's gyro filters

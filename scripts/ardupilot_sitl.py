@@ -371,31 +371,142 @@ def _connect(mavutil, procs, timeout_s: float = 60.0):
     raise ScriptError(f"no HEARTBEAT on {MAVLINK_URL} within {timeout_s:.0f} s")
 
 
+class _Mission:
+    """The mission flown over MAVLink, one message at a time (:func:`_run_mission`): what
+    each message records, then the next step of the flight it allows (home, mission upload
+    and arming, the launch switch, RTL and the end). The waits in wall time are divided by
+    ``speedup``: as long in ArduPlane's time."""
+
+    def __init__(self, mav, summary: dict, speedup: float) -> None:
+        from pymavlink import mavutil
+
+        self.m = mavutil.mavlink
+        self.mav = mav
+        self.summary = summary
+        self.arm_retry_s = ARM_RETRY_S / speedup
+        self.launch_hold_s = LAUNCH_SWITCH_S / speedup
+        self.launch_resend_s = LAUNCH_RESEND_S / speedup
+        self.state = "wait_gps"
+        self.home = None
+        self.n_items = 0
+        self.sim_s = 0.0
+        self.asked_home_s = 0.0
+        self.armed = False
+        self.arm_sent_s = 0.0
+        self.launch_until = 0.0  # wall time [s] until which the launch switch is held
+        self.launch_sent_s = 0.0
+        self.launch_released = False
+        self.current_seq = -1
+        self.leg_start_s = 0.0  # ArduPlane's time of the switch to the current item [s]
+        self.track = []  # (sim time [s], north [m], east [m], alt above home [m], item)
+
+    def _own_heartbeat(self, msg, kind: str) -> bool:
+        return kind == "HEARTBEAT" and msg.get_srcSystem() == self.mav.target_system
+
+    def record(self, msg, kind: str) -> None:
+        """What the message says about the flight (times, waypoints, track, error)."""
+        summary = self.summary
+        if kind == "STATUSTEXT":
+            summary["statustext"].append(msg.text)
+        elif kind == "SYSTEM_TIME":
+            self.sim_s = msg.time_boot_ms * 1e-3
+        elif kind == "MISSION_ITEM_REACHED":
+            summary["reached"].append(msg.seq)
+            summary.setdefault("reached_at_s", []).append(self.sim_s)
+        elif kind == "MISSION_CURRENT":
+            if msg.seq != self.current_seq:
+                self.leg_start_s = self.sim_s
+            self.current_seq = msg.seq
+        elif self._own_heartbeat(msg, kind):
+            self.armed = bool(msg.base_mode & self.m.MAV_MODE_FLAG_SAFETY_ARMED)
+            if self.armed and "armed_at_s" not in summary:
+                summary["armed_at_s"] = self.sim_s
+        elif kind == "GLOBAL_POSITION_INT" and self.state == "auto" and self.home is not None:
+            self._track(msg)
+        elif kind == "NAV_CONTROLLER_OUTPUT" and self.state == "auto":
+            # the square's legs only (items 3..5 fly from corner to corner; item 2 from the
+            # end of the take-off)
+            if 2 <= self.current_seq <= 1 + len(SQUARE_M):
+                summary["xtrack_m"].append((self.sim_s - self.leg_start_s, self.current_seq,
+                                            msg.xtrack_error))
+        elif kind == "GPS_RAW_INT" and self.state == "wait_gps" and msg.fix_type >= 3:
+            self.state = "wait_ready"
+        elif kind == "HOME_POSITION" and self.home is None:
+            self.home = (msg.latitude * 1e-7, msg.longitude * 1e-7)
+
+    def _track(self, msg) -> None:
+        home = self.home
+        dn = math.radians(msg.lat * 1e-7 - home[0]) * EARTH_RADIUS_M
+        de = (math.radians(msg.lon * 1e-7 - home[1]) * EARTH_RADIUS_M
+              * math.cos(math.radians(home[0])))
+        self.track.append((self.sim_s, dn, de, msg.relative_alt * 1e-3, self.current_seq))
+
+    def start(self) -> None:
+        """Once GPS has a fix: ask for home until it comes, then upload the mission, AUTO
+        and arm; re-send the arming while pre-arm checks refuse it."""
+        mav, m = self.mav, self.m
+        if self.state == "wait_ready" and self.home is None \
+                and time.monotonic() - self.asked_home_s > 1.0:
+            self.asked_home_s = time.monotonic()
+            mav.mav.command_long_send(mav.target_system, mav.target_component,
+                                      m.MAV_CMD_GET_HOME_POSITION, 0, 0, 0, 0, 0, 0, 0, 0)
+        if self.state == "wait_ready" and self.home is not None:
+            # SITL boots in MANUAL (seen in the documented flight); AUTO only (re)starts the
+            # mission on entering it, so go through FBWA first, then start at the take-off
+            mav.set_mode("FBWA")
+            self.n_items = _mission(mav, *self.home)
+            mav.waypoint_set_current_send(1)
+            mav.set_mode("AUTO")
+            mav.arducopter_arm()
+            self.arm_sent_s = time.monotonic()
+            self.state = "auto"
+        if self.state == "auto" and not self.armed \
+                and time.monotonic() - self.arm_sent_s > self.arm_retry_s:
+            mav.arducopter_arm()  # pre-arm checks (EKF, GPS) may refuse at first: again
+            self.arm_sent_s = time.monotonic()
+
+    def launch(self) -> None:
+        """Once armed in AUTO: the launch switch (RC 5 high, SERVO5_FUNCTION 55 passes it
+        to the physics) held and re-sent, then released (0: back to RC input)."""
+        mav, summary = self.mav, self.summary
+        if self.state == "auto" and self.armed and "launch_sent_at_s" not in summary:
+            summary["launch_sent_at_s"] = self.sim_s
+            summary["launch_sent_wall_s"] = time.monotonic()
+            self.launch_until = time.monotonic() + self.launch_hold_s
+        if self.state == "auto" and self.armed and time.monotonic() < self.launch_until \
+                and time.monotonic() - self.launch_sent_s > self.launch_resend_s:
+            self.launch_sent_s = time.monotonic()
+            mav.mav.rc_channels_override_send(
+                mav.target_system, mav.target_component,
+                *([NO_OVERRIDE] * 4), LAUNCH_SWITCH_PWM_US, *([NO_OVERRIDE] * 3))
+        elif self.launch_until and time.monotonic() >= self.launch_until \
+                and not self.launch_released:
+            self.launch_released = True
+            mav.mav.rc_channels_override_send(
+                mav.target_system, mav.target_component,
+                *([NO_OVERRIDE] * 4), 0, *([NO_OVERRIDE] * 3))
+
+    def home_reached(self, msg, kind: str) -> bool:
+        """Whether the mission's RTL has been flown: RTL_WATCH_S in RTL, then near home."""
+        summary = self.summary
+        if self.state == "auto" and self._own_heartbeat(msg, kind) \
+                and msg.custom_mode == PLANE_MODE_RTL and "rtl_at_s" not in summary:
+            summary["rtl_at_s"] = self.sim_s
+        if self.state == "auto" and "rtl_at_s" in summary \
+                and self.sim_s - summary["rtl_at_s"] > RTL_WATCH_S:
+            # the mission's RTL flown: home and loitering there
+            return self.mav.location().alt is not None and _near_home(self.mav, self.home)
+        return False
+
+
 def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1.0) -> None:
     """Wait for a GPS fix and home, upload the mission, AUTO + arm, watch until home.
     The waits in wall time are divided by ``speedup``: as long in ArduPlane's time."""
-    from pymavlink import mavutil
-
-    m = mavutil.mavlink
+    flight = _Mission(mav, summary, speedup)
     for stream in STREAMS:
         mav.mav.request_data_stream_send(mav.target_system, mav.target_component,
-                                         getattr(m, stream), STREAM_RATE_HZ, 1)
-    arm_retry_s, launch_hold_s, launch_resend_s = (
-        ARM_RETRY_S / speedup, LAUNCH_SWITCH_S / speedup, LAUNCH_RESEND_S / speedup)
+                                         getattr(flight.m, stream), STREAM_RATE_HZ, 1)
     deadline = time.monotonic() + timeout_s
-    state = "wait_gps"
-    home = None
-    n_items = 0
-    sim_s = 0.0
-    asked_home_s = 0.0
-    armed = False
-    arm_sent_s = 0.0
-    launch_until = 0.0  # wall time [s] until which the launch switch is held
-    launch_sent_s = 0.0
-    launch_released = False
-    current_seq = -1
-    leg_start_s = 0.0  # ArduPlane's time of the switch to the current item [s]
-    track = []  # (sim time [s], north [m], east [m], alt above home [m], mission item)
     while time.monotonic() < deadline:
         if any(p.poll() is not None for p in procs):
             summary["ended"] = "a process exited"
@@ -404,80 +515,16 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1
         if msg is None:
             continue
         kind = msg.get_type()
-        if kind == "STATUSTEXT":
-            summary["statustext"].append(msg.text)
-        elif kind == "SYSTEM_TIME":
-            sim_s = msg.time_boot_ms * 1e-3
-        elif kind == "MISSION_ITEM_REACHED":
-            summary["reached"].append(msg.seq)
-            summary.setdefault("reached_at_s", []).append(sim_s)
-        elif kind == "MISSION_CURRENT":
-            if msg.seq != current_seq:
-                leg_start_s = sim_s
-            current_seq = msg.seq
-        elif kind == "HEARTBEAT" and msg.get_srcSystem() == mav.target_system:
-            armed = bool(msg.base_mode & m.MAV_MODE_FLAG_SAFETY_ARMED)
-            if armed and "armed_at_s" not in summary:
-                summary["armed_at_s"] = sim_s
-        elif kind == "GLOBAL_POSITION_INT" and state == "auto" and home is not None:
-            dn = math.radians(msg.lat * 1e-7 - home[0]) * EARTH_RADIUS_M
-            de = (math.radians(msg.lon * 1e-7 - home[1]) * EARTH_RADIUS_M
-                  * math.cos(math.radians(home[0])))
-            track.append((sim_s, dn, de, msg.relative_alt * 1e-3, current_seq))
-        elif kind == "NAV_CONTROLLER_OUTPUT" and state == "auto":
-            # the square's legs only (items 3..5 fly from corner to corner; item 2 from the
-            # end of the take-off)
-            if 2 <= current_seq <= 1 + len(SQUARE_M):
-                summary["xtrack_m"].append((sim_s - leg_start_s, current_seq, msg.xtrack_error))
-        elif kind == "GPS_RAW_INT" and state == "wait_gps" and msg.fix_type >= 3:
-            state = "wait_ready"
-        elif kind == "HOME_POSITION" and home is None:
-            home = (msg.latitude * 1e-7, msg.longitude * 1e-7)
-        if state == "wait_ready" and home is None and time.monotonic() - asked_home_s > 1.0:
-            asked_home_s = time.monotonic()
-            mav.mav.command_long_send(mav.target_system, mav.target_component,
-                                      m.MAV_CMD_GET_HOME_POSITION, 0, 0, 0, 0, 0, 0, 0, 0)
-        if state == "wait_ready" and home is not None:
-            # SITL boots in MANUAL (seen in the documented flight); AUTO only (re)starts the
-            # mission on entering it, so go through FBWA first, then start at the take-off
-            mav.set_mode("FBWA")
-            n_items = _mission(mav, *home)
-            mav.waypoint_set_current_send(1)
-            mav.set_mode("AUTO")
-            mav.arducopter_arm()
-            arm_sent_s = time.monotonic()
-            state = "auto"
-        if state == "auto" and not armed and time.monotonic() - arm_sent_s > arm_retry_s:
-            mav.arducopter_arm()  # pre-arm checks (EKF, GPS) may refuse at first: again
-            arm_sent_s = time.monotonic()
-        if state == "auto" and armed and "launch_sent_at_s" not in summary:
-            summary["launch_sent_at_s"] = sim_s
-            summary["launch_sent_wall_s"] = time.monotonic()
-            launch_until = time.monotonic() + launch_hold_s
-        if state == "auto" and armed and time.monotonic() < launch_until \
-                and time.monotonic() - launch_sent_s > launch_resend_s:
-            # the launch switch: RC 5 high (SERVO5_FUNCTION 55 passes it to the physics)
-            launch_sent_s = time.monotonic()
-            mav.mav.rc_channels_override_send(
-                mav.target_system, mav.target_component,
-                *([NO_OVERRIDE] * 4), LAUNCH_SWITCH_PWM_US, *([NO_OVERRIDE] * 3))
-        elif launch_until and time.monotonic() >= launch_until and not launch_released:
-            launch_released = True
-            mav.mav.rc_channels_override_send(
-                mav.target_system, mav.target_component,
-                *([NO_OVERRIDE] * 4), 0, *([NO_OVERRIDE] * 3))  # 0: back to RC input
-        if state == "auto" and kind == "HEARTBEAT" and msg.get_srcSystem() == mav.target_system \
-                and msg.custom_mode == PLANE_MODE_RTL and "rtl_at_s" not in summary:
-            summary["rtl_at_s"] = sim_s
-        if state == "auto" and "rtl_at_s" in summary and sim_s - summary["rtl_at_s"] > RTL_WATCH_S:
-            # the mission's RTL flown: home and loitering there
-            if mav.location().alt is not None and _near_home(mav, home):
-                summary["ended"] = "home reached in RTL"
-                break
-    summary["sim_s"] = sim_s
+        flight.record(msg, kind)
+        flight.start()
+        flight.launch()
+        if flight.home_reached(msg, kind):
+            summary["ended"] = "home reached in RTL"
+            break
+    summary["sim_s"] = flight.sim_s
     summary["end_wall_s"] = time.monotonic()
-    summary["mission_items"] = n_items
-    summary["track"] = track[::10]  # ≈ 1 s apart at the 10 Hz stream
+    summary["mission_items"] = flight.n_items
+    summary["track"] = flight.track[::10]  # ≈ 1 s apart at the 10 Hz stream
 
 
 def _near_home(mav, home, radius_m: float = 100.0) -> bool:
