@@ -31,6 +31,7 @@ import pytest
 from bioflex_jsb.sinks.mcap import summarise
 from bioflex_jsb.sinks.mcap_io.protobuf import decoder
 from tests.cli_helpers import assert_one_line_error, run_cli
+from tests.polling import wait_until
 from tests.tools import protobuf_class
 
 WS_GUID = b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11"  # RFC 6455, section 1.3
@@ -553,7 +554,11 @@ def test_an_ardupilot_session_is_served_live(tmp_path):
             except TimeoutError:
                 pass
         th.join(30.0)
-        time.sleep(0.2)  # the last chunk's messages reach the reader
+        assert not th.is_alive(), "the session did not end"
+        last_ns = max(ns for topic, ns in _file_messages(out)[0] if topic == autopilot)
+        # the last chunk's messages reach the reader: the file's last frame among them
+        wait_until(lambda: any(ns == last_ns for ns, _ in got), 10.0,
+                   "the file's last autopilot message served live")
     finally:
         stop.set()
         reader.join(5.0)

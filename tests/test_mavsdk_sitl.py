@@ -48,6 +48,7 @@ from mavsdk.plugins.telemetry import Telemetry
 
 from bioflex_jsb.drivers.sitl import SitlParameters
 from bioflex_jsb.sinks.mcap import messages_by_topic, topic
+from tests.polling import wait_until
 
 pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
 
@@ -335,8 +336,8 @@ def test_mavsdk_arms_flies_a_raw_mission_and_returns_to_launch():
             time.sleep(0.1)
         assert telemetry.flight_mode() == FlightMode.RETURN_TO_LAUNCH
         action.hold()
-        time.sleep(1.5)
-        assert telemetry.flight_mode() == FlightMode.HOLD  # ArduPlane LOITER
+        wait_until(lambda: telemetry.flight_mode() == FlightMode.HOLD, 10.0,
+                   "HOLD (ArduPlane LOITER) after action.hold()")
     finally:
         if proc is not None and proc.poll() is None:
             proc.terminate()

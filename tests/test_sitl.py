@@ -4,6 +4,7 @@ loopback (every socket on 127.0.0.1)."""
 from __future__ import annotations
 
 import math
+import select
 import socket
 import struct
 import subprocess
@@ -23,6 +24,7 @@ from bioflex_jsb.drivers.sitl import SitlParameters, SitlSim, run_paced  # noqa:
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing  # noqa: E402
 from bioflex_jsb.generators import autopilot as autopilot_xml  # noqa: E402
 from bioflex_jsb.links.mavlink import LinkError, MavlinkLink, parse_endpoint  # noqa: E402
+from tests.polling import wait_until  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 PACING_TARGET_MS = 2.0  # issue 6: p99 of the step start against the wall clock
@@ -266,9 +268,10 @@ def test_live_session_handshakes_telemetry_parameters(build):
                        cond=lambda m: m.command == M.MAV_CMD_SET_MESSAGE_INTERVAL)
         assert ack.result == M.MAV_RESULT_ACCEPTED
         c.mav.request_data_stream_send(1, 1, M.MAV_DATA_STREAM_EXTRA2, 0, 0)
-        time.sleep(0.3)
-        while c.recv_match(blocking=False) is not None:
-            pass
+        # a marker after it: the vehicle handles a peer's messages in order, so once the
+        # marker's answer is here the stream is off; what came before it is read past
+        c.mav.param_request_read_send(1, 1, b"SIM_SPEEDUP", -1)
+        wait_for(c, "PARAM_VALUE", cond=lambda m: m.param_id == "SIM_SPEEDUP")
         counts = {"ATTITUDE": 0, "VFR_HUD": 0}
         end = time.monotonic() + 1.0
         while time.monotonic() < end:
@@ -296,6 +299,7 @@ import os, socket, sys, time
 s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 end = time.monotonic() + float(sys.argv[2])
 n = 0
+on = False
 while time.monotonic() < end:
     for size in (1, 17, 280, 1400, 8000):
         try:
@@ -305,6 +309,9 @@ while time.monotonic() < end:
             pass
     s.sendto(bytes([0xFD, 9, 0, 0, 0, 1, 1, 0, 0, 0]) + os.urandom(5), ("127.0.0.1",
              int(sys.argv[1])))  # truncated MAVLink 2 headers
+    if not on:
+        on = True
+        print("on", flush=True)  # the first datagrams are in the link's socket
 print(n)
 """
 
@@ -317,12 +324,15 @@ def test_flood_of_random_bytes_does_not_stop_the_loop_or_the_link(build):
     flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(port), str(duration + 0.5)],
                              stdout=subprocess.PIPE, text=True)
     try:
-        time.sleep(0.3)  # the flood is on before the loop starts
+        # the flood is on before the loop starts: its first datagrams were sent
+        wait_until(lambda: select.select([flood.stdout], [], [], 0.0)[0], 10.0,
+                   "the flood's start")
+        assert flood.stdout.readline() == "on\n"
         t0 = time.monotonic()
         stats = run_paced(sim, duration, link)
         wall = time.monotonic() - t0
     finally:
-        sent = int(flood.communicate(timeout=10)[0] or 0)
+        sent = int((flood.communicate(timeout=10)[0] or "0").split()[-1])
     assert sent > 1000, "the flood did not run"
     # Random bytes can hold a valid frame by chance: a MAVLink frame is checked by a 16-bit
     # CRC (with the message's CRC_EXTRA), so about one candidate start byte in 65 536 passes

@@ -19,6 +19,7 @@ from bioflex_jsb.links.mavlink import (
     read_signing_key,
     signing_time_10us,
 )
+from tests.polling import wait_until
 from tests.test_sitl import Session, make_sim, run_cli
 
 pytestmark = pytest.mark.slow  # real ground stations / subprocess runs: not in the fast subset
@@ -136,13 +137,13 @@ def test_signed_vehicle_answers_the_key_and_ignores_the_rest():
         # a wrong key, no signature at all: ignored, and no telemetry for them
         wrong, plain = Gcs(session.port, WRONG_KEY), Gcs(session.port, None)
         rejected = link.stats.rejected_signature
-        for _ in range(3):
+        for n in range(1, 4):  # a round at a time: a new source's burst is parsed in part
             for c in (wrong, plain):
                 c.heartbeat()
                 c.set_len(77.0)
-            time.sleep(0.1)
+            wait_until(lambda n=n: link.stats.rejected_signature >= rejected + 4 * n, 10.0,
+                       f"round {n}: the packets of the wrong key and of no key refused")
         assert sim.gust_length_m == 40.0
-        assert link.stats.rejected_signature >= rejected + 12
         assert link.peer_count == 1
         assert plain.wait("HEARTBEAT", timeout=0.5) is None
 
@@ -154,14 +155,15 @@ def test_signed_vehicle_answers_the_key_and_ignores_the_rest():
                                          M.MAV_PARAM_TYPE_REAL32).pack(replay)
         raw_sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         raw_sock.sendto(packet, ("127.0.0.1", session.port))
-        deadline = time.monotonic() + 2.0
-        while sim.gust_length_m != 55.0 and time.monotonic() < deadline:
-            time.sleep(0.02)
-        assert sim.gust_length_m == 55.0  # the first time it is a valid message
+        wait_until(lambda: sim.gust_length_m == 55.0, 10.0,
+                   "the signed packet applied the first time")  # a valid message then
         good.set_len(60.0)
         assert good.wait("PARAM_VALUE", cond=lambda m: m.param_value == 60.0) is not None
+        rejected = link.stats.rejected_signature
         raw_sock.sendto(packet, ("127.0.0.1", session.port))
-        time.sleep(0.3)
+        # the replay is read and refused (counted), not merely not yet read
+        wait_until(lambda: link.stats.rejected_signature == rejected + 1, 10.0,
+                   "the replayed packet refused")
         assert sim.gust_length_m == 60.0
 
         # a forged packet with a far-future timestamp on the good client's stream does not
@@ -173,7 +175,9 @@ def test_signed_vehicle_answers_the_key_and_ignores_the_rest():
         raw_sock.sendto(forger.param_set_encode(1, 1, b"GUST_LEN_M", 66.0,
                                                 M.MAV_PARAM_TYPE_REAL32).pack(forger),
                         ("127.0.0.1", session.port))
-        time.sleep(0.2)
+        wait_until(lambda: link.stats.rejected_signature == rejected + 2, 10.0,
+                   "the forged packet refused")
+        assert sim.gust_length_m == 60.0
         good.set_len(61.0)
         assert good.wait("PARAM_VALUE", cond=lambda m: m.param_value == 61.0) is not None
         assert sim.gust_length_m == 61.0
@@ -182,9 +186,8 @@ def test_signed_vehicle_answers_the_key_and_ignores_the_rest():
         radio = M.MAVLink(None, srcSystem=3, srcComponent=68)
         raw_sock.sendto(radio.radio_status_encode(200, 190, 80, 10, 5, 0, 0).pack(radio),
                         ("127.0.0.1", session.port))
-        deadline = time.monotonic() + 2.0
-        while "RADIO_STATUS" not in link.stats.by_type and time.monotonic() < deadline:
-            time.sleep(0.02)
+        wait_until(lambda: "RADIO_STATUS" in link.stats.by_type, 10.0,
+                   "the unsigned RADIO_STATUS read")
         assert link.stats.by_type.get("RADIO_STATUS") == 1
         raw_sock.close()
         for c in (good, wrong, plain):
