@@ -148,9 +148,11 @@ class Count(Kind):
 
 @dataclass(frozen=True)
 class Choice(Kind):
-    """One of a fixed set of strings."""
+    """One of a fixed set of strings; ``noun`` names what they are ("unknown mass basis
+    'x'; accepted: ...") where a bare list would not say it."""
 
     choices: tuple[str, ...]
+    noun: str = ""
     python_type: ClassVar[Any] = str
 
     def missing_text(self) -> str:
@@ -158,6 +160,9 @@ class Choice(Kind):
 
     def check(self, value: Any) -> str:
         if not isinstance(value, str) or value not in self.choices:
+            if self.noun:
+                raise Invalid(f"unknown {self.noun} {value!r}; accepted: "
+                              f"{', '.join(self.choices)}")
             raise Invalid(f"must be one of {', '.join(self.choices)}, got {value!r}")
         return value
 
@@ -213,6 +218,37 @@ class Triple(Kind):
             raise Invalid(f"must be [x, y, z] in {self.element.unit}, got {value!r}")
         x, y, z = (self.element.check(v) for v in value)
         return (x, y, z)
+
+
+@dataclass(frozen=True)
+class Interval(Kind):
+    """Two numbers [low, high] [unit] with lo < low < high <= hi (a speed range: its low end
+    above ``lo``, 0 by default); ``hint`` says where it comes from."""
+
+    unit: str
+    lo: float = 0.0
+    hi: float = math.inf
+    hint: str = ""
+    python_type: ClassVar[Any] = tuple[float, float]
+
+    def accepted(self) -> str:
+        high = f" <= {_g(self.hi)}" if self.hi < math.inf else ""
+        return f"[low, high] {self.unit} with {_g(self.lo)} < low < high{high}{self.hint}"
+
+    def missing_text(self) -> str:
+        return f"missing ({self.accepted()})"
+
+    def check(self, value: Any) -> tuple[float, float]:
+        ok = (isinstance(value, list | tuple) and len(value) == 2
+              and all(is_finite_real(x) for x in value)
+              and self.lo < value[0] < value[1] <= self.hi)
+        if not ok:
+            raise Invalid(f"must be {self.accepted()}, got {value!r}")
+        return (float(value[0]), float(value[1]))
+
+
+# Kinds many inputs share, declared once.
+CHORD_FRACTION = Real("chord fraction", 0.0, 1.0)  # a position along the chord, LE 0, TE 1
 
 
 def unknown_keys(table: Mapping, accepted: Sequence[str]) -> str | None:
@@ -294,7 +330,7 @@ def read_table(model: type[T], data: Any, where: str, error: type[InputError],
     field = field_path([*prefix, *loc])
     if first["type"] == "extra_forbidden":
         keys = accepted_keys(_nested_model(model, loc))
-        raise problem(error, where, field, f"unknown field; accepted: {', '.join(keys)}")
+        raise problem(error, where, field, f"unknown key; accepted: {', '.join(keys)}")
     if first["type"] == _KIND_ERROR:
         raise problem(error, where, field, first["ctx"]["text"])
     kind = _kind_of(model, loc)
