@@ -63,6 +63,15 @@ def _g(x: float) -> str:
     return f"{x:g}"
 
 
+def _in(unit: str) -> str:
+    """" in <unit>" (nothing for a dimensionless number without a unit name)."""
+    return f" in {unit}" if unit else ""
+
+
+def _u(unit: str) -> str:
+    return f" {unit}" if unit else ""
+
+
 class Kind:
     """What one field accepts; subclasses give :meth:`check` and :meth:`missing_text`."""
 
@@ -95,34 +104,39 @@ class Kind:
 @dataclass(frozen=True)
 class Real(Kind):
     """A finite real number [unit] in lo..hi; ``positive``: above 0 (the lower bound 0
-    excluded). ``hint`` follows a range message (why the range, what a value outside
-    probably is)."""
+    excluded); ``below``: under hi (the upper bound excluded). ``hint`` follows a range
+    message (why the range, what a value outside probably is). ``unit`` "" for a pure
+    number."""
 
     unit: str
     lo: float = -math.inf
     hi: float = math.inf
     positive: bool = False
     hint: str = ""
+    below: bool = False
     python_type: ClassVar[Any] = float
 
     def missing_text(self) -> str:
-        return f"missing (a number in {self.unit})"
+        return f"missing (a number{_in(self.unit)})"
 
     def check(self, value: Any) -> float:
+        u = _u(self.unit)
         if not is_finite_real(value):
-            raise Invalid(f"must be a finite number in {self.unit}, got {value!r}")
+            raise Invalid(f"must be a finite number{_in(self.unit)}, got {value!r}")
         x = float(value)
         if self.positive and x <= 0.0:
-            raise Invalid(f"must be > 0 {self.unit}, got {value!r}{self.hint}")
+            raise Invalid(f"must be > 0{u}, got {value!r}{self.hint}")
         if self.lo > -math.inf and self.hi < math.inf and not self.positive:
-            if not self.lo <= x <= self.hi:
-                raise Invalid(f"{x:g} {self.unit} is outside the valid range "
-                              f"{_g(self.lo)}..{_g(self.hi)} {self.unit}{self.hint}")
+            if not self.lo <= x <= self.hi or (self.below and x == self.hi):
+                span = (f"[{_g(self.lo)}, {_g(self.hi)})" if self.below
+                        else f"{_g(self.lo)}..{_g(self.hi)}")
+                raise Invalid(f"{x:g}{u} is outside the valid range {span}{u}{self.hint}")
             return x
         if x < self.lo:
-            raise Invalid(f"must be ≥ {_g(self.lo)} {self.unit}, got {value!r}{self.hint}")
-        if x > self.hi:
-            raise Invalid(f"must be ≤ {_g(self.hi)} {self.unit}, got {value!r}{self.hint}")
+            raise Invalid(f"must be ≥ {_g(self.lo)}{u}, got {value!r}{self.hint}")
+        if x > self.hi or (self.below and x == self.hi):
+            op = "<" if self.below else "≤"
+            raise Invalid(f"must be {op} {_g(self.hi)}{u}, got {value!r}{self.hint}")
         return x
 
 
