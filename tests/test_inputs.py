@@ -114,3 +114,30 @@ def test_a_table_reads_into_a_frozen_record():
 def test_one_line_even_from_a_multiline_text():
     assert str(problem(BadFile, "f", "a.b", "two\nlines")) == "f: a.b: two lines"
     assert field_path(["axes", "speeds_m_s", 0]) == "axes.speeds_m_s[0]"
+
+
+# The modules that still write the "a number, not a bool" guard by hand (log readers and
+# the controller's file: not yet on bioflex_jsb.inputs). The list may only shrink: a reader
+# moved onto the kinds is taken off it, and no new module may join it.
+HAND_WRITTEN_NUMBER_GUARDS = {
+    "simulation/controller.py",
+    "sinks/mcap/compare.py",
+    "sinks/mcap/history.py",
+    "sinks/mcap/reader.py",
+}
+
+
+def test_no_new_module_writes_its_own_number_guard():
+    import re
+    from pathlib import Path
+
+    import bioflex_jsb
+
+    root = Path(bioflex_jsb.__file__).parent
+    guard = re.compile(r"isinstance\([^)]*\bbool\b")
+    writers = {p.relative_to(root).as_posix() for p in root.rglob("*.py")
+               if guard.search(p.read_text(encoding="utf-8"))}
+    writers -= {"inputs.py", "values.py"}  # the one validator and its number rule
+    assert writers <= HAND_WRITTEN_NUMBER_GUARDS, sorted(writers - HAND_WRITTEN_NUMBER_GUARDS)
+    # a module taken off the list stays off it
+    assert HAND_WRITTEN_NUMBER_GUARDS <= writers, sorted(HAND_WRITTEN_NUMBER_GUARDS - writers)
