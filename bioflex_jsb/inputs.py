@@ -48,6 +48,15 @@ def problem(error: type[InputError], where: str, field: str, text: str) -> Input
     return error(": ".join([*parts, " ".join(text.split())]))
 
 
+def argument(kind: Kind, value: Any, name: str) -> Any:
+    """An API argument ``name`` checked by ``kind``: the value, or one-line
+    :class:`~bioflex_jsb.errors.InputError` ``<name>: <what is wrong; what is accepted>``."""
+    try:
+        return kind.check(value)
+    except Invalid as exc:
+        raise problem(InputError, "", name, exc.text) from None
+
+
 def field_path(loc: Sequence[str | int]) -> str:
     """A location as the files write it: ``table.key[index].key``."""
     out = ""
