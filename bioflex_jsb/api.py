@@ -64,6 +64,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     build_wing,
     resolve_variant,
 )
+from bioflex_jsb.inputs import Real, argument
 from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
@@ -611,13 +612,15 @@ def _check_choice(what: str, value, accepted) -> None:
         raise InputError(f"unknown {what} {value!r}; accepted: {', '.join(accepted)}")
 
 
+# Air density [kg/m^3] and structural damping ratio ζ [-] of the API's analyses: the
+# definition files' ranges (definition/ranges.py, with their reasons)
+DENSITY = Real("kg/m^3", *DENSITY_RANGE_KG_M3,
+               hint=" (about 33 km altitude to denser than any surface air)")
+STRUCTURAL_DAMPING = Real("(fraction of critical damping)", *DAMPING_RANGE)
+
+
 def _check_density(rho: float) -> float:
-    rho = _real(rho, "density_kg_m3 [kg/m^3]")
-    lo, hi = DENSITY_RANGE_KG_M3
-    if not lo <= float(rho) <= hi:
-        raise InputError(f"density {rho!r} kg/m^3 is outside {lo:g}..{hi:g} kg/m^3 (about 33 "
-                         "km altitude to denser than any surface air)")
-    return float(rho)
+    return argument(DENSITY, rho, "density_kg_m3")
 
 
 def _check_damping(zeta: float | None) -> float | None:
@@ -626,12 +629,7 @@ def _check_damping(zeta: float | None) -> float | None:
     p-k method failed with an IndexError at 0.95, where modes are overdamped)."""
     if zeta is None:
         return None
-    zeta = _real(zeta, "structural_damping [-]")
-    lo, hi = DAMPING_RANGE
-    if not lo <= zeta <= hi:
-        raise InputError(f"structural_damping {zeta:g} must satisfy {lo:g} <= "
-                         f"structural_damping <= {hi:g} (a fraction of critical damping)")
-    return zeta
+    return argument(STRUCTURAL_DAMPING, zeta, "structural_damping")
 
 
 def modes(wing, speed_m_s: float | Iterable[float] | None = None, model: str = "coupled", *,

@@ -85,7 +85,7 @@ def test_the_api_takes_a_surface_a_tuple_or_the_definitions():
     (dict(wing="goland", aileron=ControlSurface(1.0, 9.0, 0.8)), "beyond the semispan"),
     (dict(range_m_s=(100.0, 50.0)), "0 <= low < high <= 400"),
     (dict(range_m_s=200.0), "range must be (low, high)"),
-    (dict(density_kg_m3=50.0), "outside 0.01..2"),
+    (dict(density_kg_m3=50.0), "outside the valid range 0.01..2"),
     (dict(lift_slope="panel"), "unknown lift_slope"),
     (dict(wing=3.0), "analyses an Aircraft, a WingBuild or a clamped wing's definition"),
     (dict(wing="sgs_elastic", aileron=(0.6, 1.0, 0.8)), "a clamped analysis needs beam"),

@@ -60,8 +60,10 @@ def test_metrics_take_the_runs_own_gust_start(run):
 @pytest.mark.parametrize("other, kwargs, needle", [
     ("sgs_elastic", {}, "flown with wing 'optimised'"),  # 79 424 N m against 10.4
     ("original", {}, "flown with wing 'optimised'"),  # 11.60 N m against 10.42
-    ("optimised", {"density_kg_m3": -1.0}, "outside 0.01..2"),  # 7.65 N m, silently
-    ("optimised", {"density_kg_m3": math.nan}, "must be finite"),
+    ("optimised", {"density_kg_m3": -1.0},
+     "density_kg_m3: -1 kg/m.3 is outside the valid range 0.01..2"),  # 7.65 N m, silently
+    ("optimised", {"density_kg_m3": math.nan},
+     "density_kg_m3: must be a finite number in kg/m.3, got nan"),
 ])
 def test_section_loads_of_the_runs_own_wing_only(run, other, kwargs, needle):
     wing = (api.load_aircraft(other) if other.startswith("sgs") else api.load_wing(other))
@@ -75,9 +77,11 @@ def test_section_loads_refuse_the_native_wing(wing):
 
 
 @pytest.mark.parametrize("call, needle", [
-    (lambda w: api.modes(w, 15.0, structural_damping=-0.5), "0 <= structural_damping <= 0.3"),
-    (lambda w: api.flutter(w, structural_damping=math.nan), "must be finite"),
-    (lambda w: api.free_speed_range_m_s(w, math.nan), "must be finite"),
+    (lambda w: api.modes(w, 15.0, structural_damping=-0.5),
+     "structural_damping: -0.5 .* is outside the valid range 0..0.3"),
+    (lambda w: api.flutter(w, structural_damping=math.nan),
+     "structural_damping: must be a finite number"),
+    (lambda w: api.free_speed_range_m_s(w, math.nan), "must be a finite number"),
     (lambda w: api.linear_model(w, 15.0, model="nope"), "unknown model"),  # a ValueError
     (lambda w: api.load_wing(None), "a variant name or a variant file"),
 ])

@@ -329,15 +329,19 @@ def _variant(tmp_path, text: str, name: str = "v.toml") -> str:
 @pytest.mark.parametrize("text, needle", [
     ("", "the variant file sets nothing"),
     ("# only a comment\n\n", "the variant file sets nothing"),
-    ('[overrides]\n"C_alpha^Q1" = 1e308\n', "overrides.C_alpha^Q1 = 1e+308 is outside"),
+    ('[overrides]\n"C_alpha^Q1" = 1e308\n',
+     "overrides.C_alpha^Q1: 1e+308 is outside the valid range -100..100"),
     ('[overrides]\n"C_eta2^Q1" = -101.0\n', "overrides.C_eta2^Q1"),
-    ("pin_c_eta1_q1 = 1e308\n", "'pin_c_eta1_q1' = 1e+308 is outside"),
-    ("x_inertial_frac = 1e308\npin_c_eta1_q1 = -0.03\n", "'x_inertial_frac'"),
-    ("x_elastic_frac = -1e-308\npin_c_eta1_q1 = -0.03\n", "'x_elastic_frac'"),
-    ("structural_damping = 1e308\n", "'structural_damping'"),
-    ("structural_damping = nan\n", "'structural_damping'"),
-    ('name = "a\\nb"\n', "'name' holds a control character"),
-    ("description = 3\n", "'description' must be a string"),
+    ("pin_c_eta1_q1 = 1e308\n", "pin_c_eta1_q1: 1e+308 is outside the valid range -100..100"),
+    ("x_inertial_frac = 1e308\npin_c_eta1_q1 = -0.03\n",
+     "x_inertial_frac: 1e+308 chord fraction is outside the valid range 0..1"),
+    ("x_elastic_frac = -1e-308\npin_c_eta1_q1 = -0.03\n",
+     "x_elastic_frac: -1e-308 chord fraction is outside"),
+    ("structural_damping = 1e308\n", "structural_damping: 1e+308 (damping ratio) is outside "
+     "the valid range [0, 1)"),
+    ("structural_damping = nan\n", "structural_damping: must be a finite number"),
+    ('name = "a\\nb"\n', "name: holds a control character"),
+    ("description = 3\n", "description: must be a string"),
 ])
 def test_variant_file_fields_are_checked_by_name(capsys, tmp_path, text, needle):
     code, _, err = run_cli(capsys, "modes", "--wing", _variant(tmp_path, text))

@@ -135,12 +135,13 @@ def test_non_increasing_stations():
 
 def test_nan_in_twist():
     text = GOOD.replace("twist = [0.0, -5.0, 5.0]", "twist = [0.0, nan, 5.0]")
-    expect_error(text, "mode[2].twist", "non-finite", f"(line {line_of(text, 'twist =', 2)})")
+    expect_error(text, "mode[2].twist", "element 1: must be a finite number, got nan",
+                 f"(line {line_of(text, 'twist =', 2)})")
 
 
 def test_nan_frequency():
     text = GOOD.replace("frequency = 70.0", "frequency = nan")
-    expect_error(text, "mode[2].frequency", "non-finite",
+    expect_error(text, "mode[2].frequency", "must be a finite number, got nan",
                  f"(line {line_of(text, 'frequency = nan')})")
 
 
@@ -190,7 +191,7 @@ def test_modes_out_of_order_and_wrong_types():
     text = GOOD.replace("frequency = 70.0", "frequency = 20.0")
     expect_error(text, "mode[2].frequency", "increasing frequency")
     text = GOOD.replace("generalised_mass = 4.0e-5", 'generalised_mass = "4e-5"')
-    expect_error(text, "mode[1].generalised_mass", "expected a number")
+    expect_error(text, "mode[1].generalised_mass", "must be a finite number, got '4e-5'")
     text = GOOD.replace('format = "bioflex-jsb-modes"', 'format = "other"')
     expect_error(text, "format", "(line 1)")
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from bioflex_jsb.definition.model import Airframe, Inertia
 from bioflex_jsb.definition.reader import Reader
+from bioflex_jsb.inputs import Interval
 from bioflex_jsb.parameters.airframe import (
     AIRSPEED_RANGE_M_S,
     CRUISE_SPEED_M_S,
@@ -72,13 +73,8 @@ def _flight_speeds(r: Reader, t: dict) -> tuple[float | None, tuple[float, float
     w = "airframe"
     if "cruise_speed_m_s" not in t and "speed_range_m_s" not in t:
         return None, None
-    rng = t.get("speed_range_m_s")
-    ok = (isinstance(rng, list | tuple) and len(rng) == 2
-          and all(isinstance(x, int | float) and not isinstance(x, bool) for x in rng))
-    if not ok or not 0.0 < rng[0] < rng[1] <= FLIGHT_SPEED_MAX_M_S:
-        raise r.fail(f"{w}.speed_range_m_s", f"must be [low, high] m/s with 0 < low < high "
-                     f"<= {FLIGHT_SPEED_MAX_M_S:g} (given with cruise_speed_m_s), got {rng!r}")
-    lo, hi = float(rng[0]), float(rng[1])
+    lo, hi = r.field(Interval("m/s", hi=FLIGHT_SPEED_MAX_M_S,
+                              hint=" (given with cruise_speed_m_s)"), t, w, "speed_range_m_s")
     cruise = r.number(t, w, "cruise_speed_m_s", lo, hi, "m/s",
                       hint=" (inside airframe.speed_range_m_s)")
     return cruise, (lo, hi)

@@ -65,6 +65,7 @@ from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cl
 )
 from bioflex_jsb.definition.reader import DefinitionError, Reader
 from bioflex_jsb.definition.sensors import parse_sensors
+from bioflex_jsb.inputs import Interval
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 from bioflex_jsb.tomlfile import read_toml
 
@@ -316,13 +317,7 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
     an = r.table("analysis", ("method", "speed_range_m_s"), required=False)
     rng = an.get("speed_range_m_s")
     if rng is not None:
-        ok = (isinstance(rng, list) and len(rng) == 2
-              and all(isinstance(v, int | float) and not isinstance(v, bool) for v in rng)
-              and 0.0 < rng[0] < rng[1] <= SPEED_LIMIT_M_S)
-        if not ok:
-            raise r.fail("analysis.speed_range_m_s", f"must be [low, high] m/s with 0 < low "
-                         f"< high <= {SPEED_LIMIT_M_S:g}, got {rng!r}")
-        rng = (float(rng[0]), float(rng[1]))
+        rng = r.field(Interval("m/s", hi=SPEED_LIMIT_M_S), an, "analysis", "speed_range_m_s")
     analysis = AnalysisSettings(r.choice(an, "analysis", "method", METHODS, "pk"), rng)
     return Definition(name=name, description=r.text(data, "", "description", ""),
                       source=r.text(data, "", "source", ""), stations=stations,

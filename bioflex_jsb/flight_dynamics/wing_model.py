@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.aerodynamics.vortex_lattice import SpanwiseAerodynamics
-from bioflex_jsb.errors import InputError, unprintable
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_coefficients import (
     modal_coefficients,
@@ -36,6 +36,7 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
     shifted,
     spanwise_geometry,
 )
+from bioflex_jsb.inputs import CHORD_FRACTION, Flag, Invalid, Kind, Real, Text, problem
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME, AirframeData
 from bioflex_jsb.parameters.sensors import NO_SENSORS, Sensors
 from bioflex_jsb.parameters.wing import (
@@ -47,7 +48,7 @@ from bioflex_jsb.parameters.wing import (
 from bioflex_jsb.structures.beam_wing import BeamWing
 from bioflex_jsb.structures.modal_data import ModalData
 from bioflex_jsb.tomlfile import read_toml
-from bioflex_jsb.values import is_finite_real, is_real
+from bioflex_jsb.values import is_finite_real
 
 MASS_BASES = ("paper", "consistent")
 DEFAULT_MASS_BASIS = "consistent"
@@ -185,45 +186,37 @@ _VARIANT_KEYS = {
 MAX_PINNED_COEFFICIENT = 100.0
 
 
-def _coefficient(value, what: str, source: str) -> float:
-    """A pinned coefficient: a finite number with |value| <= MAX_PINNED_COEFFICIENT."""
-    if not is_finite_real(value):
-        raise VariantError(f"{source}: {what} must be a finite number, got {value!r}")
-    if abs(value) > MAX_PINNED_COEFFICIENT:
-        raise VariantError(f"{source}: {what} = {value!r} is outside "
-                           f"-{MAX_PINNED_COEFFICIENT:g}..{MAX_PINNED_COEFFICIENT:g} (a Table B1 "
-                           "coefficient of any wing is a few units at most)")
-    return float(value)
+# The fields of a variant file, each a kind of bioflex_jsb.inputs (its range and message).
+COEFFICIENT = Real("", -MAX_PINNED_COEFFICIENT, MAX_PINNED_COEFFICIENT,
+                   hint=" (a Table B1 coefficient of any wing is a few units at most)")
+# structural damping ratio ζ [-]: 1 is critical damping, no longer an oscillating mode
+STRUCTURAL_DAMPING = Real("(damping ratio)", 0.0, 1.0, below=True)
+NAME = Text()  # printed and logged: printable text (no newline, no bidirectional override)
+DESCRIPTION = Text(empty=True)
+PATH_TEXT = Text()  # a modes file's path
 
 
-def _text(value, what: str, source: str) -> str:
-    """A name or description: printable text (it is printed and logged;
-    :func:`bioflex_jsb.errors.unprintable`: no newline, no bidirectional override)."""
-    if not isinstance(value, str):
-        raise VariantError(f"{source}: {what} must be a string, got {type(value).__name__}")
-    bad = unprintable(value)
-    if bad:
-        raise VariantError(f"{source}: {what} holds {bad}; accepted: printable text")
-    return value
+def _field(kind: Kind, value, key: str, source: str):
+    """``value`` checked by ``kind``; the problem is one line naming the file and ``key``."""
+    try:
+        return kind.check(value)
+    except Invalid as exc:
+        raise problem(VariantError, source, key, exc.text) from None
 
 
 def variant_from_mapping(data: dict, source: str, base_dir: Path | None = None) -> WingVariant:
     """Build a variant from a parsed variant file (see docs/wing_variants.md)."""
     _check_variant_keys(data, source)
     base = _variant_base(data, source)
-    values: dict[str, object] = {"name": data.get("name", Path(source).stem)}
-    if not isinstance(values["name"], str) or not values["name"]:
-        raise VariantError(f"{source}: 'name' must be a non-empty string")
-    _text(values["name"], "'name'", source)
+    values: dict[str, object] = {"name": _field(NAME, data.get("name", Path(source).stem),
+                                                "name", source)}
     values.update(_structure_values(data, source, base_dir))
     if "overrides" in data:
         values["overrides"] = _overrides(data["overrides"], source)
     modes = _variant_modes(data, values, source)
     values["pinned_c_eta1_q1"] = _variant_pin(data, base, values, source, modes)
     if "description" in data:
-        if not isinstance(data["description"], str):
-            raise VariantError(f"{source}: 'description' must be a string")
-        values["description"] = data["description"]
+        values["description"] = _field(DESCRIPTION, data["description"], "description", source)
     return replace(base, published_c_eta1_q1=None, **values)
 
 
@@ -251,9 +244,7 @@ def _check_variant_keys(data: dict, source: str) -> None:
 def _variant_base(data: dict, source: str) -> WingVariant:
     """The named wing a variant starts from (``base``; a file's base is not a file)."""
     base_name = data.get("base", "original")
-    if not isinstance(base_name, str):
-        raise VariantError(f"{source}: 'base' must be a variant name")
-    if base_name not in VARIANTS:
+    if not isinstance(base_name, str) or base_name not in VARIANTS:
         raise VariantError(f"{source}: base {base_name!r} is not a named wing; accepted: "
                            f"{', '.join(VARIANTS)}")
     return get_variant(base_name)
@@ -265,26 +256,14 @@ def _structure_values(data: dict, source: str, base_dir: Path | None) -> dict[st
     values: dict[str, object] = {}
     for key in ("x_inertial_frac", "x_elastic_frac"):
         if key in data:
-            v = data[key]
-            if not is_finite_real(v):
-                raise VariantError(f"{source}: {key!r} must be a number, got {v!r}")
-            if not 0.0 <= float(v) <= 1.0:
-                raise VariantError(f"{source}: {key!r} must be a chord fraction 0..1, got {v!r}")
-            values[key] = float(v)
+            values[key] = _field(CHORD_FRACTION, data[key], key, source)
     if "ribs" in data:
-        if not isinstance(data["ribs"], bool):
-            raise VariantError(f"{source}: 'ribs' must be true or false")
-        values["ribs"] = data["ribs"]
+        values["ribs"] = _field(Flag(), data["ribs"], "ribs", source)
     if "structural_damping" in data:
-        z = data["structural_damping"]
-        if not is_real(z) or not 0.0 <= z < 1.0:
-            raise VariantError(f"{source}: 'structural_damping' must be a ratio in [0, 1)")
-        values["structural_damping"] = float(z)
+        values["structural_damping"] = _field(STRUCTURAL_DAMPING, data["structural_damping"],
+                                              "structural_damping", source)
     if "modes_file" in data:
-        mf = data["modes_file"]
-        if not isinstance(mf, str):
-            raise VariantError(f"{source}: 'modes_file' must be a path")
-        path = Path(mf)
+        path = Path(_field(PATH_TEXT, data["modes_file"], "modes_file", source))
         if base_dir is not None and not path.is_absolute():
             path = base_dir / path
         values["modes_file"] = str(path)
@@ -301,7 +280,7 @@ def _overrides(ov, source: str) -> dict[str, float]:
             parse_override_key(k, DEFAULT_N_MODES)
         except ValueError as exc:
             raise VariantError(f"{source}: overrides: {exc}") from None
-        checked[k] = _coefficient(v, f"overrides.{k}", source)
+        checked[k] = _field(COEFFICIENT, v, f"overrides.{k}", source)
     return checked
 
 
@@ -335,9 +314,9 @@ def _variant_pin(data: dict, base: WingVariant, values: dict, source: str, modes
     if pin == PHYSICAL_PIN:
         return None
     if not is_finite_real(pin):
-        raise VariantError(f"{source}: 'pin_c_eta1_q1' must be a finite number or "
-                           f"{PHYSICAL_PIN!r} (the strip model's own value)")
-    return _coefficient(pin, "'pin_c_eta1_q1'", source)
+        raise VariantError(f"{source}: pin_c_eta1_q1: must be a finite number or "
+                           f"{PHYSICAL_PIN!r} (the strip model's own value), got {pin!r}")
+    return _field(COEFFICIENT, pin, "pin_c_eta1_q1", source)
 
 
 def _differs(a, b) -> bool:

@@ -47,8 +47,8 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.inputs import CHORD_FRACTION, Invalid, Kind, Real
 from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
-from bioflex_jsb.values import is_real
 
 FORMAT_NAME = "bioflex-jsb-modes"
 FORMAT_VERSION = 1
@@ -93,6 +93,8 @@ MAX_DAMPING_RATIO = 1.0  # excluded
 # slender wing has little twist per metre of heave, so its m_i is large (the SGS-size beam
 # of 7 kg/m with the centre of mass 0.05 c behind the elastic axis: 1.1e5; a 20 % longer
 # one: 1.05e3 on its axes); 1e12 is 7 decades above that and still far inside doubles.
+# a modal file's numbers: finite, in the file's own [units] (ranges are checked in SI after)
+FINITE = Real("")
 MIN_GENERALISED_MASS_KG_M2 = 1e-12
 MAX_GENERALISED_MASS_KG_M2 = 1e12
 
@@ -145,13 +147,17 @@ class _Reader:
         raise ModalFileError(text)
 
     # --------------------------------------------------------------------------------------
+    def check(self, kind: Kind, value, what, table, key, index=0, element=None):
+        """``value`` checked by a kind of :mod:`bioflex_jsb.inputs`; the problem names
+        ``what`` (and the array ``element``) and the line."""
+        try:
+            return kind.check(value)
+        except Invalid as exc:
+            at = f"element {element}: " if element is not None else ""
+            self.fail(what, at + exc.text, table, key, index)
+
     def number(self, value, what, table, key, index=0) -> float:
-        if not is_real(value):
-            self.fail(what, f"expected a number, got {type(value).__name__}", table, key, index)
-        x = float(value)
-        if not math.isfinite(x):
-            self.fail(what, f"non-finite value {x}", table, key, index)
-        return x
+        return self.check(FINITE, value, what, table, key, index)
 
     def array(self, value, what, table, key, index=0, length=None) -> np.ndarray:
         if not isinstance(value, list):
@@ -159,11 +165,7 @@ class _Reader:
                       table, key, index)
         out = np.empty(len(value))
         for j, item in enumerate(value):
-            if not is_real(item):
-                self.fail(what, f"element {j} is not a number ({item!r})", table, key, index)
-            if not math.isfinite(float(item)):
-                self.fail(what, f"element {j} is non-finite ({float(item)})", table, key, index)
-            out[j] = float(item)
+            out[j] = self.check(FINITE, item, what, table, key, index, element=j)
         if length is not None and out.size != length:
             self.fail(what, f"expected {length} values (one per station), got {out.size}",
                       table, key, index)
@@ -172,11 +174,10 @@ class _Reader:
     def axis(self, value, what, key, k) -> np.ndarray:
         if isinstance(value, list):
             arr = self.array(value, what, "axes", key, length=k)
-        else:
-            arr = np.full(k, self.number(value, what, "axes", key))
-        if np.any((arr < 0.0) | (arr > 1.0)):
-            self.fail(what, "chord fractions must lie in [0, 1]", "axes", key)
-        return arr
+            for j, x in enumerate(arr):
+                self.check(CHORD_FRACTION, x, what, "axes", key, element=j)
+            return arr
+        return np.full(k, self.check(CHORD_FRACTION, value, what, "axes", key))
 
     # --------------------------------------------------------------------------------------
     def parse(self, data: dict, normalise: bool) -> ModalData:

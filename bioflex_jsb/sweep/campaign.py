@@ -44,20 +44,32 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     WingVariant,
     load_variant_file,
 )
+from bioflex_jsb.inputs import (
+    CHORD_FRACTION,
+    Choice,
+    Count,
+    Interval,
+    Invalid,
+    Kind,
+    Real,
+    Table,
+    Text,
+    problem,
+    read_table,
+    unknown_keys,
+)
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.sweep.columns import DEFAULT_AERO, result_columns
 from bioflex_jsb.sweep.columns import RUN_INFO_COLUMNS as RUN_INFO_COLUMNS  # re-exported
 from bioflex_jsb.sweep.errors import CampaignError as CampaignError  # re-exported
 from bioflex_jsb.tomlfile import read_toml
-from bioflex_jsb.values import is_whole
 
 CASE_ID_VERSION = 1  # bump when the meaning of a case's inputs changes
 MAX_CASES = 1_000_000
 
 METRICS = ("gust", "flutter", "eigenvalues", "coefficients")
 TOP_KEYS = {"name", "description", "metrics", "run", "axes"}
-RUN_KEYS = {"duration_s", "gust_start_s", "dt_s", "mass_basis", "flutter_range_m_s", "aero"}
 AERO_MODELS = ("quasi-steady", "unsteady")  # the coupled step's strips (run.aero)
 # the metrics the unsteady strips are offered for: the gust run (the coupled step) and the
 # wing's coefficients (no aerodynamics); flutter and eigenvalues are the quasi-steady LTI
@@ -303,32 +315,38 @@ def load_campaign(path: str | Path) -> Campaign:
     return parse_campaign(data, source=p.name, base_dir=p.parent, default_name=p.stem)
 
 
-def _is_number(v: Any) -> bool:
-    return not isinstance(v, bool) and isinstance(v, int | float) and math.isfinite(v)
-
-
 def _unknown(table: dict, allowed: set[str], where: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        key = f"{where}.{unknown[0]}" if where else unknown[0]
-        raise CampaignError(f"{key}: unknown key; accepted: {', '.join(sorted(allowed))}")
+    unknown = unknown_keys(table, sorted(allowed))
+    if unknown is not None:
+        raise problem(CampaignError, "", f"{where}.{unknown}" if where else unknown,
+                      f"unknown key; accepted: {', '.join(sorted(allowed))}")
+
+
+def _check(kind: Kind, v: Any, key: str) -> Any:
+    """``v`` checked by ``kind`` (:mod:`bioflex_jsb.inputs`); the problem names ``key``."""
+    try:
+        return kind.check(v)
+    except Invalid as exc:
+        raise problem(CampaignError, "", key, exc.text) from None
 
 
 MIN_SPEED_M_S = 1.0  # DECISION: a case's lowest airspeed [m/s] (1e-300 would be a failed row)
+MAX_SPEED_M_S = 100.0  # a case's highest airspeed [m/s]: the prototype's 10-30 m/s with room
+AXIS_VALUE = Real("the axis unit")  # a range's start and stop
+AXIS_STEP = Real("the axis unit", positive=True)
+SPEED = Real("m/s", MIN_SPEED_M_S, MAX_SPEED_M_S)
+SEED = Count(0)
 
 
-def _number(v: Any, key: str, unit: str, positive: bool = False, minimum: float | None = None,
-            maximum: float | None = None) -> float:
-    if not _is_number(v):
-        raise CampaignError(f"{key}: must be a number in {unit}, got {v!r}")
-    x = float(v)
-    if positive and x <= 0.0:
-        raise CampaignError(f"{key}: must be > 0 {unit}, got {v!r}")
-    if minimum is not None and x < minimum:
-        raise CampaignError(f"{key}: must be ≥ {minimum:g} {unit}, got {v!r}")
-    if maximum is not None and x > maximum:
-        raise CampaignError(f"{key}: must be ≤ {maximum:g} {unit}, got {v!r}")
-    return x
+class RunTable(Table):
+    """A campaign's [run] table (:class:`RunSettings`' fields, each with its range)."""
+
+    duration_s: Real("s", hi=600.0, positive=True).type() = RunSettings.duration_s
+    gust_start_s: Real("s", lo=0.0).type() = RunSettings.gust_start_s
+    dt_s: Real("s", MIN_DT_S, MAX_DT_S).type() = RunSettings.dt_s
+    mass_basis: Choice(MASS_BASES, noun="mass basis").type() = RunSettings.mass_basis
+    flutter_range_m_s: Interval("m/s").type() | None = None
+    aero: Choice(AERO_MODELS, noun="aerodynamics").type() = RunSettings.aero
 
 
 # The decimals an axis value keeps: a range's start + k * step carries the float error of
@@ -351,22 +369,20 @@ def _values(v: Any, key: str, integer: bool = False) -> list:
             if k not in v:
                 raise CampaignError(f"{key}.{k}: missing; a range is {{start, stop, step}} or "
                                     "{start, stop, num}")
-        start = _number(v["start"], f"{key}.start", "the axis unit")
-        stop = _number(v["stop"], f"{key}.stop", "the axis unit")
+        start = _check(AXIS_VALUE, v["start"], f"{key}.start")
+        stop = _check(AXIS_VALUE, v["stop"], f"{key}.stop")
         if stop < start:
             raise CampaignError(f"{key}: empty axis (stop {stop:g} < start {start:g})")
         if "step" in v and "num" in v:
             raise CampaignError(f"{key}: give step or num, not both")
         if "num" in v:
-            num = v["num"]
-            if not is_whole(num) or num < 1:
-                raise CampaignError(f"{key}.num: must be a whole number ≥ 1, got {num!r}")
+            num = _check(Count(1), v["num"], f"{key}.num")
             n, step = num, (stop - start) / max(num - 1, 1)
         else:
             step = v.get("step", 1 if integer else None)
             if step is None:
                 raise CampaignError(f"{key}: a range needs step or num")
-            step = _number(step, f"{key}.step", "the axis unit", positive=True)
+            step = _check(AXIS_STEP, step, f"{key}.step")
             n = int(math.floor((stop - start) / step + 1e-9)) + 1
         if n > MAX_CASES:  # before the list is made (num = 1e8 hung the command)
             raise CampaignError(f"{key}: {n} values is too many; accepted: up to {MAX_CASES}")
@@ -429,9 +445,7 @@ def parse_campaign(
         raise CampaignError(f"name: must be a non-empty string, got {name!r}")
     if "name" in data:
         _check_plain_name(name)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise CampaignError("description: must be a string")
+    description = _check(Text(empty=True), data.get("description", ""), "description")
 
     metrics_raw = data.get("metrics", ["gust"])
     if not isinstance(metrics_raw, list):
@@ -460,7 +474,7 @@ def parse_campaign(
 
     if "speeds_m_s" not in axes:
         raise CampaignError("axes.speeds_m_s: missing; give the airspeeds [m/s]")
-    speeds = [_number(v, f"axes.speeds_m_s[{i}]", "m/s", minimum=MIN_SPEED_M_S, maximum=100.0)
+    speeds = [_check(SPEED, v, f"axes.speeds_m_s[{i}]")
               for i, v in enumerate(_values(axes["speeds_m_s"], "axes.speeds_m_s"))]
     speeds = _unique(grid_values(speeds), "axes.speeds_m_s")
 
@@ -494,32 +508,12 @@ def parse_campaign(
 def _settings(run: Any) -> RunSettings:
     if not isinstance(run, dict):
         raise CampaignError("run: must be a table [run]")
-    _unknown(run, RUN_KEYS, "run")
-    d = RunSettings()
-    duration = _number(run.get("duration_s", d.duration_s), "run.duration_s", "s",
-                       positive=True, maximum=600.0)
-    start = _number(run.get("gust_start_s", d.gust_start_s), "run.gust_start_s", "s",
-                    minimum=0.0)
-    if start >= duration:
-        raise CampaignError(f"run.gust_start_s: {start:g} s must be before the end of the run "
-                            f"(run.duration_s {duration:g} s)")
-    dt = _number(run.get("dt_s", d.dt_s), "run.dt_s", "s", positive=True, minimum=MIN_DT_S,
-                 maximum=MAX_DT_S)
-    basis = run.get("mass_basis", d.mass_basis)
-    if basis not in MASS_BASES:
-        raise CampaignError(f"run.mass_basis: unknown mass basis {basis!r}; accepted: "
-                            f"{', '.join(MASS_BASES)}")
-    fr = run.get("flutter_range_m_s")
-    if fr is not None and not (isinstance(fr, list) and len(fr) == 2
-                               and all(_is_number(x) for x in fr) and 0.0 < fr[0] < fr[1]):
-        raise CampaignError(f"run.flutter_range_m_s: must be [low, high] with 0 < low < high "
-                            f"m/s, got {fr!r}")
-    aero = run.get("aero", d.aero)
-    if aero not in AERO_MODELS:
-        raise CampaignError(f"run.aero: unknown aerodynamics {aero!r}; accepted: "
-                            f"{', '.join(AERO_MODELS)}")
-    return RunSettings(duration, start, dt, basis,
-                       None if fr is None else (float(fr[0]), float(fr[1])), aero)
+    t = read_table(RunTable, run, "", CampaignError, "run")
+    if t.gust_start_s >= t.duration_s:
+        raise CampaignError(f"run.gust_start_s: {t.gust_start_s:g} s must be before the end of "
+                            f"the run (run.duration_s {t.duration_s:g} s)")
+    return RunSettings(t.duration_s, t.gust_start_s, t.dt_s, t.mass_basis,
+                       t.flutter_range_m_s, t.aero)
 
 
 def _wings(axes: dict, base_dir: Path | None, required: bool = True) -> list[WingVariant]:
@@ -552,8 +546,8 @@ def _wings(axes: dict, base_dir: Path | None, required: bool = True) -> list[Win
         for key in ("x_inertial_frac", "x_elastic_frac"):
             values = _values(axes[key], f"axes.{key}")
             grids[key] = _unique(grid_values(
-                [_number(v, f"axes.{key}[{i}]", "(fraction of the chord)", minimum=0.0,
-                         maximum=1.0) for i, v in enumerate(values)]), f"axes.{key}")
+                [_check(CHORD_FRACTION, v, f"axes.{key}[{i}]")
+                 for i, v in enumerate(values)]), f"axes.{key}")
         for xi in grids["x_inertial_frac"]:
             for xe in grids["x_elastic_frac"]:
                 wings.append(axis_variant(xi, xe))
@@ -605,8 +599,7 @@ def _gusts(axes: dict, metrics: tuple[str, ...]) -> list[str]:
     if "seeds" in axes:
         seeds = _values(axes["seeds"], "axes.seeds", integer=True)
         for i, s in enumerate(seeds):
-            if not is_whole(s) or s < 0:
-                raise CampaignError(f"axes.seeds[{i}]: must be a whole number ≥ 0, got {s!r}")
+            _check(SEED, s, f"axes.seeds[{i}]")
         seeds = _unique(seeds, "axes.seeds")
         if not any(spec.kind in TURBULENCE for _, _, spec in specs):
             raise CampaignError("axes.seeds: given but no gust is turbulence (dryden, "
