@@ -341,6 +341,22 @@ class SensorSet:
             self.values[m6:] = self.air_out
         return self.values
 
+    def clean(self, kin, eta, eta_dot, eta_ddot) -> dict[str, float]:
+        """Every channel by name as :meth:`read` gives it without the noise and the biases
+        (the sensor's true reading; its noise streams untouched): a controller's trim
+        values (:class:`~bioflex_jsb.simulation.controller.ControlLoop`)."""
+        kin = np.asarray(kin, dtype=float)
+        eta, eta_dot, eta_ddot = (np.asarray(a, dtype=float)[:self.n_modes]
+                                  for a in (eta, eta_dot, eta_ddot))
+        imu = np.zeros((len(self.imus), 6))
+        air = np.zeros(len(self.airspeeds))
+        if len(self.imus):
+            _imu_readings(kin, eta, eta_dot, eta_ddot, self.r, self.u, self.psi, self.mount,
+                          np.zeros_like(imu), imu)
+        if len(self.airspeeds):
+            _airspeed_readings(kin, eta_dot, self.r_air, self.u_air, np.zeros_like(air), air)
+        return dict(zip(self.channels, [*imu.ravel().tolist(), *air.tolist()], strict=True))
+
     def imu_index(self, name: str) -> int:
         """The position of the IMU ``name`` among :attr:`imus`."""
         for s, imu in enumerate(self.imus):
