@@ -194,6 +194,9 @@ class CoupledStep:
             t_k (its signals, the sensor channels among them), its commands are logged in
             the row (channels ``ctrl_<command>``) and written to JSBSim before its step
             (:meth:`_attach_controller`).
+        over_autopilot: the airframe's own autopilot writes the elevator command inside
+            JSBSim's step (the SITL aircraft): the controller's commands are added to the
+            autopilot's (:mod:`bioflex_jsb.runtime.control_surfaces`, "Over an autopilot").
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -205,7 +208,7 @@ class CoupledStep:
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
                  trim_mode: str = "rigid", sensors: SensorSet | None = None,
-                 controller=None) -> None:
+                 controller=None, over_autopilot: bool = False) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
         self.airframe = airframe
@@ -261,7 +264,7 @@ class CoupledStep:
                              "native wing: its modes step inside JSBSim, after the "
                              "controller; fly the coupled, qsd or rigid model")
         if controller is not None:
-            self._attach_controller(controller)
+            self._attach_controller(controller, over_autopilot)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
@@ -348,7 +351,7 @@ class CoupledStep:
         return kin
 
     # -- the controller ---------------------------------------------------------------------
-    def _attach_controller(self, controller) -> None:
+    def _attach_controller(self, controller, over_autopilot: bool = False) -> None:
         """Put ``controller`` in the loop: its command channels join the row, it is bound to
         the row's channels with every channel's trim value (the row the step would log at
         the trim in calm air) and its commands go to JSBSim through the writers of
@@ -371,7 +374,7 @@ class CoupledStep:
         if self._sensors is not None:  # their true reading at the trim, the wing at rest
             trim.update(self._sensors.set.clean(self._kinematics(0.0), zeros, zeros, zeros))
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
-        commands = commands_for(self.airframe, loop.outputs)
+        commands = commands_for(self.airframe, loop.outputs, over_autopilot)
         binding = loop.binding
         if binding is not None:  # the compiled update maps and returns the first command
             for i, c in enumerate(commands):

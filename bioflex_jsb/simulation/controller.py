@@ -547,21 +547,24 @@ class ControlLoop:
             reset(MappingProxyType(dict(trim)), self.dt_s)
         self.step = self._python_step
         self._inputs = tuple(controller.inputs)
+        self._steps = 0  # steps stepped: the controller's clock (a row k may be a scratch row)
 
     def _python_step(self, table: np.ndarray, k: int) -> tuple[float, ...]:
         row = table[k]
         signals = dict(zip(self._inputs, row[self.in_cols].tolist(), strict=True))
-        commands = self.controller.step(k * self.dt_s, signals)
+        t_s = self._steps * self.dt_s  # since it was bound: the run's start, a SITL reset
+        self._steps += 1
+        commands = self.controller.step(t_s, signals)
         try:
             values = tuple(float(commands[o]) for o in self.outputs)
         except (KeyError, TypeError, ValueError):
             raise InputError(f"controller {type(self.controller).__name__} returned "
-                             f"{commands!r} at t = {k * self.dt_s:.6f} s; expected a number "
+                             f"{commands!r} at t = {t_s:.6f} s; expected a number "
                              f"for each of {list(self.outputs)}") from None
         if not all(math.isfinite(v) for v in values):
             raise InputError(f"controller {type(self.controller).__name__} commanded "
                              f"{dict(zip(self.outputs, values, strict=True))} at t = "
-                             f"{k * self.dt_s:.6f} s: not finite")
+                             f"{t_s:.6f} s: not finite")
         row[self.out_cols] = values
         return values
 
