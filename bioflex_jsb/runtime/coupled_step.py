@@ -642,42 +642,57 @@ class CoupledStep:
         sensors = self._sensors
         if sensors is None:
             return self._bind_fast_step()
-        x, n, dt = self.wing._x, self.n_modes, self.dt_s  # x: updated in place by the kernel
-        kinematics, before, sensor_row = self._kinematics, sensors.before, sensors.row
-        cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.intp)
+        x, dt = self.wing._x, self.dt_s  # x: updated in place by the kernel
+        cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.int64)
         ft_per_m = U.FT_PER_M
+        hold, write = sensors.compiled(x, cols, U.M_PER_FT)
+        (g_fx, g_fy, g_fz, g_mass, g_pd, g_qd, g_rd, g_u, g_v, g_w, g_theta, g_phi, g_p, g_q,
+         g_r) = self._kinematics_readers()
         if self._control_step is not None:
-            control, w_col = self._control_step, self.names.index("w_g")
+            w_col = self.names.index("w_g")
 
-            def sensed_control(table: np.ndarray, k: int) -> None:
+            def sense(table: np.ndarray, k: int) -> None:
                 # JSBSim has not stepped: its forces and rates are still those of x_k
-                kin = kinematics(-table[k, w_col] * ft_per_m)
-                table[k, cols] = sensor_row(kin, x[:n], self.k * dt)
-                control(table, k)
+                write((g_fx(), g_fy(), g_fz(), g_mass(), g_pd(), g_qd(), g_rd(), g_u(), g_v(),
+                       g_w(), g_theta(), g_phi(), g_p(), g_q(), g_r()),
+                      -table[k, w_col] * ft_per_m, table, k, self.k * dt)
 
-            fast = self._bind_fast_step(sensed_control)
+            fast = self._bind_fast_step(sense)
 
             def fast_before(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
-                before(x[:n], x[n:2 * n])
+                hold()
                 return fast(w_g_m_s, table, k)
 
             return fast_before
         fast = self._bind_fast_step()
 
         def fast_sensing(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
-            kin = kinematics(-w_g_m_s * ft_per_m)
-            before(x[:n], x[n:2 * n])
+            reads = (g_fx(), g_fy(), g_fz(), g_mass(), g_pd(), g_qd(), g_rd(), g_u(), g_v(),
+                     g_w(), g_theta(), g_phi(), g_p(), g_q(), g_r())  # x_k, before the step
+            hold()
             t_s = self.k * dt
             stopped = fast(w_g_m_s, table, k)
-            table[k, cols] = sensor_row(kin, x[:n], t_s)
+            write(reads, -w_g_m_s * ft_per_m, table, k, t_s)
             return stopped
 
         return fast_sensing
 
-    def _bind_fast_step(self, control=None):
+    def _kinematics_readers(self) -> tuple:
+        """The property readers of :data:`~bioflex_jsb.simulation.sensors.KINEMATICS_READS`,
+        in that order (the compiled sensor row's; :meth:`_kinematics` the readable one)."""
+        node = self.airframe.property_node
+        g = self.get
+        forces = tuple(node(p).get_double_value for p in (
+            JP.FORCES_FBX_TOTAL_LBS, JP.FORCES_FBY_TOTAL_LBS, JP.FORCES_FBZ_TOTAL_LBS,
+            JP.INERTIA_MASS_SLUGS, JP.ACCELERATIONS_PDOT_RAD_SEC2,
+            JP.ACCELERATIONS_QDOT_RAD_SEC2, JP.ACCELERATIONS_RDOT_RAD_SEC2))
+        return forces + tuple(g[key] for key in ("u", "v", "w", "theta", "phi", "p", "q", "r"))
+
+    def _bind_fast_step(self, before_control=None):
         """The compiled path of :meth:`advance_into` as a closure over everything it uses,
-        bound once (each attribute lookup saved is ~40 ns of a ~10 µs step); ``control``
-        ``(table, k)``: called in the controller's place (:meth:`_bind_sensing`)."""
+        bound once (each attribute lookup saved is ~40 ns of a ~10 µs step);
+        ``before_control`` ``(table, k)``: called before the controller, after the wing's
+        step (the sensor channels it reads: :meth:`_bind_sensing`)."""
         params, cols = self._params, self._cols
         x = self.wing._x  # updated in place by the kernel
         # the snapshot's readers as locals, called in one tuple literal: the cheapest way
@@ -695,8 +710,8 @@ class CoupledStep:
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
         # a compiled controller of one command: its machine code for the tables the step
         # kernel's entry accepts (the same table type), then the command's setter
-        fast_control = self._control_fast if control is None else None
-        control = self._control_step if control is None else control  # None: no controller
+        fast_control = self._control_fast
+        control = self._control_step  # None without a controller
         if fast_control is not None:
             binding, set_command = fast_control
             c_params, c_entry = binding.params, binding.entry
@@ -722,6 +737,8 @@ class CoupledStep:
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
+            if before_control is not None:
+                before_control(table, k)
             if c_call is not None:  # its commands from row k, before JSBSim's step
                 set_command(c_call(table, k, c_params))
             elif control is not None:
