@@ -708,10 +708,10 @@ class CoupledStep:
         set_lift, set_drag, set_pitch = self._set_reactions
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
+        control = self._control_step  # None without a controller
         # a compiled controller of one command: its machine code for the tables the step
         # kernel's entry accepts (the same table type), then the command's setter
         fast_control = self._control_fast
-        control = self._control_step  # None without a controller
         if fast_control is not None:
             binding, set_command = fast_control
             c_params, c_entry = binding.params, binding.entry
