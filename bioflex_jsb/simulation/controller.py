@@ -40,7 +40,8 @@ shows in the sensors' sample of t_{k+1} (the forces of x_{k+1}), never in that o
 Two kinds of controller:
 
 * **a Python object** (:class:`Controller`): ``inputs`` (the signals it reads),
-  ``outputs`` (the commands it writes) and ``step(t_s, signals) -> commands`` (mappings by
+  ``outputs`` (the commands it writes) and ``step(t_s, signals) -> commands`` (``t_s``
+  [s] the time since it was bound: the run's start, a SITL session's last reset; mappings by
   name; ``signals`` holds the channels *as the run logs them*: ``u``, ``alpha``, ``theta``
   perturbations from the trim, the others absolute, ``n_z`` 1 in level flight); an optional
   ``reset(trim, dt_s)`` is called once before the first step with every channel's value at
