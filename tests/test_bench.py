@@ -308,6 +308,13 @@ def test_bench_json_has_every_figure(capsys):
                                                       "dryden:1.5:100:7"}
     assert "controlled" in data["us_per_step"]
     assert "value" in data["controller_in_loop_us_per_step"]
+    for key in ("sensors", "sensed_controlled"):  # measured in the same run
+        assert key in data["us_per_step"] and key in data["wall"]["us_per_step"]
+    for key in ("sensors_ratio", "controlled_ratio", "sensed_controlled_ratio"):
+        d = data[key]
+        assert d["value"] is None or d["value"] >= 1.0, key  # a floor of 1: never cheaper
+    for key in ("sensor_stations_us_per_step", "sensor_controller_in_loop_us_per_step"):
+        assert "value" in data[key]
     c = data["controller_us"]
     assert c["n_states"] == 10 and c["bar_us"] == 1.0 and c["meets_bar"] in (True, False)
     assert 0.0 < c["update"]["least"] <= c["in_step"]["median"]
@@ -386,6 +393,27 @@ def test_bench_bad_input_is_one_line_and_exit_2(capsys):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert word in err and err.count("\n") == 1, (argv, err)
+
+
+def test_the_bench_sensors_and_their_controller_fly_the_cosims_run():
+    """The bench's stations (the CG IMU and a tip accelerometer on the elastic axis) and the
+    10-state controller reading the tip's a_z: a run through the bench's gust stays in range
+    and the tip reads the wing (its a_z less the CG's moves: 0.40 m/s² measured through
+    sharp:0.3, the modes rung by the gust)."""
+    from bioflex_jsb.drivers.gust import RunConfig, run_gust
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.runtime.fdm import Airframe
+    from bioflex_jsb.simulation.gusts import parse_gust
+
+    build = build_wing(VARIANTS["optimised"])
+    ctrl = bench.bench_controller(signals=bench.SENSOR_CONTROLLER_SIGNALS)
+    assert ctrl.inputs == ("q", "alpha", "imu_tip_az_m_s2")
+    run = run_gust(Airframe(), build.model, "coupled",
+                   RunConfig(15.0, parse_gust("sharp:0.3"), 0.3, 0.05, models=("coupled",)),
+                   sensors=bench.bench_sensors(build), controller=ctrl)
+    assert run.stopped is None
+    assert np.ptp(run["imu_tip_az_m_s2"] - run["imu_cg_az_m_s2"]) > 0.2
+    assert np.abs(run["ctrl_elevator_rad"]).max() < math.radians(1.0)
 
 
 def test_controller_cost_is_the_step_s_own_calls():

@@ -38,12 +38,15 @@ quiet 2-core machine) printed against it; the logging costs [µs/step]: the rows
 loads, the scene. A controller in the loop: the co-simulation with a 10-state linear
 controller (q, alpha, n_z to the elevator) and its difference from the co-simulation, and
 the controller's own per-step cost (its compiled update and the command written to JSBSim,
-the least of 15 timings of 20000 calls; bar 1 µs). Also: µs per step through sharp:0.3,
-sharp:3 and Dryden gusts (a large gust
-renews the wing's reference step more often), the cost of one reference renewal [ms] of
-both wings, the step kernels' cold compile and cached load [s], the load average, and the
-SITL pacing error (step start against the wall clock, p50/p99 [ms] and resyncs) over
---sitl-seconds of simulated time at --sitl-speedup. Autopilots faster than real time
+the least of 15 timings of 20000 calls; bar 1 µs). Sensor stations: the co-simulation with
+two IMUs (the CG's and a wing-tip one) and with them and the controller reading the tip's
+a_z, q and alpha; sensors_ratio, controlled_ratio, sensed_controlled_ratio against the
+co-simulation and their costs [µs/step], measured in the same run. Also: µs per step
+through sharp:0.3, sharp:3 and Dryden gusts (a large gust renews the wing's reference step
+more often), the cost of one reference renewal [ms] of both wings, the step kernels' cold
+compile and cached load [s], the load average, and the SITL pacing error (step start
+against the wall clock, p50/p99 [ms] and resyncs) over --sitl-seconds of simulated time at
+--sitl-speedup. Autopilots faster than real time
 (--ardupilot-frames, 0 skips): the ardupilot backend (its log written, as a session logs)
 lock-stepped with the stand-in of ArduPilot's side (tests/ardupilot_standin.py, in its own
 process as ArduPlane is) at each ArduPilot physics rate of --ardupilot-sim-rates (its
@@ -243,8 +246,17 @@ def _print(p: dict) -> None:
     for gust, d in p["cosim_us_per_step_by_gust"].items():
         print(f"co-simulation, {gust:18s} {_spread(d, ' µs/step')}")
     print(f"{'  with a controller':20s} {_spread(us['controlled'], ' µs/step')}")
+    print(f"{'':20s} {'/ cosim':14s} {_spread(p['controlled_ratio'])}")
     print(f"  controller in the loop (with - without) "
           f"{_spread(p['controller_in_loop_us_per_step'], ' µs/step')}")
+    print(f"{'  with 2 IMUs':20s} {_spread(us['sensors'], ' µs/step')}")
+    print(f"{'':20s} {'/ cosim':14s} {_spread(p['sensors_ratio'])}")
+    print(f"  sensor stations (with - without) "
+          f"{_spread(p['sensor_stations_us_per_step'], ' µs/step')}")
+    print(f"{'  and a controller':20s} {_spread(us['sensed_controlled'], ' µs/step')}")
+    print(f"{'':20s} {'/ cosim':14s} {_spread(p['sensed_controlled_ratio'])}")
+    print(f"  its controller on the tip a_z (with - without) "
+          f"{_spread(p['sensor_controller_in_loop_us_per_step'], ' µs/step')}")
     c = p["controller_us"]
     print(f"controller of {c['n_states']} states ({', '.join(c['signals'])} -> elevator), per "
           f"step: {c['in_step']['least']:.3f} µs (median {c['in_step']['median']:.3f}; the "

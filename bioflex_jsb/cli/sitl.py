@@ -68,7 +68,10 @@ rudder, a PI autothrottle) with gains scaled from its rigid short period and the
 power and thrust its JSBSim model gives at the trim (docs/sitl.md, "A powered aircraft").
 Speeds: --speed and the airspeed targets (AIRSPEED_MS, DO_CHANGE_SPEED) within the
 aircraft's flight speeds: the prototype 12..22 m/s, a definition its
-airframe.speed_range_m_s (c172_elastic 31.1..68.9 m/s, cruise 57.8 m/s)."""
+airframe.speed_range_m_s (c172_elastic 31.1..68.9 m/s, cruise 57.8 m/s). --controller FILE
+adds a controller in the loop to the autopilot: its elevator over the trim is added to the
+autopilot's (through the pitch trim), its throttle to the lever the autothrottle adds to; its
+commands and signals are logged (/bioflex/<model>/controller; docs/sitl.md)."""
 
 
 def register(sub) -> None:
@@ -92,6 +95,9 @@ def register(sub) -> None:
                    "unsteady (Jones lag states, apparent mass, Kuessner gust; --model "
                    "coupled, --trim rigid); both on the compiled step")
     add_allow_unstable(p)
+    from bioflex_jsb.cli.gust import add_controller_argument
+
+    add_controller_argument(p)
     p.add_argument("--mavlink", default="udpout:127.0.0.1:14550", metavar="ENDPOINT",
                    help="udpout:HOST:PORT, udpin:HOST:PORT or tcpin:HOST:PORT "
                    "(default udpout:127.0.0.1:14550)")
@@ -146,12 +152,16 @@ def run(args: argparse.Namespace) -> int:
                          f"--model {args.model} --trim {args.trim} (its lag states are "
                          "linearised about the rigid trim; the rigid wing is quasi-steady)")
     build = wing_from_args(args)
+    from bioflex_jsb.cli.gust import controller_from_args
+
+    controller = controller_from_args(args)  # a bad file: one line before the trim
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     try:
         airframe, speeds = _airframe(args, home[2] + args.start_height)
         sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
                       trim_mode=args.trim, aero=args.aero, airframe=airframe,
+                      controller=controller,
                       **({} if speeds is None else {"airspeed_range_m_s": speeds}))
     except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing,
         raise UsageError(str(exc)) from None  # a home out of range
@@ -241,10 +251,21 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "mavlink": endpoint.text(), "signed": key is not None,
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
+               **_controller_extra(args),
                **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
     return SplitLog(args.out, description, build, args.log_max_mb,
                     live_opener(args, open_log), replace=args.force,
                     max_total_mb=args.log_max_total_mb)
+
+
+def _controller_extra(args) -> dict:
+    """The run description's ``controller`` (a file by its absolute path), or nothing."""
+    import os
+
+    c = getattr(args, "controller", None)
+    if c is None:
+        return {}
+    return {"controller": os.path.abspath(c) if os.path.isfile(c) else c}
 
 
 def _summary(args, sim, log, check, stats, link) -> dict:
@@ -260,6 +281,7 @@ def _summary(args, sim, log, check, stats, link) -> dict:
         "simulated_s": sim.t_s,
         "steps": sim.k,
         "aero": args.aero,
+        "controller": sim.controller_meta,
         "preflight": check,
         "pacing": stats.summary() if stats.steps else None,
         "link": {"received": link.stats.received, "bad": link.stats.bad,
@@ -369,6 +391,7 @@ class SplitLog:
         self._steps = 0  # steps in the file being written
         self._events: list[tuple[float, int, str]] = []  # (t_s, MAV_SEVERITY, text)
         self._reset: tuple[str, tuple[float, int, str] | None] | None = None
+        self._controller: dict | None = None  # the controller in the loop's (attach)
         self._log = self._next(None)
 
     def _next(self, reason: str | None):
@@ -381,6 +404,8 @@ class SplitLog:
                          **({"removed_before": removed} if removed else {}))
             d = self._replace(d, extra=extra)
         log = self._open(str(path), d, self._build)
+        if self._controller is not None:
+            log.log_controller(self._controller)
         self.paths.append(str(path))
         self._files += 1
         return log
@@ -439,6 +464,9 @@ class SplitLog:
         sim.on_reset = self.reset
         sim.vehicle.on_status = self.status
         names = sim.names
+        self._controller = sim.controller_meta
+        if self._controller is not None:
+            self._log.log_controller(self._controller)
 
         def on_sample(t, model, values):
             self.sample(model, t, dict(zip(names, values, strict=True)))

@@ -97,7 +97,10 @@ LOGS = (None, "rows", "loads", "gust")  # StepBench.cosim's logs
 # figure → (numerator, denominator) configurations
 RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
           "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
-          "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare")}
+          "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare"),
+          # sensor stations and controllers, against the co-simulation without them
+          "sensors_ratio": ("sensors", "cosim"), "controlled_ratio": ("controlled", "cosim"),
+          "sensed_controlled_ratio": ("sensed_controlled", "cosim")}
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
@@ -109,6 +112,11 @@ CONTROLLER_SIGNALS = ("q", "alpha", "n_z")
 CONTROLLER_BAR_US = 1.0
 CONTROLLER_CALLS = 20_000  # calls of one timing (~15 ms: shorter than the speed states)
 CONTROLLER_REPEAT = 15
+# Sensor stations (simulation/sensors.py): the autopilot's IMU at the CG and an accelerometer
+# at the starboard wing tip (the issue's pair: the autopilot's and a wing-tip one), without
+# noise; and the 10-state controller reading the tip's a_z with q and α (a GLA's signals).
+BENCH_TIP_IMU = "tip"
+SENSOR_CONTROLLER_SIGNALS = ("q", "alpha", f"imu_{BENCH_TIP_IMU}_az_m_s2")
 # The 3-D scene of a gust log: the scene's default, true scale, as cli.gust.SCENE_EXAGGERATION
 # (the CLI is above this layer; tests/test_bench.py holds the two equal).
 GUST_SCENE_EXAGGERATION = DEFAULT_EXAGGERATION
@@ -380,12 +388,12 @@ class StepBench:
 
     def cosim(self, n: int, gust: str = "sharp:0.3", log: str | None = None,
               compiled: bool = True, aero: str = "quasi-steady",
-              controller=None) -> tuple[float, float]:
+              controller=None, sensors: bool = False) -> tuple[float, float]:
         """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
         at half the shortest run; ``aero`` the strips; ``log``: None (no log, no section
         loads), ``"rows"`` (an MCAP log of the run's rows), ``"loads"`` (and the section
         loads, computed and logged) or ``"gust"`` (and the 3-D scene: what ``bioflex-jsb
-        gust`` logs, cli/gust.py)."""
+        gust`` logs, cli/gust.py); ``sensors``: with :func:`bench_sensors`' stations."""
         if log not in LOGS:
             raise ValueError(f"log must be one of {LOGS}, not {log!r}")
         dt = DEFAULT_DT_S
@@ -404,13 +412,14 @@ class StepBench:
                 overrides=dict(self.build.model.coefficients.overrides),
                 scene=GUST_SCENE_EXAGGERATION if log == "gust" else None)
         wing = self.build if aero == "unsteady" else self.build.model
+        stations = bench_sensors(self.build) if sensors else None
         try:
             c0, w0 = _clocks()
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=run_log.recorder("coupled") if run_log else None,
                            compiled=compiled,
                            loads=self.build if log in ("loads", "gust") else None,
-                           controller=controller)
+                           controller=controller, sensors=stations)
             if run_log is not None:  # closing writes the last chunks: part of the log's cost
                 run_log.close()
                 run_log = None
@@ -434,6 +443,9 @@ class StepBench:
             "native": self.native_run,
             "python": lambda n: self.cosim(n, compiled=False),
             "controlled": lambda n: self.cosim(n, controller=bench_controller()),
+            "sensors": lambda n: self.cosim(n, sensors=True),
+            "sensed_controlled": lambda n: self.cosim(
+                n, sensors=True, controller=bench_controller(signals=SENSOR_CONTROLLER_SIGNALS)),
         }
         for g in gusts:
             if g != "sharp:0.3":  # that one is "cosim"
@@ -485,6 +497,9 @@ class StepBench:
             "log_costs_us_per_step": {k: difference(cpu[a], cpu[b])
                                       for k, (a, b) in LOG_COSTS.items()},
             "controller_in_loop_us_per_step": difference(cpu["controlled"], cpu["cosim"]),
+            "sensor_stations_us_per_step": difference(cpu["sensors"], cpu["cosim"]),
+            "sensor_controller_in_loop_us_per_step": difference(cpu["sensed_controlled"],
+                                                                cpu["sensors"]),
             "wall": {"us_per_step": {k: est["wall"][k].as_dict() for k in plain},
                      **{key: ratio(est["wall"][a], est["wall"][b])
                         for key, (a, b) in RATIOS.items()}},
@@ -498,22 +513,40 @@ class StepBench:
         }
 
 
-def bench_controller(n_states: int = CONTROLLER_STATES, seed: int = 0):
+def bench_controller(n_states: int = CONTROLLER_STATES, seed: int = 0,
+                     signals: Sequence[str] = CONTROLLER_SIGNALS):
     """A discrete linear controller of ``n_states`` states at the run's step, reading
-    :data:`CONTROLLER_SIGNALS` and commanding the elevator: A random with its spectral
-    radius 0.9 (stable), B, C, D random and scaled so that a gust run's signals move the
-    elevator by well under a degree (the run stays the cosim's); seeded, the same every
-    time."""
+    ``signals`` and commanding the elevator: A random with its spectral radius 0.9
+    (stable), B, C, D random and scaled so that a gust run's signals move the elevator by
+    well under a degree (the run stays the cosim's; an accelerometer's column [per m/s²]
+    a tenth of the others: it moves ~10 times as much as α [rad] or q [rad/s]); seeded, the
+    same every time."""
     from bioflex_jsb.simulation.controller import LinearController
 
     rng = np.random.default_rng(seed)
     a = rng.normal(size=(n_states, n_states))
     a *= 0.9 / max(abs(np.linalg.eigvals(a)))
-    m = len(CONTROLLER_SIGNALS)
+    m = len(signals)
+    scale = np.array([0.1 if s.endswith("_m_s2") else 1.0 for s in signals])
     return LinearController.from_arrays(
-        a, 1e-3 * rng.normal(size=(n_states, m)), 1e-2 * rng.normal(size=(1, n_states)),
-        1e-3 * rng.normal(size=(1, m)), DEFAULT_DT_S, CONTROLLER_SIGNALS, ["elevator"],
-        f"bench{n_states}")
+        a, 1e-3 * rng.normal(size=(n_states, m)) * scale,
+        1e-2 * rng.normal(size=(1, n_states)), 1e-3 * rng.normal(size=(1, m)) * scale,
+        DEFAULT_DT_S, tuple(signals), ["elevator"], f"bench{n_states}")
+
+
+def bench_sensors(build: WingBuild):
+    """The bench's sensor stations on ``build``'s wing (:data:`BENCH_TIP_IMU`): the
+    autopilot's IMU at the CG and an accelerometer at the starboard tip on the elastic
+    axis (its body x taken as the CG's: what it costs does not depend on where it is), no
+    noise; as the run's :class:`~bioflex_jsb.simulation.sensors.SensorSet`."""
+    from bioflex_jsb.parameters.sensors import CG_IMU, ImuSpec, Sensors, WingPoint
+    from bioflex_jsb.simulation.sensors import SensorSet
+
+    modes = build.modes
+    tip_m = float(modes.stations_m[-1])
+    tip = ImuSpec(BENCH_TIP_IMU, (0.0, tip_m, 0.0),
+                  wing=WingPoint(tip_m, float(modes.x_elastic_frac[-1]), 0.0, 0.0))
+    return SensorSet(Sensors(imus=(CG_IMU, tip)), modes, build.model.n_modes)
 
 
 def controller_cost_us(build: WingBuild, speed_m_s: float = 15.0,

@@ -355,7 +355,7 @@ class SitlSim:
                  speedup: float = 1.0, airframe: Airframe | None = None,
                  trim_mode: str = "rigid", aero: str = "quasi-steady",
                  airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S,
-                 sensors: Sensors | None = None) -> None:
+                 sensors: Sensors | None = None, controller=None) -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
         :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
@@ -369,7 +369,14 @@ class SitlSim:
         speed targets accepted [m/s] (AIRSPEED_MS, DO_CHANGE_SPEED). ``sensors``: the
         aircraft's sensor stations (None: the WingBuild's, an aircraft definition's
         ``[sensors]``): each is channels of the rows (and a log topic), and the autopilot's
-        IMU is reported as HIGHRES_IMU (without sensors: an ideal IMU at the CG)."""
+        IMU is reported as HIGHRES_IMU (without sensors: an ideal IMU at the CG).
+        ``controller``: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`),
+        its commands added to the autopilot's (the elevator through the pitch trim, the
+        throttle on the lever the autothrottle adds to:
+        :mod:`bioflex_jsb.runtime.control_surfaces`, "Over an autopilot"), in every mode
+        (MANUAL too: it adds to the sticks); its commands are channels of the rows
+        (``ctrl_<command>``); a reset binds it anew (a linear controller's state back to 0,
+        a Python one's ``reset`` called)."""
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
         self.aero = aero
@@ -393,6 +400,7 @@ class SitlSim:
         self._k_base = 0  # steps flown by the cores before the present one
         self._reset_walls: list[float] = []
         self._dt0 = dt_s
+        self._controller = controller
         if sensors is None:
             sensors = getattr(wing_model, "sensors", None) or NO_SENSORS
         n_flown = getattr(getattr(wing_model, "model", wing_model), "n_modes", None)
@@ -456,7 +464,8 @@ class SitlSim:
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
                                 trim_mode="elastic" if elastic else "rigid", aero=self.aero,
-                                sensors=self._sensor_set)
+                                sensors=self._sensor_set, controller=self._controller,
+                                over_autopilot=True)
         self._autopilot_imu.dt_s = self.core.dt_s
         self._autopilot_imu.reset(self.core.n_modes)
         self.trim = self.core.trim
@@ -496,6 +505,16 @@ class SitlSim:
         for name, value in state.items():
             a[name] = value
         a.restart_from_initial_conditions()
+
+    @property
+    def controller_meta(self) -> dict | None:
+        """What the controller in the loop is (None without one:
+        :func:`~bioflex_jsb.simulation.controller.controller_meta`), for the log."""
+        if self.core.control is None:
+            return None
+        from bioflex_jsb.simulation.controller import controller_meta
+
+        return controller_meta(self.core.control)
 
     @property
     def k(self) -> int:

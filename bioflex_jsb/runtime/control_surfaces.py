@@ -20,6 +20,17 @@ controls clip beyond it).
 
 The throttle: ``fcs/throttle-cmd-norm[i]`` of every engine, the trim's plus δt (the flight
 controls clip the total to 0..1). A glider has no throttle.
+
+**Over an autopilot** (``over_autopilot``: the SITL aircraft, whose autopilot system writes
+``fcs/elevator-cmd-norm`` inside every JSBSim step, :mod:`bioflex_jsb.generators.autopilot`):
+the controller's elevator goes to ``fcs/pitch-trim-cmd-norm`` instead, c = c₀ + m⁻¹(δ₀ + δe) −
+m⁻¹(δ₀) with c₀ the trim's pitch trim, and the flight controls add the autopilot's command to
+it: the surface is the autopilot's plus δe (exactly on an elevator of one slope, the
+prototype's; on one of two slopes while the total command keeps the trim's side). The
+prototype's autothrottle adds its increment to the lever ``fcs/throttle-cmd-norm``, so the
+controller's throttle is added to the autopilot's alike; a powered aircraft's autopilot
+writes the levers itself (``ap/throttle-trim-norm[i]`` plus its increment), over which a
+controller's throttle is refused (one line).
 """
 
 from __future__ import annotations
@@ -58,8 +69,10 @@ class ElevatorMap:
         return angle_rad / (self.down_rad if angle_rad >= 0.0 else self.up_rad)
 
 
-def elevator_map(airframe: Airframe) -> ElevatorMap:
-    """The elevator map of ``airframe``'s aircraft, measured on a fresh instance of it."""
+def elevator_map(airframe: Airframe, over_autopilot: bool = False) -> ElevatorMap:
+    """The elevator map of ``airframe``'s aircraft, measured on a fresh instance of it (over
+    an autopilot, which writes ``fcs/elevator-cmd-norm`` itself: through the pitch trim,
+    the elevator command at 0)."""
     log = CapturingLogger()
     fdm = load_fdm(airframe.root, airframe.aircraft, airframe.aircraft_path, log)
     manager = fdm.get_property_manager()
@@ -68,12 +81,17 @@ def elevator_map(airframe: Airframe) -> ElevatorMap:
             raise InputError(f"aircraft {airframe.aircraft!r} has no {name}: a controller's "
                              "elevator cannot be commanded")
     has_trim = manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM)
+    if over_autopilot and not has_trim:
+        raise InputError(f"aircraft {airframe.aircraft!r} has no {JP.FCS_PITCH_TRIM_CMD_NORM}: "
+                         "a controller's elevator cannot be added to its autopilot's")
+    probe, rest = ((JP.FCS_PITCH_TRIM_CMD_NORM, JP.FCS_ELEVATOR_CMD_NORM) if over_autopilot
+                   else (JP.FCS_ELEVATOR_CMD_NORM, JP.FCS_PITCH_TRIM_CMD_NORM))
     angles = []
     with captured(log):
         for c in PROBE_COMMANDS:
-            fdm[JP.FCS_ELEVATOR_CMD_NORM] = c
+            fdm[probe] = c
             if has_trim:
-                fdm[JP.FCS_PITCH_TRIM_CMD_NORM] = 0.0
+                fdm[rest] = 0.0
             fdm.run_ic()
             angles.append(float(fdm[JP.FCS_ELEVATOR_POS_RAD]))
     zero = angles[PROBE_COMMANDS.index(0.0)]
@@ -118,25 +136,32 @@ class Command:
         self.write_value(self.value(delta))
 
 
-def elevator_command(airframe: Airframe) -> Command:
+def elevator_command(airframe: Airframe, over_autopilot: bool = False) -> Command:
     """The elevator δe [rad, + trailing edge down] over the trim as ``fcs/elevator-cmd-norm``
-    (module docstring: c₀ + m⁻¹(δ₀ + δe) − m⁻¹(δ₀)); ``airframe`` trimmed."""
-    m = elevator_map(airframe)
-    command0 = airframe[JP.FCS_ELEVATOR_CMD_NORM]
+    (module docstring: c₀ + m⁻¹(δ₀ + δe) − m⁻¹(δ₀)), or over an autopilot as
+    ``fcs/pitch-trim-cmd-norm``; ``airframe`` trimmed."""
+    m = elevator_map(airframe, over_autopilot)
+    elevator0 = airframe[JP.FCS_ELEVATOR_CMD_NORM]
     manager = airframe.jsbsim.get_property_manager()
-    pitch_trim = (airframe[JP.FCS_PITCH_TRIM_CMD_NORM]
-                  if manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM) else 0.0)
-    angle0 = m.angle_rad(command0 + pitch_trim)
-    setter = airframe.property_node(JP.FCS_ELEVATOR_CMD_NORM).set_double_value
+    has_trim = manager.hasNode(JP.FCS_PITCH_TRIM_CMD_NORM)
+    pitch_trim = airframe[JP.FCS_PITCH_TRIM_CMD_NORM] if has_trim else 0.0
+    angle0 = m.angle_rad(elevator0 + pitch_trim)
+    target = JP.FCS_PITCH_TRIM_CMD_NORM if over_autopilot else JP.FCS_ELEVATOR_CMD_NORM
+    command0 = pitch_trim if over_autopilot else elevator0
+    setter = airframe.property_node(target).set_double_value
     return Command(command0 - m.command(angle0), angle0, m.down_rad, m.up_rad, (setter,),
                    (0.0,))
 
 
-def throttle_command(airframe: Airframe) -> Command:
-    """The throttle δt [-] over the trim on every engine's command (its trim added)."""
+def throttle_command(airframe: Airframe, over_autopilot: bool = False) -> Command:
+    """The throttle δt [-] over the trim on every engine's command (its trim added); over a
+    powered aircraft's autopilot, which writes the levers itself, InputError."""
     if airframe.glider or not airframe.engines:
         raise InputError(f"aircraft {airframe.aircraft!r} has no engine: a controller cannot "
                          "command its throttle")
+    if over_autopilot and airframe.has_property("ap/throttle-trim-norm[0]"):
+        raise InputError(f"aircraft {airframe.aircraft!r}: its autopilot writes the throttle "
+                         "levers itself; a controller in the loop commands its elevator only")
     names = [JP.throttle_cmd(e.index) for e in airframe.engines]
     return Command(0.0, 0.0, 1.0, 1.0,
                    tuple(airframe.property_node(n).set_double_value for n in names),
@@ -146,7 +171,8 @@ def throttle_command(airframe: Airframe) -> Command:
 COMMANDS = {"elevator": elevator_command, "throttle": throttle_command}
 
 
-def commands_for(airframe: Airframe, outputs: tuple[str, ...]) -> tuple[Command, ...]:
+def commands_for(airframe: Airframe, outputs: tuple[str, ...], over_autopilot: bool = False
+                 ) -> tuple[Command, ...]:
     """One :class:`Command` per command of ``outputs`` (in that order), for the trimmed
-    ``airframe``."""
-    return tuple(COMMANDS[o](airframe) for o in outputs)
+    ``airframe`` (``over_autopilot``: added to its autopilot's, module docstring)."""
+    return tuple(COMMANDS[o](airframe, over_autopilot) for o in outputs)

@@ -15,7 +15,9 @@ Per step k (time t_k = k Δt, airframe state x_k), :meth:`CoupledStep.advance`:
    in that flow into ``external_reactions`` (lift and drag turned from wind to body axes
    with α_k);
    With a controller in the loop (``controller=``, :mod:`bioflex_jsb.simulation.controller`)
-   the row of t_k (step 5's) is built here, the controller reads its signals and its
+   the row of t_k (step 5's) is built here, with the sensor stations' channels of t_k (the
+   rigid body of x_k, the wing's η̈_k from η_{k−1}, η_k and the η_{k+1} just reached: all
+   known before JSBSim's step), the controller reads its signals and its
    commands go into the row (``ctrl_<command>``) and to JSBSim's flight controls
    (:mod:`bioflex_jsb.runtime.control_surfaces`), which move the surface in step 4: the
    forces of x_{k+1} carry it, one step after the LTI model's zero-order hold would;
@@ -189,8 +191,12 @@ class CoupledStep:
             η_{k+1}); None: no sensor channels (and no cost).
         controller: a controller in the loop (:mod:`bioflex_jsb.simulation.controller`: a
             Python object or a LinearController), or None. Every step it reads the row of
-            t_k (its signals), its commands are logged in the row (channels ``ctrl_<command>``)
-            and written to JSBSim before its step (:meth:`_attach_controller`).
+            t_k (its signals, the sensor channels among them), its commands are logged in
+            the row (channels ``ctrl_<command>``) and written to JSBSim before its step
+            (:meth:`_attach_controller`).
+        over_autopilot: the airframe's own autopilot writes the elevator command inside
+            JSBSim's step (the SITL aircraft): the controller's commands are added to the
+            autopilot's (:mod:`bioflex_jsb.runtime.control_surfaces`, "Over an autopilot").
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -202,7 +208,7 @@ class CoupledStep:
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
                  trim_mode: str = "rigid", sensors: SensorSet | None = None,
-                 controller=None) -> None:
+                 controller=None, over_autopilot: bool = False) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         native = model == "native"
         self.airframe = airframe
@@ -251,13 +257,14 @@ class CoupledStep:
         self.control = None  # the controller in the loop (_attach_controller)
         self._control_step = None
         self._control_fast = None
-        if controller is not None and self._sensors is not None:
-            # the sensors' channels need eta_{k+1} (after JSBSim's step); the controller reads
-            # the row of t_k before it: the two orders are not reconciled yet
-            raise InputError("a controller in the loop and sensor stations ([sensors]) in one "
-                             "run are not supported yet: fly without one of them")
+        if controller is not None and self._sensors is not None and native:
+            # the sensors' row of t_k needs η_{k+1}, which the native wing reaches only inside
+            # JSBSim's step, after the controller has written its commands
+            raise InputError("a controller in the loop and sensor stations ([sensors]) on the "
+                             "native wing: its modes step inside JSBSim, after the "
+                             "controller; fly the coupled, qsd or rigid model")
         if controller is not None:
-            self._attach_controller(controller)
+            self._attach_controller(controller, over_autopilot)
         self._row = row_getter(self.names)
         self._agl_m = self.get["agl"]
         self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
@@ -344,7 +351,7 @@ class CoupledStep:
         return kin
 
     # -- the controller ---------------------------------------------------------------------
-    def _attach_controller(self, controller) -> None:
+    def _attach_controller(self, controller, over_autopilot: bool = False) -> None:
         """Put ``controller`` in the loop: its command channels join the row, it is bound to
         the row's channels with every channel's trim value (the row the step would log at
         the trim in calm air) and its commands go to JSBSim through the writers of
@@ -364,8 +371,10 @@ class CoupledStep:
         zeros = np.zeros(self.n_modes)
         trim = self._row_dict(self._read(0.0), 0.0, WingLoads(0.0, 0.0, 0.0), zeros, zeros)
         trim.update({COMMAND_CHANNELS[o]: 0.0 for o in controller.outputs})
+        if self._sensors is not None:  # their true reading at the trim, the wing at rest
+            trim.update(self._sensors.set.clean(self._kinematics(0.0), zeros, zeros, zeros))
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
-        commands = commands_for(self.airframe, loop.outputs)
+        commands = commands_for(self.airframe, loop.outputs, over_autopilot)
         binding = loop.binding
         if binding is not None:  # the compiled update maps and returns the first command
             for i, c in enumerate(commands):
@@ -480,7 +489,10 @@ class CoupledStep:
                                   loads.drag_n * ca - loads.lift_n * sa,
                                   loads.pitch_moment_n_m)
             if self.control is not None:
-                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot)
+                if sensors is not None:  # the row of t_k with η_{k+1}, before the controller
+                    sensed = sensors.row(kin, mw.eta, t)
+                values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot,
+                                              sensed if sensors is not None else None)
             self.airframe.step()
             new_eta = mw.eta
         if self.control is None:
@@ -497,11 +509,14 @@ class CoupledStep:
                                     self._agl_m() * U.M_PER_FT, self.alpha_range_rad)
         return values
 
-    def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot
-                        ) -> tuple[float, ...]:
-        """The row of the Python step with a controller: built before JSBSim's step, the
-        controller run on it (its commands into the row and into JSBSim)."""
+    def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot,
+                        sensed: np.ndarray | None = None) -> tuple[float, ...]:
+        """The row of the Python step with a controller: built before JSBSim's step (with
+        the sensor channels ``sensed`` of t_k, :attr:`channels` order), the controller run
+        on it (its commands into the row and into JSBSim)."""
         row = self._row_dict(s, w_g, loads, eta, eta_dot)
+        if sensed is not None:
+            row.update(zip(self._sensors.channels, sensed.tolist(), strict=True))
         row.update({c: 0.0 for c in self.control.command_names})
         scratch = self._scratch_py
         scratch[0] = self._row(row)
@@ -605,7 +620,7 @@ class CoupledStep:
             table[k] = self.advance(w_g_m_s)
             return self.stopped
         if self._fast is None:
-            self._fast = self._bind_sensing(self._bind_fast_step())
+            self._fast = self._bind_sensing()
         return self._fast(w_g_m_s, table, k)
 
     def stepper(self):
@@ -614,34 +629,70 @@ class CoupledStep:
         if not self.compiled:
             return self.advance_into
         if self._fast is None:
-            self._fast = self._bind_sensing(self._bind_fast_step())
+            self._fast = self._bind_sensing()
         return self._fast
 
-    def _bind_sensing(self, fast):
-        """``fast`` with the sensor channels of the row (:meth:`_sensor_rows`): the rigid
-        body and the wing read before the step, the channels written after it; ``fast``
-        itself without sensors (a run without them pays nothing)."""
+    def _bind_sensing(self):
+        """The compiled step (:meth:`_bind_fast_step`) with the sensor channels of the row
+        (:meth:`_sensor_rows`): the rigid body and the wing read before the step, the
+        channels written after it; with a controller, written after the wing's step (η_{k+1}
+        known) and before the controller, which reads them (the row of t_k: "Timing" in
+        :mod:`bioflex_jsb.simulation.controller`). Without sensors the step itself (a run
+        without them pays nothing)."""
         sensors = self._sensors
         if sensors is None:
-            return fast
-        x, n, dt = self.wing._x, self.n_modes, self.dt_s  # x: updated in place by the kernel
-        kinematics, before, sensor_row = self._kinematics, sensors.before, sensors.row
-        cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.intp)
+            return self._bind_fast_step()
+        x, dt = self.wing._x, self.dt_s  # x: updated in place by the kernel
+        cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.int64)
         ft_per_m = U.FT_PER_M
+        hold, write = sensors.compiled(x, cols, U.M_PER_FT)
+        (g_fx, g_fy, g_fz, g_mass, g_pd, g_qd, g_rd, g_u, g_v, g_w, g_theta, g_phi, g_p, g_q,
+         g_r) = self._kinematics_readers()
+        if self._control_step is not None:
+            w_col = self.names.index("w_g")
+
+            def sense(table: np.ndarray, k: int) -> None:
+                # JSBSim has not stepped: its forces and rates are still those of x_k
+                write((g_fx(), g_fy(), g_fz(), g_mass(), g_pd(), g_qd(), g_rd(), g_u(), g_v(),
+                       g_w(), g_theta(), g_phi(), g_p(), g_q(), g_r()),
+                      -table[k, w_col] * ft_per_m, table, k, self.k * dt)
+
+            fast = self._bind_fast_step(sense)
+
+            def fast_before(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+                hold()
+                return fast(w_g_m_s, table, k)
+
+            return fast_before
+        fast = self._bind_fast_step()
 
         def fast_sensing(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
-            kin = kinematics(-w_g_m_s * ft_per_m)
-            before(x[:n], x[n:2 * n])
+            reads = (g_fx(), g_fy(), g_fz(), g_mass(), g_pd(), g_qd(), g_rd(), g_u(), g_v(),
+                     g_w(), g_theta(), g_phi(), g_p(), g_q(), g_r())  # x_k, before the step
+            hold()
             t_s = self.k * dt
             stopped = fast(w_g_m_s, table, k)
-            table[k, cols] = sensor_row(kin, x[:n], t_s)
+            write(reads, -w_g_m_s * ft_per_m, table, k, t_s)
             return stopped
 
         return fast_sensing
 
-    def _bind_fast_step(self):
+    def _kinematics_readers(self) -> tuple:
+        """The property readers of :data:`~bioflex_jsb.simulation.sensors.KINEMATICS_READS`,
+        in that order (the compiled sensor row's; :meth:`_kinematics` the readable one)."""
+        node = self.airframe.property_node
+        g = self.get
+        forces = tuple(node(p).get_double_value for p in (
+            JP.FORCES_FBX_TOTAL_LBS, JP.FORCES_FBY_TOTAL_LBS, JP.FORCES_FBZ_TOTAL_LBS,
+            JP.INERTIA_MASS_SLUGS, JP.ACCELERATIONS_PDOT_RAD_SEC2,
+            JP.ACCELERATIONS_QDOT_RAD_SEC2, JP.ACCELERATIONS_RDOT_RAD_SEC2))
+        return forces + tuple(g[key] for key in ("u", "v", "w", "theta", "phi", "p", "q", "r"))
+
+    def _bind_fast_step(self, before_control=None):
         """The compiled path of :meth:`advance_into` as a closure over everything it uses,
-        bound once (each attribute lookup saved is ~40 ns of a ~10 µs step)."""
+        bound once (each attribute lookup saved is ~40 ns of a ~10 µs step);
+        ``before_control`` ``(table, k)``: called before the controller, after the wing's
+        step (the sensor channels it reads: :meth:`_bind_sensing`)."""
         params, cols = self._params, self._cols
         x = self.wing._x  # updated in place by the kernel
         # the snapshot's readers as locals, called in one tuple literal: the cheapest way
@@ -686,6 +737,8 @@ class CoupledStep:
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
+            if before_control is not None:
+                before_control(table, k)
             if c_call is not None:  # its commands from row k, before JSBSim's step
                 set_command(c_call(table, k, c_params))
             elif control is not None:

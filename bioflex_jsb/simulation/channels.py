@@ -97,6 +97,9 @@ ALIASES: dict[str, str] = {c.alias: name for name, c in CHANNELS.items() if c.al
 _ETA = re.compile(r"eta(\d+)")
 _ETA_DOT = re.compile(r"eta(\d+)_dot")
 _LOADS = re.compile(r"loads_(fs|md)_(shear_n|bending_n_m|torque_n_m)_s(\d+)")
+# the sensor stations' channels (bioflex_jsb.simulation.sensors: imu_channels, airspeed_channel)
+_IMU = re.compile(r"imu_([a-z][a-z0-9_]{0,31})_(a|g)([xyz])_(m_s2|rad_s)")
+_PROBE = re.compile(r"airspeed_([a-z][a-z0-9_]{0,31})_m_s")
 _LOAD_METHOD = {"fs": "force summation", "md": "mode displacement"}
 _LOAD_QUANTITY = {
     "shear_n": ("N", "vertical shear of the wing outboard, up positive"),
@@ -126,6 +129,17 @@ def describe(name: str, unit: str | None = None) -> Channel:
         return Channel(q_unit, _A, f"{what}, by {_LOAD_METHOD[method]}, at monitoring station "
                        f"{station} (run.meta['loads']['stations_m']), the 1 g part included "
                        "(its value: run.meta['loads']['static_1g'])")
+    if (m := _IMU.fullmatch(name)) and (m.group(2) == "a") == (m.group(4) == "m_s2"):
+        station, kind, axis = m.group(1), m.group(2), m.group(3)
+        if kind == "a":
+            return Channel("m/s^2", _A, f"specific force along the {axis} axis of IMU "
+                           f"{station!r}, its own axes (FRD when mounted level: 1 g level "
+                           "flight reads z −9.81), at its point with the wing's modes")
+        return Channel("rad/s", _A, f"angular rate about the {axis} axis of IMU {station!r}, "
+                       "its own axes, the wing's modal rotation rates included")
+    if m := _PROBE.fullmatch(name):
+        return Channel("m/s", _A, f"true airspeed at airspeed probe {m.group(1)!r} (its "
+                       "point's velocity against the air, the wing's modes included)")
     if name == "alpha_inertial":
         return Channel("rad", _P, "the LTI model's state α: inertial angle of attack θ − γ "
                        "(the gust not included), its perturbation from trim")

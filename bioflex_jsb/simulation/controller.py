@@ -3,7 +3,10 @@ and writes control commands.
 
 **Signals** are the run's channels by name (:mod:`bioflex_jsb.simulation.channels`, SI:
 ``u``, ``alpha``, ``q``, ``theta``, ``n_z``, ``w_g``, the air data and attitude, ``eta<i>``,
-``eta<i>_dot``, ...): a controller may read any channel the step writes before JSBSim's step.
+``eta<i>_dot``, ...): a controller may read any channel the step writes before JSBSim's step,
+the sensor stations' among them (``imu_<name>_az_m_s2`` of a wing-tip accelerometer,
+``airspeed_<name>_m_s``; :mod:`bioflex_jsb.simulation.sensors`), which a linear controller
+reads as perturbations from their true (noise- and bias-free) reading at the trim.
 The section loads are not among them: a row's loads need the next row's pitch rate (its
 pitch acceleration is a central difference, ``docs/loads.md``), so they are known one step
 behind the steps. ``w_g`` is the true gust at the centre of gravity: an ideal gust sensor,
@@ -28,12 +31,17 @@ the commands computed from it are written to JSBSim before its step k, whose fli
 move the surface and whose forces of x_{k+1} act over step k+1. A command therefore reaches
 the state one step after the zero-order hold of the LTI model would apply it (the gust does
 likewise in the co-simulation): one step of delay, 1.04 ms at 960 Hz, which the closed-loop
-LTI prediction carries (:mod:`bioflex_jsb.simulation.closed_loop`).
+LTI prediction carries (:mod:`bioflex_jsb.simulation.closed_loop`). A sensor-fed controller
+is a sampled controller with one step of computation delay: at step k it reads the sensors'
+sample of t_k (the airframe's x_k, the wing's η_k; its modal acceleration the central
+difference with the η_{k+1} the wing has reached before JSBSim's step), and its command first
+shows in the sensors' sample of t_{k+1} (the forces of x_{k+1}), never in that of t_k.
 
 Two kinds of controller:
 
 * **a Python object** (:class:`Controller`): ``inputs`` (the signals it reads),
-  ``outputs`` (the commands it writes) and ``step(t_s, signals) -> commands`` (mappings by
+  ``outputs`` (the commands it writes) and ``step(t_s, signals) -> commands`` (``t_s``
+  [s] the time since it was bound: the run's start, a SITL session's last reset; mappings by
   name; ``signals`` holds the channels *as the run logs them*: ``u``, ``alpha``, ``theta``
   perturbations from the trim, the others absolute, ``n_z`` 1 in level flight); an optional
   ``reset(trim, dt_s)`` is called once before the first step with every channel's value at
@@ -540,21 +548,24 @@ class ControlLoop:
             reset(MappingProxyType(dict(trim)), self.dt_s)
         self.step = self._python_step
         self._inputs = tuple(controller.inputs)
+        self._steps = 0  # steps stepped: the controller's clock (a row k may be a scratch row)
 
     def _python_step(self, table: np.ndarray, k: int) -> tuple[float, ...]:
         row = table[k]
         signals = dict(zip(self._inputs, row[self.in_cols].tolist(), strict=True))
-        commands = self.controller.step(k * self.dt_s, signals)
+        t_s = self._steps * self.dt_s  # since it was bound: the run's start, a SITL reset
+        self._steps += 1
+        commands = self.controller.step(t_s, signals)
         try:
             values = tuple(float(commands[o]) for o in self.outputs)
         except (KeyError, TypeError, ValueError):
             raise InputError(f"controller {type(self.controller).__name__} returned "
-                             f"{commands!r} at t = {k * self.dt_s:.6f} s; expected a number "
+                             f"{commands!r} at t = {t_s:.6f} s; expected a number "
                              f"for each of {list(self.outputs)}") from None
         if not all(math.isfinite(v) for v in values):
             raise InputError(f"controller {type(self.controller).__name__} commanded "
                              f"{dict(zip(self.outputs, values, strict=True))} at t = "
-                             f"{k * self.dt_s:.6f} s: not finite")
+                             f"{t_s:.6f} s: not finite")
         row[self.out_cols] = values
         return values
 

@@ -71,6 +71,12 @@ NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]{0,31}")
 KINEMATICS = ("f_x", "f_y", "f_z", "p", "q", "r", "p_dot", "q_dot", "r_dot",
               "u_air", "v_air", "w_air")
 NOISE_BLOCK = 4096  # noise samples drawn at a time per sensor (a step then only indexes)
+# What the compiled sensor row reads of the airframe, in this order (JSBSim's units): the
+# total forces [lbf] and the mass [slug], the rates' rates [rad/s²], the body velocities
+# [ft/s], θ, φ [rad] and the rates [rad/s]; :meth:`SensorRows.compiled` turns them into the
+# :data:`KINEMATICS` as the coupled step's ``_kinematics`` does.
+KINEMATICS_READS = ("fbx_lbf", "fby_lbf", "fbz_lbf", "mass_slug", "p_dot", "q_dot", "r_dot",
+                    "u_fps", "v_fps", "w_fps", "theta", "phi", "p", "q", "r")
 
 
 def imu_channels(name: str) -> tuple[str, ...]:
@@ -182,6 +188,56 @@ def _airspeed_readings(kin, eta_dot, r, u, noise, out):
             vy += u[s, 1, i] * eta_dot[i]
             vz += u[s, 2, i] * eta_dot[i]
         out[s] = math.sqrt(vx * vx + vy * vy + vz * vz) + noise[s]
+
+
+@numba.njit(cache=True, nogil=True)
+def _hold_kernel(x, n, dt, hist, flags):
+    """:meth:`SensorRows.before` compiled: the wing's η_k, η̇_k from its state ``x`` (2n,)
+    into ``hist`` rows 1 and 2; row 0 (η_{k−1}) made η_k − Δt η̇_k at the first call
+    (``flags[0]`` 0)."""
+    for i in range(n):
+        hist[1, i] = x[i]
+        hist[2, i] = x[n + i]
+    if flags[0] == 0.0:
+        for i in range(n):
+            hist[0, i] = hist[1, i] - dt * hist[2, i]
+        flags[0] = 1.0
+
+
+@numba.njit(cache=True, nogil=True)
+def _row_kernel(reads, wind_down_fps, m_per_ft, x, n, dt, rate_state, hist, kin, dot, ddot,
+                r, u, psi, mount, noise, imu_out, r_air, u_air, air_noise, air_out, table, k,
+                cols):
+    """:meth:`SensorRows.row` and the rigid body's kinematics compiled (module docstring):
+    ``reads`` the :data:`KINEMATICS_READS`, the wind down [ft/s]; the wing's η_{k+1} the
+    first n of ``x``; the channels written into ``table[k, cols]`` (IMUs, then probes);
+    η_{k−1} ← η_k after."""
+    fx, fy, fz, mass, pd, qd, rd = reads[0], reads[1], reads[2], reads[3], reads[4], reads[5], \
+        reads[6]
+    uu, vv, ww, theta, phi = reads[7], reads[8], reads[9], reads[10], reads[11]
+    c = m_per_ft / mass
+    st, ct = math.sin(theta), math.cos(theta)
+    kin[0], kin[1], kin[2] = fx * c, fy * c, fz * c
+    kin[3], kin[4], kin[5] = reads[12], reads[13], reads[14]
+    kin[6], kin[7], kin[8] = pd, qd, rd
+    kin[9] = (uu + wind_down_fps * st) * m_per_ft
+    kin[10] = (vv - wind_down_fps * math.sin(phi) * ct) * m_per_ft
+    kin[11] = (ww - wind_down_fps * math.cos(phi) * ct) * m_per_ft
+    for i in range(n):
+        ddot[i] = (x[i] - 2.0 * hist[1, i] + hist[0, i]) / (dt * dt)
+        dot[i] = hist[2, i] if rate_state else (x[i] - hist[0, i]) / (2.0 * dt)
+    m = imu_out.shape[0]
+    if m:
+        _imu_readings(kin, hist[1], dot, ddot, r, u, psi, mount, noise, imu_out)
+        for s in range(m):
+            for j in range(6):
+                table[k, cols[6 * s + j]] = imu_out[s, j]
+    if air_out.shape[0]:
+        _airspeed_readings(kin, dot, r_air, u_air, air_noise, air_out)
+        for s in range(air_out.shape[0]):
+            table[k, cols[6 * m + s]] = air_out[s]
+    for i in range(n):
+        hist[0, i] = hist[1, i]
 
 
 def central_modal_kinematics(eta_prev, eta, eta_next, eta_dot, dt_s: float,
@@ -341,6 +397,22 @@ class SensorSet:
             self.values[m6:] = self.air_out
         return self.values
 
+    def clean(self, kin, eta, eta_dot, eta_ddot) -> dict[str, float]:
+        """Every channel by name as :meth:`read` gives it without the noise and the biases
+        (the sensor's true reading; its noise streams untouched): a controller's trim
+        values (:class:`~bioflex_jsb.simulation.controller.ControlLoop`)."""
+        kin = np.asarray(kin, dtype=float)
+        eta, eta_dot, eta_ddot = (np.asarray(a, dtype=float)[:self.n_modes]
+                                  for a in (eta, eta_dot, eta_ddot))
+        imu = np.zeros((len(self.imus), 6))
+        air = np.zeros(len(self.airspeeds))
+        if len(self.imus):
+            _imu_readings(kin, eta, eta_dot, eta_ddot, self.r, self.u, self.psi, self.mount,
+                          np.zeros_like(imu), imu)
+        if len(self.airspeeds):
+            _airspeed_readings(kin, eta_dot, self.r_air, self.u_air, np.zeros_like(air), air)
+        return dict(zip(self.channels, [*imu.ravel().tolist(), *air.tolist()], strict=True))
+
     def imu_index(self, name: str) -> int:
         """The position of the IMU ``name`` among :attr:`imus`."""
         for s, imu in enumerate(self.imus):
@@ -381,9 +453,10 @@ class SensorRows:
         self.rate_state = bool(rate_state)
         n = sensor_set.n_modes
         self.n_modes = n
-        self.eta_prev: np.ndarray | None = None
-        self.eta_k = np.zeros(n)
-        self.eta_dot_k = np.zeros(n)
+        # η_{k−1}, η_k, η̇_k: one array, shared by this readable step and :meth:`compiled`
+        self.hist = np.zeros((3, n))
+        self.eta_prev, self.eta_k, self.eta_dot_k = self.hist
+        self.flags = np.zeros(1)  # [0]: η_{k−1} set (the first before())
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -394,8 +467,54 @@ class SensorRows:
         n = self.n_modes
         self.eta_k[:] = np.asarray(eta, dtype=float)[:n]
         self.eta_dot_k[:] = np.asarray(eta_dot, dtype=float)[:n]
-        if self.eta_prev is None:
-            self.eta_prev = self.eta_k - self.dt_s * self.eta_dot_k
+        if not self.flags[0]:
+            self.eta_prev[:] = self.eta_k - self.dt_s * self.eta_dot_k
+            self.flags[0] = 1.0
+
+    def compiled(self, x: np.ndarray, cols: np.ndarray, m_per_ft: float):
+        """``(hold, write)``: :meth:`before` and :meth:`row` (with the rigid body's
+        kinematics) as compiled calls for the coupled step's compiled path, bound once to
+        the wing's state ``x`` (2n,: η, η̇, updated in place), the table columns ``cols`` of
+        :attr:`channels` and ft→m ``m_per_ft``: ``hold()`` before the wing's step,
+        ``write(reads, wind_down_fps, table, k, t_s)`` after it (``reads`` the
+        :data:`KINEMATICS_READS` of the airframe at t_k, the wind down [ft/s]) writes the
+        row's channels into ``table[k]``. The same arithmetic as the readable methods."""
+        ss, n, dt = self.set, self.n_modes, self.dt_s
+        hist, flags = self.hist, self.flags
+        x = np.ascontiguousarray(x)
+        cols = np.ascontiguousarray(cols, dtype=np.int64)
+        kin, dot, ddot = np.zeros(len(KINEMATICS)), np.zeros(n), np.zeros(n)
+        noisy, air_noisy = ss._noisy, ss._air_noisy
+        sources, air_sources = ss._noise, ss._air_noise
+        imu_noise, air_noise = ss._imu_noise, ss._air_noise_now
+        arrays = (x, n, dt, self.rate_state, hist, kin, dot, ddot, ss.r, ss.u, ss.psi,
+                  ss.mount, imu_noise, ss.imu_out, ss.r_air, ss.u_air, air_noise, ss.air_out)
+        types = tuple(numba.typeof(a) for a in arrays)
+        table_type = numba.typeof(np.zeros((1, 1)))
+        reads_type = numba.typeof((0.0,) * len(KINEMATICS_READS))
+        entry = _row_kernel.compile((reads_type, numba.float64, numba.float64, *types,
+                                     table_type, numba.int64, numba.typeof(cols)))
+        hold_entry = _hold_kernel.compile(tuple(numba.typeof(a) for a in (x, n, dt, hist,
+                                                                           flags)))
+        checked, call = None, _row_kernel
+
+        def hold() -> None:
+            hold_entry(x, n, dt, hist, flags)
+
+        def write(reads, wind_down_fps: float, table: np.ndarray, k: int, t_s: float) -> None:
+            nonlocal checked, call
+            if table is not checked:  # the machine code for the table type it was built for
+                checked = table
+                call = entry if numba.typeof(table) == table_type else _row_kernel
+            if noisy:
+                for s, src in enumerate(sources):
+                    imu_noise[s] = src.sample(t_s)
+            if air_noisy:
+                for s, src in enumerate(air_sources):
+                    air_noise[s] = src.sample(t_s)[0]
+            call(reads, wind_down_fps, m_per_ft, *arrays, table, k, cols)
+
+        return hold, write
 
     def row(self, kin, eta_next, t_s: float) -> np.ndarray:
         """The channels at t_k (``t_s`` [s]) from the rigid body's ``kin`` then and the

@@ -16,6 +16,7 @@ A campaign is a TOML file (``docs/sweeps.md``)::
     gusts = ["sharp:3", "dryden:1:100"]
     seeds = [1, 2]              # turbulence seeds (dryden / vonkarman gusts only)
     models = ["coupled", "qsd"]
+    controllers = ["none", "gla_optimised", "my_gla.toml"]  # in the loop of the gust runs
 
 The cases are the Cartesian product of the axes. Every case has a stable id: a hash of
 everything that determines its result (the wing's full definition, speed, gust, model, run
@@ -76,7 +77,8 @@ AERO_MODELS = ("quasi-steady", "unsteady")  # the coupled step's strips (run.aer
 # model's, so with run.aero = "unsteady" they are refused rather than given quasi-steady
 UNSTEADY_METRICS = ("gust", "coefficients")
 AXIS_KEYS = {"wings", "aircraft", "x_inertial_frac", "x_elastic_frac", "speeds_m_s", "gusts",
-             "seeds", "models"}
+             "seeds", "models", "controllers"}
+NO_CONTROLLER = "none"  # axes.controllers' entry for the gust run without a controller
 RANGE_KEYS = {"start", "stop", "step", "num"}
 TURBULENCE = ("dryden", "vonkarman")
 
@@ -149,11 +151,13 @@ class Case:
     aircraft: Any = None
     aircraft_column: bool = False
     turbulence_columns: bool = False
+    controller: str | None = None  # a controller file's absolute path or a shipped name
+    controller_column: bool = False  # the campaign has axes.controllers
 
     def columns(self) -> dict[str, str]:
         """The columns of this case's results table."""
         return result_columns(self.metrics, self.settings.aero, self.aircraft_column,
-                              self.turbulence_columns)
+                              self.turbulence_columns, self.controller_column)
 
     def inputs(self) -> dict[str, Any]:
         """The input columns of this case's row."""
@@ -172,6 +176,8 @@ class Case:
             "gust_length_m": g.length_m,
             "seed": g.seed if g.kind in TURBULENCE else None,
             "model": self.model,
+            **({"controller": self.controller or NO_CONTROLLER}
+               if self.controller_column else {}),
             "duration_s": self.settings.duration_s,
             "gust_start_s": self.settings.gust_start_s,
             "dt_s": self.settings.dt_s,
@@ -216,12 +222,28 @@ def _modes_digest(path: str) -> str | None:
     return _MODES_DIGESTS[path]
 
 
+def controller_identity(source: str | None) -> dict[str, str] | None:
+    """A controller as hashed into case ids: its file's name and the SHA-256 of its content
+    (a shipped controller's file alike; read bounded), None without one (a case without a
+    controller keeps the id it has in a store written before controllers)."""
+    if source is None:
+        return None
+    from bioflex_jsb.files import read_input_bytes
+    from bioflex_jsb.simulation.controller import MAX_CONTROLLER_BYTES, controller_path
+
+    path = controller_path(source)
+    data = read_input_bytes(path, "controller file", MAX_CONTROLLER_BYTES, CampaignError)
+    return {"file": path.name, "sha256": hashlib.sha256(data).hexdigest()}
+
+
 def _id_text(wing_json: str, speed_m_s: float, gust: str, model: str, settings_json: str,
-             metrics_json: str) -> str:
+             metrics_json: str, controller_json: str | None = None) -> str:
     """The hashed text: exactly ``json.dumps(payload, sort_keys=True, default=str)`` of
     :func:`case_id`'s payload, assembled from its parts (the wing's and the settings' parts
-    are serialised once per campaign, not once per case)."""
-    return (f'{{"gust": {json.dumps(gust)}, "metrics": {metrics_json}, '
+    are serialised once per campaign, not once per case; the controller's key, first in
+    sorted order, only with one)."""
+    head = "{" if controller_json is None else f'{{"controller": {controller_json}, '
+    return (f'{head}"gust": {json.dumps(gust)}, "metrics": {metrics_json}, '
             f'"model": {json.dumps(model)}, "settings": {settings_json}, '
             f'"speed_m_s": {json.dumps(speed_m_s)}, "v": {CASE_ID_VERSION}, '
             f'"wing": {wing_json}}}')
@@ -238,6 +260,8 @@ def case_id(case: Case) -> str:
         "settings": settings_identity(case.settings),
         "metrics": sorted(case.metrics),
     }
+    if case.controller is not None:
+        payload["controller"] = controller_identity(case.controller)
     text = json.dumps(payload, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -263,6 +287,8 @@ class Campaign:
     models: tuple[str, ...]
     source: str = ""
     aircraft: tuple = ()  # Aircraft of the aircraft axis (sweep/aircraft_axis.py)
+    controllers: tuple = (None,)  # axes.controllers (None: no controller)
+    controller_column: bool = False  # the campaign has axes.controllers
 
     def cases(self) -> list[Case]:
         """The Cartesian product wings × speeds × gusts × models, with ids (a list; a sweep
@@ -278,22 +304,26 @@ class Campaign:
         index = 0
         column, turbulence = bool(self.aircraft), self.has_turbulence
         wings = [(w, None) for w in self.wings] + [(a.variant(), a) for a in self.aircraft]
+        controllers = [(c, None if c is None else dumps(controller_identity(c), sort_keys=True))
+                       for c in self.controllers]
         for wing, aircraft in wings:
             wing_json = dumps(_wing_identity(wing, aircraft), sort_keys=True, default=str)
             for speed in self.speeds_m_s:
                 for gust in self.gusts:
                     for model in self.models:
-                        text = _id_text(wing_json, speed, gust, model, settings_json,
-                                        metrics_json)
-                        cid = hashlib.sha256(text.encode()).hexdigest()[:16]
-                        yield Case(index, wing, speed, gust, model, self.settings,
-                                   self.metrics, cid, aircraft, column, turbulence)
-                        index += 1
+                        for controller, controller_json in controllers:
+                            text = _id_text(wing_json, speed, gust, model, settings_json,
+                                            metrics_json, controller_json)
+                            cid = hashlib.sha256(text.encode()).hexdigest()[:16]
+                            yield Case(index, wing, speed, gust, model, self.settings,
+                                       self.metrics, cid, aircraft, column, turbulence,
+                                       controller, self.controller_column)
+                            index += 1
 
     @property
     def n_cases(self) -> int:
         return (len(self.wings) + len(self.aircraft)) * len(self.speeds_m_s) * \
-            len(self.gusts) * len(self.models)
+            len(self.gusts) * len(self.models) * len(self.controllers)
 
     @property
     def has_turbulence(self) -> bool:
@@ -302,7 +332,7 @@ class Campaign:
 
     def columns(self) -> dict[str, str]:
         return result_columns(self.metrics, self.settings.aero, bool(self.aircraft),
-                              self.has_turbulence)
+                              self.has_turbulence, self.controller_column)
 
 
 # ---------------------------------------------------------------------------------------
@@ -498,11 +528,49 @@ def parse_campaign(
                                 f"{extra!r} is the quasi-steady LTI model's; accepted with it: "
                                 f"metrics from {', '.join(UNSTEADY_METRICS)}")
 
-    n = (len(wings) + len(aircraft)) * len(speeds) * len(gusts) * len(models)
+    controllers = _controllers(axes, metrics, base_dir)
+    n = (len(wings) + len(aircraft)) * len(speeds) * len(gusts) * len(models) * \
+        len(controllers)
     if n > MAX_CASES:
         raise CampaignError(f"axes: {n} cases is more than {MAX_CASES}")
     return Campaign(name.strip(), description, metrics, settings, tuple(wings), tuple(speeds),
-                    tuple(gusts), tuple(models), source, tuple(aircraft))
+                    tuple(gusts), tuple(models), source, tuple(aircraft), tuple(controllers),
+                    "controllers" in axes)
+
+
+def _controllers(axes: dict, metrics: tuple[str, ...], base_dir: Path | None) -> list:
+    """axes.controllers: each a controller file (relative to the campaign's folder; kept
+    by its absolute path, which the workers and a case's log read) or a shipped controller's
+    name, or "none" (None: the gust run without a controller); each loaded once here, so a
+    bad file is one line before any case runs. Without the axis: [None]."""
+    if "controllers" not in axes:
+        return [None]
+    if "gust" not in metrics:
+        raise CampaignError("axes.controllers: given but metrics has no 'gust' (a controller "
+                            "flies in the gust runs)")
+    from bioflex_jsb.errors import InputError
+    from bioflex_jsb.simulation.controller import load_controller, shipped_controllers
+
+    out: list[str | None] = []
+    for i, c in enumerate(_values(axes["controllers"], "axes.controllers")):
+        key = f"axes.controllers[{i}]"
+        if not isinstance(c, str) or not c:
+            raise CampaignError(f"{key}: must be a controller file, a shipped controller's "
+                                f"name or \"{NO_CONTROLLER}\", got {c!r}")
+        if c == NO_CONTROLLER:
+            out.append(None)
+            continue
+        if c not in shipped_controllers() and (Path(c).suffix or Path(c).exists()):
+            path = Path(c)
+            if base_dir is not None and not path.is_absolute():
+                path = base_dir / path
+            c = str(path.resolve())
+        try:
+            load_controller(c)
+        except InputError as exc:
+            raise CampaignError(f"{key}: {exc}") from None
+        out.append(c)
+    return _unique(out, "axes.controllers")
 
 
 def _settings(run: Any) -> RunSettings:

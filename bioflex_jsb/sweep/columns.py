@@ -74,6 +74,11 @@ METRIC_COLUMNS: dict[str, dict[str, str]] = {
 # that ``gust`` reports), in the tables of campaigns with a turbulence gust, after the gust
 # metrics (empty for their discrete gusts); a table of discrete gusts keeps its columns.
 TURBULENCE_COLUMNS: dict[str, str] = dict.fromkeys(RMS_METRICS, "float")
+# The largest command of a case's controller over the run (|ctrl_<command>| [rad], [-]):
+# what it asked of the surface and the motor, in the tables of campaigns with a controllers
+# axis (empty for a case without a controller or a command it does not write).
+CONTROLLER_COLUMNS: dict[str, str] = {"peak_ctrl_elevator_rad": "float",
+                                      "peak_ctrl_throttle": "float"}
 # Where and when a case ran: differs between runs of the same case, so comparisons of
 # results tables leave these out (:data:`RUN_INFO_COLUMNS`).
 RUN_INFO_COLUMNS: dict[str, str] = {
@@ -84,18 +89,24 @@ RUN_INFO_COLUMNS: dict[str, str] = {
 
 
 def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
-                   aircraft: bool = False, turbulence: bool = False) -> dict[str, str]:
+                   aircraft: bool = False, turbulence: bool = False,
+                   controller: bool = False) -> dict[str, str]:
     """Every column of a results table for ``metrics``, in order, with its type. A campaign
     of the unsteady strips (``aero``) has an ``aero`` column after ``mass_basis``, one with
     an ``aircraft`` axis an ``aircraft`` column after ``wing`` (the definition's name, empty
     for the wings of ``axes.wings``), one with a ``turbulence`` gust and the gust metrics the
-    :data:`TURBULENCE_COLUMNS` after them; other tables keep the columns of a store written
-    without these options (so its files resume)."""
+    :data:`TURBULENCE_COLUMNS` after them, one with a ``controllers`` axis a
+    ``controller`` column after ``model`` (the file's path or the shipped name, "none") and
+    the controller's command peaks after the gust metrics (:data:`CONTROLLER_COLUMNS`,
+    empty without one); other tables keep the columns of a store written without these
+    options (so its files resume)."""
     cols = {}
     for name, kind in INPUT_COLUMNS.items():
         cols[name] = kind
         if name == "wing" and aircraft:
             cols["aircraft"] = "str"
+        if name == "model" and controller:
+            cols["controller"] = "str"
     if aero != DEFAULT_AERO:
         cols["aero"] = "str"
     cols.update(STATUS_COLUMNS)
@@ -104,5 +115,7 @@ def result_columns(metrics: Sequence[str], aero: str = DEFAULT_AERO,
             cols.update(columns)
             if m == "gust" and turbulence:
                 cols.update(TURBULENCE_COLUMNS)
+            if m == "gust" and controller:
+                cols.update(CONTROLLER_COLUMNS)
     cols.update(RUN_INFO_COLUMNS)
     return cols

@@ -228,7 +228,9 @@ def case_description(case: Case):
                           dt_s=s.dt_s, mass_basis=s.mass_basis,
                           extra={"case_id": case.case_id, "aero": s.aero,
                                  **({"aircraft": case.aircraft.source}
-                                    if case.aircraft is not None else {})})
+                                    if case.aircraft is not None else {}),
+                                 **({"controller": case.controller}
+                                    if case.controller is not None else {})})
 
 
 def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> None:
@@ -268,8 +270,13 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
         # the aircraft's [sensors] with the build's mode shapes (none: no sensor channels)
         sensors = (SensorSet(build.sensors, build.modes, build.model.n_modes)
                    if build.sensors else None)
+        controller = None
+        if case.controller is not None:  # a fresh one per run (a file read bounded)
+            from bioflex_jsb.simulation.controller import load_controller
+
+            controller = load_controller(case.controller)
         run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
-                       sensors=sensors)
+                       sensors=sensors, controller=controller)
         if log is not None and run.stopped:  # as a gust log says it: read_log's stopped
             log.event(run.stop_time_s, "ERROR", stop_event_text(case.model, run.stopped),
                       name=case.model)
@@ -284,6 +291,9 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     # else: stopped before the gust arrived, no gust response to summarise (left empty)
     row["time_beyond_stall_s"] = _num(run.meta.get("time_beyond_stall_s"))
     row["time_flown_s"] = float(len(run.time_s) * run.meta["dt_s"])
+    for name in ("ctrl_elevator_rad", "ctrl_throttle"):
+        if f"peak_{name}" in row and name in run.channels and len(run[name]):
+            row[f"peak_{name}"] = _num(abs(run[name]).max())
     if run.stopped:
         row["status"] = "diverged"
         row["error"] = " ".join(str(run.stopped).split())

@@ -449,7 +449,8 @@ def read_results(path: str | Path, columns: dict[str, str] | None = None) -> lis
             from bioflex_jsb.sweep.columns import METRIC_COLUMNS, result_columns
 
             # every column a table can have, with its type (aero: text)
-            columns = result_columns(list(METRIC_COLUMNS), "unsteady", turbulence=True)
+            columns = result_columns(list(METRIC_COLUMNS), "unsteady", turbulence=True,
+                                     controller=True)
         rows = [{k: _parse(v, columns.get(k, "float")) for k, v in r.items()} for r in raw]
     else:
         import pyarrow.parquet as pq

@@ -80,6 +80,12 @@ class RunLog:
         # steps' chunk (in it they would follow later steps and autopilot frames: out of
         # log-time order, which readers and `doctor --strict-message-order` refuse)
         self._scene_blocks: list = []
+        # a controller in the loop of the sampled steps (log_controller): its meta, its topic
+        # per model and the steps kept for it, written as chunks after the steps' (as a
+        # recorded run's: TableRecorder.controller)
+        self._controller_meta: dict | None = None
+        self._controllers: dict[str, Any] = {}
+        self._controller_rows: list[tuple[str, tuple[str, ...], np.ndarray, np.ndarray]] = []
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -206,6 +212,13 @@ class RunLog:
         self._ts.append(t_s)
         self._rows.append(tuple([row[k] for k in ch.names]))
 
+    def log_controller(self, meta: Mapping[str, Any]) -> None:
+        """The steps :meth:`sample` is given hold a controller's commands and signals
+        (``meta``: :func:`~bioflex_jsb.simulation.controller.controller_meta`): log them on
+        ``/bioflex/<model>/controller`` (:mod:`.controller_topic`), a chunk after each of
+        the steps' chunks."""
+        self._controller_meta = dict(meta)
+
     def _next_chunk(self, ch: ModelChannels, t_s: float) -> None:
         """Close the chunk in progress (if any) and start one for ``ch`` at ``t_s``."""
         if self._rows or any(s._frames for s in self._streams):
@@ -235,6 +248,11 @@ class RunLog:
             next(m for m, c in self._models.items() if c is ch), ch.names, ts[:n],
             v.reshape(n, len(ch.names)))  # the 3-D scene's samples of these steps
         size = len(block) + (len(scene[0]) if scene else 0)  # the scene's bytes count too
+        if self._controller_meta is not None:  # its steps, and a bound of their bytes
+            model = next(m for m, c in self._models.items() if c is ch)
+            self._controller_rows.append((model, ch.names, np.array(ts[:n], dtype=float),
+                                          v.reshape(n, len(ch.names)).copy()))
+            size += n * (CONTROLLER_STEP_BYTES + 8 * len(self._controller_meta["inputs"]))
         if not self._row_bytes_measured or size > n * self._row_bytes:
             self._row_bytes = -(-size // n)  # the first measure, then the largest
             self._row_bytes_measured = True
@@ -335,7 +353,20 @@ class RunLog:
                     self._writer.append_block(*scene)
                 self._scene_blocks.clear()
                 self._writer.close_chunk()
+            for model, names, ts, rows in self._controller_rows:
+                self._controller_topic(model, names).rows(ts, rows)  # a chunk each
+            self._controller_rows.clear()
         self._pending = None
+
+    def _controller_topic(self, model: str, names: tuple[str, ...]):
+        """The controller topic of ``model``'s sampled steps (made at its first rows)."""
+        out = self._controllers.get(model)
+        if out is None:
+            from bioflex_jsb.sinks.mcap.controller_topic import GROUP, ControllerTopic
+
+            out = self._controllers[model] = ControllerTopic(
+                self._writer, self.schema_id(GROUP), model, names, self._controller_meta)
+        return out
 
     def close(self) -> None:
         """Finish the file (summary, indexes, footer) and close it; safe to call twice."""
@@ -350,6 +381,10 @@ class RunLog:
 
 
 _MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~0.6 kB per step)
+# A bound of a controller's message [bytes] but its signals (8 bytes each): the record's
+# opcode, length, channel, sequence and two times (31), two tagged doubles and the signals'
+# tag and length (21), its message-index entry (16), with room to spare.
+CONTROLLER_STEP_BYTES = 80
 
 
 def chunk_steps(dt_s: float) -> int:
