@@ -379,3 +379,40 @@ def gust_field(spec: GustSpec, speed_m_s: float, stations: SpanStations | None =
     if stations is None:
         raise InputError(f"gust {spec.text()!r}: its spanwise parts need the wing's strips")
     return SpanwiseGustField(spec, speed_m_s, stations, tail, start_s, duration_s, dt_s)
+
+
+def tail_delay_elevator_rad(tail: TailGust, aero, w_tail_m_s, w_sym_m_s,
+                            speed_m_s: float) -> np.ndarray:
+    """The elevator angle [rad] whose tail lift is the tail delay's,
+    δe = a_t,S (1 − dε/dα) (w_t − w̄)/(V C_Lδe): a linear model with an elevator input flies
+    the delay with it (its moment follows, since :meth:`TailGust.from_derivatives` puts the
+    tail at l_t = −c̄ C_mδe/C_Lδe)."""
+    dw = np.asarray(w_tail_m_s, dtype=float) - np.asarray(w_sym_m_s, dtype=float)
+    return tail.lift_slope_per_rad * dw / (speed_m_s * aero.cl_delta_e_per_rad)
+
+
+def lateral_gust_response(ss, time_s, p_g_rad_s, v_g_m_s) -> dict[str, np.ndarray]:
+    """The rigid lateral model ``ss`` (:func:`~bioflex_jsb.flight_dynamics.lateral.
+    build_lateral_state_space`: states β, p, r, φ, input v_g first) from rest under the gust
+    roll rate p_g [rad/s] and the lateral gust v_g [m/s] at uniformly spaced ``time_s``
+    [s], each held over a step: the run's channels beta_rad, p_rad_s, r_rad_s, phi_rad.
+    p_g enters as p − p_g in the aerodynamic terms: B_p = −(the p column of A without its
+    kinematic w_0/V and φ̇ = p entries) = [−Y_p/V, −L'_p, −N'_p, 0], with Y_p/V the column's
+    first entry less w_0/V = sin α_0 (the model's notes' trim α)."""
+    from scipy.linalg import expm
+
+    t = np.asarray(time_s, dtype=float)
+    a = np.asarray(ss.a, dtype=float)
+    y_p = a[0, 1] - math.sin(float(ss.notes.get("alpha_trim_rad", 0.0)))
+    b = np.column_stack([np.asarray(ss.b, dtype=float)[:, 0],
+                         [-y_p, -a[1, 1], -a[2, 1], 0.0]])
+    dt = float(t[1] - t[0])
+    aug = np.zeros((6, 6))
+    aug[:4, :4], aug[:4, 4:] = a, b
+    e = expm(aug * dt)
+    phi, gam = e[:4, :4], e[:4, 4:]
+    u = np.column_stack([np.asarray(v_g_m_s, dtype=float), np.asarray(p_g_rad_s, dtype=float)])
+    x = np.zeros((len(t), 4))
+    for k in range(len(t) - 1):
+        x[k + 1] = phi @ x[k] + gam @ u[k]
+    return {"beta_rad": x[:, 0], "p_rad_s": x[:, 1], "r_rad_s": x[:, 2], "phi_rad": x[:, 3]}
