@@ -174,3 +174,25 @@ def test_oblique_front_rolls_left_when_it_lifts_the_right_wing_first(wing):
     p_g, p = run.channels["p_g"], run.channels["p_rad_s"]
     assert p_g.min() < -0.5 and p.min() < -0.3 and p.max() < 0.05
     assert math.isclose(run.channels["w_g"][-1], 1.0, rel_tol=1e-12)
+
+
+def test_sitl_triggers_a_rolling_gust_from_its_parameters(wing):
+    """GUST_ROLL_RADS 0.5 over GUST_LEN_M 15, the vertical amplitude 0, the autopilot off:
+    GUST_TRIG rolls the rigid aircraft as the gust command does (peak p 0.48 rad/s); a
+    parameter out of range is refused with its range."""
+    from bioflex_jsb.drivers.sitl import SitlParameters, SitlSim
+
+    sim = SitlSim(wing, wing.modes, model="rigid", speed_m_s=V)
+    params = SitlParameters(sim)
+    for name, value in (("AP_ENABLE", 0.0), ("GUST_AMP_MS", 0.0), ("GUST_ROLL_RADS", 0.5),
+                        ("GUST_LEN_M", 15.0)):
+        params.set(name, value)
+    i_p = sim.names.index("p_rad_s")
+    calm = [sim.step()[i_p] for _ in range(100)]
+    params.set("GUST_TRIG", 1.0)
+    assert params.get("GUST_TRIG") == 1.0
+    rolled = [sim.step()[i_p] for _ in range(1500)]
+    assert max(abs(p) for p in calm) < 1e-3  # the trim: 3e-5 rad/s (propeller torque)
+    assert max(rolled) == pytest.approx(0.4824, rel=0.02)  # the gust command's peak
+    with pytest.raises(ValueError, match="-2..2 rad/s"):
+        params.set("GUST_ROLL_RADS", 3.0)
