@@ -372,6 +372,7 @@ def run(args: argparse.Namespace) -> int:
     for r in runs:
         summary[r.model] = gust_metrics(r, args.gust_start).as_json()
         summary[r.model]["time_beyond_stall_s"] = r.meta["time_beyond_stall_s"]
+        summary[r.model].update(lateral_peaks(r, args.gust_start))
     if plot:
         from bioflex_jsb.sinks import plotting
 
@@ -402,6 +403,12 @@ def run(args: argparse.Namespace) -> int:
             line = controller_line(r)
             if line:
                 print(f"{r.model}: {line}")
+            lateral = summary[r.model]
+            if "peak_p_rad_s" in lateral:  # a gust that rolls or sideslips it
+                print(f"{r.model}: lateral peaks |p| {math.degrees(lateral['peak_p_rad_s']):.2f} "
+                      f"deg/s, |r| {math.degrees(lateral['peak_r_rad_s']):.2f} deg/s, |phi| "
+                      f"{math.degrees(lateral['peak_phi_rad']):.2f} deg, |beta| "
+                      f"{math.degrees(lateral['peak_beta_rad']):.2f} deg")
         if plot:
             print(f"time histories written to {plot}")
         if args.out:
@@ -411,6 +418,19 @@ def run(args: argparse.Namespace) -> int:
     if stops:
         return EXIT_DIVERGED
     return 0
+
+
+def lateral_peaks(run, gust_start_s: float) -> dict[str, float]:
+    """The largest |p|, |r| [rad/s], |phi|, |beta| [rad] after the gust start of a run whose
+    gust has parts that vary over the aircraft (its channel p_g); {} for any other run or a
+    diverged one."""
+    if "p_g" not in run.channels or run.stopped is not None:
+        return {}
+    after = run.time_s >= gust_start_s
+    if not after.any():
+        return {}
+    return {f"peak_{c}": float(abs(run[c][after]).max())
+            for c in ("p_rad_s", "r_rad_s", "phi_rad", "beta_rad")}
 
 
 def _cell(value, scale: float, width: int, digits: int = 3) -> str:
