@@ -148,6 +148,12 @@ class GustLoads:
         set_yaw(-self._cnp * rate)
         self.last = (p_g, v_g, w_t)
 
+    @property
+    def roll_rate_rad_s(self) -> float:
+        """p_g [rad/s] of the step last written: the gust roll rate an elastic wing's
+        antisymmetric strips take in the same step (their upwash (p − p_g)·y)."""
+        return self.last[0]
+
     def clear(self) -> None:
         """No gust loads and no horizontal wind left in the airframe."""
         for s in self._set:
