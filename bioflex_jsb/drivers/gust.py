@@ -275,6 +275,11 @@ class _GustRun:
         # the uniform gust, or one that varies over the aircraft (runtime/gust_loads.py)
         self.gust = field_for(setup.gust, step.airframe_data, build, setup.speed_m_s,
                               setup.gust_start_s, setup.duration_s, dt)
+        # its loads, written before each step (an aircraft without the hooks refused here,
+        # before the recorder starts)
+        self.gust_loads = None if not getattr(self.gust, "varies", False) else GustLoads(
+            step.airframe, self.gust, step.airframe_data.aero,
+            step.airframe[JP.ATTITUDE_PSI_RAD])
         self.n_steps = int(round(setup.duration_s / dt))
         names = self.names = step.names
         block = max(1, int(round(WINDOW_S / dt)))
@@ -365,10 +370,8 @@ class _GustRun:
         SIGTERM keeps what was flown; every complete step reaches the recorder however the
         run ends."""
         advance_into = self.step.stepper()  # the step, bound once (compiled or Python)
-        gust_loads = None
-        if getattr(self.gust, "varies", False):  # its loads written before each step
-            gust_loads = GustLoads(airframe, self.gust, self.step.airframe_data.aero,
-                                   airframe[JP.ATTITUDE_PSI_RAD])
+        gust_loads = self.gust_loads
+        if gust_loads is not None:
             advance_into = with_gust_loads(advance_into, self.step, gust_loads)
         self._in_block = (0, 0)
         try:
