@@ -49,7 +49,14 @@ its divergence instead of metrics, in the table and in --json (null metrics), an
 command exits with status 3. Gusts are vertical, positive up: sharp:AMPLITUDE_m_s,
 1cos:AMPLITUDE_m_s:LENGTH_m, dryden:SIGMA_m_s:SCALE_m[:SEED], vonkarman:SIGMA_m_s:SCALE_m[:SEED];
 amplitudes up to 50 m/s, LENGTH and SCALE 0.183 m (one mean chord) to 10 km, and a 1cos gust
-lasting at least 10 steps of --dt (its peak then sampled within 2.4 %).
+lasting at least 10 steps of --dt (its peak then sampled within 2.4 %). Parts that vary over
+the aircraft follow, each once, after "+" (docs/gusts.md): roll:PEAK_rad_s:LENGTH_m (a 1-cos
+rolling gust w_g = -p_g*y, |PEAK| <= 5 rad/s, p_g + = right wing down), lateral:FORM (a
+lateral gust v_g [m/s], + to starboard, FORM any vertical form above), front:ANGLE_deg (the
+sharp/1cos front at ANGLE to the span, |ANGLE| <= 80, + = starboard wing first), pg (the
+MIL-F-8785C rolling part p_g of dryden/vonkarman turbulence), tail (the tail meets the gust
+l_t/V after the wing); e.g. 1cos:3:20+roll:0.5:20+tail. Their channels: p_g [rad/s], v_g
+[m/s], w_g_tail [m/s].
 Valid ranges: --speed {SPEED_RANGE_TEXT}; --duration up to {MAX_DURATION_S:g} s; --dt
 {MIN_DT_S:g} to {MAX_DT_S:g} s.
 With no arguments: the {DEFAULT_WING} wing at {DEFAULT_SPEED_M_S:g} m/s through {DEFAULT_GUST}
@@ -76,7 +83,9 @@ def add_run_arguments(p: argparse.ArgumentParser, default_gust: str = DEFAULT_GU
                    help="trim " + speed_help(extra="; with --aircraft: within its airframe."
                                              "speed_range_m_s, default its cruise_speed_m_s"))
     p.add_argument("--gust", type=gust_type, default=gust_type(default_gust),
-                   help=f"gust specification (default {default_gust}); see above")
+                   help=f"gust specification (default {default_gust}): sharp:A, 1cos:A:L, "
+                   "dryden|vonkarman:SIGMA:SCALE[:SEED], none [m/s, m], then optional "
+                   "+roll:P:L, +lateral:FORM, +front:DEG, +pg, +tail (see `gust --help`)")
     p.add_argument("--duration", type=positive_float("duration", "s"), default=5.0,
                    help=f"simulated time [s], up to {MAX_DURATION_S:g} (default 5)")
     p.add_argument("--gust-start", type=positive_float("gust start", "s"), default=0.5,
@@ -363,6 +372,7 @@ def run(args: argparse.Namespace) -> int:
     for r in runs:
         summary[r.model] = gust_metrics(r, args.gust_start).as_json()
         summary[r.model]["time_beyond_stall_s"] = r.meta["time_beyond_stall_s"]
+        summary[r.model].update(lateral_peaks(r, args.gust_start))
     if plot:
         from bioflex_jsb.sinks import plotting
 
@@ -393,6 +403,12 @@ def run(args: argparse.Namespace) -> int:
             line = controller_line(r)
             if line:
                 print(f"{r.model}: {line}")
+            lateral = summary[r.model]
+            if "peak_p_rad_s" in lateral:  # a gust that rolls or sideslips it
+                print(f"{r.model}: lateral peaks |p| {math.degrees(lateral['peak_p_rad_s']):.2f} "
+                      f"deg/s, |r| {math.degrees(lateral['peak_r_rad_s']):.2f} deg/s, |phi| "
+                      f"{math.degrees(lateral['peak_phi_rad']):.2f} deg, |beta| "
+                      f"{math.degrees(lateral['peak_beta_rad']):.2f} deg")
         if plot:
             print(f"time histories written to {plot}")
         if args.out:
@@ -402,6 +418,19 @@ def run(args: argparse.Namespace) -> int:
     if stops:
         return EXIT_DIVERGED
     return 0
+
+
+def lateral_peaks(run, gust_start_s: float) -> dict[str, float]:
+    """The largest |p|, |r| [rad/s], |phi|, |beta| [rad] after the gust start of a run whose
+    gust has parts that vary over the aircraft (its channel p_g); {} for any other run or a
+    diverged one."""
+    if "p_g" not in run.channels or run.stopped is not None:
+        return {}
+    after = run.time_s >= gust_start_s
+    if not after.any():
+        return {}
+    return {f"peak_{c}": float(abs(run[c][after]).max())
+            for c in ("p_rad_s", "r_rad_s", "phi_rad", "beta_rad")}
 
 
 def _cell(value, scale: float, width: int, digits: int = 3) -> str:

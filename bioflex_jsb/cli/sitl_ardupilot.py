@@ -212,6 +212,10 @@ def _build(args: argparse.Namespace):
         gust = parse_gust(args.gust)
     except GustSpecError as exc:
         raise UsageError(str(exc)) from None
+    if gust.spanwise is not None:  # the ArduPilot backend flies the uniform gust
+        raise UsageError(f"--gust {gust.text()!r}: the ArduPilot backend flies a vertical gust "
+                         f"alone ({gust.vertical().text()!r}); the parts after '+' fly in gust, "
+                         "compare and sitl")
     check_time_step(args.dt)
     if args.gust_at < 0.0:
         raise UsageError(f"--gust-at must be >= 0 s, got {args.gust_at:g}")

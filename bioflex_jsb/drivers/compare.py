@@ -31,7 +31,7 @@ common to both, would only dilute it); the largest difference is the same either
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +49,8 @@ from bioflex_jsb.simulation.results import TimeHistory, nrmse
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
 COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle")  # a controller's, when one flew
+# a gust with a rolling or lateral part: the rigid lateral model's (_add_lateral)
+LATERAL_CHANNELS = ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad")
 LOADS_PREFIX = "loads_"
 
 
@@ -117,7 +119,10 @@ def check_gust_excites(gust) -> None:
     :class:`~bioflex_jsb.simulation.gusts.GustSpec`) that excites nothing: a comparison's
     errors are normalised by the response to the gust, so without one they read 1.0 on
     every channel (the trim's 1e-6 drift against itself)."""
-    if gust.kind == "none" or gust.amplitude_m_s == 0.0:
+    parts = gust.spanwise
+    moves = parts is not None and (parts.roll_peak_rad_s != 0.0 or (
+        parts.lateral is not None and parts.lateral.amplitude_m_s != 0.0))
+    if (gust.kind == "none" or gust.amplitude_m_s == 0.0) and not moves:
         raise InputError(f"{gust.text()}: a comparison needs a gust that excites the "
                          "aircraft (its errors are relative to the response to it)")
 
@@ -183,9 +188,66 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         linear = _closed_loop_response(ss, controller, nonlinear)
     else:
         linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
+    if "w_g_tail" in nonlinear.channels:  # a gust that varies over the aircraft
+        _add_tail_delay(linear, nonlinear, build, model, speed_m_s, lin.a, lm,
+                        controller is None and aero == "quasi-steady" and trim == "rigid")
+        _add_lateral(linear, nonlinear, build, speed_m_s, airframe or Airframe())
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
     return linear
+
+
+def _add_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
+                 speed_m_s: float, airframe: Airframe) -> None:
+    """Add to ``linear`` the rigid lateral model's response (identified from the run's
+    airframe at the trim, as ``bioflex-jsb modes --lateral``) to the run's gust roll rate
+    p_g and lateral gust v_g: the channels of :data:`LATERAL_CHANNELS` (none when both are
+    zero)."""
+    from bioflex_jsb.flight_dynamics.lateral import build_lateral_state_space
+    from bioflex_jsb.runtime.identification import identify_lateral
+    from bioflex_jsb.simulation.spanwise_gusts import lateral_gust_response
+
+    p_g, v_g = nonlinear["p_g"], nonlinear["v_g"]
+    if not (np.any(p_g != 0.0) or np.any(v_g != 0.0)):
+        return
+    point = identify_lateral(airframe, speed_m_s, build.airframe.reference)
+    ss = build_lateral_state_space(point.trim, point.aero)
+    for name, values in lateral_gust_response(ss, nonlinear.time_s, p_g, v_g).items():
+        linear.channels[name] = values
+        linear.units[name] = "rad/s" if name.endswith("_s") else "rad"
+
+
+def _add_tail_delay(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
+                    model: str, speed_m_s: float, a_rr: np.ndarray, lm, comparable: bool
+                    ) -> None:
+    """Add to ``linear`` the response to the tail's penetration delay of the run's gust (its
+    channels w_g, w_g_tail), the elevator that lifts the tail as the delay does
+    (:func:`~bioflex_jsb.simulation.spanwise_gusts.tail_delay_elevator_rad`), on the
+    quasi-steady model with controls about the rigid trim (else one line: InputError)."""
+    from bioflex_jsb.simulation.spanwise_gusts import TailGust, tail_delay_elevator_rad
+
+    w_t, w = nonlinear["w_g_tail"], nonlinear["w_g"]
+    if not np.any(w_t != w):
+        return
+    if not comparable:
+        raise InputError("the tail's penetration delay is compared on the quasi-steady model "
+                         "about the rigid trim without a controller (the elevator it is "
+                         "flown with there)")
+    data = build.airframe.at_speed(speed_m_s)
+    tail = TailGust.from_derivatives(data.aero, data.reference.mean_chord_m)
+    elevator = tail_delay_elevator_rad(tail, data.aero, w_t, w, speed_m_s)
+    ss = build_state_space(model, level_flight_condition(speed_m_s, airframe=build.airframe),
+                           build.model, a_rr=a_rr, controls=True)
+    if lm is not None:  # the section loads of the same response
+        ss = with_load_outputs(ss, lm)
+    column = ss.inputs.index("elevator")
+    ss_e = replace(ss, b=ss.b[:, [column]], d=ss.d[:, [column]], inputs=("elevator",),
+                   input_units=("rad",))
+    # simulate's gust conventions aside (its alpha adds w/V): the states' own response
+    extra = simulate(ss_e, nonlinear.time_s, elevator)
+    extra.channels["alpha"] = extra["alpha_inertial"]
+    for name in set(linear.channels) & set(extra.channels) - {"w_g"}:
+        linear.channels[name] = linear[name] + extra[name] - (name == "n_z")
 
 
 def _closed_loop_response(ss, controller, nonlinear: TimeHistory) -> TimeHistory:
@@ -272,7 +334,7 @@ def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s:
                                    controller)
     if drift is not None:
         _add_drift(linear, nonlinear, drift)
-    channels = tuple(c for c in CHANNELS + COMMANDS
+    channels = tuple(c for c in CHANNELS + COMMANDS + LATERAL_CHANNELS
                      if c in linear.channels and c in nonlinear.channels)
     load_channels = tuple(c for c in nonlinear.channels
                           if c.startswith(LOADS_PREFIX) and c in linear.channels)

@@ -32,9 +32,10 @@ from bioflex_jsb.loads.stream import LoadStream
 from bioflex_jsb.parameters.sensors import Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.runtime.gust_loads import GUST_CHANNELS, GustLoads, field_for, with_gust_loads
+from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation.channels import mode_tips
 from bioflex_jsb.simulation.controller import controller_meta
-from bioflex_jsb.simulation.gusts import GustField
 from bioflex_jsb.simulation.results import KEEP_ALL_MAX_S, TimeHistory
 from bioflex_jsb.simulation.run_config import RunConfig
 from bioflex_jsb.simulation.sensors import SensorSet
@@ -234,7 +235,7 @@ def run_gust(
         if refused:  # a loads model refused (InputError): the step's hold goes with it
             step.release()
     keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
-    run = _GustRun(step, setup, stream, loads_meta, recorder, keep_all)
+    run = _GustRun(step, setup, stream, loads_meta, recorder, keep_all, build)
     run.fly(airframe, on_sample, progress)
     history = run.history(model, trim_mode, build)
     if sensor_set is not None:
@@ -267,12 +268,18 @@ class _GustRun:
     topic; :meth:`fly` flies the blocks, :meth:`history` gives the TimeHistory."""
 
     def __init__(self, step: CoupledStep, setup: RunConfig, stream, loads_meta: dict,
-                 recorder, keep_all: bool) -> None:
+                 recorder, keep_all: bool, build=None) -> None:
         self.step, self.setup, self.stream, self.loads_meta = step, setup, stream, loads_meta
         self.recorder, self.keep_all = recorder, keep_all
         dt = self.dt = step.dt_s
-        self.gust = GustField(setup.gust, setup.speed_m_s, setup.gust_start_s,
-                              setup.duration_s, dt)
+        # the uniform gust, or one that varies over the aircraft (runtime/gust_loads.py)
+        self.gust = field_for(setup.gust, step.airframe_data, build, setup.speed_m_s,
+                              setup.gust_start_s, setup.duration_s, dt)
+        # its loads, written before each step (an aircraft without the hooks refused here,
+        # before the recorder starts)
+        self.gust_loads = None if not getattr(self.gust, "varies", False) else GustLoads(
+            step.airframe, self.gust, step.airframe_data.aero,
+            step.airframe[JP.ATTITUDE_PSI_RAD])
         self.n_steps = int(round(setup.duration_s / dt))
         names = self.names = step.names
         block = max(1, int(round(WINDOW_S / dt)))
@@ -363,6 +370,9 @@ class _GustRun:
         SIGTERM keeps what was flown; every complete step reaches the recorder however the
         run ends."""
         advance_into = self.step.stepper()  # the step, bound once (compiled or Python)
+        gust_loads = self.gust_loads
+        if gust_loads is not None:
+            advance_into = with_gust_loads(advance_into, self.step, gust_loads)
         self._in_block = (0, 0)
         try:
             with airframe.capturing():  # JSBSim's output captured once for the loop
@@ -380,6 +390,8 @@ class _GustRun:
         except KeyboardInterrupt:  # Ctrl-C or SIGTERM (the CLI maps it): keep what was flown
             self.interrupted = True
         finally:
+            if gust_loads is not None:
+                gust_loads.clear()
             self._finish()
 
     def _finish(self) -> None:
@@ -422,6 +434,14 @@ class _GustRun:
             history = "envelope"
         if self.stream is not None:
             units.update(self.stream.units)
+        if getattr(self.gust, "varies", False) and self.envelope is None:
+            # the parts its loads were written from, step by step (a block at a time: an
+            # oblique front's field is steps × strips)
+            blocks = [self.gust.parts(min(4096, n - k0), k0) for k0 in range(0, n, 4096)]
+            for i, name in enumerate(GUST_CHANNELS):
+                channels[name] = np.concatenate([b[1 + i] for b in blocks]) if blocks \
+                    else np.zeros(0)
+            units.update(GUST_CHANNELS)
         return TimeHistory(
             model=model,
             time_s=time_s,

@@ -45,6 +45,11 @@ AIRSPEED_MS     airspeed held by the autothrottle [m/s], 12..22 (MAV_CMD_DO_CHAN
 GUST_AMP_MS     peak of the 1-cosine vertical gust [m/s, up], ±5
 GUST_LEN_M      length of that gust [m], 1..500
 GUST_TRIG       write 1: the gust starts now; reads 1 while it blows, then 0
+GUST_ROLL_RADS  peak of a 1-cosine rolling gust p_g over GUST_LEN_M [rad/s, + right wing
+                down], ±2 (w_g = −p_g·y; docs/gusts.md)
+GUST_LAT_MS     peak of a 1-cosine lateral gust v_g over GUST_LEN_M [m/s, + to starboard], ±5
+GUST_FRONT_DEG  the vertical gust's front to the span [deg, + starboard wing first], ±80
+GUST_TAIL       1: the tail meets the vertical gust l_t/V after the wing; 0: at once
 WING_COUPLED    1: the elastic wing's modal loads act (coupled); 0: rigid wing
 SIM_SPEEDUP     simulated seconds per wall-clock second, 0.1..50
 =============== =========================================================================
@@ -69,6 +74,7 @@ from bioflex_jsb.drivers.sitl_vehicle import (
     SitlVehicle,
 )
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.generators.autopilot import (
     GLIDER_SYSTEM_FILE,
     POWERED_SYSTEM_FILE,
@@ -82,7 +88,9 @@ from bioflex_jsb.links.mavlink import VehicleState
 from bioflex_jsb.parameters.sensors import NO_SENSORS, Sensors
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
-from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust
+from bioflex_jsb.runtime.gust_loads import GustLoads, field_for
+from bioflex_jsb.simulation import jsbsim_properties as JP
+from bioflex_jsb.simulation.gusts import GustField, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.sensors import AutopilotImu, SensorSet
 
@@ -238,11 +246,36 @@ class PacingStats:
                 "resyncs": self.resyncs}
 
 
+# The parameters of a gust's parts that vary over the aircraft: (lowest, highest, unit). The
+# rolling gust up to 2 rad/s (the prototype's tips then meet ±1.7 m/s; its steady roll rate
+# at full aileron is of that order), the lateral gust as GUST_AMP_MS, the front as the gust
+# specification's (simulation/gusts.py MAX_FRONT_ANGLE_DEG).
+SPANWISE_PARAMETERS = {"GUST_ROLL_RADS": (-2.0, 2.0, " rad/s"),
+                       "GUST_LAT_MS": (-5.0, 5.0, " m/s"),
+                       "GUST_FRONT_DEG": (-80.0, 80.0, " deg"), "GUST_TAIL": (0.0, 1.0, "")}
+
+
+def spanwise_text(parts: dict[str, float], length_m: float) -> str:
+    """The ``+…`` parts of the triggered 1-cos gust (simulation/gusts.py) from the GUST_*
+    parameters ``parts``, each over ``length_m`` [m]; "" for none."""
+    text = ""
+    if parts["GUST_ROLL_RADS"]:
+        text += f"+roll:{parts['GUST_ROLL_RADS']!r}:{length_m!r}"
+    if parts["GUST_LAT_MS"]:
+        text += f"+lateral:1cos:{parts['GUST_LAT_MS']!r}:{length_m!r}"
+    if parts["GUST_FRONT_DEG"]:
+        text += f"+front:{parts['GUST_FRONT_DEG']!r}"
+    if parts["GUST_TAIL"]:
+        text += "+tail"
+    return text
+
+
 class SitlParameters:
     """The parameter set of the module docstring; ``set`` applies to the running sim."""
 
     names = ("AP_ENABLE", "AP_LOITER", "AP_ALT_M", "AP_HDG_RAD", "WP_RADIUS_M", "LOIT_RAD_M",
              "RTL_ALT_M", "AIRSPEED_MS", "GUST_AMP_MS", "GUST_LEN_M", "GUST_TRIG",
+             "GUST_ROLL_RADS", "GUST_LAT_MS", "GUST_FRONT_DEG", "GUST_TAIL",
              "WING_COUPLED", "SIM_SPEEDUP")
 
     def __init__(self, sim: SitlSim) -> None:
@@ -261,6 +294,7 @@ class SitlParameters:
             "GUST_AMP_MS": s.gust_amplitude_m_s,
             "GUST_LEN_M": s.gust_length_m,
             "GUST_TRIG": 1.0 if s.gust_active else 0.0,
+            **s.gust_parts,
             "WING_COUPLED": 1.0 if s.wing.model == "coupled" else 0.0,
             "SIM_SPEEDUP": s.speedup,
         }[name])
@@ -317,6 +351,9 @@ class SitlParameters:
         elif name == "GUST_TRIG":
             if value == 1.0:
                 s.trigger_gust()
+        elif name in SPANWISE_PARAMETERS:
+            self._range(name, value, *SPANWISE_PARAMETERS[name])
+            s.gust_parts[name] = 1.0 if name == "GUST_TAIL" and value else value
         elif name == "WING_COUPLED":
             s.set_wing_model("coupled" if value == 1.0 else "rigid")
         elif name == "SIM_SPEEDUP":
@@ -429,6 +466,8 @@ class SitlSim:
         self.gust_amplitude_m_s = 1.0
         self.gust_length_m = 30.0
         self._gust: GustField | None = None
+        self.gust_parts = dict.fromkeys(SPANWISE_PARAMETERS, 0.0)  # the GUST_* of its parts
+        self._gust_loads: GustLoads | None = None
         self._gust_start_k = 0
         self._gust_end_s = 0.0
         self.units = self.core.units
@@ -532,19 +571,35 @@ class SitlSim:
         return self._gust is not None and self.t_s < self._gust_end_s
 
     def trigger_gust(self) -> None:
-        """Start the 1-cosine gust (GUST_AMP_MS, GUST_LEN_M) now."""
-        if self.gust_amplitude_m_s == 0.0:
+        """Start the 1-cosine gust (GUST_AMP_MS, GUST_LEN_M, and the parts GUST_ROLL_RADS,
+        GUST_LAT_MS, GUST_FRONT_DEG, GUST_TAIL) now."""
+        parts = spanwise_text(self.gust_parts, self.gust_length_m)
+        if self.gust_amplitude_m_s == 0.0 and "roll" not in parts and "lateral" not in parts:
             return
         try:
-            spec = parse_gust(f"1cos:{self.gust_amplitude_m_s!r}:{self.gust_length_m!r}")
-        except GustSpecError as exc:
+            spec = parse_gust(f"1cos:{self.gust_amplitude_m_s!r}:{self.gust_length_m!r}"
+                              + parts)
+            # the gust's own clock starts at this step (step 0 of the field)
+            build = self._wing_model if isinstance(self._wing_model, WingBuild) else None
+            field = field_for(spec, self.core.airframe_data, build, self.speed_m_s, 0.0,
+                              60.0, self.dt_s)
+        except InputError as exc:  # GustSpecError too: the parameter is refused
             raise ValueError(str(exc)) from None
-        # the gust's own clock starts at this step (step 0 of the field)
-        self._gust = GustField(spec, self.speed_m_s, 0.0, 60.0, self.dt_s)
+        self._clear_gust()
+        self._gust = field
+        if getattr(field, "varies", False):  # its loads, written before each step
+            self._gust_loads = GustLoads(self.airframe, field, self.core.airframe_data.aero,
+                                         self.airframe[JP.ATTITUDE_PSI_RAD])
         self._gust_start_k = self.k
         self._gust_end_s = self.t_s + self.gust_length_m / self.speed_m_s
         self.vehicle.status(5, f"Gust {self.gust_amplitude_m_s:g} m/s over "
-                               f"{self.gust_length_m:g} m")
+                               f"{self.gust_length_m:g} m{parts}")
+
+    def _clear_gust(self) -> None:
+        """No gust any more (and none of its loads left in the airframe)."""
+        if self._gust_loads is not None:
+            self._gust_loads.clear()
+        self._gust, self._gust_loads = None, None
 
     def set_wing_model(self, model: str) -> None:
         """Switch the wing (WING_COUPLED); the unsteady wing cannot be switched
@@ -565,6 +620,8 @@ class SitlSim:
         docstring); ``self.stopped`` then says why until the next step."""
         core = self.core
         self._autopilot_imu.before_step(core.eta, core.eta_dot)
+        if self._gust_loads is not None:
+            self._gust_loads.apply(self.k - self._gust_start_k)
         values = core.advance(self._w_g(self.k))
         self._state = None  # the snapshot of t_k+1 is read when asked for (vehicle_state)
         if core.stopped:
@@ -597,7 +654,7 @@ class SitlSim:
         self._reset_walls = [w for w in self._reset_walls if now - w < 60.0] + [now]
         model = self.core.model
         self._k_base += self.core.k
-        self._gust = None
+        self._clear_gust()
         self._new_core(model)
         self.vehicle.after_reset()
         self.vehicle.status(4, "Reset to trim over home")

@@ -75,9 +75,9 @@ trailing edge left (nose left). Positions: ``fcs/elevator-pos-rad``,
 
 External reactions: hooks for the modal wing
 ---------------------------------------------
-Four external reactions, all zero by default, let the Python modal wing add its lift, drag and
-moment increments to the rigid airframe. Each is set by writing its ``magnitude`` property
-(JSBSim units) before the step in which it is to act:
+External reactions, all zero by default, let the Python modal wing add its lift, drag and
+moment increments to the rigid airframe (and a spanwise gust its own loads). Each is set by
+writing its ``magnitude`` property (JSBSim units) before the step in which it is to act:
 
 ================================================  ======  ===================================
 property                                          unit    direction and point of action
@@ -88,7 +88,17 @@ property                                          unit    direction and point of
 ``external_reactions/modal-pitch/magnitude-lbsft`` lbs*ft moment about body +y (nose up)
 ``external_reactions/modal-roll/magnitude-lbsft``  lbs*ft moment about body +x (right wing
                                                           down)
+``external_reactions/gust-lift/magnitude``        lbs     force along body −z (up), at the CG
+``external_reactions/gust-pitch/magnitude-lbsft`` lbs*ft moment about body +y (nose up)
+``external_reactions/gust-roll/magnitude-lbsft``  lbs*ft moment about body +x (right wing
+                                                          down)
+``external_reactions/gust-yaw/magnitude-lbsft``   lbs*ft moment about body +z (nose right)
 ================================================  ======  ===================================
+
+The four ``gust-*`` hooks carry the loads of a gust that varies over the aircraft which
+JSBSim's uniform wind does not give: the rolling gust's moments and the tail's lift of its
+penetration delay (:mod:`bioflex_jsb.runtime.gust_loads`); the ``modal-*`` hooks stay the
+elastic wing's.
 
 The forces are in **body** axes: a wind-axis lift increment ΔL and drag increment ΔD at angle
 of attack α are written as modal-lift = ΔL·cos α + ΔD·sin α and
@@ -145,10 +155,16 @@ EXTERNAL_FORCES = {
     # name: (body-axis unit direction, description)
     "modal-lift": ((0.0, 0.0, -1.0), "force along body -z (up) at the CG [lbs]"),
     "modal-drag": ((-1.0, 0.0, 0.0), "force along body -x (aft) at the CG [lbs]"),
+    # the gust's loads that JSBSim's uniform wind does not give (runtime/gust_loads.py)
+    "gust-lift": ((0.0, 0.0, -1.0), "gust: tail lift of its delay, body -z (up) at the CG [lbs]"),
 }
 EXTERNAL_MOMENTS = {
     "modal-pitch": ((0.0, 1.0, 0.0), "moment about body +y, nose up [lbs*ft]"),
     "modal-roll": ((1.0, 0.0, 0.0), "moment about body +x, right wing down [lbs*ft]"),
+    "gust-pitch": ((0.0, 1.0, 0.0), "gust: tail delay's moment about body +y, nose up [lbs*ft]"),
+    "gust-roll": ((1.0, 0.0, 0.0), "gust: rolling gust's moment about body +x [lbs*ft]"),
+    "gust-yaw": ((0.0, 0.0, 1.0), "gust: rolling gust's moment about body +z, nose right "
+                 "[lbs*ft]"),
 }
 
 

@@ -4,8 +4,11 @@ Every gust is a vertical wind velocity w_g(t) [m/s], positive **upward** (it rai
 of attack by about w_g/V), uniform over the aircraft: the wing and the tail meet it at the
 same instant and the whole span sees the same value. That is what JSBSim's wind input
 (``atmosphere/wind-down-fps``, which the JSBSim adapter drives with −w_g) does, and what the
-paper's Eq. (4) assumes (one input w_g). Gust penetration along the fuselage and spanwise
-variation are not modelled (docs/gusts.md).
+paper's Eq. (4) assumes (one input w_g). A specification may add, after ``+``, the components
+that vary over the aircraft (:class:`SpanwiseParts`; flown by
+:mod:`bioflex_jsb.simulation.spanwise_gusts`): a rolling gust, a lateral gust, an oblique
+front of the vertical gust, the rolling component of vertical turbulence and the penetration
+delay from the wing to the tail. :class:`GustField` is the uniform vertical gust alone.
 
 Command-line forms (:func:`parse_gust`):
 
@@ -17,12 +20,24 @@ Command-line forms (:func:`parse_gust`):
   space (Taylor) and swept at the trim airspeed, synthesised with SEED (default 0) so every
   run is reproducible.
 * ``none``: calm air.
+
+Components after the vertical form, each once, joined by ``+`` (:class:`SpanwiseParts`):
+
+* ``roll:PEAK_rad_s:LENGTH_m`` a 1-cosine rolling gust, w_g(y, t) = −p_g(t)·y with
+  p_g = P/2 (1 − cos(2π x/L)) over the same distance flown as the vertical 1-cos;
+* ``lateral:FORM`` a lateral gust v_g [m/s], positive to starboard, FORM any of sharp, 1cos,
+  dryden, vonkarman above (its amplitude/σ is v_g's, its scale L_v);
+* ``front:ANGLE_deg`` the vertical sharp or 1cos gust's front at ANGLE to the span (0: met by
+  the whole span at once; positive: the starboard wing first), |ANGLE| ≤ 80;
+* ``pg`` the rolling component p_g of the vertical dryden/vonkarman turbulence
+  (MIL-F-8785C);
+* ``tail`` the tail meets the vertical gust l_t/V after the wing.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,6 +68,15 @@ MAX_GUST_LENGTH_M = 10_000.0
 # than a step can fall between two samples and not be flown at all.
 MIN_GUST_STEPS = 10
 MAX_SEED = 2**63  # default_rng takes any int >= 0; sweep results store the seed as int64
+# Largest peak of a rolling gust [rad/s]: the tips of a 20 m span then meet ±50 m/s,
+# MAX_GUST_M_S (the prototype's 1.7 m span: ±4.3 m/s at the tips).
+MAX_ROLL_GUST_RAD_S = 5.0
+# Largest angle of an oblique gust front to the span [deg]: at 80° the front takes
+# tan 80° = 5.7 span lengths of flight to cross the span; at 90° it would run along the
+# flight path and a field frozen in the air and swept at V has no such front.
+MAX_FRONT_ANGLE_DEG = 80.0
+SPANWISE_FORMS = ("roll:PEAK_rad_s:LENGTH_m", "lateral:FORM", "front:ANGLE_deg", "pg", "tail")
+TURBULENCE_KINDS = ("dryden", "vonkarman")
 
 
 class GustSpecError(InputError):
@@ -71,9 +95,13 @@ class GustSpec:
     amplitude_m_s: float = 0.0
     length_m: float = 0.0
     seed: int = 0
+    # the components that vary over the aircraft (None: the uniform vertical gust alone)
+    spanwise: SpanwiseParts | None = None
 
     def text(self) -> str:
         """The command-line form of this gust."""
+        if self.spanwise is not None:
+            return self.vertical().text() + self.spanwise.text()
         if self.kind == "none":
             return "none"
         if self.kind == "sharp":
@@ -81,6 +109,44 @@ class GustSpec:
         if self.kind == "1cos":
             return f"1cos:{self.amplitude_m_s:g}:{self.length_m:g}"
         return f"{self.kind}:{self.amplitude_m_s:g}:{self.length_m:g}:{self.seed}"
+
+    def vertical(self) -> GustSpec:
+        """The uniform vertical gust of this specification, without its spanwise parts."""
+        return self if self.spanwise is None else replace(self, spanwise=None)
+
+
+@dataclass(frozen=True)
+class SpanwiseParts:
+    """The components of a gust that vary over the aircraft (module docstring; their field:
+    :class:`bioflex_jsb.simulation.spanwise_gusts.SpanwiseGustField`).
+
+    roll_peak_rad_s, roll_length_m: a 1-cos rolling gust p_g [rad/s] over LENGTH [m] (0, 0:
+    none); lateral: the lateral gust v_g (a vertical form read as v_g, positive to
+    starboard) or None; front_angle_rad: the vertical gust's front to the span [rad],
+    positive with the starboard wing first; rolling_turbulence: the MIL-F-8785C p_g of the
+    vertical turbulence; tail_delay: the tail meets the vertical gust l_t/V late."""
+
+    roll_peak_rad_s: float = 0.0
+    roll_length_m: float = 0.0
+    lateral: GustSpec | None = None
+    front_angle_rad: float = 0.0
+    rolling_turbulence: bool = False
+    tail_delay: bool = False
+
+    def text(self) -> str:
+        """The ``+…`` suffix of the command-line form."""
+        out = ""
+        if self.roll_length_m > 0.0:
+            out += f"+roll:{self.roll_peak_rad_s:g}:{self.roll_length_m:g}"
+        if self.lateral is not None:
+            out += f"+lateral:{self.lateral.text()}"
+        if self.front_angle_rad != 0.0:
+            out += f"+front:{math.degrees(self.front_angle_rad):g}"
+        if self.rolling_turbulence:
+            out += "+pg"
+        if self.tail_delay:
+            out += "+tail"
+        return out
 
 
 def _number(text: str, what: str, spec: str) -> float:
@@ -113,6 +179,13 @@ def _length(text: str, name: str, spec: str, min_length_m: float) -> float:
 def check_gust_resolution(gust: GustSpec, speed_m_s: float, dt_s: float) -> None:
     """A 1-cos ``gust`` flown at ``speed_m_s`` must last :data:`MIN_GUST_STEPS` steps of
     ``dt_s`` [s]; else :class:`GustSpecError` naming the shortest length and the step."""
+    parts = gust.spanwise
+    if parts is not None:  # its 1-cos components: the rolling and the lateral gust
+        if parts.roll_length_m > 0.0:
+            check_gust_resolution(GustSpec("1cos", parts.roll_peak_rad_s, parts.roll_length_m),
+                                  speed_m_s, dt_s)
+        if parts.lateral is not None:
+            check_gust_resolution(parts.lateral, speed_m_s, dt_s)
     if gust.kind != "1cos":
         return
     steps = gust.length_m / speed_m_s / dt_s
@@ -127,7 +200,73 @@ def check_gust_resolution(gust: GustSpec, speed_m_s: float, dt_s: float) -> None
 def parse_gust(spec: str, min_length_m: float = MIN_GUST_LENGTH_M) -> GustSpec:
     """Parse a command-line gust; raises :class:`GustSpecError` naming what is accepted.
     ``min_length_m``: the shortest 1-cos length and turbulence scale [m], one mean chord of
-    the aircraft flown (:data:`MIN_GUST_LENGTH_M`: the prototype's)."""
+    the aircraft flown (:data:`MIN_GUST_LENGTH_M`: the prototype's). A vertical form may be
+    followed by ``+`` and the components of :class:`SpanwiseParts` (module docstring)."""
+    head, plus, rest = spec.strip().partition("+")
+    base = _parse_vertical(head, min_length_m)
+    if not plus:
+        return base
+    return replace(base, spanwise=_parse_spanwise(spec, base, rest.split("+"), min_length_m))
+
+
+def _parse_spanwise(spec: str, base: GustSpec, items: list[str],
+                    min_length_m: float) -> SpanwiseParts:
+    """The ``+`` components of ``spec`` (after the vertical ``base``), each once."""
+    accepted = "accepted after '+': " + ", ".join(SPANWISE_FORMS)
+    seen: set[str] = set()
+    fields: dict[str, object] = {}
+    for item in items:
+        name, _, args = item.strip().partition(":")
+        name = name.lower()
+        if name in seen:
+            raise GustSpecError(f"gust {spec!r}: {name!r} is given twice; {accepted}")
+        seen.add(name)
+        if name == "roll":
+            values = args.split(":")
+            if len(values) != 2:
+                raise GustSpecError(f"gust {spec!r}: roll takes PEAK_rad_s:LENGTH_m; {accepted}")
+            peak = _number(values[0], "the rolling gust's peak [rad/s]", spec)
+            if abs(peak) > MAX_ROLL_GUST_RAD_S:
+                raise GustSpecError(f"gust {spec!r}: |roll peak| must be <= "
+                                    f"{MAX_ROLL_GUST_RAD_S:g} rad/s, got {peak:g}")
+            fields["roll_peak_rad_s"] = peak
+            fields["roll_length_m"] = _length(values[1], "rolling gust's length", spec,
+                                              min_length_m)
+        elif name == "lateral":
+            lateral = _parse_vertical(args, min_length_m)
+            if lateral.kind == "none":
+                raise GustSpecError(f"gust {spec!r}: lateral takes one of sharp, 1cos, dryden, "
+                                    "vonkarman (v_g [m/s], to starboard)")
+            fields["lateral"] = lateral
+        elif name == "front":
+            angle = _number(args, "the gust front's angle to the span [deg]", spec)
+            if abs(angle) > MAX_FRONT_ANGLE_DEG:
+                raise GustSpecError(f"gust {spec!r}: |front angle| must be <= "
+                                    f"{MAX_FRONT_ANGLE_DEG:g} deg, got {angle:g}")
+            if base.kind not in ("sharp", "1cos"):
+                raise GustSpecError(f"gust {spec!r}: front needs a sharp or 1cos vertical "
+                                    "gust (turbulence's spanwise part is '+pg')")
+            fields["front_angle_rad"] = math.radians(angle)
+        elif name in ("pg", "tail") and args:
+            raise GustSpecError(f"gust {spec!r}: {name} takes no value; {accepted}")
+        elif name == "pg":
+            if base.kind not in TURBULENCE_KINDS:
+                raise GustSpecError(f"gust {spec!r}: pg is the rolling part of dryden or "
+                                    "vonkarman vertical turbulence")
+            fields["rolling_turbulence"] = True
+        elif name == "tail":
+            if base.kind == "none":
+                raise GustSpecError(f"gust {spec!r}: tail delays the vertical gust, and there "
+                                    "is none")
+            fields["tail_delay"] = True
+        else:
+            raise GustSpecError(f"gust {spec!r}: unknown component {item.strip()!r}; "
+                                f"{accepted}")
+    return SpanwiseParts(**fields)
+
+
+def _parse_vertical(spec: str, min_length_m: float) -> GustSpec:
+    """One vertical form (no ``+``) of :func:`parse_gust`."""
     accepted = "accepted forms: " + ", ".join(GUST_FORMS)
     parts = spec.strip().split(":")
     kind = parts[0].lower()
@@ -205,6 +344,11 @@ class GustField:
         duration_s: float = 10.0,
         dt_s: float = 1.0 / 120.0,
     ) -> None:
+        if spec.spanwise is not None:
+            raise GustSpecError(
+                f"gust {spec.text()!r}: its parts after '+' (spanwise, lateral, tail) are flown "
+                "by gust, compare and sitl; here give the vertical gust alone "
+                f"({spec.vertical().text()!r})")
         self.spec = spec
         self.speed_m_s = float(speed_m_s)
         self.start_s = float(start_s)
