@@ -705,7 +705,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
             aero: str | None = None, method: str | None = None, clamped: bool = False,
             structural_damping: float | None = None, density_kg_m3: float | None = None,
             lift_slope: str | None = None, progress=None,
-            full_scan: bool = False) -> FlutterResult:
+            full_scan: bool = False, symmetry: str = "symmetric") -> FlutterResult:
     """The first instability of ``wing`` in ``range_m_s`` [m/s]: flutter, body-freedom
     flutter or static divergence, its frequency [rad/s], k, modes, mechanism, and whether it
     is already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``,
@@ -722,7 +722,22 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     ``density_kg_m3`` [kg/m^3] default to the definition's; the range to the one derived
     from the wing (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`).
     ``progress`` is called as ``progress(speed, top)`` [m/s] while the scan goes;
-    ``full_scan``: scan the whole range (for the diagram)."""
+    ``full_scan``: scan the whole range (for the diagram).
+
+    ``symmetry``: ``symmetric`` (default: the symmetric modes, Eq. 4), ``antisymmetric``
+    (the antisymmetric modes with the roll freedom, the aircraft's I_xx; a clamped wing's
+    root held: the same problem as its symmetric one) or ``both`` (the one that goes
+    unstable first, ``settings["first_symmetry"]`` saying which and
+    ``settings["other_symmetry"]`` the other's result; docs/aeroelasticity.md,
+    "Antisymmetric flutter")."""
+    from bioflex_jsb.aeroelasticity.antisymmetric import SYMMETRIES
+
+    _check_choice("symmetry", symmetry, SYMMETRIES)
+    if symmetry != "symmetric":
+        return _flutter_by_symmetry(wing, range_m_s, symmetry, aero=aero, method=method,
+                                    clamped=clamped, structural_damping=structural_damping,
+                                    density_kg_m3=density_kg_m3, lift_slope=lift_slope,
+                                    progress=progress, full_scan=full_scan)
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
@@ -760,6 +775,42 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     model = wing.model if structural_damping is None else with_damping(wing,
                                                                        structural_damping)
     return find_flutter(model, rng, step, **air, **scan)
+
+
+def _flutter_by_symmetry(wing, range_m_s, symmetry: str, **kw) -> FlutterResult:
+    """:func:`flutter` of the antisymmetric modes, or of both symmetries (the first)."""
+    from bioflex_jsb.aeroelasticity import antisymmetric as anti
+    from bioflex_jsb.aeroelasticity.free_aircraft import FREE_TOL_M_S
+    from bioflex_jsb.flight_dynamics.eigen import SCAN_START_M_S
+
+    sym = flutter(wing, range_m_s, **kw)  # the symmetric search: its checks and defaults
+    if kw["clamped"]:
+        d, m = _clamped(wing, kw["lift_slope"])
+        zeta = d.structure.damping_ratio if kw["structural_damping"] is None \
+            else float(kw["structural_damping"])
+        if sym.method == "pk":  # the root held: the antisymmetric problem is this one
+            res = replace(sym, settings=dict(sym.settings, symmetry="antisymmetric"))
+        else:
+            from bioflex_jsb.aeroelasticity.state_space import DEFAULT_SPEED_STEP_M_S
+            from bioflex_jsb.definition.clamped import scan_step_m_s
+
+            step = min(DEFAULT_SPEED_STEP_M_S, scan_step_m_s(sym.range_m_s))
+            res = anti.antisymmetric_flutter(
+                anti.clamped_strips(m, zeta, d.name), range_m_s=sym.range_m_s,
+                step_m_s=step, density_kg_m3=sym.density_kg_m3, aero=sym.aero,
+                structural_damping=zeta, tol_m_s=1e-7,
+                divergence_speed_m_s=sym.divergence_speed_m_s,
+                divergence_is_instability=True, progress=kw["progress"],
+                full_scan=kw["full_scan"])
+            res = replace(res, settings=dict(sym.settings, **res.settings))
+    else:
+        build = _Subject.of(wing).build
+        res = anti.aircraft_flutter(
+            build, range_m_s=sym.range_m_s, step_m_s=free_scan_step_m_s(sym.range_m_s),
+            density_kg_m3=sym.density_kg_m3, aero=sym.aero,
+            structural_damping=kw["structural_damping"], tol_m_s=FREE_TOL_M_S,
+            start_m_s=SCAN_START_M_S, progress=kw["progress"], full_scan=kw["full_scan"])
+    return res if symmetry == "antisymmetric" else anti.first_of(sym, res)
 
 
 def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:
