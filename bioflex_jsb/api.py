@@ -506,8 +506,10 @@ def _lateral_point(wing, speed_m_s: float | None):
     return subject, identify_lateral(airframe, speed, reference, altitude, source)
 
 
-def _lateral(wing, speed_m_s, model: str):
-    """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`."""
+def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
+    """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`;
+    ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None)."""
+    from bioflex_jsb.aeroelasticity import antisymmetric as anti
     from bioflex_jsb.flight_dynamics.lateral_elastic import (
         LATERAL_MODELS,
         antisymmetric_wing,
@@ -515,6 +517,10 @@ def _lateral(wing, speed_m_s, model: str):
     )
 
     _check_choice("model", model, LATERAL_MODELS)
+    _check_choice("aerodynamics", aero, anti.LATERAL_AERO)
+    if aero == "unsteady" and model != "coupled":
+        raise InputError(f"aero='unsteady' is the coupled lateral model's (the wing's strips "
+                         f"on its antisymmetric modes), not the {model} one")
     subject, point = _lateral_point(wing, speed_m_s)
     rigid = build_lateral_elastic("rigid", point.trim, point.aero, None)
     if model == "rigid":
@@ -523,11 +529,14 @@ def _lateral(wing, speed_m_s, model: str):
         raise InputError(f"the lateral {model} model needs an elastic wing: pass a wing or "
                          "an Aircraft, not None")
     wing_a = antisymmetric_wing(subject.build, point.trim.ixx_kg_m2)
+    if aero == "unsteady":
+        strips = anti.aircraft_strips(subject.build, wing_a, point.trim.ixx_kg_m2)
+        return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips), None)
     return build_lateral_elastic(model, point.trim, point.aero, wing_a), rigid, wing_a
 
 
-def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid"
-                  ) -> StateSpace:
+def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid",
+                  aero: str = "quasi-steady") -> StateSpace:
     """The linear lateral-directional model at ``speed_m_s`` [m/s] (None: the aircraft's
     cruise speed, the prototype's 15 m/s), about its JSBSim trim there (docs/lateral.md):
     states beta [rad] (sideslip, air from the right), p, r [rad/s] (roll right, yaw right,
@@ -541,20 +550,26 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     ``model``: ``rigid`` (default), ``coupled`` (with the wing's antisymmetric modes:
     states eta1.. [rad] and eta1_dot.. [rad/s] after phi, quasi-steady strips;
     :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`) or ``qsd`` (their static
-    deformation residualised; outputs also the quasi-static eta). ``wing`` an
+    deformation residualised; outputs also the quasi-static eta). ``aero``
+    ``quasi-steady`` (default) or ``unsteady`` (coupled only: the strips' Jones lag states
+    lag1[k], lag2[k] [m/s] and apparent mass on the modes and the roll rate;
+    :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
     :class:`Aircraft` (its JSBSim airframe and wing), the prototype's wing or None (the
     prototype, rigid only). One line (InputError) when the aircraft cannot be trimmed at
     that speed, or its wing has no beam (a modal-data file: no antisymmetric modes)."""
-    return _lateral(wing, speed_m_s, model)[0]
+    return _lateral(wing, speed_m_s, model, aero)[0]
 
 
 def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
-                  model: str = "rigid") -> ModeSet | list[ModeSet]:
+                  model: str = "rigid", aero: str = "quasi-steady"
+                  ) -> ModeSet | list[ModeSet]:
     """The labelled lateral-directional modes of :func:`lateral_model` of ``wing`` (an
     :class:`Aircraft`, the prototype's wing or None: the prototype) at ``speed_m_s``
     [m/s] (or a list, one per speed of a sequence), ``model`` rigid, coupled or qsd:
     ``roll`` (roll subsidence), ``spiral`` (unstable when its ``re`` > 0), ``dutch_roll``
-    and the coupled model's ``antisymmetric_k`` [rad/s]."""
+    and the coupled model's ``antisymmetric_k`` [rad/s]; ``aero`` as
+    :func:`lateral_model`'s (unsteady: the quasi-steady model's labels carried over by
+    continuation, the lag roots left out)."""
     from bioflex_jsb.flight_dynamics.lateral import lateral_mode_set
     from bioflex_jsb.flight_dynamics.lateral_elastic import coupled_mode_set
 
@@ -562,8 +577,10 @@ def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
         speeds = list(speed_m_s)
         if not speeds:
             raise InputError("speed_m_s: give a speed [m/s] or a non-empty sequence of them")
-        return [lateral_modes(wing, v, model) for v in speeds]
-    ss, rigid, wing_a = _lateral(wing, speed_m_s, model)
+        return [lateral_modes(wing, v, model, aero) for v in speeds]
+    ss, rigid, wing_a = _lateral(wing, speed_m_s, model, aero)
+    if aero == "unsteady":
+        return rigid  # the unsteady model's labelled modes (_lateral)
     if model == "coupled":
         return coupled_mode_set(ss, rigid, wing_a)
     return lateral_mode_set(ss)

@@ -310,7 +310,7 @@ def unsteady_lateral_model(trim: LateralTrim, aero: LateralAerodynamics,
     d = np.vstack([np.zeros((n_all, b.shape[1])), base.d[-1]])
     notes = {**base.notes, "wing": "antisymmetric modes, unsteady strips (Jones lag states, "
              "apparent mass)", "lag_states": 2 * k, "unsteadiness": float(unsteadiness)}
-    return StateSpace(model="coupled-unsteady-lateral", speed_m_s=trim.speed_m_s, a=a, b=b,
+    return StateSpace(model="unsteady-lateral", speed_m_s=trim.speed_m_s, a=a, b=b,
                       c=c, d=d, states=states, state_units=units, inputs=base.inputs,
                       input_units=base.input_units, outputs=states + ("n_y",),
                       output_units=units + ("-",), notes=notes)
@@ -354,7 +354,7 @@ def unsteady_lateral_mode_set(trim: LateralTrim, aero: LateralAerodynamics,
 
     lam, names = _homotopy(matrix, qs.a, labels)
     ss = unsteady_lateral_model(trim, aero, wing, strips)
-    return ss, _mode_set(lam, names, ss, [m.name for m in qs_modes.modes])
+    return ss, _mode_set(lam, names, ss, [m.mode for m in qs_modes.modes])
 
 
 def _root_labels(qs: StateSpace, rigid: StateSpace, wing: AntisymmetricWing) -> list[str]:
