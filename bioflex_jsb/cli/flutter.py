@@ -272,6 +272,15 @@ def _formatted(res, digits: int) -> dict:
     d["divergence_speed_m_s"] = _round(res.divergence_speed_m_s, 2)
     d["natural_frequencies_rad_s"] = [round(w, 2) for w in res.natural_frequencies_rad_s]
     d["range_m_s"] = [round(x, 2) for x in res.range_m_s]
+    other = d.get("other_symmetry")
+    if other is not None:  # --symmetry both: the other result rounded as this one
+        for key in ("speed_m_s", "flutter_speed_m_s", "unstable_at_and_below_m_s"):
+            other[key] = _round(other[key], digits)
+        other["frequency_rad_s"] = _round(other["frequency_rad_s"], 2)
+        other["reduced_frequency"] = _round(other["reduced_frequency"], 4)
+        other["divergence_speed_m_s"] = _round(other["divergence_speed_m_s"], 2)
+        other["natural_frequencies_rad_s"] = [round(w, 2) for w in
+                                              other["natural_frequencies_rad_s"]]
     return d
 
 
