@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from bioflex_jsb import api
+from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
 from bioflex_jsb.aeroelasticity import antisymmetric as A
 from bioflex_jsb.aeroelasticity.clamped_wing import clamped_wing_model, goland_sections
 from bioflex_jsb.aeroelasticity.state_space import state_space_flutter
-from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.parameters import goland as G
 from bioflex_jsb.structures.antisymmetric import solve_antisymmetric
