@@ -507,8 +507,10 @@ def _lateral_point(wing, speed_m_s: float | None):
     return subject, identify_lateral(airframe, speed, reference, altitude, source)
 
 
-def _lateral(wing, speed_m_s, model: str):
-    """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`."""
+def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
+    """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`;
+    ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None)."""
+    from bioflex_jsb.aeroelasticity import antisymmetric as anti
     from bioflex_jsb.flight_dynamics.lateral_elastic import (
         LATERAL_MODELS,
         antisymmetric_wing,
@@ -516,6 +518,10 @@ def _lateral(wing, speed_m_s, model: str):
     )
 
     _check_choice("model", model, LATERAL_MODELS)
+    _check_choice("aerodynamics", aero, anti.LATERAL_AERO)
+    if aero == "unsteady" and model != "coupled":
+        raise InputError(f"aero='unsteady' is the coupled lateral model's (the wing's strips "
+                         f"on its antisymmetric modes), not the {model} one")
     subject, point = _lateral_point(wing, speed_m_s)
     rigid = build_lateral_elastic("rigid", point.trim, point.aero, None)
     if model == "rigid":
@@ -524,11 +530,14 @@ def _lateral(wing, speed_m_s, model: str):
         raise InputError(f"the lateral {model} model needs an elastic wing: pass a wing or "
                          "an Aircraft, not None")
     wing_a = antisymmetric_wing(subject.build, point.trim.ixx_kg_m2)
+    if aero == "unsteady":
+        strips = anti.aircraft_strips(subject.build, wing_a, point.trim.ixx_kg_m2)
+        return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips), None)
     return build_lateral_elastic(model, point.trim, point.aero, wing_a), rigid, wing_a
 
 
-def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid"
-                  ) -> StateSpace:
+def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid",
+                  aero: str = "quasi-steady") -> StateSpace:
     """The linear lateral-directional model at ``speed_m_s`` [m/s] (None: the aircraft's
     cruise speed, the prototype's 15 m/s), about its JSBSim trim there (docs/lateral.md):
     states beta [rad] (sideslip, air from the right), p, r [rad/s] (roll right, yaw right,
@@ -542,20 +551,26 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     ``model``: ``rigid`` (default), ``coupled`` (with the wing's antisymmetric modes:
     states eta1.. [rad] and eta1_dot.. [rad/s] after phi, quasi-steady strips;
     :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`) or ``qsd`` (their static
-    deformation residualised; outputs also the quasi-static eta). ``wing`` an
+    deformation residualised; outputs also the quasi-static eta). ``aero``
+    ``quasi-steady`` (default) or ``unsteady`` (coupled only: the strips' Jones lag states
+    lag1[k], lag2[k] [m/s] and apparent mass on the modes and the roll rate;
+    :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
     :class:`Aircraft` (its JSBSim airframe and wing), the prototype's wing or None (the
     prototype, rigid only). One line (InputError) when the aircraft cannot be trimmed at
     that speed, or its wing has no beam (a modal-data file: no antisymmetric modes)."""
-    return _lateral(wing, speed_m_s, model)[0]
+    return _lateral(wing, speed_m_s, model, aero)[0]
 
 
 def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
-                  model: str = "rigid") -> ModeSet | list[ModeSet]:
+                  model: str = "rigid", aero: str = "quasi-steady"
+                  ) -> ModeSet | list[ModeSet]:
     """The labelled lateral-directional modes of :func:`lateral_model` of ``wing`` (an
     :class:`Aircraft`, the prototype's wing or None: the prototype) at ``speed_m_s``
     [m/s] (or a list, one per speed of a sequence), ``model`` rigid, coupled or qsd:
     ``roll`` (roll subsidence), ``spiral`` (unstable when its ``re`` > 0), ``dutch_roll``
-    and the coupled model's ``antisymmetric_k`` [rad/s]."""
+    and the coupled model's ``antisymmetric_k`` [rad/s]; ``aero`` as
+    :func:`lateral_model`'s (unsteady: the quasi-steady model's labels carried over by
+    continuation, the lag roots left out)."""
     from bioflex_jsb.flight_dynamics.lateral import lateral_mode_set
     from bioflex_jsb.flight_dynamics.lateral_elastic import coupled_mode_set
 
@@ -563,8 +578,10 @@ def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
         speeds = list(speed_m_s)
         if not speeds:
             raise InputError("speed_m_s: give a speed [m/s] or a non-empty sequence of them")
-        return [lateral_modes(wing, v, model) for v in speeds]
-    ss, rigid, wing_a = _lateral(wing, speed_m_s, model)
+        return [lateral_modes(wing, v, model, aero) for v in speeds]
+    ss, rigid, wing_a = _lateral(wing, speed_m_s, model, aero)
+    if aero == "unsteady":
+        return rigid  # the unsteady model's labelled modes (_lateral)
     if model == "coupled":
         return coupled_mode_set(ss, rigid, wing_a)
     return lateral_mode_set(ss)
@@ -703,7 +720,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
             aero: str | None = None, method: str | None = None, clamped: bool = False,
             structural_damping: float | None = None, density_kg_m3: float | None = None,
             lift_slope: str | None = None, progress=None,
-            full_scan: bool = False) -> FlutterResult:
+            full_scan: bool = False, symmetry: str = "symmetric") -> FlutterResult:
     """The first instability of ``wing`` in ``range_m_s`` [m/s]: flutter, body-freedom
     flutter or static divergence, its frequency [rad/s], k, modes, mechanism, and whether it
     is already present at the range's lower end (:class:`FlutterResult`, ``.as_dict()``,
@@ -720,7 +737,22 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     ``density_kg_m3`` [kg/m^3] default to the definition's; the range to the one derived
     from the wing (:func:`bioflex_jsb.definition.clamped.derived_speed_range_m_s`).
     ``progress`` is called as ``progress(speed, top)`` [m/s] while the scan goes;
-    ``full_scan``: scan the whole range (for the diagram)."""
+    ``full_scan``: scan the whole range (for the diagram).
+
+    ``symmetry``: ``symmetric`` (default: the symmetric modes, Eq. 4), ``antisymmetric``
+    (the antisymmetric modes with the roll freedom, the aircraft's I_xx; a clamped wing's
+    root held: the same problem as its symmetric one) or ``both`` (the one that goes
+    unstable first, ``settings["first_symmetry"]`` saying which and
+    ``settings["other_symmetry"]`` the other's result; docs/aeroelasticity.md,
+    "Antisymmetric flutter")."""
+    from bioflex_jsb.aeroelasticity.antisymmetric import SYMMETRIES
+
+    _check_choice("symmetry", symmetry, SYMMETRIES)
+    if symmetry != "symmetric":
+        return _flutter_by_symmetry(wing, range_m_s, symmetry, aero=aero, method=method,
+                                    clamped=clamped, structural_damping=structural_damping,
+                                    density_kg_m3=density_kg_m3, lift_slope=lift_slope,
+                                    progress=progress, full_scan=full_scan)
     if range_m_s is not None:
         from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
@@ -758,6 +790,42 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
     model = wing.model if structural_damping is None else with_damping(wing,
                                                                        structural_damping)
     return find_flutter(model, rng, step, **air, **scan)
+
+
+def _flutter_by_symmetry(wing, range_m_s, symmetry: str, **kw) -> FlutterResult:
+    """:func:`flutter` of the antisymmetric modes, or of both symmetries (the first)."""
+    from bioflex_jsb.aeroelasticity import antisymmetric as anti
+    from bioflex_jsb.aeroelasticity.free_aircraft import FREE_TOL_M_S
+    from bioflex_jsb.flight_dynamics.eigen import SCAN_START_M_S
+
+    sym = flutter(wing, range_m_s, **kw)  # the symmetric search: its checks and defaults
+    if kw["clamped"]:
+        d, m = _clamped(wing, kw["lift_slope"])
+        zeta = d.structure.damping_ratio if kw["structural_damping"] is None \
+            else float(kw["structural_damping"])
+        if sym.method == "pk":  # the root held: the antisymmetric problem is this one
+            res = replace(sym, settings=dict(sym.settings, symmetry="antisymmetric"))
+        else:
+            from bioflex_jsb.aeroelasticity.state_space import DEFAULT_SPEED_STEP_M_S
+            from bioflex_jsb.definition.clamped import scan_step_m_s
+
+            step = min(DEFAULT_SPEED_STEP_M_S, scan_step_m_s(sym.range_m_s))
+            res = anti.antisymmetric_flutter(
+                anti.clamped_strips(m, zeta, d.name), range_m_s=sym.range_m_s,
+                step_m_s=step, density_kg_m3=sym.density_kg_m3, aero=sym.aero,
+                structural_damping=zeta, tol_m_s=1e-7,
+                divergence_speed_m_s=sym.divergence_speed_m_s,
+                divergence_is_instability=True, progress=kw["progress"],
+                full_scan=kw["full_scan"])
+            res = replace(res, settings=dict(sym.settings, **res.settings))
+    else:
+        build = _Subject.of(wing).build
+        res = anti.aircraft_flutter(
+            build, range_m_s=sym.range_m_s, step_m_s=free_scan_step_m_s(sym.range_m_s),
+            density_kg_m3=sym.density_kg_m3, aero=sym.aero,
+            structural_damping=kw["structural_damping"], tol_m_s=FREE_TOL_M_S,
+            start_m_s=SCAN_START_M_S, progress=kw["progress"], full_scan=kw["full_scan"])
+    return res if symmetry == "antisymmetric" else anti.first_of(sym, res)
 
 
 def free_speed_range_m_s(build, density_kg_m3: float | None = None) -> tuple[float, float]:

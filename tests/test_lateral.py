@@ -251,7 +251,7 @@ def test_modes_axis_lateral_lists_roll_spiral_and_dutch_roll(capsys):
 
 @pytest.mark.parametrize("argv, needle", [
     (("--plot", "x.png"), "--plot does not apply"),
-    (("--aero", "unsteady"), "--aero unsteady does not apply"),
+    (("--structural-damping", "0.02"), "--structural-damping does not apply"),
     (("--aircraft", "sgs_elastic", "--models", "coupled"), "use --models rigid"),
     (("--speed", "5"), "cannot trim at 5 m/s"),
 ])

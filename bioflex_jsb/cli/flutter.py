@@ -30,6 +30,7 @@ AERO_CHOICES = ("unsteady", "quasi-steady")
 METHOD_CHOICES = ("pk", "state-space")
 LIFT_SLOPE_CHOICES = ("strip", "vlm")
 INERTIA_CHOICES = ("elastic-axis", "centre-of-mass")
+SYMMETRY_CHOICES = ("symmetric", "antisymmetric", "both")
 MAX_SPEED_M_S = 400.0  # upper end of --range [m/s]
 MIN_DENSITY_KG_M3, MAX_DENSITY_KG_M3 = DENSITY_RANGE_KG_M3  # --density [kg/m³], the
 # definition format's range (definition/loader.py: about 33 km altitude to denser than any
@@ -162,6 +163,11 @@ def register(sub) -> None:
                    "branch against airspeed over the whole range, the first instability "
                    "marked) to FILE (.png, .pdf, .svg; an existing file is replaced only if "
                    "bioflex-jsb wrote it)")
+    p.add_argument("--symmetry", choices=SYMMETRY_CHOICES, default="symmetric",
+                   help="which modes: symmetric (default: the wing's symmetric modes, Eq. 4), "
+                   "antisymmetric (its antisymmetric modes with the aircraft's roll freedom; "
+                   "a clamped wing's root held: the same problem) or both (each searched, "
+                   "the first reported and the other beside it; docs/aeroelasticity.md)")
     add_force_argument(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
@@ -266,7 +272,40 @@ def _formatted(res, digits: int) -> dict:
     d["divergence_speed_m_s"] = _round(res.divergence_speed_m_s, 2)
     d["natural_frequencies_rad_s"] = [round(w, 2) for w in res.natural_frequencies_rad_s]
     d["range_m_s"] = [round(x, 2) for x in res.range_m_s]
+    other = d.get("other_symmetry")
+    if other is not None:  # --symmetry both: the other result rounded as this one
+        for key in ("speed_m_s", "flutter_speed_m_s", "unstable_at_and_below_m_s"):
+            other[key] = _round(other[key], digits)
+        other["frequency_rad_s"] = _round(other["frequency_rad_s"], 2)
+        other["reduced_frequency"] = _round(other["reduced_frequency"], 4)
+        other["divergence_speed_m_s"] = _round(other["divergence_speed_m_s"], 2)
+        other["natural_frequencies_rad_s"] = [round(w, 2) for w in
+                                              other["natural_frequencies_rad_s"]]
     return d
+
+
+def _symmetry(args: argparse.Namespace) -> dict:
+    """api.flutter's ``symmetry`` when --symmetry is not the default (the default's call
+    and output are the symmetric search's, unchanged)."""
+    return {} if args.symmetry == "symmetric" else {"symmetry": args.symmetry}
+
+
+def _other_line(p: dict) -> str | None:
+    """--symmetry both: which symmetry goes unstable first, and the other's result."""
+    if "first_symmetry" not in p:
+        return None
+    o = p["other_symmetry"]
+    if o["present_at_lower_end"]:
+        other = f"unstable at and below {o['range_m_s'][0]:g} m/s"
+    elif o["speed_m_s"] is None:
+        other = "no instability in the range"
+    else:
+        other = (f"{o['kind']} at {o['speed_m_s']:.1f} m/s, {o['mode']}, "
+                 f"{o['frequency_rad_s']:.2f} rad/s, mechanism {o['mechanism']}")
+    first = {"none": "neither symmetry is unstable in the range",
+             "both": "both symmetries at the same speed (a clamped root: one problem)"}.get(
+                 p["first_symmetry"], f"the {p['first_symmetry']} modes go unstable first")
+    return f"  {first}; {o.get('symmetry', 'symmetric')}: {other}"
 
 
 def _plot(res, args: argparse.Namespace) -> str | None:
@@ -293,7 +332,7 @@ def clamped_payload(args: argparse.Namespace, target: str, progress=None) -> dic
                       clamped=True, structural_damping=args.structural_damping,
                       density_kg_m3=args.density, lift_slope=args.lift_slope,
                       progress=progress,
-                      full_scan=bool(args.plot))
+                      full_scan=bool(args.plot), **_symmetry(args))
     d = _formatted(res, 2)
     d["plot"] = _plot(res, args)
     lift_slope = res.settings["lift_slope"]
@@ -338,7 +377,7 @@ def paper_payload(args: argparse.Namespace, progress=None) -> dict:
         build, args.structural_damping)
     res = api.flutter(build, args.range, aero=args.aero, method=args.method,
                       structural_damping=args.structural_damping, density_kg_m3=args.density,
-                      progress=progress, full_scan=bool(args.plot))
+                      progress=progress, full_scan=bool(args.plot), **_symmetry(args))
     d = _formatted(res, 1)
     d["plot"] = _plot(res, args)
     d.update(
@@ -358,6 +397,8 @@ def text_report(p: dict) -> str:
     zeta_text = f"{zeta:g}" if isinstance(zeta, float) else ", ".join(f"{z:g}" for z in zeta)
     setup += f", zeta {zeta_text}"
     nat = ", ".join(f"{w:.2f}" for w in p["natural_frequencies_rad_s"])
+    if p.get("symmetry"):
+        setup += f", {p['symmetry']} modes"
     lines = [f"{head}: {setup}", f"  natural frequencies [rad/s]: {nat}"]
     lo, hi = p["range_m_s"]
     div = p.get("divergence_speed_m_s")
@@ -382,6 +423,9 @@ def text_report(p: dict) -> str:
                          f"{p['reduced_frequency']:.3f}, mechanism {p['mechanism']}{partner}")
         if p.get("caveat"):
             lines.append(f"  caveat: {p['caveat']}")
+    other = _other_line(p)
+    if other:
+        lines.append(other)
     pub = p.get("published")
     if pub is not None:
         line = (f"  published: {pub['flutter_speed_m_s']} m/s, {pub['frequency_rad_s']} rad/s "

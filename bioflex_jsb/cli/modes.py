@@ -59,10 +59,12 @@ eigenvalues in rad/s): sideslip, roll-rate, yaw-rate and bank equations whose ri
 derivatives are identified from the aircraft's JSBSim model at its trim at each --speed
 (the prototype's generated JSBSim airframe, whose lateral tables are estimates: the paper
 has no lateral data), --models rigid (the rigid aircraft), coupled (with the wing's
-antisymmetric modes on quasi-steady strips) and qsd (their static deformation); a wing given
-as a modal-data file has no antisymmetric modes (rigid only). The aircraft must trim there
-(the prototype 9..32 m/s; an --aircraft its flight speeds, default its cruise speed);
---aero unsteady, --structural-damping, --plot, --animate and --mode-sheet do not apply.
+antisymmetric modes on quasi-steady strips; --aero unsteady: Theodorsen strips with Jones
+lag states and apparent mass on the modes and the roll rate, the lag roots not listed) and
+qsd (their static deformation); a wing given as a modal-data file has no antisymmetric
+modes (rigid only). The aircraft must trim there (the prototype 9..32 m/s; an --aircraft
+its flight speeds, default its cruise speed); --structural-damping, --plot, --animate and
+--mode-sheet do not apply.
 JSON: "derivatives" (body axes, per rad; rates with b/2V) and "source" per result;
 docs/lateral.md."""
 
@@ -193,8 +195,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 DEFAULT_MODELS = ("rigid", "coupled", "qsd")
-LONGITUDINAL_ONLY = (("--aero unsteady", lambda a: a.aero != "quasi-steady"),
-                     ("--structural-damping", lambda a: a.structural_damping is not None),
+LONGITUDINAL_ONLY = (("--structural-damping", lambda a: a.structural_damping is not None),
                      ("--plot", lambda a: a.plot is not None),
                      ("--animate", lambda a: a.animate is not None),
                      ("--mode-sheet", lambda a: a.mode_sheet is not None))
@@ -206,7 +207,7 @@ def _run_lateral(args: argparse.Namespace) -> int:
 
     given = [name for name, used in LONGITUDINAL_ONLY if used(args)]
     if given:
-        raise UsageError(f"--axis lateral takes the quasi-steady models without plots: "
+        raise UsageError(f"--axis lateral takes no plots and the wing's own damping: "
                          f"{', '.join(given)} does not apply")
     aircraft = args.aircraft_definition
     subject = aircraft if aircraft is not None else wing_from_args(args)
@@ -227,8 +228,11 @@ def _run_lateral(args: argparse.Namespace) -> int:
     results = []
     for model in models:
         for v in args.speed or [None]:
-            ss = api.lateral_model(subject, v, model)
-            results.append((ss, api.lateral_modes(subject, ss.speed_m_s, model)))
+            # --aero unsteady is the coupled model's (rigid has no strips; the qsd's static
+            # deformation is the same: the unsteady increments vanish in a steady state)
+            aero = args.aero if model == "coupled" else "quasi-steady"
+            ss = api.lateral_model(subject, v, model, aero)
+            results.append((ss, api.lateral_modes(subject, ss.speed_m_s, model, aero)))
     payload = {
         "axis": "lateral", "aircraft": name,
         "results": [{**ms.as_dict(), "derivatives": ss.notes["derivatives"],
