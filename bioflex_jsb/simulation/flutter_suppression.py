@@ -292,3 +292,41 @@ def design_static_feedback(build, design_speed_m_s: float, signals=DEFAULT_SIGNA
               "grid_m_s": [float(v) for v in grid], "design_speed_m_s": v_d,
               "gain_weight": float(gain_weight), "dt_s": float(dt_s)}
     return static_gain(res.x, signals), record
+
+
+def growth_from_response(time_s, signal, frequency_rad_s: float, start_s: float,
+                         stop_s: float | None = None) -> tuple[float, int]:
+    """(the growth rate σ [1/s] of the oscillation at ``frequency_rad_s`` [rad/s] in
+    ``signal`` between ``start_s`` and ``stop_s`` [s], the number of peaks it rests on) by
+    the logarithmic decrement: the signal less its moving average over one period (the
+    slow rigid-body motion taken out), its successive maxima's ln against time fitted by a
+    straight line, σ its slope (σ = δ f, δ the decrement per cycle, f the frequency).
+    Fewer than three peaks: InputError (the window holds no oscillation to measure)."""
+    t = np.asarray(time_s, dtype=float)
+    y = np.asarray(signal, dtype=float)
+    keep = (t >= start_s) & (t <= (t[-1] if stop_s is None else stop_s)) & np.isfinite(y)
+    t, y = t[keep], y[keep]
+    dt = float(np.median(np.diff(t)))
+    period_n = max(3, int(round(2.0 * math.pi / frequency_rad_s / dt)))
+    if len(y) < 2 * period_n:
+        raise InputError("the window is shorter than two periods of the oscillation")
+    kernel = np.ones(period_n) / period_n
+    trend = np.convolve(y, kernel, mode="same")
+    half = period_n // 2
+    osc = (y - trend)[half:len(y) - half]
+    tt = t[half:len(t) - half]
+    peaks = [i for i in range(1, len(osc) - 1)
+             if osc[i] > osc[i - 1] and osc[i] >= osc[i + 1] and osc[i] > 0.0]
+    # one maximum per period: the largest within each half period of a kept peak
+    kept: list[int] = []
+    for i in peaks:
+        if kept and i - kept[-1] < period_n // 2:
+            if osc[i] > osc[kept[-1]]:
+                kept[-1] = i
+            continue
+        kept.append(i)
+    if len(kept) < 3:
+        raise InputError(f"{len(kept)} peaks of the oscillation in the window: too few for "
+                         "a logarithmic decrement")
+    slope = np.polyfit(tt[kept], np.log(osc[kept]), 1)[0]
+    return float(slope), len(kept)
