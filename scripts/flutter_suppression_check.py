@@ -49,11 +49,13 @@ def main() -> None:
     wing = api.load_wing(args.wing)
     ctrl = api.linear_controller(args.controller)
     speeds = np.arange(15.0, 24.01, 0.25)
-    growth = {"open": [], "closed": []}
+    growth = {"open": [], "closed": [], "branch": []}
     for v in speeds:
         plant = FS.controlled_plant(wing, float(v))
         growth["open"].append(FS.growth_rate_1_s(plant, None)[0])
         growth["closed"].append(FS.growth_rate_1_s(plant, ctrl)[0])
+        s = FS.closed_loop_roots(plant, ctrl)
+        growth["branch"].append(float(np.max(s.real[(s.imag > 5.0) & (s.imag < 40.0)])))
     runs, sigma = {}, {}
     for v in (20.5, 20.75, 21.0):
         r = fly(wing, v, "sharp:0.05", ctrl)
@@ -76,10 +78,10 @@ def main() -> None:
         e = np.asarray(r["elevator_rad"])
         rate = np.diff(e) / np.diff(r.time_s)
         hit = np.nonzero(np.abs(e) >= TRAVEL_RAD * (1 - 1e-6))[0]
+        stop = f"elevator at its stop at t = {r.time_s[hit[0]]:.3f} s; " if hit.size else ""
         print(f"  {v:5.2f}  {math.degrees(e[0]):6.2f}  {math.degrees(np.max(np.abs(e))):6.2f}"
               f"  {math.degrees(np.max(np.abs(rate))):8.1f}  "
-              f"{'elevator at its stop at t = %.3f s; ' % r.time_s[hit[0]] if hit.size else ''}"
-              f"{r.stopped or 'bounded'}")
+              f"{stop}{r.stopped or 'bounded'}")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -88,6 +90,8 @@ def main() -> None:
     fig, ax = plt.subplots(1, 3, figsize=(16, 5))
     ax[0].plot(speeds, growth["open"], "k-", label="open loop (LTI)")
     ax[0].plot(speeds, growth["closed"], "b-", label=f"closed loop {ctrl.name} (LTI)")
+    ax[0].plot(speeds, growth["branch"], "b--",
+               label="closed loop, its flutter branch (5-40 rad/s)")
     ax[0].plot(list(sigma), list(sigma.values()), "ro", label="nonlinear, log decrement")
     ax[0].axhline(0.0, color="grey", lw=0.8)
     ax[0].set_xlabel("airspeed [m/s]")
