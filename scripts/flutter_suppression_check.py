@@ -55,7 +55,8 @@ def main() -> None:
         growth["open"].append(FS.growth_rate_1_s(plant, None)[0])
         growth["closed"].append(FS.growth_rate_1_s(plant, ctrl)[0])
         s = FS.closed_loop_roots(plant, ctrl)
-        growth["branch"].append(float(np.max(s.real[(s.imag > 5.0) & (s.imag < 40.0)])))
+        branch = s.real[(s.imag > 5.0) & (s.imag < 40.0)]  # none once the roots are real
+        growth["branch"].append(float(np.max(branch)) if branch.size else math.nan)
     runs, sigma = {}, {}
     for v in (20.5, 20.75, 21.0):
         r = fly(wing, v, "sharp:0.05", ctrl)
