@@ -98,7 +98,7 @@ def main() -> None:
     ax[0].set_xlabel("airspeed [m/s]")
     ax[0].set_ylabel("largest growth rate Re s [1/s]")
     ax[0].set_ylim(-3.0, 6.0)
-    ax[0].legend()
+    ax[0].legend(loc="upper left")
     ax[0].set_title(f"{args.wing}, unsteady strips")
     for key, style in ((("closed", 20.75), "b-"), (("closed", 21.0), "r-"),
                        (("open", 20.0), "k-")):

@@ -149,3 +149,25 @@ def test_nonlinear_runs_bracket_the_closed_loop_flutter(wing, controller):
     open_loop = _fly(wing, below, None)
     assert open_loop.stopped is not None
     assert math.isfinite(crossing)
+
+
+def test_flutter_command_with_a_controller(capsys):
+    """``flutter --controller``: both speeds and the margin as JSON; what it does not take is
+    one line, exit 2."""
+    import json
+
+    from tests.cli_helpers import assert_one_line_error, run_cli
+
+    code, out, _ = run_cli(capsys, "flutter", "--wing", "inertial-backward", "--controller",
+                           SHIPPED, "--range", "18:21", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["open_loop"]["speed_m_s"] == pytest.approx(OPEN_LOOP_M_S, abs=SEARCH_TOL_M_S)
+    assert d["closed_loop"]["speed_m_s"] == pytest.approx(CLOSED_LOOP_M_S, abs=SEARCH_TOL_M_S)
+    assert d["margin_m_s"] == pytest.approx(CLOSED_LOOP_M_S - OPEN_LOOP_M_S, abs=0.02)
+    code, _, err = run_cli(capsys, "flutter", "--controller", SHIPPED, "--aero",
+                           "quasi-steady")
+    assert_one_line_error(code, err, "unsteady strips")
+    code, _, err = run_cli(capsys, "flutter", "--wing", "goland", "--clamped", "--controller",
+                           SHIPPED)
+    assert_one_line_error(code, err, "clamped wing has none")
