@@ -82,7 +82,8 @@ __all__ = [
     "TimeHistory", "WingBuild", "compare", "flutter", "fly_fig21", "fly_gust", "lateral_model",
     "lateral_modes", "linear_model", "load_aircraft", "load_definition", "load_wing", "metrics",
     "modes", "plot_runs", "read_log", "section_loads", "to_python_control", "load_controller",
-    "linear_controller", "predict_alleviation", "design_alleviation",
+    "linear_controller", "predict_alleviation", "design_alleviation", "closed_loop_flutter",
+    "design_flutter_suppression",
 ]
 
 
@@ -1107,3 +1108,48 @@ def design_alleviation(wing, speed_m_s: float | None = None,
     record["speed_m_s"] = v
     gains = [record["gains"][s] for s in signals]
     return static_gain(gains, signals, None, name="gla"), record
+
+
+def closed_loop_flutter(wing, controller=None, range_m_s: tuple[float, float] = (10.0, 30.0),
+                        *, step_m_s: float = 0.25, tol_m_s: float = 1e-3,
+                        dt_s: float = DEFAULT_DT_S):
+    """The flutter speed of ``wing`` (a WingBuild) with ``controller`` in the loop
+    (:func:`linear_controller`'s sources; None: the open loop by the same path) by the
+    unsteady LTI model with the elevator (:mod:`bioflex_jsb.simulation.flutter_suppression`):
+    the closed loop at the run's step ``dt_s`` [s] with its one step of delay, the first speed
+    in ``range_m_s`` [m/s] at which any of its roots grows (the phugoid included), scanned every
+    ``step_m_s`` and bisected to ``tol_m_s`` [m/s]. Returns a
+    :class:`~bioflex_jsb.simulation.flutter_suppression.ClosedLoopFlutter` (``speed_m_s``,
+    ``frequency_rad_s``, ``as_dict()``). The shipped ``fs_inertial-backward`` raises the
+    inertial-backward wing's 18.86 m/s to 20.81 m/s (docs/aeroelasticity.md)."""
+    from bioflex_jsb.simulation.flutter_suppression import closed_loop_flutter as _search
+
+    build = _Subject.of(wing).build
+    if build is None:
+        raise InputError("closed-loop flutter needs an elastic wing")
+    ctrl = None if controller is None else linear_controller(controller)
+    if range_m_s is None or isinstance(range_m_s, str) or len(tuple(range_m_s)) != 2:
+        raise InputError(f"range must be (low, high) [m/s], got {range_m_s!r}")
+    lo, hi = (_linear_speed(x) for x in range_m_s)
+    return _search(build, ctrl, (lo, hi), step_m_s=_real(step_m_s, "step_m_s [m/s]"),
+                   tol_m_s=_real(tol_m_s, "tol_m_s [m/s]"), dt_s=_real(dt_s, "dt_s [s]"))
+
+
+def design_flutter_suppression(wing, design_speed_m_s: float = 21.0,
+                               signals: tuple[str, ...] = ("q",), *,
+                               dt_s: float = DEFAULT_DT_S):
+    """A flutter suppression controller for ``wing`` (a WingBuild) designed on the unsteady
+    LTI model with the elevator
+    (:func:`bioflex_jsb.simulation.flutter_suppression.design_static_feedback`): a static
+    feedback from ``signals`` (the run's channels; default the pitch rate [rad/s]) to the
+    elevator [rad] minimising the closed loop's largest growth rate from 17 m/s to
+    ``design_speed_m_s`` [m/s] at the step ``dt_s`` [s]. Returns (the LinearController,
+    continuous; the design's record: gains, cost [1/s], grid, iterations)."""
+    from bioflex_jsb.simulation.flutter_suppression import design_static_feedback
+
+    build = _Subject.of(wing).build
+    if build is None:
+        raise InputError("flutter suppression needs an elastic wing")
+    v = _linear_speed(design_speed_m_s)
+    return design_static_feedback(build, v, signals, low_speed_m_s=min(17.0, v - 1.0),
+                                  dt_s=_real(dt_s, "dt_s [s]"))

@@ -169,6 +169,10 @@ def register(sub) -> None:
                    "a clamped wing's root held: the same problem) or both (each searched, "
                    "the first reported and the other beside it; docs/aeroelasticity.md)")
     add_force_argument(p)
+    p.add_argument("--controller", metavar="FILE", default=None,
+                   help="a linear controller in the loop (a .npz/.toml file or a shipped "
+                   "one: fs_inertial-backward): the open- and closed-loop flutter speeds on "
+                   "unsteady strips (docs/aeroelasticity.md, \"Active flutter suppression\")")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(run=run)
 
@@ -214,6 +218,11 @@ def clamped_target(args: argparse.Namespace) -> str | None:
 
 def run(args: argparse.Namespace) -> int:
     target = clamped_target(args)
+    if args.controller is not None:
+        from bioflex_jsb.cli.flutter_control import check_controller_options, run_with_controller
+
+        check_controller_options(args, target is not None)
+        return run_with_controller(args)
     check_plot_path(args.plot, args.force)
     with ScanProgress() as progress:
         payload = paper_payload(args, progress) if target is None else \

@@ -139,8 +139,9 @@ def add_controller_argument(p: argparse.ArgumentParser, linear: bool = False) ->
                    help=f"fly with {what} in the loop: a .npz or .toml file (A, B, C, D, "
                    "dt_s [s], the signals it reads: the run's channels such as alpha, q, "
                    "n_z, eta1; the commands it writes: elevator [rad], throttle [-] over the "
-                   "trim) or a shipped one by name (gla_optimised); its commands are logged "
-                   "as ctrl_elevator_rad, ctrl_throttle (docs/api.md)")
+                   "trim) or a shipped one by name (gla_optimised, fs_inertial-backward); "
+                   "its commands are logged as ctrl_elevator_rad, ctrl_throttle "
+                   "(docs/api.md)")
 
 
 def controller_from_args(args, linear: bool = False):
