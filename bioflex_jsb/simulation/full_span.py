@@ -176,3 +176,41 @@ class AntisymmetricModalWing:
         row.update(zip(eta, (float(v) for v in eta_a), strict=True))
         row.update(zip(eta_dot, (float(v) for v in eta_a_dot), strict=True))
         return row
+
+
+AILERON_INPUTS = ("step", "doublet")
+
+
+@dataclass(frozen=True)
+class AileronInput:
+    """An aileron input over the trim for a full-span run: ``kind`` ``step`` (δa from
+    ``start_s`` on) or ``doublet`` (δa for ``width_s``, then −δa for ``width_s``, then 0);
+    ``angle_rad`` δa [rad, JSBSim's ½ (left − right), + rolls right]; ``start_s`` [s]."""
+
+    kind: str
+    angle_rad: float
+    start_s: float
+    width_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.kind not in AILERON_INPUTS:
+            raise InputError(f"unknown aileron input {self.kind!r}; accepted: "
+                             f"{', '.join(AILERON_INPUTS)}")
+        for name in ("angle_rad", "start_s", "width_s"):
+            if not np.isfinite(getattr(self, name)):
+                raise InputError(f"aileron input {name} must be finite")
+        if self.start_s < 0.0 or self.width_s <= 0.0:
+            raise InputError("aileron input: need start_s >= 0 s and width_s > 0 s")
+
+    def changes(self, dt_s: float) -> dict[int, float]:
+        """{step number: δa over the trim [rad] from that step on}."""
+        k0 = int(round(self.start_s / dt_s))
+        if self.kind == "step":
+            return {k0: self.angle_rad}
+        k1 = k0 + max(1, int(round(self.width_s / dt_s)))
+        k2 = k1 + max(1, int(round(self.width_s / dt_s)))
+        return {k0: self.angle_rad, k1: -self.angle_rad, k2: 0.0}
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "angle_rad": self.angle_rad, "start_s": self.start_s,
+                "width_s": self.width_s}
