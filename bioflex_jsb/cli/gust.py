@@ -32,6 +32,11 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.lateral_options import (
+    add_lateral_arguments,
+    lateral_run_options,
+    lateral_summary,
+)
 from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.simulation.run import MAX_DURATION_S
@@ -94,6 +99,7 @@ def register(sub) -> None:
                    "with --aero unsteady: rigid,coupled)")
     add_aero_arguments(p)
     add_controller_argument(p)
+    add_lateral_arguments(p)
     add_log_arguments(p)
     add_live_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
@@ -295,6 +301,8 @@ def fly(args, build, config, log=None, airframe=None):
     from bioflex_jsb.runtime.fdm import FdmError
 
     runs, stops = [], []
+    # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
+    lateral = lateral_run_options(args, build) if hasattr(args, "aileron_step") else {}
     try:
         if airframe is None:
             airframe = airframe_from_args(args)
@@ -304,11 +312,12 @@ def fly(args, build, config, log=None, airframe=None):
             recorder = log.recorder(model) if log is not None else None
             # the bar moved once a block (0.9 s of flight), not by a callback every step
             progress = None if bar is None else (lambda k, bar=bar: bar.update(k - bar.n))
+            wing = build if config.needs_build(model) or lateral.get("span") == "full" \
+                else build.model
             try:
-                run = run_gust(airframe, build if config.needs_build(model) else build.model,
-                               model, config, progress=progress, recorder=recorder,
-                               loads=build,
-                               controller=getattr(args, "controller_object", None))
+                run = run_gust(airframe, wing, model, config, progress=progress,
+                               recorder=recorder, loads=build,
+                               controller=getattr(args, "controller_object", None), **lateral)
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -383,6 +392,8 @@ def run(args: argparse.Namespace) -> int:
             "summary": summary,
             "diverged": [r.model for r in runs if r.stopped is not None],
             "controller": runs[0].meta.get("controller") if runs else None,
+            "lateral": {r.model: lateral_summary(r) for r in runs
+                        if r.meta.get("span") == "full"},
             "stopped": stops,
             "plot": plot,
             "out": args.out,
@@ -393,6 +404,14 @@ def run(args: argparse.Namespace) -> int:
             line = controller_line(r)
             if line:
                 print(f"{r.model}: {line}")
+            if r.meta.get("span") == "full":
+                lat = lateral_summary(r)
+                print(f"{r.model}: both halves: roll rate {lat['p_min_deg_s']:+.2f} .. "
+                      f"{lat['p_max_deg_s']:+.2f} deg/s, bank {lat['phi_min_deg']:+.2f} .. "
+                      f"{lat['phi_max_deg']:+.2f} deg, tip twist starboard "
+                      f"{lat['tip_twist_starboard_max_abs_deg']:.3f}, port "
+                      f"{lat['tip_twist_port_max_abs_deg']:.3f} deg (largest), elastic "
+                      f"rolling moment {lat['modal_roll_max_abs_n_m']:.4g} N m")
         if plot:
             print(f"time histories written to {plot}")
         if args.out:

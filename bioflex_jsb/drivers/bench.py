@@ -91,13 +91,15 @@ LENGTH_SCALE = {"unsteady": 4}
 MAX_RESIDUAL = 0.10
 MAX_DISAGREEMENT = 0.25
 # The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step.
-BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2}
+BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2,
+        "full_span_ratio": 1.6}
 CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
 LOGS = (None, "rows", "loads", "gust")  # StepBench.cosim's logs
 # figure → (numerator, denominator) configurations
 RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
           "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
-          "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare")}
+          "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare"),
+          "full_span_ratio": ("full_span", "bare")}
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
@@ -359,6 +361,14 @@ class StepBench:
     def close(self) -> None:
         self._tmp.cleanup()
 
+    def _aileron(self):
+        """The wing variant's aileron (its shipped definition's), looked up once."""
+        if not hasattr(self, "_aileron_surface"):
+            from bioflex_jsb.simulation.full_span import prototype_aileron
+
+            self._aileron_surface = prototype_aileron(self.build.variant.name)
+        return self._aileron_surface
+
     def bare(self, n: int) -> tuple[float, float]:
         """``n`` steps of JSBSim alone (trimmed first, outside the timing)."""
         self.airframe.trim(self.speed_m_s)
@@ -380,7 +390,7 @@ class StepBench:
 
     def cosim(self, n: int, gust: str = "sharp:0.3", log: str | None = None,
               compiled: bool = True, aero: str = "quasi-steady",
-              controller=None) -> tuple[float, float]:
+              controller=None, span: str = "half") -> tuple[float, float]:
         """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
         at half the shortest run; ``aero`` the strips; ``log``: None (no log, no section
         loads), ``"rows"`` (an MCAP log of the run's rows), ``"loads"`` (and the section
@@ -403,14 +413,15 @@ class StepBench:
                 wing_variant=self.build.variant.as_dict(),
                 overrides=dict(self.build.model.coefficients.overrides),
                 scene=GUST_SCENE_EXAGGERATION if log == "gust" else None)
-        wing = self.build if aero == "unsteady" else self.build.model
+        wing = self.build if aero == "unsteady" or span == "full" else self.build.model
+        full = {} if span == "half" else {"span": span, "aileron": self._aileron()}
         try:
             c0, w0 = _clocks()
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=run_log.recorder("coupled") if run_log else None,
                            compiled=compiled,
                            loads=self.build if log in ("loads", "gust") else None,
-                           controller=controller)
+                           controller=controller, **full)
             if run_log is not None:  # closing writes the last chunks: part of the log's cost
                 run_log.close()
                 run_log = None
@@ -434,6 +445,7 @@ class StepBench:
             "native": self.native_run,
             "python": lambda n: self.cosim(n, compiled=False),
             "controlled": lambda n: self.cosim(n, controller=bench_controller()),
+            "full_span": lambda n: self.cosim(n, span="full"),
         }
         for g in gusts:
             if g != "sharp:0.3":  # that one is "cosim"

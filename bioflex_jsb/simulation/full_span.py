@@ -214,3 +214,16 @@ class AileronInput:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "angle_rad": self.angle_rad, "start_s": self.start_s,
                 "width_s": self.width_s}
+
+
+def prototype_aileron(variant_name: str):
+    """The aileron of the prototype's wing variant ``variant_name`` (its shipped definition
+    ``bioflex_<variant>``'s ``[aileron]``, an estimate: the paper gives none), or None when
+    there is no such definition (a modal-data wing) or it has no aileron."""
+    from bioflex_jsb.definition.aircraft import load_aircraft
+    from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT
+
+    name = f"bioflex_{variant_name}"
+    if name not in SHIPPED_AIRCRAFT:
+        return None
+    return load_aircraft(name).definition.aileron
