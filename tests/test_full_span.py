@@ -267,3 +267,28 @@ def test_full_span_refusals(aircraft):
         st.advance_into(0.0, np.zeros((1, len(st.names))), 0, 0.1)
     with pytest.raises(InputError, match="aileron input"):
         AileronInput("step", 0.01, -1.0)
+
+
+def test_the_lateral_channels_go_through_the_log_and_back(aircraft, tmp_path):
+    """A full-span run's MCAP log: /bioflex/<model>/lateral read back as the run's channels
+    (every value, as the half wing's η are)."""
+    from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks.mcap import RunLog
+
+    build = aircraft[PROTOTYPE].wing()
+    setup = RunConfig(15.0, parse_gust("none"), 0.3)
+    path = tmp_path / "lateral.mcap"
+    log = RunLog.open(path, RunDescription("gust", build.variant.name, 15.0, gust="none",
+                                           models=("coupled",), duration_s=0.3))
+    try:
+        run = run_gust(Airframe(), build, "coupled", setup, span="full",
+                       aileron=aircraft[PROTOTYPE].definition.aileron,
+                       aileron_input=AileronInput("step", math.radians(1.0), 0.05),
+                       recorder=log.recorder("coupled"))
+    finally:
+        log.close()
+    back = api.read_log(path)["coupled"]
+    for name in ("aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad",
+                 "tip_twist_port_rad", "asym_eta1", "asym_eta3_dot"):
+        np.testing.assert_array_equal(back.channels[name], run.channels[name], err_msg=name)
+    assert np.max(np.abs(run.channels["asym_eta1"])) > 1e-3

@@ -294,12 +294,15 @@ class _GustRun:
         block = max(1, int(round(WINDOW_S / dt)))
         self.loads_out = None  # the recorder's loads topic
         self.control_out = None  # the recorder's controller topic
+        self.lateral_out = None  # the recorder's antisymmetric wing's topic (span full)
         if recorder is not None:
             block = max(1, int(recorder.start(names, dt)))
             if stream is not None and hasattr(recorder, "loads"):
                 self.loads_out = recorder.loads(loads_meta["loads"])
             if step.control is not None and hasattr(recorder, "controller"):
                 self.control_out = recorder.controller(names, controller_meta(step.control))
+            if step.lateral is not None and hasattr(recorder, "lateral"):
+                self.lateral_out = recorder.lateral(names)  # both wing halves
         self.block = min(block, max(self.n_steps, 1))
         load_names = self.load_names = stream.names if stream is not None else ()
         self.loads_table = None
@@ -346,6 +349,8 @@ class _GustRun:
             self.recorder.rows(time_s, rows)
             if self.control_out is not None:
                 self.control_out.rows(time_s, rows)
+            if self.lateral_out is not None:
+                self.lateral_out.rows(time_s, rows)
         if self.stream is not None:
             known = self.stream.add(time_s, rows)
             if last:
@@ -417,6 +422,8 @@ class _GustRun:
                     self.loads_out.stop()
                 if self.control_out is not None:
                     self.control_out.stop()
+                if self.lateral_out is not None:
+                    self.lateral_out.stop()
             finally:
                 if self.recorder is not None:
                     self.recorder.stop(self.k)  # also when the loop failed: every step kept
