@@ -53,7 +53,7 @@ def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
 def lateral_run_options(args, build) -> dict:
     """run_gust's ``span``, ``aileron``, ``aileron_input`` of the arguments (only those
     that differ from a half-wing run's: {} for one)."""
-    from bioflex_jsb.simulation.full_span import AileronInput, prototype_aileron
+    from bioflex_jsb.simulation.full_span import AileronInput
 
     angle_deg = args.aileron_step if args.aileron_step is not None else args.aileron_doublet
     span = args.span or ("full" if angle_deg is not None else "half")
@@ -70,13 +70,31 @@ def lateral_run_options(args, build) -> dict:
     if getattr(args, "aero", "quasi-steady") != "quasi-steady":
         raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
                          "--aero unsteady")
+    return options | {"span": "full", "aileron": _aileron(args, build)}
+
+
+def span_options(args, build) -> dict:
+    """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
+    if args.span != "full":
+        return {}
+    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
+        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
+                         "--aero unsteady")
+    return {"span": "full", "aileron": _aileron(args, build)}
+
+
+def _aileron(args, build):
+    """The aileron of ``--aircraft``'s definition or of the prototype variant's (a note on
+    stderr when there is none)."""
+    from bioflex_jsb.simulation.full_span import prototype_aileron
+
     aircraft = getattr(args, "aircraft_definition", None)
     aileron = (aircraft.definition.aileron if aircraft is not None
                else prototype_aileron(build.variant.name))
     if aileron is None:
         print(f"bioflex-jsb: note: wing {build.variant.name!r} has no [aileron]: its "
               "antisymmetric modes are driven by the roll rate alone", file=sys.stderr)
-    return options | {"span": "full", "aileron": aileron}
+    return aileron
 
 
 def lateral_summary(run) -> dict[str, float]:

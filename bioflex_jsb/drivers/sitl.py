@@ -355,7 +355,7 @@ class SitlSim:
                  speedup: float = 1.0, airframe: Airframe | None = None,
                  trim_mode: str = "rigid", aero: str = "quasi-steady",
                  airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S,
-                 sensors: Sensors | None = None) -> None:
+                 sensors: Sensors | None = None, span: str = "half", aileron=None) -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
         :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
@@ -369,7 +369,11 @@ class SitlSim:
         speed targets accepted [m/s] (AIRSPEED_MS, DO_CHANGE_SPEED). ``sensors``: the
         aircraft's sensor stations (None: the WingBuild's, an aircraft definition's
         ``[sensors]``): each is channels of the rows (and a log topic), and the autopilot's
-        IMU is reported as HIGHRES_IMU (without sensors: an ideal IMU at the CG)."""
+        IMU is reported as HIGHRES_IMU (without sensors: an ideal IMU at the CG). ``span``:
+        ``half`` or ``full`` (both wing halves, ``wing_model`` the WingBuild: the
+        antisymmetric modes driven by the roll rate and the ailerons the autopilot flies,
+        ``aileron`` their surface; :mod:`bioflex_jsb.simulation.full_span`)."""
+        self.span, self.aileron = span, aileron
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
         self.aero = aero
@@ -451,12 +455,13 @@ class SitlSim:
 
         elastic = self.trim_mode == "elastic" and model != "rigid"
         wing = self._wing_model
-        if not elastic and self.aero != "unsteady" and hasattr(wing, "model"):
+        if not elastic and self.aero != "unsteady" and hasattr(wing, "model") \
+                and self.span == "half":
             wing = wing.model  # a WingBuild: the model is enough for the quasi-steady strips
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
                                 trim_mode="elastic" if elastic else "rigid", aero=self.aero,
-                                sensors=self._sensor_set)
+                                sensors=self._sensor_set, span=self.span, aileron=self.aileron)
         self._autopilot_imu.dt_s = self.core.dt_s
         self._autopilot_imu.reset(self.core.n_modes)
         self.trim = self.core.trim

@@ -429,8 +429,6 @@ class CoupledStep(FullSpanSteps):
             raise InputError(f"cannot switch a {self.model} wing to {model!r}")
         if self.aero == "unsteady" and model != self.model:
             raise InputError(f"cannot switch the unsteady coupled wing to {model!r}")
-        if self.lateral is not None and model != self.model:
-            raise InputError(f"cannot switch a full-span {self.model} wing to {model!r}")
         if model != self.wing.model:
             self.wing.model = model
             self.wing.eta = np.zeros(self.n_modes)
@@ -442,6 +440,8 @@ class CoupledStep(FullSpanSteps):
                 self._views["model"][0] = K.MODEL_CODES[model]
                 self.wing.prepare_arrays()
                 self._fast = None  # rebind: the wing's state array was replaced
+            if self.lateral is not None:  # the antisymmetric wing switches with it
+                self._switch_lateral(model)
 
     def prepare(self, w_g_m_s: float = 0.0) -> None:
         """Compute the wing's step matrices for the flow now (the first step would do it),

@@ -109,6 +109,20 @@ class FullSpanSteps:
             lv["input_cols"][:] = np.ravel(lat._input_cols)
             lv["key"][:] = lat._key
 
+    def _switch_lateral(self, model: str) -> None:
+        """The antisymmetric wing switched to ``model`` with the half wing (set_model),
+        undeformed; the compiled step's state rebound to both wings' (one array)."""
+        lat = self.lateral
+        lat.model = model
+        lat._x = np.zeros(2 * lat.n_modes)
+        if self.compiled:
+            x, n2 = self._x_full, 2 * self.n_modes
+            x[:] = 0.0
+            self.wing._x, lat._x = x[:n2], x[n2:]
+            self._lat_views["model"][0] = K.MODEL_CODES[model]
+            if model == "coupled" and lat._key is not None:
+                self._renew_lateral(*lat._key)
+
     def _prepare_lateral(self, w_g_m_s: float) -> None:
         """The antisymmetric wing's reference for the flow now (:meth:`prepare`)."""
         flow = self._read(-w_g_m_s * U.FT_PER_M).flow
