@@ -76,12 +76,14 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     o_scr = o_c + N_LAT_CONSTS
     o_ts = o_scr + n2a  # the symmetric modes' tip twist per unit η_s
     model = int(params[o_model])
-    refresh_rel = params[o_c]
-    va, vt_fps, vt, alpha, qbar = K.air_flow(reads, wind_down_fps, params[o_c + 1],
-                                              params[o_c + 2])
     key0, key1 = params[o_key], params[o_key + 1]
-    if model == 1 and not (abs(qbar - key0) <= refresh_rel * abs(key0)
-                           and abs(vt - key1) <= refresh_rel * abs(key1)):
+    # Both references are renewed together at one flow (CoupledStep._renew_reference), so
+    # the half wing's check of the flow against its key is this wing's too: a key that is
+    # not the half wing's (none yet: NaN) asks for a renewal at this flow.
+    o_key_s = 3 * n2s * n2s + 3 * n2s  # the half wing's key (step_kernel.layout)
+    if model == 1 and not (key0 == params[o_key_s] and key1 == params[o_key_s + 1]):
+        va, vt_fps, vt, alpha, qbar = K.air_flow(reads, wind_down_fps, params[o_c + 1],
+                                                  params[o_c + 2])
         params[o_flow], params[o_flow + 1] = alpha, reads[3]
         params[o_flow + 2], params[o_flow + 3] = qbar, vt
         return K.NEEDS_REFRESH
@@ -101,6 +103,7 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
                            w_g)
     if status == K.NEEDS_REFRESH:
         return status
+    qbar, vt = params[o_flow + 2], params[o_flow + 3]  # the flow of t_k (step_kernel's)
     aileron = 0.5 * (reads[20] - reads[21])  # JSBSim's δa: + rolls right
     delta_s = -aileron  # the starboard surface, trailing edge down
     qv = qbar / vt
