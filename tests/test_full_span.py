@@ -327,3 +327,19 @@ def test_a_sitl_turn_shows_the_antisymmetric_modes(aircraft):
     k = np.argmax(np.abs(full["p_rad_s"]))
     assert full["modal_roll_n_m"][k] * full["p_rad_s"][k] < 0.0  # damps the roll
     assert full["tip_twist_port_rad"][k] * full["tip_twist_starboard_rad"][k] < 0.0
+
+
+def test_fly_gust_flies_both_halves_with_an_aileron_step():
+    """api.fly_gust's span and aileron step: the prototype's elastic aircraft rolls left on a
+    right-rolling aileron (its reversed aileron at 15 m/s); a bad span is one line."""
+    ac = api.load_aircraft(PROTOTYPE)
+    run = api.fly_gust(ac, gust="none", models=["coupled"], duration_s=0.6, span="full",
+                       aileron_step_deg=0.5, aileron_start_s=0.1)["coupled"]
+    assert run.meta["span"] == "full"
+    assert run.channels["aileron_rad"][-1] - run.channels["aileron_rad"][0] == pytest.approx(
+        math.radians(0.5), rel=1e-6)
+    assert run.channels["p_rad_s"][-1] < -0.05
+    with pytest.raises(InputError, match="span"):
+        api.fly_gust(ac, gust="none", models=["coupled"], duration_s=0.1, span="both")
+    with pytest.raises(InputError, match="aileron_step_deg"):
+        api.fly_gust(ac, gust="none", models=["coupled"], duration_s=0.1, aileron_step_deg=45)
