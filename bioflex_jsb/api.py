@@ -245,7 +245,8 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
              aero: str = "quasi-steady", trim: str = "rigid",
-             controller=None) -> dict[str, TimeHistory]:
+             controller=None, span: str = "half", aileron_step_deg: float | None = None,
+             aileron_start_s: float = 0.5) -> dict[str, TimeHistory]:
     """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing`` (a WingBuild or an
     Aircraft), one per model of ``models`` (``rigid``, ``coupled``, ``qsd``; None: all
     three, or ``coupled`` alone with ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and
@@ -275,9 +276,18 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
     python-control's StateSpace or an object with ``inputs``, ``outputs`` and ``step``;
     :mod:`bioflex_jsb.simulation.controller`): it reads the run's signals every step and
     commands the elevator [rad] and throttle [-] over the trim; each run has its commands
-    as channels ``ctrl_<command>`` and ``meta["controller"]``."""
+    as channels ``ctrl_<command>`` and ``meta["controller"]``.
+
+    ``span``: ``half`` (the half wing, default) or ``full`` (both halves: the antisymmetric
+    modes driven by the roll rate and the ailerons, their rolling moment to JSBSim; the
+    aircraft definition's ``[aileron]`` on the strips; channels ``asym_eta<i>``,
+    ``tip_twist_port_rad``, ``tip_twist_starboard_rad``, ``modal_roll_n_m``,
+    ``aileron_rad``; docs/lateral.md "Both halves in the co-simulation").
+    ``aileron_step_deg``: an aileron step over the trim [deg, JSBSim's (left − right)/2, +
+    rolls right, |δa| <= 30] from ``aileron_start_s`` [s] (None: none)."""
     return _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m,
-                     dt_s, recorders, aero, trim, controller)[0]
+                     dt_s, recorders, aero, trim, controller,
+                     lateral=(span, aileron_step_deg, aileron_start_s))[0]
 
 
 def _gust_text(gust) -> str:
@@ -288,7 +298,7 @@ def _gust_text(gust) -> str:
 
 
 def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m, dt_s,
-              recorders, aero, trim, controller=None):
+              recorders, aero, trim, controller=None, lateral=("half", None, 0.5)):
     """:func:`fly_gust`'s runs, the JSBSim airframe flown and the wing's build: the run's
     configuration made (and so checked) before the airframe loads."""
     if models is None:
@@ -305,16 +315,37 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
     check_recorders(recorders, config.models)
     if controller is not None:
         controller = load_controller(controller)
+    options = _lateral_options(subject, build, *lateral)
     airframe = subject.jsbsim_airframe()
     out = {}
     for model in map(str, config.models):
         recorder = (recorders or {}).get(model)
-        flown = build if config.needs_build(model) else build.model
+        flown = build if config.needs_build(model) or options else build.model
         out[model] = run_gust(airframe, flown, model, config, recorder=recorder, loads=build,
-                              controller=controller)
+                              controller=controller, **options)
         # which wing flew, as the command's runs say (plot_runs' title, a user's table)
         out[model].meta.update(wing=build.variant.name, mass_basis=build.mass_basis)
     return out, airframe, build, config.speed_m_s
+
+
+def _lateral_options(subject, build, span: str, aileron_step_deg, aileron_start_s) -> dict:
+    """run_gust's ``span``, ``aileron``, ``aileron_input`` of :func:`fly_gust`'s arguments
+    ({} for the half wing without an aileron step)."""
+    from bioflex_jsb.simulation.full_span import AileronInput, prototype_aileron
+
+    _check_choice("span", span, ("half", "full"))
+    options: dict = {}
+    if aileron_step_deg is not None:
+        deg = _real(aileron_step_deg, "aileron_step_deg [deg]")
+        if abs(deg) > 30.0:
+            raise InputError(f"aileron_step_deg must be within ±30 deg, got {deg:g}")
+        options["aileron_input"] = AileronInput("step", float(np.radians(deg)),
+                                                _real(aileron_start_s, "aileron_start_s [s]"))
+    if span == "half":
+        return options
+    aileron = (subject.aircraft.definition.aileron if subject.aircraft is not None
+               else prototype_aileron(build.variant.name))
+    return {**options, "span": "full", "aileron": aileron}
 
 
 def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:

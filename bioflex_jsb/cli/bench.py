@@ -33,7 +33,9 @@ of a figure (never negative). Timed on the process's CPU clock (a run preempted 
 work is not charged for the wait; wall-clock figures beside them in --json). Ratios, the
 figure and its groups': ratio = co-simulation / bare, logged_ratio = logged co-simulation /
 bare, log_ratio = logged / unlogged, unsteady_ratio = unsteady co-simulation / bare,
-native_ratio = native / bare, python_ratio = Python step / bare; each ratio with a bar (on a
+native_ratio = native / bare, python_ratio = Python step / bare, full_span_ratio = the
+co-simulation of both wing halves (span full: the antisymmetric modes, the ailerons) / bare;
+each ratio with a bar (on a
 quiet 2-core machine) printed against it; the logging costs [µs/step]: the rows, the section
 loads, the scene. A controller in the loop: the co-simulation with a 10-state linear
 controller (q, alpha, n_z to the elevator) and its difference from the co-simulation, and
@@ -233,6 +235,7 @@ def _print(p: dict) -> None:
             ("  logged (gust log)", "logged", "logged_ratio"),
             ("  unsteady strips", "unsteady", "unsteady_ratio"),
             ("  Python step", "python", "python_ratio"),
+            ("  both halves", "full_span", "full_span_ratio"),
             ("native XML wing", "native", "native_ratio"))
     for label, key, ratio_key in rows:
         print(f"{label:20s} {_spread(us[key], ' µs/step')}")

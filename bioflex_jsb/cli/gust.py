@@ -32,6 +32,11 @@ from bioflex_jsb.cli.common import (
     print_json,
     wing_from_args,
 )
+from bioflex_jsb.cli.lateral_options import (
+    add_lateral_arguments,
+    lateral_run_options,
+    lateral_summary,
+)
 from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
 from bioflex_jsb.simulation.run import MAX_DURATION_S
@@ -103,6 +108,7 @@ def register(sub) -> None:
                    "with --aero unsteady: rigid,coupled)")
     add_aero_arguments(p)
     add_controller_argument(p)
+    add_lateral_arguments(p)
     add_log_arguments(p)
     add_live_arguments(p)
     p.add_argument("--plot", metavar="FILE.png", default=None,
@@ -305,6 +311,8 @@ def fly(args, build, config, log=None, airframe=None):
     from bioflex_jsb.runtime.fdm import FdmError
 
     runs, stops = [], []
+    # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
+    lateral = lateral_run_options(args, build) if hasattr(args, "aileron_step") else {}
     try:
         if airframe is None:
             airframe = airframe_from_args(args)
@@ -314,11 +322,12 @@ def fly(args, build, config, log=None, airframe=None):
             recorder = log.recorder(model) if log is not None else None
             # the bar moved once a block (0.9 s of flight), not by a callback every step
             progress = None if bar is None else (lambda k, bar=bar: bar.update(k - bar.n))
+            wing = build if config.needs_build(model) or lateral.get("span") == "full" \
+                else build.model
             try:
-                run = run_gust(airframe, build if config.needs_build(model) else build.model,
-                               model, config, progress=progress, recorder=recorder,
-                               loads=build,
-                               controller=getattr(args, "controller_object", None))
+                run = run_gust(airframe, wing, model, config, progress=progress,
+                               recorder=recorder, loads=build,
+                               controller=getattr(args, "controller_object", None), **lateral)
             finally:
                 close_bar(bar)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
@@ -394,6 +403,8 @@ def run(args: argparse.Namespace) -> int:
             "summary": summary,
             "diverged": [r.model for r in runs if r.stopped is not None],
             "controller": runs[0].meta.get("controller") if runs else None,
+            "lateral": {r.model: lateral_summary(r) for r in runs
+                        if r.meta.get("span") == "full"},
             "stopped": stops,
             "plot": plot,
             "out": args.out,
@@ -410,6 +421,14 @@ def run(args: argparse.Namespace) -> int:
                       f"deg/s, |r| {math.degrees(lateral['peak_r_rad_s']):.2f} deg/s, |phi| "
                       f"{math.degrees(lateral['peak_phi_rad']):.2f} deg, |beta| "
                       f"{math.degrees(lateral['peak_beta_rad']):.2f} deg")
+            if r.meta.get("span") == "full":
+                lat = lateral_summary(r)
+                print(f"{r.model}: both halves: roll rate {lat['p_min_deg_s']:+.2f} .. "
+                      f"{lat['p_max_deg_s']:+.2f} deg/s, bank {lat['phi_min_deg']:+.2f} .. "
+                      f"{lat['phi_max_deg']:+.2f} deg, tip twist starboard "
+                      f"{lat['tip_twist_starboard_max_abs_deg']:.3f}, port "
+                      f"{lat['tip_twist_port_max_abs_deg']:.3f} deg (largest), elastic "
+                      f"rolling moment {lat['modal_roll_max_abs_n_m']:.4g} N m")
         if plot:
             print(f"time histories written to {plot}")
         if args.out:

@@ -94,6 +94,11 @@ def register(sub) -> None:
                    help="the coupled wing's strips: quasi-steady (the paper's, default) or "
                    "unsteady (Jones lag states, apparent mass, Kuessner gust; --model "
                    "coupled, --trim rigid); both on the compiled step")
+    p.add_argument("--span", choices=("half", "full"), default="half",
+                   help="half (the half wing's symmetric modes, default) or full (both "
+                   "halves: the antisymmetric modes driven by the roll rate and the ailerons "
+                   "the autopilot flies in its turns, their rolling moment to JSBSim; "
+                   "quasi-steady strips; docs/lateral.md)")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
@@ -155,6 +160,8 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.cli.gust import controller_from_args
 
     controller = controller_from_args(args)  # a bad file: one line before the trim
+    from bioflex_jsb.cli.lateral_options import span_options
+
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     try:
         airframe, speeds = _airframe(args, home[2] + args.start_height)
@@ -162,7 +169,8 @@ def run(args: argparse.Namespace) -> int:
                       home=home, start_height_m=args.start_height, speedup=args.speedup,
                       trim_mode=args.trim, aero=args.aero, airframe=airframe,
                       controller=controller,
-                      **({} if speeds is None else {"airspeed_range_m_s": speeds}))
+                      **({} if speeds is None else {"airspeed_range_m_s": speeds}),
+                      **span_options(args, build))
     except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing,
         raise UsageError(str(exc)) from None  # a home out of range
     try:

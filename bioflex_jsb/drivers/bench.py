@@ -91,7 +91,8 @@ LENGTH_SCALE = {"unsteady": 4}
 MAX_RESIDUAL = 0.10
 MAX_DISAGREEMENT = 0.25
 # The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step.
-BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2}
+BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2,
+        "full_span_ratio": 1.6}
 CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
 LOGS = (None, "rows", "loads", "gust")  # StepBench.cosim's logs
 # figure → (numerator, denominator) configurations
@@ -100,7 +101,8 @@ RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
           "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare"),
           # sensor stations and controllers, against the co-simulation without them
           "sensors_ratio": ("sensors", "cosim"), "controlled_ratio": ("controlled", "cosim"),
-          "sensed_controlled_ratio": ("sensed_controlled", "cosim")}
+          "sensed_controlled_ratio": ("sensed_controlled", "cosim"),
+          "full_span_ratio": ("full_span", "bare")}
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
@@ -367,6 +369,14 @@ class StepBench:
     def close(self) -> None:
         self._tmp.cleanup()
 
+    def _aileron(self):
+        """The wing variant's aileron (its shipped definition's), looked up once."""
+        if not hasattr(self, "_aileron_surface"):
+            from bioflex_jsb.simulation.full_span import prototype_aileron
+
+            self._aileron_surface = prototype_aileron(self.build.variant.name)
+        return self._aileron_surface
+
     def bare(self, n: int) -> tuple[float, float]:
         """``n`` steps of JSBSim alone (trimmed first, outside the timing)."""
         self.airframe.trim(self.speed_m_s)
@@ -388,7 +398,8 @@ class StepBench:
 
     def cosim(self, n: int, gust: str = "sharp:0.3", log: str | None = None,
               compiled: bool = True, aero: str = "quasi-steady",
-              controller=None, sensors: bool = False) -> tuple[float, float]:
+              controller=None, sensors: bool = False,
+              span: str = "half") -> tuple[float, float]:
         """A co-simulated run of ``n`` steps (the coupled wing) through ``gust``, starting
         at half the shortest run; ``aero`` the strips; ``log``: None (no log, no section
         loads), ``"rows"`` (an MCAP log of the run's rows), ``"loads"`` (and the section
@@ -411,15 +422,16 @@ class StepBench:
                 wing_variant=self.build.variant.as_dict(),
                 overrides=dict(self.build.model.coefficients.overrides),
                 scene=GUST_SCENE_EXAGGERATION if log == "gust" else None)
-        wing = self.build if aero == "unsteady" else self.build.model
+        wing = self.build if aero == "unsteady" or span == "full" else self.build.model
         stations = bench_sensors(self.build) if sensors else None
+        full = {} if span == "half" else {"span": span, "aileron": self._aileron()}
         try:
             c0, w0 = _clocks()
             run = run_gust(self.airframe, wing, "coupled", setup, trim=trim,
                            recorder=run_log.recorder("coupled") if run_log else None,
                            compiled=compiled,
                            loads=self.build if log in ("loads", "gust") else None,
-                           controller=controller, sensors=stations)
+                           controller=controller, sensors=stations, **full)
             if run_log is not None:  # closing writes the last chunks: part of the log's cost
                 run_log.close()
                 run_log = None
@@ -446,6 +458,7 @@ class StepBench:
             "sensors": lambda n: self.cosim(n, sensors=True),
             "sensed_controlled": lambda n: self.cosim(
                 n, sensors=True, controller=bench_controller(signals=SENSOR_CONTROLLER_SIGNALS)),
+            "full_span": lambda n: self.cosim(n, span="full"),
         }
         for g in gusts:
             if g != "sharp:0.3":  # that one is "cosim"

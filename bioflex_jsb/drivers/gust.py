@@ -165,6 +165,9 @@ def run_gust(
     progress: Callable[[int], None] | None = None,
     sensors: Sensors | SensorSet | None = None,
     controller=None,
+    span: str = "half",
+    aileron=None,
+    aileron_input=None,
 ) -> TimeHistory:
     """Trim, then fly ``setup`` (a :class:`~bioflex_jsb.simulation.run_config.RunConfig`)
     with the wing ``model`` (rigid/coupled/qsd, or native for an aircraft with the wing in
@@ -215,6 +218,14 @@ def run_gust(
     state starts at the trim): every step it reads the row's signals and commands the
     elevator and throttle over the trim; the history has its commands as channels
     ``ctrl_<command>`` and ``meta["controller"]`` says what it was.
+
+    ``span``: ``half`` (the half wing, default) or ``full`` (both halves: the antisymmetric
+    modes too, ``wing`` a WingBuild; :mod:`bioflex_jsb.simulation.full_span`, its channels
+    ``asym_eta<i>``, ``tip_twist_port_rad`` …), ``aileron`` its
+    :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface` (the definition's
+    ``[aileron]``; None: none on the strips); ``aileron_input`` an
+    :class:`~bioflex_jsb.simulation.full_span.AileronInput` (a step or doublet of JSBSim's
+    aileron over the trim, ``meta["aileron_input"]``) or None.
     """
     if keep not in KEEP_CHOICES:
         raise ValueError(f"keep must be one of {', '.join(KEEP_CHOICES)}, not {keep!r}")
@@ -226,7 +237,8 @@ def run_gust(
     sensor_set = _sensor_set(sensors, build, wing)
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
-                       trim_mode=trim_mode, sensors=sensor_set, controller=controller)
+                       trim_mode=trim_mode, sensors=sensor_set, controller=controller,
+                       span=span, aileron=aileron)
     refused = True
     try:
         stream, loads_meta = _load_stream(loads, step, model, setup.speed_m_s, aero)
@@ -236,8 +248,12 @@ def run_gust(
             step.release()
     keep_all = keep == "all" or (keep == "auto" and setup.duration_s <= KEEP_ALL_MAX_S)
     run = _GustRun(step, setup, stream, loads_meta, recorder, keep_all, build)
+    run.inputs = _aileron_changes(step, aileron_input)
     run.fly(airframe, on_sample, progress)
     history = run.history(model, trim_mode, build)
+    if aileron_input is not None:
+        history.meta["aileron_input"] = aileron_input.as_dict()
+    history.meta["span"] = span
     if sensor_set is not None:
         history.meta["sensors"] = sensor_set.describe()
     return history
@@ -285,12 +301,15 @@ class _GustRun:
         block = max(1, int(round(WINDOW_S / dt)))
         self.loads_out = None  # the recorder's loads topic
         self.control_out = None  # the recorder's controller topic
+        self.lateral_out = None  # the recorder's antisymmetric wing's topic (span full)
         if recorder is not None:
             block = max(1, int(recorder.start(names, dt)))
             if stream is not None and hasattr(recorder, "loads"):
                 self.loads_out = recorder.loads(loads_meta["loads"])
             if step.control is not None and hasattr(recorder, "controller"):
                 self.control_out = recorder.controller(names, controller_meta(step.control))
+            if step.lateral is not None and hasattr(recorder, "lateral"):
+                self.lateral_out = recorder.lateral(names)  # both wing halves
         self.block = min(block, max(self.n_steps, 1))
         load_names = self.load_names = stream.names if stream is not None else ()
         self.loads_table = None
@@ -310,6 +329,7 @@ class _GustRun:
         self.k = 0  # steps handed over
         self.stopped: str | None = None
         self.interrupted = False
+        self.inputs = None  # (set(value), {step: value}) of an aileron input
 
     def hand_loads(self, time_s: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
         """Rows whose loads are known (one behind the steps): to the loads topic, the
@@ -336,6 +356,8 @@ class _GustRun:
             self.recorder.rows(time_s, rows)
             if self.control_out is not None:
                 self.control_out.rows(time_s, rows)
+            if self.lateral_out is not None:
+                self.lateral_out.rows(time_s, rows)
         if self.stream is not None:
             known = self.stream.add(time_s, rows)
             if last:
@@ -370,6 +392,8 @@ class _GustRun:
         SIGTERM keeps what was flown; every complete step reaches the recorder however the
         run ends."""
         advance_into = self.step.stepper()  # the step, bound once (compiled or Python)
+        if self.inputs is not None:  # an aileron input: its commands at their steps
+            advance_into = _with_inputs(advance_into, self.step, *self.inputs)
         gust_loads = self.gust_loads
         if gust_loads is not None:
             advance_into = with_gust_loads(advance_into, self.step, gust_loads)
@@ -410,6 +434,8 @@ class _GustRun:
                     self.loads_out.stop()
                 if self.control_out is not None:
                     self.control_out.stop()
+                if self.lateral_out is not None:
+                    self.lateral_out.stop()
             finally:
                 if self.recorder is not None:
                     self.recorder.stop(self.k)  # also when the loop failed: every step kept
@@ -472,6 +498,30 @@ class _GustRun:
             },
             stopped=stopped,
         )
+
+
+def _aileron_changes(step: CoupledStep, aileron_input):
+    """(the aileron's writer, {step: δa over the trim [rad]}) of ``aileron_input``, or None."""
+    if aileron_input is None:
+        return None
+    from bioflex_jsb.runtime.aileron_input import aileron_setter
+
+    set_angle, _ = aileron_setter(step.airframe)
+    return set_angle, aileron_input.changes(step.dt_s)
+
+
+def _with_inputs(advance_into, step: CoupledStep, set_value, changes: dict[int, float]):
+    """``advance_into`` writing each scheduled command before its step (steps flown:
+    ``step.k``)."""
+    get = changes.get
+
+    def stepped(w_g_m_s: float, table: np.ndarray, k: int, *p_g):
+        value = get(step.k)
+        if value is not None:
+            set_value(value)
+        return advance_into(w_g_m_s, table, k, *p_g)  # p_g: a full-span step's gust roll
+
+    return stepped
 
 
 def _load_stream(loads, step: CoupledStep, model: str, speed_m_s: float, aero: str

@@ -392,7 +392,8 @@ class SitlSim:
                  speedup: float = 1.0, airframe: Airframe | None = None,
                  trim_mode: str = "rigid", aero: str = "quasi-steady",
                  airspeed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S,
-                 sensors: Sensors | None = None, controller=None) -> None:
+                 sensors: Sensors | None = None, controller=None, span: str = "half",
+                 aileron=None) -> None:
         """``wing_model``: the ElasticWingModel, or the WingBuild (needed for
         ``trim_mode="elastic"``: the session starts from the static aeroelastic equilibrium,
         :class:`~bioflex_jsb.runtime.coupled_step.CoupledStep`'s ``trim_mode``; and for
@@ -413,7 +414,11 @@ class SitlSim:
         :mod:`bioflex_jsb.runtime.control_surfaces`, "Over an autopilot"), in every mode
         (MANUAL too: it adds to the sticks); its commands are channels of the rows
         (``ctrl_<command>``); a reset binds it anew (a linear controller's state back to 0,
-        a Python one's ``reset`` called)."""
+        a Python one's ``reset`` called). ``span``: ``half`` or ``full`` (both wing halves,
+        ``wing_model`` the WingBuild: the antisymmetric modes driven by the roll rate and the
+        ailerons the autopilot flies, ``aileron`` their surface;
+        :mod:`bioflex_jsb.simulation.full_span`)."""
+        self.span, self.aileron = span, aileron
         check_home(*home, start_height_m)
         self.trim_mode = trim_mode
         self.aero = aero
@@ -498,13 +503,14 @@ class SitlSim:
 
         elastic = self.trim_mode == "elastic" and model != "rigid"
         wing = self._wing_model
-        if not elastic and self.aero != "unsteady" and hasattr(wing, "model"):
+        if not elastic and self.aero != "unsteady" and hasattr(wing, "model") \
+                and self.span == "half":
             wing = wing.model  # a WingBuild: the model is enough for the quasi-steady strips
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
                                 trim_mode="elastic" if elastic else "rigid", aero=self.aero,
                                 sensors=self._sensor_set, controller=self._controller,
-                                over_autopilot=True)
+                                over_autopilot=True, span=self.span, aileron=self.aileron)
         self._autopilot_imu.dt_s = self.core.dt_s
         self._autopilot_imu.reset(self.core.n_modes)
         self.trim = self.core.trim
@@ -620,9 +626,12 @@ class SitlSim:
         docstring); ``self.stopped`` then says why until the next step."""
         core = self.core
         self._autopilot_imu.before_step(core.eta, core.eta_dot)
+        p_g = 0.0  # the gust's roll rate [rad/s] on both wing halves' strips (span full)
         if self._gust_loads is not None:
             self._gust_loads.apply(self.k - self._gust_start_k)
-        values = core.advance(self._w_g(self.k))
+            if core.lateral is not None:
+                p_g = self._gust_loads.roll_rate_rad_s
+        values = core.advance(self._w_g(self.k), p_g)
         self._state = None  # the snapshot of t_k+1 is read when asked for (vehicle_state)
         if core.stopped:
             self.reset(core.stopped)

@@ -50,6 +50,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
+from bioflex_jsb.runtime.full_span_step import FullSpanSteps, _check_span
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
@@ -156,7 +157,7 @@ def configure_airframe(airframe: Airframe, dt_s: float, modal_hooks: bool = True
     airframe.set_dt(dt_s)
 
 
-class CoupledStep:
+class CoupledStep(FullSpanSteps):
     """One aircraft (JSBSim airframe + modal wing) advanced one step at a time.
 
     Args:
@@ -197,6 +198,16 @@ class CoupledStep:
         over_autopilot: the airframe's own autopilot writes the elevator command inside
             JSBSim's step (the SITL aircraft): the controller's commands are added to the
             autopilot's (:mod:`bioflex_jsb.runtime.control_surfaces`, "Over an autopilot").
+        span: ``half`` (default: the half wing's symmetric modes, as the paper's) or
+            ``full``: both halves, the antisymmetric modes beside the symmetric ones driven by
+            the roll rate, JSBSim's ailerons and a gust roll rate, their rolling moment to
+            JSBSim's modal-roll (:mod:`bioflex_jsb.simulation.full_span`; needs the wing's
+            build and the quasi-steady strips); the rows gain the channels of
+            :func:`~bioflex_jsb.simulation.full_span.lateral_channel_units`.
+        aileron: the wing's aileron (a
+            :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`, the
+            definition's ``[aileron]``) for ``span="full"``; None: no aileron load on the
+            modes (the roll rate still drives them).
 
     After :meth:`advance`, ``k`` is the number of steps flown and ``stopped`` says why the
     run left its valid range (None while it is in range).
@@ -208,8 +219,10 @@ class CoupledStep:
                  before_trim: Callable[[Airframe], None] | None = None,
                  compiled: bool = True, aero: str = "quasi-steady",
                  trim_mode: str = "rigid", sensors: SensorSet | None = None,
-                 controller=None, over_autopilot: bool = False) -> None:
+                 controller=None, over_autopilot: bool = False, span: str = "half",
+                 aileron=None) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
+        _check_span(span, build, model, aero)
         native = model == "native"
         self.airframe = airframe
         self.native = native
@@ -247,6 +260,7 @@ class CoupledStep:
         self.model = model
         self.aero = aero
         self.units = channel_units(self.n_modes)
+        self.lateral = self._make_lateral(span, aileron, build, model)
         self._kin_get = None  # the readers of _kinematics, bound at its first call
         self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
@@ -270,6 +284,8 @@ class CoupledStep:
         self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
         if self.compiled:
             self._setup_kernel(nodes)
+            if self.lateral is not None:
+                self._setup_full_span_kernel()
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
         self.k = 0
         self.stopped: str | None = None
@@ -434,6 +450,8 @@ class CoupledStep:
                 self._views["model"][0] = K.MODEL_CODES[model]
                 self.wing.prepare_arrays()
                 self._fast = None  # rebind: the wing's state array was replaced
+            if self.lateral is not None:  # the antisymmetric wing switches with it
+                self._switch_lateral(model)
 
     def prepare(self, w_g_m_s: float = 0.0) -> None:
         """Compute the wing's step matrices for the flow now (the first step would do it),
@@ -443,6 +461,8 @@ class CoupledStep:
             self.wing.prepare(self._read(-w_g_m_s * U.FT_PER_M).flow)
             if self.compiled and self.wing._key is not None:
                 self._load_reference()
+        if self.lateral is not None:
+            self._prepare_lateral(w_g_m_s)
 
     def sense(self, w_g_m_s: float) -> Sensed:
         """Write the vertical gust ``w_g_m_s`` [m/s, up] to JSBSim's wind and read the
@@ -452,11 +472,13 @@ class CoupledStep:
         return self._read(wind_down_fps)
 
     # -- the step ---------------------------------------------------------------------------
-    def advance(self, w_g_m_s: float) -> tuple[float, ...]:
+    def advance(self, w_g_m_s: float, p_g_rad_s: float = 0.0) -> tuple[float, ...]:
         """Fly step k with the gust ``w_g_m_s`` [m/s, up] at t_k (module docstring); the row
-        of t_k (values in :attr:`names` order). Sets :attr:`stopped` when out of range."""
+        of t_k (values in :attr:`names` order). Sets :attr:`stopped` when out of range.
+        ``p_g_rad_s``: the gust roll rate [rad/s] the full-span wing's strips see
+        (:mod:`bioflex_jsb.aeroelasticity.antisymmetric_strips`); a half wing takes 0 only."""
         if self.compiled:
-            self.advance_into(w_g_m_s, self._scratch, 0)
+            self.advance_into(w_g_m_s, self._scratch, 0, p_g_rad_s)
             return tuple(self._scratch[0].tolist())
         t = self.k * self.dt_s
         state = self.sense(w_g_m_s)
@@ -488,6 +510,8 @@ class CoupledStep:
             self._write_reactions(loads.lift_n * ca + loads.drag_n * sa,
                                   loads.drag_n * ca - loads.lift_n * sa,
                                   loads.pitch_moment_n_m)
+            if self.lateral is not None:  # the antisymmetric wing (FullSpanSteps)
+                self._lateral_python_step(state, eta, p_g_rad_s)
             if self.control is not None:
                 if sensors is not None:  # the row of t_k with η_{k+1}, before the controller
                     sensed = sensors.row(kin, mw.eta, t)
@@ -495,10 +519,13 @@ class CoupledStep:
                                               sensed if sensors is not None else None)
             self.airframe.step()
             new_eta = mw.eta
+            if self.lateral is not None:  # both wings' η against the limit
+                new_eta = np.concatenate([new_eta, self.lateral.eta])
         if self.control is None:
             row = self._row_dict(state, w_g_m_s, loads, eta, eta_dot)
             if sensors is not None:
-                row.update(zip(sensors.channels, sensors.row(kin, new_eta, t).tolist(),
+                sym_eta = new_eta[:len(eta)]  # the symmetric modes (the sensors' wing)
+                row.update(zip(sensors.channels, sensors.row(kin, sym_eta, t).tolist(),
                                strict=True))
             values = self._row(row)
         self.sensed, self.w_g_m_s = state, w_g_m_s
@@ -543,6 +570,8 @@ class CoupledStep:
         for i in range(self.n_modes):
             row[self._eta_names[i]] = float(eta[i])
             row[self._etadot_names[i]] = float(eta_dot[i])
+        if self.lateral is not None:
+            row.update(self._lateral_row)
         return row
 
     @property
@@ -613,14 +642,19 @@ class CoupledStep:
         v["input_cols"][:] = np.ravel(mw._input_cols)
         v["key"][:] = mw._key
 
-    def advance_into(self, w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+    def advance_into(self, w_g_m_s: float, table: np.ndarray, k: int,
+                     p_g_rad_s: float = 0.0) -> str | None:
         """Fly step k as :meth:`advance` does, writing its row into ``table[k]`` (a run's
         table, channel order); returns :attr:`stopped`."""
+        if p_g_rad_s and self.lateral is None:
+            raise InputError("a gust roll rate needs both wing halves (span='full')")
         if not self.compiled:
-            table[k] = self.advance(w_g_m_s)
+            table[k] = self.advance(w_g_m_s, p_g_rad_s)
             return self.stopped
         if self._fast is None:
             self._fast = self._bind_sensing()
+        if p_g_rad_s:
+            return self._fast(w_g_m_s, table, k, p_g_rad_s)
         return self._fast(w_g_m_s, table, k)
 
     def stepper(self):
@@ -659,19 +693,19 @@ class CoupledStep:
 
             fast = self._bind_fast_step(sense)
 
-            def fast_before(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+            def fast_before(w_g_m_s: float, table: np.ndarray, k: int, *p_g) -> str | None:
                 hold()
-                return fast(w_g_m_s, table, k)
+                return fast(w_g_m_s, table, k, *p_g)
 
             return fast_before
         fast = self._bind_fast_step()
 
-        def fast_sensing(w_g_m_s: float, table: np.ndarray, k: int) -> str | None:
+        def fast_sensing(w_g_m_s: float, table: np.ndarray, k: int, *p_g) -> str | None:
             reads = (g_fx(), g_fy(), g_fz(), g_mass(), g_pd(), g_qd(), g_rd(), g_u(), g_v(),
                      g_w(), g_theta(), g_phi(), g_p(), g_q(), g_r())  # x_k, before the step
             hold()
             t_s = self.k * dt
-            stopped = fast(w_g_m_s, table, k)
+            stopped = fast(w_g_m_s, table, k, *p_g)  # p_g: a full-span step's gust roll rate
             write(reads, -w_g_m_s * ft_per_m, table, k, t_s)
             return stopped
 
@@ -693,6 +727,8 @@ class CoupledStep:
         bound once (each attribute lookup saved is ~40 ns of a ~10 µs step);
         ``before_control`` ``(table, k)``: called before the controller, after the wing's
         step (the sensor channels it reads: :meth:`_bind_sensing`)."""
+        if self.lateral is not None:  # both halves: the full-span kernel (FullSpanSteps)
+            return self._bind_full_span_step(before_control)
         params, cols = self._params, self._cols
         x = self.wing._x  # updated in place by the kernel
         # the snapshot's readers as locals, called in one tuple literal: the cheapest way
@@ -758,8 +794,11 @@ class CoupledStep:
 
     def _renew_reference(self) -> None:
         """The flow moved beyond the wing's reference: renew it (off the hot path)."""
-        self.wing._reference(self._out_flow[2], self._out_flow[3])
-        self._load_reference()
+        if self.lateral is None or self.wing.model == "coupled":
+            self.wing._reference(self._out_flow[2], self._out_flow[3])
+            self._load_reference()
+        if self.lateral is not None:
+            self._renew_lateral(self._out_flow[2], self._out_flow[3])
 
     def release(self) -> None:
         """Leave no modal loads behind in the airframe for its next user."""

@@ -164,8 +164,18 @@ class GustLoads:
 
 def with_gust_loads(stepper, step, loads: GustLoads):
     """``stepper`` (a coupled step's ``step(w_g, table, k) -> stopped``) with ``loads``
-    written before each step, at the coupled step's own step count (``step.k``)."""
+    written before each step, at the coupled step's own step count (``step.k``). A step of
+    both wing halves (``step.lateral`` set: runtime/full_span_step.py) also takes the step's
+    gust roll rate p_g on its antisymmetric strips (their elastic increments; the rigid
+    rolling moment stays ``gust-roll``'s, so nothing is counted twice)."""
     apply = loads.apply
+    if getattr(step, "lateral", None) is not None:
+
+        def advance_full_span(w_g_m_s: float, table: np.ndarray, k: int):
+            apply(step.k)
+            return stepper(w_g_m_s, table, k, loads.last[0])
+
+        return advance_full_span
 
     def advance(w_g_m_s: float, table: np.ndarray, k: int):
         apply(step.k)

@@ -327,12 +327,14 @@ guard_cache(step_kernel)
 # run's types, skips that; it converts what it is given to those types without checking
 # them (a table of another layout is written in the wrong places, tested), so a caller
 # checks each new table once with the ``accepts`` it comes with.
-def direct_entry(dispatcher, params: np.ndarray, x: np.ndarray, cols: np.ndarray):
+def direct_entry(dispatcher, params: np.ndarray, x: np.ndarray, cols: np.ndarray,
+                 n_reads: int = len(READ_KEYS)):
     """``(entry, accepts)`` for ``dispatcher`` (:func:`step_kernel` or the unsteady wing's
     kernel, whose arguments are the same): ``entry(reads, params, x, cols, table, k,
     wind_down_fps, w_g)`` is its machine code for a snapshot of :data:`READ_KEYS` floats,
     these ``params``, ``x``, ``cols`` (checked here), a C-ordered float64 table, an int row
-    and float winds (compiled or loaded from numba's cache once); ``accepts(table)``: whether
+    and float winds (compiled or loaded from numba's cache once; ``n_reads`` floats in the
+    snapshot, the full-span kernel's more); ``accepts(table)``: whether
     ``table`` has exactly that table type (numba's own typing), else call ``dispatcher``."""
     types = tuple(numba.typeof(a) for a in (params, x, cols))
     want = (numba.typeof(np.zeros(1)), numba.typeof(np.zeros(1)),
@@ -340,7 +342,7 @@ def direct_entry(dispatcher, params: np.ndarray, x: np.ndarray, cols: np.ndarray
     if types != want:
         raise TypeError(f"the kernel's arrays must be {want}, got {types}")
     table_type = numba.typeof(np.zeros((1, 1)))
-    reads_type = numba.typeof((0.0,) * len(READ_KEYS))
+    reads_type = numba.typeof((0.0,) * n_reads)
     entry = dispatcher.compile((reads_type, *types, table_type, numba.int64, numba.float64,
                                 numba.float64))
 

@@ -39,7 +39,7 @@ from bioflex_jsb.values import is_finite_real, is_real
 # about 90 s).
 READ_MAX_STEPS = 1_000_000
 STEP_GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "location",
-               "controller")
+               "controller", "lateral")
 REFERENCE_GROUPS = ("rigid_body", "lti_prediction")  # their messages are the run's steps
 LOADS_GROUP = "loads"
 RESAMPLED = "linear in time between the 60 Hz location samples (docs/logging.md)"
@@ -93,6 +93,12 @@ def _values(group: str, msg: dict, topic: str, ns: int) -> dict[str, float]:
         values = {c: _number(msg, f, topic, ns) for c, f in (
             ("ctrl_elevator_rad", "elevator_cmd_rad"), ("ctrl_throttle", "throttle_cmd"))}
         return {c: v for c, v in values.items() if not math.isnan(v)}
+    if group == "lateral":  # a full-span run's antisymmetric wing (lateral_topic.py)
+        out = {f: _number(msg, f, topic, ns) for f in (
+            "aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad", "tip_twist_port_rad")}
+        out.update(_indexed(msg, "asym_eta_rad", "asym_eta{}", topic, ns))
+        out.update(_indexed(msg, "asym_eta_dot_rad_s", "asym_eta{}_dot", topic, ns))
+        return out
     fields = {"modal_loads": ("lift_n", "drag_n", "pitch_moment_n_m"),
               "controls": ("elevator_rad", "throttle")}[group]
     return {f: _number(msg, f, topic, ns) for f in fields if f in msg}

@@ -451,6 +451,13 @@ class TableRecorder:
         return ControllerTopic(self._log._writer, self._log.schema_id(GROUP), self._model,
                                names, meta)
 
+    def lateral(self, names):
+        """A full-span run's antisymmetric wing on ``/bioflex/<model>/lateral`` (``names``:
+        the run's channels), a chunk per block after the steps' (:mod:`.lateral_topic`)."""
+        from bioflex_jsb.sinks.mcap.lateral_topic import GROUP, LateralTopic
+
+        return LateralTopic(self._log._writer, self._log.schema_id(GROUP), self._model, names)
+
     def loads(self, layout: dict):
         """The run's section loads on ``/bioflex/<model>/loads`` (``layout``: the run's
         ``meta["loads"]``), a chunk per block after the steps' (:mod:`.loads_topic`)."""

@@ -13,7 +13,7 @@ FRAME_METADATA = "bioflex.world_frame"
 WORLD_FRAME = "world"
 GROUPS = ("rigid_body", "modal", "modal_loads", "gust", "controls", "pose", "location",
           "lti_prediction", "autopilot", "loads", "imu", "airspeed_probe",
-          "controller")
+          "controller", "lateral")
 # The sensor stations' topics (docs/aircraft.md, "Sensors"): one per IMU, one per airspeed
 # probe, named by the sensor (topic(model, sensor_group(kind, name)))
 # The autopilot topic's enums: (JSON schema / protobuf enum name, value names from 0); the
@@ -318,6 +318,32 @@ SCHEMAS["controller"] = {
                     "description": "the signals it read at the step, element i the channel "
                     "metadata's signals[i], as the run's channels (SI; a linear controller "
                     "reads their perturbations from the trim values in the metadata)"},
+    },
+}
+# The antisymmetric wing of a full-span run (bioflex_jsb.sinks.mcap.lateral_topic;
+# bioflex_jsb.simulation.full_span), every step
+SCHEMAS["lateral"] = {
+    "title": "bioflex.Lateral",
+    "description": "Both wing halves (a full-span run, bioflex_jsb.simulation.full_span), "
+    "one message per step at the step's log time, in chunks of their own after the steps': "
+    "the aileron JSBSim flew, the elastic rolling moment applied over the step, the tip "
+    "twist of each half and the antisymmetric modal state.",
+    "type": "object",
+    "properties": {
+        "aileron_rad": _num("JSBSim's aileron, (left - right)/2 of the surfaces' angles, "
+                            "positive rolling right [rad]"),
+        "modal_roll_n_m": _num("the antisymmetric deformation's rolling moment applied to "
+                               "the airframe (JSBSim's modal-roll), right wing down "
+                               "positive [N*m]"),
+        "tip_twist_starboard_rad": _num("starboard tip twist, symmetric plus antisymmetric "
+                                        "modes, leading edge up positive [rad]"),
+        "tip_twist_port_rad": _num("port tip twist, symmetric minus antisymmetric modes, "
+                                   "leading edge up positive [rad]"),
+        "asym_eta_rad": {"type": "array", "items": {"type": "number"},
+                         "description": "antisymmetric modal coordinates eta_a (starboard "
+                         "tip twist positive) [rad]"},
+        "asym_eta_dot_rad_s": {"type": "array", "items": {"type": "number"},
+                               "description": "their rates [rad/s]"},
     },
 }
 # The LTI model's section loads on its prediction topic, under the loads topic's field names

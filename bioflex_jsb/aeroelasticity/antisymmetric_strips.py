@@ -1,0 +1,170 @@
+"""The antisymmetric modes' quasi-steady strips per unit flow, with the ailerons on them:
+what the nonlinear co-simulation's full-span step (:mod:`bioflex_jsb.simulation.full_span`)
+and the linear lateral model with ailerons (:func:`lateral_elastic_with_aileron`) share.
+
+The strips, modes and signs are those of :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`
+(:func:`~bioflex_jsb.flight_dynamics.lateral_elastic.strip_terms` divided by Q or Q/V: the
+same arithmetic, tested to 1e-12): the starboard strip at y sees
+
+    Δα = Σ θ_i η_i + Σ φ_i η̇_i / V + (p − p_g) y / V,
+
+carries the lift l = Q C_lα c Δα (up) and, where the aileron covers the part χ of it, the flap
+lift Q c χ c_lδ (a₀/2π) δ_s and the quarter-chord moment Q c² χ c_mδ δ_s (thin aerofoil:
+:mod:`~bioflex_jsb.aeroelasticity.control_surface`, the section of
+:func:`~bioflex_jsb.aeroelasticity.aileron.flight_roll_strips`); the port strip carries the
+opposite. δ_s [rad] is the starboard surface's angle in the antisymmetric sense, trailing edge
+down: δ_s = ½ (δ_right − δ_left) = −δa, δa JSBSim's aileron (½ (left − right), + rolls
+right); the symmetric part ½ (δ_left + δ_right) (a differential aileron's, flaperons) loads
+the symmetric modes and is left out.
+
+**The gust roll rate p_g** [rad/s]: the antisymmetric part of a spanwise-varying vertical
+gust, w_g(y) = −p_g y (w_g up, y to starboard: the port wing meets rising air, the starboard
+wing sinking air, for p_g > 0), which the strip sees as Δα = −p_g y / V: a gust roll rate
+p_g acts on the strips as the aircraft's own roll rate −p_g would (the standard models' p_g,
+MIL-F-8785C / MIL-HDBK-1797's p_g = ∂w_g/∂y with w_g down, in this sign: a positive p_g
+rolls the aircraft right, the way p is positive).
+
+Per unit flow (module of :class:`AntisymmetricStrips`): the generalised force on mode i
+(the virtual work of the half aircraft, whose generalised mass m_i is, Table B1's)
+
+    Q_i = Q [Σ_j F^η_ij η_j + F^δ_i δ_s] + (Q/V) [Σ_j F^η̇_ij η̇_j + F^p_i (p − p_g)]
+
+and the rolling moment of the **deformation's** lift on both halves (about body x, right
+wing down positive: a lift up at y > 0 rolls left)
+
+    ΔL = Q Σ_i R^η_i η_i + (Q/V) Σ_i R^η̇_i η̇_i,    R = −2 ∫₀^{b/2} (lift per unit) y dy.
+
+The rigid wing's own roll damping (the (p − p_g) y/V lift) and the aileron's own lift are
+**not** in ΔL: JSBSim's rigid tables carry them (C_lp p̂ and C_lδa δa), so only the
+deformation's increment goes to JSBSim; the aileron's loss of effectiveness is that
+increment, the twist the aileron's hinge moment and lift put into the modes (F^δ) times the
+lift it costs (R^η). The gust's rigid rolling moment (−C_lp p_g b/(2V) on the rigid wing) is
+the gust's imposer's to add, not this module's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bioflex_jsb.aerodynamics.theodorsen import TWO_PI
+from bioflex_jsb.aeroelasticity.control_surface import (
+    ControlSurface,
+    flap_lift_slope_per_rad,
+    flap_moment_slope_per_rad,
+    strip_coverage,
+)
+from bioflex_jsb.flight_dynamics.lateral_elastic import AntisymmetricWing
+from bioflex_jsb.state_space import StateSpace
+
+
+@dataclass(frozen=True, eq=False)
+class AntisymmetricStrips:
+    """The antisymmetric modes and their strips per unit flow (module docstring).
+
+    ``omega_rad_s``, ``zeta``, ``mass_kg_m2`` (n,) the modes' ω, ζ, generalised mass (half
+    aircraft); per unit Q [Pa]: ``force_eta`` (n, n) [N·m/Pa per rad], ``force_delta`` (n,)
+    [N·m/Pa per rad of δ_s], ``roll_eta`` (n,) [N·m/Pa per rad]; per unit Q/V [Pa·s/m]:
+    ``force_etadot`` (n, n), ``force_p`` (n,), ``roll_etadot`` (n,) [N·m/(Pa·s/m) per rad/s];
+    ``tip_twist_rad`` (n,) the starboard tip's twist per unit η_i [rad, leading edge up];
+    ``surface`` the aileron (None: no aileron on the strips, F^δ = 0)."""
+
+    omega_rad_s: np.ndarray
+    zeta: np.ndarray
+    mass_kg_m2: np.ndarray
+    force_eta: np.ndarray
+    force_etadot: np.ndarray
+    force_p: np.ndarray
+    force_delta: np.ndarray
+    roll_eta: np.ndarray
+    roll_etadot: np.ndarray
+    tip_twist_rad: np.ndarray
+    surface: ControlSurface | None = None
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.omega_rad_s.size)
+
+    def a_matrix(self, q_pa: float, q_over_v: float) -> np.ndarray:
+        """The continuous (2n × 2n) matrix of [η, η̇] at Q [Pa] and Q/V [Pa·s/m]."""
+        n, m = self.n_modes, self.mass_kg_m2[:, None]
+        a = np.zeros((2 * n, 2 * n))
+        a[:n, n:] = np.eye(n)
+        a[n:, :n] = -np.diag(self.omega_rad_s**2) + q_pa * self.force_eta / m
+        a[n:, n:] = -np.diag(2.0 * self.zeta * self.omega_rad_s) + q_over_v * self.force_etadot / m
+        return a
+
+    def forcing_columns(self) -> np.ndarray:
+        """(2n × 2) the η̈ rows per unit of the inputs (Q δ_s, (Q/V)(p − p_g))."""
+        n = self.n_modes
+        b = np.zeros((2 * n, 2))
+        b[n:, 0] = self.force_delta / self.mass_kg_m2
+        b[n:, 1] = self.force_p / self.mass_kg_m2
+        return b
+
+    def quasi_static_eta(self, q_pa: float, q_over_v: float, delta_s_rad: float,
+                         relative_roll_rad_s: float) -> np.ndarray:
+        """η [rad] balancing the flow with η̇ = η̈ = 0: (diag(m ω²) − Q F^η) η = Q F^δ δ_s +
+        (Q/V) F^p (p − p_g)."""
+        k = np.diag(self.mass_kg_m2 * self.omega_rad_s**2) - q_pa * self.force_eta
+        rhs = q_pa * self.force_delta * delta_s_rad + q_over_v * self.force_p * relative_roll_rad_s
+        return np.linalg.solve(k, rhs)
+
+
+def antisymmetric_strips(wing: AntisymmetricWing, surface: ControlSurface | None,
+                         chord_m: np.ndarray) -> AntisymmetricStrips:
+    """:class:`AntisymmetricStrips` of ``wing`` (its strips, modes; lateral_elastic's) with
+    ``surface`` on them (None: no aileron) and the strips' chords ``chord_m`` [m] (the
+    lattice's, ``build.aero.chord_m``)."""
+    w, y = wing.weights_m, wing.stations_m
+    chord = np.asarray(chord_m, dtype=float)
+    if chord.shape != y.shape:
+        raise ValueError(f"chord_m has {chord.size} strips, the wing {y.size}")
+    clac_w = wing.cl_alpha_c_m * w  # lift of a strip per rad of Δα per Pa [m]
+    work = wing.e_m * wing.theta - wing.phi  # (n, K) upward AC displacement per unit η
+    if surface is None:
+        force_delta = np.zeros(wing.n_modes)
+    else:
+        chi = strip_coverage(w, surface)
+        # flap lift per Pa per rad [m]: c χ c_lδ a₀/2π = χ C_lα c c_lδ/2π (flight_roll_strips)
+        lift_delta = chi * wing.cl_alpha_c_m * flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+        moment_delta = chord**2 * chi * flap_moment_slope_per_rad(surface.hinge)  # [m²]
+        force_delta = (w * (lift_delta * work + moment_delta * wing.theta)).sum(axis=1)
+    modes = wing.modes
+    return AntisymmetricStrips(
+        omega_rad_s=np.asarray(modes.frequencies_rad_s, dtype=float),
+        zeta=np.asarray(modes.damping_ratios, dtype=float),
+        mass_kg_m2=np.asarray(modes.generalised_masses_kg_m2, dtype=float),
+        force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, clac_w),
+        force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, clac_w),
+        force_p=work @ (clac_w * y),
+        force_delta=force_delta,
+        roll_eta=-2.0 * (wing.theta * clac_w) @ y,
+        roll_etadot=-2.0 * (wing.phi * clac_w) @ y,
+        tip_twist_rad=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
+        surface=surface)
+
+
+def lateral_elastic_with_aileron(ss: StateSpace, strips: AntisymmetricStrips,
+                                 dynamic_pressure_pa: float) -> StateSpace:
+    """The coupled lateral model ``ss`` (:func:`~bioflex_jsb.flight_dynamics.lateral_elastic
+    .build_lateral_elastic`, model ``coupled``, built on the same wing) with the aileron's
+    generalised force on the modes in its ``aileron`` column: η̈_i += −Q F^δ_i / m_i · δa
+    (δa JSBSim's aileron, δ_s = −δa), at the trim's dynamic pressure [Pa]. The rigid block's
+    aileron column (JSBSim's C_lδa) is unchanged: the model the co-simulation's full-span
+    step linearises to."""
+    if ss.model != "coupled-lateral":
+        raise ValueError(f"the aileron's load on the modes goes into the coupled lateral "
+                         f"model, not {ss.model!r}")
+    n = strips.n_modes
+    b = ss.b.copy()
+    col = ss.inputs.index("aileron")
+    first = ss.states.index("eta1_dot")
+    b[first:first + n, col] += -float(dynamic_pressure_pa) * strips.force_delta / strips.mass_kg_m2
+    notes = {**ss.notes, "aileron_on_modes": "thin-aerofoil flap lift and moment on the "
+             "lattice's strips (aeroelasticity/antisymmetric_strips.py)"}
+    return StateSpace(model=ss.model, speed_m_s=ss.speed_m_s, a=ss.a, b=b, c=ss.c, d=ss.d,
+                      states=ss.states, state_units=ss.state_units, inputs=ss.inputs,
+                      input_units=ss.input_units, outputs=ss.outputs,
+                      output_units=ss.output_units, notes=notes)

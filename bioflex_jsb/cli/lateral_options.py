@@ -1,0 +1,120 @@
+"""``gust``'s options for both wing halves: ``--span`` and an aileron step or doublet
+(docs/lateral.md, "Both halves in the co-simulation").
+
+``--aileron-step DEG`` / ``--aileron-doublet DEG``: JSBSim's aileron δa = ½ (left − right)
+[deg, + rolls right] over the trim, from ``--aileron-start`` [s] (a doublet: +DEG for
+``--aileron-width`` [s], −DEG as long, then back to the trim). An aileron input flies both
+halves unless ``--span half`` is given (then the modes stay symmetric and only JSBSim's rigid
+tables roll). The aileron's strips are the definition's ``[aileron]`` (``--aircraft``), or
+the prototype variant's shipped definition's (``--wing``); a wing without one flies its
+antisymmetric modes driven by the roll rate alone (said on stderr).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from bioflex_jsb.cli.common import UsageError, number_type
+
+AILERON_MAX_DEG = 30.0  # |δa| accepted [deg]; the flight controls clip it to their travel
+WIDTH_RANGE_S = (0.01, 10.0)  # a doublet's half width [s]
+
+HELP_SPAN = ("half (the half wing's symmetric modes, the paper's) or full (both halves: the "
+             "antisymmetric modes too, driven by the roll rate and the ailerons; their rolling "
+             "moment to JSBSim; channels asym_eta<i>, tip_twist_port_rad, "
+             "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad). Default: full with an "
+             "aileron input, else half")
+
+
+def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
+    """--span, --aileron-step, --aileron-doublet, --aileron-start, --aileron-width."""
+    p.add_argument("--span", choices=("half", "full"), default=None, help=HELP_SPAN)
+    angle = number_type("aileron angle", "deg", low=-AILERON_MAX_DEG, high=AILERON_MAX_DEG)
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--aileron-step", type=angle, default=None, metavar="DEG",
+                       help="an aileron step over the trim [deg, JSBSim's delta_a = (left - "
+                       f"right)/2, + rolls right], |DEG| <= {AILERON_MAX_DEG:g} (the surfaces "
+                       "stop at their travel), from --aileron-start")
+    group.add_argument("--aileron-doublet", type=angle, default=None, metavar="DEG",
+                       help="an aileron doublet [deg]: +DEG for --aileron-width, -DEG as long, "
+                       "then the trim's")
+    p.add_argument("--aileron-start", type=number_type("aileron start", "s", low=0.0),
+                   default=0.5, metavar="S",
+                   help="when the aileron input starts [s], before the end of --duration "
+                   "(default 0.5)")
+    p.add_argument("--aileron-width", type=number_type(
+        "aileron doublet width", "s", low=WIDTH_RANGE_S[0], high=WIDTH_RANGE_S[1]),
+        default=0.5, metavar="S", help=f"each half of the doublet [s], {WIDTH_RANGE_S[0]:g} "
+        f"to {WIDTH_RANGE_S[1]:g} (default 0.5)")
+
+
+def lateral_run_options(args, build) -> dict:
+    """run_gust's ``span``, ``aileron``, ``aileron_input`` of the arguments (only those
+    that differ from a half-wing run's: {} for one)."""
+    from bioflex_jsb.simulation.full_span import AileronInput
+
+    angle_deg = args.aileron_step if args.aileron_step is not None else args.aileron_doublet
+    span = args.span or ("full" if angle_deg is not None else "half")
+    options: dict = {}
+    if angle_deg is not None:
+        if args.aileron_start >= args.duration:
+            raise UsageError(f"--aileron-start {args.aileron_start:g} s is not before the end "
+                             f"of --duration {args.duration:g} s")
+        kind = "step" if args.aileron_step is not None else "doublet"
+        options["aileron_input"] = AileronInput(kind, math.radians(angle_deg),
+                                                args.aileron_start, args.aileron_width)
+    if span == "half":
+        return options | {"span": "half"} if options else {}
+    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
+        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
+                         "--aero unsteady")
+    return options | {"span": "full", "aileron": _aileron(args, build)}
+
+
+def span_options(args, build) -> dict:
+    """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
+    if args.span != "full":
+        return {}
+    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
+        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
+                         "--aero unsteady")
+    return {"span": "full", "aileron": _aileron(args, build)}
+
+
+def _aileron(args, build):
+    """The aileron of ``--aircraft``'s definition or of the prototype variant's (a note on
+    stderr when there is none)."""
+    from bioflex_jsb.simulation.full_span import prototype_aileron
+
+    aircraft = getattr(args, "aircraft_definition", None)
+    aileron = (aircraft.definition.aileron if aircraft is not None
+               else prototype_aileron(build.variant.name))
+    if aileron is None:
+        print(f"bioflex-jsb: note: wing {build.variant.name!r} has no [aileron]: its "
+              "antisymmetric modes are driven by the roll rate alone", file=sys.stderr)
+    return aileron
+
+
+def lateral_summary(run) -> dict[str, float]:
+    """A full-span run's lateral peaks (its history's channels): roll rate and bank
+    [deg/s, deg], the largest tip twist of each half [deg] and elastic rolling moment
+    [N·m]."""
+    import numpy as np
+
+    c = run.channels
+
+    def deg(name: str, f) -> float:
+        v = np.asarray(c[name], dtype=float)
+        return float(np.degrees(f(v))) if v.size else math.nan
+
+    moment = np.asarray(c["modal_roll_n_m"], dtype=float)
+    return {
+        "p_min_deg_s": deg("p_rad_s", np.min), "p_max_deg_s": deg("p_rad_s", np.max),
+        "phi_min_deg": deg("phi_rad", np.min), "phi_max_deg": deg("phi_rad", np.max),
+        "tip_twist_starboard_max_abs_deg": deg("tip_twist_starboard_rad",
+                                               lambda v: np.max(np.abs(v))),
+        "tip_twist_port_max_abs_deg": deg("tip_twist_port_rad", lambda v: np.max(np.abs(v))),
+        "modal_roll_max_abs_n_m": float(np.max(np.abs(moment))) if moment.size else math.nan,
+    }
