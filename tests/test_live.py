@@ -155,10 +155,12 @@ def free_port() -> int:
 NEEDS_SDK = pytest.mark.skipif(importlib.util.find_spec("foxglove") is None,
                                reason="foxglove-sdk (bioflex-jsb[live]) is not installed")
 
-# Wall-time bounds [s]: a command starts (imports, wing build, trim) in 3-10 s on this
-# shared 2-core machine at load 4-6 (measured); the bounds are ~10x that, only so that a
-# hang ends the test instead of the suite.
-START_S = 120.0
+# Wall-time bounds [s], only so that a hang ends the test instead of the suite: a command
+# starts (imports, wing build, trim) in 3-10 s on this shared 2-core machine at load 4-6
+# with the compiled kernel cached, but a fresh CI venv compiles it first, with the other
+# test worker compiling too: the ardupilot session's start-up took ~120 s there (CI run of
+# dc059eb). They are not speed bars.
+START_S = 600.0
 RUN_S = 300.0
 LIVE_LINE = re.compile(r"live view on ws://127\.0\.0\.1:(\d+) ")
 

@@ -96,21 +96,26 @@ class DaskExecutor:
                     scheduler_kwargs={"allowed_failures": 1},
                 )
             self.client = Client(self.cluster)
-        self._warm_up()
         return self
 
     def _warm_up(self) -> None:
-        """Import the simulation on every worker now (as the local forkserver does), which
-        also fails early, in one line, on workers that cannot import bioflex-jsb. The rest
-        of what a case needs and the compiled kernel load with a worker's first case, as
-        they would here: a Dask worker is a process of its own, nothing is shared by a fork
-        (and a scheduler lost during a long warm-up here would be reported as a worker that
-        cannot import)."""
+        """Import the simulation on every worker before the first case (as the local
+        forkserver does), which also fails early, in one line, on workers that cannot
+        import bioflex-jsb (:class:`DaskUnavailable`, a usage error). The rest of what a case
+        needs and the compiled kernel load with a worker's first case, as they would here:
+        a Dask worker is a process of its own, nothing is shared by a fork. A scheduler lost
+        during the warm-up stops the sweep like one lost later (:class:`RecordingError`):
+        its connection error is an OSError too, and is not the worker's environment."""
         import importlib
+
+        from distributed.comm.core import CommClosedError
 
         try:
             for module in WORKER_IMPORTS:
                 self.client.run(importlib.import_module, module)
+        except (CommClosedError, TimeoutError) as exc:
+            raise RecordingError(f"lost the Dask scheduler {self._address()} (before the "
+                                 f"first case: {type(exc).__name__})") from None
         except (ImportError, OSError) as exc:  # the worker's environment, in one line
             self.close()
             raise DaskUnavailable(f"the Dask workers cannot import {module}: "
@@ -141,6 +146,7 @@ class DaskExecutor:
         from distributed import wait
         from distributed.scheduler import KilledWorker
 
+        self._warm_up()
         token = uuid.uuid4().hex[:8]
         pending = iter(cases)
         exhausted = False
