@@ -132,6 +132,10 @@ def test_root_locus_speed_labels_keep_apart_and_coinciding_models_are_named(tmp_
     assert min(gaps) >= LABEL_CLEARANCE_PX  # the phugoid zoom crowds at high speed
     notes = [t.get_text() for t in ax_ph.texts if "agree" in t.get_text()]
     assert notes and "coupled and QSD" in notes[0], [t.get_text() for t in ax_ph.texts]
+    # which rigid block the models have (their phugoid is not JSBSim's): on the figure
+    foot = " ".join(t.get_text() for t in fig.texts)
+    assert "rigid block of every model here: analytic (Table B2" in foot, foot
+    assert "not JSBSim's" in foot, foot
 
 
 def _flight_run(seconds: float = 20.0) -> TimeHistory:
