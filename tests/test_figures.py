@@ -132,6 +132,10 @@ def test_root_locus_speed_labels_keep_apart_and_coinciding_models_are_named(tmp_
     assert min(gaps) >= LABEL_CLEARANCE_PX  # the phugoid zoom crowds at high speed
     notes = [t.get_text() for t in ax_ph.texts if "agree" in t.get_text()]
     assert notes and "coupled and QSD" in notes[0], [t.get_text() for t in ax_ph.texts]
+    # which rigid block the models have (their phugoid is not JSBSim's): on the figure
+    foot = " ".join(t.get_text() for t in fig.texts)
+    assert "rigid block of every model here: analytic (Table B2" in foot, foot
+    assert "not JSBSim's" in foot, foot
 
 
 def _flight_run(seconds: float = 20.0) -> TimeHistory:
@@ -176,6 +180,30 @@ def test_a_flight_figure_has_the_flight_the_track_and_the_events(captured):
     foot = " ".join(t.get_text() for t in fig.texts)
     assert "1: t = 2.0 s Mode LOITER; at once" in foot and "2: t = 12.0 s" in foot, foot
     assert " x" not in foot.split("events:")[1].split("\n")[0]  # after the run: not drawn
+
+
+def test_a_level_flight_reads_as_level(captured):
+    """Still air: altitude and airspeed held to millimetres show as flat lines on plain
+    ticks (no '+6.84e2' offset), each axis at least its MIN_SPAN wide."""
+    from bioflex_jsb.sinks.flight_plot import MIN_SPAN, flight_figure
+
+    run = _flight_run()
+    t = run.time_s
+    run.channels["altitude_m"] = 684.0 + 0.009 * (1.0 - np.exp(-t / 5.0))  # as sitl logged
+    run.channels["airspeed_m_s"] = 15.0 + 6e-4 * np.sin(t / 3.0)
+    run.channels["n_z"] = 0.998 + 0 * t
+    flight_figure(run, "x.png", "a level flight")
+    fig = captured[0]
+    fig.canvas.draw()
+    labels = _labels(fig)
+    for label, key in (("altitude [m] (MSL)", "altitude_m"), ("airspeed [m/s]", "airspeed_m_s"),
+                       ("load factor n_z [-]", "n_z"), ("angle of attack α [deg]", "alpha_deg")):
+        ax = fig.axes[labels.index(label)]
+        low, high = ax.get_ylim()
+        assert high - low >= MIN_SPAN[key] * (1 - 1e-9), (label, low, high)
+        assert ax.yaxis.get_offset_text().get_text() == "", label
+    ax = fig.axes[labels.index("altitude [m] (MSL)")]
+    assert ax.get_ylim()[0] < 684.0 < ax.get_ylim()[1]
 
 
 def test_a_sitl_log_is_plotted_as_a_flight(tmp_path, monkeypatch, capsys, captured):

@@ -30,7 +30,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.gust import damping_ratio, wing_for_run
 from bioflex_jsb.flight_dynamics import eigen
-from bioflex_jsb.flight_dynamics.lti import rigid_block_note
+from bioflex_jsb.flight_dynamics.lti import RIGID_BLOCK_ANALYTIC, rigid_block_note
 from bioflex_jsb.sinks.mcap import scene_modes
 
 PLOT_TOP_M_S = 25.0  # the root loci run to the largest --speed, at least this [m/s]
@@ -278,6 +278,17 @@ def _shapes(args, build, speed_m_s: float) -> dict:
     return out
 
 
+def locus_note(build) -> str:
+    """The root-locus figure's line on the models' rigid block (the phugoid depends on it:
+    ``compare`` and ``loads --frequency`` use JSBSim's, whose phugoid is better damped)."""
+    block = rigid_block_note(None, build.model.airframe)
+    note = f"rigid block of every model here: {block}"
+    if block == RIGID_BLOCK_ANALYTIC:
+        note += ("; its phugoid is not JSBSim's (compare, loads --frequency), "
+                 "docs/aeroelasticity.md: 'Two coupled LTI models and the phugoid'")
+    return note
+
+
 def _plot(args, build, speeds, flight_top_m_s: float | None = None) -> None:
     from bioflex_jsb.sinks import plotting
 
@@ -296,6 +307,7 @@ def _plot(args, build, speeds, flight_top_m_s: float | None = None) -> None:
                                   full.labels, full.eigenvectors[k0:], full.wing,
                                   full.density_kg_m3))
     try:
-        plotting.root_locus(sweeps, args.plot, f"wing {build.variant.name}")
+        plotting.root_locus(sweeps, args.plot, f"wing {build.variant.name}",
+                            note=locus_note(build))
     except OSError as exc:
         raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None

@@ -19,6 +19,13 @@ from bioflex_jsb.sinks.plotting import ModeDisplay, running_envelope
 FLIGHT_POINTS = 4000  # samples drawn per line: a 600 s session at 960 Hz is 576 000 steps
 MAX_EVENT_LABELS = 14  # events written on the figure; the rest are counted in the note
 _DEG = 180.0 / np.pi  # rad to deg
+# The smallest span each state axis shows, in its unit: a flight in still air holds its
+# altitude to millimetres and its airspeed to 1e-3 m/s, which matplotlib would spread over
+# the whole panel with an offset (+6.84e2) and ticks of 0.002 m; these spans show such a
+# flight as level. About the sensors' noise or an autopilot's hold band: 2 m of altitude,
+# 1 m/s of airspeed, 2 degrees of attitude and of α, 0.1 of load factor.
+MIN_SPAN = {"altitude_m": 2.0, "airspeed_m_s": 1.0, "attitude_deg": 2.0, "n_z": 0.1,
+            "alpha_deg": 2.0}
 
 
 def _thinned(t: np.ndarray, x: np.ndarray):
@@ -130,6 +137,16 @@ def flight_figure(runs: TimeHistory | Sequence[TimeHistory], path: str | Path, t
     return plotting.save_figure(fig, path)
 
 
+def _plain_axis(ax, min_span: float | None = None) -> None:
+    """``ax``'s y ticks as plain numbers (no offset or scientific notation) and, given
+    ``min_span`` [the axis' unit], at least that span about the middle of the data."""
+    ax.ticklabel_format(axis="y", style="plain", useOffset=False)
+    low, high = ax.get_ylim()
+    if min_span is not None and high - low < min_span:
+        mid = 0.5 * (low + high)
+        ax.set_ylim(mid - 0.5 * min_span, mid + 0.5 * min_span)
+
+
 def _line(ax, run: TimeHistory, t: np.ndarray, name: str, scale: float = 1.0, **kw) -> None:
     """``run``'s channel ``name`` × ``scale`` against ``t`` [s] (thinned), if it has it."""
     if name in run.channels:
@@ -149,6 +166,9 @@ def _state_panels(axes, run: TimeHistory, t: np.ndarray) -> None:
           label="pitch θ (nose up +)")
     ax_att.set_ylabel("attitude [deg]")
     ax_att.legend(fontsize=8, loc="best")
+    _plain_axis(ax_alt, MIN_SPAN["altitude_m"])
+    _plain_axis(ax_v, MIN_SPAN["airspeed_m_s"])
+    _plain_axis(ax_att, MIN_SPAN["attitude_deg"])
     if "psi_rad" in run.channels:
         tt, psi = _thinned(t, run["psi_rad"] * _DEG)
         tt, psi, low = _heading(tt, psi)
@@ -179,6 +199,8 @@ def _mode_panel(ax_eta, run: TimeHistory, t: np.ndarray) -> dict[str, list[str]]
         _band(ax, t, run[f"eta{i}"] * shown.scale(run), colours[k % len(colours)],
               f"mode {i}" + (f" ({shown.unit})" if len(axes_by_unit) > 1 else ""))
         notes.setdefault(shown.quantity, []).append(str(i))
+    for ax in axes_by_unit.values():
+        _plain_axis(ax)
     if modes:
         handles = [h for ax in axes_by_unit.values() for h in ax.get_legend_handles_labels()[0]]
         ax_eta.legend(handles, [h.get_label() for h in handles], fontsize=8,
@@ -195,8 +217,10 @@ def _load_panels(ax_nz, ax_alpha, run: TimeHistory, t: np.ndarray) -> None:
         _band(ax_nz, t, run["n_z"], "tab:blue", "n_z")
     ax_nz.axhline(1.0, color="0.5", lw=0.7)
     ax_nz.set_ylabel("load factor n_z [-]")
+    _plain_axis(ax_nz, MIN_SPAN["n_z"])
     _line(ax_alpha, run, t, "alpha_rad", _DEG, color="tab:blue", lw=1.3, label="α")
     ax_alpha.set_ylabel("angle of attack α [deg]")
+    _plain_axis(ax_alpha, MIN_SPAN["alpha_deg"])
     gust = run.channels.get("w_g")
     if gust is not None and np.any(gust != 0.0):
         ax_w = ax_alpha.twinx()

@@ -161,7 +161,8 @@ def _box(points: np.ndarray, margin: float = 0.12, min_span: float = 0.2):
     return (x0 - margin * dx, x1 + margin * dx), (y0 - margin * dy, y1 + margin * dy)
 
 
-def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
+def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str,
+               note: str | None = None) -> Path:
     """Root loci of one or more models over their speed sweeps (Figs. 15, 16, 18, 19).
 
     Four panels, rad/s on every axis: (a) every root of every model; (b) the short period,
@@ -171,7 +172,8 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
     (rigid black, coupled wide pale blue underneath, QSD thin red with open markers on top,
     so that both show where they agree), marker and line style = mode; numbers beside the
     roots are airspeeds [m/s], arrows point to increasing speed; the right half plane
-    (unstable) is shaded.
+    (unstable) is shaded. ``note``: a line under the panels (which rigid block the models
+    have: their phugoid depends on it).
     """
     fig, axes = plt.subplots(2, 2, figsize=(14, 11))
     ax_all, ax_sp, ax_ph, ax_re = axes.flat
@@ -263,7 +265,12 @@ def root_locus(sweeps: Sequence[Sweep], path: str | Path, title: str) -> Path:
                     " here:\nthe wide pale blue line lies under the red one",
                     transform=ax.transAxes, fontsize=8, va="bottom", ha="left",
                     bbox=dict(facecolor="white", alpha=0.85, lw=0))
-    fig.tight_layout()
+    if note:
+        fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=9, color="0.2",
+                 wrap=True)
+        fig.tight_layout(rect=(0.0, 0.03, 1.0, 1.0))
+    else:
+        fig.tight_layout()
     _speed_labels(label_jobs, fig)
     return save_figure(fig, path)
 
