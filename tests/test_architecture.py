@@ -1,13 +1,16 @@
 """The architecture as tests: the import-linter contracts (``pyproject.toml``: the layers, one
 package importing jsbsim, no import circle between sibling modules), no blanket exception
-handlers."""
+handlers, the prototype's parameter constants read only by the loader, no history (issues,
+reviews, dates) in the code's comments."""
 
 from __future__ import annotations
 
 import ast
+import io
 import re
 import subprocess
 import sys
+import tokenize
 from pathlib import Path
 
 import pytest
@@ -139,3 +142,44 @@ def test_prototype_constants_are_read_only_by_the_loader():
                             f"in: {unexpected}")
     moved = sorted(set(NOT_YET_MOVED) - set(readers))
     assert not moved, f"no longer reading the prototype's constants: remove from the list {moved}"
+
+
+# History belongs to the changelog and the issue tracker, not to the code: a comment says what
+# and why, not which issue, review or day asked for it.
+HISTORY_IN_COMMENTS = re.compile(
+    r"\bissues?\s*#?\d+|\bthe issue's\b|\b20\d\d-\d\d-\d\d\b|\breview(s|ed|er|ers)?\b"
+    r"|\bPR\s*#?\d+", re.IGNORECASE)
+# In strings (docstrings, help texts) dates are data (the MAVLink signing epoch, a generated
+# file's creation date); only the references to an issue are history there.
+HISTORY_IN_STRINGS = re.compile(r"\bissues?\s*#?\d+|\bthe issue's\b", re.IGNORECASE)
+
+
+def _history(path: Path) -> list[str]:
+    found = []
+    source = path.read_text(encoding="utf-8")
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        pattern = {tokenize.COMMENT: HISTORY_IN_COMMENTS,
+                   tokenize.STRING: HISTORY_IN_STRINGS}.get(tok.type)
+        if pattern is None:
+            continue
+        for m in pattern.finditer(tok.string):
+            line = tok.start[0] + tok.string[:m.start()].count("\n")
+            found.append(f"{path.relative_to(ROOT)}:{line}: {m.group(0)!r}")
+    return found
+
+
+def test_no_history_in_code_comments():
+    """No comment of the package or its scripts names an issue, a review or a date; no
+    docstring or help text names an issue."""
+    files = sorted(PACKAGE.rglob("*.py")) + sorted((ROOT / "scripts").rglob("*.py"))
+    assert len(files) > 100, "the walk found too few files: it is broken"
+    found = [hit for path in files for hit in _history(path)]
+    assert not found, found
+
+
+@pytest.mark.parametrize("comment, history", [
+    ("# see issue 42", True), ("# fixed for Issue #7", True), ("# 2026-12-02, night", True),
+    ("# as the review asked", True), ("# the issue's figure", True),
+    ("# a wing issue: 3 modes", False), ("# reviewing the trim: 2 iterations", False)])
+def test_the_history_pattern_tells_history_from_physics(comment, history):
+    assert bool(HISTORY_IN_COMMENTS.search(comment)) is history
