@@ -183,3 +183,25 @@ def test_no_history_in_code_comments():
     ("# a wing issue: 3 modes", False), ("# reviewing the trim: 2 iterations", False)])
 def test_the_history_pattern_tells_history_from_physics(comment, history):
     assert bool(HISTORY_IN_COMMENTS.search(comment)) is history
+
+
+# JSBSim's own property trees (FGFDMExec's; the ``ap/`` and ``bioflex/`` trees are the
+# generated aircraft's systems and are named by their generators).
+JSBSIM_TREES = ("accelerations", "aero", "atmosphere", "attitude", "external_reactions", "fcs",
+                "flight-path", "forces", "ic", "inertia", "metrics", "moments", "position",
+                "propulsion", "simulation", "velocities")
+PROPERTY_LITERAL = re.compile(rf"({'|'.join(JSBSIM_TREES)})/[^\s:]*")
+
+
+def test_the_runtime_names_jsbsim_properties_in_one_module():
+    """The runtime reads and writes JSBSim's properties by the names of
+    simulation/jsbsim_properties.py: no other runtime module spells one (an error message
+    naming a property is prose, with spaces, and is not counted)."""
+    found = []
+    for path in sorted((PACKAGE / "runtime").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                    and PROPERTY_LITERAL.fullmatch(node.value)):
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
+    assert not found, found
+    assert PROPERTY_LITERAL.fullmatch("propulsion/engine[")  # an f-string's part counts

@@ -308,7 +308,7 @@ class Airframe:
     def total_thrust_n(self) -> float:
         """Thrust of all engines (the contra-rotating pair) [N]."""
         lbs = sum(
-            float(self._fdm[f"propulsion/engine[{i}]/thrust-lbs"]) for i in range(self.engine_count)
+            float(self._fdm[JP.engine(i, "thrust-lbs")]) for i in range(self.engine_count)
         )
         return lbs * U.N_PER_LBF
 
@@ -525,7 +525,7 @@ class Airframe:
         line = diagnose_trim_failure(text, v, self.alpha_limits_rad,
                                      self._first_message(jsbsim.LogLevel.WARN), engine)
         stopped = [e for e in self.engines
-                   if self._has(name := f"propulsion/engine[{e.index}]/engine-rpm")
+                   if self._has(name := JP.engine(e.index, "engine-rpm"))
                    and self._trim_fdm[name] <= 0.0]
         if stopped and not self.has_companion:
             names = ", ".join(f"{e.index} ({e.kind}, {e.file})" for e in stopped)
