@@ -205,3 +205,12 @@ def test_the_runtime_names_jsbsim_properties_in_one_module():
                 found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
     assert not found, found
     assert PROPERTY_LITERAL.fullmatch("propulsion/engine[")  # an f-string's part counts
+
+
+def test_one_class_named_airframe():
+    """``Airframe`` is the JSBSim adapter's (runtime/fdm.py); a definition's ``[airframe]``
+    table is an ``AirframeDefinition``."""
+    owners = sorted(str(path.relative_to(PACKAGE)) for path in PACKAGE.rglob("*.py")
+                    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+                    if isinstance(node, ast.ClassDef) and node.name == "Airframe")
+    assert owners == ["runtime/fdm.py"], owners
