@@ -12,6 +12,7 @@ from bioflex_jsb.flight_dynamics.modal_coefficients import (
     modal_coefficients,
 )
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
 SEMISPAN_M = P.SPAN_M / 2.0
@@ -48,7 +49,9 @@ def wing(
     overrides=None,
 ) -> ElasticWingModel:
     n = len(frequencies_hz)
-    coeffs = modal_coefficients(twist_modes(n, bending_per_twist_m), strips(x_elastic_frac))
+    coeffs = modal_coefficients(twist_modes(n, bending_per_twist_m), strips(x_elastic_frac),
+                                reference_area_m2=PROTOTYPE_AIRFRAME.reference.area_m2,
+                                cbar_m=PROTOTYPE_AIRFRAME.reference.mean_chord_m)
     if overrides:
         coeffs = coeffs.with_overrides(overrides)
     return ElasticWingModel(

@@ -1,12 +1,16 @@
 """The architecture as tests: the import-linter contracts (``pyproject.toml``: the layers, one
 package importing jsbsim, no import circle between sibling modules), no blanket exception
-handlers."""
+handlers, the prototype's parameter constants read only by the loader, no history (issues,
+reviews, dates) in the code's comments."""
 
 from __future__ import annotations
 
+import ast
+import io
 import re
 import subprocess
 import sys
+import tokenize
 from pathlib import Path
 
 import pytest
@@ -47,3 +51,166 @@ def test_no_blanket_exception_handlers():
              for text in [p.read_text(encoding="utf-8")]
              for m in pattern.finditer(text)]
     assert not found, found
+
+
+# The prototype's parameter modules (the paper's numbers and the estimates calibrated for the
+# prototype); constants (physical constants), sensors and goland (the Goland benchmark wing)
+# are not the prototype's.
+PROTOTYPE_MODULES = ("airframe", "airframe_consistent", "prototype", "wing", "wing_structure")
+# Where the prototype's parameter constants may be read: the parameters themselves and the
+# loader that builds the aircraft from them (bioflex_jsb.definition), and the modules whose
+# subject is the prototype itself: the generators writing its JSBSim files, the paper's
+# named wing variants (flight_dynamics.wing_model), the published-number checks
+# (validation) and the comparison of the paper's and the consistent parameter sets.
+ALLOWED_READERS = (
+    "bioflex_jsb.parameters",
+    "bioflex_jsb.definition",
+    "bioflex_jsb.generators.airframe",
+    "bioflex_jsb.generators.native_aircraft",
+    "bioflex_jsb.flight_dynamics.wing_model",
+    "bioflex_jsb.flight_dynamics.consistent_aircraft",
+    "bioflex_jsb.validation",
+)
+# Readers not moved yet onto the aircraft object passed in (each reads the prototype as the
+# default aircraft of a call made without one). The list only shrinks: a module that stops
+# reading them must leave it (second assertion).
+NOT_YET_MOVED = {
+    "bioflex_jsb.aerodynamics.airframe_polars": "default post-stall model and derivatives",
+    "bioflex_jsb.aerodynamics.propeller": "the prototype's propeller tables",
+    "bioflex_jsb.aerodynamics.vortex_lattice": "default planform",
+    "bioflex_jsb.aeroelasticity.parameter_set": "the prototype's parameter sweep",
+    "bioflex_jsb.api": "the prototype as the API's default aircraft",
+    "bioflex_jsb.cli.export_jsbsim": "the prototype's speed range",
+    "bioflex_jsb.cli.linearize": "the prototype as the default aircraft",
+    "bioflex_jsb.cli.loads": "the prototype as the default aircraft",
+    "bioflex_jsb.cli.speed_option": "the prototype's speed range",
+    "bioflex_jsb.drivers.native": "the paper's Section 5 case",
+    "bioflex_jsb.flight_dynamics.eigen": "the prototype as the default aircraft",
+    "bioflex_jsb.flight_dynamics.lti": "the prototype as the default aircraft",
+    "bioflex_jsb.flight_dynamics.rigid": "the prototype as the default aircraft",
+    "bioflex_jsb.generators.native_wing": "default export speed and speed range",
+    "bioflex_jsb.loads.model": "the named variants' membrane beam",
+    "bioflex_jsb.loads.tuned": "the paper's tuned wing",
+    "bioflex_jsb.runtime.companion": "the prototype's drive for the trim companion's spin-up",
+    "bioflex_jsb.runtime.coupled_step": "the prototype as the airframe of a native-wing run",
+    "bioflex_jsb.simulation.gusts": "default reference chord",
+    "bioflex_jsb.simulation.limits": "the prototype's post-stall limits",
+    "bioflex_jsb.sinks.mcap.scene": "the prototype's drawn geometry",
+    "bioflex_jsb.structures.wing_model": "the prototype's membrane beam",
+}
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _prototype_names(tree) -> set[str]:
+    """Names of the prototype's parameter modules an AST imports: UPPER_CASE constants
+    (not the types), or a whole module; function-level imports count too."""
+    found: set[str] = set()
+    prefix = "bioflex_jsb.parameters"
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module == prefix:
+                found.update(a.name for a in node.names if a.name in PROTOTYPE_MODULES)
+            elif (node.module.startswith(prefix + ".")
+                  and node.module.split(".")[2] in PROTOTYPE_MODULES):
+                found.update(a.name for a in node.names
+                             if re.fullmatch(r"[A-Z][A-Z0-9_]*", a.name))
+        elif isinstance(node, ast.Import):
+            found.update(a.name for a in node.names if a.name.startswith(prefix + ".")
+                         and a.name.split(".")[2] in PROTOTYPE_MODULES)
+    return found
+
+
+def test_prototype_constants_are_read_only_by_the_loader():
+    """Every analysis takes the aircraft passed in: the prototype's parameter constants are
+    imported by the parameters, the loader and the prototype's own generators and checks,
+    and by the readers listed as not moved yet, and by no other module."""
+    readers = {}
+    for path in PACKAGE.rglob("*.py"):
+        names = _prototype_names(ast.parse(path.read_text(encoding="utf-8")))
+        if names:
+            readers[_module_name(path)] = sorted(names)
+    assert readers, "the AST walk found no reader at all: it is broken"
+    allowed = [m for m in readers
+               if any(m == a or m.startswith(a + ".") for a in ALLOWED_READERS)]
+    unexpected = {m: n for m, n in readers.items()
+                  if m not in allowed and m not in NOT_YET_MOVED}
+    assert not unexpected, ("take these values from the aircraft/definition object passed "
+                            f"in: {unexpected}")
+    moved = sorted(set(NOT_YET_MOVED) - set(readers))
+    assert not moved, f"no longer reading the prototype's constants: remove from the list {moved}"
+
+
+# History belongs to the changelog and the issue tracker, not to the code: a comment says what
+# and why, not which issue, review or day asked for it.
+HISTORY_IN_COMMENTS = re.compile(
+    r"\bissues?\s*#?\d+|\bthe issue's\b|\b20\d\d-\d\d-\d\d\b|\breview(s|ed|er|ers)?\b"
+    r"|\bPR\s*#?\d+", re.IGNORECASE)
+# In strings (docstrings, help texts) dates are data (the MAVLink signing epoch, a generated
+# file's creation date); only the references to an issue are history there.
+HISTORY_IN_STRINGS = re.compile(r"\bissues?\s*#?\d+|\bthe issue's\b", re.IGNORECASE)
+
+
+def _history(path: Path) -> list[str]:
+    found = []
+    source = path.read_text(encoding="utf-8")
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        pattern = {tokenize.COMMENT: HISTORY_IN_COMMENTS,
+                   tokenize.STRING: HISTORY_IN_STRINGS}.get(tok.type)
+        if pattern is None:
+            continue
+        for m in pattern.finditer(tok.string):
+            line = tok.start[0] + tok.string[:m.start()].count("\n")
+            found.append(f"{path.relative_to(ROOT)}:{line}: {m.group(0)!r}")
+    return found
+
+
+def test_no_history_in_code_comments():
+    """No comment of the package or its scripts names an issue, a review or a date; no
+    docstring or help text names an issue."""
+    files = sorted(PACKAGE.rglob("*.py")) + sorted((ROOT / "scripts").rglob("*.py"))
+    assert len(files) > 100, "the walk found too few files: it is broken"
+    found = [hit for path in files for hit in _history(path)]
+    assert not found, found
+
+
+@pytest.mark.parametrize("comment, history", [
+    ("# see issue 42", True), ("# fixed for Issue #7", True), ("# 2026-12-02, night", True),
+    ("# as the review asked", True), ("# the issue's figure", True),
+    ("# a wing issue: 3 modes", False), ("# reviewing the trim: 2 iterations", False)])
+def test_the_history_pattern_tells_history_from_physics(comment, history):
+    assert bool(HISTORY_IN_COMMENTS.search(comment)) is history
+
+
+# JSBSim's own property trees (FGFDMExec's; the ``ap/`` and ``bioflex/`` trees are the
+# generated aircraft's systems and are named by their generators).
+JSBSIM_TREES = ("accelerations", "aero", "atmosphere", "attitude", "external_reactions", "fcs",
+                "flight-path", "forces", "ic", "inertia", "metrics", "moments", "position",
+                "propulsion", "simulation", "velocities")
+PROPERTY_LITERAL = re.compile(rf"({'|'.join(JSBSIM_TREES)})/[^\s:]*")
+
+
+def test_the_runtime_names_jsbsim_properties_in_one_module():
+    """The runtime reads and writes JSBSim's properties by the names of
+    simulation/jsbsim_properties.py: no other runtime module spells one (an error message
+    naming a property is prose, with spaces, and is not counted)."""
+    found = []
+    for path in sorted((PACKAGE / "runtime").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                    and PROPERTY_LITERAL.fullmatch(node.value)):
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
+    assert not found, found
+    assert PROPERTY_LITERAL.fullmatch("propulsion/engine[")  # an f-string's part counts
+
+
+def test_one_class_named_airframe():
+    """``Airframe`` is the JSBSim adapter's (runtime/fdm.py); a definition's ``[airframe]``
+    table is an ``AirframeDefinition``."""
+    owners = sorted(str(path.relative_to(PACKAGE)) for path in PACKAGE.rglob("*.py")
+                    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+                    if isinstance(node, ast.ClassDef) and node.name == "Airframe")
+    assert owners == ["runtime/fdm.py"], owners

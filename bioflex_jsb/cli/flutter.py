@@ -61,7 +61,7 @@ goland (or --wing goland --clamped): the shipped Goland cantilever (semi-span 6.
 chord 1.8288 m; bioflex_jsb/data/aircraft/goland.toml), published strip theory result
 137.2 m/s, 70.7 rad/s (Goland 1945, as tabulated by Patil, Hodges & Cesnik 2001). Defaults
 from the definition (Goland: --aero unsteady, --method pk, --lift-slope strip,
---structural-damping 0, --inertia-about elastic-axis, --density 1.225 kg/m^3; the issue's
+--structural-damping 0, --inertia-about elastic-axis, --density 1.225 kg/m^3; the other
 literal reading of the data is --inertia-about centre-of-mass --density 1.02); default
 --range derived from the wing: up to 1.5 x its static divergence speed, from 5 % of that
 (docs/aircraft.md).
@@ -147,7 +147,7 @@ def register(sub) -> None:
                    "on every strip) or vlm (the vortex lattice's spanwise C_la(y))")
     p.add_argument("--inertia-about", choices=INERTIA_CHOICES, default=None,
                    help="axis of the definition's pitch inertia (--clamped only): "
-                   "elastic-axis or centre-of-mass (Goland's 8.64 kg m: the issue's wording)")
+                   "elastic-axis or centre-of-mass (Goland's 8.64 kg m may be read either way)")
     p.add_argument("--density", type=density, default=None, metavar="RHO",
                    help=f"air density [kg/m^3], {MIN_DENSITY_KG_M3:g} <= RHO <= "
                    f"{MAX_DENSITY_KG_M3:g}; default the definition's for --clamped, 1.225 "

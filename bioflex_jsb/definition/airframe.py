@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bioflex_jsb.definition.model import Airframe, Inertia
+from bioflex_jsb.definition.model import AirframeDefinition, Inertia
 from bioflex_jsb.definition.reader import Reader
 from bioflex_jsb.inputs import Interval
 from bioflex_jsb.parameters.airframe import (
@@ -165,8 +165,9 @@ def _derivatives(r: Reader, t: dict) -> dict[str, float] | None:
     return out
 
 
-def parse_airframe(r: Reader, data: dict, base_dir: Path | None) -> Airframe:
-    """The :class:`Airframe` of the ``[airframe]`` table (module docstring for the ranges).
+def parse_airframe(r: Reader, data: dict, base_dir: Path | None) -> AirframeDefinition:
+    """The :class:`AirframeDefinition` of the ``[airframe]`` table (module docstring for the
+    ranges).
     On a JSBSim aircraft every field but ``jsbsim`` is optional (None: taken from the
     JSBSim aircraft when the aircraft is completed); the generated prototype ``bioflex``
     needs its numbers written (they are the paper's, and its model is generated from
@@ -206,7 +207,7 @@ def parse_airframe(r: Reader, data: dict, base_dir: Path | None) -> Airframe:
     cruise, speeds = _flight_speeds(r, t)
     if generated and cruise is None:  # the prototype's: Table 1's cruise, the paper's speeds
         cruise, speeds = CRUISE_SPEED_M_S, AIRSPEED_RANGE_M_S
-    return Airframe(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
+    return AirframeDefinition(jsbsim=name, jsbsim_path=path, reference_area_m2=area, span_m=span,
                     mean_chord_m=chord, mass_kg=mass, cg_m=cg, inertia=inertia,
                     wing_root_leading_edge_m=root, derivatives=derivatives,
                     cruise_speed_m_s=cruise, speed_range_m_s=speeds, checked=generated)

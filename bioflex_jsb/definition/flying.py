@@ -21,7 +21,7 @@ import numpy as np
 from bioflex_jsb.definition.airframe import GENERATED
 from bioflex_jsb.definition.model import (
     AeroSettings,
-    Airframe,
+    AirframeDefinition,
     FlyingWing,
     MembraneStructure,
     ModalStructure,
@@ -56,7 +56,7 @@ AXIS_TOLERANCE = 1e-9
 MODAL_AXIS_TOLERANCE = 1e-6
 
 
-def check_span(r: Reader, stations: tuple[WingStation, ...], airframe: Airframe) -> None:
+def check_span(r: Reader, stations: tuple[WingStation, ...], airframe: AirframeDefinition) -> None:
     """The wing's span matches the airframe's (:data:`SPAN_TOLERANCE`); an airframe whose
     span comes from its JSBSim aircraft is checked when it is completed
     (:meth:`~bioflex_jsb.definition.aircraft.Aircraft.with_jsbsim`)."""

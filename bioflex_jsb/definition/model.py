@@ -5,7 +5,7 @@ A definition has a wing (planform by span stations, :class:`WingStation`), its s
 (:class:`AeroSettings`), the air (:class:`Air`) and the analysis settings
 (:class:`AnalysisSettings`), and optionally the wing's aileron
 (:class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`). ``airframe``
-(:class:`Airframe`: the JSBSim aircraft, reference geometry, mass properties, the wing's
+(:class:`AirframeDefinition`: the JSBSim aircraft, reference geometry, mass properties, the wing's
 attachment, the rigid derivatives) is ``None`` for a clamped wing: "a clamped wing is the
 same definition without an airframe".
 The wing on an airframe has one more structure kind than a clamped wing
@@ -123,7 +123,7 @@ class Inertia:
 
 
 @dataclass(frozen=True)
-class Airframe:
+class AirframeDefinition:
     """The rigid aircraft the elastic wing is attached to.
 
     ``jsbsim``: ``bioflex`` (the generated prototype), or the name of an aircraft in the
@@ -241,7 +241,7 @@ class Definition:
     aero: AeroSettings
     air: Air
     analysis: AnalysisSettings
-    airframe: Airframe | None = None
+    airframe: AirframeDefinition | None = None
     path: str = ""
     flying: FlyingWing | None = None  # with an airframe
     # [loads] stations: the monitoring stations of the wing's section loads, fractions of

@@ -106,7 +106,7 @@ RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
 # the logging costs [µs/step]: name → (with, without)
 LOG_COSTS = {"rows": ("logged_rows", "cosim"), "section_loads": ("logged_no_scene", "logged_rows"),
              "scene": ("logged", "logged_no_scene"), "all": ("logged", "cosim")}
-# A controller in the loop (simulation/controller.py): the figure is a linear
+# A controller in the loop (simulation/controller.py): the figure benchmarked is a linear
 # controller of 10 states, here reading q, α and n_z and commanding the elevator, within
 # CONTROLLER_BAR_US a step (its update and the command written to JSBSim).
 CONTROLLER_STATES = 10
@@ -115,8 +115,9 @@ CONTROLLER_BAR_US = 1.0
 CONTROLLER_CALLS = 20_000  # calls of one timing (~15 ms: shorter than the speed states)
 CONTROLLER_REPEAT = 15
 # Sensor stations (simulation/sensors.py): the autopilot's IMU at the CG and an accelerometer
-# at the starboard wing tip (the pair: the autopilot's and a wing-tip one), without
-# noise; and the 10-state controller reading the tip's a_z with q and α (a GLA's signals).
+# at the starboard wing tip (the pair a gust-load controller reads: the autopilot's and a
+# wing-tip one), without noise; and the 10-state controller reading the tip's a_z with q and
+# α (a GLA's signals).
 BENCH_TIP_IMU = "tip"
 SENSOR_CONTROLLER_SIGNALS = ("q", "alpha", f"imu_{BENCH_TIP_IMU}_az_m_s2")
 # The 3-D scene of a gust log: the scene's default, true scale, as cli.gust.SCENE_EXAGGERATION

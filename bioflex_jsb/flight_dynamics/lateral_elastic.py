@@ -88,10 +88,10 @@ def wing_sections(build):
         raise InputError(f"wing {v.name!r} is a modal-data file ({v.modes_file}): its "
                          "antisymmetric modes need the beam (the file holds the clamped "
                          "symmetric ones only)")
-    from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING
+    from bioflex_jsb.flight_dynamics.wing_model import membrane_structure
     from bioflex_jsb.structures.wing_model import wing_sections as membrane_sections
 
-    return membrane_sections(RIBBED_WING if v.ribs else UNRIBBED_WING,
+    return membrane_sections(membrane_structure(v),
                              x_inertial_frac=v.x_inertial_frac,
                              x_elastic_frac=v.x_elastic_frac)
 

@@ -30,8 +30,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
-
 
 @dataclass(frozen=True)
 class ModalCoefficients:
@@ -168,8 +166,8 @@ def modal_coefficients(
     modes,
     strips: SpanwiseGeometry,
     *,
-    reference_area_m2: float = REFERENCE_GEOMETRY.area_m2,
-    cbar_m: float = REFERENCE_GEOMETRY.mean_chord_m,
+    reference_area_m2: float,
+    cbar_m: float,
 ) -> ModalCoefficients:
     """Table B1 coefficients of ``modes`` (a :class:`~bioflex_jsb.structures.modal_data.ModalData`).
 
@@ -178,6 +176,9 @@ def modal_coefficients(
     distribution is taken proportional to C_lα c(y) at the wing's effective angle
     α_w = C_L0/C_Lα,w, and ``c_mac_q``_i = (1/(S c̄)) ∫ θ_i c² dy is the work of a unit
     section moment coefficient about the aerodynamic centre (Table B1, C_0^Q, second term).
+    ``reference_area_m2`` S [m²] and ``cbar_m`` c̄ [m]: the aircraft's reference geometry
+    (its :class:`~bioflex_jsb.parameters.airframe.AirframeData`), which the coefficients are
+    normalised by.
     """
     y = strips.stations_m
     w = strips.weights_m * 2.0  # whole span: symmetric modes on a symmetric wing
@@ -214,9 +215,8 @@ def modal_coefficients(
     )
 
 
-def offset_shift_for_c_eta11(modes, strips: SpanwiseGeometry, target: float,
-                             reference_area_m2: float = REFERENCE_GEOMETRY.area_m2,
-                             cbar_m: float = REFERENCE_GEOMETRY.mean_chord_m) -> float:
+def offset_shift_for_c_eta11(modes, strips: SpanwiseGeometry, target: float, *,
+                             reference_area_m2: float, cbar_m: float) -> float:
     """Uniform shift Δe [m] of the aerodynamic-centre offset e(y) that makes C_η1^Q1 = target.
 
     C_η1^Q1 = (1/(S c̄)) ∫ θ_1 (e θ_1 − φ_1) C_lα c dy is linear in e, so

@@ -444,6 +444,15 @@ def modes_used_note(variant: WingVariant, n_modes: int = DEFAULT_N_MODES) -> str
             "exports are made for them")
 
 
+def membrane_structure(variant: WingVariant):
+    """The calibrated membrane wing structure of a named variant (the prototype's ribbed or
+    unribbed wing, :mod:`bioflex_jsb.parameters.wing_structure`): the beam its modes and
+    sections are computed from when the variant has neither a beam nor a modes file."""
+    from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING
+
+    return RIBBED_WING if variant.ribs else UNRIBBED_WING
+
+
 def _all_modes(variant: WingVariant, n_modes: int):
     """Every mode of the variant's modal file, or ``n_modes`` of its beam wing (a
     definition's) or of the calibrated membrane beam."""
@@ -454,11 +463,10 @@ def _all_modes(variant: WingVariant, n_modes: int):
 
         modes = read_modal_file(variant.modes_file)
     else:
-        from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING
         from bioflex_jsb.structures.wing_model import wing_modes
 
         modes = wing_modes(
-            RIBBED_WING if variant.ribs else UNRIBBED_WING,
+            membrane_structure(variant),
             n_modes,
             x_inertial_frac=variant.x_inertial_frac,
             x_elastic_frac=variant.x_elastic_frac,

@@ -68,7 +68,6 @@ from pathlib import Path
 from bioflex_jsb import units as U
 from bioflex_jsb.generators import airframe as AX
 from bioflex_jsb.generators.xml_writer import XmlWriter, num_repr, serialise
-from bioflex_jsb.parameters.airframe import PROPULSION
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 
 SYSTEM_FILE = "bioflex_autopilot"
@@ -554,8 +553,9 @@ def render_powered_autopilot(gains: PoweredGains, engines: int) -> str:
     return serialise(root, _HEADER)
 
 
-def render_autothrottle() -> str:
-    """Text of ``systems/bioflex_autothrottle.xml`` (module docstring: airspeed hold)."""
+def render_autothrottle(engines: int) -> str:
+    """Text of ``systems/bioflex_autothrottle.xml`` (module docstring: airspeed hold) for an
+    aircraft with ``engines`` engines (one throttle position each)."""
     root = ET.Element("system", name="bioflex-autothrottle")
     for prop, value in (("ap/armed", 1), ("ap/autothrottle", 0), ("ap/airspeed-hold-mps", 0)):
         el(root, "property", prop, value=repr(float(value)))
@@ -571,7 +571,7 @@ def render_autothrottle() -> str:
     t.set("logic", "AND")
     t = el(sw, "test", "ap/autothrottle == 1", value="ap/throttle-auto-norm")
     t.set("logic", "AND")
-    for i in range(PROPULSION.rotor_count):
+    for i in range(engines):
         el(sw, "output", f"fcs/throttle-pos-norm[{i}]")
     return serialise(root, _HEADER)
 
@@ -593,9 +593,10 @@ def _sitl_aircraft(trim_companion: bool) -> str:
 def render_all() -> dict[str, str]:
     """Every SITL file: path relative to the JSBSim root → text."""
     craft, comp = f"aircraft/{SITL_AIRCRAFT}", f"aircraft/{SITL_TRIM_AIRCRAFT}"
+    engines = len(AX.airframe_tree(trim_companion=False).findall("propulsion/engine"))
     return {
         f"systems/{SYSTEM_FILE}.xml": render_autopilot(),
-        f"systems/{THROTTLE_SYSTEM_FILE}.xml": render_autothrottle(),
+        f"systems/{THROTTLE_SYSTEM_FILE}.xml": render_autothrottle(engines),
         f"{craft}/{SITL_AIRCRAFT}.xml": _sitl_aircraft(False),
         f"{craft}/Engines/{AX.ENGINE_FILE}.xml": AX.render_engine(),
         f"{craft}/Engines/{AX.PROPELLER_FILE}.xml": AX.render_propeller(),

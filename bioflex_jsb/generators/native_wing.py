@@ -98,7 +98,6 @@ from bioflex_jsb.generators.xml_writer import XmlWriter, collapse, num_12g, seri
 from bioflex_jsb.parameters.airframe import (
     AIRSPEED_RANGE_M_S,
     CRUISE_SPEED_M_S,
-    REFERENCE_GEOMETRY,
     ReferenceGeometry,
 )
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
@@ -666,8 +665,7 @@ def _stored_state(n: int) -> tuple[list[str], list[str]]:
 
 
 def modal_wing_aerodynamics(nums: ModalMatrices, co: LeapfrogCoefficients,
-                            reference: ReferenceGeometry = REFERENCE_GEOMETRY,
-                            ) -> dict[str, ET.Element]:
+                            reference: ReferenceGeometry) -> dict[str, ET.Element]:
     """The native modal wing's loads as JSBSim aerodynamics of the airframe: ``<function>``
     elements keyed by where they go (``speed``, then ``functions``: before the first axis, in
     that order; ``LIFT``, ``DRAG``, ``PITCH``: into those axes).

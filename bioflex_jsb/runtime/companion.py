@@ -21,8 +21,7 @@ from bioflex_jsb.simulation import jsbsim_properties as JP
 RPM_SETTLE_REL_TOL = 1e-9
 RPM_SETTLE_MAX_S = 60.0
 # JSBSim's integrator choices (FGPropagate) and the one that holds a state: 0 = eNone.
-_INTEGRATOR_PROPERTIES = tuple(f"simulation/integrator/{a}/{b}" for a in ("rate", "position")
-                               for b in ("rotational", "translational"))
+_INTEGRATOR_PROPERTIES = JP.INTEGRATOR_PROPERTIES
 _INTEGRATOR_NONE = 0
 
 
@@ -45,7 +44,7 @@ def spin_up_propellers(fdm, speed_m_s: float, aircraft_path: Path, engine_count:
     power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
     throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
     for i in range(engine_count):
-        fdm[f"fcs/throttle-cmd-norm[{i}]"] = throttle
+        fdm[JP.throttle_cmd(i)] = throttle
     fdm.run()
 
 
@@ -69,12 +68,10 @@ def fly_at_companion_trim(fdm, src, v: float, controls: tuple[str, ...],
     fdm[JP.IC_P_RAD_SEC] = src[JP.VELOCITIES_P_RAD_SEC]
     fdm[JP.IC_Q_RAD_SEC] = src[JP.VELOCITIES_Q_RAD_SEC]
     fdm[JP.IC_R_RAD_SEC] = src[JP.VELOCITIES_R_RAD_SEC]
-    controls = controls + tuple(
-        f"fcs/throttle-cmd-norm[{i}]" for i in range(engine_count)
-    )
+    controls = controls + tuple(JP.throttle_cmd(i) for i in range(engine_count))
     for name in controls:
         fdm[name] = src[name]
-    rpm_names = [f"propulsion/engine[{i}]/propeller-rpm" for i in range(engine_count)]
+    rpm_names = [JP.engine(i, "propeller-rpm") for i in range(engine_count)]
     targets = [float(src[name]) for name in rpm_names]
     integrators = {name: fdm[name] for name in _INTEGRATOR_PROPERTIES}
     dt = fdm.get_delta_t()

@@ -38,6 +38,7 @@ from bioflex_jsb.runtime.identification import (
     State,
 )
 from bioflex_jsb.runtime.results import LinearizationError
+from bioflex_jsb.simulation import jsbsim_properties as JP
 
 SLUG_FT2_TO_KG_M2 = U.KG_PER_SLUG * U.M_PER_FT**2
 
@@ -82,13 +83,13 @@ def measure_control_power(airframe, speed_m_s: float, altitude_m: float = 0.0
     fdm = airframe.jsbsim
     ev = Evaluator(airframe)
     powered = bool(airframe.engines)
-    throttle = float(fdm["fcs/throttle-cmd-norm[0]"]) if powered else 0.0
+    throttle = float(fdm[JP.throttle_cmd(0)]) if powered else 0.0
     base = State(trim.speed_m_s, trim.alpha_rad,
-                 elevator_cmd=float(fdm["fcs/elevator-cmd-norm"]),
-                 aileron_cmd=float(fdm["fcs/aileron-cmd-norm"]),
-                 rudder_cmd=float(fdm["fcs/rudder-cmd-norm"]), throttle=throttle)
-    mass_kg = float(fdm["inertia/mass-slugs"]) * U.KG_PER_SLUG
-    ixx, iyy, izz = (float(fdm[f"inertia/i{a}{a}-slugs_ft2"]) * SLUG_FT2_TO_KG_M2
+                 elevator_cmd=float(fdm[JP.FCS_ELEVATOR_CMD_NORM]),
+                 aileron_cmd=float(fdm[JP.FCS_AILERON_CMD_NORM]),
+                 rudder_cmd=float(fdm[JP.FCS_RUDDER_CMD_NORM]), throttle=throttle)
+    mass_kg = float(fdm[JP.INERTIA_MASS_SLUGS]) * U.KG_PER_SLUG
+    ixx, iyy, izz = (float(fdm[JP.inertia_slugs_ft2(f"i{a}{a}")]) * SLUG_FT2_TO_KG_M2
                      for a in "xyz")
 
     def at(**changes) -> State:
@@ -115,7 +116,7 @@ def measure_control_power(airframe, speed_m_s: float, altitude_m: float = 0.0
         return r.thrust_x * cos0 + r.thrust_z * sin0
 
     m_alpha = diff("alpha_rad", ALPHA_STEP_RAD, lambda r: r.pitch) / iyy
-    q_step = RATE_STEP * 2.0 * base.speed_m_s / (float(fdm["metrics/cbarw-ft"]) * U.M_PER_FT)
+    q_step = RATE_STEP * 2.0 * base.speed_m_s / (float(fdm[JP.METRICS_CBARW_FT]) * U.M_PER_FT)
     m_q = diff("q_rad_s", q_step, lambda r: r.pitch) / iyy
     l_alpha = diff("alpha_rad", ALPHA_STEP_RAD, lambda r: r.lift) / (mass_kg * base.speed_m_s)
     per_throttle = climb = idle = 0.0
@@ -138,4 +139,4 @@ def measure_control_power(airframe, speed_m_s: float, altitude_m: float = 0.0
 
 def airframe_span_m(fdm) -> float:
     """The wing span of the loaded aircraft [m] (JSBSim's ``metrics/bw-ft``)."""
-    return float(fdm["metrics/bw-ft"]) * U.M_PER_FT
+    return float(fdm[JP.METRICS_BW_FT]) * U.M_PER_FT

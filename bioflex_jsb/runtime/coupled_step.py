@@ -70,7 +70,6 @@ from bioflex_jsb.simulation.sensors import SensorRows, SensorSet
 
 STEP_MODELS = (*WING_MODELS, "native")
 TRIM_MODES = ("rigid", "elastic")  # the trim a run starts from (``trim_mode``)
-ELASTIC_TRIM_TOL_RAD = 1e-6  # the elastic trim's fixed point on α with JSBSim's trim [rad]
 AERO_MODELS = ("quasi-steady", "unsteady")  # the wing's strip aerodynamics (``aero``)
 # The JSBSim properties of a snapshot (JSBSim units, as the names say).
 PROPERTIES: Mapping[str, str] = MappingProxyType({
@@ -229,11 +228,11 @@ class CoupledStep(FullSpanSteps):
         configure_airframe(airframe, dt_s, modal_hooks=not native)
         if before_trim is not None:
             before_trim(airframe)
-        self.elastic_trim = None
-        if trim_mode == "elastic":
-            trim, self.elastic_trim = _trim_elastic(airframe, build, speed_m_s, altitude_m)
-        elif trim is None:
-            trim = airframe.trim(speed_m_s, altitude_m)
+        if trim_mode == "elastic" or trim is None:
+            trim = airframe.trim(speed_m_s, altitude_m,
+                                 wing=build if trim_mode == "elastic" else None)
+        # the wing's static state of the elastic trim; None flying from the rigid trim
+        self.elastic_trim = trim.elastic if trim_mode == "elastic" else None
         self.trim = trim
         self.trim_mode = trim_mode
         self.speed_m_s = float(speed_m_s)
@@ -838,33 +837,6 @@ def _step_options(wing, model: str, aero: str, trim_mode: str, trim) -> tuple:
     if model_ is None and model != "native":
         raise InputError(f"the {model} model needs a wing")
     return build, model_
-
-
-def _trim_elastic(airframe: Airframe, build: WingBuild, speed_m_s: float, altitude_m: float):
-    """JSBSim's trim of the rigid states carrying the static wing loads of the elastic trim
-    (:func:`bioflex_jsb.flight_dynamics.elastic_trim.elastic_trim` with JSBSim as its rigid
-    trim): (the final JSBSim trim, the elastic trim). The loads, lift and drag against the
-    air, go into the external reactions in body axes with the trim's α; the airframe is left
-    trimmed with them. Beyond the wing's static divergence speed: InputError, one line."""
-    from bioflex_jsb.flight_dynamics.elastic_trim import RigidTrimPoint, elastic_trim
-
-    state = {"trim": airframe.trim(speed_m_s, altitude_m)}  # rigid: the start, and ρ
-
-    def jsbsim_trim(loads) -> RigidTrimPoint:
-        alpha = state["trim"].alpha_rad
-        ca, sa = math.cos(alpha), math.sin(alpha)
-        airframe.set_external_reactions(loads.lift_n * ca + loads.drag_n * sa,
-                                        loads.drag_n * ca - loads.lift_n * sa,
-                                        loads.pitch_moment_n_m)
-        state["trim"] = airframe.trim(speed_m_s, altitude_m)
-        return RigidTrimPoint(state["trim"].alpha_rad, state["trim"].elevator_rad)
-
-    rho = airframe[JP.ATMOSPHERE_RHO_SLUGS_FT3] * U.KG_M3_PER_SLUG_FT3
-    # JSBSim's trim resolves α to its own tolerances: 1e-6 rad is well within them
-    elastic = elastic_trim(build, speed_m_s, density_kg_m3=rho, rigid_trim=jsbsim_trim,
-                           tol_rad=ELASTIC_TRIM_TOL_RAD)
-    jsbsim_trim(elastic.loads)  # leave the airframe trimmed with the final loads
-    return state["trim"], elastic
 
 
 def _check_pair(airframe: Airframe, data) -> None:

@@ -86,7 +86,7 @@ def start(fdm, engines: tuple[Engine, ...]) -> None:
                 fdm[name] = 1.0
     fdm.run_ic()
     for e in engines:
-        name = f"propulsion/engine[{e.index}]/set-running"
+        name = JP.engine(e.index, "set-running")
         if manager.hasNode(name) and fdm[name] < 0.5:
             raise TrimError(f"engine {e.index} ({e.kind}, {e.file}) did not start: JSBSim "
                             f"leaves it stopped after propulsion/set-running (its fuel, "

@@ -60,6 +60,7 @@ Linearization: :mod:`bioflex_jsb.runtime.linearization` (the reduction to x_R = 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 from collections.abc import Callable, Iterator
@@ -125,6 +126,9 @@ TRIM_MODE_FULL = 1
 # [rad/s²]; the flying instance, set to the companion's trim, must meet them too.
 TRIM_TOLERANCE_FT_S2 = 1e-3
 TRIM_TOLERANCE_RAD_S2 = 1e-4
+# The elastic trim's fixed point on α with JSBSim's trim [rad]: JSBSim's trim resolves α to
+# its own tolerances (above), 1e-6 rad is well within them.
+ELASTIC_TRIM_TOL_RAD = 1e-6
 # Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
 # throttle commands of every engine are added per aircraft.
 TRIM_CONTROLS = (
@@ -304,7 +308,7 @@ class Airframe:
     def total_thrust_n(self) -> float:
         """Thrust of all engines (the contra-rotating pair) [N]."""
         lbs = sum(
-            float(self._fdm[f"propulsion/engine[{i}]/thrust-lbs"]) for i in range(self.engine_count)
+            float(self._fdm[JP.engine(i, "thrust-lbs")]) for i in range(self.engine_count)
         )
         return lbs * U.N_PER_LBF
 
@@ -364,15 +368,52 @@ class Airframe:
             fdm.run_ic()
 
     # ---- trim -----------------------------------------------------------------------
-    def trim(self, speed_m_s: float, altitude_m: float = 0.0) -> TrimResult:
-        """Trim for level flight in still air at ``speed_m_s`` [m/s], ``altitude_m`` [m]
-        (JSBSim full trim of the companion, the flying instance set to it: module docstring).
+    def trim(self, speed_m_s: float, altitude_m: float = 0.0, wing=None) -> TrimResult:
+        """The one trim of the airframe: level flight in still air at ``speed_m_s`` [m/s],
+        ``altitude_m`` [m] (JSBSim full trim of the companion, the flying instance set to
+        it: module docstring; an aircraft without an engine: its steady glide,
+        runtime/glide.py).
+
+        ``wing``: a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild` for the
+        elastic trim: this rigid trim carrying the wing's static loads, solved to their
+        fixed point by :func:`bioflex_jsb.flight_dynamics.elastic_trim.elastic_trim` with
+        this trim as its rigid trim. The loads (lift and drag against the air) go into the
+        external reactions in body axes at the trim's α; the airframe is left trimmed with
+        them and the result carries the wing's static state in ``elastic``. None: the rigid
+        trim (the external reactions as they are).
 
         Raises:
-            ValueError: speed or altitude outside the accepted range.
+            InputError: speed or altitude outside the accepted range; with ``wing``, a
+                speed at or beyond the wing's static divergence speed.
             TrimError: JSBSim's trim failed, or the flying instance is not in trim at the
                 companion's trim point; one-line diagnosis.
         """
+        if wing is None:
+            return self._rigid_trim(speed_m_s, altitude_m)
+        return self._elastic_trim(wing, speed_m_s, altitude_m)
+
+    def _elastic_trim(self, build, speed_m_s: float, altitude_m: float) -> TrimResult:
+        """The rigid trim with the wing's static loads at their fixed point (:meth:`trim`)."""
+        from bioflex_jsb.flight_dynamics.elastic_trim import RigidTrimPoint, elastic_trim
+
+        state = {"trim": self._rigid_trim(speed_m_s, altitude_m)}  # the start, and ρ
+
+        def jsbsim_trim(loads) -> RigidTrimPoint:
+            alpha = state["trim"].alpha_rad
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            self.set_external_reactions(loads.lift_n * ca + loads.drag_n * sa,
+                                        loads.drag_n * ca - loads.lift_n * sa,
+                                        loads.pitch_moment_n_m)
+            state["trim"] = self._rigid_trim(speed_m_s, altitude_m)
+            return RigidTrimPoint(state["trim"].alpha_rad, state["trim"].elevator_rad)
+
+        rho = float(self._fdm[JP.ATMOSPHERE_RHO_SLUGS_FT3]) * U.KG_M3_PER_SLUG_FT3
+        elastic = elastic_trim(build, speed_m_s, density_kg_m3=rho, rigid_trim=jsbsim_trim,
+                               tol_rad=ELASTIC_TRIM_TOL_RAD)
+        jsbsim_trim(elastic.loads)  # leave the airframe trimmed with the final loads
+        return dataclasses.replace(state["trim"], elastic=elastic)
+
+    def _rigid_trim(self, speed_m_s: float, altitude_m: float) -> TrimResult:
         v = _check_speed(speed_m_s)
         h = _check_altitude(altitude_m)
         self._restore_time_step()
@@ -484,7 +525,7 @@ class Airframe:
         line = diagnose_trim_failure(text, v, self.alpha_limits_rad,
                                      self._first_message(jsbsim.LogLevel.WARN), engine)
         stopped = [e for e in self.engines
-                   if self._has(name := f"propulsion/engine[{e.index}]/engine-rpm")
+                   if self._has(name := JP.engine(e.index, "engine-rpm"))
                    and self._trim_fdm[name] <= 0.0]
         if stopped and not self.has_companion:
             names = ", ".join(f"{e.index} ({e.kind}, {e.file})" for e in stopped)

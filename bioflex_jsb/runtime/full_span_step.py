@@ -24,7 +24,7 @@ from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
 
 SPANS = ("half", "full")
 AILERON_PROPERTIES = (JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD)
-IXX_PROPERTY = "inertia/ixx-slugs_ft2"
+IXX_PROPERTY = JP.INERTIA_IXX_SLUGS_FT2
 
 
 def _check_span(span: str, build, model: str, aero: str) -> None:

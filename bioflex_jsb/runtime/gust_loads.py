@@ -65,8 +65,8 @@ GUST_HOOKS = ("gust-lift", "gust-pitch", "gust-roll", "gust-yaw")
 BLOCK_STEPS = 256  # the field's parts are computed this many steps at a time
 # The run's extra channels (units): the parts the loads were written from.
 GUST_CHANNELS = {"p_g": "rad/s", "v_g": "m/s", "w_g_tail": "m/s"}
-_BI2VEL, _QBAR, _VT = "aero/bi2vel", JP.AERO_QBAR_PSF, "velocities/vt-fps"
-_SW, _BW = "metrics/Sw-sqft", "metrics/bw-ft"
+_BI2VEL, _QBAR, _VT = JP.AERO_BI2VEL, JP.AERO_QBAR_PSF, JP.VELOCITIES_VT_FPS
+_SW, _BW = JP.METRICS_SW_SQFT, JP.METRICS_BW_FT
 
 
 def span_stations(build, airframe_data) -> SpanStations:

@@ -73,8 +73,8 @@ HOLD_PASSES = 8
 # at 4e-7 ft/s², the rounding of its forces).
 HOLD_TOLERANCE_FT_S2 = 1e-6
 
-HOOK_LIFT = "external_reactions/modal-lift/magnitude"  # along body −z [lbf]
-HOOK_DRAG = "external_reactions/modal-drag/magnitude"  # along body −x [lbf]
+HOOK_LIFT = JP.external_force_magnitude("modal-lift")  # along body −z [lbf]
+HOOK_DRAG = JP.external_force_magnitude("modal-drag")  # along body −x [lbf]
 
 
 @dataclass(frozen=True)
@@ -185,7 +185,7 @@ class Evaluator:
         fdm[JP.FCS_AILERON_CMD_NORM] = s.aileron_cmd
         fdm[JP.FCS_RUDDER_CMD_NORM] = s.rudder_cmd
         for e in self.engines:
-            fdm[f"fcs/throttle-cmd-norm[{e.index}]"] = s.throttle
+            fdm[JP.throttle_cmd(e.index)] = s.throttle
         lift_hook = drag_hook = 0.0
         for k in range(HOLD_PASSES):
             fdm[HOOK_LIFT], fdm[HOOK_DRAG] = lift_hook, drag_hook
@@ -377,7 +377,7 @@ def identify_lateral(airframe, speed_m_s: float, reference: ReferenceGeometry,
     theta0 = float(fdm[JP.ATTITUDE_THETA_RAD])
     slug_ft2 = U.KG_PER_SLUG * U.M_PER_FT**2
     mass = float(fdm[JP.INERTIA_MASS_SLUGS]) * U.KG_PER_SLUG
-    ixx, izz, j13 = (float(fdm[f"inertia/{k}-slugs_ft2"]) * slug_ft2
+    ixx, izz, j13 = (float(fdm[JP.inertia_slugs_ft2(k)]) * slug_ft2
                      for k in ("ixx", "izz", "ixz"))
     rho = float(fdm[JP.ATMOSPHERE_RHO_SLUGS_FT3]) * U.KG_PER_SLUG / U.M_PER_FT**3
     s_ref, b = reference.area_m2, reference.span_m

@@ -101,15 +101,15 @@ def probe(jsbsim_path: str) -> JSBSimValues:
         with captured(log):
             fdm.run_ic()
         ft2 = U.M_PER_FT**2
-        inertia = Inertia(*(fdm[f"inertia/{k}-slugs_ft2"] * SLUG_FT2_KG_M2
+        inertia = Inertia(*(fdm[JP.inertia_slugs_ft2(k)] * SLUG_FT2_KG_M2
                             for k in ("ixx", "iyy", "izz", "ixz")))
         return JSBSimValues(
             reference_area_m2=fdm[JP.METRICS_SW_SQFT] * ft2, span_m=fdm[JP.METRICS_BW_FT] *
             U.M_PER_FT, mean_chord_m=fdm[JP.METRICS_CBARW_FT] * U.M_PER_FT,
             mass_kg=fdm[JP.INERTIA_MASS_SLUGS] * U.KG_PER_SLUG,
-            cg_m=tuple(fdm[f"inertia/cg-{a}-in"] * INCH_M for a in "xyz"),
+            cg_m=tuple(fdm[JP.cg_in(a)] * INCH_M for a in "xyz"),
             inertia=inertia,
-            aero_reference_point_m=tuple(fdm[f"metrics/aero-rp-{a}-in"] * INCH_M
+            aero_reference_point_m=tuple(fdm[JP.aero_rp_in(a)] * INCH_M
                                          for a in "xyz"),
             source=f"JSBSim aircraft {jsbsim_path}")
     finally:

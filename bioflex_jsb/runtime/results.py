@@ -62,6 +62,9 @@ class TrimResult:
     converged: bool
     residuals: dict[str, float] = field(default_factory=dict)
     flight_path_rad: float = 0.0  # γ [rad], positive climbing: 0 level, < 0 a glide
+    # the elastic trim's static wing state (flight_dynamics.elastic_trim.ElasticTrim) the
+    # rigid trim carries; None for a rigid trim (runtime/fdm.py Airframe.trim)
+    elastic: object | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)

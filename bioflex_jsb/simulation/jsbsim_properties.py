@@ -22,6 +22,7 @@ AERO_FORCE_MODAL_DRAG = "aero/force/modal-drag"
 AERO_FORCE_MODAL_LIFT = "aero/force/modal-lift"
 AERO_MOMENT_MODAL_PITCH = "aero/moment/modal-pitch"
 AERO_QBAR_PSF = "aero/qbar-psf"
+AERO_BI2VEL = "aero/bi2vel"  # b/(2V) [s]
 
 # atmosphere/
 ATMOSPHERE_RHO_SLUGS_FT3 = "atmosphere/rho-slugs_ft3"
@@ -87,6 +88,7 @@ IC_W_FPS = "ic/w-fps"
 
 # inertia/
 INERTIA_MASS_SLUGS = "inertia/mass-slugs"
+INERTIA_IXX_SLUGS_FT2 = "inertia/ixx-slugs_ft2"
 
 # metrics/
 METRICS_SW_SQFT = "metrics/Sw-sqft"
@@ -120,6 +122,11 @@ VELOCITIES_V_EAST_FPS = "velocities/v-east-fps"
 VELOCITIES_V_FPS = "velocities/v-fps"
 VELOCITIES_V_NORTH_FPS = "velocities/v-north-fps"
 VELOCITIES_W_FPS = "velocities/w-fps"
+VELOCITIES_VT_FPS = "velocities/vt-fps"
+
+# simulation/: JSBSim's integrator choices (FGPropagate)
+INTEGRATOR_PROPERTIES = tuple(f"simulation/integrator/{a}/{b}" for a in ("rate", "position")
+                              for b in ("rotational", "translational"))
 
 
 def engine(index: int, leaf: str) -> str:
@@ -130,3 +137,23 @@ def engine(index: int, leaf: str) -> str:
 def throttle_cmd(index: int) -> str:
     """The throttle command of engine ``index`` [0..1]."""
     return f"fcs/throttle-cmd-norm[{index}]"
+
+
+def inertia_slugs_ft2(moment: str) -> str:
+    """``inertia/<moment>-slugs_ft2``: ``ixx``, ``iyy``, ``izz``, ``ixz`` [slug·ft²]."""
+    return f"inertia/{moment}-slugs_ft2"
+
+
+def cg_in(axis: str) -> str:
+    """The CG's structural-frame coordinate ``axis`` (x, y, z) [in]."""
+    return f"inertia/cg-{axis}-in"
+
+
+def aero_rp_in(axis: str) -> str:
+    """The aerodynamic reference point's structural-frame coordinate ``axis`` [in]."""
+    return f"metrics/aero-rp-{axis}-in"
+
+
+def external_force_magnitude(name: str) -> str:
+    """The magnitude [lbf] of the external force ``name`` (``modal-lift``, ...)."""
+    return f"external_reactions/{name}/magnitude"
