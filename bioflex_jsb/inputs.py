@@ -258,7 +258,7 @@ class Interval(Kind):
     python_type: ClassVar[Any] = tuple[float, float]
 
     def accepted(self) -> str:
-        high = f" <= {_g(self.hi)}" if self.hi < math.inf else ""
+        high = f" <= {_g(self.hi)} {self.unit}" if self.hi < math.inf else ""
         op = "<=" if self.from_lo else "<"
         return f"[low, high] {self.unit} with {_g(self.lo)} {op} low < high{high}{self.hint}"
 
