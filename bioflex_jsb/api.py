@@ -23,7 +23,7 @@ are data objects with named channels and units (``TimeHistory``) or named signal
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -45,7 +45,12 @@ from bioflex_jsb.definition.aircraft import Aircraft
 from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
 from bioflex_jsb.definition.clamped import free_speed_range_m_s as _free_speed_range_m_s
 from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
-from bioflex_jsb.definition.loader import DAMPING_RANGE, DENSITY_RANGE_KG_M3, LIFT_SLOPES
+from bioflex_jsb.definition.loader import (
+    DAMPING_RANGE,
+    DENSITY_RANGE_KG_M3,
+    LIFT_SLOPES,
+    SPEED_LIMIT_M_S,
+)
 from bioflex_jsb.drivers.compare import (
     Comparison,
     check_comparable,
@@ -64,7 +69,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     build_wing,
     resolve_variant,
 )
-from bioflex_jsb.inputs import Real, argument
+from bioflex_jsb.inputs import Choice, Interval, Real, argument
 from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
@@ -75,7 +80,6 @@ from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 from bioflex_jsb.simulation.results import GustMetrics, TimeHistory, gust_metrics
 from bioflex_jsb.simulation.run import check_run_length
 from bioflex_jsb.simulation.run_checks import check_recorders
-from bioflex_jsb.simulation.run_checks import finite_number as _real
 
 __all__ = [
     "DEFAULT_DT_S", "Aircraft", "Comparison", "FlutterResult", "GustMetrics", "StateSpace",
@@ -176,7 +180,7 @@ class _Subject:
         if self.aircraft is None:
             return CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
         cruise, (lo, hi) = flight_speeds(self.aircraft)
-        v = cruise if speed_m_s is None else _real(speed_m_s, "speed_m_s [m/s]")
+        v = cruise if speed_m_s is None else _real(speed_m_s, "speed_m_s", "m/s")
         if not lo <= v <= hi:
             raise InputError(f"speed {v:g} m/s is outside aircraft {self.aircraft.name!r}'s "
                              f"flight speeds {lo:g}..{hi:g} m/s (airframe.speed_range_m_s)")
@@ -226,18 +230,11 @@ class _Subject:
 LINEAR_SPEED_MIN_M_S = 0.1
 
 
-def _linear_speed(speed_m_s) -> float:
+def _linear_speed(speed_m_s, name: str = "speed_m_s") -> float:
     """A linear analysis' speed [m/s]: finite, LINEAR_SPEED_MIN_M_S <= V <= SPEED_LIMIT_M_S
     (the strips are incompressible; a speed of 1e5 m/s took 71 s and answered nothing
     physical)."""
-    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
-
-    v = _real(speed_m_s, "speed_m_s [m/s]")
-    if not LINEAR_SPEED_MIN_M_S <= v <= SPEED_LIMIT_M_S:
-        raise InputError(f"speed {v:g} m/s is outside {LINEAR_SPEED_MIN_M_S:g}.."
-                         f"{SPEED_LIMIT_M_S:g} m/s (the strip aerodynamics are "
-                         "incompressible)")
-    return v
+    return argument(LINEAR_SPEED, speed_m_s, name)
 
 
 def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:3",
@@ -336,11 +333,9 @@ def _lateral_options(subject, build, span: str, aileron_step_deg, aileron_start_
     _check_choice("span", span, ("half", "full"))
     options: dict = {}
     if aileron_step_deg is not None:
-        deg = _real(aileron_step_deg, "aileron_step_deg [deg]")
-        if abs(deg) > 30.0:
-            raise InputError(f"aileron_step_deg must be within ±30 deg, got {deg:g}")
+        deg = argument(AILERON_STEP, aileron_step_deg, "aileron_step_deg")
         options["aileron_input"] = AileronInput("step", float(np.radians(deg)),
-                                                _real(aileron_start_s, "aileron_start_s [s]"))
+                                                _real(aileron_start_s, "aileron_start_s", "s"))
     if span == "half":
         return options
     aileron = (subject.aircraft.definition.aileron if subject.aircraft is not None
@@ -354,9 +349,8 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
     native XML wing, ``aircraft/bioflex_optimised``), flown for ``duration_s`` [s]. The
     golden check cases."""
     _check_choice("model", model, (*RUN_MODELS, "native"))
-    duration_s = _real(duration_s, "duration_s [s]")
-    if duration_s <= 0.0:  # 0 s returned an empty run, −1 s a numpy "negative dimensions"
-        raise InputError(f"duration_s must be > 0 s, got {duration_s:g}")
+    # 0 s returned an empty run, −1 s a numpy "negative dimensions"
+    duration_s = argument(Real("s", positive=True), duration_s, "duration_s")
     check_run_length(duration_s, DEFAULT_DT_S, turbulence=False)
     setup = RunConfig(15.0, parse_gust("sharp:3"), duration_s)
     if model == "native":
@@ -386,8 +380,7 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     run's step with the run's one step of delay, :mod:`bioflex_jsb.simulation.closed_loop`);
     its commands are compared too (``ctrl_<command>``). The quasi-steady ``coupled``,
     ``qsd`` or ``rigid`` model about the rigid trim."""
-    if model not in MODELS:
-        raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+    _check_choice("model", model, MODELS)
     check_comparable(model, aero, trim, controller is not None)  # before flying
     check_gust_excites(parse_gust(_gust_text(gust)))
     if controller is not None:
@@ -411,7 +404,7 @@ def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:
         raise InputError(f"run: a TimeHistory (fly_gust's), not {type(run).__name__}")
     if gust_start_s is None:
         gust_start_s = run.meta.get("gust_start_s", 0.5)
-    gust_start_s = _real(gust_start_s, "gust_start_s [s]")
+    gust_start_s = _real(gust_start_s, "gust_start_s", "s")
     return gust_metrics(run, gust_start_s)
 
 
@@ -482,8 +475,7 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     air = subject.density(None)
     speed_m_s = subject.analysis_speed(speed_m_s)
     wing = subject.build
-    if trim not in ("rigid", "elastic"):
-        raise InputError(f"unknown trim {trim!r}; accepted: rigid, elastic")
+    _check_choice("trim", trim, ("rigid", "elastic"))
     if trim == "elastic":
         if aero != "quasi-steady" or wing is None:
             raise InputError("trim='elastic' linearises the quasi-steady coupled or qsd model "
@@ -495,10 +487,8 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
 
         return linearise_about_elastic_trim(model, elastic_trim(wing, speed_m_s, **air),
                                             wing.model)
-    if aero not in AERO_MODELS:
-        raise InputError(f"unknown aerodynamics {aero!r}; accepted: {', '.join(AERO_MODELS)}")
-    if model not in MODELS:
-        raise InputError(f"unknown model {model!r}; accepted: {', '.join(MODELS)}")
+    _check_choice("aerodynamics", aero, AERO_MODELS)
+    _check_choice("model", model, MODELS)
     if aero == "unsteady":
         if model != "coupled" or wing is None:
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
@@ -656,9 +646,35 @@ def _clamped(definition, lift_slope: str | None):
     return d, clamped_model(d, lift_slope)
 
 
+# The API's arguments are checked by bioflex_jsb.inputs' kinds and reported by
+# inputs.argument as one line, "<argument>: <what is wrong; what is accepted>".
 def _check_choice(what: str, value, accepted) -> None:
-    if value not in accepted:
-        raise InputError(f"unknown {what} {value!r}; accepted: {', '.join(accepted)}")
+    """``value`` one of ``accepted``: "<argument>: unknown <what> 'x'; accepted: …"."""
+    name = {"aerodynamics": "aero"}.get(what, what)
+    argument(Choice(tuple(accepted), noun=what), value, name)
+
+
+def _real(value, name: str, unit: str) -> float:
+    """A finite number [unit]: "<name>: must be a finite number in <unit>, got …"."""
+    return argument(Real(unit), value, name)
+
+
+def _speed_range(range_m_s, kind: Interval) -> tuple[float, float]:
+    """A (low, high) speed range [m/s] (any sequence of two numbers: a tuple, a list, a
+    numpy array) checked by ``kind``: "range_m_s: must be [low, high] m/s with …"."""
+    if isinstance(range_m_s, Iterable) and not isinstance(range_m_s, str | bytes | Mapping):
+        range_m_s = tuple(range_m_s)
+    return argument(kind, range_m_s, "range_m_s")
+
+
+# A linear analysis' speed [m/s]: LINEAR_SPEED_MIN_M_S..SPEED_LIMIT_M_S (the strips are
+# incompressible; a speed of 1e5 m/s took 71 s and answered nothing physical)
+LINEAR_SPEED = Real("m/s", LINEAR_SPEED_MIN_M_S, SPEED_LIMIT_M_S,
+                    hint=" (the strip aerodynamics are incompressible)")
+# A flutter search's speed range [m/s]: above 0, within the definitions' speed limit
+SPEED_RANGE = Interval("m/s", 0.0, SPEED_LIMIT_M_S)
+# An aileron step [deg]: within the prototype aileron's ±30 deg travel
+AILERON_STEP = Real("deg", -30.0, 30.0)
 
 
 # Air density [kg/m^3] and structural damping ratio ζ [-] of the API's analyses: the
@@ -786,15 +802,7 @@ def flutter(wing, range_m_s: tuple[float, float] | None = None, *,
                                     density_kg_m3=density_kg_m3, lift_slope=lift_slope,
                                     progress=progress, full_scan=full_scan)
     if range_m_s is not None:
-        from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
-
-        if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
-                or len(tuple(range_m_s)) != 2:  # a bare number: "int is not iterable"
-            raise InputError(f"flutter range must be (low, high) [m/s], got {range_m_s!r}")
-        lo, hi = (_real(x, "flutter range [m/s]") for x in range_m_s)
-        if not 0.0 < lo < hi <= SPEED_LIMIT_M_S:
-            raise InputError(f"flutter range must satisfy 0 < low < high <= "
-                             f"{SPEED_LIMIT_M_S:g} m/s, got {lo:g}:{hi:g}")
+        _speed_range(range_m_s, SPEED_RANGE)
     if density_kg_m3 is not None:
         _check_density(density_kg_m3)
     structural_damping = _check_damping(structural_damping)
@@ -920,17 +928,10 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
     ``lift_slope`` (``strip``, ``vlm``: a clamped wing's; an aircraft's is the lattice's)
     to the definition's."""
     from bioflex_jsb.aeroelasticity import aileron as A
-    from bioflex_jsb.definition.loader import SPEED_LIMIT_M_S
 
     if range_m_s is not None:
-        if isinstance(range_m_s, str) or not isinstance(range_m_s, Iterable) \
-                or len(tuple(range_m_s)) != 2:
-            raise InputError(f"range must be (low, high) [m/s], got {range_m_s!r}")
-        lo, hi = (_real(x, "range [m/s]") for x in range_m_s)
-        if not 0.0 <= lo < hi <= SPEED_LIMIT_M_S:
-            raise InputError(f"range must satisfy 0 <= low < high <= {SPEED_LIMIT_M_S:g} m/s, "
-                             f"got {lo:g}:{hi:g}")
-        range_m_s = (lo, hi)
+        range_m_s = _speed_range(range_m_s, Interval("m/s", 0.0, SPEED_LIMIT_M_S,
+                                                     from_lo=True))
     if lift_slope is not None:
         _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
     cruise = None
@@ -1043,7 +1044,7 @@ def section_loads(wing, run: TimeHistory, stations=None, *,
         if isinstance(stations, str | bytes) or not isinstance(stations, Iterable):
             raise InputError(f"stations: a sequence of fractions of the semispan (e.g. "
                              f"(0.0, 0.5)), not {stations!r}")
-        stations = [_real(x, "station [fraction of the semispan]") for x in stations]
+        stations = [_real(x, "stations", "fraction of the semispan") for x in stations]
     if density_kg_m3 is not None:
         density_kg_m3 = _check_density(density_kg_m3)
     return _section_loads(build, run, stations, static=static, density_kg_m3=density_kg_m3)
@@ -1106,11 +1107,9 @@ def predict_alleviation(wing, controller, speed_m_s: float | None = None,
     from bioflex_jsb.loads.alleviation import predict
 
     controller = linear_controller(controller)
-    u_ref = _real(u_ref_m_s, "u_ref_m_s [m/s]")
-    if u_ref <= 0.0:
-        raise InputError(f"u_ref_m_s must be > 0 m/s, got {u_ref:g}")
+    u_ref = argument(Real("m/s", positive=True), u_ref_m_s, "u_ref_m_s")
     _, _, plant = _gla_plant(wing, speed_m_s)
-    return predict(plant, controller, _real(dt_s, "dt_s [s]"), u_ref_m_s=u_ref)
+    return predict(plant, controller, _real(dt_s, "dt_s", "s"), u_ref_m_s=u_ref)
 
 
 def design_alleviation(wing, speed_m_s: float | None = None,
@@ -1129,12 +1128,11 @@ def design_alleviation(wing, speed_m_s: float | None = None,
     from bioflex_jsb.simulation.controller import check_signals
 
     signals = check_signals(signals)
-    limit = _real(elevator_limit_rad, "elevator_limit_rad [rad]")
-    if not 0.0 < limit <= 0.5:
-        raise InputError(f"elevator_limit_rad must be in (0, 0.5] rad, got {limit:g}")
+    limit = argument(Real("rad", hi=0.5, positive=True), elevator_limit_rad,
+                     "elevator_limit_rad")
     _, v, plant = _gla_plant(wing, speed_m_s)
-    ctrl, record = design_output_feedback(plant, _real(dt_s, "dt_s [s]"), signals,
-                                          u_ref_m_s=_real(u_ref_m_s, "u_ref_m_s [m/s]"),
+    ctrl, record = design_output_feedback(plant, _real(dt_s, "dt_s", "s"), signals,
+                                          u_ref_m_s=_real(u_ref_m_s, "u_ref_m_s", "m/s"),
                                           elevator_limit_rad=limit)
     record["speed_m_s"] = v
     gains = [record["gains"][s] for s in signals]
@@ -1159,11 +1157,10 @@ def closed_loop_flutter(wing, controller=None, range_m_s: tuple[float, float] = 
     if build is None:
         raise InputError("closed-loop flutter needs an elastic wing")
     ctrl = None if controller is None else linear_controller(controller)
-    if range_m_s is None or isinstance(range_m_s, str) or len(tuple(range_m_s)) != 2:
-        raise InputError(f"range must be (low, high) [m/s], got {range_m_s!r}")
-    lo, hi = (_linear_speed(x) for x in range_m_s)
-    return _search(build, ctrl, (lo, hi), step_m_s=_real(step_m_s, "step_m_s [m/s]"),
-                   tol_m_s=_real(tol_m_s, "tol_m_s [m/s]"), dt_s=_real(dt_s, "dt_s [s]"))
+    lo, hi = _speed_range(range_m_s, Interval("m/s", LINEAR_SPEED_MIN_M_S, SPEED_LIMIT_M_S,
+                                              from_lo=True))
+    return _search(build, ctrl, (lo, hi), step_m_s=_real(step_m_s, "step_m_s", "m/s"),
+                   tol_m_s=_real(tol_m_s, "tol_m_s", "m/s"), dt_s=_real(dt_s, "dt_s", "s"))
 
 
 def design_flutter_suppression(wing, design_speed_m_s: float = 21.0,
@@ -1181,6 +1178,6 @@ def design_flutter_suppression(wing, design_speed_m_s: float = 21.0,
     build = _Subject.of(wing).build
     if build is None:
         raise InputError("flutter suppression needs an elastic wing")
-    v = _linear_speed(design_speed_m_s)
+    v = _linear_speed(design_speed_m_s, "design_speed_m_s")
     return design_static_feedback(build, v, signals, low_speed_m_s=min(17.0, v - 1.0),
-                                  dt_s=_real(dt_s, "dt_s [s]"))
+                                  dt_s=_real(dt_s, "dt_s", "s"))

@@ -246,17 +246,21 @@ class Triple(Kind):
 @dataclass(frozen=True)
 class Interval(Kind):
     """Two numbers [low, high] [unit] with lo < low < high <= hi (a speed range: its low end
-    above ``lo``, 0 by default); ``hint`` says where it comes from."""
+    above ``lo``, 0 by default; ``from_lo``: lo <= low); ``hint`` says where it comes from.
+    A list or a tuple (an API argument: any sequence but a string, made a tuple by the
+    caller)."""
 
     unit: str
     lo: float = 0.0
     hi: float = math.inf
     hint: str = ""
+    from_lo: bool = False
     python_type: ClassVar[Any] = tuple[float, float]
 
     def accepted(self) -> str:
-        high = f" <= {_g(self.hi)}" if self.hi < math.inf else ""
-        return f"[low, high] {self.unit} with {_g(self.lo)} < low < high{high}{self.hint}"
+        high = f" <= {_g(self.hi)} {self.unit}" if self.hi < math.inf else ""
+        op = "<=" if self.from_lo else "<"
+        return f"[low, high] {self.unit} with {_g(self.lo)} {op} low < high{high}{self.hint}"
 
     def missing_text(self) -> str:
         return f"missing ({self.accepted()})"
@@ -264,7 +268,8 @@ class Interval(Kind):
     def check(self, value: Any) -> tuple[float, float]:
         ok = (isinstance(value, list | tuple) and len(value) == 2
               and all(is_finite_real(x) for x in value)
-              and self.lo < value[0] < value[1] <= self.hi)
+              and (self.lo <= value[0] if self.from_lo else self.lo < value[0])
+              and value[0] < value[1] <= self.hi)
         if not ok:
             raise Invalid(f"must be {self.accepted()}, got {value!r}")
         return (float(value[0]), float(value[1]))
@@ -278,6 +283,29 @@ def unknown_keys(table: Mapping, accepted: Sequence[str]) -> str | None:
     """The first (sorted) key of ``table`` that is not ``accepted``, or None."""
     unknown = sorted(str(k) for k in set(table) - set(accepted))
     return unknown[0] if unknown else None
+
+
+def unknown_key_text(key: str, accepted: Sequence[str]) -> str:
+    """The one wording of an unknown key, in every reader: ``unknown key 'X'; accepted: a,
+    b, c`` (the accepted keys sorted; the line's field is the table that holds the key)."""
+    return f"unknown key {str(key)!r}; accepted: {', '.join(sorted(accepted))}"
+
+
+def check_keys(table: Mapping, accepted: Sequence[str]) -> None:
+    """:class:`Invalid` (:func:`unknown_key_text`) for the first (sorted) key of ``table``
+    that is not ``accepted``."""
+    unknown = unknown_keys(table, accepted)
+    if unknown is not None:
+        raise Invalid(unknown_key_text(unknown, accepted))
+
+
+def more_text(n: int) -> str:
+    """What follows the first problem of a reader that finds several at once (a
+    :class:`Table`): `` (and N more problems)``; nothing for none. The first problem is
+    reported in full and the others counted, so that the message stays one line."""
+    if n <= 0:
+        return ""
+    return f" (and {n} more problem{'s' if n > 1 else ''})"
 
 
 # ---------------------------------------------------------------------------------------
@@ -338,7 +366,8 @@ def read_table(model: type[T], data: Any, where: str, error: type[InputError],
                          table: str = "") -> T:
     """``data`` checked as ``model``; the first problem raises ``error`` with one line
     (:func:`problem`): an unknown key first (the first in sorted order, with the accepted
-    keys), then the first field in declaration order."""
+    keys), then the first field in declaration order; the others pydantic found are
+    counted after it (:func:`more_text`)."""
     prefix = [table] if table else []
     if not isinstance(data, Mapping):
         raise problem(error, where, table, "must be a table")
@@ -349,17 +378,23 @@ def read_table(model: type[T], data: Any, where: str, error: type[InputError],
     extras = sorted((e for e in errors if e["type"] == "extra_forbidden"),
                     key=lambda e: [str(p) for p in e["loc"]])
     first = extras[0] if extras else errors[0]
-    loc = list(first["loc"])
+    field, text = _error_line(model, first, prefix)
+    raise problem(error, where, field, text + more_text(len(errors) - 1))
+
+
+def _error_line(model: type[BaseModel], error: Any, prefix: list[str]) -> tuple[str, str]:
+    """One pydantic error as (field, text) in the kinds' wording."""
+    loc = list(error["loc"])
     field = field_path([*prefix, *loc])
-    if first["type"] == "extra_forbidden":
+    if error["type"] == "extra_forbidden":
         keys = accepted_keys(_nested_model(model, loc))
-        raise problem(error, where, field, f"unknown key; accepted: {', '.join(keys)}")
-    if first["type"] == _KIND_ERROR:
-        raise problem(error, where, field, first["ctx"]["text"])
+        return field_path([*prefix, *loc[:-1]]), unknown_key_text(str(loc[-1]), keys)
+    if error["type"] == _KIND_ERROR:
+        return field, error["ctx"]["text"]
     kind = _kind_of(model, loc)
-    if first["type"] == "missing":
-        raise problem(error, where, field, kind.missing_text() if kind else "missing")
-    if first["type"] in ("model_type", "model_attributes_type", "dict_type"):
-        raise problem(error, where, field, "must be a table")
+    if error["type"] == "missing":
+        return field, kind.missing_text() if kind else "missing"
+    if error["type"] in ("model_type", "model_attributes_type", "dict_type"):
+        return field, "must be a table"
     # any other type check of pydantic's (a tuple's length, a list): its message, one line
-    raise problem(error, where, field, f"{first['msg']}, got {first.get('input')!r}")
+    return field, f"{error['msg']}, got {error.get('input')!r}"

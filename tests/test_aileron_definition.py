@@ -49,7 +49,8 @@ BAD = [
     ("span = [0.5, 0.9]", "aileron.hinge", "missing"),
     ("span = [0.5, 0.9]\nhinge = 25", "aileron.hinge", "a 25 %-chord aileron is 0.75"),
     ("span = [0.5, 0.9]\nhinge = 0.3", "aileron.hinge", "0.5..0.95"),
-    ("span = [0.5, 0.9]\nhinge = 0.75\nchord = 0.2", "aileron.chord", "unknown field"),
+    ("span = [0.5, 0.9]\nhinge = 0.75\nchord = 0.2", "aileron",
+     "unknown key 'chord'; accepted: "),
     ("span = [0.5, 0.9]\nhinge = nan", "aileron.hinge", "finite number"),
 ]
 

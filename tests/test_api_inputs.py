@@ -53,7 +53,7 @@ def test_metrics_take_the_runs_own_gust_start(run):
     """It used 0.5 s for a gust at 0.1 s: peak Δα 0.0215 rad instead of 0.197."""
     assert api.metrics(run).as_dict() == api.metrics(run, 0.1).as_dict()
     assert api.metrics(run).peak_dalpha_rad > 2.0 * api.metrics(run, 0.5).peak_dalpha_rad
-    with pytest.raises(InputError, match="must be finite"):
+    with pytest.raises(InputError, match="gust_start_s: must be a finite number in s"):
         api.metrics(run, math.nan)
 
 
@@ -109,11 +109,14 @@ def test_a_plot_never_replaces_a_users_file(tmp_path, wing):
 
 
 @pytest.mark.parametrize("call, needle", [
-    (lambda w: api.modes(w, 1e5), "outside 0.1..400 m/s"),  # 71 s for no physical answer
-    (lambda w: api.linear_model(w, 0.0), "outside 0.1..400 m/s"),  # a numpy ValueError
-    (lambda w: api.modes(w, math.nan), "must be finite"),  # "arange: cannot compute length"
-    (lambda w: api.flutter(w, (5.0, math.inf)), "must be finite"),  # "Maximum allowed size"
-    (lambda w: api.flutter(w, "5:40"), "must be \\(low, high\\)"),
+    # 71 s for no physical answer
+    (lambda w: api.modes(w, 1e5), "outside the valid range 0.1..400 m/s"),
+    (lambda w: api.linear_model(w, 0.0), "speed_m_s: 0 m/s is outside"),  # a numpy ValueError
+    # "arange: cannot compute length"
+    (lambda w: api.modes(w, math.nan), "speed_m_s: must be a finite number in m/s"),
+    (lambda w: api.flutter(w, (5.0, math.inf)), "range_m_s: must be"),  # "Maximum allowed size"
+    (lambda w: api.flutter(w, "5:40"),
+     r"range_m_s: must be \[low, high\] m/s with 0 < low < high <= 400 m/s"),
     (lambda w: api.fly_gust("optimised"), "a WingBuild\\) or an Aircraft"),  # AttributeError
     (lambda w: api.flutter("goland"), "clamped=True"),  # "'str' object has no attribute"
 ])

@@ -171,7 +171,7 @@ def test_modes_at_several_speeds(optimised_wing):
     assert len(api.modes(optimised_wing, (15.0,), "rigid")) == 1
     with pytest.raises(InputError, match="non-empty sequence"):
         api.modes(optimised_wing, [])
-    with pytest.raises(InputError, match="must be a number"):
+    with pytest.raises(InputError, match="speed_m_s: must be a finite number in m/s"):
         api.modes(optimised_wing, [15.0, "fast"])
 
 

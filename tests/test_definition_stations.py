@@ -60,8 +60,8 @@ def test_bad_stations_are_one_line(tmp_path, value, reason):
 
 def test_unknown_loads_field_is_refused(tmp_path, capsys):
     path = _write(tmp_path, GOLAND_TEXT + "\n[loads]\nstation = [0.5]\n")
-    with pytest.raises(DefinitionError, match="loads.station: unknown field; accepted: "
+    with pytest.raises(DefinitionError, match="loads: unknown key 'station'; accepted: "
                        "stations"):
         load_definition(path)
     code, _, err = run_cli(capsys, "flutter", "--clamped", str(path))
-    assert_one_line_error(code, err, "loads.station")
+    assert_one_line_error(code, err, "loads: unknown key 'station'")

@@ -72,7 +72,8 @@ def _goland_file(tmp_path: Path) -> Path:
      "unknown lift_slope 'foo'"),
     (lambda w, r, t: api.flutter(w, clamped=True), "clamped=True analyses"),
     (lambda w, r, t: api.modes(w, 15.0, clamped=True), "not WingBuild"),
-    (lambda w, r, t: api.flutter(w, 5), "must be \\(low, high\\)"),
+    (lambda w, r, t: api.flutter(w, 5),
+     r"range_m_s: must be \[low, high\] m/s with 0 < low < high <= 400 m/s"),
     (lambda w, r, t: api.section_loads(w, "run"), "not str"),
     (lambda w, r, t: api.section_loads(w, {"coupled": r}), "not the dict of runs"),
     (lambda w, r, t: api.section_loads(w, r, 0.5), "a sequence of fractions"),
@@ -84,10 +85,12 @@ def _goland_file(tmp_path: Path) -> Path:
     (lambda w, r, t: api.fly_gust(w, recorders={"rigid": "x"}, models=("rigid",)),
      "must be a StepRecorder"),
     (lambda w, r, t: api.metrics(None), "a TimeHistory"),
-    (lambda w, r, t: api.linear_model(w, 1e-300), "outside 0.1..400 m/s"),  # ZeroDivision
-    (lambda w, r, t: api.fly_fig21("rigid", duration_s=-1), "must be > 0"),
+    (lambda w, r, t: api.linear_model(w, 1e-300),  # ZeroDivision
+     "speed_m_s: 1e-300 m/s is outside the valid range 0.1..400 m/s"),
+    (lambda w, r, t: api.fly_fig21("rigid", duration_s=-1), "duration_s: must be > 0 s"),
     (lambda w, r, t: api.fly_fig21("rigid", duration_s=0), "must be > 0"),  # an empty run
-    (lambda w, r, t: api.fly_fig21("rigid", duration_s="1"), "must be a number"),
+    (lambda w, r, t: api.fly_fig21("rigid", duration_s="1"),
+     "duration_s: must be a finite number in s"),
     (lambda w, r, t: api.fly_fig21("nope"), "unknown model 'nope'"),
     (lambda w, r, t: api.fly_gust(w, duration_s=1e6, models=("rigid",)), "too long"),
     (lambda w, r, t: api.fly_gust(w, gust="dryden:1:50", duration_s=4000.0,

@@ -93,7 +93,7 @@ def test_without_sensors_the_autopilot_imu_is_at_the_cg():
      "gyro_noise_rad_s"),
     ("[[sensors.imu]]\nname = \"a\"\nposition_m = [0, 0, 0]\nframe = \"wing\"\n", "frame"),
     ("[[sensors.imu]]\nname = \"a\"\nposition_m = [0, 0, 0]\nbias = 1\n",
-     "sensors.imu[0].bias: unknown field"),
+     "sensors.imu[0]: unknown key 'bias'; accepted: "),
     ("[[sensors.imu]]\nname = \"a\"\nposition_m = [0, 0, 0]\nautopilot = true\n"
      "[[sensors.imu]]\nname = \"b\"\nposition_m = [0, 0, 0]\nautopilot = true\n",
      "the autopilot reads one IMU"),

@@ -17,8 +17,8 @@ from bioflex_jsb.inputs import (
     Real,
     Text,
     Triple,
+    check_keys,
     problem,
-    unknown_keys,
 )
 
 
@@ -57,10 +57,12 @@ class Reader:
         return t
 
     def keys(self, t: dict, where: str, allowed: tuple[str, ...]) -> None:
-        unknown = unknown_keys(t, allowed)
-        if unknown is not None:
-            raise self.fail(f"{where}.{unknown}", f"unknown field; accepted: "
-                            f"{', '.join(allowed)}")
+        """An unknown key of table ``where``: ``<file>: <where>: unknown key 'X'; accepted:
+        …`` (the one wording of :func:`bioflex_jsb.inputs.unknown_key_text`)."""
+        try:
+            check_keys(t, allowed)
+        except Invalid as exc:
+            raise self.fail(where, exc.text) from None
 
     def number(self, t: dict, where: str, key: str, lo: float, hi: float, unit: str,
                default: float | None = None, hint: str = "") -> float:

@@ -55,9 +55,9 @@ from bioflex_jsb.inputs import (
     Real,
     Table,
     Text,
+    check_keys,
     problem,
     read_table,
-    unknown_keys,
 )
 from bioflex_jsb.simulation.gusts import GustSpecError, parse_gust
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
@@ -346,10 +346,12 @@ def load_campaign(path: str | Path) -> Campaign:
 
 
 def _unknown(table: dict, allowed: set[str], where: str) -> None:
-    unknown = unknown_keys(table, sorted(allowed))
-    if unknown is not None:
-        raise problem(CampaignError, "", f"{where}.{unknown}" if where else unknown,
-                      f"unknown key; accepted: {', '.join(sorted(allowed))}")
+    """An unknown key of table ``where`` ("" the top level): ``<where>: unknown key 'X';
+    accepted: …`` (:func:`bioflex_jsb.inputs.unknown_key_text`)."""
+    try:
+        check_keys(table, sorted(allowed))
+    except Invalid as exc:
+        raise problem(CampaignError, "", where, exc.text) from None
 
 
 def _check(kind: Kind, v: Any, key: str) -> Any:
@@ -483,8 +485,7 @@ def parse_campaign(
     if not metrics_raw:
         raise CampaignError(f"metrics: empty; give some of {', '.join(METRICS)}")
     for m in metrics_raw:
-        if m not in METRICS:
-            raise CampaignError(f"metrics: unknown metric {m!r}; accepted: {', '.join(METRICS)}")
+        _check(Choice(METRICS, noun="metric"), m, "metrics")
     metrics = tuple(m for m in METRICS if m in metrics_raw)
 
     settings = _settings(data.get("run", {}))
@@ -512,9 +513,7 @@ def parse_campaign(
 
     models_raw = _values(axes.get("models", ["coupled"]), "axes.models")
     for i, m in enumerate(models_raw):
-        if m not in MODELS:
-            raise CampaignError(
-                f"axes.models[{i}]: unknown model {m!r}; accepted: {', '.join(MODELS)}")
+        _check(Choice(MODELS, noun="model"), m, f"axes.models[{i}]")
     models = _unique(models_raw, "axes.models")
     if settings.aero != DEFAULT_AERO:
         other = next((m for m in models if m != "coupled"), None)
