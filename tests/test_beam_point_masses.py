@@ -178,7 +178,7 @@ stiffness_n_m = 2.0e6
     ("[[structure.point_masses]]\ny_m = 1.0\nmass_kg = -1.0\nchord_position = 0.3",
      "point_masses[0].mass_kg"),
     ("[[structure.point_masses]]\ny_m = 1.0\nmass_kg = 1.0\nchord_position = 0.3\nx = 1",
-     "point_masses[0].x"),
+     "point_masses[0]: unknown key 'x'"),
     ("[[structure.struts]]\ny_m = 1.0\nstiffness_n_m = 0.0", "struts[0].stiffness_n_m"),
     ("[[structure.struts]]\nstiffness_n_m = 1e6", "struts[0].y_m"),
 ])
