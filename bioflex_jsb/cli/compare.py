@@ -97,8 +97,11 @@ def run(args: argparse.Namespace) -> int:
 
     resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
-    full_span = (args.span or ("half" if args.aileron_step is None
-                               and args.aileron_doublet is None else "full")) == "full"
+    aileron_input = args.aileron_step is not None or args.aileron_doublet is not None
+    if aileron_input and args.span == "half":
+        raise UsageError("--span half: an aileron input is compared with both wing halves "
+                         "(the lateral model); drop --span half")
+    full_span = (args.span or ("full" if aileron_input else "half")) == "full"
     try:
         check_comparable(args.model, args.aero, args.trim, args.controller is not None,
                          "full" if full_span else "half")
@@ -112,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
 
         if not isinstance(controller, LinearController):  # a file is always linear
             raise UsageError("--controller: the LTI model needs a linear controller")
-    if args.aileron_step is None and args.aileron_doublet is None:  # an aileron excites
+    if not aileron_input:  # an aileron input excites the aircraft
         try:
             check_gust_excites(args.gust)
         except InputError as exc:
