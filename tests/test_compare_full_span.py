@@ -158,3 +158,15 @@ def test_api_compare_span_full():
                     model="coupled", duration_s=1.0, span="full")
     assert c.nonlinear.meta["span"] == "full"
     assert c.nrmse["p_rad_s"] < 0.02 and c.nrmse["asym_eta1"] < 0.05
+
+
+def test_the_half_wings_rolling_gust_prediction_has_no_gust_side_force(c172):
+    """The half wing's compare predicts a rolling gust with the rigid lateral model
+    (simulation/spanwise_gusts.lateral_gust_response); its p_g column carries what the run
+    applies, C_lp and C_np with p − p_g, and no side force. Measured on the c172_elastic
+    (C_Yp −0.075), 3 s: NRMSE β 0.0030, r 0.0018, p 0.0023 (with a −Y_p/V p_g side force in
+    the prediction, as before: 0.042, 0.029, 0.0059)."""
+    c = api.compare(c172, SPEED_M_S, gust=GUST, model="coupled", duration_s=DURATION_S)
+    assert c.nonlinear.meta["span"] == "half" and "asym_eta1" not in c.channels
+    assert c.nrmse["beta_rad"] < 0.01 and c.nrmse["r_rad_s"] < 0.01
+    assert c.nrmse["p_rad_s"] < 0.01
