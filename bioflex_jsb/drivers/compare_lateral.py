@@ -81,13 +81,38 @@ def full_span_lateral_model(build: WingBuild, airframe: Airframe, model: str,
     q_pa = point.trim.dynamic_pressure_pa
     if model == "rigid":
         ss, strips = build_lateral_elastic("rigid", point.trim, point.aero, None), None
-    else:
-        wing_a = antisymmetric_wing(build, point.trim.ixx_kg_m2)
-        strips = antisymmetric_strips(wing_a, aileron, build.aero.chord_m)
-        ss = build_lateral_elastic(model, point.trim, point.aero, wing_a)
-        if model == "coupled":
-            ss = lateral_elastic_with_aileron(ss, strips, q_pa)
-    return FullSpanLateralModel(_with_gust_roll(ss), strips, q_pa, point.trim.speed_m_s)
+        return FullSpanLateralModel(_with_gust_roll(ss), None, q_pa, point.trim.speed_m_s)
+    wing_a = antisymmetric_wing(build, point.trim.ixx_kg_m2)
+    strips = antisymmetric_strips(wing_a, aileron, build.aero.chord_m)
+    ss = _with_gust_roll(lateral_elastic_with_aileron(
+        build_lateral_elastic("coupled", point.trim, point.aero, wing_a), strips, q_pa))
+    if model == "qsd":  # the modes' quasi-static balance, the aileron's load and p_g in it
+        ss = quasi_static(ss)
+    return FullSpanLateralModel(ss, strips, q_pa, point.trim.speed_m_s)
+
+
+def quasi_static(ss: StateSpace) -> StateSpace:
+    """The coupled lateral model ``ss`` (states β, p, r, φ, η, η̇) with its modes residualised
+    (η̇ = η̈ = 0: η = −A_ff⁻¹ (A_fr x + B_f u), f = [η, η̇]), as the nonlinear ``qsd`` step
+    balances them each step (``AntisymmetricStrips.quasi_static_eta``: the aileron's load
+    and the gust roll rate in the balance); states β, p, r, φ, outputs those, η_i and n_y.
+    Without the aileron's load it is ``build_lateral_elastic("qsd")`` (tested)."""
+    a, b = np.asarray(ss.a, dtype=float), np.asarray(ss.b, dtype=float)
+    c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
+    r = 4  # β, p, r, φ
+    solve_fr = np.linalg.solve(a[r:, r:], a[r:, :r])  # A_ff⁻¹ A_fr
+    solve_fu = np.linalg.solve(a[r:, r:], b[r:])  # A_ff⁻¹ B_f
+    keep = [i for i, name in enumerate(ss.outputs) if not name.endswith("_dot")]
+    c_q = c[:, :r] - c[:, r:] @ solve_fr
+    d_q = d - c[:, r:] @ solve_fu
+    return StateSpace(model="qsd-lateral", speed_m_s=ss.speed_m_s,
+                      a=a[:r, :r] - a[:r, r:] @ solve_fr, b=b[:r] - a[:r, r:] @ solve_fu,
+                      c=c_q[keep], d=d_q[keep], states=ss.states[:r],
+                      state_units=ss.state_units[:r], inputs=ss.inputs,
+                      input_units=ss.input_units,
+                      outputs=tuple(ss.outputs[i] for i in keep),
+                      output_units=tuple(ss.output_units[i] for i in keep),
+                      notes={**ss.notes, "wing": "antisymmetric modes residualised (QSD)"})
 
 
 def _with_gust_roll(ss: StateSpace) -> StateSpace:
