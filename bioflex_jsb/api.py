@@ -363,7 +363,8 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
 def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:0.3",
             model: str = "coupled", duration_s: float = 5.0, gust_start_s: float = 0.5,
             aero: str = "quasi-steady", trim: str = "rigid",
-            recorder: StepRecorder | None = None, controller=None) -> Comparison:
+            recorder: StepRecorder | None = None, controller=None, span: str = "half"
+            ) -> Comparison:
     """The nonlinear gust run of ``model`` with ``wing`` (as :func:`fly_gust`: ``speed_m_s``
     [m/s], ``gust``, ``duration_s`` [s] from ``gust_start_s`` [s]) and the LTI model of Eq. (4)
     driven by the same gust samples at the same trim (its rigid block JSBSim's own
@@ -379,21 +380,31 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     sources but a Python object: the LTI model closes the loop with its state space, at the
     run's step with the run's one step of delay, :mod:`bioflex_jsb.simulation.closed_loop`);
     its commands are compared too (``ctrl_<command>``). The quasi-steady ``coupled``,
-    ``qsd`` or ``rigid`` model about the rigid trim."""
+    ``qsd`` or ``rigid`` model about the rigid trim.
+
+    ``span="full"``: both wing halves in the run (as :func:`fly_gust`'s) and the lateral
+    model of the same wing model beside Eq. (4), driven by the run's gust roll rate, lateral
+    gust and aileron (:mod:`bioflex_jsb.drivers.compare_lateral`): β, p, r, φ, ``asym_eta1``
+    and ``modal_roll_n_m`` compared too (quasi-steady, about the rigid trim)."""
     _check_choice("model", model, MODELS)
-    check_comparable(model, aero, trim, controller is not None)  # before flying
+    _check_choice("span", span, ("half", "full"))
+    check_comparable(model, aero, trim, controller is not None, span)  # before flying
     check_gust_excites(parse_gust(_gust_text(gust)))
     if controller is not None:
         controller = linear_controller(controller)
     runs, airframe, build, speed = _fly_gust(
         wing, speed_m_s, gust, (model,), duration_s, gust_start_s, 0.0, DEFAULT_DT_S,
-        {model: recorder} if recorder is not None else None, aero, trim, controller)
+        {model: recorder} if recorder is not None else None, aero, trim, controller,
+        lateral=(span, None, 0.5))
     drift = None
     if airframe.glider:  # the glide's own drift in calm air (drivers/compare.py)
         drift = _fly_gust(wing, speed, "none", (model,), duration_s, gust_start_s, 0.0,
-                          DEFAULT_DT_S, None, aero, trim, controller)[0][model]
+                          DEFAULT_DT_S, None, aero, trim, controller,
+                          lateral=(span, None, 0.5))[0][model]
+    aileron = None if span == "half" else _lateral_options(
+        _Subject.of(wing), build, span, None, 0.5)["aileron"]
     return compare_run(build, runs[model], model, speed, aero, trim, airframe=airframe,
-                       drift=drift, controller=controller)
+                       drift=drift, controller=controller, aileron=aileron)
 
 
 def metrics(run: TimeHistory, gust_start_s: float | None = None) -> GustMetrics:

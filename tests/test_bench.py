@@ -288,7 +288,7 @@ def test_bench_json_has_every_figure(capsys):
                  "--sitl-speedups-seconds", "0.2", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     for key in ("ratio", "logged_ratio", "log_ratio", "unsteady_ratio", "native_ratio",
-                "python_ratio", *(f"cost {k}" for k in bench.LOG_COSTS)):
+                "python_ratio", "full_span_ratio", *(f"cost {k}" for k in bench.LOG_COSTS)):
         d = data[key] if key in data else data["log_costs_us_per_step"][key[5:]]
         # shape, not values: 100-step timings on a shared machine may not be trusted
         if d["trusted"]:
@@ -299,7 +299,7 @@ def test_bench_json_has_every_figure(capsys):
             assert d["bar"] == BARS[key]
             assert d["meets_bar"] in (None, True, False)
     for key in ("bare", "cosim", "logged", "logged_rows", "logged_no_scene", "unsteady",
-                "native", "python"):
+                "native", "python", "full_span"):
         d = data["us_per_step"][key]
         assert (d["value"] is None) == (d["median"] is None) == (not d["trusted"]), key
         assert d["value"] is None or d["value"] > 0.0, key

@@ -37,6 +37,7 @@ from bioflex_jsb.cli.gust import (
     run_description,
     wing_for_run,
 )
+from bioflex_jsb.cli.lateral_options import add_lateral_arguments, span_aileron
 
 HELP = f"""Fly --gust through the nonlinear JSBSim co-simulation and through the linear model
 of Eq. (4) with its gust input G (same wing model, same time grid, same gust samples) and
@@ -51,7 +52,11 @@ where the linear model leaves the nonlinear one. A nonlinear run that diverges h
 holds every step of the nonlinear run and the linear model's response on
 /bioflex/<model>/lti_prediction (docs/logging.md; --out, --no-log). With --controller the
 same linear controller flies in both: the LTI model with its controls closes the loop at the
-run's step, with the run's one step of delay, and the commands are compared too."""
+run's step, with the run's one step of delay, and the commands are compared too. With
+--span full (both wing halves; implied by --aileron-step or --aileron-doublet) the lateral
+model of the same wing model (beta, p, r, phi and the antisymmetric modes, docs/lateral.md)
+is driven by the run's gust roll rate, lateral gust and aileron, and beta_rad, p_rad_s,
+r_rad_s, phi_rad, asym_eta1 and modal_roll_n_m are compared too."""
 
 # The table's unit of each channel's largest difference, and its factor from SI.
 DISPLAY_UNITS = {"u": ("m/s", 1.0), "alpha": ("deg", 57.29577951308232),
@@ -68,6 +73,7 @@ def register(sub) -> None:
                    help="wing model of both runs (default coupled)")
     add_aero_arguments(p)
     add_controller_argument(p, linear=True)
+    add_lateral_arguments(p)  # --span full: the lateral model too (drivers/compare_lateral)
     add_log_arguments(p)
     p.add_argument("--plot", metavar="FILE.png",
                    help="overlay of both time histories, NRMSE in the legends (.png, .pdf, "
@@ -91,10 +97,17 @@ def run(args: argparse.Namespace) -> int:
 
     resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
+    aileron_input = args.aileron_step is not None or args.aileron_doublet is not None
+    if aileron_input and args.span == "half":
+        raise UsageError("--span half: an aileron input is compared with both wing halves "
+                         "(the lateral model); drop --span half")
+    full_span = (args.span or ("full" if aileron_input else "half")) == "full"
     try:
-        check_comparable(args.model, args.aero, args.trim, args.controller is not None)
+        check_comparable(args.model, args.aero, args.trim, args.controller is not None,
+                         "full" if full_span else "half")
     except InputError as exc:
-        raise UsageError(f"--model {args.model} --aero {args.aero} --trim {args.trim}: "
+        span = " --span full" if full_span else ""
+        raise UsageError(f"--model {args.model} --aero {args.aero} --trim {args.trim}{span}: "
                          f"{exc}") from None
     controller = controller_from_args(args)
     if controller is not None:
@@ -102,10 +115,11 @@ def run(args: argparse.Namespace) -> int:
 
         if not isinstance(controller, LinearController):  # a file is always linear
             raise UsageError("--controller: the LTI model needs a linear controller")
-    try:
-        check_gust_excites(args.gust)
-    except InputError as exc:
-        raise UsageError(f"--gust {exc}") from None
+    if not aileron_input:  # an aileron input excites the aircraft
+        try:
+            check_gust_excites(args.gust)
+        except InputError as exc:
+            raise UsageError(f"--gust {exc}") from None
     config = run_config(args, (args.model,))
     check_plot_path(args.plot, args.force)
     check_distinct_outputs(("--out", args.out), ("--plot", args.plot))
@@ -131,7 +145,8 @@ def run(args: argparse.Namespace) -> int:
         nonlinear = runs[0]
         try:
             linear = linear_prediction(build, nonlinear, args.model, args.speed, args.aero,
-                                       args.trim, airframe, controller)
+                                       args.trim, airframe, controller,
+                                       span_aileron(args, build) if full_span else None)
         except FdmError as exc:
             raise UsageError(str(exc)) from None
         if log is not None:
@@ -183,6 +198,10 @@ def run(args: argparse.Namespace) -> int:
             if line:
                 print(f"{line}; the LTI model closes the loop at the run's step, with its "
                       "one step of delay")
+            if full_span and (args.gust.kind == "none" or args.gust.amplitude_m_s == 0.0):
+                print("no vertical gust: the longitudinal LTI model is not excited (NRMSE 1 "
+                      "on u ... eta1: the run's roll couples into them, the linear models "
+                      "keep the axes apart)")
             print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
                   "largest difference and when it occurs")
         if args.plot:

@@ -34,7 +34,11 @@ back in Python with bioflex_jsb.sinks.model_export.read_state_space(path), or as
 python-control StateSpace with to_python_control(path) (pip install ".[control]").
 Valid range: --speed {SPEED_RANGE_TEXT}. Default: the {DEFAULT_WING} wing at
 {DEFAULT_SPEED_M_S:g} m/s (the paper's Fig. 21 case). An existing --out is replaced only if
-it is a model file bioflex-jsb wrote, else give --force."""
+it is a model file bioflex-jsb wrote, else give --force. --axis lateral writes the
+lateral-directional model instead (api.lateral_model, docs/lateral.md): states beta [rad],
+p [rad/s], r [rad/s], phi [rad] and, coupled, the antisymmetric modes eta_i [rad],
+eta_i_dot [rad/s]; inputs v_g [m/s] (lateral gust), aileron, rudder [rad]; outputs the
+states (QSD: and its quasi-static eta_i) and n_y [-]."""
 
 
 def register(sub) -> None:
@@ -44,6 +48,10 @@ def register(sub) -> None:
                    help="trim " + speed_help(extra="; an --aircraft's own cruise speed"))
     p.add_argument("--model", choices=("rigid", "coupled", "qsd"), default="coupled",
                    help="which linear model (default coupled)")
+    p.add_argument("--axis", choices=("longitudinal", "lateral"), default="longitudinal",
+                   help="longitudinal (default: Eq. 4) or lateral (the lateral-directional "
+                   "model of the aircraft's JSBSim airframe and the wing's antisymmetric "
+                   "modes)")
     p.add_argument("--out", required=True, metavar="FILE.npz|FILE.mat",
                    help="the model file (required)")
     add_force_argument(p)
@@ -72,12 +80,17 @@ def run(args: argparse.Namespace) -> int:
     build = wing_from_args(args)
     if args.speed is None:
         args.speed = aircraft_speeds(args)[0]
-    # the API's model (one builder): the wing's own aircraft (its S, mass, derivatives)
-    ss = api.linear_model(build, args.speed, args.model)
+    if args.axis == "lateral":  # its JSBSim airframe's trim (api.lateral_model)
+        aircraft = getattr(args, "aircraft_definition", None)
+        ss = api.lateral_model(aircraft if aircraft is not None else build, args.speed,
+                               args.model)
+    else:  # the API's model (one builder): the wing's own aircraft (its S, mass, derivatives)
+        ss = api.linear_model(build, args.speed, args.model)
     metadata = {"software": f"bioflex-jsb {__version__}", "wing": build.variant.name,
                 "wing_variant": build.variant.as_dict(), "speed_m_s": args.speed,
-                "mass_basis": build.mass_basis, "model": args.model,
-                "altitude_m": 0.0, "overrides": dict(build.model.coefficients.overrides)}
+                "mass_basis": build.mass_basis, "model": args.model, "axis": args.axis,
+                "altitude_m": float(ss.notes.get("altitude_m", 0.0)),
+                "overrides": dict(build.model.coefficients.overrides)}
     try:
         write_state_space(ss, args.out, metadata)
     except OSError as exc:

@@ -83,14 +83,18 @@ def span_options(args, build) -> dict:
     return {"span": "full", "aileron": _aileron(args, build)}
 
 
-def _aileron(args, build):
-    """The aileron of ``--aircraft``'s definition or of the prototype variant's (a note on
-    stderr when there is none)."""
+def span_aileron(args, build):
+    """The aileron of ``--aircraft``'s definition or of the prototype variant's, or None."""
     from bioflex_jsb.simulation.full_span import prototype_aileron
 
     aircraft = getattr(args, "aircraft_definition", None)
-    aileron = (aircraft.definition.aileron if aircraft is not None
-               else prototype_aileron(build.variant.name))
+    return (aircraft.definition.aileron if aircraft is not None
+            else prototype_aileron(build.variant.name))
+
+
+def _aileron(args, build):
+    """:func:`span_aileron`, with a note on stderr when there is none."""
+    aileron = span_aileron(args, build)
     if aileron is None:
         print(f"bioflex-jsb: note: wing {build.variant.name!r} has no [aileron]: its "
               "antisymmetric modes are driven by the roll rate alone", file=sys.stderr)

@@ -86,12 +86,28 @@ RTF_DEFINITION = (
     "silence are left out)")
 
 
+def _span(args: argparse.Namespace, build) -> dict:
+    """``span`` and ``aileron`` of ``--span`` (cli/lateral_options.py; {} for the half
+    wing); the native wing has no antisymmetric modes of ours."""
+    from bioflex_jsb.cli.lateral_options import span_options
+
+    if args.span == "full" and args.model == NATIVE:
+        raise UsageError("--span full flies our wing's antisymmetric modes: not with --model "
+                         "native")
+    return span_options(args, build)
+
+
 def register(sub) -> None:
     p = sub.add_parser("ardupilot", help="ArduPlane SITL physics backend (JSON, lock-step)",
                        description=HELP)
     add_wing_arguments(p, default="optimised")
     p.add_argument("--model", choices=("coupled", "rigid", "qsd", NATIVE), default="coupled",
                    help="wing model (default coupled; native: the exported JSBSim wing)")
+    p.add_argument("--span", choices=("half", "full"), default="half",
+                   help="half (the half wing's symmetric modes, default) or full (both "
+                   "halves: the antisymmetric modes driven by the roll rate and the ailerons "
+                   "ArduPlane flies, their rolling moment to JSBSim; quasi-steady strips; "
+                   "docs/lateral.md)")
     from bioflex_jsb.cli.aircraft_option import cruise_speed_default
 
     p.add_argument("--speed", type=airspeed, default=cruise_speed_default(),
@@ -275,7 +291,7 @@ def _build(args: argparse.Namespace):
                                    gust=gust, gust_at_s=args.gust_at,
                                    launcher=launcher, record_every=args.record_every,
                                    gust_repeat=args.gust_repeat, aero=args.aero,
-                                   compiled=compiled, **extra)
+                                   compiled=compiled, **extra, **_span(args, build))
     except FdmError as exc:  # the airframe cannot load or trim (InputErrors reach the CLI)
         raise UsageError(str(exc)) from None
     return physics, variant, overrides, check

@@ -332,6 +332,9 @@ class ArduPilotPhysics:
         sensors: the aircraft's sensor stations (None: the wing build's, an aircraft
             definition's ``[sensors]``): every one is logged (its channels in the run
             topics' rows, its own topic), the autopilot's IMU is sent (module docstring).
+        span: ``half`` (default) or ``full``: both wing halves (``wing`` a WingBuild), the
+            ailerons ArduPlane flies loading the antisymmetric modes through JSBSim's
+            flight controls; ``aileron`` the strips' surface (None: none).
     """
 
     def __init__(self, airframe: Airframe, wing: ElasticWingModel | WingBuild | None,
@@ -341,7 +344,8 @@ class ArduPilotPhysics:
                  record_every: int = 8, gust_repeat: bool = False,
                  aero: str = "quasi-steady", compiled: bool = True,
                  sensors: Sensors | None = None,
-                 channels: tuple[Channel, ...] = CHANNEL_MAP) -> None:
+                 channels: tuple[Channel, ...] = CHANNEL_MAP, span: str = "half",
+                 aileron=None) -> None:
         if not (math.isfinite(gust_at_s) and gust_at_s >= 0.0):
             raise InputError(f"gust start must be >= 0 s after the launch, got {gust_at_s!r}")
         if not is_whole(record_every) or record_every < 0:
@@ -349,6 +353,9 @@ class ArduPilotPhysics:
         self.airframe = airframe
         self.wing_model = wing
         self.model = model
+        # both wing halves (CoupledStep's span, aileron): the ailerons ArduPlane flies load
+        # the antisymmetric modes (docs/lateral.md, "Both halves in the co-simulation")
+        self.span, self.aileron = span, aileron
         self.speed_m_s = float(speed_m_s)
         self.altitude_m = float(altitude_m)
         self.launcher = launcher or Launcher()
@@ -409,7 +416,9 @@ class ArduPilotPhysics:
             self.core.release()
         core = CoupledStep(self.airframe, self.wing_model, self.model, self.speed_m_s,
                            self.altitude_m, dt_s, compiled=self.compiled, aero=self.aero,
-                           sensors=self._sensor_set)
+                           sensors=self._sensor_set,
+                           **({} if self.span == "half" else {"span": self.span,
+                                                              "aileron": self.aileron}))
         self.core = core
         self._autopilot.dt_s = core.dt_s
         self._autopilot.reset(core.n_modes)  # the wing at rest before the flight

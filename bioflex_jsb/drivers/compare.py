@@ -51,6 +51,9 @@ CHANNELS = ("u", "alpha", "q", "theta", "eta1")
 COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle")  # a controller's, when one flew
 # a gust with a rolling or lateral part: the rigid lateral model's (_add_lateral)
 LATERAL_CHANNELS = ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad")
+# both wing halves: the first antisymmetric mode and the modes' rolling moment
+# (drivers/compare_lateral.py)
+FULL_SPAN_CHANNELS = ("asym_eta1", "modal_roll_n_m")
 LOADS_PREFIX = "loads_"
 
 
@@ -127,9 +130,15 @@ def check_gust_excites(gust) -> None:
                          "aircraft (its errors are relative to the response to it)")
 
 
-def check_comparable(model: str, aero: str, trim: str, controller: bool = False) -> None:
+def check_comparable(model: str, aero: str, trim: str, controller: bool = False,
+                     span: str = "half") -> None:
     """Raise InputError (one line) for a model, aerodynamics and trim with no linear model
-    (with a ``controller``: one with the controls, quasi-steady about the rigid trim)."""
+    (with a ``controller``: one with the controls, quasi-steady about the rigid trim; with
+    ``span`` ``full``, both wing halves: the quasi-steady lateral model about the rigid
+    trim)."""
+    if span == "full" and (aero != "quasi-steady" or trim != "rigid"):
+        raise InputError("both wing halves are compared on the quasi-steady lateral model "
+                         "about the rigid trim (--aero quasi-steady --trim rigid)")
     if controller and (aero != "quasi-steady" or trim != "rigid"):
         raise InputError("a controller is compared on the quasi-steady model about the rigid "
                          "trim (the unsteady and elastic-trim LTI models have no controls)")
@@ -144,7 +153,8 @@ def check_comparable(model: str, aero: str, trim: str, controller: bool = False)
 
 def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
                       aero: str = "quasi-steady", trim: str = "rigid",
-                      airframe: Airframe | None = None, controller=None) -> TimeHistory:
+                      airframe: Airframe | None = None, controller=None, aileron=None
+                      ) -> TimeHistory:
     """The LTI model's response to the gust samples ``nonlinear["w_g"]`` [m/s] at its times.
 
     ``model``: ``rigid``, ``coupled`` or ``qsd``; ``aero="unsteady"`` (coupled only): Eq. (4)
@@ -155,8 +165,14 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     ``controller``: the linear controller the run flew with
     (:class:`~bioflex_jsb.simulation.controller.LinearController`): the model with its
     controls closes the loop at the run's step with its one step of delay
-    (:mod:`bioflex_jsb.simulation.closed_loop`); the prediction has its commands too."""
-    check_comparable(model, aero, trim, controller is not None)
+    (:mod:`bioflex_jsb.simulation.closed_loop`); the prediction has its commands too.
+
+    A run with both wing halves (``nonlinear.meta["span"] == "full"``): the lateral model of
+    the same wing model is added, driven by the run's v_g, aileron and gust roll rate
+    (:mod:`bioflex_jsb.drivers.compare_lateral`; ``aileron`` the run's
+    :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`, None: none)."""
+    check_comparable(model, aero, trim, controller is not None,
+                     nonlinear.meta.get("span", "half"))
     # the JSBSim airframe the run flew (the prototype's by default): A_RR at its trim (an
     # aircraft without an engine: its steady glide, runtime/glide.py)
     lin = (airframe or Airframe()).linearize(speed_m_s)
@@ -188,10 +204,17 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         linear = _closed_loop_response(ss, controller, nonlinear)
     else:
         linear = simulate(ss, nonlinear.time_s, nonlinear["w_g"])
+    full_span = nonlinear.meta.get("span") == "full"
     if "w_g_tail" in nonlinear.channels:  # a gust that varies over the aircraft
         _add_tail_delay(linear, nonlinear, build, model, speed_m_s, lin.a, lm,
                         controller is None and aero == "quasi-steady" and trim == "rigid")
-        _add_lateral(linear, nonlinear, build, speed_m_s, airframe or Airframe())
+        if not full_span:
+            _add_lateral(linear, nonlinear, build, speed_m_s, airframe or Airframe())
+    if full_span:  # both wing halves: the lateral model of the run's wing model
+        from bioflex_jsb.drivers.compare_lateral import add_full_span_lateral
+
+        add_full_span_lateral(linear, nonlinear, build, model, speed_m_s,
+                              airframe or Airframe(), aileron)
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
     return linear
@@ -322,7 +345,8 @@ def _add_drift(linear: TimeHistory, nonlinear: TimeHistory, drift: TimeHistory) 
 def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s: float,
                 aero: str = "quasi-steady", trim: str = "rigid",
                 linear: TimeHistory | None = None, airframe: Airframe | None = None,
-                drift: TimeHistory | None = None, controller=None) -> Comparison:
+                drift: TimeHistory | None = None, controller=None, aileron=None
+                ) -> Comparison:
     """Compare ``nonlinear`` (a gust run of ``model``) with the LTI prediction (``linear``,
     computed by :func:`linear_prediction` on ``airframe``, the JSBSim airframe flown, when
     not given); ``drift``: the calm-air run of the same trim and steps, added to the
@@ -331,10 +355,10 @@ def compare_run(build: WingBuild, nonlinear: TimeHistory, model: str, speed_m_s:
     the module docstring."""
     if linear is None:
         linear = linear_prediction(build, nonlinear, model, speed_m_s, aero, trim, airframe,
-                                   controller)
+                                   controller, aileron)
     if drift is not None:
         _add_drift(linear, nonlinear, drift)
-    channels = tuple(c for c in CHANNELS + COMMANDS + LATERAL_CHANNELS
+    channels = tuple(c for c in CHANNELS + COMMANDS + LATERAL_CHANNELS + FULL_SPAN_CHANNELS
                      if c in linear.channels and c in nonlinear.channels)
     load_channels = tuple(c for c in nonlinear.channels
                           if c.startswith(LOADS_PREFIX) and c in linear.channels)

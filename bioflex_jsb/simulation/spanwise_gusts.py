@@ -396,16 +396,16 @@ def lateral_gust_response(ss, time_s, p_g_rad_s, v_g_m_s) -> dict[str, np.ndarra
     build_lateral_state_space`: states β, p, r, φ, input v_g first) from rest under the gust
     roll rate p_g [rad/s] and the lateral gust v_g [m/s] at uniformly spaced ``time_s``
     [s], each held over a step: the run's channels beta_rad, p_rad_s, r_rad_s, phi_rad.
-    p_g enters as p − p_g in the aerodynamic terms: B_p = −(the p column of A without its
-    kinematic w_0/V and φ̇ = p entries) = [−Y_p/V, −L'_p, −N'_p, 0], with Y_p/V the column's
-    first entry less w_0/V = sin α_0 (the model's notes' trim α)."""
+    p_g enters as p − p_g in the rolling and yawing moments, as the run applies it
+    (``runtime/gust_loads.py``: JSBSim's C_lp and C_np, no side force): B_p = [0, −L'_p,
+    −N'_p, 0] (the p column of A without β's w_0/V and Y_p/V, which the gust does not
+    apply, and φ̇ = p)."""
     from scipy.linalg import expm
 
     t = np.asarray(time_s, dtype=float)
     a = np.asarray(ss.a, dtype=float)
-    y_p = a[0, 1] - math.sin(float(ss.notes.get("alpha_trim_rad", 0.0)))
     b = np.column_stack([np.asarray(ss.b, dtype=float)[:, 0],
-                         [-y_p, -a[1, 1], -a[2, 1], 0.0]])
+                         [0.0, -a[1, 1], -a[2, 1], 0.0]])
     dt = float(t[1] - t[0])
     aug = np.zeros((6, 6))
     aug[:4, :4], aug[:4, 4:] = a, b

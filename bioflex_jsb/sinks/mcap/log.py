@@ -29,6 +29,7 @@ from bioflex_jsb.sinks.mcap.formatting import (
     log_message,
     lti_records,
 )
+from bioflex_jsb.sinks.mcap.lateral_topic import lateral_modes
 from bioflex_jsb.sinks.mcap.loads_topic import GROUP as LOADS_GROUP
 from bioflex_jsb.sinks.mcap.loads_topic import LoadsTopic, prediction_loads
 from bioflex_jsb.sinks.mcap.metadata import run_metadata
@@ -86,6 +87,11 @@ class RunLog:
         self._controller_meta: dict | None = None
         self._controllers: dict[str, Any] = {}
         self._controller_rows: list[tuple[str, tuple[str, ...], np.ndarray, np.ndarray]] = []
+        # the sampled steps of both wing halves (rows with asym_eta<i>): their antisymmetric
+        # wing on /bioflex/<model>/lateral, chunks after the steps' (as a recorded run's:
+        # TableRecorder.lateral)
+        self._laterals: dict[str, Any] = {}
+        self._lateral_rows: list[tuple[str, tuple[str, ...], np.ndarray, np.ndarray]] = []
         self._first_t = 0.0
         self._due_t = -math.inf  # the chunk closes at this simulated time …
         self._due_wall = 0.0  # … or at this wall (monotonic) time
@@ -253,6 +259,12 @@ class RunLog:
             self._controller_rows.append((model, ch.names, np.array(ts[:n], dtype=float),
                                           v.reshape(n, len(ch.names)).copy()))
             size += n * (CONTROLLER_STEP_BYTES + 8 * len(self._controller_meta["inputs"]))
+        n_lateral = lateral_modes(ch.names)
+        if n_lateral:  # both wing halves: their topic's steps, and a bound of their bytes
+            model = next(m for m, c in self._models.items() if c is ch)
+            self._lateral_rows.append((model, ch.names, np.array(ts[:n], dtype=float),
+                                       v.reshape(n, len(ch.names)).copy()))
+            size += n * (LATERAL_STEP_BYTES + 16 * n_lateral)
         if not self._row_bytes_measured or size > n * self._row_bytes:
             self._row_bytes = -(-size // n)  # the first measure, then the largest
             self._row_bytes_measured = True
@@ -356,7 +368,20 @@ class RunLog:
             for model, names, ts, rows in self._controller_rows:
                 self._controller_topic(model, names).rows(ts, rows)  # a chunk each
             self._controller_rows.clear()
+            for model, names, ts, rows in self._lateral_rows:
+                self._lateral_topic(model, names).rows(ts, rows)  # a chunk each
+            self._lateral_rows.clear()
         self._pending = None
+
+    def _lateral_topic(self, model: str, names: tuple[str, ...]):
+        """The lateral topic of ``model``'s sampled steps (made at its first rows)."""
+        out = self._laterals.get(model)
+        if out is None:
+            from bioflex_jsb.sinks.mcap.lateral_topic import GROUP, LateralTopic
+
+            out = self._laterals[model] = LateralTopic(self._writer, self.schema_id(GROUP),
+                                                       model, names)
+        return out
 
     def _controller_topic(self, model: str, names: tuple[str, ...]):
         """The controller topic of ``model``'s sampled steps (made at its first rows)."""
@@ -385,6 +410,10 @@ _MAX_PENDING_STEPS = 4096  # also bounds the chunk size (~0.6 kB per step)
 # opcode, length, channel, sequence and two times (31), two tagged doubles and the signals'
 # tag and length (21), its message-index entry (16), with room to spare.
 CONTROLLER_STEP_BYTES = 80
+# The same of a lateral message but its modal coordinates (16 bytes a mode: η and η̇): the
+# record (31), four tagged doubles (36), two packed arrays' tags and lengths (4), its
+# message-index entry (16), with room to spare.
+LATERAL_STEP_BYTES = 96
 
 
 def chunk_steps(dt_s: float) -> int:

@@ -1,0 +1,194 @@
+"""The lateral half of a comparison of a run with both wing halves (``span="full"``) with its
+linear model: the lateral-directional model of the run's wing model (``rigid``, ``coupled``,
+``qsd``; docs/lateral.md) at the run's trim, driven by what the run flew.
+
+The nonlinear run (:mod:`bioflex_jsb.simulation.full_span`) flies the antisymmetric modes on
+quasi-steady strips with the roll rate, their own η_a, η̇_a, JSBSim's ailerons and the gust
+roll rate p_g; its linear model is the coupled lateral model of the same strips
+(:func:`~bioflex_jsb.flight_dynamics.lateral_elastic.build_lateral_elastic`, with the
+aileron's generalised force on the modes:
+:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_elastic_with_aileron`), its
+rigid block identified from the run's JSBSim airframe at the same trim
+(:func:`~bioflex_jsb.runtime.identification.identify_lateral`). Its inputs, each held over
+a step and exactly discretised (zero-order hold, as the run holds them):
+
+* ``v_g`` [m/s], the run's lateral gust (JSBSim's wind: β − v_g/V in its tables);
+* ``aileron`` [rad], the run's ``aileron_rad`` over its first sample (JSBSim's δa; a gust
+  run's stays at the trim's unless an aileron step or doublet was given);
+* ``p_g`` [rad/s], the run's gust roll rate. The run applies it as p − p_g in JSBSim's
+  rolling and yawing moments (``runtime/gust_loads.py``: C_lp and C_np only, no side force)
+  and on the antisymmetric strips (their elastic increments), so its column is minus the
+  model's p column without the terms p has alone: B_pg = −A[:, p] with the β row (the
+  kinematic w₀/V and C_Yp, which the run's gust does not apply) and the φ row (φ̇ = p) set
+  to zero; a quasi-static model's η outputs likewise D_pg = −C[η, p];
+* the rudder stays at the trim's (a gust run does not move it).
+
+The compared channels: β, p, r, φ (``beta_rad``, ``p_rad_s``, ``r_rad_s``, ``phi_rad``), the
+first antisymmetric mode ``asym_eta1`` [rad] and the modes' rolling moment
+``modal_roll_n_m`` [N·m] = Q Σ R^η_i η_i + (Q/V) Σ R^η̇_i η̇_i at the trim's Q and V (the
+quasi-static model: its η̇ is zero); the rigid model has neither of the last two.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bioflex_jsb.flight_dynamics.wing_model import WingBuild
+from bioflex_jsb.runtime.fdm import Airframe
+from bioflex_jsb.simulation.results import TimeHistory
+from bioflex_jsb.state_space import StateSpace
+
+RIGID_CHANNELS = ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad")
+ELASTIC_CHANNELS = ("asym_eta1", "modal_roll_n_m")
+UNITS = {"beta_rad": "rad", "p_rad_s": "rad/s", "r_rad_s": "rad/s", "phi_rad": "rad",
+         "asym_eta1": "rad", "modal_roll_n_m": "N*m"}
+INPUTS = ("v_g", "aileron", "p_g")  # the driven inputs, in this order
+
+
+@dataclass(frozen=True)
+class FullSpanLateralModel:
+    """The linear lateral model of a full-span run: ``ss`` with the inputs v_g [m/s],
+    aileron [rad], p_g [rad/s] (:data:`INPUTS`; module docstring) and the outputs of the
+    lateral model; ``strips`` the antisymmetric strips (None for the rigid model), ``q_pa``
+    and ``speed_m_s`` the trim's dynamic pressure [Pa] and airspeed [m/s]."""
+
+    ss: StateSpace
+    strips: object | None
+    q_pa: float
+    speed_m_s: float
+
+
+def full_span_lateral_model(build: WingBuild, airframe: Airframe, model: str,
+                            speed_m_s: float, aileron=None, altitude_m: float = 0.0
+                            ) -> FullSpanLateralModel:
+    """The lateral model (module docstring) of the wing model ``model`` of ``build`` on the
+    JSBSim ``airframe`` trimmed at ``speed_m_s`` [m/s], ``altitude_m`` [m]; ``aileron`` the
+    run's :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface` (None: none on
+    the strips)."""
+    from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
+        antisymmetric_strips,
+        lateral_elastic_with_aileron,
+    )
+    from bioflex_jsb.flight_dynamics.lateral_elastic import (
+        antisymmetric_wing,
+        build_lateral_elastic,
+    )
+    from bioflex_jsb.runtime.identification import identify_lateral
+
+    point = identify_lateral(airframe, speed_m_s, build.airframe.reference, altitude_m)
+    q_pa = point.trim.dynamic_pressure_pa
+    if model == "rigid":
+        ss, strips = build_lateral_elastic("rigid", point.trim, point.aero, None), None
+        return FullSpanLateralModel(_with_gust_roll(ss), None, q_pa, point.trim.speed_m_s)
+    wing_a = antisymmetric_wing(build, point.trim.ixx_kg_m2)
+    strips = antisymmetric_strips(wing_a, aileron, build.aero.chord_m)
+    ss = _with_gust_roll(lateral_elastic_with_aileron(
+        build_lateral_elastic("coupled", point.trim, point.aero, wing_a), strips, q_pa))
+    if model == "qsd":  # the modes' quasi-static balance, the aileron's load and p_g in it
+        ss = quasi_static(ss)
+    return FullSpanLateralModel(ss, strips, q_pa, point.trim.speed_m_s)
+
+
+def quasi_static(ss: StateSpace) -> StateSpace:
+    """The coupled lateral model ``ss`` (states β, p, r, φ, η, η̇) with its modes residualised
+    (η̇ = η̈ = 0: η = −A_ff⁻¹ (A_fr x + B_f u), f = [η, η̇]), as the nonlinear ``qsd`` step
+    balances them each step (``AntisymmetricStrips.quasi_static_eta``: the aileron's load
+    and the gust roll rate in the balance); states β, p, r, φ, outputs those, η_i and n_y.
+    Without the aileron's load it is ``build_lateral_elastic("qsd")`` (tested)."""
+    a, b = np.asarray(ss.a, dtype=float), np.asarray(ss.b, dtype=float)
+    c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
+    r = 4  # β, p, r, φ
+    solve_fr = np.linalg.solve(a[r:, r:], a[r:, :r])  # A_ff⁻¹ A_fr
+    solve_fu = np.linalg.solve(a[r:, r:], b[r:])  # A_ff⁻¹ B_f
+    keep = [i for i, name in enumerate(ss.outputs) if not name.endswith("_dot")]
+    c_q = c[:, :r] - c[:, r:] @ solve_fr
+    d_q = d - c[:, r:] @ solve_fu
+    return StateSpace(model="qsd-lateral", speed_m_s=ss.speed_m_s,
+                      a=a[:r, :r] - a[:r, r:] @ solve_fr, b=b[:r] - a[:r, r:] @ solve_fu,
+                      c=c_q[keep], d=d_q[keep], states=ss.states[:r],
+                      state_units=ss.state_units[:r], inputs=ss.inputs,
+                      input_units=ss.input_units,
+                      outputs=tuple(ss.outputs[i] for i in keep),
+                      output_units=tuple(ss.output_units[i] for i in keep),
+                      notes={**ss.notes, "wing": "antisymmetric modes residualised (QSD)"})
+
+
+def _with_gust_roll(ss: StateSpace) -> StateSpace:
+    """``ss`` with the inputs v_g, aileron, p_g (the rudder dropped; p_g's column: module
+    docstring)."""
+    p = ss.states.index("p")
+    b_pg = -np.asarray(ss.a, dtype=float)[:, p].copy()
+    b_pg[ss.states.index("beta")] = 0.0
+    b_pg[ss.states.index("phi")] = 0.0
+    c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
+    d_pg = np.zeros(len(ss.outputs))
+    for i, name in enumerate(ss.outputs):  # a quasi-static model's η: its static response
+        if name.startswith("eta") and name[3:].isdigit() and name not in ss.states:
+            d_pg[i] = -c[i, p]
+    cols = [ss.inputs.index(n) for n in INPUTS[:2]]
+    b = np.column_stack([np.asarray(ss.b, dtype=float)[:, cols], b_pg])
+    d = np.column_stack([d[:, cols], d_pg])
+    units = tuple(ss.input_units[k] for k in cols) + ("rad/s",)
+    return StateSpace(model=ss.model, speed_m_s=ss.speed_m_s, a=ss.a, b=b, c=c, d=d,
+                      states=ss.states, state_units=ss.state_units, inputs=INPUTS,
+                      input_units=units, outputs=ss.outputs, output_units=ss.output_units,
+                      notes={**ss.notes, "p_g": "gust roll rate, as p - p_g in the rolling "
+                             "and yawing moments and on the strips (drivers/compare_lateral)"})
+
+
+def respond(lm: FullSpanLateralModel, time_s, inputs: np.ndarray) -> dict[str, np.ndarray]:
+    """The outputs of ``lm`` from rest under ``inputs`` (steps × :data:`INPUTS`, each held
+    over its step) at the uniformly spaced ``time_s`` [s]: the compared channels (module
+    docstring)."""
+    from scipy.linalg import expm
+
+    ss = lm.ss
+    t = np.asarray(time_s, dtype=float)
+    a, b = np.asarray(ss.a, dtype=float), np.asarray(ss.b, dtype=float)
+    n, m = a.shape[0], b.shape[1]
+    aug = np.zeros((n + m, n + m))
+    aug[:n, :n], aug[:n, n:] = a, b
+    e = expm(aug * float(t[1] - t[0]))
+    phi, gam = e[:n, :n], e[:n, n:]
+    u = np.asarray(inputs, dtype=float)
+    x = np.zeros((t.size, n))
+    for k in range(t.size - 1):
+        x[k + 1] = phi @ x[k] + gam @ u[k]
+    y = x @ np.asarray(ss.c, dtype=float).T + u @ np.asarray(ss.d, dtype=float).T
+    out = dict(zip(ss.outputs, y.T, strict=True))
+    channels = {c: out[s] for c, s in zip(RIGID_CHANNELS, ("beta", "p", "r", "phi"),
+                                          strict=True)}
+    if lm.strips is not None:
+        s = lm.strips
+        eta = np.column_stack([out[f"eta{i + 1}"] for i in range(s.n_modes)])
+        roll = lm.q_pa * eta @ s.roll_eta
+        if "eta1_dot" in out:  # the coupled model; the quasi-static one has η̇ = 0
+            eta_dot = np.column_stack([out[f"eta{i + 1}_dot"] for i in range(s.n_modes)])
+            roll = roll + lm.q_pa / lm.speed_m_s * eta_dot @ s.roll_etadot
+        channels["asym_eta1"] = eta[:, 0]
+        channels["modal_roll_n_m"] = roll
+    return channels
+
+
+def add_full_span_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
+                          model: str, speed_m_s: float, airframe: Airframe, aileron=None
+                          ) -> None:
+    """Add to ``linear`` the lateral model's response (module docstring) to what the
+    full-span run ``nonlinear`` flew: its v_g, aileron and p_g (channels absent: zero)."""
+    lm = full_span_lateral_model(build, airframe, model, speed_m_s, aileron)
+    t = np.asarray(nonlinear.time_s, dtype=float)
+    zeros = np.zeros(t.size)
+
+    def flown(name: str) -> np.ndarray:
+        return np.asarray(nonlinear[name], dtype=float) if name in nonlinear.channels \
+            else zeros
+
+    delta = flown("aileron_rad")
+    inputs = np.column_stack([flown("v_g"), delta - (delta[0] if delta.size else 0.0),
+                              flown("p_g")])
+    for name, values in respond(lm, t, inputs).items():
+        linear.channels[name] = values
+        linear.units[name] = UNITS[name]
+    linear.meta["lateral_model"] = f"{lm.ss.model} (drivers/compare_lateral.py)"
