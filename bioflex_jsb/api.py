@@ -1103,9 +1103,10 @@ def linear_controller(source):
     return controller
 
 
-def _gla_plant(wing, speed_m_s):
+def _gla_plant(wing, speed_m_s, flaperon: bool = False):
     """(the WingBuild, the trim speed [m/s], the GLA plant of loads/alleviation.py with
-    JSBSim's rigid block at the trim and the loads at the trim's density)."""
+    JSBSim's rigid block at the trim and the loads at the trim's density; ``flaperon``: with
+    the flaperon input, loads/alleviation_flaperon.py)."""
     from bioflex_jsb.loads.alleviation import gla_plant
     from bioflex_jsb.loads.model import build_loads_model
 
@@ -1116,6 +1117,11 @@ def _gla_plant(wing, speed_m_s):
     lin = airframe.linearize(v)
     rho = airframe[JP.ATMOSPHERE_RHO_SLUGS_FT3] * U.KG_M3_PER_SLUG_FT3  # the trim's air
     lm = build_loads_model(build, v, density_kg_m3=rho, static="elastic")
+    if flaperon:
+        from bioflex_jsb.loads.alleviation_flaperon import flaperon_plant
+
+        return build, v, flaperon_plant(build, v, lm, _flaperon_surface(subject, build),
+                                        a_rr=lin.a)
     return build, v, gla_plant(build, v, lm, a_rr=lin.a)
 
 
@@ -1136,7 +1142,7 @@ def predict_alleviation(wing, controller, speed_m_s: float | None = None,
     u_ref = _real(u_ref_m_s, "u_ref_m_s [m/s]")
     if u_ref <= 0.0:
         raise InputError(f"u_ref_m_s must be > 0 m/s, got {u_ref:g}")
-    _, _, plant = _gla_plant(wing, speed_m_s)
+    _, _, plant = _gla_plant(wing, speed_m_s, flaperon="flaperon" in controller.outputs)
     return predict(plant, controller, _real(dt_s, "dt_s [s]"), u_ref_m_s=u_ref)
 
 
