@@ -20,8 +20,9 @@ lies aft of the CG) pitches the aircraft the other way, which the elevator can h
 s (default α, an α vane that sees the gust at once, and q), minimising the root bending
 moment's tuned-gust peak ratio with its turbulence RMS ratio held within a cap (0.9,
 below the elevator-only controller's 0.907) by the LTI model with each
-command's peak in the reference gusts within its limit (a quadratic penalty beyond, 100 per degree² over), the loop stable,
-by Nelder-Mead (as :func:`~bioflex_jsb.loads.alleviation.design_output_feedback`).
+command's peak in the reference gusts within its limit (a quadratic penalty beyond, 100 per
+degree² over), the loop stable, by Nelder-Mead (as
+:func:`~bioflex_jsb.loads.alleviation.design_output_feedback`).
 """
 
 from __future__ import annotations
@@ -115,7 +116,8 @@ def design_two_surface(plant: StateSpace, dt_s: float, signals=DEFAULT_SIGNALS,
     of the open loop's; on their sum the tuned ratio rose to 0.991, measured) and each
     command within its limit (module docstring),
     from ``start`` (2, m) (default: the elevator's 2 rad/rad on α and 0.1 s on q, the
-    flaperon's 0.7 rad/rad and 0.03 s, near the tuned-peak-only optimum: from zero flaperon gains Nelder-Mead's first simplex
+    flaperon's 0.7 rad/rad and 0.03 s, near the tuned-peak-only optimum: from zero
+    flaperon gains Nelder-Mead's first simplex
     is too small to leave the elevator-only optimum, measured): (the controller, the
     optimiser's record)."""
     from scipy.optimize import minimize
