@@ -553,6 +553,10 @@ def _load_stream(loads, step: CoupledStep, model: str, speed_m_s: float, aero: s
     else:
         raise TypeError(f"loads must be a WingBuild or a LoadsModel, not "
                         f"{type(loads).__name__}")
+    if getattr(step, "flaperon", None) is not None and lm.flaperon is None:
+        from bioflex_jsb.loads.flaperon import with_flaperon  # its strips' loads
+
+        lm = with_flaperon(lm, step.flaperon.deriv)
     static_eta = None if step.elastic_trim is None else step.elastic_trim.eta_rad
     stream = LoadStream(lm, step.names, step.dt_s, model, static_eta, aero)
     layout = {"names": list(stream.names), "units": dict(stream.units),
