@@ -254,6 +254,8 @@ def run_gust(
     if aileron_input is not None:
         history.meta["aileron_input"] = aileron_input.as_dict()
     history.meta["span"] = span
+    if step.step_note is not None:  # the step flown is not the one asked for (a flaperon)
+        history.meta["step_note"] = step.step_note
     if sensor_set is not None:
         history.meta["sensors"] = sensor_set.describe()
     return history

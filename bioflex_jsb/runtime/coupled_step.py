@@ -262,6 +262,7 @@ class CoupledStep(FullSpanSteps):
         self.lateral = self._make_lateral(span, aileron, build, model)
         self._build, self._aileron = build, aileron  # a controller's flaperon's strips
         self.flaperon = None  # a controller's flaperon (runtime/flaperon_step.py)
+        self.step_note: str | None = None  # why the step is not the one asked for
         self._kin_get = None  # the readers of _kinematics, bound at its first call
         self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
@@ -383,9 +384,10 @@ class CoupledStep(FullSpanSteps):
 
         controller = check_controller(controller)
         if "flaperon" in controller.outputs:  # on the Python step (runtime/flaperon_step.py)
-            from bioflex_jsb.runtime.flaperon_step import flaperon_for
+            from bioflex_jsb.runtime.flaperon_step import flaperon_for, python_step_fallback
 
             self.flaperon = flaperon_for(self, self._build, self._aileron)
+            self.step_note = python_step_fallback(self.compiled)  # said, never silent
             self.compiled = False
             self.units["flaperon_rad"] = "rad"
         for o in controller.outputs:

@@ -20,13 +20,19 @@ command δf_k of the row of t_k is clipped to the travel and
 The row of t_k logs the command (``ctrl_flaperon_rad``), the deflection whose loads acted
 over step k (``flaperon_rad``: δf_{k−1} clipped, as ``elevator_rad`` is JSBSim's surface at
 x_k), and in ``lift_n``, ``drag_n``, ``pitch_moment_n_m`` the reactions as written, the
-flaperon's included. The compiled kernel has no flaperon column: a run with a flaperon
-flies the readable Python step (the kernel's reference, ``tests/test_step_kernel.py``).
+flaperon's included.
+
+**The step.** The compiled kernel has no flaperon column: a run with a flaperon flies the
+readable Python step (the kernel's reference, ``tests/test_step_kernel.py``), at the Python
+step's cost (``bench``'s ``python``). When the compiled step was asked for (every driver's
+default) the fall-back is said, never silent: a :class:`FlaperonStepWarning` (printed once
+on stderr by the CLI) and ``meta["step_note"]`` of the run's history.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 
 from bioflex_jsb.aeroelasticity.flaperon import (
     FLAPERON_LIMIT_RAD,
@@ -35,6 +41,24 @@ from bioflex_jsb.aeroelasticity.flaperon import (
 )
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.runtime.control_surfaces import Command
+
+# What a run that asked for the compiled step is told when its flaperon flies the Python one
+PYTHON_STEP_NOTE = ("a flaperon command flies the Python coupled step: the compiled kernel "
+                    "has no flaperon column")
+
+
+class FlaperonStepWarning(UserWarning):
+    """The compiled step was asked for, the flaperon flies the Python one (module
+    docstring, "The step")."""
+
+
+def python_step_fallback(compiled: bool) -> str | None:
+    """The note of a step with a flaperon (None: the Python step was asked for); warns
+    (:class:`FlaperonStepWarning`) when ``compiled`` was asked for."""
+    if not compiled:
+        return None
+    warnings.warn(PYTHON_STEP_NOTE, FlaperonStepWarning, stacklevel=3)
+    return PYTHON_STEP_NOTE
 
 
 class FlaperonLoads:
