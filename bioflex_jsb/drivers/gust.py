@@ -256,6 +256,8 @@ def run_gust(
     history.meta["span"] = span
     if step.step_note is not None:  # the step flown is not the one asked for (a flaperon)
         history.meta["step_note"] = step.step_note
+    if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
+        history.meta["flaperon"] = step.flaperon.deriv.as_dict()
     if sensor_set is not None:
         history.meta["sensors"] = sensor_set.describe()
     return history
