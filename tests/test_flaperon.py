@@ -18,7 +18,6 @@ at 75 % chord). Measured (the tolerances stand above these):
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 
@@ -34,7 +33,11 @@ from bioflex_jsb.aeroelasticity.control_surface import (
     flap_moment_slope_per_rad,
     strip_coverage,
 )
-from bioflex_jsb.aeroelasticity.flaperon import FLAPERON_LIMIT_RAD, flaperon_derivatives
+from bioflex_jsb.aeroelasticity.flaperon import (
+    FLAPERON_LIMIT_RAD,
+    flaperon_derivatives,
+    lift_matrices,
+)
 from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.loads.alleviation import ROOT_BENDING
@@ -226,14 +229,10 @@ def test_reversal_against_the_aileron(wing, surface):
     0.68 m out) loses lift to the flap's nose-down twist with the twist's lift unweighted,
     so it reverses first (12.33 m/s against the aileron's 12.82 m/s). Its reversal speed by
     the LTI model (brentq on the root-held effectiveness) is the bordered eigenproblem's of
-    the aileron analysis with the rolling moment's y dropped (to 1e-6: independent codes)."""
+    the aileron analysis with the rolling moment's y dropped (flaperon.lift_matrices; to
+    1e-6: independent codes)."""
     v_lti = brentq(lambda v: _lti_lift_effectiveness(wing, v), 5.0, 20.0, xtol=1e-8)
-    m = A.static_roll_matrices(A.flight_roll_strips(wing, surface))
-    rs = A.flight_roll_strips(wing, surface)
-    w, la = rs.weights_m, rs.chord_m * rs.lift_slope_per_rad
-    lift = dataclasses.replace(
-        m, moment_eta=rs.twist_rad @ (w * la),
-        moment_delta=float(np.sum(w * rs.chord_m * rs.coverage * rs.flap_lift_per_rad)))
+    lift = lift_matrices(wing, surface)
     v_eig = math.sqrt(2.0 * lift.reversal_dynamic_pressure_pa() / RHO_SEA_LEVEL)
     assert v_lti == pytest.approx(v_eig, rel=1e-6)
     assert v_lti == pytest.approx(12.332, abs=0.005)
@@ -242,6 +241,9 @@ def test_reversal_against_the_aileron(wing, surface):
     assert aileron["reversal_speed_m_s"] == pytest.approx(12.820, abs=0.005)
     assert v_lti < aileron["reversal_speed_m_s"] < V  # both reversed at the cruise speed
     assert _lti_lift_effectiveness(wing, V) == pytest.approx(-0.245, abs=0.005)
+    q_cruise = 0.5 * RHO_SEA_LEVEL * V**2
+    assert lift.effectiveness(q_cruise) == pytest.approx(_lti_lift_effectiveness(wing, V),
+                                                         rel=1e-6)
 
 
 # -- logging, the step asked for, refusals -----------------------------------------------------

@@ -168,3 +168,24 @@ def with_flaperon(ss: StateSpace, condition: FlightCondition,
                       states=ss.states, state_units=ss.state_units,
                       inputs=ss.inputs + (FLAPERON,), input_units=ss.input_units + ("rad",),
                       outputs=ss.outputs, output_units=ss.output_units, notes=notes)
+
+
+def lift_matrices(build, surface: ControlSurface):
+    """The root-held static problem of the flaperon's lift (its reversal): the aileron
+    analysis' matrices (:func:`~bioflex_jsb.aeroelasticity.aileron.static_roll_matrices` on
+    :func:`~bioflex_jsb.aeroelasticity.aileron.flight_roll_strips`) with the rolling
+    moment's output Σ w y L' replaced by the half wing's lift Σ w L': the same stiffness,
+    aerodynamic and flap forcing, the output unweighted by the span station. Its
+    ``effectiveness(q_pa)`` is the lift per δf elastic over rigid, its
+    ``reversal_dynamic_pressure_pa()`` where that lift vanishes (optimised wing: 12.33 m/s
+    at sea level, below its aileron's 12.82 m/s: ``tests/test_flaperon.py``)."""
+    from dataclasses import replace
+
+    from bioflex_jsb.aeroelasticity.aileron import flight_roll_strips, static_roll_matrices
+
+    rs = flight_roll_strips(build, surface)
+    w = rs.weights_m
+    lift_alpha = rs.chord_m * rs.lift_slope_per_rad  # [m/rad]
+    return replace(static_roll_matrices(rs), moment_eta=rs.twist_rad @ (w * lift_alpha),
+                   moment_delta=float(np.sum(w * rs.chord_m * rs.coverage
+                                             * rs.flap_lift_per_rad)))
