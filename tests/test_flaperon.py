@@ -389,3 +389,24 @@ def test_two_surface_tuned_gust_nonlinear_gives_the_prediction(wing, gla_both):
     assert tuned == pytest.approx(pred.tuned_ratio, abs=0.01)
     assert np.abs(peaks[:, 1] / peaks[:, 0] - pred.peak_ratios).max() < 0.025
     assert 0.0 < max(flap) < math.radians(8.0)
+
+
+def test_cli_flies_the_flaperon_with_a_note(capsys, tmp_path, monkeypatch):
+    """``gust --controller gla_flaperon_optimised``: the build's strips flown (the CLI
+    otherwise flies the bare flight model), the fall-back said as one note on stderr, the
+    flaperon's peak in the summary; the unsteady strips refused in one line (exit 2)."""
+    from tests.cli_helpers import assert_one_line_error, run_cli
+
+    monkeypatch.chdir(tmp_path)  # its figure
+    code, out, err = run_cli(capsys, "gust", "--models", "coupled", "--duration", "1",
+                             "--gust", "1cos:1:2", "--controller", "gla_flaperon_optimised",
+                             "--no-log")
+    assert code == 0, err
+    notes = [ln for ln in err.splitlines() if ln.strip()]
+    assert notes == ["bioflex-jsb: note: coupled: a flaperon command flies the Python "
+                     "coupled step: the compiled kernel has no flaperon column"]
+    assert "ctrl_flaperon_rad peak" in out
+    code, _, err = run_cli(capsys, "gust", "--models", "coupled", "--aero", "unsteady",
+                           "--duration", "1", "--controller", "gla_flaperon_optimised",
+                           "--no-log")
+    assert_one_line_error(code, err, "the unsteady wing has no flap terms")
