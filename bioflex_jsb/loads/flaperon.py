@@ -19,7 +19,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from bioflex_jsb.aeroelasticity.flaperon import FlaperonDerivatives
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+from bioflex_jsb.aeroelasticity.flaperon import (
+    FLAPERON_LIMIT_RAD,
+    FlaperonDerivatives,
+    flaperon_derivatives,
+)
+from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.modal_coefficients import shifted, spanwise_geometry
 from bioflex_jsb.loads.model import LoadsModel
 
@@ -55,3 +61,34 @@ def flaperon_loads(lm: LoadsModel, deriv: FlaperonDerivatives) -> FlaperonLoads:
 def with_flaperon(lm: LoadsModel, deriv: FlaperonDerivatives) -> LoadsModel:
     """``lm`` carrying the flaperon's loads (``lm.flaperon``)."""
     return replace(lm, flaperon=flaperon_loads(lm, deriv))
+
+
+def of_run(lm: LoadsModel, run) -> tuple[LoadsModel, np.ndarray | None]:
+    """(``lm`` with the flaperon ``run`` flew, the deflection [rad] of each row; None: the
+    run flew none). The deflection is the run's ``flaperon_rad``; a history that kept only
+    the command (a log read back) gives it as the runtime does: ``ctrl_flaperon_rad`` one
+    row later, within the travel (:mod:`bioflex_jsb.runtime.flaperon_step`). The surface is
+    ``lm``'s, else the run's record (``meta["flaperon"]``); a run whose flaperon moved with
+    neither is refused (InputError, one line): its loads would miss the flap's own."""
+    channels = run.channels
+    if "flaperon_rad" in channels:
+        delta = np.asarray(run["flaperon_rad"], dtype=float)
+    elif "ctrl_flaperon_rad" in channels:
+        cmd = np.clip(np.asarray(run["ctrl_flaperon_rad"], dtype=float), -FLAPERON_LIMIT_RAD,
+                      FLAPERON_LIMIT_RAD)
+        delta = np.concatenate([[0.0], cmd[:-1]])
+    else:
+        return lm, None
+    if lm.flaperon is not None:
+        return lm, delta
+    record = run.meta.get("flaperon")
+    if not isinstance(record, dict) or not isinstance(record.get("surface"), dict):
+        if not np.any(delta):
+            return lm, None
+        raise InputError("the run flew a flaperon whose surface it does not record "
+                         "(meta['flaperon']): give the loads model its flaperon "
+                         "(loads.flaperon.with_flaperon)")
+    s = record["surface"]
+    surface = ControlSurface(float(s["start_m"]), float(s["end_m"]),
+                             float(s["hinge_chord_fraction"]), str(s["name"]))
+    return with_flaperon(lm, flaperon_derivatives(lm.build, surface)), delta

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.loads.flaperon import of_run as flaperon_of_run
 from bioflex_jsb.loads.model import METHODS, QUANTITIES, QUANTITY_UNITS, LoadsModel
 from bioflex_jsb.parameters import constants as C
 from bioflex_jsb.simulation.results import TimeHistory
@@ -176,9 +177,10 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
     s = lm.n_stations
     shape = (len(z), 3, s)
     flap = np.zeros((len(z), 3 * s))  # a flaperon's strip loads (loads/flaperon.py)
-    if lm.flaperon is not None and "flaperon_rad" in run.channels:
+    lm, flap_rad = flaperon_of_run(lm, run)
+    if flap_rad is not None:
         q_flap = (0.5 * lm.density_kg_m3 * np.asarray(run["airspeed_m_s"], dtype=float)**2
-                  * np.asarray(run["flaperon_rad"], dtype=float))
+                  * flap_rad)
         flap = np.outer(q_flap, lm.flaperon.fs_rows)
         if run.model == "coupled":
             n = lm.n_modes
