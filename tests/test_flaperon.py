@@ -458,3 +458,23 @@ def test_two_surface_turbulence_rms_nonlinear_gives_the_prediction(wing, gla_bot
                                  kind=kind, sigma_m_s=sigma, scale_m=scale, speed_m_s=V)
             rms.append(float(sc.run_rms_band[0]))
     assert rms[1] / rms[0] == pytest.approx(pred.rms_ratio, abs=0.03)
+
+
+def test_a_sweep_case_flies_the_flaperon(tmp_path):
+    """A campaign's ``controllers`` axis with gla_flaperon_optimised: the case flies the
+    build's strips (it flew the bare flight model) and its log reads back the flaperon's
+    command."""
+    import tomllib
+
+    from bioflex_jsb.sweep.campaign import parse_campaign
+    from bioflex_jsb.sweep.evaluate import run_case
+    from tests.test_sweep_controller import BASE
+
+    (case,) = parse_campaign(tomllib.loads(
+        BASE + 'controllers = ["gla_flaperon_optimised"]\n')).cases()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FlaperonStepWarning)
+        row = run_case(case, str(tmp_path))
+    assert row["status"] == "ok", row["error"]
+    back = api.read_log(tmp_path / f"{case.case_id}.mcap")["coupled"]
+    assert np.abs(back["ctrl_flaperon_rad"]).max() > 0.0
