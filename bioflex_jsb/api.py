@@ -313,6 +313,8 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
     if controller is not None:
         controller = load_controller(controller)
     options = _lateral_options(subject, build, *lateral)
+    if "flaperon" in getattr(controller, "outputs", ()) and "aileron" not in options:
+        options["aileron"] = _flaperon_surface(subject, build)  # the half wing's flaperon
     airframe = subject.jsbsim_airframe()
     out = {}
     for model in map(str, config.models):
@@ -454,7 +456,7 @@ def plot_runs(runs, path: str | Path, title: str | None = None, force: bool = Fa
 
 def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
                  model: str = "coupled", aero: str = "quasi-steady",
-                 trim: str = "rigid") -> StateSpace:
+                 trim: str = "rigid", flaperon: bool = False) -> StateSpace:
     """The paper's LTI model (Eq. 4) of ``wing`` at ``speed_m_s`` [m/s] (None: the
     aircraft's cruise speed, the prototype's 15 m/s): ``model`` ``rigid`` (A_RR),
     ``coupled`` or ``qsd`` (Eq. 9-10), with named states, inputs, outputs and their units.
@@ -478,6 +480,12 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
     modes' force per unit airspeed from the deflected wing); ``notes["eta_static_rad"]``
     holds the static deflection η₀ the states are measured from. The unsteady and the
     elastic-trim models take the gust w_g alone and output their states.
+
+    ``flaperon`` (the quasi-steady coupled model about the rigid trim): the input
+    ``flaperon`` [rad] after the others, the wing's ``[aileron]`` deflected together, both
+    trailing edges down positive (:mod:`bioflex_jsb.aeroelasticity.flaperon`: its lift and
+    moment on the rigid rows, its strip loads on the modes; ``notes["flaperon"]`` its
+    derivatives), as a controller's ``flaperon`` command flies it.
 
     ``wing`` an :class:`Aircraft` (or its wing): the model is its own (S, c̄, mass, I_yy, the
     derivatives of its file, its planform; the air of its [air]); ``None`` the prototype's
@@ -505,8 +513,27 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
         return unsteady_state_space(wing, speed_m_s, gust=True, **air)
     airframe = PROTOTYPE_AIRFRAME if wing is None else wing.model.airframe
-    return build_state_space(model, level_flight_condition(speed_m_s, airframe=airframe, **air),
-                             None if wing is None else wing.model, controls=True)
+    condition = level_flight_condition(speed_m_s, airframe=airframe, **air)
+    ss = build_state_space(model, condition, None if wing is None else wing.model,
+                           controls=True)
+    if not flaperon:
+        return ss
+    if wing is None or model != "coupled":
+        raise InputError("flaperon=True is the quasi-steady coupled model of an elastic wing")
+    from bioflex_jsb.aeroelasticity.flaperon import flaperon_derivatives, with_flaperon
+
+    deriv = flaperon_derivatives(wing, _flaperon_surface(subject, wing))
+    return with_flaperon(ss, condition, deriv, wing.model.generalised_masses_kg_m2)
+
+
+def _flaperon_surface(subject, build):
+    """The aileron a flaperon deflects: the aircraft definition's ``[aileron]``, else the
+    prototype variant's shipped definition's (None: none)."""
+    from bioflex_jsb.simulation.full_span import prototype_aileron
+
+    if subject.aircraft is not None:
+        return subject.aircraft.definition.aileron
+    return prototype_aileron(build.variant.name)
 
 
 
@@ -1088,9 +1115,10 @@ def linear_controller(source):
     return controller
 
 
-def _gla_plant(wing, speed_m_s):
+def _gla_plant(wing, speed_m_s, flaperon: bool = False):
     """(the WingBuild, the trim speed [m/s], the GLA plant of loads/alleviation.py with
-    JSBSim's rigid block at the trim and the loads at the trim's density)."""
+    JSBSim's rigid block at the trim and the loads at the trim's density; ``flaperon``: with
+    the flaperon input, loads/alleviation_flaperon.py)."""
     from bioflex_jsb.loads.alleviation import gla_plant
     from bioflex_jsb.loads.model import build_loads_model
 
@@ -1101,6 +1129,11 @@ def _gla_plant(wing, speed_m_s):
     lin = airframe.linearize(v)
     rho = airframe[JP.ATMOSPHERE_RHO_SLUGS_FT3] * U.KG_M3_PER_SLUG_FT3  # the trim's air
     lm = build_loads_model(build, v, density_kg_m3=rho, static="elastic")
+    if flaperon:
+        from bioflex_jsb.loads.alleviation_flaperon import flaperon_plant
+
+        return build, v, flaperon_plant(build, v, lm, _flaperon_surface(subject, build),
+                                        a_rr=lin.a)
     return build, v, gla_plant(build, v, lm, a_rr=lin.a)
 
 
@@ -1119,7 +1152,7 @@ def predict_alleviation(wing, controller, speed_m_s: float | None = None,
 
     controller = linear_controller(controller)
     u_ref = argument(Real("m/s", positive=True), u_ref_m_s, "u_ref_m_s")
-    _, _, plant = _gla_plant(wing, speed_m_s)
+    _, _, plant = _gla_plant(wing, speed_m_s, flaperon="flaperon" in controller.outputs)
     return predict(plant, controller, _real(dt_s, "dt_s", "s"), u_ref_m_s=u_ref)
 
 

@@ -153,7 +153,8 @@ def test_cli_refuses_a_bad_controller_in_one_line(capsys, tmp_path):
         code, _, err = run_cli(capsys, command, "--controller", str(bad), "--no-log")
         assert_one_line_error(code, err, "'qq' is not a signal of the run")
     code, _, err = run_cli(capsys, "gust", "--controller", "no_such", "--no-log")
-    assert_one_line_error(code, err, "shipped controller (fs_inertial-backward, gla_optimised)")
+    assert_one_line_error(code, err, "shipped controller (fs_inertial-backward, "
+                                     "gla_flaperon_optimised, gla_optimised)")
 
 
 def test_rerun_flies_the_controller_again():

@@ -6,6 +6,7 @@ import argparse
 import math
 import os
 import sys
+import warnings
 
 from bioflex_jsb.cli.case import (
     DEFAULT_GUST,
@@ -309,10 +310,17 @@ def fly(args, build, config, log=None, airframe=None):
     from bioflex_jsb.cli.aircraft_option import airframe_from_args
     from bioflex_jsb.drivers.gust import run_gust
     from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.runtime.flaperon_step import FlaperonStepWarning
 
     runs, stops = [], []
     # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
     lateral = lateral_run_options(args, build) if hasattr(args, "aileron_step") else {}
+    controller = getattr(args, "controller_object", None)
+    flaperon = "flaperon" in getattr(controller, "outputs", ())
+    if flaperon and "aileron" not in lateral:  # the aileron it deflects: --aircraft's
+        aircraft = getattr(args, "aircraft_definition", None)  # (None: the prototype's)
+        lateral = {**lateral, "aileron": None if aircraft is None
+                   else aircraft.definition.aileron}
     try:
         if airframe is None:
             airframe = airframe_from_args(args)
@@ -323,13 +331,17 @@ def fly(args, build, config, log=None, airframe=None):
             # the bar moved once a block (0.9 s of flight), not by a callback every step
             progress = None if bar is None else (lambda k, bar=bar: bar.update(k - bar.n))
             wing = build if config.needs_build(model) or lateral.get("span") == "full" \
-                else build.model
+                or flaperon else build.model  # a flaperon's strips are the build's
             try:
-                run = run_gust(airframe, wing, model, config, progress=progress,
-                               recorder=recorder, loads=build,
-                               controller=getattr(args, "controller_object", None), **lateral)
+                with warnings.catch_warnings():  # said once, below, as a note
+                    warnings.simplefilter("ignore", FlaperonStepWarning)
+                    run = run_gust(airframe, wing, model, config, progress=progress,
+                                   recorder=recorder, loads=build, controller=controller,
+                                   **lateral)
             finally:
                 close_bar(bar)
+            if run.meta.get("step_note"):
+                print(f"bioflex-jsb: note: {model}: {run.meta['step_note']}", file=sys.stderr)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)

@@ -48,7 +48,7 @@ from bioflex_jsb.simulation.lti_response import simulate
 from bioflex_jsb.simulation.results import TimeHistory, nrmse
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
-COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle")  # a controller's, when one flew
+COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle", "ctrl_flaperon_rad")  # a controller's
 # a gust with a rolling or lateral part: the rigid lateral model's (_add_lateral)
 LATERAL_CHANNELS = ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad")
 # both wing halves: the first antisymmetric mode and the modes' rolling moment
@@ -198,6 +198,8 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         ss = build_state_space(model, level_flight_condition(speed_m_s,
                                                              airframe=build.airframe),
                                build.model, a_rr=lin.a, controls=True)
+        if "flaperon" in controller.outputs:  # its input and its strips' loads
+            ss, lm = _with_flaperon(build, nonlinear, speed_m_s, ss, lm)
     if lm is not None and aero != "unsteady":
         ss = with_load_outputs(ss, lm)
     if controller is not None:
@@ -218,6 +220,27 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
     return linear
+
+
+def _with_flaperon(build: WingBuild, nonlinear: TimeHistory, speed_m_s: float, ss, lm):
+    """The LTI model ``ss`` with the ``flaperon`` input of the surface the run flew
+    (``meta["flaperon"]``, :mod:`bioflex_jsb.aeroelasticity.flaperon`) and the loads model
+    ``lm`` (None: none) with its strips' loads."""
+    from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+    from bioflex_jsb.aeroelasticity.flaperon import flaperon_derivatives, with_flaperon
+    from bioflex_jsb.loads.flaperon import with_flaperon as loads_with_flaperon
+
+    record = nonlinear.meta.get("flaperon")
+    if not isinstance(record, dict) or not isinstance(record.get("surface"), dict):
+        raise InputError("the run has no record of its flaperon (meta['flaperon']): fly it "
+                         "again to compare it")
+    s = record["surface"]
+    surface = ControlSurface(float(s["start_m"]), float(s["end_m"]),
+                             float(s["hinge_chord_fraction"]), str(s["name"]))
+    deriv = flaperon_derivatives(build, surface)
+    cond = level_flight_condition(speed_m_s, airframe=build.airframe)
+    ss = with_flaperon(ss, cond, deriv, build.model.generalised_masses_kg_m2)
+    return ss, None if lm is None else loads_with_flaperon(lm, deriv)
 
 
 def _add_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,

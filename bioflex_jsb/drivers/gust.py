@@ -254,6 +254,10 @@ def run_gust(
     if aileron_input is not None:
         history.meta["aileron_input"] = aileron_input.as_dict()
     history.meta["span"] = span
+    if step.step_note is not None:  # the step flown is not the one asked for (a flaperon)
+        history.meta["step_note"] = step.step_note
+    if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
+        history.meta["flaperon"] = step.flaperon.deriv.as_dict()
     if sensor_set is not None:
         history.meta["sensors"] = sensor_set.describe()
     return history
@@ -553,6 +557,10 @@ def _load_stream(loads, step: CoupledStep, model: str, speed_m_s: float, aero: s
     else:
         raise TypeError(f"loads must be a WingBuild or a LoadsModel, not "
                         f"{type(loads).__name__}")
+    if getattr(step, "flaperon", None) is not None and lm.flaperon is None:
+        from bioflex_jsb.loads.flaperon import with_flaperon  # its strips' loads
+
+        lm = with_flaperon(lm, step.flaperon.deriv)
     static_eta = None if step.elastic_trim is None else step.elastic_trim.eta_rad
     stream = LoadStream(lm, step.names, step.dt_s, model, static_eta, aero)
     layout = {"names": list(stream.names), "units": dict(stream.units),

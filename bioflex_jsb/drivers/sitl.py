@@ -504,8 +504,11 @@ class SitlSim:
         elastic = self.trim_mode == "elastic" and model != "rigid"
         wing = self._wing_model
         if not elastic and self.aero != "unsteady" and hasattr(wing, "model") \
-                and self.span == "half":
-            wing = wing.model  # a WingBuild: the model is enough for the quasi-steady strips
+                and self.span == "half" \
+                and "flaperon" not in getattr(self._controller, "outputs", ()):
+            # a WingBuild: the model is enough for the quasi-steady strips (a flaperon's
+            # strips are the build's)
+            wing = wing.model
         self.core = CoupledStep(a, wing, model, self.speed_m_s, self.start_altitude_m,
                                 self._dt0, before_trim=disengage,
                                 trim_mode="elastic" if elastic else "rigid", aero=self.aero,

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.loads.flaperon import of_run as flaperon_of_run
 from bioflex_jsb.loads.model import METHODS, QUANTITIES, QUANTITY_UNITS, LoadsModel
 from bioflex_jsb.parameters import constants as C
 from bioflex_jsb.simulation.results import TimeHistory
@@ -175,7 +176,16 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
     z = run_signals(lm, run)
     s = lm.n_stations
     shape = (len(z), 3, s)
-    values = {"force_summation": lm.force_summation(z).reshape(shape)}
+    flap = np.zeros((len(z), 3 * s))  # a flaperon's strip loads (loads/flaperon.py)
+    lm, flap_rad = flaperon_of_run(lm, run)
+    if flap_rad is not None:
+        q_flap = (0.5 * lm.density_kg_m3 * np.asarray(run["airspeed_m_s"], dtype=float)**2
+                  * flap_rad)
+        flap = np.outer(q_flap, lm.flaperon.fs_rows)
+        if run.model == "coupled":
+            n = lm.n_modes
+            z[:, 5 + 2 * n:] += np.outer(q_flap, lm.flaperon.force)
+    values = {"force_summation": (lm.force_summation(z) + flap).reshape(shape)}
     static_all = lm.static_loads()
     static = {"force_summation": static_all["force_summation"]}
     if run.model in ("coupled", "qsd") and lm.md_matrix is not None:
@@ -193,7 +203,7 @@ def section_loads_of_run(lm: LoadsModel, run: TimeHistory) -> SectionLoads:
         meta["mode_displacement_unavailable"] = lm.md_unavailable
     return SectionLoads(lm.wing, run.model, np.asarray(run.time_s, dtype=float), lm.stations_m,
                         lm.station_fractions, values, static,
-                        lm.force_summation(z, "aero").reshape(shape),
+                        (lm.force_summation(z, "aero") + flap).reshape(shape),
                         lm.force_summation(z, "inertia").reshape(shape), meta)
 
 

@@ -123,6 +123,11 @@ def load_outputs(ss: StateSpace, lm: LoadsModel) -> LoadOutputs:
     others = [j for j in range(ss.b.shape[1]) if j != ig]
     columns = {j: _input_signal_column(ss, lm, j) for j in others}
     du = {j: [lm.fs_matrix @ columns[j][0]] for j in others}
+    if "flaperon" in ss.inputs and lm.flaperon is not None:  # its strips' own loads
+        du[ss.inputs.index("flaperon")][0] += lm.dynamic_pressure_pa * lm.flaperon.fs_rows
+    elif "flaperon" in ss.inputs:
+        raise InputError("the model has a flaperon input: give the loads model its "
+                         "flaperon (loads.flaperon.with_flaperon)")
     static = [static_all["force_summation"].reshape(-1)]
     if ss.model != "rigid" and lm.md_matrix is not None:
         names += [f"md_{q}_s{j}" for q in QUANTITIES for j in range(s)]

@@ -125,6 +125,8 @@ class LoadsModel:
     cell_shapes: tuple[np.ndarray, np.ndarray] = field(repr=False)  # (φ, θ) at the cells
     cell_strips: np.ndarray = field(repr=False)  # the lattice strip of each cell
     build: object = field(repr=False)  # the WingBuild (the unsteady wing's strips)
+    # a flaperon's loads (loads/flaperon.py: its FS rows and modal forcing), None: none
+    flaperon: object = field(default=None, repr=False)
 
     @property
     def n_stations(self) -> int:

@@ -159,6 +159,10 @@ class LoadStream:
                         np.ascontiguousarray(lm.static_eta_rad, dtype=float), G,
                         mm.omega**2, 2.0 * mm.zeta * mm.omega, mm.b_alpha, mm.b_q,
                         np.asarray(self._b0, dtype=float), lm.dynamic_pressure_pa)
+        # a flaperon's strip loads and modal forcing (loads/flaperon.py), from its channel
+        self._flap = None
+        if lm.flaperon is not None and "flaperon_rad" in col:
+            self._flap = (col["flaperon_rad"], lm.flaperon)
         self._held_t: float | None = None  # the last row handed in, its loads not yet out
         self._held: np.ndarray | None = None
         self._q_before = None  # q of the row before the held one (None: the run's first)
@@ -248,6 +252,12 @@ class LoadStream:
         eta = np.empty((m, n))
         z = _signals(rows, self._cols, np.asarray(q_dot, dtype=float), d_eta, d_eta_dot, ke, de,
                      eta, *self._consts, modal)
+        flap = None
+        if self._flap is not None:  # Q δf of each row: its strips' loads and its η̈ forcing
+            i_flap, fl = self._flap
+            flap = self._consts[0] * rows[:, self._i_v] ** 2 * rows[:, i_flap]
+            if modal:
+                z[:, 5 + 2 * n:] += np.outer(flap, fl.force)
         parts = []
         if self._fs is not None:
             if self._unsteady is not None:
@@ -256,6 +266,8 @@ class LoadStream:
                 parts.append(z @ self._fs + extra)
             else:
                 parts.append(z @ self._fs)
+            if flap is not None:
+                parts[-1] = parts[-1] + np.outer(flap, self._flap[1].fs_rows)
         if self._md is not None:
             parts.append(eta @ self._md)
         return parts[0] if len(parts) == 1 else np.hstack(parts)

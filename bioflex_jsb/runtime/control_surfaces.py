@@ -1,5 +1,6 @@
 """A controller's commands into JSBSim: the elevator [rad] and the throttle [-] as the
-aircraft's flight controls take them, converted here, once, at the JSBSim boundary.
+aircraft's flight controls take them, converted here, once, at the JSBSim boundary (the
+flaperon: its own path, below).
 
 The elevator. An aircraft's flight controls map the normalised command
 ``fcs/elevator-cmd-norm`` (plus ``fcs/pitch-trim-cmd-norm``, clipped to −1..1) to the
@@ -31,6 +32,12 @@ prototype's autothrottle adds its increment to the lever ``fcs/throttle-cmd-norm
 controller's throttle is added to the autopilot's alike; a powered aircraft's autopilot
 writes the levers itself (``ap/throttle-trim-norm[i]`` plus its increment), over which a
 controller's throttle is refused (one line).
+
+**The flaperon** (both ailerons down together, :mod:`bioflex_jsb.aeroelasticity.flaperon`)
+has no JSBSim property: JSBSim's tables carry no symmetric aileron. Its command is the
+coupled step's own (:mod:`bioflex_jsb.runtime.flaperon_step`): its loads go to the external
+reactions and its strip loads to the symmetric modes; ``fcs/aileron-cmd-norm`` is not
+written, so nothing is counted twice.
 """
 
 from __future__ import annotations
@@ -171,8 +178,13 @@ def throttle_command(airframe: Airframe, over_autopilot: bool = False) -> Comman
 COMMANDS = {"elevator": elevator_command, "throttle": throttle_command}
 
 
-def commands_for(airframe: Airframe, outputs: tuple[str, ...], over_autopilot: bool = False
-                 ) -> tuple[Command, ...]:
+def commands_for(airframe: Airframe, outputs: tuple[str, ...], over_autopilot: bool = False,
+                 flaperon: Command | None = None) -> tuple[Command, ...]:
     """One :class:`Command` per command of ``outputs`` (in that order), for the trimmed
-    ``airframe`` (``over_autopilot``: added to its autopilot's, module docstring)."""
-    return tuple(COMMANDS[o](airframe, over_autopilot) for o in outputs)
+    ``airframe`` (``over_autopilot``: added to its autopilot's, module docstring);
+    ``flaperon`` the flaperon's writer (module docstring, "The flaperon")."""
+    if "flaperon" in outputs and flaperon is None:
+        raise InputError("a flaperon command needs the coupled step's flaperon (the half "
+                         "wing's strips): runtime/flaperon_step.py")
+    return tuple(flaperon if o == "flaperon" else COMMANDS[o](airframe, over_autopilot)
+                 for o in outputs)

@@ -260,6 +260,9 @@ class CoupledStep(FullSpanSteps):
         self.aero = aero
         self.units = channel_units(self.n_modes)
         self.lateral = self._make_lateral(span, aileron, build, model)
+        self._build, self._aileron = build, aileron  # a controller's flaperon's strips
+        self.flaperon = None  # a controller's flaperon (runtime/flaperon_step.py)
+        self.step_note: str | None = None  # why the step is not the one asked for
         self._kin_get = None  # the readers of _kinematics, bound at its first call
         self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
@@ -380,6 +383,13 @@ class CoupledStep(FullSpanSteps):
         )
 
         controller = check_controller(controller)
+        if "flaperon" in controller.outputs:  # on the Python step (runtime/flaperon_step.py)
+            from bioflex_jsb.runtime.flaperon_step import flaperon_for, python_step_fallback
+
+            self.flaperon = flaperon_for(self, self._build, self._aileron)
+            self.step_note = python_step_fallback(self.compiled)  # said, never silent
+            self.compiled = False
+            self.units["flaperon_rad"] = "rad"
         for o in controller.outputs:
             self.units[COMMAND_CHANNELS[o]] = CONTROL_OUTPUTS[o]
         self.names = tuple(self.units)
@@ -389,7 +399,8 @@ class CoupledStep(FullSpanSteps):
         if self._sensors is not None:  # their true reading at the trim, the wing at rest
             trim.update(self._sensors.set.clean(self._kinematics(0.0), zeros, zeros, zeros))
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
-        commands = commands_for(self.airframe, loop.outputs, over_autopilot)
+        commands = commands_for(self.airframe, loop.outputs, over_autopilot,
+                                None if self.flaperon is None else self.flaperon.command())
         binding = loop.binding
         if binding is not None:  # the compiled update maps and returns the first command
             for i, c in enumerate(commands):
@@ -516,6 +527,10 @@ class CoupledStep(FullSpanSteps):
                     sensed = sensors.row(kin, mw.eta, t)
                 values = self._controlled_row(state, w_g_m_s, loads, eta, eta_dot,
                                               sensed if sensors is not None else None)
+                if self.flaperon is not None:
+                    from bioflex_jsb.runtime.flaperon_step import apply_flaperon
+
+                    values = apply_flaperon(self, flow, loads, values)
             self.airframe.step()
             new_eta = mw.eta
             if self.lateral is not None:  # both wings' η against the limit
@@ -571,6 +586,8 @@ class CoupledStep(FullSpanSteps):
             row[self._etadot_names[i]] = float(eta_dot[i])
         if self.lateral is not None:
             row.update(self._lateral_row)
+        if self.flaperon is not None:
+            row["flaperon_rad"] = self.flaperon.applied_rad
         return row
 
     @property

@@ -88,6 +88,12 @@ COMMAND_CHANNELS: dict[str, Channel] = {
                                  "surface's angle, within its travel: elevator_rad)"),
     "ctrl_throttle": Channel("-", _P, "throttle commanded by the controller in the loop, added "
                              "to the trim's (the total clipped to 0..1: throttle)"),
+    "ctrl_flaperon_rad": Channel("rad", _P, "flaperon (both ailerons together, trailing edges "
+                                 "down positive) commanded by the controller in the loop "
+                                 "(the deflection, within its travel: flaperon_rad)"),
+    "flaperon_rad": Channel("rad", _P, "flaperon deflection whose loads act over this step "
+                            "(the previous step's command within the ±10° travel), trailing "
+                            "edges down positive"),
 }
 BASE_UNITS: dict[str, str] = {name: c.unit for name, c in CHANNELS.items()}
 # the self-describing name → the channel's own (``TimeHistory`` answers to both)

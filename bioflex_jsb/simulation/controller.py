@@ -18,7 +18,15 @@ and signs (its inputs ``elevator`` and ``throttle``, :mod:`bioflex_jsb.flight_dy
 * ``elevator`` [rad]: elevator deflection added to the trim's, + trailing edge down
   (nose-down moment);
 * ``throttle`` [-]: throttle added to the trim's (fraction of full throttle); the total is
-  clipped to 0..1 by the flight controls.
+  clipped to 0..1 by the flight controls;
+* ``flaperon`` [rad]: the wing's ailerons deflected together, **both trailing edges down
+  positive** (more lift, a nose-down moment on the prototype), on the half-wing co-simulation
+  only; the definition's ``[aileron]`` on the strips, its travel ±10°
+  (:mod:`bioflex_jsb.aeroelasticity.flaperon`: sign, section data, what is left out).
+  JSBSim's tables have no symmetric aileron: its loads go to JSBSim's external reactions
+  beside the modes' (never through ``fcs/aileron-cmd-norm``), its strip loads onto the
+  symmetric modes, and the run's steps are the Python (reference) step's
+  (:mod:`bioflex_jsb.runtime.control_surfaces`, "The flaperon").
 
 The runtime converts them once at the JSBSim boundary (``fcs/elevator-cmd-norm`` through
 the aircraft's own rad-per-command scaling, ``fcs/throttle-cmd-norm[i]``); the surface's
@@ -82,10 +90,11 @@ from bioflex_jsb.state_space import StateSpace
 from bioflex_jsb.tomlfile import loads_toml
 
 # The commands a controller may write: name → unit (increments over the trim, module
-# docstring). The ailerons join once the lateral axis flies.
-CONTROL_OUTPUTS: dict[str, str] = {"elevator": "rad", "throttle": "-"}
+# docstring).
+CONTROL_OUTPUTS: dict[str, str] = {"elevator": "rad", "throttle": "-", "flaperon": "rad"}
 # The channel each command is logged as.
-COMMAND_CHANNELS: dict[str, str] = {"elevator": "ctrl_elevator_rad", "throttle": "ctrl_throttle"}
+COMMAND_CHANNELS: dict[str, str] = {"elevator": "ctrl_elevator_rad", "throttle": "ctrl_throttle",
+                                    "flaperon": "ctrl_flaperon_rad"}
 # A controller file is read whole: at most this many bytes (a 10-state controller of a few
 # signals is ~2 kB as .npz; 1000 states of double matrices would be 8 MB).
 MAX_CONTROLLER_BYTES = 16 * 1024 * 1024

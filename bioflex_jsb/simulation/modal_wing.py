@@ -163,6 +163,17 @@ class ModalWing:
         self._load_x = np.hstack([self._load_eta, np.zeros_like(self._load_eta)])
         self._key: tuple[float, float] | None = None
         self._phi = self._gamma = None
+        # a flaperon (set_flaperon): η̈ per unit Q δf, its step column and the deflection held
+        self._flap_force: np.ndarray | None = None
+        self._flap_cols: np.ndarray | None = None
+        self.flaperon_rad = 0.0
+
+    def set_flaperon(self, force_per_q: np.ndarray) -> None:
+        """Let a flaperon force the modes: η̈ gains Q b_δf δf (``force_per_q`` b_δf (n,)
+        [1/(Pa·s²) per rad], :mod:`bioflex_jsb.aeroelasticity.flaperon`), δf
+        :attr:`flaperon_rad` [rad] held over each step (zero-order hold, as the flow)."""
+        self._flap_force = np.asarray(force_per_q, dtype=float).reshape(self.n_modes)
+        self._key = None  # the step's columns again, with the flaperon's
 
     # -- modal dynamics -------------------------------------------------------------------
     def _matrices(self, q_pa: float, v_m_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -199,6 +210,8 @@ class ModalWing:
             expm_frechet(a * self.dt_s, d_a_dqv * self.dt_s, compute_expm=False),
         ])
         self._input_cols = psi_lower @ self._forcing
+        if self._flap_force is not None:
+            self._flap_cols = psi_lower @ self._flap_force
         self._key = (q_pa, v_m_s)
 
     def prepare_arrays(self) -> None:
@@ -237,6 +250,8 @@ class ModalWing:
              q_pa - self.trim.dynamic_pressure_pa)
         self._x = (y[:m] + (q_pa - q_r) * y[m : 2 * m] + (q_pa / v - q_r / v_r) * y[2 * m :]
                    + self._input_cols @ f)
+        if self._flap_force is not None:
+            self._x += self._flap_cols * (q_pa * self.flaperon_rad)
 
     @property
     def eta(self) -> np.ndarray:
@@ -269,7 +284,10 @@ class ModalWing:
         """Δη that balances the current flow with η̇ = η̈ = 0 (Eq. 9-10) [rad]."""
         a, b = self._matrices(flow.dynamic_pressure_pa, flow.airspeed_m_s)
         n = self.n_modes
-        return np.linalg.solve(a[n:, :n], -b[n:] @ self._inputs(flow))
+        force = b[n:] @ self._inputs(flow)
+        if self._flap_force is not None:
+            force = force + flow.dynamic_pressure_pa * self.flaperon_rad * self._flap_force
+        return np.linalg.solve(a[n:, :n], -force)
 
     def step(self, flow: FlowState) -> None:
         """Advance the modal state over one step with ``flow`` held (zero-order hold)."""

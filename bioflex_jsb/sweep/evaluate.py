@@ -275,6 +275,8 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
             from bioflex_jsb.simulation.controller import load_controller
 
             controller = load_controller(case.controller)
+            if "flaperon" in controller.outputs:  # its strips are the build's
+                wing = build
         run = run_gust(airframe(case.aircraft), wing, case.model, setup, recorder=recorder,
                        sensors=sensors, controller=controller)
         if log is not None and run.stopped:  # as a gust log says it: read_log's stopped

@@ -1,13 +1,14 @@
 """A gust run's controller on ``/bioflex/<model>/controller``.
 
 ``bioflex.Controller`` (:data:`~.schemas.SCHEMAS` ``["controller"]``): per step the commands
-the controller wrote (``elevator_cmd_rad``, ``throttle_cmd``: increments over the trim, NaN
-for a command it does not write) and the signals it read (``signals``, a packed array in the
-order the channel's metadata lists them). The run hands the step rows over a block at a
-time (``drivers.gust.StepRecorder``'s optional ``controller``), and each block is written as
-a chunk of its own right after the steps' chunk, so every chunk is in log-time order. The
-channel's metadata says what the controller was (:func:`~bioflex_jsb.simulation.
-controller.controller_meta`) and the signals' trim values.
+the controller wrote (``elevator_cmd_rad``, ``throttle_cmd``, ``flaperon_cmd_rad``:
+increments over the trim, NaN for a command it does not write) and the signals it read
+(``signals``, a packed array in the order the channel's metadata lists them). The run hands
+the step rows over a block at a time (``drivers.gust.StepRecorder``'s optional
+``controller``), and each block is written as a chunk of its own right after the steps'
+chunk, so every chunk is in log-time order. The channel's metadata says what the controller
+was (:func:`~bioflex_jsb.simulation.controller.controller_meta`) and the signals' trim
+values.
 """
 
 from __future__ import annotations
@@ -25,7 +26,8 @@ if TYPE_CHECKING:
     from bioflex_jsb.sinks.mcap_io.writer import McapFileWriter
 
 GROUP = "controller"
-COMMAND_FIELDS = {"ctrl_elevator_rad": "elevator_cmd_rad", "ctrl_throttle": "throttle_cmd"}
+COMMAND_FIELDS = {"ctrl_elevator_rad": "elevator_cmd_rad", "ctrl_throttle": "throttle_cmd",
+                  "ctrl_flaperon_rad": "flaperon_cmd_rad"}
 
 
 def channel_metadata(model: str, meta: dict) -> dict[str, str]:
@@ -35,7 +37,8 @@ def channel_metadata(model: str, meta: dict) -> dict[str, str]:
             "signals": json.dumps(list(meta["inputs"])),
             "commands": ",".join(meta["outputs"]),
             "n_states": json.dumps(meta.get("n_states")), "dt_s": json.dumps(meta.get("dt_s")),
-            "units": "elevator_cmd_rad rad, throttle_cmd -, signals: the channels' "
+            "units": "elevator_cmd_rad rad, throttle_cmd -, flaperon_cmd_rad rad, signals: "
+                     "the channels' "
                      "(docs/api.md)"}
 
 
@@ -65,10 +68,11 @@ class ControllerTopic:
         if not len(time_s):
             return
         n = len(time_s)
-        values = np.empty((n, 2 + len(self.signal_cols)))
+        k = len(self.command_cols)
+        values = np.empty((n, k + len(self.signal_cols)))
         for j, c in enumerate(self.command_cols):
             values[:, j] = rows[:, c] if c >= 0 else np.nan
-        values[:, 2:] = rows[:, self.signal_cols]
+        values[:, k:] = rows[:, self.signal_cols]
         ns = np.rint(np.asarray(time_s, dtype=float) * 1e9).astype(np.int64)
         w = self._writer
         with signals_deferred():

@@ -318,6 +318,10 @@ SCHEMAS["controller"] = {
                     "description": "the signals it read at the step, element i the channel "
                     "metadata's signals[i], as the run's channels (SI; a linear controller "
                     "reads their perturbations from the trim values in the metadata)"},
+        # after signals: the older fields keep their protobuf numbers
+        "flaperon_cmd_rad": _num("flaperon (both ailerons together) commanded over the "
+                                 "trim, trailing edges down positive; NaN when it does not "
+                                 "command the flaperon [rad]"),
     },
 }
 # The antisymmetric wing of a full-span run (bioflex_jsb.sinks.mcap.lateral_topic;
