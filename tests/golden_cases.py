@@ -135,8 +135,10 @@ def wing_from_dict(data: dict):
                 for k, v in d.items()}
 
     fields = arrays({k: v for k, v in data.items() if k != "coefficients"})
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
     return ElasticWingModel(coefficients=ModalCoefficients(**arrays(data["coefficients"])),
-                            **fields)
+                            airframe=PROTOTYPE_AIRFRAME, **fields)
 
 
 def stored_wing():
