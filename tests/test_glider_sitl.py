@@ -36,7 +36,7 @@ from tests.test_sitl_mission import free_port
 
 SPEED_M_S = 25.0  # sgs_elastic.toml cruise_speed_m_s
 # SGS.xml's polar at 25 m/s: L/D 25 on its CLwbh/CDwbh tables (sgs_elastic.toml), so a
-# sink of V/(L/D) = 1.0 m/s; the glide trim's γ is -2.3° (runtime/trim.py).
+# sink of V/(L/D) = 1.0 m/s; the glide trim's γ is -2.3° (runtime/glide.py).
 POLAR_SINK_M_S = 1.0
 
 
