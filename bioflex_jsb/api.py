@@ -1137,6 +1137,17 @@ def _gla_plant(wing, speed_m_s, flaperon: bool = False):
     return build, v, gla_plant(build, v, lm, a_rr=lin.a)
 
 
+def _gla_gradients():
+    """The tuned gust's gradients [m] of the alleviation's prediction and design: the
+    default ones of ``loads --tuned`` on the prototype (1.5 of its chords to 15 m), for every
+    aircraft (another aircraft's own scales, loads.tuned.aircraft_gust_scales, are not used
+    here)."""
+    from bioflex_jsb.loads.tuned import default_gradients_m
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
+    return default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)
+
+
 def predict_alleviation(wing, controller, speed_m_s: float | None = None,
                         u_ref_m_s: float = 3.0, dt_s: float = DEFAULT_DT_S):
     """What ``controller`` (a linear one, :func:`linear_controller`) does to the root bending
@@ -1153,7 +1164,8 @@ def predict_alleviation(wing, controller, speed_m_s: float | None = None,
     controller = linear_controller(controller)
     u_ref = argument(Real("m/s", positive=True), u_ref_m_s, "u_ref_m_s")
     _, _, plant = _gla_plant(wing, speed_m_s, flaperon="flaperon" in controller.outputs)
-    return predict(plant, controller, _real(dt_s, "dt_s", "s"), u_ref_m_s=u_ref)
+    return predict(plant, controller, _real(dt_s, "dt_s", "s"), gradients_m=_gla_gradients(),
+                   u_ref_m_s=u_ref)
 
 
 def design_alleviation(wing, speed_m_s: float | None = None,
@@ -1176,6 +1188,7 @@ def design_alleviation(wing, speed_m_s: float | None = None,
                      "elevator_limit_rad")
     _, v, plant = _gla_plant(wing, speed_m_s)
     ctrl, record = design_output_feedback(plant, _real(dt_s, "dt_s", "s"), signals,
+                                          gradients_m=_gla_gradients(),
                                           u_ref_m_s=_real(u_ref_m_s, "u_ref_m_s", "m/s"),
                                           elevator_limit_rad=limit)
     record["speed_m_s"] = v

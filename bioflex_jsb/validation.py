@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from bioflex_jsb.flight_dynamics import eigen
 from bioflex_jsb.flight_dynamics.wing_model import DEFAULT_MASS_BASIS, VARIANTS, build_wing
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
 # Where the paper prints a table for a variant: (table name, data) — Tables 4, 5, 7 are
 # held out of our copy of the paper.
@@ -50,7 +51,8 @@ def short_period_rows(wing_name: str, mass_basis: str = DEFAULT_MASS_BASIS) -> l
     speeds = sorted({v for v, _ in data})
     rows = []
     for model in ("rigid", "coupled", "qsd"):
-        sets = eigen.modes_at(model, speeds, None if model == "rigid" else build.model)
+        sets = eigen.modes_at(model, speeds, None if model == "rigid" else build.model,
+                              airframe=PROTOTYPE_AIRFRAME if model == "rigid" else None)
         for s in sets:
             re_p, im_p = data[(s.speed_m_s, model)]
             sp = s.get("short_period")
@@ -83,7 +85,8 @@ class TrendRow:
 def trend_rows(speeds_m_s=(15.0, 20.0), mass_basis: str = DEFAULT_MASS_BASIS) -> list[TrendRow]:
     """Short-period change against rigid for every named variant."""
     rows = []
-    rigid = {s.speed_m_s: s.get("short_period") for s in eigen.modes_at("rigid", speeds_m_s)}
+    rigid = {s.speed_m_s: s.get("short_period") for s in eigen.modes_at("rigid", speeds_m_s,
+                                                                   airframe=PROTOTYPE_AIRFRAME)}
     for name, variant in VARIANTS.items():
         expected = "backward" if name.endswith("backward") else "forward"
         build = build_wing(variant, mass_basis=mass_basis)

@@ -41,7 +41,8 @@ def main() -> None:
     wing = api.load_wing(args.wing)
     _, v, plant = api._gla_plant(wing, args.speed, flaperon=True)
     dt = 1.0 / 960.0
-    ctrl, record = design_two_surface(plant, dt)
+    gradients = api._gla_gradients()  # the elevator-only design's tuned gradients [m]
+    ctrl, record = design_two_surface(plant, dt, gradients_m=gradients)
     pred = api.predict_alleviation(wing, ctrl, v)
     elev = api.predict_alleviation(wing, "gla_optimised", v)
     gains = record["gains"]
@@ -51,7 +52,7 @@ def main() -> None:
           f"elevator only {elev.tuned_ratio:.4f}")
     print("per gradient H [m]:", np.round(pred.open_peaks.gradients_m, 3).tolist())
     print("  ratio closed/open:", np.round(pred.peak_ratios, 4).tolist())
-    peaks = command_peaks(pred.closed_model, v)
+    peaks = command_peaks(pred.closed_model, v, gradients)
     for name, values in peaks.items():
         print(f"  {name} peak [deg]:", np.round(np.degrees(values), 2).tolist())
     print(f"von Karman 1 m/s, L 30 m, 0.25-150 Hz: RMS ratio elevator + flaperon "

@@ -40,7 +40,7 @@ from bioflex_jsb.flight_dynamics import lti
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.parameters import prototype as P
-from bioflex_jsb.parameters.airframe import MASS_PROPERTIES
+from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import GustSpec
 from bioflex_jsb.simulation.results import gust_metrics
@@ -161,7 +161,7 @@ def fig21_claims(metrics: dict[str, dict], after_gust_s: float, alpha_gap_rad: f
 def short_period_re(speed_m_s: float = P.SECTION5_AIRSPEED_M_S) -> dict[str, float]:
     """Re λ of the short period [1/s] of the optimised wing's linear models: the decay rate
     of its envelope, which sets the settling time."""
-    cond = level_flight_condition(speed_m_s)
+    cond = level_flight_condition(speed_m_s, airframe=PROTOTYPE_AIRFRAME)
     wing = build_wing(VARIANTS["optimised"]).model
     out = {}
     for m in MODELS:
@@ -213,7 +213,7 @@ def phugoid(a: np.ndarray) -> dict[str, float]:
 
 def phugoid_study(speed_m_s: float = PHUGOID_SPEED_M_S) -> dict:
     """Phugoid of rigid/coupled/QSD and its sensitivity (module docstring)."""
-    cond = level_flight_condition(speed_m_s)
+    cond = level_flight_condition(speed_m_s, airframe=PROTOTYPE_AIRFRAME)
     wing = build_wing(VARIANTS["optimised"]).model
     coeffs = wing.coefficients
     out: dict = {"speed_m_s": speed_m_s, "wing": "optimised"}

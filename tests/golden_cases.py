@@ -79,7 +79,7 @@ WING_RTOL = 1e-9
 BUILT_WING_RTOL_OF_RANGE = 1e-9
 # The second aircraft's case (issue 23): JSBSim's SGS glider with its modal wing
 # (bioflex_jsb/data/aircraft/sgs_elastic.toml) in its steady glide at its cruise speed
-# 25 m/s (runtime/glide.py) through a 1 m/s, 25 m (25 chords) 1-cos gust from
+# 25 m/s (runtime/trim.py) through a 1 m/s, 25 m (25 chords) 1-cos gust from
 # 0.5 s, 3 s at the default step: tests/golden/sgs_<model>.csv and its wing
 # tests/golden/sgs_wing.json (the modes and Table B1 of the wing; the airframe is the file's).
 SGS_CASES = ("sgs_rigid", "sgs_coupled", "sgs_qsd")
@@ -135,8 +135,10 @@ def wing_from_dict(data: dict):
                 for k, v in d.items()}
 
     fields = arrays({k: v for k, v in data.items() if k != "coefficients"})
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
     return ElasticWingModel(coefficients=ModalCoefficients(**arrays(data["coefficients"])),
-                            **fields)
+                            airframe=PROTOTYPE_AIRFRAME, **fields)
 
 
 def stored_wing():

@@ -62,4 +62,5 @@ def wing(
         coefficients=coeffs,
         wing_lift_slope_per_rad=5.0,
         cm_ac=-0.05,
+        airframe=PROTOTYPE_AIRFRAME,
     )

@@ -24,6 +24,7 @@ import pytest
 from bioflex_jsb.cli import build_parser
 from bioflex_jsb.cli.common import LOG_DIR_ENV_VAR, UsageError, log_path
 from bioflex_jsb.errors import InputError
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.simulation.gusts import (
     MIN_GUST_LENGTH_M,
     MIN_GUST_STEPS,
@@ -459,7 +460,8 @@ def test_fuzzed_modal_numbers_build_a_finite_model_or_one_line(tmp_path):
                 assert "\n" not in str(exc)
                 refused += 1
                 continue
-            ss = build_state_space("coupled", level_flight_condition(15.0), build.model)
+            cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
+            ss = build_state_space("coupled", cond, build.model)
             assert np.all(np.isfinite(ss.a)) and np.all(np.isfinite(ss.b)), (key, v)
             assert np.all(np.isfinite(np.linalg.eigvals(ss.a))), (key, v)
             built += 1

@@ -35,6 +35,7 @@ from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.parameters import airframe as default_set
 from bioflex_jsb.parameters import airframe_consistent as C
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -138,7 +139,8 @@ def test_exchanged_unsteady_system(set_name):
         np.testing.assert_array_equal(ss.b, ref.b)
     # a steady state of the unsteady system is the set's quasi-steady Eq. (4) (the strips'
     # increments vanish in a steady state): static gust response to round-off (1e-9)
-    qs = build_state_space("coupled", level_flight_condition(17.0, aero=aset.aero),
+    qs = build_state_space("coupled", level_flight_condition(17.0, aero=aset.aero,
+                                                             airframe=PROTOTYPE_AIRFRAME),
                            build.model, aset.aero)
     n0 = qs.n_states
     steady = -np.linalg.solve(ss.a, ss.b)[:n0]

@@ -23,12 +23,13 @@ from bioflex_jsb.flight_dynamics.modal_matrices import modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.parameters.airframe import RIGID_AERODYNAMICS as AERO
 
 
 def _direct_solution(build, v):
     """The fixed point as one linear system in (η, α, δe) with the linear rigid trim."""
-    cond = level_flight_condition(v)
+    cond = level_flight_condition(v, airframe=PROTOTYPE_AIRFRAME)
     q = cond.dynamic_pressure_pa
     mm = modal_matrices(build.model, cond.cl_trim)
     n = mm.n
@@ -92,7 +93,7 @@ def test_secant_converges_on_a_nonlinear_rigid_trim():
     """A rigid trim that is not linear in the loads (a stand-in for JSBSim's): the fixed point
     still converges, to the given tolerance, and satisfies α = T(α)."""
     build = build_wing(VARIANTS["original"])
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     linear = linear_rigid_trim(cond)
 
     def curved(loads: StaticWingLoads) -> RigidTrimPoint:
@@ -128,7 +129,7 @@ def test_beyond_the_divergence_speed_trim_refuses_with_one_line_naming_it():
 def test_linearised_about_a_zero_deflection_is_the_paper_model_and_qsd_is_consistent():
     build = build_wing(VARIANTS["optimised"])
     t = elastic_trim(build, 15.0)
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     # a trim whose H_u is the paper's gives back build_state_space exactly
     blk = coupled_blocks(build.model, cond)
     paper = ElasticTrim(**{**t.__dict__, "h_u_elastic_per_m": blk.a_er[:, 0].copy()})
@@ -156,7 +157,8 @@ def test_linear_rigid_trim_is_close_to_jsbsim():
     from bioflex_jsb.runtime import fdm as jsbsim_fdm
 
     jsb = jsbsim_fdm.load_airframe(None, jsbsim_fdm.DEFAULT_AIRCRAFT).trim(15.0)
-    lin = linear_rigid_trim(level_flight_condition(15.0))(StaticWingLoads())
+    lin = linear_rigid_trim(level_flight_condition(15.0,
+                                                   airframe=PROTOTYPE_AIRFRAME))(StaticWingLoads())
     assert math.degrees(lin.alpha_rad) == pytest.approx(math.degrees(jsb.alpha_rad), abs=0.05)
     assert math.degrees(lin.elevator_rad) == pytest.approx(math.degrees(jsb.elevator_rad),
                                                            abs=0.15)

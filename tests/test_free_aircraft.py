@@ -21,6 +21,7 @@ from bioflex_jsb.flight_dynamics import eigen
 from bioflex_jsb.flight_dynamics.lti import build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, WingVariant, build_wing
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
 RIGID = ("u", "alpha", "q", "theta")
 
@@ -39,7 +40,8 @@ def test_steady_state_is_the_paper_model(name):
     # to a constant gust equals the quasi-steady Eq. (4)'s, same algebra: 1e-10 relative.
     build = build_wing(VARIANTS[name])
     ss = unsteady_state_space(build, 15.0)
-    qs = build_state_space("coupled", level_flight_condition(15.0), build.model)
+    qs = build_state_space("coupled", level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME),
+                           build.model)
     x_u = np.linalg.solve(ss.a, -ss.b)[:qs.n_states, 0]
     x_q = np.linalg.solve(qs.a, -qs.b)[:, 0]
     assert np.max(np.abs(x_u - x_q)) < 1e-10 * np.max(np.abs(x_q))
@@ -125,7 +127,8 @@ def test_kussner_gust_states():
     assert d.states[-1].startswith("kussner2[")
     assert len(d.states) == 10 + 4 * strip_geometry(build).chord_m.size
     ss = unsteady_state_space(build, 15.0, gust=True)
-    qs = build_state_space("coupled", level_flight_condition(15.0), build.model)
+    qs = build_state_space("coupled", level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME),
+                           build.model)
     x_u = np.linalg.solve(ss.a, -ss.b)[:qs.n_states, 0]
     x_q = np.linalg.solve(qs.a, -qs.b)[:, 0]
     assert np.max(np.abs(x_u - x_q)) < 1e-10 * np.max(np.abs(x_q))

@@ -9,6 +9,7 @@ import pytest
 
 from bioflex_jsb.flight_dynamics.lti import coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.simulation.gusts import GustField, GustSpecError, parse_gust, turbulence_psd
 from bioflex_jsb.simulation.modal_wing import FlowState, ModalWing, TrimReference
 from tests import synthetic
@@ -72,7 +73,7 @@ def _wing_and_trim(speed=15.0):
     w = synthetic.wing(x_elastic_frac=0.22, frequencies_hz=(30.9, 71.9),
                        masses_kg_m2=(6.57e-5, 5.7e-5), damping=(0.02, 0.02),
                        bending_per_twist_m=0.01)
-    cond = level_flight_condition(speed)
+    cond = level_flight_condition(speed, airframe=PROTOTYPE_AIRFRAME)
     return w, cond, TrimReference(cond.alpha_trim_rad, cond.dynamic_pressure_pa, cond.cl_trim)
 
 
@@ -104,7 +105,7 @@ def test_modal_wing_step_is_exact_for_any_step_size():
 def _optimised_wing_and_trim(speed=15.0):
     from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
 
-    cond = level_flight_condition(speed)
+    cond = level_flight_condition(speed, airframe=PROTOTYPE_AIRFRAME)
     return (build_wing(VARIANTS["optimised"]).model, cond,
             TrimReference(cond.alpha_trim_rad, cond.dynamic_pressure_pa, cond.cl_trim))
 

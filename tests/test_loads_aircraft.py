@@ -16,10 +16,11 @@ from bioflex_jsb import api
 from bioflex_jsb.loads.tuned import (
     CODE_H_MAX_M,
     DEFAULT_H_MIN_CHORDS,
-    PROTOTYPE_SCALES,
     aircraft_gust_scales,
     default_gradients_m,
+    default_scales,
 )
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from tests.cli_helpers import run_cli
 
 G_M_S2 = 9.80665
@@ -37,7 +38,8 @@ def test_an_aircrafts_gust_scales_are_its_chord_and_short_period():
     assert (s.h_min_m, s.h_max_m, s.settle_after_s) == pytest.approx((2.25, 50.0, 2.0))
     assert aircraft_gust_scales(1.5, 200.0, 1.0).h_max_m == pytest.approx(CODE_H_MAX_M)
     assert CODE_H_MAX_M == pytest.approx(106.68)  # 350 ft, CS/FAR 25.341
-    assert np.array_equal(PROTOTYPE_SCALES.gradients_m(), default_gradients_m())
+    chord_m = PROTOTYPE_AIRFRAME.reference.mean_chord_m
+    assert np.array_equal(default_scales(chord_m).gradients_m(), default_gradients_m(chord_m))
     from bioflex_jsb.errors import InputError
 
     with pytest.raises(InputError, match="give --gradients"):

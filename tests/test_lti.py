@@ -12,11 +12,14 @@ from bioflex_jsb.flight_dynamics.lti import build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.modal_coefficients import parse_override_key
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import prototype as P
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from tests import synthetic
 
 
 def short_period(model, speed, wing=None):
-    return eigen.modes_at(model, [speed], wing)[0].get("short_period")
+    return eigen.modes_at(model, [speed], wing,
+                          airframe=PROTOTYPE_AIRFRAME if wing is None else None)[0].get(
+                              "short_period")
 
 
 @pytest.mark.parametrize("speed", [15.0, 20.0])
@@ -30,7 +33,7 @@ def test_rigid_short_period_matches_table3(speed):
 
 def test_coupled_matrix_layout():
     w = synthetic.wing(frequencies_hz=(30.9, 71.9), masses_kg_m2=(6.57e-5, 5.7e-5))
-    ss = build_state_space("coupled", level_flight_condition(15.0), w)
+    ss = build_state_space("coupled", level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME), w)
     assert ss.states == ("u", "alpha", "q", "theta", "eta1", "eta2", "eta1_dot", "eta2_dot")
     assert ss.a.shape == (8, 8) and ss.b.shape == (8, 1)
     # kinematic rows: d(eta)/dt = eta_dot exactly
@@ -64,7 +67,7 @@ def test_qsd_equals_coupled_for_a_large_frequency_gap():
 
 def test_qsd_reduction_formula():
     w = synthetic.wing(frequencies_hz=(30.9, 71.9), masses_kg_m2=(6.57e-5, 5.7e-5))
-    cond = level_flight_condition(18.0)
+    cond = level_flight_condition(18.0, airframe=PROTOTYPE_AIRFRAME)
     blk = coupled_blocks(w, cond)
     qsd = build_state_space("qsd", cond, w)
     expected = blk.a_rr - blk.a_re @ np.linalg.inv(blk.a_ee) @ blk.a_er
@@ -134,7 +137,7 @@ def test_override_keys_are_checked():
 
 def test_overrides_are_reported():
     w = synthetic.wing(overrides={"C_eta1^Q1": -0.14})
-    ss = build_state_space("coupled", level_flight_condition(15.0), w)
+    ss = build_state_space("coupled", level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME), w)
     assert ss.notes["overrides"] == {"C_eta1^Q1": -0.14}
     assert w.coefficients.c_eta_q[0, 0] == -0.14
 

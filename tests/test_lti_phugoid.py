@@ -14,6 +14,7 @@ from bioflex_jsb.flight_dynamics.lti import (
     build_state_space,
 )
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
 
 def _phugoid_zeta(a: np.ndarray) -> float:
@@ -33,7 +34,7 @@ def test_the_thrust_change_is_the_whole_phugoid_difference():
     from bioflex_jsb.runtime.fdm import Airframe
 
     wing = api.load_wing("optimised")
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     jsb_rr = Airframe().linearize(15.0).a
     analytic = build_state_space("coupled", cond, wing.model)
     jsbsim = build_state_space("coupled", cond, wing.model, a_rr=jsb_rr)
@@ -48,5 +49,6 @@ def test_the_thrust_change_is_the_whole_phugoid_difference():
     assert 0.0 < z_analytic < 0.01 and z_jsbsim > 0.025
     assert z_thrust == pytest.approx(z_jsbsim, abs=0.003)
     # the analytic coupled phugoid is unstable inside the speeds the aircraft flies
-    assert _phugoid_zeta(build_state_space("coupled", level_flight_condition(10.0),
+    assert _phugoid_zeta(build_state_space("coupled", level_flight_condition(10.0,
+                                                                             airframe=PROTOTYPE_AIRFRAME),
                                            wing.model).a) < -0.01

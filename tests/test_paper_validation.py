@@ -25,6 +25,7 @@ from bioflex_jsb import validation
 from bioflex_jsb.flight_dynamics import eigen, lti
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.simulation.results import TimeHistory, gust_metrics
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -307,7 +308,7 @@ def test_section5_text_has_no_raw_none():
 def _lti_gust_response(model: str, t: np.ndarray, w_g: float = 3.0):
     """Step response to a w_g [m/s] updraft at t = 0 of the optimised wing's linear model
     at 15 m/s, as (TimeHistory with α to the relative wind, the fast modes' part of it)."""
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     ss = lti.build_state_space(model, cond, None if model == "rigid"
                                else build_wing(VARIANTS["optimised"]).model)
     lam, vec = np.linalg.eig(ss.a)
@@ -356,7 +357,7 @@ def test_elastic_phugoid_damping_comes_from_the_wing_speed_derivative():
     m_i/m: dimensionally not a generalised acceleration). With the propeller's dT/dV that
     JSBSim flies in X_u: 0.071 rigid, 0.032 coupled (the nonlinear runs' u decay: 0.069,
     0.036). Pins ±0.0005: a tenth of the smallest gap the conclusion rests on."""
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     wing = build_wing(VARIANTS["optimised"]).model
 
     def zeta(a):

@@ -110,7 +110,8 @@ def test_the_model_is_this_aircrafts(sgs):
     wing = sgs.wing().model
     assert wing.airframe.reference.area_m2 == S and wing.airframe is not PROTOTYPE_AIRFRAME
     with pytest.raises(ValueError, match="built for airframe 'sgs_elastic'"):
-        build_state_space("coupled", level_flight_condition(25.0), wing)
+        build_state_space("coupled", level_flight_condition(25.0,
+                                                            airframe=PROTOTYPE_AIRFRAME), wing)
     # the elastic trim is the glider's: C_L = m g / (Q S) = 0.631 at 25 m/s
     cond = level_flight_condition(25.0, airframe=wing.airframe)
     assert cond.cl_trim == pytest.approx(MASS * G / (0.5 * RHO * 625 * S), rel=1e-12)

@@ -3,7 +3,7 @@
 
 Plausibility, each against a number worked out by hand from SGS.xml:
 
-* the steady glide (SGS.xml has no engine; runtime/glide.py): L/D and C_L of the
+* the steady glide (SGS.xml has no engine; runtime/trim.py): L/D and C_L of the
   trim against the XML's CLwbh/CDwbh tables at the trim's α, and the weight balance;
 * the glide's own drift in calm air against the ISA density gradient it sinks through;
 * the short-period response of the nonlinear run against the LTI model (``compare``) at the

@@ -29,6 +29,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.parameters import goland as G
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.state_space import StateSpace
 
 control = pytest.importorskip("control", reason="python-control: the 'control' extra")
@@ -41,8 +42,8 @@ def _prototype_coupled() -> StateSpace:
     """The prototype's coupled LTI model (Eq. 4) at 15 m/s with the controls and the n_z and
     tip-twist outputs (what ``bioflex-jsb export`` writes)."""
     wing = api.load_wing("original")
-    return build_state_space("coupled", level_flight_condition(15.0), wing.model,
-                             controls=True)
+    return build_state_space("coupled", level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME),
+                             wing.model, controls=True)
 
 
 def _goland_aeroelastic() -> StateSpace:

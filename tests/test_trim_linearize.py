@@ -12,7 +12,7 @@ from bioflex_jsb import units as U
 from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import MASS_PROPERTIES, RIGID_AERODYNAMICS
 from bioflex_jsb.runtime import fdm as jsbsim_fdm
-from bioflex_jsb.runtime.companion import RPM_SETTLE_MAX_S
+from bioflex_jsb.runtime.trim import RPM_SETTLE_MAX_S
 
 REPO = Path(__file__).resolve().parents[1]
 SPEEDS_M_S = (10.0, 12.5, 15.0, 20.0, 25.0)  # the trim sweep

@@ -15,6 +15,7 @@ from bioflex_jsb.drivers.gust import RunConfig, run_gust
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.coupled_step import CoupledStep
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.simulation.gusts import parse_gust
@@ -75,7 +76,8 @@ def test_wing_alone_follows_the_lti_model_given_its_body_motion():
     lti = simulate(ss, t, w)
     alpha0 = 0.05  # any trim angle: the wing sees perturbations
     q0 = 0.5 * RHO_KG_M3 * SPEED_M_S**2
-    trim = TrimReference(alpha0, q0, level_flight_condition(SPEED_M_S).cl_trim)
+    trim = TrimReference(alpha0, q0, level_flight_condition(SPEED_M_S,
+                                                            airframe=PROTOTYPE_AIRFRAME).cl_trim)
     wing = UnsteadyModalWing.from_build(build, trim, dt)
     states = np.zeros((t.size, len(wing.state_names)))
     for k in range(t.size - 1):
@@ -93,7 +95,8 @@ def test_steady_state_is_the_quasi_steady_wing():
     model), so η and the loads are the paper's quasi-steady wing's."""
     build = build_wing(VARIANTS["inertial-backward"])
     q0 = 0.5 * RHO_KG_M3 * SPEED_M_S**2
-    trim = TrimReference(0.05, q0, level_flight_condition(SPEED_M_S).cl_trim)
+    trim = TrimReference(0.05, q0, level_flight_condition(SPEED_M_S,
+                                                          airframe=PROTOTYPE_AIRFRAME).cl_trim)
     wing = UnsteadyModalWing.from_build(build, trim, DEFAULT_DT_S)
     flow = FlowState(0.05 + 0.002, 0.0, SPEED_M_S, q0)
     for _ in range(int(round(8.0 / DEFAULT_DT_S))):

@@ -23,7 +23,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     get_variant,
     load_variant_file,
 )
-from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S, MASS_PROPERTIES
+from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S, MASS_PROPERTIES, PROTOTYPE_AIRFRAME
 from bioflex_jsb.simulation.results import TimeHistory, gust_metrics
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -242,7 +242,8 @@ def test_linearize_explains_the_phugoid_and_prints_b(capsys):
     assert c["jsbsim_x_u_1_s"] - c["analytic_x_u_1_s"] == pytest.approx(
         c["thrust_term_1_s"], abs=2e-3)
     assert c["thrust_term_1_s"] == pytest.approx(
-        thrust_speed_derivative_n_s_m(level_flight_condition(15.0)) / MASS_PROPERTIES.mass_kg)
+        thrust_speed_derivative_n_s_m(level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME))
+        / MASS_PROPERTIES.mass_kg)
     assert np.array(data["B"]).shape == (4, 3)
     code, out, _ = run_cli(capsys, "linearize", "--speed", 15)
     assert "B, u = [w_g" in out and "dT/dV" in out
@@ -263,7 +264,7 @@ def test_export_has_controls_outputs_metadata_and_reads_back(capsys, tmp_path):
             assert key in ss.notes, key
         assert ss.notes["wing"] == "optimised" and ss.notes["mass_basis"] == "consistent"
     # n_z = u0 (q - alpha_dot)/g, as the co-simulation's channel; elevator nose down
-    cond = level_flight_condition(15.0)
+    cond = level_flight_condition(15.0, airframe=PROTOTYPE_AIRFRAME)
     full = build_state_space("coupled", cond, build_wing(get_variant("optimised")).model,
                              controls=True)
     x = np.random.default_rng(1).normal(size=full.n_states)

@@ -18,6 +18,13 @@ PROPELLER_TABLE_ROWS = 27  # J stations of the C_T, C_P tables (ΔJ = 0.05 up to
 PROPELLER_BLADE_STATIONS = 40  # blade-element annuli of the momentum calculation
 
 
+def has_tables(prop: Propulsion) -> bool:
+    """Whether :func:`propeller_tables` holds ``prop``'s propeller: the prototype's drive
+    (:data:`~bioflex_jsb.parameters.airframe.PROPULSION`, its blade); another drive's blade is
+    not modelled."""
+    return prop is PROPULSION
+
+
 def propeller_coefficients(
     advance_ratio: float, prop: Propulsion = PROPULSION, stations: int = PROPELLER_BLADE_STATIONS
 ) -> tuple[float, float]:

@@ -25,6 +25,7 @@ from bioflex_jsb.aeroelasticity import free_aircraft as fa
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
 from bioflex_jsb.parameters.airframe import (
+    PROTOTYPE_AIRFRAME,
     REFERENCE_GEOMETRY,
     RIGID_AERODYNAMICS,
     RigidAerodynamics,
@@ -43,8 +44,9 @@ def unsteady_state_space_with(build, speed_m_s: float, aero: RigidAerodynamics,
     d = fa.unsteady_descriptor(build, v, structural_damping=structural_damping,
                                density_kg_m3=density_kg_m3, geometry=geometry)
     model = fa.with_damping(build, structural_damping)
-    cond = level_flight_condition(v, density_kg_m3)
-    new_base = build_state_space("coupled", level_flight_condition(v, density_kg_m3, aero),
+    cond = level_flight_condition(v, density_kg_m3, airframe=PROTOTYPE_AIRFRAME)
+    new_base = build_state_space("coupled", level_flight_condition(v, density_kg_m3, aero,
+                                                                   airframe=PROTOTYPE_AIRFRAME),
                                  model, aero)
     n0 = d.base.n_states
     a, e, b = d.a.copy(), d.e.copy(), d.b.copy()

@@ -142,8 +142,10 @@ def sigma_list(text: str) -> tuple[float, ...]:
 
 def register(sub) -> None:
     from bioflex_jsb.loads.tuned import DEFAULT_H_MAX_M, DEFAULT_N_LENGTHS, default_gradients_m
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
-    text = HELP.format(h_min=default_gradients_m()[0], h_max=DEFAULT_H_MAX_M,
+    h_min = default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)[0]
+    text = HELP.format(h_min=h_min, h_max=DEFAULT_H_MAX_M,
                        n=DEFAULT_N_LENGTHS)
     p = sub.add_parser("loads", help="wing section loads in a gust; --tuned: critical 1-cos "
                        "gradients and load envelopes", description=text)
@@ -403,7 +405,7 @@ def _gust_scales(args, build):
     chords (2H >= c̄)."""
     from bioflex_jsb.errors import InputError
     from bioflex_jsb.flight_dynamics.eigen import modes_at
-    from bioflex_jsb.loads.tuned import PROTOTYPE_SCALES, aircraft_gust_scales
+    from bioflex_jsb.loads.tuned import aircraft_gust_scales, default_scales
     from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
     chord_m = build.model.airframe.reference.mean_chord_m
@@ -412,7 +414,7 @@ def _gust_scales(args, build):
                          f"the aircraft's mean chord {chord_m:.3g} m; each H must be at least "
                          f"{chord_m / 2.0:.3g} m")
     if build.airframe is PROTOTYPE_AIRFRAME:
-        return PROTOTYPE_SCALES
+        return default_scales(chord_m)
     aircraft = getattr(args, "aircraft_definition", None)
     density = {} if aircraft is None else {
         "density_kg_m3": float(aircraft.definition.air.density_kg_m3)}

@@ -27,7 +27,7 @@ definition (docs/aircraft.md; a name that is not a JSBSim aircraft under aircraf
 JSBSim airframe, its speeds (--speed within its airframe.speed_range_m_s, default its
 cruise_speed_m_s) and the elastic trim of its wing; an aircraft without an engine (the SGS
 glider) is trimmed to its steady glide at --speed (the flight-path angle gamma < 0 that
-holds the speed: runtime/glide.py), the throttle row then 0."""
+holds the speed: runtime/trim.py), the throttle row then 0."""
 
 
 def add_flight_condition_arguments(p: argparse.ArgumentParser) -> None:
@@ -181,7 +181,7 @@ def run(args: argparse.Namespace) -> int:
         ("propeller", f"{result.propeller_rpm:.0f}", "rev/min"),
         ("thrust", f"{result.thrust_n:.3f}", "N"),
     ]
-    if airframe.glider:  # no engine: the steady glide (runtime/glide.py)
+    if airframe.glider:  # no engine: the steady glide (runtime/trim.py)
         rows[5] = ("elevator", f"{result.elevator_norm:.3f}", "command with pitch trim, -1..1")
         rows[6:9] = [("gamma", f"{deg(result.flight_path_rad):.3f}", "deg (flight path, + up)"),
                      ("sink", f"{-result.speed_m_s * math.sin(result.flight_path_rad):.3f}",

@@ -11,7 +11,7 @@ Errors: NRMSE = RMS(linear − nonlinear) / RMS(nonlinear) [-] per channel over 
 largest absolute difference (in the channel's SI unit) with its time [s]. A nonlinear run that
 diverged is no reference: its errors are None.
 
-A glide (an aircraft without an engine, trimmed to its steady glide: runtime/glide.py)
+A glide (an aircraft without an engine, trimmed to its steady glide: runtime/trim.py)
 is not steady in the nonlinear run: as it sinks the air gets denser (ISA: +0.0096 % per m)
 and at a constant attitude the glider slows (SGS at 25 m/s, 1.0 m/s sink: u −0.011 m/s, θ
 +0.26 mrad in 8 s of calm air), a drift the LTI model (ρ held) cannot have and that is no
@@ -174,7 +174,7 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     check_comparable(model, aero, trim, controller is not None,
                      nonlinear.meta.get("span", "half"))
     # the JSBSim airframe the run flew (the prototype's by default): A_RR at its trim (an
-    # aircraft without an engine: its steady glide, runtime/glide.py)
+    # aircraft without an engine: its steady glide, runtime/trim.py)
     lin = (airframe or Airframe()).linearize(speed_m_s)
     if aero == "unsteady":
         from bioflex_jsb.aeroelasticity.free_aircraft import unsteady_state_space

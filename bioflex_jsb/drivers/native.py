@@ -60,7 +60,7 @@ def aircraft_trim_state(files: dict[str, str], spec: J.ExportSpec) -> NA.TrimSta
     ``spec.speed_m_s`` [m/s] true airspeed, ISA sea level, by :meth:`Airframe.trim` with the
     export's step and integrators, as :func:`trim_state` trims the prototype: a glider's
     steady, straight, wings-level glide (α, the flight-path angle γ and the pitch trim by
-    Newton in JSBSim's initial-condition run, runtime/glide.py); a powered aircraft's level
+    Newton in JSBSim's initial-condition run, runtime/trim.py); a powered aircraft's level
     flight, its engines started as JSBSim expects (runtime/engines.py) and trimmed by
     JSBSim. The controls kept are the trim's surfaces and each engine's levers JSBSim has
     (throttle, mixture, propeller advance, turboprop condition) as the trim left them. The

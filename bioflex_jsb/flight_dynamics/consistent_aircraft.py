@@ -41,6 +41,7 @@ from bioflex_jsb.parameters import prototype as P
 from bioflex_jsb.parameters.airframe import (
     CRUISE_SPEED_M_S,
     MASS_PROPERTIES,
+    PROTOTYPE_AIRFRAME,
     REFERENCE_GEOMETRY,
     RigidAerodynamics,
 )
@@ -71,7 +72,7 @@ def cm0_for_elevator(aero: RigidAerodynamics, elevator_rad: float,
                      speed_m_s: float = CRUISE_SPEED_M_S) -> float:
     """C_m0 [-] that makes the linear rigid trim of ``aero`` at ``speed_m_s`` need
     ``elevator_rad`` (the tail incidence that does it)."""
-    cond = level_flight_condition(speed_m_s, aero=aero)
+    cond = level_flight_condition(speed_m_s, aero=aero, airframe=PROTOTYPE_AIRFRAME)
     # α from the lift balance with that elevator, then C_m0 from the moment balance
     qs = cond.dynamic_pressure_pa * REFERENCE_GEOMETRY.area_m2
     alpha = ((MASS_PROPERTIES.mass_kg * STANDARD_GRAVITY_M_S2 / qs - aero.cl0
@@ -105,7 +106,8 @@ def consistent_derivatives(
         cl_delta_e_per_rad=lat.cl_delta_e,
         cm_delta_e_per_rad=lat.cm_delta_e,
     )
-    base_trim = linear_rigid_trim(level_flight_condition(CRUISE_SPEED_M_S, aero=base),
+    base_trim = linear_rigid_trim(level_flight_condition(CRUISE_SPEED_M_S, aero=base,
+                                                         airframe=PROTOTYPE_AIRFRAME),
                                   base)(StaticWingLoads())
     aero = replace(aero, cm0=cm0_for_elevator(aero, base_trim.elevator_rad))
     return ConsistentDerivatives(cg_fraction, lat, d_cm_f, aero)
@@ -114,7 +116,7 @@ def consistent_derivatives(
 def rigid_short_period(aero: RigidAerodynamics, speed_m_s: float,
                        density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> complex:
     """The rigid short-period root (upper half plane) of A_RR with ``aero`` [rad/s]."""
-    cond = level_flight_condition(speed_m_s, density_kg_m3, aero)
+    cond = level_flight_condition(speed_m_s, density_kg_m3, aero, airframe=PROTOTYPE_AIRFRAME)
     lam = np.linalg.eigvals(rigid_matrices(rigid_derivatives(cond, aero))[0])
     root = lam[np.argmax(np.abs(lam))]
     return complex(root.real, abs(root.imag))
@@ -157,7 +159,8 @@ def modes_with(model: str, speeds_m_s: Sequence[float], wing: ElasticWingModel |
                aero: RigidAerodynamics,
                density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> list[eigen.ModeSet]:
     """:func:`eigen.modes_at` with ``aero`` (labels tracked from 2 m/s, 0.25 m/s grid)."""
-    return eigen.modes_at(model, speeds_m_s, wing, density_kg_m3, aero)
+    return eigen.modes_at(model, speeds_m_s, wing, density_kg_m3, aero,
+                          airframe=PROTOTYPE_AIRFRAME if wing is None else None)
 
 
 def flutter_with(wing: ElasticWingModel, aero: RigidAerodynamics,

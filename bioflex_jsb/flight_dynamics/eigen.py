@@ -25,11 +25,7 @@ from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.flutter_engine import FlutterResult
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel, build_state_space, coupled_blocks
 from bioflex_jsb.flight_dynamics.rigid import FlightCondition, level_flight_condition
-from bioflex_jsb.parameters.airframe import (
-    PROTOTYPE_AIRFRAME,
-    AirframeData,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import AirframeData, RigidAerodynamics
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 
 RIGID_LABELS = ("short_period", "phugoid")
@@ -141,11 +137,14 @@ class ModeSet:
 
 
 def airframe_of(wing: ElasticWingModel | None, airframe: AirframeData | None) -> AirframeData:
-    """The aircraft of an analysis: the wing's (it was built for it), else ``airframe``,
-    else the prototype's (a rigid analysis called without one); a different ``airframe``
-    beside a wing is a caller's bug (ValueError)."""
+    """The aircraft of an analysis: the wing's (it was built for it), else ``airframe``; a
+    rigid analysis without either, or a different ``airframe`` beside a wing, is a caller's
+    bug (ValueError)."""
     if wing is None:
-        return PROTOTYPE_AIRFRAME if airframe is None else airframe
+        if airframe is None:
+            raise ValueError("a rigid analysis needs the aircraft: give airframe= (an "
+                             "AirframeData) or a wing built for it")
+        return airframe
     if airframe is not None and airframe.reference != wing.airframe.reference:
         raise ValueError(f"wing {wing.name!r} was built for airframe {wing.airframe.name!r}, "
                          f"not {airframe.name!r}")

@@ -24,7 +24,7 @@ C_Dη̇_i = 2 k C_L0 C_Lη̇_i (induced drag of the extra lift, parabolic polar)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -39,11 +39,7 @@ from bioflex_jsb.flight_dynamics.rigid import (
     rigid_derivatives,
     rigid_matrices,
 )
-from bioflex_jsb.parameters.airframe import (
-    PROTOTYPE_AIRFRAME,
-    AirframeData,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import AirframeData, RigidAerodynamics
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.state_space import StateSpace  # the one state-space type (re-exported)
 
@@ -71,7 +67,7 @@ class ElasticWingModel:
     wing_lift_slope_per_rad: float
     cm_ac: float
     tip_twist_per_eta: np.ndarray | None = None  # θ_i at the tip per unit η_i [rad/rad]
-    airframe: AirframeData = PROTOTYPE_AIRFRAME
+    airframe: AirframeData = field(kw_only=True)  # the aircraft the wing was built for
 
     @property
     def n_modes(self) -> int:
@@ -266,10 +262,10 @@ def _drive(condition: FlightCondition):
     trimmed where the thrust equals the drag C_D Q S; trim J None if the tables cannot."""
     from scipy.optimize import brentq
 
-    from bioflex_jsb.aerodynamics.propeller import propeller_tables
+    from bioflex_jsb.aerodynamics.propeller import has_tables, propeller_tables
 
     prop = condition.airframe.propulsion
-    if prop is None or prop is not PROTOTYPE_AIRFRAME.propulsion:
+    if prop is None or not has_tables(prop):
         raise ValueError(f"airframe {condition.airframe.name!r}: the propeller tables are "
                          "the prototype's (aerodynamics/propeller.py); another drive has none")
     j_tab, ct_tab, cp_tab = _propeller_tables_cached(propeller_tables)

@@ -19,11 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from bioflex_jsb.parameters.airframe import (
-    PROTOTYPE_AIRFRAME,
-    AirframeData,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import AirframeData, RigidAerodynamics
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_M_S2
 
 RIGID_STATES = ("u", "alpha", "q", "theta")
@@ -49,7 +45,7 @@ class FlightCondition:
     cl_trim: float
     cd_trim: float
     alpha_trim_rad: float
-    airframe: AirframeData = PROTOTYPE_AIRFRAME
+    airframe: AirframeData
 
     @property
     def dynamic_pressure_pa(self) -> float:
@@ -62,7 +58,8 @@ def level_flight_condition(
     density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3,
     aero: RigidAerodynamics | None = None,
     mass_kg: float | None = None,
-    airframe: AirframeData = PROTOTYPE_AIRFRAME,
+    *,
+    airframe: AirframeData,
 ) -> FlightCondition:
     """Level-flight trim of the linear aerodynamic model at ``speed_m_s`` [m/s].
 

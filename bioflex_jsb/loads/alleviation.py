@@ -45,7 +45,6 @@ from bioflex_jsb.loads.tuned import (
     DEFAULT_AMPLITUDE_M_S,
     GUST_START_S,
     SETTLE_AFTER_S,
-    default_gradients_m,
     gust_amplitude_m_s,
 )
 from bioflex_jsb.simulation.closed_loop import close_loop, signal_outputs
@@ -126,11 +125,14 @@ class TunedPeaks:
                 "critical_gradient_m": float(self.gradients_m[self.critical])}
 
 
-def tuned_cases(speed_m_s: float, gradients_m=None, u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S,
+def tuned_cases(speed_m_s: float, gradients_m, u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S,
                 scaling: str = "cs25") -> list[dict]:
     """The upward gusts of the tuned sweep (``loads --tuned``'s, one sign: the LTI model
     is linear), each with its gradient [m], amplitude [m/s], text, duration [s], start [s]."""
-    h = default_gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
+    if gradients_m is None:
+        raise ValueError("tuned gust: give the aircraft's gradients [m] "
+                         "(loads.tuned.default_gradients_m of its mean chord)")
+    h = np.asarray(gradients_m, dtype=float)
     h_max = float(h.max())
     out = []
     for hm in h:

@@ -207,10 +207,10 @@ def _sections(variant):
             f"wing {variant.name!r}: section loads need the beam's mass and stiffness "
             "(EI, GJ, m', I'), which a modes file does not give; use a beam-model wing "
             "(a named wing, or a variant file without modes_file)")
-    from bioflex_jsb.parameters.wing_structure import RIBBED_WING, UNRIBBED_WING
+    from bioflex_jsb.flight_dynamics.wing_model import membrane_structure
     from bioflex_jsb.structures.wing_model import wing_sections
 
-    return wing_sections(RIBBED_WING if variant.ribs else UNRIBBED_WING,
+    return wing_sections(membrane_structure(variant),
                          x_inertial_frac=variant.x_inertial_frac,
                          x_elastic_frac=variant.x_elastic_frac)
 

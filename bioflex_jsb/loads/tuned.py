@@ -42,7 +42,6 @@ import numpy as np
 
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.loads.model import QUANTITIES
-from bioflex_jsb.parameters import prototype as P
 
 DEFAULT_H_MIN_CHORDS = 1.5  # shortest gradient [chords]: near the first wing mode (above)
 DEFAULT_H_MAX_M = 15.0  # longest gradient [m]: quasi-static short period at 15 m/s (above)
@@ -59,9 +58,15 @@ GUST_START_S = 0.2  # time before the gust [s]: the trim (the loads are steady f
 CODE_H_MAX_M = 350.0 * 0.3048
 
 
-def default_gradients_m(n: int = DEFAULT_N_LENGTHS) -> np.ndarray:
-    """Log-spaced gradients H [m] from DEFAULT_H_MIN_CHORDS c̄ to DEFAULT_H_MAX_M."""
-    return np.geomspace(DEFAULT_H_MIN_CHORDS * P.MEAN_AERODYNAMIC_CHORD_M, DEFAULT_H_MAX_M, n)
+# The record of the default scales (the settings' ``scales``): the rule of the module
+# docstring, chosen for the prototype.
+DEFAULT_SCALES_SOURCE = "the prototype's defaults (loads/tuned.py)"
+
+
+def default_gradients_m(mean_chord_m: float, n: int = DEFAULT_N_LENGTHS) -> np.ndarray:
+    """``n`` log-spaced gradients H [m] from DEFAULT_H_MIN_CHORDS c̄ (``mean_chord_m`` [m],
+    the aircraft's mean chord) to DEFAULT_H_MAX_M."""
+    return np.geomspace(DEFAULT_H_MIN_CHORDS * mean_chord_m, DEFAULT_H_MAX_M, n)
 
 
 @dataclass(frozen=True)
@@ -79,9 +84,20 @@ class GustScales:
         return np.geomspace(self.h_min_m, self.h_max_m, n)
 
 
-PROTOTYPE_SCALES = GustScales(DEFAULT_H_MIN_CHORDS * P.MEAN_AERODYNAMIC_CHORD_M,
-                              DEFAULT_H_MAX_M, SETTLE_AFTER_S,
-                              "the prototype's defaults (loads/tuned.py)")
+def default_scales(mean_chord_m: float) -> GustScales:
+    """The default scales (module docstring, chosen for the prototype) of an aircraft of
+    mean chord ``mean_chord_m`` [m]: H from DEFAULT_H_MIN_CHORDS c̄ to DEFAULT_H_MAX_M,
+    SETTLE_AFTER_S after the gust."""
+    return GustScales(DEFAULT_H_MIN_CHORDS * mean_chord_m, DEFAULT_H_MAX_M, SETTLE_AFTER_S,
+                      DEFAULT_SCALES_SOURCE)
+
+
+def _settling(scales: GustScales | None) -> tuple[float, str]:
+    """(the time a run goes on after its gust [s], the scales' record) of ``scales``; None
+    (gradients given without scales): the defaults' SETTLE_AFTER_S."""
+    if scales is None:
+        return SETTLE_AFTER_S, DEFAULT_SCALES_SOURCE
+    return scales.settle_after_s, scales.source
 
 
 def aircraft_gust_scales(mean_chord_m: float, speed_m_s: float,
@@ -147,17 +163,21 @@ class TunedGustResult:
 
 def tuned_cases(speed_m_s: float, gradients_m=None, *,
                 u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
-                scales: GustScales = PROTOTYPE_SCALES) -> list[dict]:
+                scales: GustScales | None = None) -> list[dict]:
     """The sweep's gusts, in order: every gradient of ``gradients_m`` [m] (default
-    ``scales.gradients_m()``, the prototype's :func:`default_gradients_m`) up then down, each
-    a dict of its gradient [m], sign, amplitude [m/s, up +], gust text (``1cos:U:L``,
-    L = 2H), duration [s] (the gust, then ``scales.settle_after_s``) and gust start [s]."""
+    ``scales.gradients_m()``: the aircraft's, :func:`default_scales` or
+    :func:`aircraft_gust_scales`) up then down, each a dict of its gradient [m], sign,
+    amplitude [m/s, up +], gust text (``1cos:U:L``, L = 2H), duration [s] (the gust, then
+    ``scales.settle_after_s``, SETTLE_AFTER_S without scales) and gust start [s]."""
+    if gradients_m is None and scales is None:
+        raise ValueError("tuned gust: give the gradients [m] or the aircraft's scales")
     h = scales.gradients_m() if gradients_m is None else np.asarray(gradients_m, dtype=float)
     if h.ndim != 1 or h.size == 0 or not np.all(np.isfinite(h)) or np.any(h <= 0.0):
         raise InputError("gust gradients must be positive lengths [m]")
     if not (math.isfinite(u_ref_m_s) and u_ref_m_s > 0.0):
         raise InputError(f"gust amplitude must be a positive speed [m/s], got {u_ref_m_s!r}")
     h_max = float(h.max())
+    settle_after_s, _ = _settling(scales)
     cases = []
     for hm in h:
         u = gust_amplitude_m_s(float(hm), u_ref_m_s, h_max, scaling)
@@ -166,14 +186,14 @@ def tuned_cases(speed_m_s: float, gradients_m=None, *,
                           "amplitude_m_s": sign * u,
                           "gust": f"1cos:{sign * u:.6g}:{2.0 * hm:.6g}",
                           "duration_s": GUST_START_S + 2.0 * hm / speed_m_s
-                          + scales.settle_after_s,
+                          + settle_after_s,
                           "gust_start_s": GUST_START_S})
     return cases
 
 
 def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
                u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S, scaling: str = "cs25",
-               progress=None, scales: GustScales = PROTOTYPE_SCALES) -> TunedGustResult:
+               progress=None, scales: GustScales | None = None) -> TunedGustResult:
     """Fly 1-cos gusts of every gradient in ``gradients_m`` [m] up and down through
     ``fly(gust_text, duration_s, gust_start_s)`` (returns a SectionLoads), one after the
     other, and find the critical cases (:func:`tuned_result`). The command flies the same
@@ -191,7 +211,7 @@ def tuned_gust(fly, speed_m_s: float, gradients_m=None, *,
 
 def tuned_result(cases: list[dict], loads: list, speed_m_s: float, *,
                  u_ref_m_s: float = DEFAULT_AMPLITUDE_M_S,
-                 scaling: str = "cs25", scales: GustScales = PROTOTYPE_SCALES
+                 scaling: str = "cs25", scales: GustScales | None = None
                  ) -> TunedGustResult:
     """The critical case per station, quantity, method and direction (largest increment up,
     largest down, over the run after the gust start) of ``cases`` (:func:`tuned_cases`, in
@@ -230,9 +250,10 @@ def tuned_result(cases: list[dict], loads: list, speed_m_s: float, *,
                     if best is not None:
                         critical.append(best)
     gradients = list(dict.fromkeys(c["gradient_m"] for c in cases))
+    settle_after_s, source = _settling(scales)
     settings = {"speed_m_s": speed_m_s, "gradients_m": gradients, "u_ref_m_s": u_ref_m_s,
                 "scaling": scaling, "h_max_m": h_max, "gust_start_s": GUST_START_S,
-                "settle_after_s": scales.settle_after_s, "scales": scales.source,
+                "settle_after_s": settle_after_s, "scales": source,
                 "model": first.model, "wing": first.wing,
                 "static": first.meta.get("static")}
     for c in cases:

@@ -10,49 +10,15 @@ printed: see :attr:`Airframe.load_messages` and :attr:`Airframe.warnings`.
 
 Trim
 ----
-:meth:`Airframe.trim` uses JSBSim's own trim routine, ``FGFDMExec::DoTrim`` in *full* mode
-(α, throttle and elevator for u̇, ẇ, q̇; bank, aileron, rudder and sideslip for the lateral
-accelerations): wings-level, constant-altitude flight at the requested true airspeed. The
-propulsion is a contra-rotating pair (see :mod:`bioflex_jsb.generators.airframe`): JSBSim's
-trim drives both motors' throttles together, the reaction torques cancel, and the lateral
-controls come out at zero. When it fails, :class:`TrimError` carries one line naming the
-control that ran out (throttle at 1, elevator at a stop, α at the stall limit) or the
-condition that stayed out of tolerance.
-
-Two JSBSim instances: the flying aircraft and its trim companion
-------------------------------------------------------------------
-JSBSim's trim finds the propeller's steady RPM by explicit Euler steps of a fixed 0.5 s
-(``FGPropulsion::GetSteadyState``), stable only with a rotor inertia about 8 times the
-physical one (``PROPULSION.trim_rotor_inertia_kg_m2``). The flying aircraft (``bioflex``)
-has the physical ``rotor_inertia_kg_m2``, so that in time simulations the RPM, and the
-thrust, follow the airspeed within ≈ 0.3 s (quasi-static on the phugoid time scale, as in
-JSBSim's linearization); an 8-times inertia made the RPM lag the airspeed by seconds. The
-generator writes a trim companion (``bioflex_trim``: the same aircraft, only the propeller
-inertia differs), which :class:`Airframe` loads beside the flying instance when its file
-exists. :meth:`Airframe.trim`:
-
-1. trims the companion with ``DoTrim``. The Euler steps cannot start from the propeller at
-   rest (an ``electric`` engine at 0 RPM applies its power over 1 rad/s): one normal time
-   step with a throttle chosen for the purpose first brings both propellers to their
-   windmilling RPM at the trim speed (the trim restarts the airframe from the initial
-   condition; only the RPM carries over);
-2. sets the flying instance to that trim: initial condition (position, Euler angles, body
-   velocities and rates) and every control command copied from the companion; then, with
-   JSBSim's integrators of the airframe state switched off (``eNone``: the airframe holds
-   the trim state while the propeller model keeps integrating its RPM), time steps until
-   both rotors' RPM equal the companion's trim RPM (the same steady state: the inertia
-   does not enter it); finally ``RunIC`` from the trim initial condition with the
-   integrators restored (the RPM carries over, the multistep integrators' history starts
-   afresh);
-3. checks the flying instance is in trim: its accelerations within JSBSim's trim tolerances
-   (``TrimResult.residuals`` are the flying instance's).
-
-The linear model is JSBSim's linearization of the companion at its trim: with the RPM
-residualised as quasi-static (below) the reduced model does not depend on the rotor inertia
-(it only scales the RPM row), so the flying instance's is the same. An aircraft without a
-companion file (``<name>_trim``) is trimmed and linearized itself, as before. In both
-instances the two rotors' gyroscopic moments, equal and opposite, cancel exactly (a
-symmetric gust stays symmetric).
+:meth:`Airframe.trim` is the one trim of a JSBSim aircraft: level flight by JSBSim's own
+trim (``DoTrim``, full mode) or a glider's steady glide, the elastic trim with a wing. The
+procedure (the trim companion of the generated prototype, the glide's Newton solver, the
+one-line diagnosis of a failed trim) is :mod:`bioflex_jsb.runtime.trim`'s. The linear model
+is JSBSim's linearization of the trim instance (the companion) at its trim: with the RPM
+residualised as quasi-static the reduced model does not depend on the rotor inertia (it
+only scales the RPM row), so the flying instance's is the same. In both instances the two
+rotors' gyroscopic moments, equal and opposite, cancel exactly (a symmetric gust stays
+symmetric).
 
 Linearization: :mod:`bioflex_jsb.runtime.linearization` (the reduction to x_R = [u, α, q, θ]).
 """
@@ -77,10 +43,7 @@ from bioflex_jsb.runtime.aircraft_files import (
     alpha_table_range_rad,
     derived_root,
 )
-from bioflex_jsb.runtime.companion import fly_at_companion_trim, spin_up_propellers
 from bioflex_jsb.runtime.engines import engines_of
-from bioflex_jsb.runtime.engines import start as start_engines
-from bioflex_jsb.runtime.glide import glide_elevator_norm, glide_trim
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, LogRecord, captured
 from bioflex_jsb.runtime.linearization import (
     lateral_jacobian,
@@ -107,7 +70,15 @@ from bioflex_jsb.runtime.roots import (  # noqa: F401  (where the JSBSim files a
     candidate_roots,
     locate_root,
 )
-from bioflex_jsb.runtime.trim_diagnosis import diagnose_trim_failure, trim_report
+from bioflex_jsb.runtime.trim import (  # noqa: F401  (the trim's tolerances and controls)
+    TRIM_CONTROLS,
+    TRIM_TOLERANCE_FT_S2,
+    TRIM_TOLERANCE_RAD_S2,
+    JSBSimTrim,
+    has_property,
+    set_level_ic,
+    total_thrust_n,
+)
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD
 
@@ -120,30 +91,9 @@ ALTITUDE_RANGE_M = (-500.0, 11000.0)
 # sound (the aerodynamic model is incompressible; Table 1's UAV flies at 10–25 m/s).
 SPEED_MAX_M_S = 110.0
 
-# JSBSim's trim modes (FGFDMExec::DoTrim): 0 longitudinal, 1 full.
-TRIM_MODE_FULL = 1
-# JSBSim's trim tolerances (FGTrimAxis): on udot, wdot [ft/s²] and on qdot, pdot, rdot
-# [rad/s²]; the flying instance, set to the companion's trim, must meet them too.
-TRIM_TOLERANCE_FT_S2 = 1e-3
-TRIM_TOLERANCE_RAD_S2 = 1e-4
 # The elastic trim's fixed point on α with JSBSim's trim [rad]: JSBSim's trim resolves α to
-# its own tolerances (above), 1e-6 rad is well within them.
+# its own tolerances (runtime/trim.py), 1e-6 rad is well within them.
 ELASTIC_TRIM_TOL_RAD = 1e-6
-# Control commands JSBSim's full trim sets (FGTrimAxis), copied to the flying instance; the
-# throttle commands of every engine are added per aircraft.
-TRIM_CONTROLS = (
-    JP.FCS_ELEVATOR_CMD_NORM,
-    JP.FCS_AILERON_CMD_NORM,
-    JP.FCS_RUDDER_CMD_NORM,
-    JP.FCS_PITCH_TRIM_CMD_NORM,
-    JP.FCS_ROLL_TRIM_CMD_NORM,
-    JP.FCS_YAW_TRIM_CMD_NORM,
-)
-_WIND_PROPERTIES = (
-    JP.ATMOSPHERE_WIND_NORTH_FPS,
-    JP.ATMOSPHERE_WIND_EAST_FPS,
-    JP.ATMOSPHERE_WIND_DOWN_FPS,
-)
 
 
 def _one_line(text: str) -> str:
@@ -262,11 +212,12 @@ class Airframe:
             self.trim_aircraft = aircraft
             self._trim_fdm = self._fdm
         self._nodes: dict[str, object] = {}
-        self.last_rpm_settle_s = 0.0  # time the flying instance's RPM took to settle [s]
+        self._trim = JSBSimTrim(self._fdm, self._trim_fdm, self._log, self.engines,
+                                self._trim_aircraft_path, self.alpha_limits_rad)
         # α range of the aerodynamic tables [rad] (the generated prototype's: limits.py)
         self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
         self.definition_name: str | None = None  # the aircraft definition it flies
-        self.glider = self.engine_count == 0  # trimmed to a glide (runtime/glide.py)
+        self.glider = self.engine_count == 0  # trimmed to a glide (runtime/trim.py)
         self._workdir = None  # the temporary root of an aircraft from a file (aircraft_files.py)
 
     @classmethod
@@ -297,20 +248,17 @@ class Airframe:
             if jsbsim.LogLevel.WARN <= r.level <= jsbsim.LogLevel.FATAL
         ]
 
-    def _first_message(self, min_level: int) -> str:
-        for r in self._log.records:
-            if min_level <= r.level <= jsbsim.LogLevel.FATAL:
-                return _one_line(r.text)
-        return ""
-
     # ---- properties ---------------------------------------------------------------
     @property
     def total_thrust_n(self) -> float:
         """Thrust of all engines (the contra-rotating pair) [N]."""
-        lbs = sum(
-            float(self._fdm[JP.engine(i, "thrust-lbs")]) for i in range(self.engine_count)
-        )
-        return lbs * U.N_PER_LBF
+        return total_thrust_n(self._fdm, self.engine_count)
+
+    @property
+    def last_rpm_settle_s(self) -> float:
+        """Time the flying instance's RPM took to settle on the trim companion's trim RPM
+        in the last trim [s] (0 until a companion was trimmed)."""
+        return self._trim.last_rpm_settle_s
 
     @property
     def jsbsim(self):
@@ -350,29 +298,14 @@ class Airframe:
         level, ρ = 1.225 kg/m³), at 45° latitude where JSBSim's gravity is the standard
         9.806 m/s². The ground is put ``TERRAIN_CLEARANCE_M`` below."""
         self._restore_time_step()
-        self._set_level_ic(self._fdm, _check_speed(speed_m_s), _check_altitude(altitude_m))
-
-    def _set_level_ic(self, fdm: jsbsim.FGFDMExec, v: float, h: float) -> None:
-        fdm[JP.IC_LAT_GEOD_RAD] = airframe_xml.INIT_LATITUDE_RAD  # standard gravity there
-        fdm[JP.IC_LONG_GC_RAD] = 0.0
-        fdm[JP.IC_TERRAIN_ELEVATION_FT] = (h - airframe_xml.TERRAIN_CLEARANCE_M) * U.FT_PER_M
-        fdm[JP.IC_H_SL_FT] = h * U.FT_PER_M
-        for name in (JP.IC_PHI_RAD, JP.IC_PSI_TRUE_RAD, JP.IC_BETA_RAD, JP.IC_GAMMA_RAD):
-            fdm[name] = 0.0
-        for name in (JP.IC_P_RAD_SEC, JP.IC_Q_RAD_SEC, JP.IC_R_RAD_SEC, JP.IC_ALPHA_RAD):
-            fdm[name] = 0.0
-        fdm[JP.IC_VT_FPS] = v * U.FT_PER_M
-        for name in TRIM_CONTROLS:
-            fdm[name] = 0.0
-        with captured(self._log):
-            fdm.run_ic()
+        set_level_ic(self._fdm, _check_speed(speed_m_s), _check_altitude(altitude_m), self._log)
 
     # ---- trim -----------------------------------------------------------------------
     def trim(self, speed_m_s: float, altitude_m: float = 0.0, wing=None) -> TrimResult:
         """The one trim of the airframe: level flight in still air at ``speed_m_s`` [m/s],
-        ``altitude_m`` [m] (JSBSim full trim of the companion, the flying instance set to
-        it: module docstring; an aircraft without an engine: its steady glide,
-        runtime/glide.py).
+        ``altitude_m`` [m] (JSBSim's full trim of the trim companion, the flying instance set
+        to it; an aircraft without an engine: its steady glide; the procedure:
+        :class:`~bioflex_jsb.runtime.trim.JSBSimTrim`).
 
         ``wing``: a :class:`~bioflex_jsb.flight_dynamics.wing_model.WingBuild` for the
         elastic trim: this rigid trim carrying the wing's static loads, solved to their
@@ -417,122 +350,16 @@ class Airframe:
         v = _check_speed(speed_m_s)
         h = _check_altitude(altitude_m)
         self._restore_time_step()
-        for fdm in self._instances():
-            for name in _WIND_PROPERTIES:
-                fdm[name] = 0.0
-        tfdm = self._trim_fdm
-        self._set_level_ic(tfdm, v, h)
-        if self.glider:  # no engine: the steady glide at v (runtime/glide.py)
-            with captured(self._log):
-                glide_trim(tfdm, v)
-            result = self._trim_result(v, h)
-            self._check_in_trim(result)
-            return result
-        if self.has_companion:
-            with captured(self._log):
-                spin_up_propellers(tfdm, v, self._trim_aircraft_path, self.engine_count)
-        else:
-            with captured(self._log):
-                start_engines(tfdm, self.engines)
-        self._log.records.clear()
-        with captured(self._log), trim_report(tfdm):
-            try:
-                tfdm.do_trim(TRIM_MODE_FULL)
-                failed = False
-            except jsbsim.TrimFailureError:
-                failed = True
-        if failed:
-            if tfdm is not self._fdm:  # leave the flying instance at a defined state
-                self._set_level_ic(self._fdm, v, h)
-            raise TrimError(self._diagnose_trim_failure(v))
-        if tfdm is not self._fdm:
-            with captured(self._log):
-                self.last_rpm_settle_s = fly_at_companion_trim(
-                    self._fdm, tfdm, v, TRIM_CONTROLS, self.engine_count)
-        result = self._trim_result(v, h)
-        self._check_in_trim(result)
-        return result
-
-    def _check_in_trim(self, result: TrimResult) -> None:
-        """The flying instance's accelerations are within JSBSim's trim tolerances."""
-        r = result.residuals
-        ft_s2 = max(abs(r["udot_m_s2"]), abs(r["wdot_m_s2"])) * U.FT_PER_M
-        rad_s2 = max(abs(r["qdot_rad_s2"]), abs(r["pdot_rad_s2"]), abs(r["rdot_rad_s2"]))
-        if ft_s2 > TRIM_TOLERANCE_FT_S2 or rad_s2 > TRIM_TOLERANCE_RAD_S2:
-            worst = ", ".join(f"{k} {x:.1e}" for k, x in r.items())
-            raise TrimError(
-                f"cannot trim at {result.speed_m_s:g} m/s: the flying aircraft set to the trim "
-                f"companion's trim is out of tolerance ({worst})"
-            )
-
-    def _trim_result(self, v: float, h: float) -> TrimResult:
-        fdm = self._fdm
-        return TrimResult(
-            speed_m_s=v,
-            altitude_m=h,
-            alpha_rad=float(fdm[JP.AERO_ALPHA_RAD]),
-            theta_rad=float(fdm[JP.ATTITUDE_THETA_RAD]),
-            elevator_norm=(glide_elevator_norm(fdm) if self.glider  # its command: SGS.xml
-                           else float(fdm[JP.FCS_ELEVATOR_POS_NORM])),  # writes no position
-            elevator_rad=float(fdm[JP.FCS_ELEVATOR_POS_RAD]),
-            throttle=0.0 if self.glider else float(fdm[JP.FCS_THROTTLE_POS_NORM]),
-            aileron_norm=self._aileron_norm(),
-            propeller_rpm=self._propeller_rpm(),
-            thrust_n=self.total_thrust_n,
-            converged=True,
-            residuals={
-                "udot_m_s2": float(fdm[JP.ACCELERATIONS_UDOT_FT_SEC2]) * U.M_PER_FT,
-                "wdot_m_s2": float(fdm[JP.ACCELERATIONS_WDOT_FT_SEC2]) * U.M_PER_FT,
-                "qdot_rad_s2": float(fdm[JP.ACCELERATIONS_QDOT_RAD_SEC2]),
-                "pdot_rad_s2": float(fdm[JP.ACCELERATIONS_PDOT_RAD_SEC2]),
-                "rdot_rad_s2": float(fdm[JP.ACCELERATIONS_RDOT_RAD_SEC2]),
-            },
-            flight_path_rad=float(fdm[JP.FLIGHT_PATH_GAMMA_RAD]) if self.glider else 0.0,
-        )
-
-    def _has(self, name: str) -> bool:
-        return bool(self._fdm.get_property_manager().hasNode(name))
+        return self._trim.rigid(v, h)
 
     def has_property(self, name: str) -> bool:
         """Whether the flying instance has the JSBSim property ``name`` (an engine's lever,
         an FCS output)."""
-        return self._has(name)
-
-    def _aileron_norm(self) -> float:
-        """The aileron position −1..1 (+ roll right): the left surface's normalised
-        position where the FCS writes one per side (c172p, the prototype), else the single
-        ``fcs/aileron-pos-norm``, else the command with its trim (an FCS that writes only
-        radians)."""
-        for name in (JP.FCS_LEFT_AILERON_POS_NORM, JP.FCS_AILERON_POS_NORM):
-            if self._has(name):
-                return float(self._fdm[name])
-        command = float(self._fdm[JP.FCS_AILERON_CMD_NORM]) + float(
-            self._fdm[JP.FCS_ROLL_TRIM_CMD_NORM])
-        return min(1.0, max(-1.0, command))
-
-    def _propeller_rpm(self) -> float:
-        """Engine 0's propeller speed [rev/min]; 0 for an aircraft without a propeller (a
-        glider, a jet)."""
-        name = JP.PROPULSION_ENGINE_0_PROPELLER_RPM
-        return float(self._fdm[name]) if self.engines and self._has(name) else 0.0
+        return has_property(self._fdm, name)
 
     def _diagnose_trim_failure(self, v: float) -> str:
-        """One line: which control saturated or which condition failed; an engine that
-        stopped during the trim is named first (its thrust was missing, not the throttle's)."""
-        text = "\n".join(r.text for r in self._log.records)
-        engine = "the motor gives" if self.has_companion else (
-            "the engine gives" if len(self.engines) == 1 else "the engines give")
-        line = diagnose_trim_failure(text, v, self.alpha_limits_rad,
-                                     self._first_message(jsbsim.LogLevel.WARN), engine)
-        stopped = [e for e in self.engines
-                   if self._has(name := JP.engine(e.index, "engine-rpm"))
-                   and self._trim_fdm[name] <= 0.0]
-        if stopped and not self.has_companion:
-            names = ", ".join(f"{e.index} ({e.kind}, {e.file})" for e in stopped)
-            line = (f"cannot trim at {v:g} m/s: engine {names} stopped during the trim (0 "
-                    "rev/min: its fuel feed or the aircraft's systems hold it; "
-                    f"JSBSim's trim then says: {line.split(': ', 1)[-1]})")
-        return line
+        """One line: why the last trim at ``v`` [m/s] failed (runtime/trim.py)."""
+        return self._trim.diagnose_failure(v)
 
     # ---- linearization ----------------------------------------------------------------
     def linearize(self, speed_m_s: float, altitude_m: float = 0.0) -> RigidLinearization:

@@ -43,7 +43,7 @@ class TrimResult:
             thrust_n: total thrust of the pair [N].
         converged: True: JSBSim reported every trim condition within tolerance.
         flight_path_rad: the flight-path angle γ [rad] (0: level flight; an aircraft
-            without an engine is trimmed to its steady glide, γ < 0: runtime/glide.py).
+            without an engine is trimmed to its steady glide, γ < 0: runtime/trim.py).
         residuals: the accelerations left: ``udot_m_s2``, ``wdot_m_s2`` [m/s²],
             ``qdot_rad_s2``, ``pdot_rad_s2``, ``rdot_rad_s2`` [rad/s²] (of the flying
             instance, set to the companion's trim; see the module docstring).
