@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import math
 import re
+from types import SimpleNamespace
 
 import pytest
 from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as M
 
+from bioflex_jsb.drivers import sitl_vehicle
 from bioflex_jsb.drivers.sitl import PacingStats, SitlParameters
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.links import mavlink as L
@@ -48,8 +50,12 @@ def test_bad_home_is_one_line(build):  # noqa: F811
         make_sim(build, home=(95.0, 0.0, 0.0))
 
 
-def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
+def test_a_crash_is_reported_and_reset_to_trim_over_home(build, monkeypatch):  # noqa: F811
     sim = make_sim(build, start_height_m=20.0)
+    # the sticks' age is wall time (older than 1 s: RTL); here the station's 10 Hz sticks
+    # are sent in simulated time, so the vehicle reads that clock (a loaded machine that
+    # stepped 96 steps in more than 1 s of wall time turned the dive into an RTL)
+    monkeypatch.setattr(sitl_vehicle, "time", SimpleNamespace(monotonic=lambda: sim.t_s))
     v = sim.vehicle
     heard = []  # the on_status hook (the session log's events): every STATUSTEXT, timed
     v.on_status = lambda t_s, severity, text: heard.append((t_s, severity, text))
