@@ -22,11 +22,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Annotated, Any, ClassVar, TypeVar
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, PlainValidator, ValidationError
 from pydantic_core import PydanticCustomError
 
 from bioflex_jsb.errors import InputError, unprintable
-from bioflex_jsb.values import is_finite_real, is_whole
+from bioflex_jsb.values import is_finite_real, is_real, is_whole
 
 # The error type of a kind's problem inside pydantic (its text is the kind's message).
 _KIND_ERROR = "bioflex_input"
@@ -275,6 +276,56 @@ class Interval(Kind):
         return (float(value[0]), float(value[1]))
 
 
+@dataclass(frozen=True)
+class Matrix(Kind):
+    """A matrix of numbers: a list of rows of equal length (a file's table; a row may be
+    empty) or a numeric array (an .npz file's), as a float array (a list: 2-D; an array
+    keeps its shape, which the reader fits). Finiteness is the reader's to check, with the
+    matrix's name."""
+
+    python_type: ClassVar[Any] = Any
+
+    def missing_text(self) -> str:
+        return "missing (a list of rows of numbers)"
+
+    def check(self, value: Any) -> Any:
+        if isinstance(value, np.ndarray):
+            if value.dtype.kind not in "fiu":
+                raise Invalid(f"must be a matrix of numbers, got an array of {value.dtype}")
+            return value.astype(float)
+        if not (isinstance(value, list) and all(isinstance(r, list) for r in value)
+                and all(is_real(v) for r in value for v in r)):
+            raise Invalid(f"must be a list of rows of numbers, got {value!r}")
+        if len({len(r) for r in value}) > 1:
+            raise Invalid(f"its rows differ in length ({', '.join(str(len(r)) for r in value)} "
+                          "numbers)")
+        return np.array(value, dtype=float).reshape(len(value), -1 if value else 0)
+
+
+@dataclass(frozen=True)
+class Names(Kind):
+    """A non-empty list of non-empty names, each once (a list or a tuple; a string is not
+    a list of names), as a tuple."""
+
+    python_type: ClassVar[Any] = tuple[str, ...]
+
+    def missing_text(self) -> str:
+        return "missing (a list of names)"
+
+    def check(self, value: Any) -> tuple[str, ...]:
+        if isinstance(value, str) or not isinstance(value, list | tuple):
+            raise Invalid(f"must be a list of names, got {value!r}")
+        if not value:
+            raise Invalid("none given; accepted: a list of names")
+        bad = [n for n in value if not isinstance(n, str) or not n]
+        if bad:
+            raise Invalid(f"must be non-empty names, got {bad[0]!r}")
+        dup = sorted({n for n in value if value.count(n) > 1})
+        if dup:
+            raise Invalid(f"name {dup[0]!r} more than once")
+        return tuple(value)
+
+
 # Kinds many inputs share, declared once.
 CHORD_FRACTION = Real("chord fraction", 0.0, 1.0)  # a position along the chord, LE 0, TE 1
 
@@ -291,12 +342,21 @@ def unknown_key_text(key: str, accepted: Sequence[str]) -> str:
     return f"unknown key {str(key)!r}; accepted: {', '.join(sorted(accepted))}"
 
 
+def keys_text(table: Mapping, accepted: Sequence[str]) -> str | None:
+    """The problem of ``table``'s unknown keys, or None: the first (sorted) in the one
+    wording (:func:`unknown_key_text`), the others counted (:func:`more_text`)."""
+    unknown = sorted(str(k) for k in set(table) - set(accepted))
+    if not unknown:
+        return None
+    return unknown_key_text(unknown[0], accepted) + more_text(len(unknown) - 1)
+
+
 def check_keys(table: Mapping, accepted: Sequence[str]) -> None:
-    """:class:`Invalid` (:func:`unknown_key_text`) for the first (sorted) key of ``table``
-    that is not ``accepted``."""
-    unknown = unknown_keys(table, accepted)
-    if unknown is not None:
-        raise Invalid(unknown_key_text(unknown, accepted))
+    """:class:`Invalid` (:func:`keys_text`) if ``table`` has a key that is not
+    ``accepted``."""
+    text = keys_text(table, accepted)
+    if text is not None:
+        raise Invalid(text)
 
 
 def more_text(n: int) -> str:

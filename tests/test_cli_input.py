@@ -388,6 +388,36 @@ def test_modal_file_fields_are_checked_by_name(capsys, tmp_path, fields, needle)
     assert_one_line_error(code, err, needle)
 
 
+@pytest.mark.parametrize("old, new, needle", [
+    ("[stations]", "[stations]\nz = [0.0]\nx = [1.0]",
+     "m.toml: stations: unknown key 'x'; accepted: y (and 1 more problem)"),
+    ('length = "mm"', 'length = "ft"', "units.length: unknown unit 'ft'; accepted: m, mm"),
+])
+def test_modal_file_keys_in_the_one_wording(capsys, tmp_path, old, new, needle):
+    text = EXAMPLE_MODES.read_text(encoding="utf-8")
+    assert old in text
+    (tmp_path / "m.toml").write_text(text.replace(old, new, 1), encoding="utf-8")
+    wing = _variant(tmp_path, 'modes_file = "m.toml"\n')
+    code, _, err = run_cli(capsys, "modes", "--wing", wing)
+    assert_one_line_error(code, err, needle)
+
+
+_GAIN = '[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
+
+
+@pytest.mark.parametrize("command", ["gust", "flutter"])
+@pytest.mark.parametrize("text, needle", [
+    (_GAIN + "gain = 3\nk = 1\n", "c.toml': controller: unknown key 'gain'; accepted: a, b, "
+     "c, d, dt_s, inputs, name, notes, outputs (and 1 more problem)"),
+    (_GAIN.replace("dt_s = 0", "dt_s = -1"), "controller.dt_s: must be ≥ 0 s, got -1"),
+    (_GAIN.replace("d = [[1.0]]", "d = 1.0"), "controller.d: must be a list of rows of "
+     "numbers, got 1.0"),
+])
+def test_controller_file_keys_in_the_one_wording(capsys, tmp_path, command, text, needle):
+    (tmp_path / "c.toml").write_text(text, encoding="utf-8")
+    code, _, err = run_cli(capsys, command, "--controller", str(tmp_path / "c.toml"))
+    assert_one_line_error(code, err, needle)
+
 def _pure_bending_mode_1(tmp_path) -> None:
     from dataclasses import replace
 

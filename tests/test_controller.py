@@ -92,14 +92,37 @@ def test_toml_static_gain(tmp_path):
 
 
 @pytest.mark.parametrize("text, fragment", [
+    # the one validator's wording (bioflex_jsb.inputs): <file>: <table>: <problem>
     ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
-     'gain = 3\n', "unknown key 'gain'"),
-    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\n', "lacks 'd'"),
+     'gain = 3\n', "c.toml': controller: unknown key 'gain'; accepted: a, b, c, d, dt_s, "
+     "inputs, name, notes, outputs"),
+    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
+     'gain = 3\nk = 1\n', "unknown key 'gain'; accepted: a, b, c, d, dt_s, inputs, name, "
+     "notes, outputs (and 1 more problem)"),
+    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\n',
+     "controller.d: missing (a list of rows of numbers)"),
+    ('[controller]\ndt_s = -1\ninputs = "q"\noutputs = ["elevator"]\n',
+     "controller.d: missing (a list of rows of numbers) (and 2 more problems)"),
     ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
      'a = [[1.0]]\n', "a, b and c go together"),
     ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [["x"]]\n',
-     "d must be a list of rows of numbers"),
-    ('[other]\nx = 1\n', "one [controller] table"),
+     "controller.d: must be a list of rows of numbers, got [['x']]"),
+    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0], []]\n',
+     "controller.d: its rows differ in length (1, 0 numbers)"),
+    ('[controller]\ndt_s = -0.5\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n',
+     "controller.dt_s: must be ≥ 0 s, got -0.5 (0: continuous, else the sample time)"),
+    ('[controller]\ndt_s = true\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n',
+     "controller.dt_s: must be a finite number in s, got True"),
+    ('[controller]\ndt_s = 0\ninputs = ["q", "q"]\noutputs = ["elevator"]\nd = [[1.0]]\n',
+     "controller.inputs: name 'q' more than once"),
+    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
+     'notes = 3\n', "controller.notes: must be a table"),
+    ('[controller]\ndt_s = 0\ninputs = ["q"]\noutputs = ["elevator"]\nd = [[1.0]]\n'
+     'name = "a\\nb"\n', "controller.name: holds a control character"),
+    ('[other]\nx = 1\n', "c.toml': unknown key 'other'; accepted: controller"),
+    ('x = 1\n', "c.toml': unknown key 'x'; accepted: controller"),
+    ('', "c.toml': controller: missing table"),
+    ('controller = 3\n', "c.toml': controller: must be a table"),
     ('[controller\n', "is not valid TOML"),
     ('[controller]\ndt_s = 0\ninputs = ["eta9x"]\noutputs = ["elevator"]\nd = [[1.0]]\n',
      "'eta9x' is not a signal"),
@@ -129,6 +152,37 @@ def test_bad_npz_and_other_files(tmp_path):
     with pytest.raises(InputError):  # object arrays need pickle: refused, one line
         LinearController.load(tmp_path / "pickled.npz")
 
+
+
+def _npz(path, **arrays):
+    base = {"d": np.array([[1.0]]), "dt_s": np.float64(0.0), "inputs": np.array(["q"]),
+            "outputs": np.array(["elevator"])}
+    base.update(arrays)
+    np.savez(path, **{k: v for k, v in base.items() if v is not None})
+    return path
+
+
+@pytest.mark.parametrize("arrays, needle", [
+    ({"gain": np.array(3.0)}, "c.npz': unknown key 'gain'; accepted: a, b, c, d, dt_s, "
+     "inputs, name, notes, outputs"),
+    ({"gain": np.array(3.0), "k": np.array(1.0), "dt_s": None},
+     "unknown key 'gain'; accepted: a, b, c, d, dt_s, inputs, name, notes, outputs "
+     "(and 2 more problems)"),
+    ({"d": np.array([["x"]])}, "c.npz': d: must be a matrix of numbers, got an array of <U1"),
+    ({"d": None}, "c.npz': d: missing (a list of rows of numbers)"),
+    ({"dt_s": np.float64(-1.0)}, "c.npz': dt_s: must be ≥ 0 s, got -1.0"),
+    ({"inputs": np.array([], dtype=str)}, "c.npz': inputs: none given"),
+])
+def test_bad_npz_keys_are_one_line(tmp_path, arrays, needle):
+    path = _npz(tmp_path / "c.npz", **arrays)
+    with pytest.raises(InputError) as exc:
+        LinearController.load(path)
+    assert needle in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_npz_static_gain_reads(tmp_path):
+    c = LinearController.load(_npz(tmp_path / "c.npz"))
+    assert c.n_states == 0 and c.dt_s is None and c.name == "c"
 
 def test_python_control_in_and_out():
     control = pytest.importorskip("control")

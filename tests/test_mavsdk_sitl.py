@@ -88,6 +88,10 @@ class Recorder:
         with self._lock:
             return list(self.events)
 
+    def n_attitudes(self) -> int:
+        """How many ATTITUDE callbacks have arrived."""
+        return sum(1 for kind, _ in self.snapshot() if kind == "attitude")
+
     def last_attitude_s(self) -> float:
         for kind, v in reversed(self.snapshot()):
             if kind == "attitude":
@@ -211,12 +215,15 @@ def test_mavsdk_flies_with_the_sitl_vehicle_and_matches_the_log(tmp_path):
         param.set_param_float("AP_HDG_RAD", HEADING_RAD)
         assert param.get_param_float("AP_HDG_RAD") == pytest.approx(HEADING_RAD, rel=1e-6)
         param.set_param_float("GUST_AMP_MS", GUST_AMP_MS)
-        deadline = time.monotonic() + 2.0
-        while math.isnan(rec.last_attitude_s()) and time.monotonic() < deadline:
-            time.sleep(0.02)
-        before_trigger_s = rec.last_attitude_s()
-        param.set_param_float("GUST_TRIG", 1.0)
-        time.sleep(0.1)
+        before_trigger_s = wait_until(lambda: rec.n_attitudes() and rec.last_attitude_s(),
+                                      30.0, "a first ATTITUDE")
+        param.set_param_float("GUST_TRIG", 1.0)  # returns when the vehicle acknowledged it
+        # the upper bound: an ATTITUDE sent after the acknowledgement (the vehicle's time
+        # then is past the trigger's); the two delivered after the set returned (in order:
+        # one socket, one stream), not a fixed wait that a loaded machine may not cover
+        acked = rec.n_attitudes()
+        wait_until(lambda: rec.n_attitudes() >= acked + 2, 30.0,
+                   "two ATTITUDE messages after GUST_TRIG was acknowledged")
         after_trigger_s = rec.last_attitude_s()
 
         # the mission: only home (ArduPilot's item 0)

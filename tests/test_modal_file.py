@@ -179,7 +179,27 @@ def test_missing_mode_key_points_at_the_mode_table():
 
 def test_unknown_key_in_mode():
     text = GOOD.replace("frequency = 70.0", "frequency = 70.0\nfrequncy = 71.0")
-    expect_error(text, "mode[2].frequncy", "unknown key", f"(line {line_of(text, 'frequncy')})")
+    expect_error(text, "bad.toml: mode[2]: unknown key 'frequncy'; accepted: bending, "
+                 "damping_ratio, frequency, generalised_mass, twist "
+                 f"(line {line_of(text, 'frequncy')})")
+
+
+@pytest.mark.parametrize("old, new, needle, key", [
+    # the one wording of every reader (bioflex_jsb.inputs): <file>: <table>: unknown key ...
+    ("format_version = 1", "format_version = 1\nauthor = 'x'\nzz = 1",
+     "bad.toml: unknown key 'author'; accepted: axes, format, format_version, mode, notes, "
+     "source, stations, units (and 1 more problem)", "author ="),
+    ('length = "mm"', 'length = "mm"\nmass = "kg"', "bad.toml: units: unknown key 'mass'; "
+     "accepted: angle, frequency, generalised_mass, length", "mass ="),
+    ("[stations]", "[stations]\nz = [0.0]\nx = [1.0]\nw = 3", "bad.toml: stations: unknown "
+     "key 'w'; accepted: y (and 2 more problems)", "w = 3"),
+    ('length = "mm"', 'length = "ft"', "bad.toml: units.length: unknown unit 'ft'; "
+     "accepted: m, mm", "length = \"ft\""),
+])
+def test_unknown_keys_in_the_one_wording(old, new, needle, key):
+    assert old in GOOD
+    text = GOOD.replace(old, new, 1)
+    expect_error(text, needle, f"(line {line_of(text, key)})")
 
 
 def test_toml_syntax_error_gives_line():

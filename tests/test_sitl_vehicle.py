@@ -5,18 +5,20 @@ from __future__ import annotations
 
 import math
 import re
-import time
+from types import SimpleNamespace
 
 import pytest
 from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as M
 
+from bioflex_jsb.drivers import sitl_vehicle
 from bioflex_jsb.drivers.sitl import PacingStats, SitlParameters
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.links import mavlink as L
 from bioflex_jsb.links import mavlink_modes as MODES
 from bioflex_jsb.links.mavlink import MavlinkLink
 from bioflex_jsb.simulation import guidance as G
+from tests.polling import wait_until
 from tests.test_sitl import build, make_sim  # noqa: F401  (the module's wing fixture)
 
 
@@ -48,8 +50,12 @@ def test_bad_home_is_one_line(build):  # noqa: F811
         make_sim(build, home=(95.0, 0.0, 0.0))
 
 
-def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
+def test_a_crash_is_reported_and_reset_to_trim_over_home(build, monkeypatch):  # noqa: F811
     sim = make_sim(build, start_height_m=20.0)
+    # the sticks' age is wall time (older than 1 s: RTL); here the station's 10 Hz sticks
+    # are sent in simulated time, so the vehicle reads that clock (a loaded machine that
+    # stepped 96 steps in more than 1 s of wall time turned the dive into an RTL)
+    monkeypatch.setattr(sitl_vehicle, "time", SimpleNamespace(monotonic=lambda: sim.t_s))
     v = sim.vehicle
     heard = []  # the on_status hook (the session log's events): every STATUSTEXT, timed
     v.on_status = lambda t_s, severity, text: heard.append((t_s, severity, text))
@@ -91,11 +97,20 @@ def _peer(port: int, sysid: int = 255):
     return c
 
 
-def _service(link, sim, seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
+def _service_until(link, sim, condition, what: str, timeout_s: float = 10.0):
+    """Service the link until ``condition()`` is true (returned): the messages sent have
+    been read and handled; ``timeout_s`` [s] only bounds a failure (a loaded machine makes
+    the test slower, not wrong)."""
+    def serviced():
         link.service(sim.vehicle_state())
-        time.sleep(0.005)
+        return condition()
+
+    return wait_until(serviced, timeout_s, what, poll_s=0.005)
+
+
+def _read(link, name: str) -> int:
+    """How many ``name`` messages the link has read (and handled)."""
+    return link.stats.by_type.get(name, 0)
 
 
 def test_unknown_parameter_gets_param_error_and_peers_expire(build, monkeypatch):  # noqa: F811
@@ -103,19 +118,22 @@ def test_unknown_parameter_gets_param_error_and_peers_expire(build, monkeypatch)
     link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.vehicle)
     try:
         c = _peer(link.local_address[1])
-        _service(link, sim, 0.2)
-        assert link.peer_count == 1
+        _service_until(link, sim, lambda: link.peer_count == 1, "the peer's heartbeat")
         c.mav.param_request_read_send(1, 1, b"NO_SUCH", -1)
         c.mav.param_set_send(1, 1, b"WP_RADIUS_M", 1e6, M.MAV_PARAM_TYPE_REAL32)
-        _service(link, sim, 0.3)
         errors = []
-        while (m := c.recv_match(type="PARAM_ERROR", blocking=False)) is not None:
-            errors.append((m.param_id, m.error))
-        assert ("NO_SUCH", M.MAV_PARAM_ERROR_DOES_NOT_EXIST) in errors
-        assert ("WP_RADIUS_M", M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE) in errors
+        expected = {("NO_SUCH", M.MAV_PARAM_ERROR_DOES_NOT_EXIST),
+                    ("WP_RADIUS_M", M.MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)}
+
+        def both_answered() -> bool:
+            while (m := c.recv_match(type="PARAM_ERROR", blocking=False)) is not None:
+                errors.append((m.param_id, m.error))
+            return expected <= set(errors)
+
+        _service_until(link, sim, both_answered, f"two PARAM_ERRORs (got {errors})")
         monkeypatch.setattr(L, "PEER_TIMEOUT_S", 0.3)
-        _service(link, sim, 0.6)
-        assert link.peer_count == 0 and link.stats.peers_expired == 1
+        _service_until(link, sim, lambda: link.stats.peers_expired == 1, "the peer expired")
+        assert link.peer_count == 0
     finally:
         link.close()
 
@@ -129,8 +147,11 @@ def test_unsigned_radio_status_takes_no_peer_slot_when_signing(build):  # noqa: 
                                        source_system=51, dialect="common")
         for _ in range(5):
             c.mav.radio_status_send(200, 190, 100, 10, 10, 0, 0)
-        _service(link, sim, 0.2)
-        assert link.stats.by_type.get("RADIO_STATUS", 0) >= 1 and link.peer_count == 0
+        # all five datagrams taken in (the link's counter; an unknown source's datagrams past
+        # the first few of one call are dropped unparsed, unknown_dropped), and none of the
+        # RADIO_STATUS handled took a peer slot
+        _service_until(link, sim, lambda: link.stats.datagrams == 5, "five datagrams read")
+        assert _read(link, "RADIO_STATUS") >= 1 and link.peer_count == 0
     finally:
         link.close()
 
@@ -140,14 +161,20 @@ def test_sticks_only_from_the_controlling_station_and_only_in_stick_modes(build)
     link = MavlinkLink("udpin:127.0.0.1:0", SitlParameters(sim), sim.vehicle)
     try:
         a, b = _peer(link.local_address[1], 255), _peer(link.local_address[1], 254)
+        # each MANUAL_CONTROL is proven read (the link's counter) before what it did is
+        # asserted, so that an ignored one is one that was read and ignored
         a.mav.manual_control_send(1, 500, 0, 500, 0, 0)  # CRUISE: not obeyed
-        _service(link, sim, 0.1)
+        _service_until(link, sim, lambda: _read(link, "MANUAL_CONTROL") == 1,
+                       "the first MANUAL_CONTROL read")
         assert sim.vehicle._stick_wall is None
         sim.vehicle.set_mode(MODES.STABILIZE)
         a.mav.manual_control_send(1, 0, 400, 500, 0, 0)
-        _service(link, sim, 0.1)
+        _service_until(link, sim, lambda: _read(link, "MANUAL_CONTROL") == 2,
+                       "the second MANUAL_CONTROL read")
+        assert sim.vehicle._sticks == pytest.approx((0.0, 0.4))
         b.mav.manual_control_send(1, 0, -900, 500, 0, 0)  # another station: ignored
-        _service(link, sim, 0.1)
+        _service_until(link, sim, lambda: _read(link, "MANUAL_CONTROL") == 3,
+                       "the other station's MANUAL_CONTROL read")
         assert sim.vehicle._sticks == pytest.approx((0.0, 0.4))
     finally:
         link.close()

@@ -85,6 +85,17 @@ import numpy as np
 
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.files import read_input_bytes
+from bioflex_jsb.inputs import (
+    Invalid,
+    Matrix,
+    Names,
+    Real,
+    Table,
+    Text,
+    check_keys,
+    problem,
+    read_table,
+)
 from bioflex_jsb.simulation.channels import describe
 from bioflex_jsb.state_space import StateSpace
 from bioflex_jsb.tomlfile import loads_toml
@@ -151,18 +162,14 @@ def check_outputs(names, what: str = "controller") -> tuple[str, ...]:
 
 
 def _name_tuple(names, what: str) -> tuple[str, ...]:
-    if isinstance(names, str) or not hasattr(names, "__iter__"):
-        raise InputError(f"{what} must be a list of names, got {names!r}")
-    out = tuple(names)
-    if not out:
-        raise InputError(f"{what}: none given")
-    bad = [n for n in out if not isinstance(n, str) or not n]
-    if bad:
-        raise InputError(f"{what} must be non-empty names, got {bad[0]!r}")
-    dup = sorted({n for n in out if out.count(n) > 1})
-    if dup:
-        raise InputError(f"{what} name {dup[0]!r} more than once")
-    return out
+    """``names`` (any iterable but a string) checked by :class:`bioflex_jsb.inputs.Names`;
+    InputError ``<what>: <problem>``."""
+    if not isinstance(names, str) and hasattr(names, "__iter__"):
+        names = tuple(names)
+    try:
+        return Names().check(names)
+    except Invalid as exc:
+        raise problem(InputError, "", what, exc.text) from None
 
 
 def check_controller(controller) -> Controller:
@@ -313,30 +320,26 @@ class LinearController:
     @classmethod
     def load(cls, path: str | Path) -> LinearController:
         """Read a controller file (``.npz`` arrays or a ``.toml`` ``[controller]`` table,
-        keys :data:`FILE_KEYS`; at most :data:`MAX_CONTROLLER_BYTES`, a regular file);
-        every problem is one line (InputError) naming the file."""
+        keys :data:`FILE_KEYS`, :class:`ControllerFile`; at most
+        :data:`MAX_CONTROLLER_BYTES`, a regular file); every problem is one line
+        (InputError) naming the file and the key."""
         p = Path(path)
         if p.suffix.lower() not in FILE_SUFFIXES:
             raise InputError(f"controller file {str(p)!r}: give a .npz or .toml file")
         data = read_input_bytes(p, "controller file", MAX_CONTROLLER_BYTES, InputError)
         source = f"controller file {str(p)!r}"
-        fields = _npz_fields(data, source) if p.suffix.lower() == ".npz" else \
-            _toml_fields(data, source)
-        unknown = sorted(set(fields) - set(FILE_KEYS))
-        if unknown:
-            raise InputError(f"{source}: unknown key {unknown[0]!r}; accepted: "
-                             f"{', '.join(FILE_KEYS)}")
-        missing = [k for k in ("d", "dt_s", "inputs", "outputs") if k not in fields]
-        if missing:
-            raise InputError(f"{source} lacks {missing[0]!r}")
-        states = [k for k in "abc" if k in fields]
+        if p.suffix.lower() == ".npz":
+            table = read_table(ControllerFile, _npz_fields(data, source), source, InputError)
+        else:
+            table = read_table(ControllerFile, _toml_table(data, source), source, InputError,
+                               "controller")
+        states = [k for k in "abc" if getattr(table, k) is not None]
         if states and len(states) != 3:
             raise InputError(f"{source}: a, b and c go together (a static gain has d alone)")
-        name = str(fields.get("name") or p.stem)
+        name = table.name.strip() or p.stem
         try:
-            return cls.from_arrays(fields.get("a"), fields.get("b"), fields.get("c"),
-                                   fields["d"], fields["dt_s"], fields["inputs"],
-                                   fields["outputs"], name, fields.get("notes") or {})
+            return cls.from_arrays(table.a, table.b, table.c, table.d, table.dt_s,
+                                   table.inputs, table.outputs, name, table.notes or {})
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
 
@@ -379,6 +382,23 @@ class LinearController:
             r.x = r.system.a @ r.x + r.system.b @ u
         r.count = (r.count + 1) % r.every
         return dict(zip(self.outputs, r.y.tolist(), strict=True))
+
+
+class ControllerFile(Table):
+    """The keys of a controller file (:data:`FILE_KEYS`), checked by the one validator
+    (:mod:`bioflex_jsb.inputs`): the matrices (``a``, ``b``, ``c`` together or absent: a
+    static gain), the sample time [s] (0: continuous), the signals read and the commands
+    written, a name and notes (a table; JSON text in an .npz)."""
+
+    a: Matrix().type() | None = None
+    b: Matrix().type() | None = None
+    c: Matrix().type() | None = None
+    d: Matrix().type()
+    dt_s: Real("s", 0.0, hint=" (0: continuous, else the sample time)").type()
+    inputs: Names().type()
+    outputs: Names().type()
+    name: Text(empty=True).type() = ""
+    notes: dict | None = None
 
 
 class _Reference:
@@ -427,35 +447,26 @@ def _npz_fields(data: bytes, source: str) -> dict:
             raise InputError(f"{source}: its notes are not JSON") from None
         if not isinstance(out["notes"], dict):
             raise InputError(f"{source}: its notes are not a JSON object")
-    for key in "abcd":
-        if key in out and out[key].dtype.kind not in "fiu":
-            raise InputError(f"{source}: {key} is not a matrix of numbers")
+    if "dt_s" in out and np.size(out["dt_s"]) == 1:
+        out["dt_s"] = np.asarray(out["dt_s"]).reshape(-1)[0].item()  # a Python scalar
     return out
 
 
-def _toml_fields(data: bytes, source: str) -> dict:
+def _toml_table(data: bytes, source: str) -> object:
+    """The ``[controller]`` table of a .toml controller file (its keys are the
+    :class:`ControllerFile`'s to check); InputError if the file holds another table."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise InputError(f"{source} is not UTF-8 text") from None
     doc = loads_toml(text, source, InputError)
-    table = doc.get("controller")
-    if not isinstance(table, dict) or set(doc) != {"controller"}:
-        raise InputError(f"{source}: a controller file holds one [controller] table")
-    out = dict(table)
-    for key in "abcd":
-        if key in out:
-            rows = out[key]
-            if not isinstance(rows, list) or not all(isinstance(r, list) for r in rows) or \
-                    not all(isinstance(v, int | float) and not isinstance(v, bool)
-                            for r in rows for v in r):
-                raise InputError(f"{source}: {key} must be a list of rows of numbers")
-            if len({len(r) for r in rows}) > 1:
-                raise InputError(f"{source}: the rows of {key} differ in length")
-            out[key] = np.array(rows, dtype=float).reshape(len(rows), -1 if rows else 0)
-    if "notes" in out and not isinstance(out["notes"], dict):
-        raise InputError(f"{source}: notes must be a table")
-    return out
+    try:
+        check_keys(doc, ("controller",))
+    except Invalid as exc:
+        raise problem(InputError, source, "", exc.text) from None
+    if "controller" not in doc:
+        raise problem(InputError, source, "controller", "missing table")
+    return doc["controller"]
 
 
 def _toml_text(controller: LinearController, dt_s: float) -> str:

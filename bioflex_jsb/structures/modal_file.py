@@ -47,7 +47,15 @@ from pathlib import Path
 import numpy as np
 
 from bioflex_jsb.errors import InputError
-from bioflex_jsb.inputs import CHORD_FRACTION, Invalid, Kind, Real
+from bioflex_jsb.inputs import (
+    CHORD_FRACTION,
+    Choice,
+    Invalid,
+    Kind,
+    Real,
+    keys_text,
+    problem,
+)
 from bioflex_jsb.structures.modal_data import ModalData, ModalDataError
 
 FORMAT_NAME = "bioflex-jsb-modes"
@@ -143,8 +151,16 @@ class _Reader:
         if line is None and table is None and key:  # an unknown top-level [table]
             line = self.loc.line_of(key)
         where = f" (line {line})" if line is not None else ""
-        text = f"{self.name}: {what}: {message}{where}".replace("\n", " ")
-        raise ModalFileError(text)
+        raise problem(ModalFileError, self.name, what, message + where)
+
+    def keys(self, t: dict, accepted, what: str, table=None, index: int = 0) -> None:
+        """Unknown keys of table ``what`` in the one wording (:func:`bioflex_jsb.inputs.
+        keys_text`): ``<file>: <table>: unknown key 'X'; accepted: … (and N more
+        problems)``, at the first unknown key's line."""
+        text = keys_text(t, sorted(accepted))
+        if text is not None:
+            first = sorted(str(k) for k in set(t) - set(accepted))[0]
+            self.fail(what, text, table, first, index)
 
     # --------------------------------------------------------------------------------------
     def check(self, kind: Kind, value, what, table, key, index=0, element=None):
@@ -225,10 +241,7 @@ class _Reader:
 
     def _header(self, data: dict) -> None:
         """Known top-level keys, the format's name and version, text source and notes."""
-        unknown = sorted(set(data) - _TOP_KEYS)
-        if unknown:
-            self.fail(unknown[0], f"unknown key (accepted: {', '.join(sorted(_TOP_KEYS))})",
-                      None, unknown[0])
+        self.keys(data, _TOP_KEYS, "")
         if data.get("format") != FORMAT_NAME:
             self.fail("format", f"missing or not {FORMAT_NAME!r}", None, "format")
         if data.get("format_version") != FORMAT_VERSION:
@@ -244,16 +257,12 @@ class _Reader:
         if not isinstance(units, dict):
             self.fail("units", "missing [units] table (length, angle, frequency, "
                       "generalised_mass)")
-        for key in sorted(set(units) - set(_UNIT_TABLES)):
-            self.fail(f"units.{key}", "unknown key", "units", key)
+        self.keys(units, _UNIT_TABLES, "units", "units")
         factor = {}
         for key, table in _UNIT_TABLES.items():
             if key not in units:
-                self.fail(f"units.{key}", "missing", "units")
-            if units[key] not in table:
-                self.fail(f"units.{key}",
-                          f"unknown unit {units[key]!r} (accepted: {', '.join(table)})",
-                          "units", key)
+                self.fail(f"units.{key}", Choice(tuple(table)).missing_text(), "units")
+            self.check(Choice(tuple(table), "unit"), units[key], f"units.{key}", "units", key)
             factor[key] = table[units[key]]
         return units, factor
 
@@ -263,8 +272,7 @@ class _Reader:
         stations = data.get("stations")
         if not isinstance(stations, dict) or "y" not in stations:
             self.fail("stations.y", "missing [stations] table with y = [...]")
-        for key in sorted(set(stations) - {"y"}):
-            self.fail(f"stations.{key}", "unknown key", "stations", key)
+        self.keys(stations, ("y",), "stations", "stations")
         y = self.array(stations["y"], "stations.y", "stations", "y") * factor["length"]
         if y.size < 2:
             self.fail("stations.y", "need at least two stations", "stations", "y")
@@ -281,8 +289,7 @@ class _Reader:
         axes = data.get("axes", {})
         if not isinstance(axes, dict):
             self.fail("axes", "expected a table")
-        for key in sorted(set(axes) - {"x_elastic_frac", "x_inertial_frac"}):
-            self.fail(f"axes.{key}", "unknown key", "axes", key)
+        self.keys(axes, ("x_elastic_frac", "x_inertial_frac"), "axes", "axes")
         x_e = self.axis(axes.get("x_elastic_frac", DEFAULT_AXIS_FRAC), "axes.x_elastic_frac",
                         "x_elastic_frac", k)
         x_i = self.axis(axes.get("x_inertial_frac", DEFAULT_AXIS_FRAC),
@@ -295,9 +302,7 @@ class _Reader:
         tag = f"mode[{i + 1}]"
         if not isinstance(mode, dict):
             self.fail(tag, "expected a [[mode]] table")
-        for key in sorted(set(mode) - _MODE_KEYS):
-            accepted = ", ".join(sorted(_MODE_KEYS))
-            self.fail(f"{tag}.{key}", f"unknown key (accepted: {accepted})", "mode", key, i)
+        self.keys(mode, _MODE_KEYS, tag, "mode", i)
         for key in ("frequency", "generalised_mass", "bending", "twist"):
             if key not in mode:
                 self.fail(f"{tag}.{key}", "missing", "mode", None, i)
