@@ -157,9 +157,8 @@ NEEDS_SDK = pytest.mark.skipif(importlib.util.find_spec("foxglove") is None,
 
 # Wall-time bounds [s], only so that a hang ends the test instead of the suite: a command
 # starts (imports, wing build, trim) in 3-10 s on this shared 2-core machine at load 4-6
-# with the compiled kernel cached, but a fresh CI venv compiles it first, with the other
-# test worker compiling too: the ardupilot session's start-up took ~120 s there (CI run of
-# dc059eb). They are not speed bars.
+# with the compiled kernel cached; a fresh venv compiles it first, with the other test
+# worker compiling too, which takes minutes. They are not speed bars.
 START_S = 600.0
 RUN_S = 300.0
 LIVE_LINE = re.compile(r"live view on ws://127\.0\.0\.1:(\d+) ")
@@ -506,9 +505,9 @@ def test_one_server_serves_a_sitl_session_across_its_log_files(tmp_path):
 def test_an_ardupilot_session_is_served_live(tmp_path):
     """``ardupilot --live`` in a process of its own, flown by the ArduPilot stand-in
     (tests/ardupilot_standin.py) from this one: a client subscribed to the autopilot topic
-    receives the file's messages, one per servo frame answered. (Run in this process, the
-    session once never started its server within 600 s in the full suite, though it did
-    alone: a process of its own keeps it clear of what earlier tests leave behind.)"""
+    receives the file's messages, one per servo frame answered. A process of its own: in
+    the test worker's process, after the suite's earlier tests, the session can wait for
+    its server past any deadline (it starts in seconds alone; the cause is not found)."""
     from tests.ardupilot_standin import ArduPilotStandin
 
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:

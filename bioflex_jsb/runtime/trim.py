@@ -487,25 +487,32 @@ def spin_up_propellers(fdm, speed_m_s: float, aircraft_path: Path, engine_count:
 
 
 
+# The flying instance's initial conditions from the companion's state, in this order:
+# position and attitude first, then the body velocities in that attitude (JSBSim units).
+_IC_FROM_STATE = (
+    (JP.IC_LAT_GEOD_RAD, JP.POSITION_LAT_GEOD_RAD),
+    (JP.IC_LONG_GC_RAD, JP.POSITION_LONG_GC_RAD),
+    (JP.IC_TERRAIN_ELEVATION_FT, JP.POSITION_TERRAIN_ELEVATION_ASL_FT),
+    (JP.IC_H_SL_FT, JP.POSITION_H_SL_FT),
+    (JP.IC_PHI_RAD, JP.ATTITUDE_PHI_RAD),
+    (JP.IC_THETA_RAD, JP.ATTITUDE_THETA_RAD),
+    (JP.IC_PSI_TRUE_RAD, JP.ATTITUDE_PSI_RAD),
+    (JP.IC_U_FPS, JP.VELOCITIES_U_FPS),
+    (JP.IC_V_FPS, JP.VELOCITIES_V_FPS),
+    (JP.IC_W_FPS, JP.VELOCITIES_W_FPS),
+    (JP.IC_P_RAD_SEC, JP.VELOCITIES_P_RAD_SEC),
+    (JP.IC_Q_RAD_SEC, JP.VELOCITIES_Q_RAD_SEC),
+    (JP.IC_R_RAD_SEC, JP.VELOCITIES_R_RAD_SEC),
+)
+
+
 def fly_at_companion_trim(fdm, src, v: float, controls: tuple[str, ...],
                           engine_count: int) -> float:
     """Set the flying instance ``fdm`` to the companion ``src``'s trim at ``v`` [m/s]:
     state, ``controls`` and every engine's throttle, propeller RPM; returns the time
     the RPM took to settle [s]."""
-    # position and attitude first, then the body velocities in that attitude
-    fdm[JP.IC_LAT_GEOD_RAD] = src[JP.POSITION_LAT_GEOD_RAD]
-    fdm[JP.IC_LONG_GC_RAD] = src[JP.POSITION_LONG_GC_RAD]
-    fdm[JP.IC_TERRAIN_ELEVATION_FT] = src[JP.POSITION_TERRAIN_ELEVATION_ASL_FT]
-    fdm[JP.IC_H_SL_FT] = src[JP.POSITION_H_SL_FT]
-    fdm[JP.IC_PHI_RAD] = src[JP.ATTITUDE_PHI_RAD]
-    fdm[JP.IC_THETA_RAD] = src[JP.ATTITUDE_THETA_RAD]
-    fdm[JP.IC_PSI_TRUE_RAD] = src[JP.ATTITUDE_PSI_RAD]
-    fdm[JP.IC_U_FPS] = src[JP.VELOCITIES_U_FPS]
-    fdm[JP.IC_V_FPS] = src[JP.VELOCITIES_V_FPS]
-    fdm[JP.IC_W_FPS] = src[JP.VELOCITIES_W_FPS]
-    fdm[JP.IC_P_RAD_SEC] = src[JP.VELOCITIES_P_RAD_SEC]
-    fdm[JP.IC_Q_RAD_SEC] = src[JP.VELOCITIES_Q_RAD_SEC]
-    fdm[JP.IC_R_RAD_SEC] = src[JP.VELOCITIES_R_RAD_SEC]
+    for ic, state in _IC_FROM_STATE:
+        fdm[ic] = src[state]
     controls = controls + tuple(JP.throttle_cmd(i) for i in range(engine_count))
     for name in controls:
         fdm[name] = src[name]
