@@ -209,3 +209,18 @@ def test_one_class_named_airframe():
                     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
                     if isinstance(node, ast.ClassDef) and node.name == "Airframe")
     assert owners == ["runtime/fdm.py"], owners
+
+
+def test_no_function_is_graded_e_or_f():
+    """Functions an engineer can read: radon's cyclomatic complexity of every function and
+    method of the package and of scripts/ stays below grade E (31 and over), so a function
+    that grows branches by accretion fails here and is broken up along its seams."""
+    radon = pytest.importorskip("radon.complexity", reason="radon is in the test extra")
+    graded = []
+    for path in sorted([*PACKAGE.rglob("*.py"), *(ROOT / "scripts").rglob("*.py")]):
+        for block in radon.cc_visit(path.read_text(encoding="utf-8")):
+            rank = radon.cc_rank(block.complexity)
+            if rank in ("E", "F"):
+                graded.append(f"{path.relative_to(ROOT)}:{block.lineno} {block.name} "
+                              f"{rank} ({block.complexity})")
+    assert not graded, graded

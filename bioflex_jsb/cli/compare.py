@@ -84,16 +84,42 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bioflex_jsb.cli.aircraft_option import airframe_from_args, resolve_flight
-    from bioflex_jsb.drivers.compare import (
-        check_comparable,
-        check_gust_excites,
-        compare_run,
-        linear_prediction,
-    )
+    """Check the arguments, fly the nonlinear run and the linear model, report both."""
+    build, full_span, controller, config = _checked(args)
+    flown = _fly_and_predict(args, build, full_span, controller, config)
+    if flown is None:
+        return 130
+    nonlinear, linear, stops, drift = flown
+    from bioflex_jsb.drivers.compare import compare_run
+
+    result = compare_run(build, nonlinear, args.model, args.speed, args.aero, args.trim,
+                         linear=linear, drift=drift)
+    if args.plot:
+        try:
+            result.plot(args.plot, force=True, title=f"{build.variant.name} wing, "
+                        f"{args.speed:g} m/s, gust "
+                        f"{args.gust.text()}: LTI (Eq. 4) vs JSBSim, {args.model} model")
+        except OSError as exc:
+            raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None
+    if args.json:
+        print_json(_payload(args, build, result, nonlinear, stops))
+    else:
+        _print_report(args, build, result, nonlinear, full_span)
+    if stops:
+        for stop in stops:
+            print(f"bioflex-jsb compare: diverged: {stop}", file=sys.stderr)
+        return EXIT_DIVERGED
+    return 0
+
+
+def _checked(args: argparse.Namespace):
+    """Every argument checked before anything flies (exit 2, one line): the wing model, the
+    span (an aileron input needs both halves), the comparable combination of model, aero and
+    trim, a linear controller, a gust that excites the aircraft, the output paths. Returns
+    (wing build, full span?, controller or None, run configuration)."""
+    from bioflex_jsb.cli.aircraft_option import resolve_flight
+    from bioflex_jsb.drivers.compare import check_comparable, check_gust_excites
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.runtime.fdm import FdmError
-    from bioflex_jsb.simulation.gusts import parse_gust
 
     resolve_flight(args)  # --speed and --gust of the aircraft
     build = wing_for_run(wing_from_args(args), args)
@@ -124,6 +150,19 @@ def run(args: argparse.Namespace) -> int:
     check_plot_path(args.plot, args.force)
     check_distinct_outputs(("--out", args.out), ("--plot", args.plot))
     args.out = log_path(args, "compare", args.wing)
+    return build, full_span, controller, config
+
+
+def _fly_and_predict(args, build, full_span, controller, config):
+    """The nonlinear run (and, for a glider, its drift in calm air) and the linear model's
+    prediction of it, both in the log when there is one. Returns (nonlinear run, linear
+    prediction, stops, drift run or None), or None when interrupted (the log keeps every step
+    flown)."""
+    from bioflex_jsb.cli.aircraft_option import airframe_from_args
+    from bioflex_jsb.drivers.compare import linear_prediction
+    from bioflex_jsb.runtime.fdm import FdmError
+    from bioflex_jsb.simulation.gusts import parse_gust
+
     log = None
     try:
         airframe = airframe_from_args(args)
@@ -141,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
         except Interrupted:
             kept = f"; the log {args.out} holds every step flown" if args.out else ""
             print(f"bioflex-jsb compare: interrupted{kept}", file=sys.stderr)
-            return 130
+            return None
         nonlinear = runs[0]
         try:
             linear = linear_prediction(build, nonlinear, args.model, args.speed, args.aero,
@@ -155,61 +194,58 @@ def run(args: argparse.Namespace) -> int:
         if log is not None:
             with closing():  # a stop signal now waits until the log is finished
                 log.close()
-    result = compare_run(build, nonlinear, args.model, args.speed, args.aero, args.trim,
-                         linear=linear, drift=drift)
-    channels, errors, worst, diverged = (result.channels, result.nrmse, result.worst,
-                                         result.diverged)
-    if args.plot:
-        try:
-            result.plot(args.plot, force=True, title=f"{build.variant.name} wing, "
-                        f"{args.speed:g} m/s, gust "
-                        f"{args.gust.text()}: LTI (Eq. 4) vs JSBSim, {args.model} model")
-        except OSError as exc:
-            raise UsageError(f"cannot write plot {args.plot!r}: {exc.strerror}") from None
-    payload = {
+    return nonlinear, linear, stops, drift
+
+
+def _payload(args, build, result, nonlinear, stops) -> dict:
+    """The --json record: the case, each channel's NRMSE and largest difference, the stops."""
+    return {
         "wing": build.variant.name, "speed_m_s": args.speed, "gust": args.gust.text(),
         "model": args.model, "mass_basis": build.mass_basis,
         "overrides": dict(build.model.coefficients.overrides),
-        "nrmse": errors, "worst": worst, "stopped": stops, "diverged": diverged,
-        "divergence_time_s": nonlinear.stop_time_s,
+        "nrmse": result.nrmse, "worst": result.worst, "stopped": stops,
+        "diverged": result.diverged, "divergence_time_s": nonlinear.stop_time_s,
         "controller": nonlinear.meta.get("controller"),
         "duration_s": float(nonlinear.time_s[-1]) if len(nonlinear.time_s) else 0.0,
         "plot": args.plot, "out": args.out,
     }
-    if args.json:
-        print_json(payload)
+
+
+def _print_report(args, build, result, nonlinear, full_span) -> None:
+    """The text report: the case, the table of channels (NRMSE, largest difference, unit,
+    time), the section loads, the controller and what was written."""
+    print(f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}, "
+          f"{args.model} model: LTI (Eq. 4) vs nonlinear JSBSim run")
+    if result.diverged:
+        print(f"the nonlinear run diverged at t = {nonlinear.stop_time_s:.3f} s: no "
+              "comparison (NRMSE null); see the reason below")
     else:
-        print(f"{build.variant.name} wing, {args.speed:g} m/s, gust {args.gust.text()}, "
-              f"{args.model} model: LTI (Eq. 4) vs nonlinear JSBSim run")
-        if diverged:
-            print(f"the nonlinear run diverged at t = {nonlinear.stop_time_s:.3f} s: no "
-                  "comparison (NRMSE null); see the reason below")
-        else:
-            width = max(8, *(len(c) for c in channels))  # a controller's command is longer
-            print(f"{'channel':<{width}} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} "
-                  f"{'at t [s]':>9}")
-            for c in channels:
-                unit, scale = DISPLAY_UNITS.get(c, (worst[c]["unit"], 1.0))
-                print(f"{c:<{width}} {errors[c]:9.4f} "
-                      f"{worst[c]['max_abs_difference'] * scale:11.5f} "
-                      f"{unit:<6} {worst[c]['at_time_s']:9.3f}")
-            print(result.loads_table(), end="")  # section loads (drivers/compare.py)
-            line = controller_line(nonlinear)
-            if line:
-                print(f"{line}; the LTI model closes the loop at the run's step, with its "
-                      "one step of delay")
-            if full_span and (args.gust.kind == "none" or args.gust.amplitude_m_s == 0.0):
-                print("no vertical gust: the longitudinal LTI model is not excited (NRMSE 1 "
-                      "on u ... eta1: the run's roll couples into them, the linear models "
-                      "keep the axes apart)")
-            print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
-                  "largest difference and when it occurs")
-        if args.plot:
-            print(f"time histories written to {args.plot}")
-        if args.out:
-            print(f"log written to {args.out}")
-    if stops:
-        for stop in stops:
-            print(f"bioflex-jsb compare: diverged: {stop}", file=sys.stderr)
-        return EXIT_DIVERGED
-    return 0
+        _print_table(result)
+        line = controller_line(nonlinear)
+        if line:
+            print(f"{line}; the LTI model closes the loop at the run's step, with its "
+                  "one step of delay")
+        if full_span and (args.gust.kind == "none" or args.gust.amplitude_m_s == 0.0):
+            print("no vertical gust: the longitudinal LTI model is not excited (NRMSE 1 "
+                  "on u ... eta1: the run's roll couples into them, the linear models "
+                  "keep the axes apart)")
+        print("NRMSE = RMS(LTI - JSBSim) / RMS(JSBSim) over the run; max |diff| the "
+              "largest difference and when it occurs")
+    if args.plot:
+        print(f"time histories written to {args.plot}")
+    if args.out:
+        print(f"log written to {args.out}")
+
+
+def _print_table(result) -> None:
+    """One row per channel, the largest difference in its display unit, then section loads."""
+    channels, errors, worst = result.channels, result.nrmse, result.worst
+    width = max(8, *(len(c) for c in channels))  # a controller's command is longer
+    print(f"{'channel':<{width}} {'NRMSE [-]':>9} {'max |diff|':>11} {'unit':<6} "
+          f"{'at t [s]':>9}")
+    for c in channels:
+        unit, scale = DISPLAY_UNITS.get(c, (worst[c]["unit"], 1.0))
+        print(f"{c:<{width}} {errors[c]:9.4f} "
+              f"{worst[c]['max_abs_difference'] * scale:11.5f} "
+              f"{unit:<6} {worst[c]['at_time_s']:9.3f}")
+    print(result.loads_table(), end="")  # section loads (drivers/compare.py)
