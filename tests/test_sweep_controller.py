@@ -98,3 +98,52 @@ def test_a_case_flies_its_controller_logs_it_and_reruns_with_it(tmp_path):
     plain = run_case(none)
     assert plain["controller"] == "none" and plain["peak_ctrl_elevator_rad"] is None
     assert plain["peak_dn_z"] != row["peak_dn_z"]
+
+
+def test_a_flaperon_controller_fills_its_command_peak(tmp_path):
+    """A case of the shipped elevator-and-flaperon controller: its row's flaperon peak is
+    the run's largest |ctrl_flaperon_rad| (read back from its log), beside the elevator's;
+    the elevator-only controller leaves the flaperon peak empty."""
+    from bioflex_jsb import api
+    from bioflex_jsb.sweep.evaluate import run_case
+
+    text = BASE + 'controllers = ["gla_flaperon_optimised", "gla_optimised"]\n'
+    flap, elevator_only = parse_campaign(tomllib.loads(text)).cases()
+    assert "peak_ctrl_flaperon_rad" in parse_campaign(tomllib.loads(text)).columns()
+    row = run_case(flap, str(tmp_path))
+    assert row["status"] == "ok"
+    back = api.read_log(tmp_path / f"{flap.case_id}.mcap")["coupled"]
+    assert row["peak_ctrl_flaperon_rad"] == pytest.approx(
+        np.abs(back["ctrl_flaperon_rad"]).max(), rel=1e-12)
+    assert row["peak_ctrl_flaperon_rad"] > 1e-4  # rad: the gust moved it
+    assert row["peak_ctrl_elevator_rad"] > 1e-3
+    assert run_case(elevator_only)["peak_ctrl_flaperon_rad"] is None
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_controller_table_written_before_the_flaperon_column_resumes_without_it(
+        tmp_path, suffix):
+    from bioflex_jsb.sweep.store import StoreError, open_store, read_results
+
+    camp = parse_campaign(tomllib.loads(WITH_AXIS))
+    old = {k: v for k, v in camp.columns().items() if k != "peak_ctrl_flaperon_rad"}
+    out = tmp_path / f"old{suffix}"
+    first = camp.cases()[0]
+    store = open_store(out, old, resume=False)
+    store.append({"case_id": first.case_id, "status": "ok"})
+    store.close()
+    store = open_store(out, camp.columns(), resume=True)
+    assert store.done_ids == {first.case_id}
+    store.append({"case_id": "c" * 16, "status": "ok", "peak_ctrl_flaperon_rad": 0.01})
+    store.close()
+    rows = read_results(out)
+    assert {r["case_id"] for r in rows} == {first.case_id, "c" * 16}
+    assert all("peak_ctrl_flaperon_rad" not in r for r in rows)
+    # a table lacking a column that is not a later one is still refused
+    other = {k: v for k, v in camp.columns().items() if k != "peak_ctrl_elevator_rad"}
+    out2 = tmp_path / f"other{suffix}"
+    store = open_store(out2, other, resume=False)
+    store.append({"case_id": first.case_id, "status": "ok"})
+    store.close()
+    with pytest.raises(StoreError, match="other columns than this campaign"):
+        open_store(out2, camp.columns(), resume=True)

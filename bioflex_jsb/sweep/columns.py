@@ -78,7 +78,11 @@ TURBULENCE_COLUMNS: dict[str, str] = dict.fromkeys(RMS_METRICS, "float")
 # what it asked of the surface and the motor, in the tables of campaigns with a controllers
 # axis (empty for a case without a controller or a command it does not write).
 CONTROLLER_COLUMNS: dict[str, str] = {"peak_ctrl_elevator_rad": "float",
-                                      "peak_ctrl_throttle": "float"}
+                                      "peak_ctrl_throttle": "float",
+                                      "peak_ctrl_flaperon_rad": "float"}
+# Columns a table of the same campaign written by an earlier version lacks; such a table is
+# resumed without them (its new rows leave them out, as its earlier rows do).
+LATER_COLUMNS: frozenset[str] = frozenset({*TURBULENCE_COLUMNS, "peak_ctrl_flaperon_rad"})
 # Where and when a case ran: differs between runs of the same case, so comparisons of
 # results tables leave these out (:data:`RUN_INFO_COLUMNS`).
 RUN_INFO_COLUMNS: dict[str, str] = {

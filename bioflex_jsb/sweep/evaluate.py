@@ -293,7 +293,7 @@ def _gust_run(case: Case, build, row: dict[str, Any], log_dir: str | None) -> No
     # else: stopped before the gust arrived, no gust response to summarise (left empty)
     row["time_beyond_stall_s"] = _num(run.meta.get("time_beyond_stall_s"))
     row["time_flown_s"] = float(len(run.time_s) * run.meta["dt_s"])
-    for name in ("ctrl_elevator_rad", "ctrl_throttle"):
+    for name in ("ctrl_elevator_rad", "ctrl_throttle", "ctrl_flaperon_rad"):
         if f"peak_{name}" in row and name in run.channels and len(run[name]):
             row[f"peak_{name}"] = _num(abs(run[name]).max())
     if run.stopped:

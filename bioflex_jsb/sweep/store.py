@@ -148,16 +148,17 @@ def open_store(path: str | Path, columns: dict[str, str], resume: bool):
 
 def _resumed_columns(path: Path, found: list[str], columns: dict[str, str]
                      ) -> dict[str, str]:
-    """The columns to go on writing an existing table with: the campaign's, or the same
-    campaign's table written before the RMS columns of turbulence existed
-    (:data:`~bioflex_jsb.sweep.columns.TURBULENCE_COLUMNS`), which is resumed as it is,
-    without them (its rows then have no RMS values, as its earlier rows); StoreError for
-    any other table."""
-    from bioflex_jsb.sweep.columns import TURBULENCE_COLUMNS
+    """The columns to go on writing an existing table with: the campaign's, or those of the
+    same campaign's table written before some of its columns existed (the RMS columns of
+    turbulence, the flaperon's command peak: :data:`~bioflex_jsb.sweep.columns.LATER_COLUMNS`),
+    which is resumed as it is, without them (its new rows then lack those values, as its
+    earlier rows do); StoreError for any other table."""
+    from bioflex_jsb.sweep.columns import LATER_COLUMNS
 
     if found == list(columns):
         return columns
-    if found == [c for c in columns if c not in TURBULENCE_COLUMNS]:
+    kept = [c for c in columns if c in found]
+    if found == kept and all(c in LATER_COLUMNS for c in columns if c not in found):
         return {c: columns[c] for c in found}
     raise StoreError(f"--out {str(path)!r} has other columns than this campaign (other "
                      "metrics?); choose another --out")
