@@ -286,6 +286,33 @@ def test_the_log_holds_the_flaperon_command(wing, tmp_path):
     assert np.array_equal(back["ctrl_flaperon_rad"], run["ctrl_flaperon_rad"])
     assert back["ctrl_flaperon_rad"].max() == STEP_RAD
     assert "ctrl_elevator_rad" not in back.channels
+    assert back.meta["controller"]["channels"] == ["ctrl_flaperon_rad"]
+    # the surface flown is recorded, so the log's section loads carry the flap's own: the
+    # root bending from the log read back equals the run's (the deflection from the command
+    # one row later, as the runtime flies it)
+    assert back.meta["flaperon"]["surface"] == run.meta["flaperon"]["surface"]
+
+    def bending(r):
+        return api.section_loads(wing, r).values["force_summation"][:, 1, 0]
+
+    assert np.abs(bending(back) - bending(run)).max() < 1e-9  # N·m; measured 0
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("[1", "is not JSON"),
+    ('{"surface": 3}', "no surface with a name"),
+    ('{"surface": {"name": "aileron", "start_m": 0.5, "end_m": 0.2, '
+     '"hinge_chord_fraction": 0.75}}', "start < end"),
+    ('{"surface": {"name": "aileron", "start_m": 0.2, "end_m": 0.5, '
+     '"hinge_chord_fraction": "x"}}', "no surface with a name"),
+])
+def test_a_damaged_flaperon_record_is_one_line(text, needle):
+    from bioflex_jsb.sinks.mcap.history import _flaperon_meta
+    from bioflex_jsb.sinks.mcap_io.errors import LogError
+
+    with pytest.raises(LogError, match=needle) as err:
+        _flaperon_meta(text)
+    assert "\n" not in str(err.value)
 
 
 def test_compiled_step_asked_for_falls_back_aloud(wing):

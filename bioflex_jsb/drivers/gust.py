@@ -311,7 +311,10 @@ class _GustRun:
             if stream is not None and hasattr(recorder, "loads"):
                 self.loads_out = recorder.loads(loads_meta["loads"])
             if step.control is not None and hasattr(recorder, "controller"):
-                self.control_out = recorder.controller(names, controller_meta(step.control))
+                meta = controller_meta(step.control)
+                if step.flaperon is not None:  # its surface: a log's loads need it
+                    meta["flaperon"] = step.flaperon.deriv.as_dict()
+                self.control_out = recorder.controller(names, meta)
             if step.lateral is not None and hasattr(recorder, "lateral"):
                 self.lateral_out = recorder.lateral(names)  # both wing halves
         self.block = min(block, max(self.n_steps, 1))

@@ -32,8 +32,12 @@ COMMAND_FIELDS = {"ctrl_elevator_rad": "elevator_cmd_rad", "ctrl_throttle": "thr
 
 def channel_metadata(model: str, meta: dict) -> dict[str, str]:
     """The controller channel's metadata (strings): the model, the controller's name, kind,
-    signals (JSON list, the order of ``signals``), commands, states and sample time [s]."""
-    return {"model": model, "name": str(meta["name"]), "kind": str(meta["kind"]),
+    signals (JSON list, the order of ``signals``), commands, states and sample time [s], and
+    for a controller that flies flaperons their surface and derivatives (``flaperon``, JSON:
+    :meth:`~bioflex_jsb.aeroelasticity.flaperon.FlaperonDerivatives.as_dict`), which the
+    section loads of the log read back need."""
+    extra = {"flaperon": json.dumps(meta["flaperon"])} if meta.get("flaperon") else {}
+    return {**extra, "model": model, "name": str(meta["name"]), "kind": str(meta["kind"]),
             "signals": json.dumps(list(meta["inputs"])),
             "commands": ",".join(meta["outputs"]),
             "n_states": json.dumps(meta.get("n_states")), "dt_s": json.dumps(meta.get("dt_s")),

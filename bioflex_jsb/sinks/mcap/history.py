@@ -26,7 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
 from bioflex_jsb.simulation.channels import CHANNELS, describe
+from bioflex_jsb.simulation.controller import COMMAND_CHANNELS
 from bioflex_jsb.simulation.results import TimeHistory
 from bioflex_jsb.sinks.mcap.reader import NotOurs, iter_messages, open_reader, read_metadata
 from bioflex_jsb.sinks.mcap.schemas import EVENTS_TOPIC, RIGID_BODY_CHANNELS, RUN_METADATA
@@ -187,6 +189,8 @@ def histories(path: str | Path, *, loads: bool = False, start_s: float | None = 
         control = channel_meta.get(f"/bioflex/{model}/controller")
         if control and not prediction:
             run.meta["controller"] = _controller_meta(control)
+            if "flaperon" in control:  # the surface its flaperon commands moved
+                run.meta["flaperon"] = _flaperon_meta(control["flaperon"])
         if prediction:
             run.meta.update(label=f"LTI {model}", linestyle="--")
         else:
@@ -322,10 +326,28 @@ def _controller_meta(metadata: dict[str, str]) -> dict:
     return {"name": metadata.get("name"), "kind": metadata.get("kind"),
             "inputs": _json(metadata.get("signals"), "controller signals") or [],
             "outputs": outputs,
-            "channels": [{"elevator": "ctrl_elevator_rad", "throttle": "ctrl_throttle"}.get(o, o)
-                         for o in outputs],
+            "channels": [COMMAND_CHANNELS.get(o, o) for o in outputs],
             "n_states": _json(metadata.get("n_states"), "controller n_states"),
             "dt_s": _json(metadata.get("dt_s"), "controller dt_s")}
+
+
+def _flaperon_meta(text: str) -> dict:
+    """A run's ``meta["flaperon"]`` (its ``surface``: span range [m], hinge [chord
+    fraction], name) from the controller channel's metadata; LogError (one line) for one
+    bioflex-jsb does not write."""
+    record = _json(text, "controller flaperon")
+    surface = record.get("surface") if isinstance(record, dict) else None
+    try:
+        if not isinstance(surface, dict) or not isinstance(surface.get("name"), str) or not all(
+                is_finite_real(surface.get(k)) for k in ("start_m", "end_m",
+                                                         "hinge_chord_fraction")):
+            raise ValueError("no surface with a name, span range and hinge")
+        ControlSurface(float(surface["start_m"]), float(surface["end_m"]),
+                       float(surface["hinge_chord_fraction"]), surface["name"])
+    except ValueError as exc:
+        raise LogError(f"the log's controller flaperon is not one bioflex-jsb writes ({exc})"
+                       ) from None
+    return record
 
 
 _FLOAT_META = ("speed_m_s", "duration_s", "gust_start_s", "dt_s")
