@@ -562,7 +562,10 @@ class SitlSim:
             return None
         from bioflex_jsb.simulation.controller import controller_meta
 
-        return controller_meta(self.core.control)
+        meta = controller_meta(self.core.control)
+        if self.core.flaperon is not None:  # its surface: the log's section loads need it
+            meta["flaperon"] = self.core.flaperon.deriv.as_dict()
+        return meta
 
     @property
     def k(self) -> int:
