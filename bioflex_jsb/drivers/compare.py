@@ -248,7 +248,9 @@ def _add_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
     """Add to ``linear`` the rigid lateral model's response (identified from the run's
     airframe at the trim, as ``bioflex-jsb modes --lateral``) to the run's gust roll rate
     p_g and lateral gust v_g: the channels of :data:`LATERAL_CHANNELS` (none when both are
-    zero)."""
+    zero), each the run's absolute value predicted as the trim's (the run's first sample:
+    JSBSim's trim is not exactly wings level, the c172's bank −0.16 mrad) plus the model's
+    increment, as the full-span comparison does (drivers/compare_lateral.py)."""
     from bioflex_jsb.flight_dynamics.lateral import build_lateral_state_space
     from bioflex_jsb.runtime.identification import identify_lateral
     from bioflex_jsb.simulation.spanwise_gusts import lateral_gust_response
@@ -259,7 +261,7 @@ def _add_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
     point = identify_lateral(airframe, speed_m_s, build.airframe.reference)
     ss = build_lateral_state_space(point.trim, point.aero)
     for name, values in lateral_gust_response(ss, nonlinear.time_s, p_g, v_g).items():
-        linear.channels[name] = values
+        linear.channels[name] = values + float(nonlinear[name][0])
         linear.units[name] = "rad/s" if name.endswith("_s") else "rad"
 
 
