@@ -314,7 +314,7 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
         controller = load_controller(controller)
     options = _lateral_options(subject, build, *lateral)
     if "flaperon" in getattr(controller, "outputs", ()) and "aileron" not in options:
-        options["aileron"] = _flaperon_surface(subject, build)  # the half wing's flaperon
+        options["aileron"] = _aileron_surface(subject, build)  # the half wing's flaperon
     airframe = subject.jsbsim_airframe()
     out = {}
     for model in map(str, config.models):
@@ -330,7 +330,7 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
 def _lateral_options(subject, build, span: str, aileron_step_deg, aileron_start_s) -> dict:
     """run_gust's ``span``, ``aileron``, ``aileron_input`` of :func:`fly_gust`'s arguments
     ({} for the half wing without an aileron step)."""
-    from bioflex_jsb.simulation.full_span import AileronInput, prototype_aileron
+    from bioflex_jsb.simulation.full_span import AileronInput
 
     _check_choice("span", span, ("half", "full"))
     options: dict = {}
@@ -340,9 +340,7 @@ def _lateral_options(subject, build, span: str, aileron_step_deg, aileron_start_
                                                 _real(aileron_start_s, "aileron_start_s", "s"))
     if span == "half":
         return options
-    aileron = (subject.aircraft.definition.aileron if subject.aircraft is not None
-               else prototype_aileron(build.variant.name))
-    return {**options, "span": "full", "aileron": aileron}
+    return {**options, "span": "full", "aileron": _aileron_surface(subject, build)}
 
 
 def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
@@ -522,12 +520,13 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
         raise InputError("flaperon=True is the quasi-steady coupled model of an elastic wing")
     from bioflex_jsb.aeroelasticity.flaperon import flaperon_derivatives, with_flaperon
 
-    deriv = flaperon_derivatives(wing, _flaperon_surface(subject, wing))
+    deriv = flaperon_derivatives(wing, _aileron_surface(subject, wing))
     return with_flaperon(ss, condition, deriv, wing.model.generalised_masses_kg_m2)
 
 
-def _flaperon_surface(subject, build):
-    """The aileron a flaperon deflects: the aircraft definition's ``[aileron]``, else the
+def _aileron_surface(subject, build):
+    """The aircraft's aileron (what the full-span strips carry, a flaperon deflects and the
+    lateral model loads the modes with): the aircraft definition's ``[aileron]``, else the
     prototype variant's shipped definition's (None: none)."""
     from bioflex_jsb.simulation.full_span import prototype_aileron
 
@@ -571,6 +570,7 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
     """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`;
     ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None)."""
     from bioflex_jsb.aeroelasticity import antisymmetric as anti
+    from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
     from bioflex_jsb.flight_dynamics.lateral_elastic import (
         LATERAL_MODELS,
         antisymmetric_wing,
@@ -593,7 +593,12 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
     if aero == "unsteady":
         strips = anti.aircraft_strips(subject.build, wing_a, point.trim.ixx_kg_m2)
         return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips), None)
-    return build_lateral_elastic(model, point.trim, point.aero, wing_a), rigid, wing_a
+    # the model compare --span full drives (drivers/compare_lateral.py): the aircraft's
+    # aileron on the strips, its generalised force on the modes
+    surface = _aileron_surface(subject, subject.build)
+    ss, _ = lateral_model_with_aileron(model, point.trim, point.aero, wing_a, surface,
+                                       subject.build.aero.chord_m)
+    return ss, rigid, wing_a
 
 
 def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid",
@@ -611,7 +616,12 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     ``model``: ``rigid`` (default), ``coupled`` (with the wing's antisymmetric modes:
     states eta1.. [rad] and eta1_dot.. [rad/s] after phi, quasi-steady strips;
     :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`) or ``qsd`` (their static
-    deformation residualised; outputs also the quasi-static eta). ``aero``
+    deformation residualised; outputs also the quasi-static eta). In both, the aileron
+    column carries the aircraft's aileron's generalised force on the modes (its
+    ``[aileron]`` on the strips, thin-aerofoil flap lift and moment; qsd: in their static
+    balance) beside JSBSim's rigid C_l_delta_a: the model ``compare --span full`` drives
+    (:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`;
+    ``notes["aileron_on_modes"]``). ``aero``
     ``quasi-steady`` (default) or ``unsteady`` (coupled only: the strips' Jones lag states
     lag1[k], lag2[k] [m/s] and apparent mass on the modes and the roll rate;
     :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
@@ -1132,7 +1142,7 @@ def _gla_plant(wing, speed_m_s, flaperon: bool = False):
     if flaperon:
         from bioflex_jsb.loads.alleviation_flaperon import flaperon_plant
 
-        return build, v, flaperon_plant(build, v, lm, _flaperon_surface(subject, build),
+        return build, v, flaperon_plant(build, v, lm, _aileron_surface(subject, build),
                                         a_rr=lin.a)
     return build, v, gla_plant(build, v, lm, a_rr=lin.a)
 

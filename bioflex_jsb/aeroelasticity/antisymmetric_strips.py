@@ -2,6 +2,9 @@
 what the nonlinear co-simulation's full-span step (:mod:`bioflex_jsb.simulation.full_span`)
 and the linear lateral model with ailerons (:func:`lateral_elastic_with_aileron`) share.
 
+The lateral model of the wing with its aileron, :func:`lateral_model_with_aileron`, is the one
+:func:`bioflex_jsb.api.lateral_model` returns and ``compare --span full`` drives.
+
 The strips, modes and signs are those of :mod:`bioflex_jsb.flight_dynamics.lateral_elastic`
 (:func:`~bioflex_jsb.flight_dynamics.lateral_elastic.strip_terms` divided by Q or Q/V: the
 same arithmetic, tested to 1e-12): the starboard strip at y sees
@@ -55,7 +58,13 @@ from bioflex_jsb.aeroelasticity.control_surface import (
     flap_moment_slope_per_rad,
     strip_coverage,
 )
-from bioflex_jsb.flight_dynamics.lateral_elastic import AntisymmetricWing
+from bioflex_jsb.flight_dynamics.lateral import LateralAerodynamics, LateralTrim
+from bioflex_jsb.flight_dynamics.lateral_elastic import (
+    LATERAL_MODELS,
+    AntisymmetricWing,
+    build_lateral_elastic,
+    residualised,
+)
 from bioflex_jsb.state_space import StateSpace
 
 
@@ -162,9 +171,35 @@ def lateral_elastic_with_aileron(ss: StateSpace, strips: AntisymmetricStrips,
     col = ss.inputs.index("aileron")
     first = ss.states.index("eta1_dot")
     b[first:first + n, col] += -float(dynamic_pressure_pa) * strips.force_delta / strips.mass_kg_m2
-    notes = {**ss.notes, "aileron_on_modes": "thin-aerofoil flap lift and moment on the "
-             "lattice's strips (aeroelasticity/antisymmetric_strips.py)"}
+    notes = {**ss.notes, "aileron_on_modes": (
+        "none: no aileron on the strips" if strips.surface is None else
+        "thin-aerofoil flap lift and moment on the lattice's strips, "
+        f"{strips.surface.start_m:.6g}-{strips.surface.end_m:.6g} m, hinge "
+        f"{strips.surface.hinge:.6g} c (aeroelasticity/antisymmetric_strips.py)")}
     return StateSpace(model=ss.model, speed_m_s=ss.speed_m_s, a=ss.a, b=b, c=ss.c, d=ss.d,
                       states=ss.states, state_units=ss.state_units, inputs=ss.inputs,
                       input_units=ss.input_units, outputs=ss.outputs,
                       output_units=ss.output_units, notes=notes)
+
+
+def lateral_model_with_aileron(model: str, trim: LateralTrim, aero: LateralAerodynamics,
+                               wing: AntisymmetricWing | None, surface: ControlSurface | None,
+                               chord_m: np.ndarray | None
+                               ) -> tuple[StateSpace, AntisymmetricStrips | None]:
+    """(the lateral model, its strips) of ``model`` at ``trim`` with ``aero``'s rigid
+    derivatives: ``rigid`` (:func:`~bioflex_jsb.flight_dynamics.lateral_elastic
+    .build_lateral_elastic`; strips None), ``coupled`` (the antisymmetric modes of ``wing``
+    with ``surface``'s generalised force on them in the aileron column:
+    :func:`lateral_elastic_with_aileron`) or ``qsd`` (that model with its modes
+    residualised, the aileron's load in their static balance:
+    :func:`~bioflex_jsb.flight_dynamics.lateral_elastic.residualised`). ``surface`` None: no
+    aileron on the strips (the aileron drives the rigid rolling moment only); ``chord_m``
+    [m] the strips' chords (the lattice's, ``build.aero.chord_m``). Inputs v_g [m/s],
+    aileron, rudder [rad]."""
+    if model == "rigid" or model not in LATERAL_MODELS or wing is None:
+        # the rigid model, or the one-line refusal of an unknown model or a missing wing
+        return build_lateral_elastic(model, trim, aero, wing), None
+    strips = antisymmetric_strips(wing, surface, chord_m)
+    coupled = lateral_elastic_with_aileron(build_lateral_elastic("coupled", trim, aero, wing),
+                                           strips, trim.dynamic_pressure_pa)
+    return (coupled if model == "coupled" else residualised(coupled)), strips

@@ -4,10 +4,9 @@ linear model: the lateral-directional model of the run's wing model (``rigid``, 
 
 The nonlinear run (:mod:`bioflex_jsb.simulation.full_span`) flies the antisymmetric modes on
 quasi-steady strips with the roll rate, their own η_a, η̇_a, JSBSim's ailerons and the gust
-roll rate p_g; its linear model is the coupled lateral model of the same strips
-(:func:`~bioflex_jsb.flight_dynamics.lateral_elastic.build_lateral_elastic`, with the
-aileron's generalised force on the modes:
-:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_elastic_with_aileron`), its
+roll rate p_g; its linear model is :func:`bioflex_jsb.api.lateral_model`'s, the coupled
+lateral model of the same strips with the aileron's generalised force on the modes (one
+builder: :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`), its
 rigid block identified from the run's JSBSim airframe at the same trim
 (:func:`~bioflex_jsb.runtime.identification.identify_lateral`). Its inputs, each held over
 a step and exactly discretised (zero-order hold, as the run holds them):
@@ -23,7 +22,10 @@ a step and exactly discretised (zero-order hold, as the run holds them):
   to zero; a quasi-static model's η outputs likewise D_pg = −C[η, p];
 * the rudder stays at the trim's (a gust run does not move it).
 
-The compared channels: β, p, r, φ (``beta_rad``, ``p_rad_s``, ``r_rad_s``, ``phi_rad``), the
+The compared channels: β, p, r, φ (``beta_rad``, ``p_rad_s``, ``r_rad_s``, ``phi_rad``: the
+run's absolute values, so the prediction is the trim's, the run's first sample, plus the
+model's increment; JSBSim's trim is not exactly wings level, the prototype's and the c172's
+bank −0.16 mrad, held in calm air), the
 first antisymmetric mode ``asym_eta1`` [rad] and the modes' rolling moment
 ``modal_roll_n_m`` [N·m] = Q Σ R^η_i η_i + (Q/V) Σ R^η̇_i η̇_i at the trim's Q and V (the
 quasi-static model: its η̇ is zero); the rigid model has neither of the last two.
@@ -66,53 +68,19 @@ def full_span_lateral_model(build: WingBuild, airframe: Airframe, model: str,
     """The lateral model (module docstring) of the wing model ``model`` of ``build`` on the
     JSBSim ``airframe`` trimmed at ``speed_m_s`` [m/s], ``altitude_m`` [m]; ``aileron`` the
     run's :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface` (None: none on
-    the strips)."""
-    from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
-        antisymmetric_strips,
-        lateral_elastic_with_aileron,
-    )
-    from bioflex_jsb.flight_dynamics.lateral_elastic import (
-        antisymmetric_wing,
-        build_lateral_elastic,
-    )
+    the strips). The model is :func:`bioflex_jsb.api.lateral_model`'s (one builder:
+    :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`)
+    with the inputs v_g, aileron, p_g."""
+    from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
+    from bioflex_jsb.flight_dynamics.lateral_elastic import antisymmetric_wing
     from bioflex_jsb.runtime.identification import identify_lateral
 
     point = identify_lateral(airframe, speed_m_s, build.airframe.reference, altitude_m)
-    q_pa = point.trim.dynamic_pressure_pa
-    if model == "rigid":
-        ss, strips = build_lateral_elastic("rigid", point.trim, point.aero, None), None
-        return FullSpanLateralModel(_with_gust_roll(ss), None, q_pa, point.trim.speed_m_s)
-    wing_a = antisymmetric_wing(build, point.trim.ixx_kg_m2)
-    strips = antisymmetric_strips(wing_a, aileron, build.aero.chord_m)
-    ss = _with_gust_roll(lateral_elastic_with_aileron(
-        build_lateral_elastic("coupled", point.trim, point.aero, wing_a), strips, q_pa))
-    if model == "qsd":  # the modes' quasi-static balance, the aileron's load and p_g in it
-        ss = quasi_static(ss)
-    return FullSpanLateralModel(ss, strips, q_pa, point.trim.speed_m_s)
-
-
-def quasi_static(ss: StateSpace) -> StateSpace:
-    """The coupled lateral model ``ss`` (states β, p, r, φ, η, η̇) with its modes residualised
-    (η̇ = η̈ = 0: η = −A_ff⁻¹ (A_fr x + B_f u), f = [η, η̇]), as the nonlinear ``qsd`` step
-    balances them each step (``AntisymmetricStrips.quasi_static_eta``: the aileron's load
-    and the gust roll rate in the balance); states β, p, r, φ, outputs those, η_i and n_y.
-    Without the aileron's load it is ``build_lateral_elastic("qsd")`` (tested)."""
-    a, b = np.asarray(ss.a, dtype=float), np.asarray(ss.b, dtype=float)
-    c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
-    r = 4  # β, p, r, φ
-    solve_fr = np.linalg.solve(a[r:, r:], a[r:, :r])  # A_ff⁻¹ A_fr
-    solve_fu = np.linalg.solve(a[r:, r:], b[r:])  # A_ff⁻¹ B_f
-    keep = [i for i, name in enumerate(ss.outputs) if not name.endswith("_dot")]
-    c_q = c[:, :r] - c[:, r:] @ solve_fr
-    d_q = d - c[:, r:] @ solve_fu
-    return StateSpace(model="qsd-lateral", speed_m_s=ss.speed_m_s,
-                      a=a[:r, :r] - a[:r, r:] @ solve_fr, b=b[:r] - a[:r, r:] @ solve_fu,
-                      c=c_q[keep], d=d_q[keep], states=ss.states[:r],
-                      state_units=ss.state_units[:r], inputs=ss.inputs,
-                      input_units=ss.input_units,
-                      outputs=tuple(ss.outputs[i] for i in keep),
-                      output_units=tuple(ss.output_units[i] for i in keep),
-                      notes={**ss.notes, "wing": "antisymmetric modes residualised (QSD)"})
+    wing_a = None if model == "rigid" else antisymmetric_wing(build, point.trim.ixx_kg_m2)
+    ss, strips = lateral_model_with_aileron(model, point.trim, point.aero, wing_a, aileron,
+                                            build.aero.chord_m)
+    return FullSpanLateralModel(_with_gust_roll(ss), strips, point.trim.dynamic_pressure_pa,
+                                point.trim.speed_m_s)
 
 
 def _with_gust_roll(ss: StateSpace) -> StateSpace:
@@ -189,6 +157,9 @@ def add_full_span_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: Wi
     inputs = np.column_stack([flown("v_g"), delta - (delta[0] if delta.size else 0.0),
                               flown("p_g")])
     for name, values in respond(lm, t, inputs).items():
-        linear.channels[name] = values
+        # β, p, r, φ are the run's absolute values, the model's their increments over the
+        # trim: the trim's own (its first sample) added
+        start = float(nonlinear[name][0]) if name in RIGID_CHANNELS and t.size else 0.0
+        linear.channels[name] = start + values
         linear.units[name] = UNITS[name]
     linear.meta["lateral_model"] = f"{lm.ss.model} (drivers/compare_lateral.py)"

@@ -19,7 +19,9 @@ quasi-steady strips, as Eq. (4) couples the symmetric modes to the longitudinal 
   term of Table B1, on the half aircraft whose generalised mass m_i is), with the rigid
   roll rate's lift in it; η̈_i = −ω_i² η_i − 2 ζ_i ω_i η̇_i + Q_i / m_i;
 * left out: the modes' side force and yawing moment (the asymmetric induced drag), the
-  lateral gust's and the surfaces' loads on the modes, unsteady strips.
+  lateral gust's load on the modes, unsteady strips; the aileron's load on the modes is
+  added by :func:`bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`
+  (the model the API and ``compare`` return).
 
 The QSD reduction (η̈ = η̇ = 0, as Eq. 9-10 for the longitudinal model) keeps the states
 β, p, r, φ with the static deformation residualised.
@@ -215,6 +217,32 @@ def build_lateral_elastic(model: str, trim: LateralTrim, aero: LateralAerodynami
                       inputs=LATERAL_INPUTS, input_units=rigid.input_units,
                       outputs=LATERAL_STATES + names + ("n_y",),
                       output_units=LATERAL_STATE_UNITS + ("rad",) * n + ("-",), notes=notes)
+
+
+def residualised(ss: StateSpace) -> StateSpace:
+    """The coupled lateral model ``ss`` (states β, p, r, φ, η, η̇; any inputs) with its modes
+    residualised (η̇ = η̈ = 0: η = −A_ff⁻¹ (A_fr x + B_f u), f = [η, η̇]): the QSD model,
+    states β, p, r, φ, outputs those, the quasi-static η_i and n_y. An input that loads the
+    modes (the aileron's generalised force) enters the balance through B_f; without one it
+    is ``build_lateral_elastic("qsd")`` (tested to round-off)."""
+    if ss.model != "coupled-lateral":
+        raise ValueError(f"residualised takes the coupled lateral model, not {ss.model!r}")
+    a, b = np.asarray(ss.a, dtype=float), np.asarray(ss.b, dtype=float)
+    c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
+    r = len(LATERAL_STATES)
+    solve_fr = np.linalg.solve(a[r:, r:], a[r:, :r])  # A_ff⁻¹ A_fr
+    solve_fu = np.linalg.solve(a[r:, r:], b[r:])  # A_ff⁻¹ B_f
+    keep = [i for i, name in enumerate(ss.outputs) if not name.endswith("_dot")]
+    c_q = c[:, :r] - c[:, r:] @ solve_fr
+    d_q = d - c[:, r:] @ solve_fu
+    return StateSpace(model="qsd-lateral", speed_m_s=ss.speed_m_s,
+                      a=a[:r, :r] - a[:r, r:] @ solve_fr, b=b[:r] - a[:r, r:] @ solve_fu,
+                      c=c_q[keep], d=d_q[keep], states=ss.states[:r],
+                      state_units=ss.state_units[:r], inputs=ss.inputs,
+                      input_units=ss.input_units,
+                      outputs=tuple(ss.outputs[i] for i in keep),
+                      output_units=tuple(ss.output_units[i] for i in keep),
+                      notes={**ss.notes, "wing": "antisymmetric modes residualised (QSD)"})
 
 
 def coupled_mode_set(ss: StateSpace, rigid: StateSpace, wing: AntisymmetricWing) -> ModeSet:
