@@ -72,7 +72,7 @@ def test_zero_controller_is_the_open_loop(wing):
     """The loop closed with a zero gain is the plant (to rounding), delayed or not."""
     _, _, plant = api._gla_plant(wing, V)
     zero = G.static_gain([0.0, 0.0], dt_s=DEFAULT_DT_S)
-    h = api._gla_gradients()
+    h = api._gla_gradients(wing, V)
     ol = G.tuned_peaks(G.open_loop(plant, DEFAULT_DT_S), V, gradients_m=h)
     for delay in (0, 1):
         cl = G.tuned_peaks(close_loop(plant, zero, DEFAULT_DT_S, delay), V, gradients_m=h)
@@ -83,7 +83,7 @@ def test_tuned_gust_nonlinear_gives_the_prediction(wing, gla, prediction):
     """Every gradient up, open and closed: the nonlinear ratios against the LTI's."""
     airframe = Airframe()
     ratios = []
-    for c in G.tuned_cases(V, api._gla_gradients()):
+    for c in G.tuned_cases(V, api._gla_gradients(wing, V)):
         setup = RunConfig(V, parse_gust(c["gust"]), c["duration_s"], c["gust_start_s"],
                           models=("coupled",))
         peaks = [np.abs(_increment(run_gust(airframe, wing.model, "coupled", setup,
