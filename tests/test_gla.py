@@ -68,6 +68,25 @@ def test_shipped_controller_and_its_prediction(gla, prediction):
         pytest.approx(1.042, abs=1e-3)
 
 
+def test_tuned_gradients_are_those_loads_tuned_flies_for_the_aircraft(wing):
+    """The alleviation's tuned gust is the aircraft's own, as ``loads --tuned`` flies it
+    (loads.tuned.gust_scales): the prototype's defaults on its airframe (1.5 c̄ = 0.2745 m
+    to 15 m); c172_elastic's from its chord and rigid short period at its 57.8 m/s cruise
+    (loads/tuned.py: H 2.24..45.9 m), not the prototype's."""
+    from bioflex_jsb.loads.tuned import default_gradients_m, gust_scales
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
+    own = default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)
+    assert np.array_equal(api._gla_gradients(wing, V), own)
+    c172 = api.load_aircraft("c172_elastic")
+    v = api._Subject.of(c172).flight_speed(None)
+    h = api._gla_gradients(c172, v)
+    assert np.array_equal(h, gust_scales(c172.wing(), v, c172.definition.air.density_kg_m3)
+                          .gradients_m())
+    assert h[0] == pytest.approx(1.5 * c172.airframe.mean_chord_m, rel=1e-12)
+    assert (h[0], h[-1]) == pytest.approx((2.24, 45.9), abs=0.01)
+
+
 def test_zero_controller_is_the_open_loop(wing):
     """The loop closed with a zero gain is the plant (to rounding), delayed or not."""
     _, _, plant = api._gla_plant(wing, V)
