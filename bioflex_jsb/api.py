@@ -41,7 +41,7 @@ from bioflex_jsb.aeroelasticity.free_aircraft import (
 )
 from bioflex_jsb.definition import Definition
 from bioflex_jsb.definition import load_definition as _load_definition
-from bioflex_jsb.definition.aircraft import Aircraft
+from bioflex_jsb.definition.aircraft import Aircraft, default_aircraft
 from bioflex_jsb.definition.aircraft import load_aircraft as _load_aircraft
 from bioflex_jsb.definition.clamped import free_speed_range_m_s as _free_speed_range_m_s
 from bioflex_jsb.definition.flying import SHIPPED_AIRCRAFT, flight_refusal, flight_speeds
@@ -70,7 +70,6 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     resolve_variant,
 )
 from bioflex_jsb.inputs import Choice, Interval, Real, argument
-from bioflex_jsb.parameters.airframe import CRUISE_SPEED_M_S, PROTOTYPE_AIRFRAME
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.runtime.jsbsim_aircraft import complete as complete_aircraft
@@ -127,6 +126,19 @@ def load_aircraft(name_or_file: str = "bioflex_optimised") -> Aircraft:
     return complete_aircraft(_load_aircraft(name_or_file))
 
 
+def _prototype_airframe():
+    """The airframe data of the default aircraft, the prototype (the loader's
+    :func:`~bioflex_jsb.definition.aircraft.default_aircraft`): a bare wing's airframe, and
+    the object an analysis' airframe is compared with (``is``) to learn whether it is the
+    prototype's."""
+    return default_aircraft().airframe_data()
+
+
+def _prototype_cruise_m_s() -> float:
+    """The default aircraft's cruise speed [m/s] (the prototype's 15 m/s, Table 1)."""
+    return flight_speeds(default_aircraft())[0]
+
+
 @dataclass(frozen=True)
 class _Subject:
     """What an analysis below is given, read once (:meth:`of`): an :class:`Aircraft` (its
@@ -165,7 +177,7 @@ class _Subject:
         if build is None:
             raise InputError("give a wing (a WingBuild: api.load_wing) or an Aircraft "
                              "(api.load_aircraft) to fly, not None")
-        if self.aircraft is None and build.model.airframe is not PROTOTYPE_AIRFRAME:
+        if self.aircraft is None and build.model.airframe is not _prototype_airframe():
             raise InputError(f"wing {build.variant.name!r} is built for airframe "
                              f"{build.model.airframe.name!r}: a bare wing flies on the "
                              "prototype's airframe only; pass its Aircraft "
@@ -178,7 +190,7 @@ class _Subject:
         flight speeds, default its cruise speed; the prototype's 15 m/s (Table 1) for a bare
         wing."""
         if self.aircraft is None:
-            return CRUISE_SPEED_M_S if speed_m_s is None else speed_m_s
+            return _prototype_cruise_m_s() if speed_m_s is None else speed_m_s
         cruise, (lo, hi) = flight_speeds(self.aircraft)
         v = cruise if speed_m_s is None else _real(speed_m_s, "speed_m_s", "m/s")
         if not lo <= v <= hi:
@@ -211,14 +223,14 @@ class _Subject:
             return _linear_speed(speed_m_s)
         if self.aircraft is not None:
             a = self.aircraft
-            cruise = (CRUISE_SPEED_M_S if a.flight_problem() is None
+            cruise = (_prototype_cruise_m_s() if a.flight_problem() is None
                       else a.airframe.cruise_speed_m_s)
             if cruise is None:
                 raise InputError(f"aircraft {a.name!r} has no airframe.cruise_speed_m_s: "
                                  "give speed_m_s [m/s]")
             return float(cruise)
-        if self.build is None or self.build.model.airframe is PROTOTYPE_AIRFRAME:
-            return CRUISE_SPEED_M_S
+        if self.build is None or self.build.model.airframe is _prototype_airframe():
+            return _prototype_cruise_m_s()
         raise InputError(f"wing {self.build.variant.name!r} is built for airframe "
                          f"{self.build.model.airframe.name!r}: give speed_m_s [m/s] (or pass "
                          "its Aircraft, whose cruise speed is the default)")
@@ -510,7 +522,7 @@ def linear_model(wing: WingBuild | None, speed_m_s: float | None = None,
         if model != "coupled" or wing is None:
             raise InputError("aero='unsteady' is the coupled model of an elastic wing")
         return unsteady_state_space(wing, speed_m_s, gust=True, **air)
-    airframe = PROTOTYPE_AIRFRAME if wing is None else wing.model.airframe
+    airframe = _prototype_airframe() if wing is None else wing.model.airframe
     condition = level_flight_condition(speed_m_s, airframe=airframe, **air)
     ss = build_state_space(model, condition, None if wing is None else wing.model,
                            controls=True)
@@ -539,7 +551,6 @@ def _aileron_surface(subject, build):
 def _lateral_point(wing, speed_m_s: float | None):
     """(the subject, the identified lateral point) of ``wing`` (an Aircraft, a bare
     prototype wing or None): its JSBSim airframe trimmed at the speed [m/s]."""
-    from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
     from bioflex_jsb.runtime.identification import identify_lateral
     from bioflex_jsb.runtime.jsbsim_aircraft import isa_altitude_m
 
@@ -551,8 +562,8 @@ def _lateral_point(wing, speed_m_s: float | None):
             raise InputError(problem)
         reference = subject.aircraft.airframe_data().reference
         altitude = isa_altitude_m(subject.aircraft.definition.air.density_kg_m3)
-    elif subject.build is None or subject.build.model.airframe is PROTOTYPE_AIRFRAME:
-        reference, altitude = REFERENCE_GEOMETRY, 0.0
+    elif subject.build is None or subject.build.model.airframe is _prototype_airframe():
+        reference, altitude = _prototype_airframe().reference, 0.0
     else:
         raise InputError(f"wing {subject.build.variant.name!r} is built for airframe "
                          f"{subject.build.model.airframe.name!r}: pass its Aircraft "
@@ -986,7 +997,7 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
     if isinstance(wing, Aircraft | WingBuild):
         strips, rho, name, settings = _aircraft_roll_strips(wing, aileron, density_kg_m3,
                                                             lift_slope)
-        if isinstance(wing, Aircraft) or wing.airframe is PROTOTYPE_AIRFRAME:
+        if isinstance(wing, Aircraft) or wing.airframe is _prototype_airframe():
             cruise = _Subject.of(wing).flight_speed(None)  # its cruise speed [m/s]
     else:
         strips, rho, name, settings = _clamped_roll_strips(wing, aileron, density_kg_m3,
@@ -1147,15 +1158,17 @@ def _gla_plant(wing, speed_m_s, flaperon: bool = False):
     return build, v, gla_plant(build, v, lm, a_rr=lin.a)
 
 
-def _gla_gradients():
-    """The tuned gust's gradients [m] of the alleviation's prediction and design: the
-    default ones of ``loads --tuned`` on the prototype (1.5 of its chords to 15 m), for every
-    aircraft (another aircraft's own scales, loads.tuned.aircraft_gust_scales, are not used
-    here)."""
-    from bioflex_jsb.loads.tuned import default_gradients_m
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+def _gla_gradients(wing, speed_m_s: float):
+    """The tuned gust's gradients [m] of the alleviation's prediction and design for
+    ``wing`` (a WingBuild or an Aircraft) at ``speed_m_s`` [m/s]: those ``loads --tuned``
+    flies for its aircraft (:func:`bioflex_jsb.loads.tuned.gust_scales`): the prototype's
+    defaults on its airframe (1.5 of its chords to 15 m), another aircraft's own (1.5 of its
+    chords to V·T_sp of its rigid short period at the speed, in its definition's air)."""
+    from bioflex_jsb.loads.tuned import gust_scales
 
-    return default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)
+    subject = _Subject.of(wing)
+    return gust_scales(subject.flying_build(), speed_m_s, **subject.density(None)
+                       ).gradients_m()
 
 
 def predict_alleviation(wing, controller, speed_m_s: float | None = None,
@@ -1173,9 +1186,9 @@ def predict_alleviation(wing, controller, speed_m_s: float | None = None,
 
     controller = linear_controller(controller)
     u_ref = argument(Real("m/s", positive=True), u_ref_m_s, "u_ref_m_s")
-    _, _, plant = _gla_plant(wing, speed_m_s, flaperon="flaperon" in controller.outputs)
-    return predict(plant, controller, _real(dt_s, "dt_s", "s"), gradients_m=_gla_gradients(),
-                   u_ref_m_s=u_ref)
+    _, v, plant = _gla_plant(wing, speed_m_s, flaperon="flaperon" in controller.outputs)
+    return predict(plant, controller, _real(dt_s, "dt_s", "s"),
+                   gradients_m=_gla_gradients(wing, v), u_ref_m_s=u_ref)
 
 
 def design_alleviation(wing, speed_m_s: float | None = None,
@@ -1198,7 +1211,7 @@ def design_alleviation(wing, speed_m_s: float | None = None,
                      "elevator_limit_rad")
     _, v, plant = _gla_plant(wing, speed_m_s)
     ctrl, record = design_output_feedback(plant, _real(dt_s, "dt_s", "s"), signals,
-                                          gradients_m=_gla_gradients(),
+                                          gradients_m=_gla_gradients(wing, v),
                                           u_ref_m_s=_real(u_ref_m_s, "u_ref_m_s", "m/s"),
                                           elevator_limit_rad=limit)
     record["speed_m_s"] = v

@@ -41,7 +41,7 @@ def main() -> None:
     wing = api.load_wing(args.wing)
     _, v, plant = api._gla_plant(wing, args.speed, flaperon=True)
     dt = 1.0 / 960.0
-    gradients = api._gla_gradients()  # the elevator-only design's tuned gradients [m]
+    gradients = api._gla_gradients(wing, v)  # the elevator-only design's tuned gradients [m]
     ctrl, record = design_two_surface(plant, dt, gradients_m=gradients)
     pred = api.predict_alleviation(wing, ctrl, v)
     elev = api.predict_alleviation(wing, "gla_optimised", v)

@@ -253,20 +253,22 @@ def test_rectangular_wing_tends_to_two_pi():
 
 def test_default_planform_converges_with_panel_count():
     spanwise = [
-        ll.solve_spanwise_aerodynamics(n_spanwise=n, n_chordwise=4) for n in (20, 40, 80, 160)
+        ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_spanwise=n, n_chordwise=4)
+        for n in (20, 40, 80, 160)
     ]
     slopes = np.array([a.wing_lift_slope_per_rad for a in spanwise])
     acs = np.array([a.wing_ac_x_m for a in spanwise])
     steps = np.abs(np.diff(slopes))
     assert np.all(np.diff(steps) < 0.0)  # successive refinements change less and less
-    default = ll.solve_spanwise_aerodynamics()
+    default = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM)
     assert default.wing_lift_slope_per_rad == slopes[1]  # default is n = 40, 4 chordwise
     # 0.2 %: measured 0.06 % between 40 and 160 strips (the kink converges like 1/n)
     assert slopes[1] == pytest.approx(slopes[-1], rel=0.002)
     # AC within 0.1 % of the chord (measured 0.02 %)
     assert abs(acs[1] - acs[-1]) < 0.001 * DEFAULT_PLANFORM.chord_m
 
-    chordwise = [ll.solve_spanwise_aerodynamics(n_chordwise=m) for m in (1, 2, 4, 8)]
+    chordwise = [ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_chordwise=m)
+                 for m in (1, 2, 4, 8)]
     c_slopes = np.array([a.wing_lift_slope_per_rad for a in chordwise])
     # 4 → 8 chordwise panels: measured 0.06 %; 1 panel (Weissinger) is 0.5 % low
     assert c_slopes[2] == pytest.approx(c_slopes[3], rel=0.002)
@@ -281,7 +283,7 @@ def test_default_planform_converges_with_panel_count():
 
 
 def test_default_planform_numbers_are_plausible():
-    aero = ll.solve_spanwise_aerodynamics()
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM)
     c = DEFAULT_PLANFORM.chord_m
     s = DEFAULT_PLANFORM.semispan_m
     print(
@@ -325,7 +327,7 @@ def test_default_planform_numbers_are_plausible():
 
 
 def test_default_lattice_has_a_node_on_the_kink_and_consistent_weights():
-    aero = ll.solve_spanwise_aerodynamics()
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM)
     assert DEFAULT_PLANFORM.outer_panel_start_m in aero.edges_m
     s = DEFAULT_PLANFORM.semispan_m
     assert np.sum(aero.weights_m) == pytest.approx(s, rel=1e-14)
@@ -363,7 +365,7 @@ def _full_span_strip_loads(planform, alpha_starboard, antisymmetric, n_spanwise=
 
 @pytest.mark.parametrize("antisymmetric", [False, True])
 def test_influence_matrices_match_a_full_span_solution(antisymmetric):
-    aero = ll.solve_spanwise_aerodynamics(n_spanwise=24, n_chordwise=3)
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_spanwise=24, n_chordwise=3)
     rng = np.random.default_rng(11)
     alpha = rng.normal(size=aero.stations_m.size) * 0.05
     lift, lift_x = _full_span_strip_loads(DEFAULT_PLANFORM, alpha, antisymmetric)
@@ -375,14 +377,14 @@ def test_influence_matrices_match_a_full_span_solution(antisymmetric):
 
 
 def test_uniform_alpha_through_the_influence_matrix_reproduces_the_strips():
-    aero = ll.solve_spanwise_aerodynamics()
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM)
     ones = np.ones_like(aero.stations_m)
     assert np.allclose(aero.lift_per_span_for_alpha(ones), aero.cl_alpha_c_m_per_rad, rtol=1e-12)
     assert np.allclose(aero.centre_of_pressure_x_for_alpha(ones), aero.x_ac_m, rtol=1e-12)
     # Weissinger (1 chordwise panel): the load sits on the quarter-chord line, so the local
     # AC equals the quarter-chord point up to the sweep times the offset between the strip
     # centroid and its station (< 0.05 % c here)
-    w1 = ll.solve_spanwise_aerodynamics(n_chordwise=1)
+    w1 = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_chordwise=1)
     assert np.allclose(w1.x_ac_m, w1.x_quarter_chord_m, atol=5e-4 * DEFAULT_PLANFORM.chord_m)
     # strip theory would give 2π c = 1.150 m/rad everywhere; the lattice is below it
     assert np.all(aero.cl_alpha_c_m_per_rad < TWO_PI * DEFAULT_PLANFORM.chord_m)
@@ -390,7 +392,7 @@ def test_uniform_alpha_through_the_influence_matrix_reproduces_the_strips():
 
 def test_twist_loads_are_not_strip_theory():
     """A linear washout loads the wing differently from strip theory, but lift is linear."""
-    aero = ll.solve_spanwise_aerodynamics()
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM)
     y = aero.stations_m
     twist = -0.05 * y / aero.semispan_m  # tip 0.05 rad nose down [rad]
     lift = aero.lift_per_span_for_alpha(twist)
@@ -402,12 +404,12 @@ def test_twist_loads_are_not_strip_theory():
 
 
 def test_bad_inputs_are_rejected():
-    aero = ll.solve_spanwise_aerodynamics(n_spanwise=10, n_chordwise=1)
+    aero = ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_spanwise=10, n_chordwise=1)
     with pytest.raises(ValueError):
         aero.lift_per_span_for_alpha(np.ones(9))
     with pytest.raises(ValueError):
-        ll.solve_spanwise_aerodynamics(section_lift_slope_per_rad=-1.0)
+        ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, section_lift_slope_per_rad=-1.0)
     with pytest.raises(ValueError):
-        ll.solve_spanwise_aerodynamics(spacing="random")
+        ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, spacing="random")
     with pytest.raises(ValueError):
-        ll.solve_spanwise_aerodynamics(n_chordwise=0)
+        ll.solve_spanwise_aerodynamics(DEFAULT_PLANFORM, n_chordwise=0)

@@ -202,7 +202,7 @@ def test_rendered_coefficients_are_the_parameters():
 
 
 def test_propeller_tables_are_plausible_and_size_the_motor():
-    j, ct, cp = propeller_tables()
+    j, ct, cp = propeller_tables(PROPULSION)
     # static thrust and power coefficients in the range of 12-inch thin-electric propellers
     assert 0.08 < ct[0] < 0.14 and 0.03 < cp[0] < 0.07
     eta = j * ct / np.where(cp > 0, cp, np.nan)
@@ -307,7 +307,7 @@ def test_propulsion_is_a_contra_rotating_pair():
     prop = ET.parse(REPO / "aircraft/bioflex/Engines/bioflex_propeller.xml").getroot()
     ixx = float(prop.findtext("ixx")) / U.SLUG_FT2_PER_KG_M2
     assert ixx == pytest.approx(PROPULSION.rotor_inertia_kg_m2 / 2, rel=1e-8)  # physical
-    _, ct, cp = propeller_tables()
+    _, ct, cp = propeller_tables(PROPULSION)
     for name, full in (("C_THRUST", ct), ("C_POWER", cp)):
         text = prop.find(f"table[@name='{name}']/tableData").text
         half = np.array([float(line.split()[1]) for line in text.strip().splitlines()])

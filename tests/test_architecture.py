@@ -60,14 +60,19 @@ PROTOTYPE_MODULES = ("airframe", "airframe_consistent", "prototype", "wing", "wi
 # Where the prototype's parameter constants may be read: the parameters themselves and the
 # loader that builds the aircraft from them (bioflex_jsb.definition), and the modules whose
 # subject is the prototype itself: the generators writing its JSBSim files, the paper's
-# named wing variants (flight_dynamics.wing_model), the published-number checks
-# (validation) and the comparison of the paper's and the consistent parameter sets.
+# named wing variants (flight_dynamics.wing_model), the prototype's membrane beam and its
+# calibration to Table 2's frequencies and generalised masses (structures.wing_model), the
+# paper's Section 5 gust case (15 m/s, 3 m/s) flown by the native export
+# (drivers.native), the published-number checks (validation) and the comparison of the
+# paper's and the consistent parameter sets.
 ALLOWED_READERS = (
     "bioflex_jsb.parameters",
     "bioflex_jsb.definition",
     "bioflex_jsb.generators.airframe",
     "bioflex_jsb.generators.native_aircraft",
     "bioflex_jsb.flight_dynamics.wing_model",
+    "bioflex_jsb.structures.wing_model",
+    "bioflex_jsb.drivers.native",
     "bioflex_jsb.flight_dynamics.consistent_aircraft",
     "bioflex_jsb.validation",
 )
@@ -75,23 +80,8 @@ ALLOWED_READERS = (
 # default aircraft of a call made without one). The list only shrinks: a module that stops
 # reading them must leave it (second assertion).
 NOT_YET_MOVED = {
-    "bioflex_jsb.aerodynamics.airframe_polars": "default post-stall model and derivatives",
-    "bioflex_jsb.aerodynamics.propeller": "the prototype's propeller tables",
-    "bioflex_jsb.aerodynamics.vortex_lattice": "default planform",
-    "bioflex_jsb.aeroelasticity.parameter_set": "the prototype's parameter sweep",
-    "bioflex_jsb.api": "the prototype as the API's default aircraft",
-    "bioflex_jsb.cli.export_jsbsim": "the prototype's speed range",
-    "bioflex_jsb.cli.linearize": "the prototype as the default aircraft",
-    "bioflex_jsb.cli.loads": "the prototype as the default aircraft",
-    "bioflex_jsb.cli.speed_option": "the prototype's speed range",
-    "bioflex_jsb.drivers.native": "the paper's Section 5 case",
-    "bioflex_jsb.generators.native_wing": "default export speed and speed range",
     "bioflex_jsb.runtime.coupled_step": "the prototype as the airframe of a native-wing run",
     "bioflex_jsb.runtime.trim": "the prototype's drive for the trim companion's spin-up",
-    "bioflex_jsb.simulation.gusts": "default reference chord",
-    "bioflex_jsb.simulation.limits": "the prototype's post-stall limits",
-    "bioflex_jsb.sinks.mcap.scene": "the prototype's drawn geometry",
-    "bioflex_jsb.structures.wing_model": "the prototype's membrane beam",
 }
 
 

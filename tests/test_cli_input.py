@@ -26,7 +26,6 @@ from bioflex_jsb.cli.common import LOG_DIR_ENV_VAR, UsageError, log_path
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 from bioflex_jsb.simulation.gusts import (
-    MIN_GUST_LENGTH_M,
     MIN_GUST_STEPS,
     GustField,
     GustSpecError,
@@ -203,7 +202,11 @@ def test_a_nanometre_gust_and_absurd_gusts_are_refused(capsys):
                          ("vonkarman:1:1e9", "too long"), ("1cos:3:-5", "length must be > 0")]:
         with pytest.raises(GustSpecError, match=needle):
             parse_gust(spec)
-    assert parse_gust(f"1cos:3:{MIN_GUST_LENGTH_M}").length_m == MIN_GUST_LENGTH_M
+    # without an aircraft the shortest gust is one mean chord of the prototype (Table 1)
+    chord_m = PROTOTYPE_AIRFRAME.reference.mean_chord_m
+    assert parse_gust(f"1cos:3:{chord_m}").length_m == chord_m
+    with pytest.raises(GustSpecError, match="shorter than one mean chord"):
+        parse_gust(f"1cos:3:{0.999 * chord_m}")
 
 
 def test_a_gust_shorter_than_ten_steps_is_refused_and_ten_steps_sample_its_peak(capsys):
@@ -514,7 +517,8 @@ def _valid(value) -> bool:
     if isinstance(value, GustSpec):
         return (abs(value.amplitude_m_s) <= MAX_GUST_M_S and _valid(value.length_m)
                 and (value.kind in ("none", "sharp")
-                     or MIN_GUST_LENGTH_M <= value.length_m <= MAX_GUST_LENGTH_M))
+                     or PROTOTYPE_AIRFRAME.reference.mean_chord_m <= value.length_m
+                     <= MAX_GUST_LENGTH_M))
     return True
 
 

@@ -327,6 +327,24 @@ def test_shipped_airframe_is_the_prototype_parameter_set(variant):
     assert aircraft.rigid_aerodynamics() == RIGID_AERODYNAMICS
 
 
+def test_default_aircraft_is_the_prototype_loaded_once():
+    """A call made without an aircraft gets the prototype from the loader's one function:
+    its airframe data is the prototype's own object (what the analyses compare with), its
+    flight speeds Table 1's 15 m/s cruise and 5-40 m/s, and it is loaded once."""
+    from bioflex_jsb.definition.aircraft import DEFAULT_AIRCRAFT, default_aircraft
+    from bioflex_jsb.definition.flying import flight_speeds
+    from bioflex_jsb.parameters.airframe import (
+        AIRSPEED_RANGE_M_S,
+        CRUISE_SPEED_M_S,
+        PROTOTYPE_AIRFRAME,
+    )
+
+    aircraft = default_aircraft()
+    assert aircraft is default_aircraft() and aircraft.name == DEFAULT_AIRCRAFT
+    assert aircraft.airframe_data() is PROTOTYPE_AIRFRAME
+    assert flight_speeds(aircraft) == (CRUISE_SPEED_M_S, AIRSPEED_RANGE_M_S)
+
+
 def test_beam_wing_on_an_airframe_is_analysed_clamped_and_flies_as_modes(tmp_path):
     # a beam wing on an airframe: its modes are the flight model's (tests/
     # test_beam_wing_flight.py), and the same wing is still analysed clamped

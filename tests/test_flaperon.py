@@ -401,7 +401,7 @@ def test_two_surface_tuned_gust_nonlinear_gives_the_prediction(wing, gla_both):
     peaks, flap = [], []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FlaperonStepWarning)
-        for c in G.tuned_cases(V, api._gla_gradients()):
+        for c in G.tuned_cases(V, api._gla_gradients(wing, V)):
             setup = RunConfig(V, parse_gust(c["gust"]), c["duration_s"], c["gust_start_s"],
                               models=("coupled",))
             row = []

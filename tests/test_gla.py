@@ -68,11 +68,30 @@ def test_shipped_controller_and_its_prediction(gla, prediction):
         pytest.approx(1.042, abs=1e-3)
 
 
+def test_tuned_gradients_are_those_loads_tuned_flies_for_the_aircraft(wing):
+    """The alleviation's tuned gust is the aircraft's own, as ``loads --tuned`` flies it
+    (loads.tuned.gust_scales): the prototype's defaults on its airframe (1.5 c̄ = 0.2745 m
+    to 15 m); c172_elastic's from its chord and rigid short period at its 57.8 m/s cruise
+    (loads/tuned.py: H 2.24..45.9 m), not the prototype's."""
+    from bioflex_jsb.loads.tuned import default_gradients_m, gust_scales
+    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+
+    own = default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)
+    assert np.array_equal(api._gla_gradients(wing, V), own)
+    c172 = api.load_aircraft("c172_elastic")
+    v = api._Subject.of(c172).flight_speed(None)
+    h = api._gla_gradients(c172, v)
+    assert np.array_equal(h, gust_scales(c172.wing(), v, c172.definition.air.density_kg_m3)
+                          .gradients_m())
+    assert h[0] == pytest.approx(1.5 * c172.airframe.mean_chord_m, rel=1e-12)
+    assert (h[0], h[-1]) == pytest.approx((2.24, 45.9), abs=0.01)
+
+
 def test_zero_controller_is_the_open_loop(wing):
     """The loop closed with a zero gain is the plant (to rounding), delayed or not."""
     _, _, plant = api._gla_plant(wing, V)
     zero = G.static_gain([0.0, 0.0], dt_s=DEFAULT_DT_S)
-    h = api._gla_gradients()
+    h = api._gla_gradients(wing, V)
     ol = G.tuned_peaks(G.open_loop(plant, DEFAULT_DT_S), V, gradients_m=h)
     for delay in (0, 1):
         cl = G.tuned_peaks(close_loop(plant, zero, DEFAULT_DT_S, delay), V, gradients_m=h)
@@ -83,7 +102,7 @@ def test_tuned_gust_nonlinear_gives_the_prediction(wing, gla, prediction):
     """Every gradient up, open and closed: the nonlinear ratios against the LTI's."""
     airframe = Airframe()
     ratios = []
-    for c in G.tuned_cases(V, api._gla_gradients()):
+    for c in G.tuned_cases(V, api._gla_gradients(wing, V)):
         setup = RunConfig(V, parse_gust(c["gust"]), c["duration_s"], c["gust_start_s"],
                           models=("coupled",))
         peaks = [np.abs(_increment(run_gust(airframe, wing.model, "coupled", setup,

@@ -1,7 +1,8 @@
 """Lift and drag polars of the rigid airframe over the whole α range (wing and body, δe = 0).
 
-The coefficients are :data:`~bioflex_jsb.parameters.airframe.RIGID_AERODYNAMICS`; the
-post-stall shape is :data:`~bioflex_jsb.parameters.airframe.POST_STALL`:
+The coefficients are the airframe's :class:`~bioflex_jsb.parameters.airframe.RigidAerodynamics`
+and the post-stall shape its :class:`~bioflex_jsb.parameters.airframe.PostStall` (the
+prototype's, passed in by the generator of its JSBSim files):
 
 * lift C_L(α): linear, C_L0 + C_Lα·α, from ``alpha_negative_stall_rad`` (−10°) to
   ``alpha_stall_rad`` (11°), rounded over by a parabola to ``cl_max`` (at
@@ -19,18 +20,13 @@ import math
 
 import numpy as np
 
-from bioflex_jsb.parameters.airframe import (
-    POST_STALL,
-    RIGID_AERODYNAMICS,
-    PostStall,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import PostStall, RigidAerodynamics
 
 
 def lift_curve(
     alpha_rad: np.ndarray,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    stall: PostStall = POST_STALL,
+    aero: RigidAerodynamics,
+    stall: PostStall,
 ) -> np.ndarray:
     """Wing-body lift coefficient C_L(α) at δe = 0 [-] (see :class:`PostStall`)."""
     a = np.asarray(alpha_rad, dtype=float)
@@ -70,7 +66,7 @@ def lift_curve(
     return out
 
 
-def alpha_peak_rad(aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> float:
+def alpha_peak_rad(aero: RigidAerodynamics) -> float:
     """α of the lift peak C_L,max [rad] (end of the round-over parabola)."""
     cl_edge = aero.cl0 + aero.cl_alpha_per_rad * aero.alpha_stall_rad
     return aero.alpha_stall_rad + 2.0 * (aero.cl_max - cl_edge) / aero.cl_alpha_per_rad
@@ -78,8 +74,8 @@ def alpha_peak_rad(aero: RigidAerodynamics = RIGID_AERODYNAMICS) -> float:
 
 def separated_drag(
     alpha_rad: np.ndarray,
-    aero: RigidAerodynamics = RIGID_AERODYNAMICS,
-    stall: PostStall = POST_STALL,
+    aero: RigidAerodynamics,
+    stall: PostStall,
 ) -> np.ndarray:
     """Separated-flow drag increment ΔC_D(α) [-], zero inside the linear range."""
     a = np.asarray(alpha_rad, dtype=float)

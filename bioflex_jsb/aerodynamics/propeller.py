@@ -1,9 +1,10 @@
 """The fixed-pitch propeller of the airframe: C_T(J), C_P(J) by blade-element momentum theory.
 
-The blade (diameter, pitch, chord stations, section polar) is
-:data:`~bioflex_jsb.parameters.airframe.PROPULSION`; the JSBSim airframe generator
-(:mod:`bioflex_jsb.generators.airframe`) tabulates :func:`propeller_tables` per rotor, the
-runtime finds the windmilling advance ratio from them.
+The blade (diameter, pitch, chord stations, section polar) is the drive's
+:class:`~bioflex_jsb.parameters.airframe.Propulsion` (an airframe's ``propulsion``, passed
+in); the JSBSim airframe generator (:mod:`bioflex_jsb.generators.airframe`) tabulates
+:func:`propeller_tables` per rotor, the LTI model trims its drive on them
+(:mod:`bioflex_jsb.flight_dynamics.lti`).
 """
 
 from __future__ import annotations
@@ -12,21 +13,14 @@ import math
 
 import numpy as np
 
-from bioflex_jsb.parameters.airframe import PROPULSION, Propulsion
+from bioflex_jsb.parameters.airframe import Propulsion
 
 PROPELLER_TABLE_ROWS = 27  # J stations of the C_T, C_P tables (ΔJ = 0.05 up to J = 1.3)
 PROPELLER_BLADE_STATIONS = 40  # blade-element annuli of the momentum calculation
 
 
-def has_tables(prop: Propulsion) -> bool:
-    """Whether :func:`propeller_tables` holds ``prop``'s propeller: the prototype's drive
-    (:data:`~bioflex_jsb.parameters.airframe.PROPULSION`, its blade); another drive's blade is
-    not modelled."""
-    return prop is PROPULSION
-
-
 def propeller_coefficients(
-    advance_ratio: float, prop: Propulsion = PROPULSION, stations: int = PROPELLER_BLADE_STATIONS
+    advance_ratio: float, prop: Propulsion, stations: int = PROPELLER_BLADE_STATIONS
 ) -> tuple[float, float]:
     """Thrust and power coefficients (C_T = T/(ρn²D⁴), C_P = P/(ρn³D⁵)) at J = V/(nD).
 
@@ -71,8 +65,9 @@ def propeller_coefficients(
     return thrust / (rho * n_rev_s**2 * d**4), omega * torque / (rho * n_rev_s**3 * d**5)
 
 
-def propeller_tables(prop: Propulsion = PROPULSION) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(J, C_T, C_P) on ``PROPELLER_TABLE_ROWS`` stations from 0 to ``advance_ratio_max``."""
+def propeller_tables(prop: Propulsion) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(J, C_T, C_P) of the drive ``prop`` on ``PROPELLER_TABLE_ROWS`` stations from 0 to its
+    ``advance_ratio_max``."""
     j = np.linspace(0.0, prop.advance_ratio_max, PROPELLER_TABLE_ROWS)
     ct, cp = zip(*(propeller_coefficients(float(x), prop) for x in j), strict=True)
     return j, np.array(ct), np.array(cp)

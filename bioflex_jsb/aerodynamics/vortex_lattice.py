@@ -46,13 +46,11 @@ from typing import Protocol
 
 import numpy as np
 
-from bioflex_jsb.parameters.wing import DEFAULT_PLANFORM
-
 TWO_PI = 2.0 * math.pi
 """Thin-aerofoil lift slope of a flat or cambered thin plate [1/rad] (the default a_0)."""
 
 # Defaults from the convergence study (docs/aerodynamics.md, tests): with 40 strips and 4
-# chordwise panels the default planform's C_Lα is within 0.05 % of the 160 × 8 lattice and
+# chordwise panels the prototype's planform's C_Lα is within 0.05 % of the 160 × 8 lattice and
 # its aerodynamic centre within 0.01 % of the chord; the solve takes a few hundredths of a
 # second.
 DEFAULT_N_SPANWISE = 40
@@ -448,7 +446,7 @@ def _horseshoe_velocity(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.
 
 
 def solve_spanwise_aerodynamics(
-    planform: PlanformLike = DEFAULT_PLANFORM,
+    planform: PlanformLike,
     *,
     n_spanwise: int = DEFAULT_N_SPANWISE,
     n_chordwise: int = DEFAULT_N_CHORDWISE,

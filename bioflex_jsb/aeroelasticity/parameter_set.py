@@ -2,8 +2,9 @@
 geometry-consistent one, parameters/airframe_consistent.py).
 
 :mod:`bioflex_jsb.aeroelasticity.free_aircraft` assembles its descriptor system with the
-default rigid aerodynamics and planform. The rigid set enters that system in exactly three
-places, so it can be exchanged afterwards without touching the strips:
+rigid aerodynamics of the wing's airframe and its planform. The rigid set enters that
+system in exactly three places, so it can be exchanged afterwards without touching the
+strips:
 
 * the quasi-steady Eq. (4) block (``base.a``, the top-left 4+2n square of A, and ``base.b``);
 * M_ẇ in the strips' pitch rows: q̇ gets M_ẇ·ΔZ/m, and ΔZ/m = u₀ × (the strips' α̇ row),
@@ -24,12 +25,7 @@ import numpy as np
 from bioflex_jsb.aeroelasticity import free_aircraft as fa
 from bioflex_jsb.flight_dynamics.lti import StateSpace, build_state_space
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition, rigid_derivatives
-from bioflex_jsb.parameters.airframe import (
-    PROTOTYPE_AIRFRAME,
-    REFERENCE_GEOMETRY,
-    RIGID_AERODYNAMICS,
-    RigidAerodynamics,
-)
+from bioflex_jsb.parameters.airframe import RigidAerodynamics
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.parameters.wing import Planform
 
@@ -38,23 +34,24 @@ def unsteady_state_space_with(build, speed_m_s: float, aero: RigidAerodynamics,
                               planform: Planform, *, structural_damping: float | None = None,
                               density_kg_m3: float = SEA_LEVEL_DENSITY_KG_M3) -> StateSpace:
     """:func:`free_aircraft.unsteady_state_space` (paper's gust input) with the rigid set
-    ``aero`` and the CG of ``planform``; ``build`` must be built on ``planform``."""
+    ``aero`` in place of the set of the airframe ``build`` was built for (its S, c̄, mass
+    kept) and the CG of ``planform``; ``build`` must be built on ``planform``."""
     v = float(speed_m_s)
     geometry = fa.strip_geometry(build, planform)
     d = fa.unsteady_descriptor(build, v, structural_damping=structural_damping,
                                density_kg_m3=density_kg_m3, geometry=geometry)
     model = fa.with_damping(build, structural_damping)
-    cond = level_flight_condition(v, density_kg_m3, airframe=PROTOTYPE_AIRFRAME)
+    airframe = model.airframe  # the descriptor's: its rigid set is the one exchanged
+    cond = level_flight_condition(v, density_kg_m3, airframe=airframe)
     new_base = build_state_space("coupled", level_flight_condition(v, density_kg_m3, aero,
-                                                                   airframe=PROTOTYPE_AIRFRAME),
+                                                                   airframe=airframe),
                                  model, aero)
     n0 = d.base.n_states
     a, e, b = d.a.copy(), d.e.copy(), d.b.copy()
     strips_a = a.copy()
     strips_a[:n0, :n0] -= d.base.a  # what the strips add on x
     strips_e = np.eye(e.shape[0]) - e  # what the strips add on ẋ (apparent mass)
-    d_m_wdot = (rigid_derivatives(cond, aero).m_wdot
-                - rigid_derivatives(cond, RIGID_AERODYNAMICS).m_wdot)
+    d_m_wdot = rigid_derivatives(cond, aero).m_wdot - rigid_derivatives(cond).m_wdot
     ia, iq = 1, 2
     a[:n0, :n0] += new_base.a - d.base.a
     a[iq] += d_m_wdot * v * strips_a[ia]
@@ -94,7 +91,7 @@ def unsteady_flutter_with(build, aero: RigidAerodynamics, planform: Planform, *,
         ref.eigenvalues[0], ref.labels, rest_label="lag", excluded=fa.EXCLUDED,
         rigid_labels=eigen.RIGID_LABELS,
         natural_frequencies_rad_s=tuple(float(w) for w in model.frequencies_rad_s),
-        reference_semichord_m=REFERENCE_GEOMETRY.mean_chord_m / 2.0, aero="unsteady",
+        reference_semichord_m=model.airframe.reference.mean_chord_m / 2.0, aero="unsteady",
         name=build.variant.name)
     return engine.first_instability(
         fam, engine.default_grid((lo, hi), step_m_s, start), (lo, hi), tol_m_s=tol_m_s,

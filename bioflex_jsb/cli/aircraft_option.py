@@ -157,6 +157,16 @@ def resolve_flight(args: argparse.Namespace) -> None:
             raise UsageError(f"--gust: {exc} (aircraft {aircraft.name!r})") from None
 
 
+def default_airframe():
+    """The airframe data (an ``AirframeData``) of the default aircraft, the prototype
+    (definition/aircraft.py default_aircraft): what a command without ``--aircraft``
+    analyses, and the object an analysis' airframe is compared with (``is``) to learn
+    whether it is the prototype's."""
+    from bioflex_jsb.definition.aircraft import default_aircraft
+
+    return default_aircraft().airframe_data()
+
+
 def airframe_from_args(args: argparse.Namespace):
     """The JSBSim airframe of ``--aircraft`` (its own aircraft; the generated prototype
     without the option): runtime/jsbsim_aircraft.py ``airframe_for``."""

@@ -11,6 +11,8 @@ from bioflex_jsb.cli.case import (
     DEFAULT_GUST,
     DEFAULT_SPEED_M_S,
     DEFAULT_WING,
+    SPEED_MAX_M_S,
+    SPEED_MIN_M_S,
     add_force_argument,
     airspeed,
     check_time_step,
@@ -26,7 +28,6 @@ from bioflex_jsb.cli.common import (
     wing_from_args,
 )
 from bioflex_jsb.files import read_input_bytes
-from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S
 
 HELP = f"""Write a JSBSim root under --out DIR: systems/bioflex_modal_<wing>.xml (the modal wing
 integrated by JSBSim: each mode's structure exact, the aerodynamic coupling as a leapfrog kick),
@@ -41,8 +42,8 @@ taken relative to DIR by JSBSim, not to the working directory, and must exist: e
 writes nothing and exits 0. The system holds for one time step, --dt [s] (default 1/960 s; a
 step at which the integration's eigenvalues are more than 1 % off the exact ones up to 40 m/s
 is refused, naming a halved step that is not); the trim lift coefficient and the reference
-flow of the exact part are those of level flight at --speed, {AIRSPEED_RANGE_M_S[0]:g} to
-{AIRSPEED_RANGE_M_S[1]:g} m/s (the airframe trims at about 9.4 to 32.7 m/s: outside, the export
+flow of the exact part are those of level flight at --speed, {SPEED_MIN_M_S:g} to
+{SPEED_MAX_M_S:g} m/s (the airframe trims at about 9.4 to 32.7 m/s: outside, the export
 refuses with the trim's reason). For `--model qsd` the names end in _qsd. --aircraft NAME|FILE
 exports a definition's wing with its values (S, c-bar, mass, derivatives, modes): on the
 generated airframe as --wing does; on a JSBSim aircraft file (e.g. sgs_elastic: the jsbsim

@@ -126,14 +126,14 @@ def _airframe(args: argparse.Namespace):
 
     aircraft = aircraft_definition(args)
     if aircraft is None:
-        from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+        from bioflex_jsb.cli.aircraft_option import default_airframe
         from bioflex_jsb.runtime.fdm import DEFAULT_AIRCRAFT
 
         airframe = load_airframe(args)
         args.speed = float(args.speed)
         name = airframe.aircraft
         prototype = name == DEFAULT_AIRCRAFT or name.startswith(DEFAULT_AIRCRAFT + "_")
-        return airframe, PROTOTYPE_AIRFRAME if prototype else None
+        return airframe, default_airframe() if prototype else None
     airframe = definition_airframe(args, aircraft)
     return airframe, (None if aircraft.linear_problem() else aircraft.airframe_data())
 

@@ -101,9 +101,9 @@ def gradients(text: str) -> tuple[float, ...]:
     import numpy as np
 
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.simulation.gusts import MAX_GUST_LENGTH_M, MIN_GUST_LENGTH_M
+    from bioflex_jsb.simulation.gusts import MAX_GUST_LENGTH_M, default_min_gust_length_m
 
-    lo_h, hi_h = MIN_GUST_LENGTH_M / 2.0, MAX_GUST_LENGTH_M / 2.0
+    lo_h, hi_h = default_min_gust_length_m() / 2.0, MAX_GUST_LENGTH_M / 2.0
     try:
         if ":" in text:
             parts = text.split(":")
@@ -141,10 +141,10 @@ def sigma_list(text: str) -> tuple[float, ...]:
 
 
 def register(sub) -> None:
+    from bioflex_jsb.cli.aircraft_option import default_airframe
     from bioflex_jsb.loads.tuned import DEFAULT_H_MAX_M, DEFAULT_N_LENGTHS, default_gradients_m
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
 
-    h_min = default_gradients_m(PROTOTYPE_AIRFRAME.reference.mean_chord_m)[0]
+    h_min = default_gradients_m(default_airframe().reference.mean_chord_m)[0]
     text = HELP.format(h_min=h_min, h_max=DEFAULT_H_MAX_M,
                        n=DEFAULT_N_LENGTHS)
     p = sub.add_parser("loads", help="wing section loads in a gust; --tuned: critical 1-cos "
@@ -404,22 +404,16 @@ def _gust_scales(args, build):
     loads.tuned.aircraft_gust_scales); given --gradients must be gusts of at least one of its
     chords (2H >= c̄)."""
     from bioflex_jsb.errors import InputError
-    from bioflex_jsb.flight_dynamics.eigen import modes_at
-    from bioflex_jsb.loads.tuned import aircraft_gust_scales, default_scales
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+    from bioflex_jsb.loads.tuned import gust_scales
 
     chord_m = build.model.airframe.reference.mean_chord_m
     if args.gradients is not None and min(args.gradients) * 2.0 < chord_m:
         raise InputError(f"--gradients: H {min(args.gradients):g} m is a gust shorter than "
                          f"the aircraft's mean chord {chord_m:.3g} m; each H must be at least "
                          f"{chord_m / 2.0:.3g} m")
-    if build.airframe is PROTOTYPE_AIRFRAME:
-        return default_scales(chord_m)
     aircraft = getattr(args, "aircraft_definition", None)
-    density = {} if aircraft is None else {
-        "density_kg_m3": float(aircraft.definition.air.density_kg_m3)}
-    sp = modes_at("rigid", [args.speed], build.model, **density)[0].get("short_period")
-    return aircraft_gust_scales(chord_m, args.speed, sp.frequency_rad_s)
+    density = None if aircraft is None else float(aircraft.definition.air.density_kg_m3)
+    return gust_scales(build, args.speed, density)
 
 
 def _fly_tuned(args, build, cases: list[dict]) -> list[dict]:
@@ -488,10 +482,10 @@ def _default_sigmas(args, build, lin, airframe) -> tuple[float, ...]:
     the small one and the largest whose SIGMA_TABLE_MARGIN-sigma angle of attack w/V from
     the trim stays inside the airframe's tables (rounded down to 0.1 m/s; c172p at 57.8 m/s:
     α -0.42 deg, tables from -5.16 deg: 1.1 m/s)."""
-    from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+    from bioflex_jsb.cli.aircraft_option import default_airframe
 
     small, large = FREQUENCY_OPTIONS["sigmas"]
-    if build.airframe is PROTOTYPE_AIRFRAME:
+    if build.airframe is default_airframe():
         return (small, large)
     lo, hi = airframe.alpha_table_range_rad
     margin_rad = min(lin.trim.alpha_rad - lo, hi - lin.trim.alpha_rad)

@@ -1,7 +1,7 @@
 """``--speed``: an airspeed [m/s] typed on the command line and its range, the aircraft's
-own (the prototype's 5-40 m/s, an aircraft definition's flight speeds), checked once the
-whole command line is read (:func:`check_speed`; the prototype's range's reason is
-:data:`~bioflex_jsb.parameters.airframe.AIRSPEED_RANGE_M_S`'s)."""
+own (an aircraft definition's flight speeds; without ``--aircraft`` the default aircraft's,
+the prototype's 5-40 m/s: definition/flying.py flight_speeds), checked once the whole
+command line is read (:func:`check_speed`)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,12 @@ import argparse
 import math
 
 from bioflex_jsb.cli.usage import UsageError
-from bioflex_jsb.parameters.airframe import AIRSPEED_RANGE_M_S
+from bioflex_jsb.definition.aircraft import default_aircraft
+from bioflex_jsb.definition.flying import flight_speeds
 
-DEFAULT_SPEED_M_S = 15.0  # the paper's Fig. 21 case (Table 1's cruise)
-SPEED_MIN_M_S, SPEED_MAX_M_S = AIRSPEED_RANGE_M_S
+# The default aircraft's cruise speed and flight speeds [m/s] (the prototype's: Table 1's
+# 15 m/s cruise, the paper's Fig. 21 case; 5-40 m/s)
+DEFAULT_SPEED_M_S, (SPEED_MIN_M_S, SPEED_MAX_M_S) = flight_speeds(default_aircraft())
 # The linear analyses (modes, export) of an aircraft definition take any speed from 1 m/s to
 # the end of the incompressible airframe model (definition/airframe.py FLIGHT_SPEED_MAX_M_S):
 # the linear model exists below the stall and above the fastest trim (root loci scan it).

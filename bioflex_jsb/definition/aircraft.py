@@ -33,6 +33,7 @@ model holds the prototype's numbers), never flown with them in its place.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from pathlib import Path
 
@@ -423,3 +424,18 @@ def load_aircraft(name_or_file: str | Path) -> Aircraft:
     """A shipped aircraft by name (``bioflex_<variant>``) or a definition file with an
     ``[airframe]`` (docs/aircraft.md)."""
     return Aircraft(load_definition(name_or_file))
+
+
+# The aircraft of a call made without one: the prototype with the optimised wing (the paper's
+# Fig. 21 case; every shipped bioflex_<variant> has the same airframe).
+DEFAULT_AIRCRAFT = "bioflex_optimised"
+
+
+@functools.cache
+def default_aircraft() -> Aircraft:
+    """The default aircraft (:data:`DEFAULT_AIRCRAFT`), loaded once: the one place where a
+    call made without an aircraft gets the prototype's values (its airframe, speeds,
+    planform, post-stall limits). Its :meth:`Aircraft.airframe_data` is the prototype's
+    own object, so ``airframe is default_aircraft().airframe_data()`` says whether an
+    analysis' airframe is the prototype's."""
+    return load_aircraft(DEFAULT_AIRCRAFT)

@@ -136,15 +136,16 @@ def _state(af: Airframe) -> dict[str, tuple[str, float]]:
 
 
 def aircraft_spec(aircraft, build, model: str = "coupled", dt_s: float = DEFAULT_DT_S,
-                  speed_m_s: float = P.CRUISE_SPEED_M_S) -> J.ExportSpec:
+                  speed_m_s: float | None = None) -> J.ExportSpec:
     """The :class:`~bioflex_jsb.generators.native_wing.ExportSpec` of an aircraft definition
     (``aircraft``: :class:`bioflex_jsb.definition.aircraft.Aircraft`, ``build``: its wing,
     :meth:`~bioflex_jsb.definition.aircraft.Aircraft.wing`): the generated prototype's
     airframe exports as ``--wing`` does (aircraft ``bioflex_<wing>``); an aircraft file's
     (``airframe.jsbsim``: a jsbsim package aircraft or a directory) as a copy of that file
     named after the definition, with the wing's values (S, c̄, mass, derivatives) from the
-    definition and the chord of ``aero/ci2vel`` from the file. Raises DefinitionError or
-    ExportError (one line)."""
+    definition and the chord of ``aero/ci2vel`` from the file; trimmed at ``speed_m_s``
+    [m/s] (None: the aircraft's cruise speed). Raises DefinitionError or ExportError (one
+    line)."""
     a, d = aircraft.airframe, aircraft.definition
     rho = d.air.density_kg_m3
     if abs(rho - SEA_LEVEL_DENSITY_KG_M3) > DENSITY_REL_TOL * SEA_LEVEL_DENSITY_KG_M3:
@@ -156,9 +157,11 @@ def aircraft_spec(aircraft, build, model: str = "coupled", dt_s: float = DEFAULT
         problem = aircraft.flight_problem()  # the generated XML holds the prototype's numbers
         if problem:
             raise DefinitionError(problem)
+    cruise, speeds = flight_speeds(aircraft)
+    speed_m_s = cruise if speed_m_s is None else speed_m_s
+    if a.jsbsim == GENERATED:
         return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho)
     craft = re.sub(r"[^A-Za-z0-9_-]+", "_", d.name)
-    _cruise, speeds = flight_speeds(aircraft)
     return J.ExportSpec(wing, variant, model, dt_s, speed_m_s, rho, jsbsim_path=a.jsbsim_path,
                         aircraft=craft, jsbsim_chord_m=NA.jsbsim_chord_m(a.jsbsim_path),
                         speed_range_m_s=(float(speeds[0]), float(speeds[1])))

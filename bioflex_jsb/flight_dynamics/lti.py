@@ -262,13 +262,11 @@ def _drive(condition: FlightCondition):
     trimmed where the thrust equals the drag C_D Q S; trim J None if the tables cannot."""
     from scipy.optimize import brentq
 
-    from bioflex_jsb.aerodynamics.propeller import has_tables, propeller_tables
-
     prop = condition.airframe.propulsion
-    if prop is None or not has_tables(prop):
-        raise ValueError(f"airframe {condition.airframe.name!r}: the propeller tables are "
-                         "the prototype's (aerodynamics/propeller.py); another drive has none")
-    j_tab, ct_tab, cp_tab = _propeller_tables_cached(propeller_tables)
+    if prop is None:
+        raise ValueError(f"airframe {condition.airframe.name!r} has no propulsion model (its "
+                         "throttle column is zero)")
+    j_tab, ct_tab, cp_tab = _propeller_tables_cached(prop)
     rho, d = condition.density_kg_m3, prop.prop_diameter_m
     drag = condition.cd_trim * condition.dynamic_pressure_pa * condition.airframe.reference.area_m2
 
@@ -321,13 +319,17 @@ def thrust_speed_derivative_n_s_m(condition: FlightCondition) -> float:
     return float((out[0] - out[1]) / (2e-4 * v0))
 
 
-_TABLES: list = []
+_TABLES: dict = {}
 
 
-def _propeller_tables_cached(make):
-    if not _TABLES:
-        _TABLES.append(make())
-    return _TABLES[0]
+def _propeller_tables_cached(prop):
+    """The drive ``prop``'s propeller tables (aerodynamics/propeller.py), computed once per
+    drive (a blade-element calculation of 27 advance ratios)."""
+    if prop not in _TABLES:
+        from bioflex_jsb.aerodynamics.propeller import propeller_tables
+
+        _TABLES[prop] = propeller_tables(prop)
+    return _TABLES[prop]
 
 
 def _with_outputs(ss: StateSpace, a_alpha_row: np.ndarray, b_alpha_row: np.ndarray,

@@ -210,6 +210,11 @@ def alpha_table_rad(
     return np.unique(np.round(np.concatenate([grid, breaks]), 12))
 
 
+# The α range of the generated airframe's aerodynamic tables [rad] (its first and last
+# stations, alpha_table_rad): a run of it stops when α leaves it (simulation/limits.py).
+ALPHA_TABLE_RANGE_RAD = (POST_STALL.alpha_table_min_rad, POST_STALL.alpha_table_max_rad)
+
+
 
 W = XmlWriter(num_9g)
 el, comment, num = W.el, W.comment, W.number

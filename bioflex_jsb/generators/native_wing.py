@@ -90,16 +90,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from bioflex_jsb import units as U
+from bioflex_jsb.definition.aircraft import default_aircraft
+from bioflex_jsb.definition.flying import flight_speeds
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.modal_matrices import ModalMatrices, modal_matrices
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.generators.xml_writer import XmlWriter, collapse, num_12g, serialise
-from bioflex_jsb.parameters.airframe import (
-    AIRSPEED_RANGE_M_S,
-    CRUISE_SPEED_M_S,
-    ReferenceGeometry,
-)
+from bioflex_jsb.parameters.airframe import ReferenceGeometry
 from bioflex_jsb.parameters.constants import SEA_LEVEL_DENSITY_KG_M3
 from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for the checks)
     GRID_SPEED_MAX_M_S,
@@ -113,6 +111,9 @@ from bioflex_jsb.simulation.leapfrog import (  # noqa: F401  (re-exported for th
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S
 
 EXPORT_MODELS = ("coupled", "qsd")
+# The trim speed and flight speeds [m/s] of an export given neither: the default aircraft's
+# (the prototype's Table 1 cruise, 15 m/s; 5-40 m/s)
+DEFAULT_SPEED_M_S, DEFAULT_SPEED_RANGE_M_S = flight_speeds(default_aircraft())
 PREFIX = "bioflex/modal"
 # Named variants written into the repository's systems/ and aircraft/ (coupled model).
 REPOSITORY_VARIANTS = ("original", "optimised", "inertial-forward", "elastic-forward",
@@ -201,20 +202,21 @@ class ExportSpec:
     reference density [kg/m³]; ``jsbsim_path``: the aircraft file it is attached to (empty:
     the generated prototype), ``aircraft``: the exported aircraft's name (empty:
     :func:`aircraft_name`), ``jsbsim_chord_m``: c̄ [m] of the file's ``aero/ci2vel`` (0: c̄);
-    ``speed_range_m_s``: the speeds [m/s] the aircraft flies (the prototype's 5-40 m/s, an
-    aircraft definition's flight speeds), where the trim speed must lie and over which, from
-    0, the step's eigenvalues are checked (:attr:`check_speed_max_m_s`)."""
+    ``speed_range_m_s``: the speeds [m/s] the aircraft flies (the default aircraft's, the
+    prototype's 5-40 m/s; an aircraft definition's flight speeds), where the trim speed must
+    lie and over which, from 0, the step's eigenvalues are checked
+    (:attr:`check_speed_max_m_s`)."""
 
     wing: ElasticWingModel
     variant: str
     model: str = "coupled"
     dt_s: float = DEFAULT_DT_S
-    speed_m_s: float = CRUISE_SPEED_M_S
+    speed_m_s: float = DEFAULT_SPEED_M_S
     rho_ref: float = SEA_LEVEL_DENSITY_KG_M3
     jsbsim_path: str = ""
     aircraft: str = ""
     jsbsim_chord_m: float = 0.0
-    speed_range_m_s: tuple[float, float] = AIRSPEED_RANGE_M_S
+    speed_range_m_s: tuple[float, float] = DEFAULT_SPEED_RANGE_M_S
 
     def __post_init__(self) -> None:
         if self.model not in EXPORT_MODELS:
@@ -224,7 +226,7 @@ class ExportSpec:
         lo, hi = self.speed_range_m_s
         if not (math.isfinite(self.speed_m_s) and lo <= self.speed_m_s <= hi):
             whose = ("the range every command accepts for the prototype"
-                     if self.speed_range_m_s == AIRSPEED_RANGE_M_S else
+                     if self.speed_range_m_s == DEFAULT_SPEED_RANGE_M_S else
                      f"the flight speeds of {self.airframe_label}")
             raise ExportError(f"speed {self.speed_m_s:g} m/s is outside {lo:g}..{hi:g} m/s, "
                               f"{whose}")

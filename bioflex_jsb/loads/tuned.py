@@ -124,6 +124,24 @@ def aircraft_gust_scales(mean_chord_m: float, speed_m_s: float,
                       f"{period_s:.3f} s (the rigid short period at {speed_m_s:g} m/s)")
 
 
+def gust_scales(build, speed_m_s: float, density_kg_m3: float | None = None) -> GustScales:
+    """The tuned gust's scales of the aircraft the wing ``build`` (a ``WingBuild``) was built
+    for, at ``speed_m_s`` [m/s]: the prototype's defaults (:func:`default_scales`) on the
+    default aircraft's airframe (definition/aircraft.py default_aircraft), else the
+    aircraft's own (:func:`aircraft_gust_scales`: its mean chord and its rigid short period
+    at the speed, in air of ``density_kg_m3`` [kg/m^3]; None: sea level)."""
+    from bioflex_jsb.definition.aircraft import default_aircraft
+    from bioflex_jsb.flight_dynamics.eigen import modes_at
+
+    airframe = build.model.airframe
+    chord_m = airframe.reference.mean_chord_m
+    if airframe is default_aircraft().airframe_data():
+        return default_scales(chord_m)
+    density = {} if density_kg_m3 is None else {"density_kg_m3": density_kg_m3}
+    sp = modes_at("rigid", [speed_m_s], build.model, **density)[0].get("short_period")
+    return aircraft_gust_scales(chord_m, speed_m_s, sp.frequency_rad_s)
+
+
 def gust_amplitude_m_s(h_m: float, u_ref_m_s: float, h_max_m: float, scaling: str) -> float:
     """U [m/s] of the gradient ``h_m``: U_ref (H/H_max)^(1/6) (cs25) or U_ref (fixed)."""
     if scaling not in SCALINGS:

@@ -80,7 +80,6 @@ from bioflex_jsb.runtime.trim import (  # noqa: F401  (the trim's tolerances and
     total_thrust_n,
 )
 from bioflex_jsb.simulation import jsbsim_properties as JP
-from bioflex_jsb.simulation.limits import ALPHA_TABLE_RANGE_RAD
 
 DEFAULT_AIRCRAFT = airframe_xml.AIRCRAFT_NAME
 
@@ -214,8 +213,8 @@ class Airframe:
         self._nodes: dict[str, object] = {}
         self._trim = JSBSimTrim(self._fdm, self._trim_fdm, self._log, self.engines,
                                 self._trim_aircraft_path, self.alpha_limits_rad)
-        # α range of the aerodynamic tables [rad] (the generated prototype's: limits.py)
-        self.alpha_table_range_rad = ALPHA_TABLE_RANGE_RAD
+        # α range of the aerodynamic tables [rad]: the generated airframe's (its generator's)
+        self.alpha_table_range_rad = airframe_xml.ALPHA_TABLE_RANGE_RAD
         self.definition_name: str | None = None  # the aircraft definition it flies
         self.glider = self.engine_count == 0  # trimmed to a glide (runtime/trim.py)
         self._workdir = None  # the temporary root of an aircraft from a file (aircraft_files.py)

@@ -42,7 +42,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bioflex_jsb.errors import InputError, plain_integer, plain_number
-from bioflex_jsb.parameters.airframe import REFERENCE_GEOMETRY
 
 GUST_FORMS = (
     "sharp:AMPLITUDE_m_s",
@@ -53,13 +52,13 @@ GUST_FORMS = (
 )
 MAX_GUST_M_S = 50.0  # beyond this the small-UAV model is meaningless (3x the cruise speed)
 # Shortest 1-cos length and turbulence scale [m]: one mean aerodynamic chord of the aircraft
-# flown (parse_gust's min_length_m; the prototype's by default: Table 1, c̄ = 0.183 m).
+# flown (parse_gust's min_length_m; without one the default aircraft's,
+# default_min_gust_length_m: the prototype's Table 1 c̄ = 0.183 m).
 # Every wing model here treats the gust as uniform over the chord at each instant
 # (quasi-steady strips; the unsteady strips' Küssner penetration starts from the
 # same assumption of a gust wider than the section); a shorter gust is thinner than the wing
 # it crosses. For scale: the classic 1-cos gust of the airworthiness codes (FAR 23.341) is
 # 25 chords long, and MIL-F-8785C's smallest turbulence scale is 10 ft (3 m).
-MIN_GUST_LENGTH_M = REFERENCE_GEOMETRY.mean_chord_m
 # Longest 1-cos length and turbulence scale [m]: 10 km, 13 times MIL-F-8785C's largest
 # scale (2500 ft = 762 m, von Kármán above 2000 ft); a longer gust is steady wind for any run.
 MAX_GUST_LENGTH_M = 10_000.0
@@ -197,11 +196,23 @@ def check_gust_resolution(gust: GustSpec, speed_m_s: float, dt_s: float) -> None
             f"2.4 %), a length >= {shortest:.3g} m or a smaller --dt")
 
 
-def parse_gust(spec: str, min_length_m: float = MIN_GUST_LENGTH_M) -> GustSpec:
+def default_min_gust_length_m() -> float:
+    """The shortest 1-cos length and turbulence scale [m] of a gust given without its
+    aircraft: one mean chord of the default aircraft
+    (:func:`~bioflex_jsb.definition.aircraft.default_aircraft`, the prototype: 0.183 m)."""
+    from bioflex_jsb.definition.aircraft import default_aircraft
+
+    return default_aircraft().airframe_data().reference.mean_chord_m
+
+
+def parse_gust(spec: str, min_length_m: float | None = None) -> GustSpec:
     """Parse a command-line gust; raises :class:`GustSpecError` naming what is accepted.
     ``min_length_m``: the shortest 1-cos length and turbulence scale [m], one mean chord of
-    the aircraft flown (:data:`MIN_GUST_LENGTH_M`: the prototype's). A vertical form may be
-    followed by ``+`` and the components of :class:`SpanwiseParts` (module docstring)."""
+    the aircraft flown (None: :func:`default_min_gust_length_m`, the default aircraft's). A
+    vertical form may be followed by ``+`` and the components of :class:`SpanwiseParts`
+    (module docstring)."""
+    if min_length_m is None:
+        min_length_m = default_min_gust_length_m()
     head, plus, rest = spec.strip().partition("+")
     base = _parse_vertical(head, min_length_m)
     if not plus:

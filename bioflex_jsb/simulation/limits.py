@@ -8,27 +8,26 @@ from __future__ import annotations
 
 import math
 
-from bioflex_jsb.parameters.airframe import POST_STALL
-
 # A modal coordinate beyond this is outside the linear (small-twist) range of the model:
 # the modes are normalised on twist, and at 0.52 rad (30°) of twist sin η differs from η by
 # 4.5 %, the limit we accept for the small-angle kinematics behind Eq. (3).
 ETA_LIMIT_RAD = 0.52
-# The run stops when α leaves the airframe's aerodynamic tables (no data beyond). Between the
-# lift peak and the table end JSBSim's post-stall model holds while the modal derivatives,
-# linear in α, do not: that time is reported (``time_beyond_stall_s``), not stopped, so that
-# a transient excursion past the lift peak (the paper's 3 m/s gust at 15 m/s reaches
-# 13.1° against a 12.8° peak) is shown rather than hidden or fatal.
-ALPHA_TABLE_RANGE_RAD = (POST_STALL.alpha_table_min_rad, POST_STALL.alpha_table_max_rad)
+# The run stops when α leaves the airframe's aerodynamic tables (no data beyond: the range is
+# the airframe's own, runtime/fdm.py Airframe.alpha_table_range_rad). Between the lift peak
+# and the table end JSBSim's post-stall model holds while the modal derivatives, linear in α,
+# do not: that time is reported (``time_beyond_stall_s``), not stopped, so that a transient
+# excursion past the lift peak (the paper's 3 m/s gust at 15 m/s reaches 13.1° against a
+# 12.8° peak) is shown rather than hidden or fatal.
 
 
 def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float,
-                 alpha_range_rad: tuple[float, float] = ALPHA_TABLE_RANGE_RAD) -> str | None:
+                 alpha_range_rad: tuple[float, float]) -> str | None:
     """Why the run must stop after the step whose row is ``values`` (``names`` its channel
     names) at ``t_s`` [s], with the angle of attack ``alpha_rad`` [rad], the new modal
     state ``eta`` [rad] and the height above ground ``agl_m`` [m]; None if it may go on.
-    ``alpha_range_rad``: the α range of the airframe's tables [rad] (the generated
-    prototype's by default; another aircraft's from its XML: runtime/aircraft_files.py)."""
+    ``alpha_range_rad``: the α range of the flown airframe's tables [rad] (the generated
+    prototype's from its generator; another aircraft's from its XML:
+    runtime/aircraft_files.py)."""
     isfinite = math.isfinite
     if not all(map(isfinite, values)):
         bad = next(n for n, v in zip(names, values, strict=True) if not isfinite(v))

@@ -29,12 +29,13 @@ of a chunk's samples come from one compiled pass (:func:`_sample_floats`, the ar
 from __future__ import annotations
 
 import math
-from dataclasses import astuple, dataclass
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 
+from bioflex_jsb.definition.outline import AirframeOutline, airframe_outline
 from bioflex_jsb.simulation.step_kernel import guard_cache
 from bioflex_jsb.sinks.mcap.schemas import (
     AIRFRAME_GROUP,
@@ -96,55 +97,6 @@ AIRFRAME_PARTS = ("fuselage", "tail", "fin")
 # a SITL session closes a chunk every few tens of ms (its latency and crash-safety promise),
 # and one airframe a chunk there made the log 80 % larger (810 against 452 bytes a step).
 AIRFRAME_PERIOD_NS = 500_000_000
-
-
-# -- the airframe's outline: the one place its dimensions are read --------------------------
-@dataclass(frozen=True)
-class AirframeOutline:
-    """What the scene draws of the rigid airframe [m]: the fuselage (a prolate spheroid of
-    ``fuselage_length_m`` and ``fuselage_max_diameter_m`` on the body x axis, z = 0, its nose
-    ``nose_ahead_of_root_le_m`` ahead of the wing's root leading edge), the wing plane at
-    ``wing_height_m`` above the fuselage axis, the rectangular horizontal tail (semispan,
-    chord, leading edge ``tail_le_x_m`` aft of the wing's root leading edge, on the axis) and
-    a fin on the tail (root chord = the tail's, ``fin_height_m`` tall, ``fin_tip_chord_m``)."""
-
-    fuselage_length_m: float
-    fuselage_max_diameter_m: float
-    nose_ahead_of_root_le_m: float
-    wing_height_m: float
-    tail_semispan_m: float
-    tail_chord_m: float
-    tail_le_x_m: float
-    fin_height_m: float
-    fin_tip_chord_m: float
-
-
-def airframe_outline(airframe=None) -> AirframeOutline:
-    """The outline of ``airframe`` (an ``AirframeData``; None: the prototype's), the
-    prototype's from ``parameters/``. A definition describes no fuselage or tail geometry:
-    another aircraft's outline is the prototype's scaled by the span ratio (an ESTIMATE for
-    the drawing only, nothing is computed with it; the wing is drawn from the definition's
-    own planform, :func:`wing_shape`)."""
-    from bioflex_jsb.parameters.airframe import AIRFRAME_GEOMETRY, PROTOTYPE_AIRFRAME
-    from bioflex_jsb.parameters.airframe_consistent import FUSELAGE, TAIL
-
-    outline = AirframeOutline(
-        fuselage_length_m=FUSELAGE.length_m,  # Table 1
-        fuselage_max_diameter_m=FUSELAGE.max_diameter_m,  # ESTIMATE there (Fig. 1)
-        nose_ahead_of_root_le_m=AIRFRAME_GEOMETRY.wing_root_leading_edge_x_m,
-        # airframe_consistent.TAIL: "tail on the fuselage axis, wing on top of the fusiform
-        # fuselage: 3 cm between the planes"
-        wing_height_m=TAIL.height_m,
-        tail_semispan_m=TAIL.semispan_m, tail_chord_m=TAIL.chord_m,
-        tail_le_x_m=TAIL.leading_edge_x_m,
-        # ESTIMATE (drawing only, nothing is computed with it): "a small fin on a short
-        # arm" (airframe.py, C_nβ): as tall as the tail is half-wide, half its chord at the tip
-        fin_height_m=0.5 * TAIL.semispan_m, fin_tip_chord_m=0.5 * TAIL.chord_m,
-    )
-    if airframe is None or airframe.reference == PROTOTYPE_AIRFRAME.reference:
-        return outline
-    scale = airframe.reference.span_m / PROTOTYPE_AIRFRAME.reference.span_m
-    return AirframeOutline(*(scale * v for v in astuple(outline)))
 
 
 # -- the half wing at the mesh's stations ---------------------------------------------------
@@ -488,7 +440,8 @@ class SceneLog:
         """The scene of the run ``description``: its wing ``build`` (a ``WingBuild``: its
         planform, modes and airframe), or else built as the run built it (the variant
         ``wing_variant``, a ``WingVariant.as_dict()``, or else the description's ``wing``, on
-        the prototype's airframe; the build cache returns the run's own build)."""
+        the prototype's airframe; the build cache returns the run's own build); the airframe
+        drawn is the build's (definition/outline.py)."""
         if build is not None:
             return cls(writer, AircraftMesh(wing_shape(build, max_stations=SCENE_MESH_STATIONS),
                                             airframe_outline(build.airframe), exaggeration))
@@ -502,7 +455,7 @@ class SceneLog:
                    else resolve_variant(description.wing))
         build = build_wing(variant, mass_basis=description.mass_basis)
         return cls(writer, AircraftMesh(wing_shape(build, max_stations=SCENE_MESH_STATIONS),
-                                        airframe_outline(), exaggeration))
+                                        airframe_outline(build.airframe), exaggeration))
 
     def schema_id(self) -> int:
         """The id of the ``foxglove.SceneUpdate`` schema (added at the first call)."""
