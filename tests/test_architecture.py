@@ -86,7 +86,6 @@ NOT_YET_MOVED = {
     "bioflex_jsb.cli.speed_option": "the prototype's speed range",
     "bioflex_jsb.drivers.native": "the paper's Section 5 case",
     "bioflex_jsb.generators.native_wing": "default export speed and speed range",
-    "bioflex_jsb.runtime.coupled_step": "the prototype as the airframe of a native-wing run",
     "bioflex_jsb.simulation.gusts": "default reference chord",
     "bioflex_jsb.simulation.limits": "the prototype's post-stall limits",
     "bioflex_jsb.sinks.mcap.scene": "the prototype's drawn geometry",

@@ -48,7 +48,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
-from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.runtime.full_span_step import FullSpanSteps, _check_span
 from bioflex_jsb.simulation import jsbsim_properties as JP
@@ -227,8 +227,10 @@ class CoupledStep(FullSpanSteps):
         self.speed_m_s = float(speed_m_s)
         # the native wing has no step of ours; a controller's flaperon flies the Python step
         self.compiled = bool(compiled) and not native
-        # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's
-        data = PROTOTYPE_AIRFRAME if wing is None else wing.airframe.at_speed(speed_m_s)
+        # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's, or for a
+        # native wing given alone its aircraft definition's
+        data = (_native_airframe_data(airframe) if wing is None else wing.airframe
+                ).at_speed(speed_m_s)
         self.airframe_data = data
         # C_L0 of the linear model's level flight, W/(Q S) at sea level, as the LTI model
         # takes it; a glide's W cos γ/(Q S) differs by 1 − cos γ (γ −2.3°: 0.08 %)
@@ -291,6 +293,8 @@ class CoupledStep(FullSpanSteps):
         property nodes (returned, by :data:`PROPERTIES` key), the readers and writers the
         step binds, the trim reference the wing linearises about, and the native wing's
         published state."""
+        if not self.native:  # one aircraft, before it is touched
+            _check_pair(airframe, self.airframe_data)
         self.airframe = airframe
         configure_airframe(airframe, dt_s, modal_hooks=not self.native)
         if before_trim is not None:
@@ -298,6 +302,9 @@ class CoupledStep(FullSpanSteps):
         elastic = self.trim_mode == "elastic"
         if elastic or trim is None:
             trim = airframe.trim(speed_m_s, altitude_m, wing=build if elastic else None)
+        if not self.native:  # the Python wing's loads go into the external reactions
+            self._write_reactions = airframe.external_reaction_writer()
+            self._set_reactions = airframe.external_reaction_setters()
         # the wing's static state of the elastic trim; None flying from the rigid trim
         self.elastic_trim = trim.elastic if elastic else None
         self.trim = trim
@@ -306,20 +313,10 @@ class CoupledStep(FullSpanSteps):
                  if not (k == "throttle" and airframe.glider)}
         if airframe.glider:  # no engine, no throttle property: the throttle channel is 0
             nodes["throttle"] = _NO_THROTTLE
-        _check_pair(airframe, self.airframe_data)
         self.alpha_range_rad = airframe.alpha_table_range_rad
         self._set_wind = airframe.property_node(WIND_DOWN).set_double_value
-        if self.native:  # the wing's state and loads are JSBSim's properties
-            self.n_modes = _native_mode_count(airframe)
-            get_node = airframe.property_node
-            self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
-                                for i in range(self.n_modes)]
-            self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
-                                   for i in range(self.n_modes)]
-            self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
-        else:  # the Python wing's loads go into the external reactions
-            self._write_reactions = airframe.external_reaction_writer()
-            self._set_reactions = airframe.external_reaction_setters()
+        if self.native:
+            self._bind_native_wing(airframe)
         self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
         self._read = state_reader(self.get)
         self._agl_m = self.get["agl"]
@@ -327,6 +324,16 @@ class CoupledStep(FullSpanSteps):
         rho0 = self.get["rho"]() * U.KG_M3_PER_SLUG_FT3
         self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
         return nodes
+
+    def _bind_native_wing(self, airframe: Airframe) -> None:
+        """The native wing's modal state and loads: JSBSim's properties (its readers)."""
+        self.n_modes = _native_mode_count(airframe)
+        get_node = airframe.property_node
+        self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
+                            for i in range(self.n_modes)]
+        self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
+                               for i in range(self.n_modes)]
+        self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
 
     def _make_wing(self, model: str, aero: str, build, wing) -> None:
         """The wing of the step (``self.wing``, ``self.n_modes``): none for the native wing
@@ -887,16 +894,35 @@ def _step_options(wing, model: str, aero: str, trim_mode: str, trim) -> tuple:
 
 
 def _check_pair(airframe: Airframe, data) -> None:
-    """The JSBSim airframe and the wing's aircraft are one aircraft: the generated prototype
-    with the prototype's :class:`AirframeData`, a definition's JSBSim aircraft
-    (``airframe.definition_name``, runtime/aircraft_files.py) with that definition's; else
+    """The JSBSim airframe and the wing's aircraft are one aircraft: a definition's JSBSim
+    aircraft (``airframe.definition_name``, runtime/aircraft_files.py) with that
+    definition's :class:`AirframeData`, any other (the generated prototype's family) with
+    the data named as the generated aircraft (``generators.airframe.AIRCRAFT_NAME``); else
     InputError, one line (a wing's loads are in its aircraft's S, c̄)."""
-    mine = airframe.definition_name
-    if (mine is None) != (data is PROTOTYPE_AIRFRAME) or (mine is not None
-                                                          and mine != data.name):
+    mine = airframe.definition_name or airframe_xml.AIRCRAFT_NAME
+    if data.name != mine:
         raise InputError(f"the wing is built for aircraft {data.name!r}, the JSBSim airframe "
-                         f"is {mine or airframe.aircraft!r}: fly a wing on its own aircraft's "
-                         "airframe (runtime/jsbsim_aircraft.py airframe_for)")
+                         f"is {airframe.definition_name or airframe.aircraft!r}: fly a wing on "
+                         "its own aircraft's airframe (runtime/jsbsim_aircraft.py airframe_for)")
+
+
+def _native_airframe_data(airframe: Airframe):
+    """The :class:`AirframeData` of a native aircraft flown without its wing: the aircraft
+    definition of its name (the one it was exported from: ``bioflex_<variant>``,
+    ``sgs_elastic`` …), completed from its JSBSim model as ``--aircraft`` is; InputError,
+    one line, for a native aircraft of no shipped definition (give its wing then)."""
+    # imported here: the definitions' loader and the identification behind it add ~0.9 s
+    # to this module's import, which only a native run without its wing needs
+    from bioflex_jsb.definition.aircraft import load_aircraft
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
+
+    name = airframe.aircraft
+    try:
+        return complete(load_aircraft(name)).airframe_data()
+    except InputError as exc:
+        raise InputError(f"the native aircraft {name!r} takes its data (S, c̄, derivatives) "
+                         f"from the aircraft definition of its name, which cannot be used "
+                         f"({exc}); give its wing (wing=)") from None
 
 
 class _ZeroNode:
