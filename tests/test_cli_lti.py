@@ -105,7 +105,7 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv, needle):
     [
         ("x_elastic_frac = 1.5\n", "chord fraction"),
         ("colour = 'red'\n", "unknown key 'colour'"),
-        ("[overrides]\n'C_banana' = 1.0\n", "unknown coefficient"),
+        ("[overrides]\n'C_banana' = 1.0\n", "overrides: unknown key 'C_banana'; accepted: "),
         ("x_inertial_frac = \n", "not valid TOML"),
         ("modes_file = 'nowhere.toml'\n", "nowhere.toml"),
         # a base that is a file: "unknown wing (or a variant file ending in .toml)", though
@@ -121,6 +121,18 @@ def test_malformed_variant_files(capsys, tmp_path, text, needle):
     f.write_text(text)
     code, _, err = run_cli(capsys, "modes", "--wing", str(f), "--speed", "15")
     assert_one_line_error(code, err, needle)
+
+
+def test_unknown_override_is_the_one_unknown_key_line(capsys, tmp_path):
+    """An unknown [overrides] key: exit 2 and the line every table's unknown key gives
+    (bioflex_jsb.inputs.unknown_key_text), the accepted keys sorted."""
+    f = tmp_path / "v.toml"
+    f.write_text("[overrides]\n'C_banana' = 1.0\n")
+    code, _, err = run_cli(capsys, "modes", "--wing", str(f), "--speed", "15")
+    assert_one_line_error(code, err, (
+        f"{f}: overrides: unknown key 'C_banana'; accepted: C_L_eta<i>, C_L_etadot<i>, "
+        "C_alpha^Q<i>, C_eta<j>^Q<i>, C_etadot<j>^Q<i>, C_m_eta<i>, C_m_etadot<i>, "
+        "C_q^Q<i>"))
 
 
 def test_variant_file_changes_the_model(capsys, tmp_path):

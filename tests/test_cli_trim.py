@@ -190,3 +190,36 @@ def test_linearize_of_a_bare_jsbsim_aircraft_prints_only_what_it_knows(capsys):
                                  "--aircraft", "SGS", "--speed", "25"])
     assert code == 0 and "need the aircraft's analytic model" in out
     assert "Table B2" not in out and "propeller" not in out
+
+
+def test_trim_wing_prints_the_jsbsim_elastic_trim_the_runs_fly(capsys):
+    """``trim --wing`` is ``Airframe.trim(wing=)``: JSBSim's trim carrying the wing's static
+    loads, the trim a run with ``--trim elastic`` starts from, and says so; not the linear
+    airframe model's elastic trim (flight_dynamics.elastic_trim), which differs from it."""
+    from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.runtime.coupled_step import CoupledStep
+
+    code, out, err = _run(capsys, ["trim", "--wing", "inertial-backward", "--speed", "15",
+                                   "--json"])
+    assert code == 0, err
+    e = json.loads(out)["elastic"]
+    assert e["trim"] == "jsbsim" and e["converged"]
+    build = build_wing(VARIANTS["inertial-backward"])
+    step = CoupledStep(jsbsim_fdm.Airframe(), build, "coupled", 15.0, trim_mode="elastic")
+    flown = step.elastic_trim
+    step.release()
+    # the run configures its integrators and step before its trim: 2.2e-15 rad apart
+    assert e["alpha_rad"] == pytest.approx(flown.alpha_rad, abs=1e-12)
+    assert e["elevator_rad"] == pytest.approx(flown.elevator_rad, abs=1e-12)
+    # measured at 15 m/s, sea level: alpha 1.1412 deg, elevator 0.2021 deg; the linear
+    # model's elastic trim there is 1.1537 deg, 0.1932 deg (0.0125 deg and 0.0089 deg apart)
+    assert math.degrees(e["alpha_rad"]) == pytest.approx(1.1412, abs=1e-4)
+    assert math.degrees(e["elevator_rad"]) == pytest.approx(0.2021, abs=1e-4)
+    linear = elastic_trim(build, 15.0, density_kg_m3=e["density_kg_m3"])  # JSBSim's ρ
+    assert math.degrees(e["alpha_rad"] - linear.alpha_rad) == pytest.approx(-0.0125, abs=1e-3)
+    assert math.degrees(e["elevator_rad"] - linear.elevator_rad) == pytest.approx(0.0089,
+                                                                                 abs=1e-3)
+    code, out, err = _run(capsys, ["trim", "--wing", "inertial-backward", "--speed", "15"])
+    assert code == 0, err
+    assert "JSBSim's trim with the wing's static loads" in out

@@ -129,7 +129,7 @@ def test_labels_follow_modes_not_sort_order():
 
 def test_override_keys_are_checked():
     assert parse_override_key("C_eta2^Q1", 3) == ("c_eta_q", (0, 1))
-    with pytest.raises(ValueError, match="unknown coefficient"):
+    with pytest.raises(ValueError, match=r"^unknown key 'C_banana'; accepted: C_L_eta<i>, "):
         parse_override_key("C_banana", 3)
     with pytest.raises(ValueError, match="mode 4"):
         parse_override_key("C_eta4^Q1", 3)

@@ -421,7 +421,7 @@ def test_rc_override_channels_apply_one_by_one(bench):
     _rc(bench, 0, 1700)  # channel 1 released: centred
     assert v._sticks == pytest.approx((0.4, 0.0))
     _rc(bench, 0, 0)  # both released: the autopilot's
-    assert v._stick_wall is None and bench.link.sticks.controller is None
+    assert v._stick_t_s is None and bench.link.sticks.controller is None
     assert v.set_mode(MODES.CRUISE) is None
     out = _rc(bench, 1800)
     assert any("Sticks ignored in CRUISE" in t for t in texts(out)), texts(out)

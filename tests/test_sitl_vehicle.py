@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import re
-from types import SimpleNamespace
+import time
 
 import pytest
 from pymavlink import mavutil
@@ -50,12 +50,30 @@ def test_bad_home_is_one_line(build):  # noqa: F811
         make_sim(build, home=(95.0, 0.0, 0.0))
 
 
-def test_a_crash_is_reported_and_reset_to_trim_over_home(build, monkeypatch):  # noqa: F811
+def test_sticks_time_out_in_simulated_seconds_not_wall_seconds(build, monkeypatch):  # noqa: F811
+    """The sticks' age is simulated time: a wall clock that races ahead (a paused or slow
+    simulation) keeps them, and MANUAL_TIMEOUT_S of simulated time without new sticks is
+    control lost (RTL), however little wall time passed."""
+    sim = make_sim(build)
+    v = sim.vehicle
+    wall = [0.0]
+    monkeypatch.setattr(time, "monotonic", lambda: wall[0])
+    assert v.set_mode(MODES.STABILIZE) is None
+    assert sim.manual(0.0, 0.5)
+    t0 = sim.t_s
+    wall[0] += 3600.0  # an hour of wall time, no simulated time: the sticks hold
+    v.update(sim.t_s)
+    assert v.mode == MODES.STABILIZE and v._sticks == pytest.approx((0.0, 0.5))
+    # simulated time only (the wall clock stands): held up to the timeout, lost past it
+    v.update(t0 + sitl_vehicle.MANUAL_TIMEOUT_S)
+    assert v.mode == MODES.STABILIZE and v._stick_t_s == t0
+    v.update(t0 + sitl_vehicle.MANUAL_TIMEOUT_S + sim.dt_s)
+    assert v.mode == MODES.RTL and v._stick_t_s is None
+    assert "Manual control lost: RTL" in [t for _, t in v.events]
+
+
+def test_a_crash_is_reported_and_reset_to_trim_over_home(build):  # noqa: F811
     sim = make_sim(build, start_height_m=20.0)
-    # the sticks' age is wall time (older than 1 s: RTL); here the station's 10 Hz sticks
-    # are sent in simulated time, so the vehicle reads that clock (a loaded machine that
-    # stepped 96 steps in more than 1 s of wall time turned the dive into an RTL)
-    monkeypatch.setattr(sitl_vehicle, "time", SimpleNamespace(monotonic=lambda: sim.t_s))
     v = sim.vehicle
     heard = []  # the on_status hook (the session log's events): every STATUSTEXT, timed
     v.on_status = lambda t_s, severity, text: heard.append((t_s, severity, text))
@@ -63,7 +81,7 @@ def test_a_crash_is_reported_and_reset_to_trim_over_home(build, monkeypatch):  #
     with sim.airframe.capturing():
         for k in range(int(30.0 / sim.dt_s)):
             if k % 96 == 0:  # stick forward, nose down into the ground, held (10 Hz, as a
-                sim.manual(0.8, 0.0)  # station: sticks older than 1 s wall mean RTL)
+                sim.manual(0.8, 0.0)  # station: sticks older than 1 simulated s mean RTL)
             sim.step()
             if sim.resets:
                 break
@@ -166,7 +184,7 @@ def test_sticks_only_from_the_controlling_station_and_only_in_stick_modes(build)
         a.mav.manual_control_send(1, 500, 0, 500, 0, 0)  # CRUISE: not obeyed
         _service_until(link, sim, lambda: _read(link, "MANUAL_CONTROL") == 1,
                        "the first MANUAL_CONTROL read")
-        assert sim.vehicle._stick_wall is None
+        assert sim.vehicle._stick_t_s is None
         sim.vehicle.set_mode(MODES.STABILIZE)
         a.mav.manual_control_send(1, 0, 400, 500, 0, 0)
         _service_until(link, sim, lambda: _read(link, "MANUAL_CONTROL") == 2,

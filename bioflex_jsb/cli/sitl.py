@@ -46,7 +46,9 @@ starts 100 m above home (--home, default the CMAC field near Canberra) in CRUISE
 stations set modes (MANUAL, STABILIZE, CRUISE, LOITER, AUTO, RTL, GUIDED), fly missions and
 change parameters (AP_*, WP_RADIUS_M, LOIT_RAD_M, RTL_ALT_M, AIRSPEED_MS, GUST_*,
 WING_COUPLED, SIM_SPEEDUP); docs/sitl.md. A crash or divergence is reported and the aircraft
-is reset to trim over home; the session goes on. --mavlink:
+is reset to trim over home; the session goes on. Sticks (MANUAL_CONTROL, RC_CHANNELS_OVERRIDE)
+steer in MANUAL, STABILIZE and FBWA; sticks older than 1 s of simulated time (not wall time:
+a paused or slowed session keeps them) mean "Manual control lost" and RTL. --mavlink:
 udpout:HOST:PORT (send to a listening ground station; default udpout:127.0.0.1:14550),
 udpin:HOST:PORT or tcpin:HOST:PORT (listen); without HOST, 127.0.0.1. Runs --duration
 simulated seconds, or until Ctrl-C (the log grows ≈ 0.4 MB per simulated second, ≈ 1.4 GB

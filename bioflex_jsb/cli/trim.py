@@ -17,9 +17,11 @@ maximum shaft power. With --json, angles are in rad (keys ending in _rad), resid
 accelerations in m/s^2 and rad/s^2. Valid range: --speed {SPEED_RANGE_TEXT}, default
 {DEFAULT_SPEED_M_S:g} (the paper's cruise); a speed in it that the aircraft cannot fly (below
 the stall speed, beyond the motor's thrust at about 32 m/s) ends with a one-line reason and
-exit status 2. With --wing W: also the elastic trim of that wing (the static aeroelastic
-equilibrium under the trim loads, with the aerodynamic stiffness at the trim's dynamic
-pressure, iterated with the rigid trim to a fixed point): the modal deflections eta_i [rad],
+exit status 2. With --wing W: also the elastic trim of that wing, the one the co-simulation
+flies from (--trim elastic): JSBSim's trim carrying the wing's static loads (the static
+aeroelastic equilibrium under the trim loads, with the aerodynamic stiffness at the trim's
+dynamic pressure, iterated with JSBSim's trim to a fixed point; --json: elastic.trim
+"jsbsim"): the modal deflections eta_i [rad],
 the tip twist [deg, leading edge up], alpha and elevator rigid -> elastic, the wing's loads
 and its static divergence speed; at or beyond that speed it ends with one line naming it
 (docs/decisions.md, "Elastic trim"). With --aircraft NAME|FILE.toml naming an aircraft
@@ -166,7 +168,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         payload = trim_payload(result)
         if elastic is not None:
-            payload["elastic"] = elastic.as_dict()
+            # which elastic trim: JSBSim's with the wing's loads, not the linear model's
+            payload["elastic"] = {**elastic.as_dict(), "trim": "jsbsim"}
         print_json(payload)
         return 0
     deg = math.degrees
@@ -199,22 +202,23 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _elastic_trim(args, airframe, build=None):
-    """The elastic trim of --wing (or ``build``, an aircraft definition's wing) at --speed,
-    at the density JSBSim's trim flew in."""
-    from bioflex_jsb import units as U
+    """The elastic trim of --wing (or ``build``, an aircraft definition's wing) at --speed
+    and --altitude: JSBSim's trim carrying the wing's static loads to their fixed point
+    (``Airframe.trim(wing=)``, the trim a run with ``--trim elastic`` starts from)."""
     from bioflex_jsb.cli.common import wing_from_args
-    from bioflex_jsb.flight_dynamics.elastic_trim import elastic_trim
 
-    rho = airframe["atmosphere/rho-slugs_ft3"] * U.KG_M3_PER_SLUG_FT3
     wing = wing_from_args(args) if build is None else build
-    return elastic_trim(wing, args.speed, density_kg_m3=rho)
+    try:
+        return airframe.trim(args.speed, args.altitude, wing=wing).elastic
+    finally:
+        airframe.set_external_reactions()  # no wing loads left behind in the airframe
 
 
 def _print_elastic(e: dict) -> None:
     deg = math.degrees
-    print(f"Elastic trim of the {e['wing']} wing at {e['speed_m_s']:g} m/s "
-          f"(Q = {e['dynamic_pressure_pa']:.1f} Pa; converged: {e['converged']} in "
-          f"{e['iterations']} iterations)")
+    print(f"Elastic trim of the {e['wing']} wing at {e['speed_m_s']:g} m/s, JSBSim's trim "
+          f"with the wing's static loads (Q = {e['dynamic_pressure_pa']:.1f} Pa; converged: "
+          f"{e['converged']} in {e['iterations']} iterations)")
     for i, eta in enumerate(e["eta_rad"]):
         print(f"  eta{i + 1:<7} {eta:10.5f}  rad (modal deflection)")
     print(f"  {'tip twist':<10} {e['tip_twist_deg']:10.2f}  deg (+ leading edge up)")

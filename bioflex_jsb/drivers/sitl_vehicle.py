@@ -33,7 +33,6 @@ DO_REPOSITION, RTL_ALT_M) are not flown, which the mode's STATUSTEXT says once.
 from __future__ import annotations
 
 import math
-import time
 from collections import deque
 from collections.abc import Callable
 
@@ -60,7 +59,9 @@ from bioflex_jsb.simulation.battery import Battery
 M_INVALID_PARAM, M_INVALID_PARAM7 = INVALID_PARAM, INVALID_PARAM7
 
 GUIDANCE_PERIOD_S = 0.02  # simulated time between guidance updates [s]
-MANUAL_TIMEOUT_S = 1.0  # sticks older than this [wall s]: control lost → RTL
+# sticks older than this [simulated s]: control lost → RTL (a paused or slowed simulation keeps
+# them; one faster than real time ages them in its own seconds)
+MANUAL_TIMEOUT_S = 1.0
 STICK_BANK_RAD = math.radians(30.0)
 STICK_PITCH_RAD = math.radians(15.0)
 FORCE_DISARM = 21196  # MAV_CMD_COMPONENT_ARM_DISARM param2: disarm in flight
@@ -108,7 +109,7 @@ class SitlVehicle:
         self.heading_target_rad = 0.0
         self.mode = start_mode
         self._sticks = (0.0, 0.0)
-        self._stick_wall: float | None = None
+        self._stick_t_s: float | None = None  # simulated time of the last sticks [s]
         self._nav: tuple = ("heading",)
         self._item_state: dict = {}
         self._last_t = 0.0
@@ -235,14 +236,14 @@ class SitlVehicle:
         """Sticks (−1..1; pitch + = nose down, roll + = right), or None: released. Obeyed
         only in MANUAL, STABILIZE and FBWA."""
         if pitch is None or roll is None:
-            self._sticks, self._stick_wall = (0.0, 0.0), None
+            self._sticks, self._stick_t_s = (0.0, 0.0), None
             if self.mode == MODES.MANUAL:
                 self._apply_mode_flags()
             return True
         if self.mode not in MODES.STICK_MODES:
             return False
         self._sticks = (max(-1.0, min(1.0, pitch)), max(-1.0, min(1.0, roll)))
-        self._stick_wall = time.monotonic()
+        self._stick_t_s = self.sim.t_s
         if self.mode == MODES.MANUAL:
             a = self.sim.airframe
             a["ap/manual-elevator-norm"], a["ap/manual-aileron-norm"] = self._sticks
@@ -469,9 +470,9 @@ class SitlVehicle:
         dt = t_s - self._last_t
         self._last_t = t_s
         self._battery(dt)
-        if self._stick_wall is not None and self.mode in MODES.STICK_MODES and \
-                time.monotonic() - self._stick_wall > MANUAL_TIMEOUT_S:
-            self._stick_wall = None
+        if self._stick_t_s is not None and self.mode in MODES.STICK_MODES and \
+                t_s - self._stick_t_s > MANUAL_TIMEOUT_S:
+            self._stick_t_s = None
             self._sticks = (0.0, 0.0)
             self.status(4, "Manual control lost: RTL")
             self.set_mode(MODES.RTL)
@@ -563,7 +564,7 @@ class SitlVehicle:
 
     def after_reset(self) -> None:
         """The aircraft was put back at home in trim: loiter there."""
-        self._sticks, self._stick_wall = (0.0, 0.0), None
+        self._sticks, self._stick_t_s = (0.0, 0.0), None
         self.armed = True
         self.set_mode(MODES.LOITER, quiet=True)
         self._nav = ("circle", (0.0, 0.0), self.settings.loiter_radius_m, True)

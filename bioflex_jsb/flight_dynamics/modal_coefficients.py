@@ -30,6 +30,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from bioflex_jsb.inputs import unknown_key_text
+
 
 @dataclass(frozen=True)
 class ModalCoefficients:
@@ -101,10 +103,9 @@ _KEY_FORMS = (
     (re.compile(r"^C_eta(\d+)\^Q(\d+)$"), "c_eta_q"),
     (re.compile(r"^C_etadot(\d+)\^Q(\d+)$"), "c_etadot_q"),
 )
-OVERRIDE_KEY_HELP = (
-    "C_L_eta<i>, C_L_etadot<i>, C_m_eta<i>, C_m_etadot<i>, C_alpha^Q<i>, "
-    "C_q^Q<i>, C_eta<j>^Q<i>, C_etadot<j>^Q<i> (modes numbered from 1)"
-)
+# The override keys a file or a call may give, <i> and <j> mode numbers from 1.
+OVERRIDE_KEYS = ("C_L_eta<i>", "C_L_etadot<i>", "C_m_eta<i>", "C_m_etadot<i>", "C_alpha^Q<i>",
+                 "C_q^Q<i>", "C_eta<j>^Q<i>", "C_etadot<j>^Q<i>")
 
 
 def parse_override_key(key: str, n_modes: int) -> tuple[str, tuple[int, ...]]:
@@ -121,7 +122,7 @@ def parse_override_key(key: str, n_modes: int) -> tuple[str, tuple[int, ...]]:
                 j, i = numbers
                 return attr, (i - 1, j - 1)
             return attr, (numbers[0] - 1,)
-    raise ValueError(f"unknown coefficient {key!r}; accepted: {OVERRIDE_KEY_HELP}")
+    raise ValueError(unknown_key_text(key, OVERRIDE_KEYS))
 
 
 @dataclass(frozen=True)

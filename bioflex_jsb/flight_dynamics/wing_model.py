@@ -273,13 +273,13 @@ def _structure_values(data: dict, source: str, base_dir: Path | None) -> dict[st
 def _overrides(ov, source: str) -> dict[str, float]:
     """``overrides``: a table of coefficient name (docs/wing_variants.md) = value."""
     if not isinstance(ov, dict):
-        raise VariantError(f"{source}: 'overrides' must be a table of coefficient = value")
+        raise problem(VariantError, source, "overrides", "must be a table (coefficient = value)")
     checked = {}
     for k, v in ov.items():
         try:
             parse_override_key(k, DEFAULT_N_MODES)
         except ValueError as exc:
-            raise VariantError(f"{source}: overrides: {exc}") from None
+            raise problem(VariantError, source, "overrides", str(exc)) from None
         checked[k] = _field(COEFFICIENT, v, f"overrides.{k}", source)
     return checked
 

@@ -48,7 +48,7 @@ from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.lti import ElasticWingModel
 from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
-from bioflex_jsb.parameters.airframe import PROTOTYPE_AIRFRAME
+from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
 from bioflex_jsb.runtime.full_span_step import FullSpanSteps, _check_span
 from bioflex_jsb.simulation import jsbsim_properties as JP
@@ -223,89 +223,124 @@ class CoupledStep(FullSpanSteps):
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
         _check_span(span, build, model, aero)
         native = model == "native"
-        self.airframe = airframe
-        self.native = native
-        configure_airframe(airframe, dt_s, modal_hooks=not native)
-        if before_trim is not None:
-            before_trim(airframe)
-        if trim_mode == "elastic" or trim is None:
-            trim = airframe.trim(speed_m_s, altitude_m,
-                                 wing=build if trim_mode == "elastic" else None)
-        # the wing's static state of the elastic trim; None flying from the rigid trim
-        self.elastic_trim = trim.elastic if trim_mode == "elastic" else None
-        self.trim = trim
-        self.trim_mode = trim_mode
+        self.native, self.model, self.aero, self.trim_mode = native, model, aero, trim_mode
         self.speed_m_s = float(speed_m_s)
-        self.dt_s = airframe.dt_s
-        nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()
-                 if not (k == "throttle" and airframe.glider)}
-        if airframe.glider:  # no engine, no throttle property: the throttle channel is 0
-            nodes["throttle"] = _NO_THROTTLE
-        # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's
-        self.airframe_data = (PROTOTYPE_AIRFRAME if wing is None
-                              else wing.airframe.at_speed(speed_m_s))
-        _check_pair(airframe, self.airframe_data)
-        self.alpha_range_rad = airframe.alpha_table_range_rad
-        self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
-        self._read = state_reader(self.get)
-        self._set_wind = airframe.property_node(WIND_DOWN).set_double_value
-        # the reference dynamic pressure is JSBSim's own at trim (same density as the run)
-        rho0 = self.get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        # the native wing has no step of ours; a controller's flaperon flies the Python step
+        self.compiled = bool(compiled) and not native
+        # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's, or for a
+        # native wing given alone its aircraft definition's
+        data = (_native_airframe_data(airframe) if wing is None else wing.airframe
+                ).at_speed(speed_m_s)
+        self.airframe_data = data
         # C_L0 of the linear model's level flight, W/(Q S) at sea level, as the LTI model
         # takes it; a glide's W cos γ/(Q S) differs by 1 − cos γ (γ −2.3°: 0.08 %)
-        cl_trim = level_flight_condition(speed_m_s, airframe=self.airframe_data).cl_trim
-        self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
-        self._make_wing(model, aero, build, wing, airframe)
-        self.model = model
-        self.aero = aero
+        cl_trim = level_flight_condition(self.speed_m_s, airframe=data).cl_trim
+        self.alpha_peak_rad = alpha_peak_rad(data.aero)
+        controller = self._controller_outputs(controller, sensors, build, aileron)
+        # the JSBSim side: the airframe configured and trimmed, its readers and writers
+        nodes = self._take_airframe(airframe, dt_s, before_trim, trim, build, speed_m_s,
+                                    altitude_m, cl_trim)
+        # the wing, its sensors, the controller, the compiled step
+        self._make_wing(model, aero, build, wing)
         self.units = channel_units(self.n_modes)
         self.lateral = self._make_lateral(span, aileron, build, model)
-        self._build, self._aileron = build, aileron  # a controller's flaperon's strips
-        self.flaperon = None  # a controller's flaperon (runtime/flaperon_step.py)
-        self.step_note: str | None = None  # why the step is not the one asked for
-        self._kin_get = None  # the readers of _kinematics, bound at its first call
         self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
             self.units.update(sensors.units)
         self.names = tuple(self.units)
         self._eta_names, self._etadot_names = eta_names(self.n_modes)
-        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
-        self.control = None  # the controller in the loop (_attach_controller)
-        self._control_step = None
-        self._control_fast = None
-        if controller is not None and self._sensors is not None and native:
-            # the sensors' row of t_k needs η_{k+1}, which the native wing reaches only inside
-            # JSBSim's step, after the controller has written its commands
-            raise InputError("a controller in the loop and sensor stations ([sensors]) on the "
-                             "native wing: its modes step inside JSBSim, after the "
-                             "controller; fly the coupled, qsd or rigid model")
         if controller is not None:
             self._attach_controller(controller, over_autopilot)
         self._row = row_getter(self.names)
-        self._agl_m = self.get["agl"]
-        self.alpha_peak_rad = alpha_peak_rad(self.airframe_data.aero)
         if self.compiled:
             self._setup_kernel(nodes)
             if self.lateral is not None:
                 self._setup_full_span_kernel()
+        if controller is not None:
+            self._map_commands()
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
         self.k = 0
         self.stopped: str | None = None
         self.sensed: Sensed | None = None  # the snapshot of the last step's start
         self.w_g_m_s = 0.0
 
-    def _make_wing(self, model: str, aero: str, build, wing, airframe: Airframe) -> None:
-        """The wing of the step: the native wing's properties, the unsteady strips or the
-        quasi-steady modal wing (``self.wing``, ``self.n_modes``, the reactions' writer)."""
+    def _controller_outputs(self, controller, sensors, build, aileron):
+        """The controller checked before the airframe is touched (None without one), and the
+        step's attributes its outputs decide: a flaperon flies the Python step."""
+        self._build, self._aileron = build, aileron  # a controller's flaperon's strips
+        self.flaperon = None  # a controller's flaperon (runtime/flaperon_step.py)
+        self.step_note: str | None = None  # why the step is not the one asked for
+        self._kin_get = None  # the readers of _kinematics, bound at its first call
+        self.control = None  # the controller in the loop (_attach_controller)
+        self._control_step = None
+        self._control_fast = None
+        if controller is None:
+            return None
+        if sensors is not None and len(sensors) and self.native:
+            # the sensors' row of t_k needs η_{k+1}, which the native wing reaches only inside
+            # JSBSim's step, after the controller has written its commands
+            raise InputError("a controller in the loop and sensor stations ([sensors]) on the "
+                             "native wing: its modes step inside JSBSim, after the "
+                             "controller; fly the coupled, qsd or rigid model")
+        from bioflex_jsb.simulation.controller import check_controller
+
+        return check_controller(controller)
+
+    def _take_airframe(self, airframe: Airframe, dt_s: float, before_trim, trim,
+                       build, speed_m_s: float, altitude_m: float, cl_trim: float) -> dict:
+        """The JSBSim side of the step, all of it before the wing: ``airframe`` configured
+        (:func:`configure_airframe`) and trimmed (unless ``trim`` is given), the snapshot's
+        property nodes (returned, by :data:`PROPERTIES` key), the readers and writers the
+        step binds, the trim reference the wing linearises about, and the native wing's
+        published state."""
+        if not self.native:  # one aircraft, before it is touched
+            _check_pair(airframe, self.airframe_data)
+        self.airframe = airframe
+        configure_airframe(airframe, dt_s, modal_hooks=not self.native)
+        if before_trim is not None:
+            before_trim(airframe)
+        elastic = self.trim_mode == "elastic"
+        if elastic or trim is None:
+            trim = airframe.trim(speed_m_s, altitude_m, wing=build if elastic else None)
+        if not self.native:  # the Python wing's loads go into the external reactions
+            self._write_reactions = airframe.external_reaction_writer()
+            self._set_reactions = airframe.external_reaction_setters()
+        # the wing's static state of the elastic trim; None flying from the rigid trim
+        self.elastic_trim = trim.elastic if elastic else None
+        self.trim = trim
+        self.dt_s = airframe.dt_s
+        nodes = {k: airframe.property_node(v) for k, v in PROPERTIES.items()
+                 if not (k == "throttle" and airframe.glider)}
+        if airframe.glider:  # no engine, no throttle property: the throttle channel is 0
+            nodes["throttle"] = _NO_THROTTLE
+        self.alpha_range_rad = airframe.alpha_table_range_rad
+        self._set_wind = airframe.property_node(WIND_DOWN).set_double_value
+        if self.native:
+            self._bind_native_wing(airframe)
+        self.get = MappingProxyType({k: n.get_double_value for k, n in nodes.items()})
+        self._read = state_reader(self.get)
+        self._agl_m = self.get["agl"]
+        # the reference dynamic pressure is JSBSim's own at trim (same density as the run)
+        rho0 = self.get["rho"]() * U.KG_M3_PER_SLUG_FT3
+        self.reference = TrimReference(trim.alpha_rad, 0.5 * rho0 * speed_m_s**2, cl_trim)
+        return nodes
+
+    def _bind_native_wing(self, airframe: Airframe) -> None:
+        """The native wing's modal state and loads: JSBSim's properties (its readers)."""
+        self.n_modes = _native_mode_count(airframe)
+        get_node = airframe.property_node
+        self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
+                            for i in range(self.n_modes)]
+        self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
+                               for i in range(self.n_modes)]
+        self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
+
+    def _make_wing(self, model: str, aero: str, build, wing) -> None:
+        """The wing of the step (``self.wing``, ``self.n_modes``): none for the native wing
+        (its modes are JSBSim's), the unsteady strips or the quasi-steady modal wing, about
+        the trim reference of the JSBSim side."""
         if model == "native":
             self.wing = None
-            self.n_modes = _native_mode_count(airframe)
-            get_node = airframe.property_node
-            self._native_eta = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}").get_double_value
-                                for i in range(self.n_modes)]
-            self._native_etadot = [get_node(f"{NATIVE_PREFIX}/eta{i + 1}-dot").get_double_value
-                                   for i in range(self.n_modes)]
-            self._native_loads = [get_node(p).get_double_value for p in NATIVE_LOADS]
             return
         if aero == "unsteady":
             # imported here: the unsteady strips pull in scipy's integrators and optimisers,
@@ -319,7 +354,6 @@ class CoupledStep(FullSpanSteps):
             self.wing = ModalWing(wing, self.reference, model=model, dt_s=self.dt_s,
                                   static_eta=static, aero=self.airframe_data.aero)
         self.n_modes = wing.n_modes
-        self._write_reactions = airframe.external_reaction_writer()
 
     # -- the sensors ------------------------------------------------------------------------
     def _sensor_rows(self, sensors: SensorSet | None) -> SensorRows | None:
@@ -379,10 +413,8 @@ class CoupledStep(FullSpanSteps):
             COMMAND_CHANNELS,
             CONTROL_OUTPUTS,
             ControlLoop,
-            check_controller,
         )
 
-        controller = check_controller(controller)
         if "flaperon" in controller.outputs:  # on the Python step (runtime/flaperon_step.py)
             from bioflex_jsb.runtime.flaperon_step import flaperon_for, python_step_fallback
 
@@ -401,15 +433,8 @@ class CoupledStep(FullSpanSteps):
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
         commands = commands_for(self.airframe, loop.outputs, over_autopilot,
                                 None if self.flaperon is None else self.flaperon.command())
+        self._commands = commands  # their maps go into the compiled update last
         binding = loop.binding
-        if binding is not None:  # the compiled update maps and returns the first command
-            for i, c in enumerate(commands):
-                binding.set_map(i, c.offset, c.angle, c.down, c.up)
-        self._control_fast = None
-        if binding is not None and len(commands) == 1 and len(commands[0].setters) == 1 \
-                and commands[0].adds == (0.0,):
-            # the fast path (_bind_fast_step): the update's machine code, then the setter
-            self._control_fast = (binding, commands[0].setters[0])
         step = loop.step
         if binding is not None:
             values = binding.values
@@ -426,6 +451,19 @@ class CoupledStep(FullSpanSteps):
         self.control = loop
         self._control_step = control
         self._scratch_py = np.zeros((1, len(self.names)))  # the Python step's row
+
+    def _map_commands(self) -> None:
+        """The compiled controller's update maps its commands to the surfaces' JSBSim
+        values (each command's offset, scale and limits) and returns the first; one command
+        with one setter flies the fast path (:meth:`_bind_fast_step`: the update's machine
+        code, then the setter)."""
+        binding, commands = self.control.binding, self._commands
+        if binding is None:
+            return
+        for i, c in enumerate(commands):
+            binding.set_map(i, c.offset, c.angle, c.down, c.up)
+        if len(commands) == 1 and len(commands[0].setters) == 1 and commands[0].adds == (0.0,):
+            self._control_fast = (binding, commands[0].setters[0])
 
     # -- the wing ---------------------------------------------------------------------------
     @property
@@ -605,7 +643,6 @@ class CoupledStep(FullSpanSteps):
         its own (:mod:`bioflex_jsb.simulation.unsteady_kernel`) with the same arguments."""
         mw, mm = self.wing, self.wing.matrices
         self._getters = tuple(nodes[k].get_double_value for k in K.READ_KEYS)
-        self._set_reactions = self.airframe.external_reaction_setters()
         if self.aero == "unsteady":
             from bioflex_jsb.simulation import unsteady_kernel as UK
 
@@ -857,16 +894,35 @@ def _step_options(wing, model: str, aero: str, trim_mode: str, trim) -> tuple:
 
 
 def _check_pair(airframe: Airframe, data) -> None:
-    """The JSBSim airframe and the wing's aircraft are one aircraft: the generated prototype
-    with the prototype's :class:`AirframeData`, a definition's JSBSim aircraft
-    (``airframe.definition_name``, runtime/aircraft_files.py) with that definition's; else
+    """The JSBSim airframe and the wing's aircraft are one aircraft: a definition's JSBSim
+    aircraft (``airframe.definition_name``, runtime/aircraft_files.py) with that
+    definition's :class:`AirframeData`, any other (the generated prototype's family) with
+    the data named as the generated aircraft (``generators.airframe.AIRCRAFT_NAME``); else
     InputError, one line (a wing's loads are in its aircraft's S, c̄)."""
-    mine = airframe.definition_name
-    if (mine is None) != (data is PROTOTYPE_AIRFRAME) or (mine is not None
-                                                          and mine != data.name):
+    mine = airframe.definition_name or airframe_xml.AIRCRAFT_NAME
+    if data.name != mine:
         raise InputError(f"the wing is built for aircraft {data.name!r}, the JSBSim airframe "
-                         f"is {mine or airframe.aircraft!r}: fly a wing on its own aircraft's "
-                         "airframe (runtime/jsbsim_aircraft.py airframe_for)")
+                         f"is {airframe.definition_name or airframe.aircraft!r}: fly a wing on "
+                         "its own aircraft's airframe (runtime/jsbsim_aircraft.py airframe_for)")
+
+
+def _native_airframe_data(airframe: Airframe):
+    """The :class:`AirframeData` of a native aircraft flown without its wing: the aircraft
+    definition of its name (the one it was exported from: ``bioflex_<variant>``,
+    ``sgs_elastic`` …), completed from its JSBSim model as ``--aircraft`` is; InputError,
+    one line, for a native aircraft of no shipped definition (give its wing then)."""
+    # imported here: the definitions' loader and the identification behind it add ~0.9 s
+    # to this module's import, which only a native run without its wing needs
+    from bioflex_jsb.definition.aircraft import load_aircraft
+    from bioflex_jsb.runtime.jsbsim_aircraft import complete
+
+    name = airframe.aircraft
+    try:
+        return complete(load_aircraft(name)).airframe_data()
+    except InputError as exc:
+        raise InputError(f"the native aircraft {name!r} takes its data (S, c̄, derivatives) "
+                         f"from the aircraft definition of its name, which cannot be used "
+                         f"({exc}); give its wing (wing=)") from None
 
 
 class _ZeroNode:

@@ -17,8 +17,8 @@ Two JSBSim instances: the flying aircraft and its trim companion
 ------------------------------------------------------------------
 JSBSim's trim finds the propeller's steady RPM by explicit Euler steps of a fixed 0.5 s
 (``FGPropulsion::GetSteadyState``), stable only with a rotor inertia about 8 times the
-physical one (``PROPULSION.trim_rotor_inertia_kg_m2``). The flying aircraft (``bioflex``)
-has the physical ``rotor_inertia_kg_m2``, so that in time simulations the RPM, and the
+physical one (the companion's propeller ``<ixx>``). The flying aircraft (``bioflex``)
+has the physical rotor inertia, so that in time simulations the RPM, and the
 thrust, follow the airspeed within ≈ 0.3 s (quasi-static on the phugoid time scale, as in
 JSBSim's linearization); an 8-times inertia made the RPM lag the airspeed by seconds. The
 generator writes a trim companion (``bioflex_trim``: the same aircraft, only the propeller
@@ -65,6 +65,7 @@ from __future__ import annotations
 import contextlib
 import math
 import re
+from functools import lru_cache
 from pathlib import Path
 
 import jsbsim
@@ -72,7 +73,7 @@ import numpy as np
 
 from bioflex_jsb import units as U
 from bioflex_jsb.generators import airframe as airframe_xml
-from bioflex_jsb.parameters.airframe import PROPULSION
+from bioflex_jsb.runtime.aircraft_files import read_aircraft_xml, read_xml
 from bioflex_jsb.runtime.engines import Engine, zero_thrust_advance_ratio
 from bioflex_jsb.runtime.engines import start as start_engines
 from bioflex_jsb.runtime.jsbsim_log import CapturingLogger, captured
@@ -463,28 +464,67 @@ _INTEGRATOR_PROPERTIES = JP.INTEGRATOR_PROPERTIES
 _INTEGRATOR_NONE = 0
 
 
+# JSBSim's units of the rotor data the spin-up reads (FGJSBBase's conversions): to ft, to
+# slug·ft², to ft·lbf/s (one mechanical horsepower is 550 ft·lbf/s); a value without a unit is
+# in the unit JSBSim converts it to (FGPropeller: FT, SLUG*FT2; FGElectric: WATTS).
+_LENGTH_TO_FT = {"FT": 1.0, "IN": 1.0 / 12.0, "M": U.FT_PER_M}
+_INERTIA_TO_SLUG_FT2 = {"SLUG*FT2": 1.0, "KG*M2": U.SLUG_FT2_PER_KG_M2}
+_POWER_TO_FT_LBF_S = {"WATTS": U.LBF_FT_PER_N_M, "HP": 550.0}
+
+
+def _xml_value(element, tag: str, units: dict[str, float], default_unit: str,
+               source: Path) -> float:
+    """``<tag unit=...>value</tag>`` of ``element`` in the unit the table converts to."""
+    node = element.find(tag)
+    unit = (node.get("unit", default_unit) if node is not None else default_unit).upper()
+    try:
+        return float(node.text) * units[unit]
+    except (AttributeError, TypeError, ValueError, KeyError):
+        raise TrimError(f"{str(source)!r}: no <{tag}> in {', '.join(units)} for the "
+                        "propeller spin-up") from None
+
+
+@lru_cache(maxsize=8)
+def rotor_spin_up_data(aircraft_path: Path) -> tuple[float, float, float]:
+    """(diameter [ft], rotor inertia [slug·ft²], motor power [ft·lbf/s]) of the first engine
+    of the aircraft file ``aircraft_path`` (the trim companion's: its effective rotor
+    inertia), read from its thruster and engine files as JSBSim reads them
+    (``<diameter>``, ``<ixx>`` of the propeller, ``<power>`` of the electric motor)."""
+    aircraft = read_aircraft_xml(aircraft_path).getroot()
+    engine = aircraft.find(".//propulsion/engine")
+    thruster = None if engine is None else engine.find("thruster")
+    if thruster is None or not engine.get("file") or not thruster.get("file"):
+        raise TrimError(f"{str(aircraft_path)!r} has no engine with a propeller to spin up")
+    engines_dir = aircraft_path.parent / "Engines"
+    prop_path = engines_dir / f"{thruster.get('file')}.xml"
+    motor_path = engines_dir / f"{engine.get('file')}.xml"
+    prop = read_xml(prop_path, "the propeller").getroot()
+    motor = read_xml(motor_path, "the engine").getroot()
+    return (_xml_value(prop, "diameter", _LENGTH_TO_FT, "FT", prop_path),
+            _xml_value(prop, "ixx", _INERTIA_TO_SLUG_FT2, "SLUG*FT2", prop_path),
+            _xml_value(motor, "power", _POWER_TO_FT_LBF_S, "WATTS", motor_path))
+
+
 def spin_up_propellers(fdm, speed_m_s: float, aircraft_path: Path, engine_count: int) -> None:
     """Bring both propellers of ``fdm`` (the trim instance) from rest to their windmilling
     RPM at ``speed_m_s`` in one step.
 
     At 0 RPM JSBSim's propeller turns the engine power P [ft·lbf/s] into a torque of
-    P/(1 rad/s), so one step of dt [s] gives ω = throttle·P·dt/I per rotor (each rotor
-    has 1/rotor_count of the power and of the inertia, the companion's effective one).
+    P/(1 rad/s), so one step of dt [s] gives ω = throttle·P·dt/I per rotor (P, I and the
+    diameter D of one rotor, as the aircraft's files give them to JSBSim:
+    :func:`rotor_spin_up_data`; the companion's effective inertia).
     The throttle for ω = 2πV/(J₀D) (J₀: zero-thrust advance ratio) is set on every
     engine for that step.
     """
-    n = PROPULSION.rotor_count
+    diameter_ft, inertia_slug_ft2, power_ft_lbf_s = rotor_spin_up_data(aircraft_path)
     omega_rad_s = (
         2.0 * math.pi * speed_m_s
-        / (zero_thrust_advance_ratio(aircraft_path) * PROPULSION.prop_diameter_m)
+        / (zero_thrust_advance_ratio(aircraft_path) * diameter_ft * U.M_PER_FT)
     )
-    inertia_slug_ft2 = PROPULSION.trim_rotor_inertia_kg_m2 / n * U.SLUG_FT2_PER_KG_M2
-    power_ft_lbf_s = PROPULSION.motor_max_shaft_power_w / n * U.LBF_FT_PER_N_M
     throttle = min(1.0, omega_rad_s * inertia_slug_ft2 / (power_ft_lbf_s * fdm.get_delta_t()))
     for i in range(engine_count):
         fdm[JP.throttle_cmd(i)] = throttle
     fdm.run()
-
 
 
 # The flying instance's initial conditions from the companion's state, in this order:
