@@ -325,7 +325,8 @@ def test_bench_json_has_every_figure(capsys):
     assert 0.0 <= data["sitl"]["p50_ms"] <= data["sitl"]["p99_ms"]
     assert data["steps"] == 100 and data["repeat"] == 2
     assert data["run_lengths"] == [100, 200, 400]
-    assert data["run_lengths_by_configuration"] == {"unsteady": [400, 800, 1600]}
+    assert data["run_lengths_by_configuration"] == {"unsteady": [400, 800, 1600],
+                                                    "full_span": [6400, 12800, 25600]}
     assert len(data["load_average"]) == 3 and all(math.isfinite(x)
                                                   for x in data["load_average"])
     assert len(data["load_average_before"]) == 3

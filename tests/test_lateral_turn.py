@@ -120,9 +120,13 @@ def turns(aircraft):
 # The times the roll rates are compared at [s after the step]: from within the roll
 # subsidence (1/8.2 s) to the steady roll rate.
 COMPARE_AT_S = (0.1, 0.2, 0.3, 0.5, 0.7, 0.9)
-# The elastic/rigid ratio of the roll rates, nonlinear over linear: measured within 1.3e-4
-# (0.98632 against 0.98619 0.1 s after the step; 0.95443 against 0.95442 at 0.5 s)
-RATIO_RTOL = 1e-3
+# The elastic/rigid ratio of the roll rates, nonlinear over linear: measured within 1.45e-3
+# (0.98633 against 0.98619 0.1 s after the step; 0.95405 against 0.95442 at 0.5 s; 0.95248
+# against 0.95386 at 0.9 s). The linear lateral model's antisymmetric modes see p and δa
+# only; the nonlinear step's also see the sideslip on the dihedral and the yaw rate, and
+# give a yawing moment (simulation/full_span.py): without those terms the two agree within
+# 1.3e-4 (0.95383 at 0.9 s), the terms move the ratio by 1.4e-3 as the sideslip builds up
+RATIO_RTOL = 3e-3
 # Each run's roll rate against its linear model's: measured within 1.3e-3 (the rigid
 # 0.11965 against 0.11949 rad/s at 0.5 s: the longitudinal motion the lateral model has not)
 ROLL_RATE_RTOL = 5e-3
@@ -156,13 +160,18 @@ def test_an_aileron_step_in_sitl_rolls_the_elastic_aircraft_as_the_linear_model_
         lin["coupled"]["phi"][j] / lin["rigid"]["phi"][j], rel=RATIO_RTOL)
     eta = runs["coupled"][1]["asym_eta1"]  # the antisymmetric mode, as the linear one
     assert np.max(np.abs(eta)) > 1e-5
-    assert _nrmse(eta, lin["coupled"]["eta1"]) < 0.02
+    # measured 0.0246 (0.0016 without the sideslip's and yaw rate's forcing of the modes,
+    # which the linear model has not: the aileron's adverse sideslip on the dihedral)
+    assert _nrmse(eta, lin["coupled"]["eta1"]) < 0.04
 
 
 # The loiter entry's histories against the linear models driven by the surfaces flown
-# (NRMSE over the range): measured p 0.0063 (rigid), 0.0061 (coupled), asym_eta1 0.0060; the
-# bank 0.016 (20 deg of bank and the turn's pitch-up, which the linear lateral model has not)
-TURN_NRMSE = {"p": 0.02, "eta1": 0.02}
+# (NRMSE over the range): measured p 0.0063 (rigid), 0.0061 (coupled), asym_eta1 0.0224; the
+# bank 0.016 (20 deg of bank and the turn's pitch-up, which the linear lateral model has not).
+# asym_eta1 was 0.0060 without the yaw rate's and sideslip's forcing, which the linear
+# model's modes have not: in the steady turn (r 0.06 rad/s) the outer wing's faster air
+# holds the mode at 1.28e-6 rad, where the linear model settles at -4.3e-7
+TURN_NRMSE = {"p": 0.02, "eta1": 0.04}
 
 
 def test_a_sitl_turn_shows_the_antisymmetric_modes_and_the_predicted_roll(turns, linear):
@@ -170,7 +179,7 @@ def test_a_sitl_turn_shows_the_antisymmetric_modes_and_the_predicted_roll(turns,
     rigid and elastic; each run's roll rate and antisymmetric mode against its linear model
     driven by the aileron and rudder that run's autopilot flew. Measured: the peak roll rate
     0.2761 rad/s elastic against 0.2848 rigid (0.9696; the linear models' 0.9696 to 3e-5),
-    asym_eta1 up to 6.64e-5 rad (linear 6.63e-5), the modes' rolling moment up to 238 N·m
+    asym_eta1 up to 6.69e-5 rad (linear 6.63e-5), the modes' rolling moment up to 237 N·m
     against the roll, the tips twisted opposite ways."""
     peak_nl, peak_lin = {}, {}
     for m in ("rigid", "coupled"):
@@ -194,17 +203,19 @@ def test_a_sitl_turn_shows_the_antisymmetric_modes_and_the_predicted_roll(turns,
 
 
 # The loiter entry at dt and dt/2 (max difference over the channel's range): measured bank
-# 2.0e-4, roll rate 9.3e-3, asym_eta1 9.3e-3, tip twist 9.1e-3, the modes' rolling moment
-# 8.6e-4; at dt/2 against dt/4 1.0e-4, 1.5e-3, 4.6e-3, 4.5e-3, 2.2e-4 (η_a first order: the
-# explicit coupling holds p of t_k over the step, docs/lateral.md "Validation")
+# 2.0e-4, roll rate 9.3e-3, asym_eta1 9.1e-3, tip twist 9.0e-3, the modes' rolling moment
+# 8.5e-4, side force 5.3e-4, yawing moment 2.0e-3; at dt/2 against dt/4 1.0e-4, 4.6e-3,
+# 4.5e-3, 4.4e-3, 2.2e-4, 1.4e-4, 4.9e-4 (η_a first order: the explicit coupling holds p, r
+# and β of t_k over the step, docs/lateral.md "Validation")
 DT_HALVING_OF_RANGE = {"phi_rad": 1e-3, "p_rad_s": 0.02, "asym_eta1": 0.02,
-                       "tip_twist_port_rad": 0.02, "modal_roll_n_m": 0.005}
+                       "tip_twist_port_rad": 0.02, "modal_roll_n_m": 0.005,
+                       "modal_side_n": 0.005, "modal_yaw_n_m": 0.01}
 
 
 def test_the_sitl_turn_at_half_the_step(turns):
     """dt-halving of the loiter entry flown by sitl with both halves: bank, roll rate, the
-    first antisymmetric mode, the tip twist and the modes' rolling moment at dt and dt/2 on
-    the common times."""
+    first antisymmetric mode, the tip twist and the modes' rolling moment, side force and
+    yawing moment at dt and dt/2 on the common times."""
     t1, a = turns["coupled"]
     t2, b = turns["coupled_half_dt"]
     np.testing.assert_allclose(t2[::2][:t1.size], t1, atol=1e-12)

@@ -203,3 +203,107 @@ def lateral_model_with_aileron(model: str, trim: LateralTrim, aero: LateralAerod
     coupled = lateral_elastic_with_aileron(build_lateral_elastic("coupled", trim, aero, wing),
                                            strips, trim.dynamic_pressure_pa)
     return (coupled if model == "coupled" else residualised(coupled)), strips
+def _slope_at(stations_m: np.ndarray, bending_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """dφ/dy [m/m per unit η] of the bending ``bending_m`` (n, k) given at ``stations_m``,
+    at ``y_m`` (second-order differences on the modes' own stations, then linear)."""
+    slope = np.gradient(np.asarray(bending_m, dtype=float), np.asarray(stations_m, dtype=float),
+                        axis=1)
+    return np.array([np.interp(y_m, stations_m, s) for s in slope])
+
+
+def dihedral_rad(planform, y_m: np.ndarray) -> np.ndarray:
+    """The planform's geometric dihedral Γ(y) [rad, tip up positive] at the starboard
+    stations ``y_m``: the slope of its leading edge's height (zero for a flat wing)."""
+    y = np.asarray(y_m, dtype=float)
+    if not getattr(planform, "has_dihedral", False):
+        return np.zeros_like(y)
+    grid = np.linspace(0.0, float(planform.semispan_m), 4001)
+    return np.arctan(np.interp(y, grid, np.gradient(planform.height_at(grid), grid)))
+
+
+@dataclass(frozen=True, eq=False)
+class YawSideslipTerms:
+    """The yaw rate's, the sideslip's and the side force's terms of the full-span step, per
+    unit flow (the physics: :mod:`bioflex_jsb.simulation.full_span`, "Yaw rate, sideslip,
+    side force and yawing moment"). ``n_a`` antisymmetric, ``n_s`` symmetric modes; L_w the
+    wing's lift [N] (n_z W), Q [Pa], V [m/s], r, p [rad/s], β [rad]; η_s the symmetric
+    modes' total deflection [rad] (the trim's static one plus the run's Δη_s).
+
+    Generalised forces on the antisymmetric modes [N·m]: ``force_r`` (n_a) per unit L_w r/V,
+    ``force_beta`` (n_a) per unit Q β, ``force_beta_s`` (n_a, n_s) per unit Q β η_s.
+    Rolling moment, right wing down [N·m]: ``roll_r_s`` (n_s) per unit (Q r/V) η_s,
+    ``roll_beta_s`` (n_s) per unit Q β η_s. Side force along body +y [N]: ``side_eta``
+    (n_a) per unit L_w η_a, ``side_dihedral_eta`` per unit Q η_a, ``side_dihedral_etadot``
+    per unit (Q/V) η̇_a. Yawing moment about body +z, nose right [N·m]: ``yaw_etadot``
+    (n_a) per unit (L_w/V) η̇_a, ``yaw_p_s`` (n_s) per unit (Q p/V) η_s, and
+    −``induced_per_lift`` L_w/Q times the elastic rolling moment [1/m²: 1/(π b²)]."""
+
+    force_r: np.ndarray
+    force_beta: np.ndarray
+    force_beta_s: np.ndarray
+    roll_r_s: np.ndarray
+    roll_beta_s: np.ndarray
+    side_eta: np.ndarray
+    side_dihedral_eta: np.ndarray
+    side_dihedral_etadot: np.ndarray
+    yaw_etadot: np.ndarray
+    yaw_p_s: np.ndarray
+    induced_per_lift: float
+
+    def forcing(self, q_pa: float, v_m_s: float, wing_lift_n: float, r_rad_s: float,
+                beta_rad: float, eta_s) -> np.ndarray:
+        """The generalised force on the antisymmetric modes [N·m] (n_a)."""
+        return (wing_lift_n * r_rad_s / v_m_s * self.force_r
+                + q_pa * beta_rad * (self.force_beta + self.force_beta_s @ eta_s))
+
+    def roll_n_m(self, q_pa: float, v_m_s: float, r_rad_s: float, beta_rad: float,
+                 eta_s) -> float:
+        """The rolling moment of the yaw rate and the sideslip on the symmetric deflection
+        [N·m, right wing down]."""
+        return float(q_pa * r_rad_s / v_m_s * (self.roll_r_s @ eta_s)
+                     + q_pa * beta_rad * (self.roll_beta_s @ eta_s))
+
+    def side_n(self, q_pa: float, v_m_s: float, wing_lift_n: float, eta_a, eta_a_dot
+               ) -> float:
+        """The side force of the antisymmetric deformation [N, body +y, to starboard]."""
+        return float(wing_lift_n * (self.side_eta @ eta_a)
+                     + q_pa * (self.side_dihedral_eta @ eta_a)
+                     + q_pa / v_m_s * (self.side_dihedral_etadot @ eta_a_dot))
+
+    def yaw_n_m(self, q_pa: float, v_m_s: float, wing_lift_n: float, p_rad_s: float,
+                eta_a_dot, eta_s, roll_n_m: float) -> float:
+        """The yawing moment of the deformation [N·m, body +z, nose right]; ``roll_n_m`` the
+        elastic rolling moment of the same step (its lift's induced drag)."""
+        return float(wing_lift_n / v_m_s * (self.yaw_etadot @ eta_a_dot)
+                     + q_pa * p_rad_s / v_m_s * (self.yaw_p_s @ eta_s)
+                     - self.induced_per_lift * wing_lift_n / q_pa * roll_n_m)
+
+
+def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, planform,
+                       span_m: float) -> YawSideslipTerms:
+    """:class:`YawSideslipTerms` of ``wing``'s strips and antisymmetric modes with the
+    first ``n_symmetric`` modes of ``symmetric`` (the half wing's ModalData, the same sign
+    conventions: bending down, twist leading edge up), the planform's dihedral and the
+    wing's span ``span_m`` [m]."""
+    y, w = wing.stations_m, wing.weights_m
+    clac_w = wing.cl_alpha_c_m * w  # a c w: a strip's lift per Pa per rad [m²]
+    share = clac_w / (2.0 * clac_w.sum())  # a strip's part of the wing's lift [-]
+    work = wing.e_m * wing.theta - wing.phi  # (n_a, K) upward AC displacement per unit η
+    ns = int(n_symmetric)
+    st = symmetric.stations_m
+    theta_s = np.array([np.interp(y, st, t) for t in symmetric.twist_rad[:ns]])
+    slope_s = _slope_at(st, symmetric.bending_m[:ns], y)  # (n_s, K) down per outboard
+    slope_a = _slope_at(wing.modes.stations_m, wing.modes.bending_m, y)
+    gamma = dihedral_rad(planform, y)
+    return YawSideslipTerms(
+        force_r=-2.0 * work @ (y * share),
+        force_beta=work @ (clac_w * gamma),
+        force_beta_s=-np.einsum("ik,jk,k->ij", work, slope_s, clac_w),
+        roll_r_s=4.0 * theta_s @ (clac_w * y * y),
+        roll_beta_s=2.0 * slope_s @ (clac_w * y),
+        side_eta=2.0 * slope_a @ share,
+        side_dihedral_eta=-2.0 * wing.theta @ (clac_w * gamma),
+        side_dihedral_etadot=-2.0 * wing.phi @ (clac_w * gamma),
+        yaw_etadot=-2.0 * wing.phi @ (share * y),
+        yaw_p_s=-2.0 * theta_s @ (clac_w * y * y),
+        induced_per_lift=1.0 / (np.pi * float(span_m) ** 2))

@@ -5,8 +5,8 @@ lengths, the simplest estimator, gives per-step costs below zero (ratio min −0
 median of 2.3) when one of the two runs is slowed. Here:
 
 * every configuration is timed at several run lengths N_j (``steps`` × 1, 2, 4; the unsteady
-  wing's 4 times longer, :data:`LENGTH_SCALE`), the lengths and the configurations
-  interleaved, ``repeat`` times, on two clocks: the process's CPU time
+  wing's 4 times longer and the full-span run's 64 times, :data:`LENGTH_SCALE`), the lengths
+  and the configurations interleaved, ``repeat`` times, on two clocks: the process's CPU time
   (``time.process_time``: what the code costs; a run preempted by another engineer's job is
   not charged for the wait) and the wall clock;
 * :func:`estimate_per_step`: noise on a shared machine only ever adds time, so the fit is
@@ -84,7 +84,11 @@ MAX_SPREAD = 0.20
 # and the Fréchet derivative), ~25 times the quasi-steady run's fixed cost: its runs are 4
 # times longer, or the fixed cost's own noise (±10 ms under load) bends the line (residual
 # 11 % at 1200-4800 steps, measured).
-LENGTH_SCALE = {"unsteady": 4}
+# A full-span run's set-up (the antisymmetric modes' beam solve, both wings' first reference
+# steps) costs 60-125 ms per run, measured under load 4: at 300-1200 steps (3-12 ms of
+# stepping) its noise alone leaves the figure not trusted (residual 22 %, or 45-126 % between
+# groups); at 64 times longer (0.2-0.8 s of stepping) it was trusted (1.90 under load 4).
+LENGTH_SCALE = {"unsteady": 4, "full_span": 64}
 # An estimate is trusted when the least times lie on a line within 10 % (rms) of their
 # mean (a run of a few thousand steps under load 4-5 on 2 cores: 1-6 % measured) and the
 # slope agrees with the least per-repeat cost within 25 %.

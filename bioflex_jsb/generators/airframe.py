@@ -88,6 +88,9 @@ property                                          unit    direction and point of
 ``external_reactions/modal-pitch/magnitude-lbsft`` lbs*ft moment about body +y (nose up)
 ``external_reactions/modal-roll/magnitude-lbsft``  lbs*ft moment about body +x (right wing
                                                           down)
+``external_reactions/modal-side/magnitude``       lbs     force along body +y (to starboard),
+                                                          at the CG
+``external_reactions/modal-yaw/magnitude-lbsft``  lbs*ft moment about body +z (nose right)
 ``external_reactions/gust-lift/magnitude``        lbs     force along body −z (up), at the CG
 ``external_reactions/gust-pitch/magnitude-lbsft`` lbs*ft moment about body +y (nose up)
 ``external_reactions/gust-roll/magnitude-lbsft``  lbs*ft moment about body +x (right wing
@@ -155,12 +158,15 @@ EXTERNAL_FORCES = {
     # name: (body-axis unit direction, description)
     "modal-lift": ((0.0, 0.0, -1.0), "force along body -z (up) at the CG [lbs]"),
     "modal-drag": ((-1.0, 0.0, 0.0), "force along body -x (aft) at the CG [lbs]"),
+    # the antisymmetric modes' side force (simulation/full_span.py)
+    "modal-side": ((0.0, 1.0, 0.0), "force along body +y (to starboard) at the CG [lbs]"),
     # the gust's loads that JSBSim's uniform wind does not give (runtime/gust_loads.py)
     "gust-lift": ((0.0, 0.0, -1.0), "gust: tail lift of its delay, body -z (up) at the CG [lbs]"),
 }
 EXTERNAL_MOMENTS = {
     "modal-pitch": ((0.0, 1.0, 0.0), "moment about body +y, nose up [lbs*ft]"),
     "modal-roll": ((1.0, 0.0, 0.0), "moment about body +x, right wing down [lbs*ft]"),
+    "modal-yaw": ((0.0, 0.0, 1.0), "moment about body +z, nose right [lbs*ft]"),
     "gust-pitch": ((0.0, 1.0, 0.0), "gust: tail delay's moment about body +y, nose up [lbs*ft]"),
     "gust-roll": ((1.0, 0.0, 0.0), "gust: rolling gust's moment about body +x [lbs*ft]"),
     "gust-yaw": ((0.0, 0.0, 1.0), "gust: rolling gust's moment about body +z, nose right "

@@ -284,10 +284,11 @@ def alpha_limits_rad(path: Path) -> tuple[float, float]:
 
 
 # -- the modal wing's hooks, the α range of the aircraft -------------------------------------
-# The co-simulation writes the elastic wing's incremental loads into four external reactions
-# (bioflex_jsb.generators.airframe: modal-lift, modal-drag at the CG, body axes; modal-pitch,
-# modal-roll moments). The generated prototype has them in its XML; another aircraft gets the
-# same four in its private copy, at its CG (structural frame, metres to inches).
+# The co-simulation writes the elastic wing's incremental loads into external reactions
+# (bioflex_jsb.generators.airframe: modal-lift, modal-drag, modal-side forces at the CG, body
+# axes; modal-pitch, modal-roll, modal-yaw moments; and the gust's). The generated prototype
+# has them in its XML; another aircraft gets the same ones in its private copy, at its CG
+# (structural frame, metres to inches).
 INCH_PER_M = 1.0 / 0.0254  # the inch is 0.0254 m exactly
 
 

@@ -428,19 +428,25 @@ class Airframe:
         drag_n: float = 0.0,
         pitch_moment_n_m: float = 0.0,
         roll_moment_n_m: float = 0.0,
+        side_force_n: float = 0.0,
+        yaw_moment_n_m: float = 0.0,
     ) -> None:
         """Set the external-reaction hooks (see :mod:`bioflex_jsb.generators.airframe`).
 
         lift_n: force along body −z (up) [N]; drag_n: along body −x (aft) [N];
         pitch_moment_n_m: about body +y, nose up [N·m]; roll_moment_n_m: about body +x,
-        right wing down [N·m]. They act from the next time step on, in the flying instance
-        and in the trim companion (so that a trim carries them: the elastic trim).
+        right wing down [N·m]; side_force_n: along body +y (to starboard) [N];
+        yaw_moment_n_m: about body +z, nose right [N·m]. They act from the next time step
+        on, in the flying instance and in the trim companion (so that a trim carries them:
+        the elastic trim).
         """
         prop = airframe_xml.external_property
         values = {"modal-lift": float(lift_n) * U.LBF_PER_N,
                   "modal-drag": float(drag_n) * U.LBF_PER_N,
                   "modal-pitch": float(pitch_moment_n_m) * U.LBF_FT_PER_N_M,
-                  "modal-roll": float(roll_moment_n_m) * U.LBF_FT_PER_N_M}
+                  "modal-roll": float(roll_moment_n_m) * U.LBF_FT_PER_N_M,
+                  "modal-side": float(side_force_n) * U.LBF_PER_N,
+                  "modal-yaw": float(yaw_moment_n_m) * U.LBF_FT_PER_N_M}
         for fdm in self._instances():
             manager = fdm.get_property_manager()
             for name, value in values.items():

@@ -6,9 +6,12 @@ the antisymmetric modal wing of the run's build on the JSBSim airframe's roll in
 (:func:`~bioflex_jsb.flight_dynamics.lateral_elastic.antisymmetric_wing`), adds its channels
 to the row, steps it (the Python reference, or the compiled
 :func:`~bioflex_jsb.simulation.full_span_kernel.full_span_kernel` in one call with the half
-wing's), reads JSBSim's two aileron positions and writes its rolling moment to
-``external_reactions/modal-roll`` each step. Per step it costs two property reads, one write
-and the antisymmetric modes' arithmetic (``bioflex-jsb bench``).
+wing's), reads JSBSim's two aileron positions and writes its rolling moment, side force and
+yawing moment to ``external_reactions/modal-roll``, ``modal-side`` and ``modal-yaw`` each
+step. Per step it costs two property reads, three writes and the antisymmetric modes'
+arithmetic (``bioflex-jsb bench``). The wing's lift L_w = n_z W of the yaw rate's terms
+takes the aircraft's weight W from JSBSim's mass once, at set-up (a run's fuel burn is not
+followed).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 from bioflex_jsb import units as U
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.generators.airframe import external_property
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
@@ -53,7 +57,10 @@ class FullSpanSteps:
         :attr:`units`, the aileron readers and the roll writer bound."""
         if span == "half":
             return None
-        from bioflex_jsb.aeroelasticity.antisymmetric_strips import antisymmetric_strips
+        from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
+            antisymmetric_strips,
+            yaw_sideslip_terms,
+        )
         from bioflex_jsb.flight_dynamics.lateral_elastic import antisymmetric_wing
         from bioflex_jsb.simulation.full_span import (
             AntisymmetricModalWing,
@@ -69,13 +76,23 @@ class FullSpanSteps:
         wing_a = antisymmetric_wing(build, ixx)
         strips = antisymmetric_strips(wing_a, aileron, np.asarray(build.aero.chord_m))
         sym_tip = np.asarray(build.modes.twist_rad, dtype=float)[:self.n_modes, -1]
+        terms = yaw_sideslip_terms(wing_a, build.modes, self.n_modes, build.planform,
+                                   2.0 * float(build.aero.semispan_m))
         lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
-                                         refresh_rel=getattr(self.wing, "refresh_rel", 0.05))
+                                         refresh_rel=getattr(self.wing, "refresh_rel", 0.05),
+                                         terms=terms)
+        # the aircraft's weight [N] (L_w = n_z W) and the symmetric trim deflection [rad]
+        self._weight_n = (airframe[JP.INERTIA_MASS_SLUGS] * U.KG_PER_SLUG
+                          * STANDARD_GRAVITY_M_S2)
+        self._static_eta_s = np.asarray(getattr(self.wing, "static_eta",
+                                                np.zeros(self.n_modes)), dtype=float).copy()
         self.units.update(lateral_channel_units(lateral.n_modes))
         node = airframe.property_node
         self._get_left_aileron = node(AILERON_PROPERTIES[0]).get_double_value
         self._get_right_aileron = node(AILERON_PROPERTIES[1]).get_double_value
         self._set_roll = node(external_property("modal-roll")).set_double_value
+        self._set_side = node(external_property("modal-side")).set_double_value
+        self._set_yaw = node(external_property("modal-yaw")).set_double_value
         zeros = np.zeros(lateral.n_modes)
         self._lateral_row = lateral.row(0.0, 0.0, zeros, zeros, np.zeros(self.n_modes))
         self.antisymmetric_wing = wing_a
@@ -92,10 +109,19 @@ class FullSpanSteps:
         aileron = 0.5 * (self._get_left_aileron() - self._get_right_aileron())
         eta_a, eta_a_dot = lat.eta.copy(), lat.eta_dot.copy()
         q_pa, v = f.dynamic_pressure_pa, f.airspeed_m_s
-        lat.step(q_pa, v, LateralInputs(state.p_rad_s, aileron, float(p_g_rad_s)))
-        moment = lat.roll_moment_n_m(q_pa, v)
+        lift = state.n_z * self._weight_n
+        static = self._static_eta_s
+        inputs = LateralInputs(state.p_rad_s, aileron, float(p_g_rad_s), state.r_rad_s,
+                               state.beta_rad, lift, static + np.asarray(eta_s))
+        lat.step(q_pa, v, inputs)
+        # the loads of η_{k+1} with the symmetric wing's η_{k+1} (stepped before this one)
+        after = LateralInputs(state.p_rad_s, aileron, float(p_g_rad_s), state.r_rad_s,
+                              state.beta_rad, lift, static + self.wing.eta)
+        moment, side, yaw = lat.reactions(q_pa, v, after)
         self._set_roll(moment * U.LBF_FT_PER_N_M)
-        self._lateral_row = lat.row(aileron, moment, eta_a, eta_a_dot, eta_s)
+        self._set_side(side * U.LBF_PER_N)
+        self._set_yaw(yaw * U.LBF_FT_PER_N_M)
+        self._lateral_row = lat.row(aileron, moment, eta_a, eta_a_dot, eta_s, side, yaw)
 
     def _renew_lateral(self, q_pa: float, v_m_s: float) -> None:
         """Renew the antisymmetric wing's reference step at (Q, V) (with the half wing's)."""
@@ -107,6 +133,7 @@ class FullSpanSteps:
             lv = self._lat_views
             lv["stack"][:] = np.ravel(lat._stack)
             lv["input_cols"][:] = np.ravel(lat._input_cols)
+            lv["force_map"][:] = np.ravel(lat._force_map)
             lv["key"][:] = lat._key
 
     def _switch_lateral(self, model: str) -> None:
@@ -141,15 +168,13 @@ class FullSpanSteps:
         n_a = lat.n_modes
         s = lat.strips
         sym_size = self._params.size
-        lay = FK.lateral_layout(n_a)
+        lay = FK.lateral_layout(n_a, n_s)
         block = FK.lateral_block_size(n_a, n_s)
         params = np.zeros(sym_size + block + FK.N_DIMS)
         params[:sym_size] = self._params
         self._params = params
         self._views = {name: params[o:o + size] for name, (o, size) in K.layout(n_s).items()}
         lv = {name: params[sym_size + o:sym_size + o + size] for name, (o, size) in lay.items()}
-        end = sym_size + block
-        lv["tip_sym"] = params[end - n_s:end]
         lv["force_eta"][:] = np.ravel(s.force_eta)
         lv["force_p"][:] = s.force_p
         lv["force_delta"][:] = s.force_delta
@@ -159,13 +184,20 @@ class FullSpanSteps:
         lv["tip_anti"][:] = s.tip_twist_rad
         lv["tip_sym"][:] = lat.symmetric_tip_twist_rad
         lv["model"][0] = K.MODEL_CODES[lat.model]
+        t = lat.terms
         lv["consts"][:] = (lat.refresh_rel, U.M_PER_FT, U.KG_M3_PER_SLUG_FT3,
-                           U.LBF_FT_PER_N_M, ETA_LIMIT_RAD)
+                           U.LBF_FT_PER_N_M, ETA_LIMIT_RAD, U.LBF_PER_N, self._weight_n,
+                           t.induced_per_lift)
+        for name in ("force_r", "force_beta", "force_beta_s", "roll_r_s", "roll_beta_s",
+                     "side_eta", "side_dihedral_eta", "side_dihedral_etadot", "yaw_etadot",
+                     "yaw_p_s"):
+            lv[name][:] = np.ravel(getattr(t, name))
+        lv["static_s"][:] = self._static_eta_s
         lv["key"][:] = np.nan  # no reference yet: the first step asks for one
         self._lat_views = lv
         lay_s = K.layout(n_s)
         params[-FK.N_DIMS:] = (sym_size, self._cols.size, n_s, n_a, lay_s["out_flow"][0])
-        self._reactions = lv["reactions"]  # lift, drag, pitch, roll (lbf, lbf·ft)
+        self._reactions = lv["reactions"]  # lift, drag, pitch, roll, side, yaw (lbf, lbf·ft)
         self._out_flow = self._views["out_flow"]
         x = np.zeros(2 * n_s + 2 * n_a)
         x[:2 * n_s] = self.wing._x
@@ -182,7 +214,7 @@ class FullSpanSteps:
 
     def _bind_full_span_step(self, before_control=None):
         """The compiled full-span step as a closure (CoupledStep._bind_fast_step's, with the
-        two aileron reads, the gust roll rate and the roll moment's write):
+        two aileron reads, the gust roll rate and the roll, side and yaw writes):
         ``fast(w_g_m_s, table, k, p_g_rad_s=0.0) -> stopped``; ``before_control`` as there
         (the sensor channels, written before the controller reads them)."""
         from bioflex_jsb.simulation.controller_kernel import linear_step
@@ -198,7 +230,7 @@ class FullSpanSteps:
         checked, call = None, kernel
         set_wind, jsbsim_step, agl = self._set_wind, self.airframe.step_function(), self._agl_m
         set_lift, set_drag, set_pitch = self._set_reactions
-        set_roll = self._set_roll
+        set_roll, set_side, set_yaw = self._set_roll, self._set_side, self._set_yaw
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
         control = self._control_step
@@ -224,11 +256,14 @@ class FullSpanSteps:
             if status == needs_refresh:
                 self._renew_reference()
                 status = call(reads, params, x, cols, table, k, wind_down_fps, w_g_m_s)
-            lift_lbf, drag_lbf, pitch_lbf_ft, roll_lbf_ft = reactions.tolist()
+            lift_lbf, drag_lbf, pitch_lbf_ft, roll_lbf_ft, side_lbf, yaw_lbf_ft = (
+                reactions.tolist())
             set_lift(lift_lbf)
             set_drag(drag_lbf)
             set_pitch(pitch_lbf_ft)
             set_roll(roll_lbf_ft)
+            set_side(side_lbf)
+            set_yaw(yaw_lbf_ft)
             if before_control is not None:
                 before_control(table, k)
             if c_call is not None:

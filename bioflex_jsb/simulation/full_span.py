@@ -30,8 +30,45 @@ the flow of t_k, η̇_a = 0; ``rigid``: no antisymmetric wing (η_a = 0, no mome
 No double count: the rigid wing's roll damping and the aileron's own rolling moment are
 JSBSim's (C_lp, C_lδa in its rigid tables); ΔL is the lift of the deformation alone, which is
 also how the aileron's loss of effectiveness (its twist of the wing) reaches the airframe.
-Left out: the modes' side force and yawing moment (the asymmetric induced drag), β and r on
-the strips, unsteady strips for the antisymmetric modes.
+
+**Yaw rate, sideslip, side force and yawing moment** (:class:`~bioflex_jsb.aeroelasticity
+.antisymmetric_strips.YawSideslipTerms`). Each starboard strip at y has the lift
+l(y) = l_r(y) + l_e(y): the rigid wing's, taken as the wing's lift L_w = n_z W (JSBSim's
+load factor and weight: the wing carries the aircraft's normal load, the tail's share left
+out) spread as the strips' additional loading a c(y) / (2 Σ a c w), and the symmetric
+deflection's, l_e = Q a c θ_s η_s (η_s the trim's static deflection plus Δη_s). The port
+strip mirrors it. First order in the lateral quantities:
+
+* yaw rate r [rad/s, nose right]: the strip's airspeed is V − r y, its lift l (1 − 2 r y/V);
+  the rolling moment of l_r (C_lr) is JSBSim's, the strips add that of l_e,
+  ΔL_r = (4 Q r/V) Σ y² a c w θ_s η_s, and force the antisymmetric modes with all of it,
+  −2 (r/V) Σ (e θ − φ) y l w;
+* sideslip β [rad, wind from the right]: each half's angle of attack changes by ±β Γ(y)
+  (starboard +), Γ the geometric dihedral less the bending slope of the symmetric
+  deflection, Γ = Γ_g − dφ_s/dy η_s; the geometric part's rolling moment is JSBSim's
+  (C_lβ), the strips add that of the bending slope, ΔL_β = 2 Q β Σ y a c w dφ_s/dy η_s, and
+  force the modes with both;
+* side force [N, body +y]: the lift of a half bent antisymmetrically leans with its local
+  slope, Y = 2 L_w Σ s dφ_a/dy η_a (s a strip's share), and the deformation's own lift on
+  the geometric dihedral, −2 Σ Δl_e Γ_g (a rigid wing's antisymmetric lift on its dihedral,
+  C_Yp, is JSBSim's);
+* yawing moment [N·m, body +z, nose right]: a strip's lift leans forward by its local
+  upwash angle, the plunge rate φ_a η̇_a/V of the antisymmetric modes on the lift l,
+  −2 (L_w/V) Σ s y φ_a η̇_a, and the roll rate's p y/V on l_e, −2 (Q p/V) Σ y² a c w θ_s η_s
+  (the rigid lift's, C_np, is JSBSim's); and back by the trim's induced angle
+  α_i = L_w/(Q π b²) (elliptic loading), the deformation's lift's induced drag,
+  ΔN = −α_i ΔL (ΔL all the elastic rolling moment: less lift on a half, less drag there).
+
+These go to JSBSim beside modal-roll: ΔL_r + ΔL_β into modal-roll, Y into ``modal-side``,
+N into ``modal-yaw`` (external_reactions; N, N·m turned into lbf, lbf·ft at the boundary),
+computed as ΔL with η_{k+1} in the flow, r, β and n_z of t_k; the forcing enters the modal
+step as the aileron's does (held over the step). With nothing lateral (r = β = 0,
+η_a = 0) every one is zero: the symmetric runs are unchanged. Left out: the side force's
+moment arm (the wing's aerodynamic centre is taken at the CG, where the reaction acts),
+the products of two lateral quantities (β η_a, r η_a: symmetric loads), the plunge rate of
+the symmetric modes under r and β, the drag's own change with V − r y (C_nr of the rigid
+drag is JSBSim's) and the change of the induced angle the deformation's lift makes (a
+lattice term), unsteady strips for the antisymmetric modes.
 """
 
 from __future__ import annotations
@@ -41,14 +78,17 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm, expm_frechet
 
-from bioflex_jsb.aeroelasticity.antisymmetric_strips import AntisymmetricStrips
+from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
+    AntisymmetricStrips,
+    YawSideslipTerms,
+)
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.simulation.modal_wing import WING_MODELS, one_blas_thread
 
 # The channels of a full-span run, after the half wing's (their meanings:
 # simulation/channels.py describe)
 LATERAL_FIXED = ("aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad",
-                 "tip_twist_port_rad")
+                 "tip_twist_port_rad", "modal_side_n", "modal_yaw_n_m")
 
 
 def lateral_names(n_modes: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -62,7 +102,7 @@ def lateral_channel_units(n_modes: int) -> dict[str, str]:
     """The full-span run's extra channels and their units, in the row's order."""
     eta, eta_dot = lateral_names(n_modes)
     units = {"aileron_rad": "rad", "modal_roll_n_m": "N*m", "tip_twist_starboard_rad": "rad",
-             "tip_twist_port_rad": "rad"}
+             "tip_twist_port_rad": "rad", "modal_side_n": "N", "modal_yaw_n_m": "N*m"}
     units.update({n: "rad" for n in eta})
     units.update({n: "rad/s" for n in eta_dot})
     return units
@@ -72,20 +112,29 @@ def lateral_channel_units(n_modes: int) -> dict[str, str]:
 class LateralInputs:
     """What the antisymmetric strips see at t_k: ``p_rad_s`` the body roll rate [rad/s, right
     wing down], ``aileron_rad`` JSBSim's δa = ½ (δ_left − δ_right) [rad, + rolls right],
-    ``p_g_rad_s`` the gust roll rate [rad/s] (antisymmetric_strips' sign)."""
+    ``p_g_rad_s`` the gust roll rate [rad/s] (antisymmetric_strips' sign); ``r_rad_s`` the
+    yaw rate [rad/s, nose right], ``beta_rad`` the sideslip [rad, wind from the right],
+    ``wing_lift_n`` the wing's lift n_z W [N], ``eta_s`` the symmetric modes' total
+    deflection [rad] (static plus Δη_s; None: undeformed)."""
 
     p_rad_s: float
     aileron_rad: float
     p_g_rad_s: float = 0.0
+    r_rad_s: float = 0.0
+    beta_rad: float = 0.0
+    wing_lift_n: float = 0.0
+    eta_s: tuple | np.ndarray | None = None
 
 
 class AntisymmetricModalWing:
     """The antisymmetric modal state [η_a, η̇_a] and its step (module docstring); the
     readable reference of the compiled kernel. ``model`` rigid, coupled or qsd (the run's);
-    ``symmetric_tip_twist_rad`` (n_s,) the symmetric modes' tip twist per unit η_s [rad]."""
+    ``symmetric_tip_twist_rad`` (n_s,) the symmetric modes' tip twist per unit η_s [rad];
+    ``terms`` the yaw rate's, sideslip's, side force's and yawing moment's (None: none)."""
 
     def __init__(self, strips: AntisymmetricStrips, model: str, dt_s: float,
-                 symmetric_tip_twist_rad, refresh_rel: float = 0.05) -> None:
+                 symmetric_tip_twist_rad, refresh_rel: float = 0.05,
+                 terms: YawSideslipTerms | None = None) -> None:
         if model not in WING_MODELS:
             raise InputError(f"unknown wing model {model!r}; accepted: {', '.join(WING_MODELS)}")
         self.strips = strips
@@ -98,6 +147,9 @@ class AntisymmetricModalWing:
         self._key: tuple[float, float] | None = None
         self._stack = np.zeros((6 * self.n_modes, 2 * self.n_modes))
         self._input_cols = np.zeros((2 * self.n_modes, 2))
+        self.terms = terms
+        # [η_a, η̇_a]_{k+1} per unit generalised force held over the step [1/(N·m)]
+        self._force_map = np.zeros((2 * self.n_modes, self.n_modes))
 
     @property
     def eta(self) -> np.ndarray:
@@ -130,6 +182,7 @@ class AntisymmetricModalWing:
                 expm_frechet(a * self.dt_s, d_q * self.dt_s, compute_expm=False),
                 expm_frechet(a * self.dt_s, d_qv * self.dt_s, compute_expm=False)])
             self._input_cols = psi @ s.forcing_columns()
+            self._force_map = psi[:, n:] / s.mass_kg_m2[None, :]
             self._key = (float(q_pa), float(v_m_s))
 
     def needs_reference(self, q_pa: float, v_m_s: float) -> bool:
@@ -145,9 +198,14 @@ class AntisymmetricModalWing:
         qv = q_pa / v_m_s
         delta_s = -inputs.aileron_rad
         rel_p = inputs.p_rad_s - inputs.p_g_rad_s
+        force = self.forcing_n_m(q_pa, v_m_s, inputs)
         if self.model == "qsd":
-            self._x = np.concatenate([self.strips.quasi_static_eta(q_pa, qv, delta_s, rel_p),
-                                      np.zeros(self.n_modes)])
+            s = self.strips
+            k = np.diag(s.mass_kg_m2 * s.omega_rad_s**2) - q_pa * s.force_eta
+            eta = s.quasi_static_eta(q_pa, qv, delta_s, rel_p)
+            if force is not None:
+                eta = eta + np.linalg.solve(k, force)
+            self._x = np.concatenate([eta, np.zeros(self.n_modes)])
             return
         if self.needs_reference(q_pa, v_m_s):
             self.reference(q_pa, v_m_s)
@@ -157,6 +215,37 @@ class AntisymmetricModalWing:
         f = np.array([q_pa * delta_s, qv * rel_p])
         self._x = (y[:n2] + (q_pa - q_r) * y[n2:2 * n2] + (qv - q_r / v_r) * y[2 * n2:]
                    + self._input_cols @ f)
+        if force is not None:
+            self._x = self._x + self._force_map @ force
+
+    def forcing_n_m(self, q_pa: float, v_m_s: float, inputs: LateralInputs):
+        """The yaw rate's and sideslip's generalised force on the modes [N·m] (None: no
+        terms)."""
+        if self.terms is None:
+            return None
+        return self.terms.forcing(q_pa, v_m_s, inputs.wing_lift_n, inputs.r_rad_s,
+                                  inputs.beta_rad, self._symmetric(inputs.eta_s))
+
+    def _symmetric(self, eta_s) -> np.ndarray:
+        n_s = self.symmetric_tip_twist_rad.size
+        return np.zeros(n_s) if eta_s is None else np.asarray(eta_s, dtype=float)
+
+    def reactions(self, q_pa: float, v_m_s: float, inputs: LateralInputs
+                  ) -> tuple[float, float, float]:
+        """(rolling moment [N·m, right wing down], side force [N, body +y], yawing moment
+        [N·m, nose right]) of the current state in the flow (Q, V) and ``inputs`` (its
+        ``eta_s`` the symmetric deflection of the same instant): ΔL, plus the yaw rate's and
+        sideslip's, and the side force and yawing moment (module docstring)."""
+        roll = self.roll_moment_n_m(q_pa, v_m_s)
+        t = self.terms
+        if self.model == "rigid" or t is None:
+            return roll, 0.0, 0.0
+        eta_s = self._symmetric(inputs.eta_s)
+        roll += t.roll_n_m(q_pa, v_m_s, inputs.r_rad_s, inputs.beta_rad, eta_s)
+        side = t.side_n(q_pa, v_m_s, inputs.wing_lift_n, self.eta, self.eta_dot)
+        yaw = t.yaw_n_m(q_pa, v_m_s, inputs.wing_lift_n, inputs.p_rad_s, self.eta_dot, eta_s,
+                        roll)
+        return roll, side, yaw
 
     def roll_moment_n_m(self, q_pa: float, v_m_s: float) -> float:
         """ΔL of the current state in the flow (Q, V) [N·m, right wing down]."""
@@ -165,14 +254,17 @@ class AntisymmetricModalWing:
         s = self.strips
         return float(q_pa * (s.roll_eta @ self.eta) + q_pa / v_m_s * (s.roll_etadot @ self.eta_dot))
 
-    def row(self, aileron_rad: float, moment_n_m: float, eta_a, eta_a_dot, eta_s) -> dict:
+    def row(self, aileron_rad: float, moment_n_m: float, eta_a, eta_a_dot, eta_s,
+            side_n: float = 0.0, yaw_n_m: float = 0.0) -> dict:
         """The extra channels of a row: the aileron δa, the moment applied over the step,
-        the tip twists and η_a, η̇_a of t_k (before the step), η_s of t_k."""
+        the tip twists and η_a, η̇_a of t_k (before the step), η_s of t_k, the side force and
+        yawing moment applied over the step."""
         sym = float(self.symmetric_tip_twist_rad @ np.asarray(eta_s, dtype=float))
         anti = float(self.strips.tip_twist_rad @ np.asarray(eta_a, dtype=float))
         eta, eta_dot = lateral_names(self.n_modes)
         row = {"aileron_rad": aileron_rad, "modal_roll_n_m": moment_n_m,
-               "tip_twist_starboard_rad": sym + anti, "tip_twist_port_rad": sym - anti}
+               "tip_twist_starboard_rad": sym + anti, "tip_twist_port_rad": sym - anti,
+               "modal_side_n": side_n, "modal_yaw_n_m": yaw_n_m}
         row.update(zip(eta, (float(v) for v in eta_a), strict=True))
         row.update(zip(eta_dot, (float(v) for v in eta_a_dot), strict=True))
         return row

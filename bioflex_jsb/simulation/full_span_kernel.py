@@ -8,7 +8,8 @@ state and columns of both wings end to end: the half wing's block first (its own
 is), the antisymmetric block after it (:func:`lateral_layout`) and :data:`N_DIMS` sizes
 last. It does the arithmetic of :class:`~bioflex_jsb.simulation.full_span
 .AntisymmetricModalWing` (the reference it is tested against): the antisymmetric modal step
-with the flow of t_k, the rolling moment of η_{k+1} into the reactions (lbf·ft) and the
+with the flow of t_k (the yaw rate's and sideslip's forcing with it), the rolling moment,
+side force and yawing moment of η_{k+1} into the reactions (lbf·ft, lbf, lbf·ft) and the
 row's full-span channels. A half-wing run does not call it (its step is unchanged).
 """
 
@@ -26,16 +27,26 @@ from bioflex_jsb.simulation import step_kernel as K
 # the step's input).
 EXTRA_READS = ("left_aileron", "right_aileron", "p_g")
 N_DIMS = 5  # the sizes at the end of params: (half wing's params, its cols, n_s, n_a, out_flow)
-N_LAT_CONSTS = 5  # refresh_rel, ft→m, slug/ft³→kg/m³, N·m→lbf·ft, η limit [rad]
+# refresh_rel, ft→m, slug/ft³→kg/m³, N·m→lbf·ft, η limit [rad], N→lbf, the weight W [N],
+# 1/(π b²) [1/m²] (the induced angle per unit L_w/Q)
+N_LAT_CONSTS = 8
+N_FIXED = 6  # the full-span row's fixed channels (full_span.LATERAL_FIXED)
+BETA_SLOT = K.KERNEL_SLOTS.index("beta_rad")  # the row's β [rad], written by the half wing's
 
 
-def lateral_layout(n_modes: int) -> dict[str, tuple[int, int]]:
-    """The antisymmetric block (``n_modes`` antisymmetric modes), offsets from its start."""
-    n, n2 = n_modes, 2 * n_modes
+def lateral_layout(n_modes: int, n_symmetric: int) -> dict[str, tuple[int, int]]:
+    """The antisymmetric block (``n_modes`` antisymmetric, ``n_symmetric`` symmetric
+    modes), offsets from its start; the yaw rate's and sideslip's terms are
+    :class:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.YawSideslipTerms`' arrays."""
+    n, n2, ns = n_modes, 2 * n_modes, n_symmetric
     sizes = (("stack", 3 * n2 * n2), ("input_cols", n2 * 2), ("key", 2),
              ("force_eta", n * n), ("force_p", n), ("force_delta", n), ("stiffness", n),
              ("roll_eta", n), ("roll_etadot", n), ("tip_anti", n), ("model", 1),
-             ("reactions", 4), ("consts", N_LAT_CONSTS), ("scratch", n2))
+             ("reactions", 6), ("consts", N_LAT_CONSTS), ("scratch", n2 + n),
+             ("force_map", n2 * n), ("force_r", n), ("force_beta", n), ("force_beta_s", n * ns),
+             ("roll_r_s", ns), ("roll_beta_s", ns), ("side_eta", n), ("side_dihedral_eta", n),
+             ("side_dihedral_etadot", n), ("yaw_etadot", n), ("yaw_p_s", ns),
+             ("static_s", ns), ("tip_sym", ns))
     out, offset = {}, 0
     for name, size in sizes:
         out[name] = (offset, size)
@@ -44,8 +55,8 @@ def lateral_layout(n_modes: int) -> dict[str, tuple[int, int]]:
 
 
 def lateral_block_size(n_modes: int, n_symmetric: int) -> int:
-    """The antisymmetric block's length with the symmetric tip twists (n_symmetric)."""
-    return sum(s for _, s in lateral_layout(n_modes).values()) + n_symmetric
+    """The antisymmetric block's length."""
+    return sum(s for _, s in lateral_layout(n_modes, n_symmetric).values())
 
 
 @numba.njit(cache=True, nogil=True)
@@ -60,6 +71,7 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     na = int(params[size - 2])
     o_flow = int(params[size - 1])  # the half wing's out_flow block
     n2s, n2a = 2 * ns, 2 * na
+    # the offsets of lateral_layout, in its order
     o_stack = p_sym
     o_in = o_stack + 3 * n2a * n2a
     o_key = o_in + 2 * n2a
@@ -72,9 +84,21 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     o_ta = o_rd + na
     o_model = o_ta + na
     o_rx = o_model + 1
-    o_c = o_rx + 4
+    o_c = o_rx + 6
     o_scr = o_c + N_LAT_CONSTS
-    o_ts = o_scr + n2a  # the symmetric modes' tip twist per unit η_s
+    o_fm = o_scr + n2a + na
+    o_fr = o_fm + n2a * na
+    o_fb = o_fr + na
+    o_fbs = o_fb + na
+    o_rrs = o_fbs + na * ns
+    o_rbs = o_rrs + ns
+    o_se = o_rbs + ns
+    o_sge = o_se + na
+    o_sgd = o_sge + na
+    o_yd = o_sgd + na
+    o_yps = o_yd + na
+    o_ss = o_yps + ns
+    o_ts = o_ss + ns  # the symmetric modes' tip twist per unit η_s
     model = int(params[o_model])
     key0, key1 = params[o_key], params[o_key + 1]
     # Both references are renewed together at one flow (CoupledStep._renew_reference), so
@@ -92,13 +116,20 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     base = c_sym  # the full-span channels' columns: LATERAL_FIXED, η_a, η̇_a
     row = table[k]
     for i in range(n2a):
-        row[cols[base + 4 + i]] = xa[i]
+        row[cols[base + N_FIXED + i]] = xa[i]
     tip = 0.0
     for i in range(ns):  # η_s of t_k, before the half wing's step
         tip += params[o_ts + i] * xs[i]
     anti = 0.0
     for i in range(na):
         anti += params[o_ta + i] * xa[i]
+    # the sideslip's forcing's symmetric part with η_s of t_k: Σ_j F^βs_ij (η_static + Δη)_j
+    o_g = o_scr + n2a  # the generalised force on the antisymmetric modes [N·m]
+    for i in range(na):
+        acc = 0.0
+        for j in range(ns):
+            acc += params[o_fbs + ns * i + j] * (params[o_ss + j] + xs[j])
+        params[o_g + i] = acc
     status = K.step_kernel(reads, params[:p_sym], xs, cols[:c_sym], table, k, wind_down_fps,
                            w_g)
     if status == K.NEEDS_REFRESH:
@@ -107,7 +138,13 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     aileron = 0.5 * (reads[20] - reads[21])  # JSBSim's δa: + rolls right
     delta_s = -aileron  # the starboard surface, trailing edge down
     qv = qbar / vt
-    rel_p = reads[4] - reads[22]
+    p_rate, r_rate = reads[4], reads[5]
+    rel_p = p_rate - reads[22]
+    beta = row[cols[BETA_SLOT]]  # the row's β of t_k (step_kernel.finish_row)
+    lift = reads[10] * params[o_c + 6]  # the wing's lift n_z W [N]
+    for i in range(na):
+        params[o_g + i] = (lift * r_rate / vt * params[o_fr + i]
+                           + qbar * beta * (params[o_fb + i] + params[o_g + i]))
     if model == 1:
         dq, dqv = qbar - key0, qv - key0 / key1
         s1, s2 = n2a * n2a, 2 * n2a * n2a
@@ -118,6 +155,8 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             for j in range(n2a):
                 acc += (params[r + j] + dq * params[r + s1 + j] + dqv * params[r + s2 + j]) * xa[j]
             c = o_in + 2 * i
+            for j in range(na):
+                acc += params[o_fm + na * i + j] * params[o_g + j]
             params[o_scr + i] = acc + params[c] * f0 + params[c + 1] * f1
         for i in range(n2a):
             xa[i] = params[o_scr + i]
@@ -128,26 +167,44 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             for j in range(na):
                 kq[i, j] = -qbar * params[o_fe + na * i + j]
             kq[i, i] += params[o_st + i]
-            rhs[i] = qbar * params[o_fd + i] * delta_s + qv * params[o_fp + i] * rel_p
+            rhs[i] = (qbar * params[o_fd + i] * delta_s + qv * params[o_fp + i] * rel_p
+                      + params[o_g + i])
         eta = np.linalg.solve(kq, rhs)
         for i in range(na):
             xa[i] = eta[i]
             xa[na + i] = 0.0
-    moment = 0.0
+    moment, side, yaw = 0.0, 0.0, 0.0
     if model != 0:
         for i in range(na):
             moment += qbar * params[o_re + i] * xa[i] + qv * params[o_rd + i] * xa[na + i]
+        # the yaw rate's and sideslip's rolling moment and the yawing moment of the
+        # symmetric deflection after the half wing's step (η_s of t_k+1)
+        roll_s, yaw_s = 0.0, 0.0
+        for j in range(ns):
+            eta_s = params[o_ss + j] + xs[j]
+            roll_s += (qv * r_rate * params[o_rrs + j] + qbar * beta * params[o_rbs + j]) * eta_s
+            yaw_s += qv * p_rate * params[o_yps + j] * eta_s
+        moment += roll_s
+        for i in range(na):
+            side += ((lift * params[o_se + i] + qbar * params[o_sge + i]) * xa[i]
+                     + qv * params[o_sgd + i] * xa[na + i])
+            yaw += lift / vt * params[o_yd + i] * xa[na + i]
+        yaw += yaw_s - params[o_c + 7] * lift / qbar * moment
     params[o_rx] = params[o_flow - 3]  # the half wing's reactions (lbf, lbf, lbf·ft), the
     params[o_rx + 1] = params[o_flow - 2]  # block before its out_flow (step_kernel.layout) …
     params[o_rx + 2] = params[o_flow - 1]
-    params[o_rx + 3] = moment * params[o_c + 3]  # … and the roll [lbf·ft]
+    params[o_rx + 3] = moment * params[o_c + 3]  # … and the roll [lbf·ft], side [lbf],
+    params[o_rx + 4] = side * params[o_c + 5]
+    params[o_rx + 5] = yaw * params[o_c + 3]  # yaw [lbf·ft]
     row[cols[base]] = aileron
     row[cols[base + 1]] = moment
     row[cols[base + 2]] = tip + anti
     row[cols[base + 3]] = tip - anti
+    row[cols[base + 4]] = side
+    row[cols[base + 5]] = yaw
     if status != K.OK:
         return status
-    for c in range(base, base + 4 + n2a):
+    for c in range(base, base + N_FIXED + n2a):
         if not math.isfinite(row[cols[c]]):
             return K.NON_FINITE
     for i in range(na):

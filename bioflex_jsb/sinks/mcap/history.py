@@ -98,7 +98,8 @@ def _values(group: str, msg: dict, topic: str, ns: int) -> dict[str, float]:
         return {c: v for c, v in values.items() if not math.isnan(v)}
     if group == "lateral":  # a full-span run's antisymmetric wing (lateral_topic.py)
         out = {f: _number(msg, f, topic, ns) for f in (
-            "aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad", "tip_twist_port_rad")}
+            "aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad", "tip_twist_port_rad",
+            "modal_side_n", "modal_yaw_n_m")}
         out.update(_indexed(msg, "asym_eta_rad", "asym_eta{}", topic, ns))
         out.update(_indexed(msg, "asym_eta_dot_rad_s", "asym_eta{}_dot", topic, ns))
         return out

@@ -1,8 +1,8 @@
 """A full-span run's antisymmetric wing on ``/bioflex/<model>/lateral``.
 
 ``bioflex.Lateral`` (:data:`~.schemas.SCHEMAS` ``["lateral"]``): per step JSBSim's aileron
-δa, the elastic rolling moment applied, the tip twist of each half and the antisymmetric
-modal coordinates η_a, η̇_a (packed arrays, as the ``modal`` topic's η, η̇;
+δa, the elastic rolling moment, side force and yawing moment applied, the tip twist of each
+half and the antisymmetric modal coordinates η_a, η̇_a (packed arrays, as the ``modal`` topic's η, η̇;
 :mod:`bioflex_jsb.simulation.full_span`). The run hands the rows over a block at a time
 (``drivers.gust.StepRecorder``'s optional ``lateral``), each block a chunk of its own after
 the steps' chunk (log-time order), as the controller's topic does.
@@ -23,7 +23,8 @@ if TYPE_CHECKING:
 
 GROUP = "lateral"
 # the run's channels → the message's scalar fields (the same names)
-SCALARS = ("aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad", "tip_twist_port_rad")
+SCALARS = ("aileron_rad", "modal_roll_n_m", "tip_twist_starboard_rad", "tip_twist_port_rad",
+           "modal_side_n", "modal_yaw_n_m")
 
 
 def lateral_modes(names) -> int:

@@ -331,7 +331,8 @@ SCHEMAS["lateral"] = {
     "description": "Both wing halves (a full-span run, bioflex_jsb.simulation.full_span), "
     "one message per step at the step's log time, in chunks of their own after the steps': "
     "the aileron JSBSim flew, the elastic rolling moment applied over the step, the tip "
-    "twist of each half and the antisymmetric modal state.",
+    "twist of each half, the antisymmetric modal state, and the side force and yawing "
+    "moment applied over the step.",
     "type": "object",
     "properties": {
         "aileron_rad": _num("JSBSim's aileron, (left - right)/2 of the surfaces' angles, "
@@ -348,6 +349,12 @@ SCHEMAS["lateral"] = {
                          "tip twist positive) [rad]"},
         "asym_eta_dot_rad_s": {"type": "array", "items": {"type": "number"},
                                "description": "their rates [rad/s]"},
+        "modal_side_n": _num("the antisymmetric deformation's side force applied to the "
+                             "airframe (JSBSim's modal-side), along body +y (to starboard) "
+                             "[N]"),
+        "modal_yaw_n_m": _num("the deformation's yawing moment applied to the airframe "
+                              "(JSBSim's modal-yaw), about body +z, nose right positive "
+                              "[N*m]"),
     },
 }
 # The LTI model's section loads on its prediction topic, under the loads topic's field names
