@@ -58,13 +58,18 @@ from bioflex_jsb.aeroelasticity.control_surface import (
     flap_moment_slope_per_rad,
     strip_coverage,
 )
-from bioflex_jsb.flight_dynamics.lateral import LateralAerodynamics, LateralTrim
+from bioflex_jsb.flight_dynamics.lateral import (
+    LateralAerodynamics,
+    LateralTrim,
+    inertia_matrix,
+)
 from bioflex_jsb.flight_dynamics.lateral_elastic import (
     LATERAL_MODELS,
     AntisymmetricWing,
     build_lateral_elastic,
     residualised,
 )
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.state_space import StateSpace
 
 
@@ -184,7 +189,7 @@ def lateral_elastic_with_aileron(ss: StateSpace, strips: AntisymmetricStrips,
 
 def lateral_model_with_aileron(model: str, trim: LateralTrim, aero: LateralAerodynamics,
                                wing: AntisymmetricWing | None, surface: ControlSurface | None,
-                               chord_m: np.ndarray | None
+                               chord_m: np.ndarray | None, static_eta_s=None
                                ) -> tuple[StateSpace, AntisymmetricStrips | None]:
     """(the lateral model, its strips) of ``model`` at ``trim`` with ``aero``'s rigid
     derivatives: ``rigid`` (:func:`~bioflex_jsb.flight_dynamics.lateral_elastic
@@ -195,14 +200,113 @@ def lateral_model_with_aileron(model: str, trim: LateralTrim, aero: LateralAerod
     :func:`~bioflex_jsb.flight_dynamics.lateral_elastic.residualised`). ``surface`` None: no
     aileron on the strips (the aileron drives the rigid rolling moment only); ``chord_m``
     [m] the strips' chords (the lattice's, ``build.aero.chord_m``). Inputs v_g [m/s],
-    aileron, rudder [rad]."""
+    aileron, rudder [rad].
+
+    The coupled and qsd models also hold the yaw rate's and sideslip's terms of the
+    nonlinear step linearised about the trim (:func:`lateral_elastic_with_yaw_sideslip`),
+    where ``wing`` carries its build's symmetric modes and planform; ``static_eta_s`` [rad]
+    the trim's static symmetric deflection (None: zero, a rigid trim's, the one JSBSim
+    trims and ``compare --span full`` flies from)."""
     if model == "rigid" or model not in LATERAL_MODELS or wing is None:
         # the rigid model, or the one-line refusal of an unknown model or a missing wing
         return build_lateral_elastic(model, trim, aero, wing), None
     strips = antisymmetric_strips(wing, surface, chord_m)
     coupled = lateral_elastic_with_aileron(build_lateral_elastic("coupled", trim, aero, wing),
                                            strips, trim.dynamic_pressure_pa)
+    terms = wing_yaw_sideslip_terms(wing)
+    if terms is not None:
+        coupled = lateral_elastic_with_yaw_sideslip(coupled, strips, terms, trim, static_eta_s)
     return (coupled if model == "coupled" else residualised(coupled)), strips
+
+
+def trim_wing_lift_n(trim: LateralTrim) -> float:
+    """The wing's lift L_w = n_z W [N] of the yaw rate's terms at the level trim: n_z = 1
+    (W = m g)."""
+    return float(trim.mass_kg) * STANDARD_GRAVITY_M_S2
+
+
+def wing_yaw_sideslip_terms(wing: AntisymmetricWing) -> YawSideslipTerms | None:
+    """:class:`YawSideslipTerms` of ``wing`` with its build's symmetric modes, planform and
+    span (as the full-span step makes them, ``runtime/full_span_step.py``); None for a wing
+    without them."""
+    if wing.symmetric is None or wing.planform is None:
+        return None
+    return yaw_sideslip_terms(wing, wing.symmetric, wing.n_symmetric, wing.planform,
+                              wing.span_m)
+
+
+def yaw_sideslip_rows(ss: StateSpace, strips: AntisymmetricStrips, terms: YawSideslipTerms,
+                      trim: LateralTrim, static_eta_s=None) -> dict[str, np.ndarray]:
+    """The yaw rate's and sideslip's terms of the nonlinear step linearised about ``trim``
+    (L_w = m g, its Q, V; η_s = ``static_eta_s`` [rad], None zero), each a row over the
+    states of the coupled model ``ss``: ``forcing`` (n_a × states) the generalised force on
+    the antisymmetric modes [N·m per unit state] (:meth:`YawSideslipTerms.forcing`: r and β
+    columns); ``roll`` the rolling moment of the yaw rate and sideslip on η_s [N·m, right
+    wing down] (:meth:`~YawSideslipTerms.roll_n_m`: r, β); ``side`` the side force [N,
+    body +y] (:meth:`~YawSideslipTerms.side_n`: η_a, η̇_a); ``yaw`` the yawing moment [N·m,
+    nose right] (:meth:`~YawSideslipTerms.yaw_n_m`: η̇_a, p, and the induced drag of all the
+    elastic rolling moment, ΔL of η_a, η̇_a and the roll row's r, β). Products of the
+    lateral quantities with the changes of L_w, Q, V and η_s are second order and left out."""
+    n, n_s = strips.n_modes, terms.roll_r_s.size
+    q, v = float(trim.dynamic_pressure_pa), float(trim.speed_m_s)
+    lift = trim_wing_lift_n(trim)
+    eta_s = np.zeros(n_s) if static_eta_s is None else np.asarray(static_eta_s, dtype=float)
+    if eta_s.shape != (n_s,):
+        raise ValueError(f"static_eta_s has {eta_s.size} modes, the terms {n_s}")
+    states = ss.states
+    i_b, i_p, i_r = (states.index(k) for k in ("beta", "p", "r"))
+    e0, d0 = states.index("eta1"), states.index("eta1_dot")
+    n_x = len(states)
+    forcing = np.zeros((n, n_x))
+    forcing[:, i_r] = lift / v * terms.force_r
+    forcing[:, i_b] = q * (terms.force_beta + terms.force_beta_s @ eta_s)
+    roll = np.zeros(n_x)
+    roll[i_r] = q / v * (terms.roll_r_s @ eta_s)
+    roll[i_b] = q * (terms.roll_beta_s @ eta_s)
+    side = np.zeros(n_x)
+    side[e0:e0 + n] = lift * terms.side_eta + q * terms.side_dihedral_eta
+    side[d0:d0 + n] = q / v * terms.side_dihedral_etadot
+    elastic_roll = roll.copy()  # all the elastic rolling moment: ΔL and the roll row
+    elastic_roll[e0:e0 + n] += q * strips.roll_eta
+    elastic_roll[d0:d0 + n] += q / v * strips.roll_etadot
+    yaw = -terms.induced_per_lift * lift / q * elastic_roll
+    yaw[d0:d0 + n] += lift / v * terms.yaw_etadot
+    yaw[i_p] += q / v * (terms.yaw_p_s @ eta_s)
+    return {"forcing": forcing, "roll": roll, "side": side, "yaw": yaw}
+
+
+def lateral_elastic_with_yaw_sideslip(ss: StateSpace, strips: AntisymmetricStrips,
+                                      terms: YawSideslipTerms, trim: LateralTrim,
+                                      static_eta_s=None) -> StateSpace:
+    """The coupled lateral model ``ss`` with the rows of :func:`yaw_sideslip_rows`: the
+    forcing in the η̈ rows (÷ m_i), the rolling and yawing moments in ṗ, ṙ through J⁻¹ (as
+    ΔL is), the side force in β̇ (÷ m V) and in n_y (÷ m g). The β terms act on the air's
+    sideslip β − v_g/V (the nonlinear step reads JSBSim's, wind included): their v_g column
+    is their β column over −V, as the rigid model's."""
+    if ss.model != "coupled-lateral":
+        raise ValueError(f"the yaw rate's and sideslip's terms go into the coupled lateral "
+                         f"model, not {ss.model!r}")
+    rows = yaw_sideslip_rows(ss, strips, terms, trim, static_eta_s)
+    n, v, mass = strips.n_modes, float(trim.speed_m_s), float(trim.mass_kg)
+    d0 = ss.states.index("eta1_dot")
+    extra = np.zeros_like(np.asarray(ss.a, dtype=float))
+    extra[d0:d0 + n] = rows["forcing"] / strips.mass_kg_m2[:, None]
+    j_inv = np.linalg.inv(inertia_matrix(trim))  # (ṗ, ṙ) per unit (L, N)
+    extra[1:3] = np.outer(j_inv[:, 0], rows["roll"]) + np.outer(j_inv[:, 1], rows["yaw"])
+    extra[ss.states.index("beta")] = rows["side"] / (mass * v)
+    i_b, i_vg = ss.states.index("beta"), ss.inputs.index("v_g")
+    b = np.asarray(ss.b, dtype=float).copy()
+    b[:, i_vg] += -extra[:, i_b] / v
+    c = np.asarray(ss.c, dtype=float).copy()
+    c[ss.outputs.index("n_y")] += rows["side"] / (mass * STANDARD_GRAVITY_M_S2)
+    notes = {**ss.notes, "yaw_sideslip": (
+        "yaw rate's and sideslip's forcing of the modes, their rolling moment on the "
+        "symmetric deflection, the modes' side force and yawing moment, linearised about "
+        "the trim (aeroelasticity/antisymmetric_strips.py)")}
+    return StateSpace(model=ss.model, speed_m_s=ss.speed_m_s, a=np.asarray(ss.a) + extra,
+                      b=b, c=c, d=ss.d, states=ss.states, state_units=ss.state_units,
+                      inputs=ss.inputs, input_units=ss.input_units, outputs=ss.outputs,
+                      output_units=ss.output_units, notes=notes)
 def _slope_at(stations_m: np.ndarray, bending_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
     """dφ/dy [m/m per unit η] of the bending ``bending_m`` (n, k) given at ``stations_m``,
     at ``y_m`` (second-order differences on the modes' own stations, then linear)."""

@@ -18,10 +18,11 @@ quasi-steady strips, as Eq. (4) couples the symmetric modes to the longitudinal 
 * the generalised force on mode i, Q_i = ∫_0^{b/2} l (e θ_i − φ_i) dy (the virtual-work
   term of Table B1, on the half aircraft whose generalised mass m_i is), with the rigid
   roll rate's lift in it; η̈_i = −ω_i² η_i − 2 ζ_i ω_i η̇_i + Q_i / m_i;
-* left out: the modes' side force and yawing moment (the asymmetric induced drag), the
-  lateral gust's load on the modes, unsteady strips; the aileron's load on the modes is
-  added by :func:`bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`
-  (the model the API and ``compare`` return).
+* added by :func:`bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`
+  (the model the API and ``compare`` return): the aileron's load on the modes, and the yaw
+  rate's and sideslip's forcing of the modes, the modes' side force and yawing moment
+  (:class:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.YawSideslipTerms` linearised
+  about the trim); left out: the lateral gust's load on the modes, unsteady strips.
 
 The QSD reduction (η̈ = η̇ = 0, as Eq. 9-10 for the longitudinal model) keeps the states
 β, p, r, φ with the static deformation residualised.
@@ -63,7 +64,11 @@ class AntisymmetricWing:
     [kg·m²]); ``stations_m``, ``weights_m`` [m] the strips; ``cl_alpha_c_m`` C_lα c
     [m/rad]; ``e_m`` [m] the aerodynamic centre ahead of the elastic axis; ``phi``,
     ``theta`` (n, K) bending [m, down] and twist [rad, LE up] per unit η at the strips;
-    ``fuselage_roll_inertia_kg_m2`` [kg·m²] (the aircraft's I_xx less the two wing halves')."""
+    ``fuselage_roll_inertia_kg_m2`` [kg·m²] (the aircraft's I_xx less the two wing halves').
+    What the yaw rate's and sideslip's terms take from the wing's build (None, 0: a wing
+    without them): ``symmetric`` the half wing's symmetric modes (:class:`ModalData`, bending
+    down, twist leading edge up), ``n_symmetric`` how many of them the wing model flies,
+    ``planform`` (its dihedral) and ``span_m`` [m] the wing's span."""
 
     modes: ModalData
     stations_m: np.ndarray
@@ -73,6 +78,10 @@ class AntisymmetricWing:
     phi: np.ndarray
     theta: np.ndarray
     fuselage_roll_inertia_kg_m2: float
+    symmetric: ModalData | None = None
+    n_symmetric: int = 0
+    planform: object = None
+    span_m: float = 0.0
 
     @property
     def n_modes(self) -> int:
@@ -131,7 +140,9 @@ def antisymmetric_wing(build, aircraft_ixx_kg_m2: float, n_modes: int = 3) -> An
     phi = np.array([np.interp(y, modes.stations_m, b) for b in modes.bending_m])
     theta = np.array([np.interp(y, modes.stations_m, t) for t in modes.twist_rad])
     return AntisymmetricWing(modes, y, strips.weights_m, strips.cl_alpha_c_m, strips.e_m, phi,
-                             theta, j_f)
+                             theta, j_f, symmetric=build.modes,
+                             n_symmetric=int(build.model.n_modes), planform=build.planform,
+                             span_m=2.0 * float(build.aero.semispan_m))
 
 
 @dataclass(frozen=True)
