@@ -25,8 +25,8 @@ from bioflex_jsb.flight_dynamics.lateral_elastic import (
     build_lateral_elastic,
     residualised,
 )
-from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.runtime.identification import identify_lateral
+from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.simulation.full_span import AntisymmetricModalWing, LateralInputs
 
 pytest.importorskip("jsbsim")
