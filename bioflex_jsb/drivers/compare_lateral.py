@@ -3,10 +3,12 @@ linear model: the lateral-directional model of the run's wing model (``rigid``, 
 ``qsd``; docs/lateral.md) at the run's trim, driven by what the run flew.
 
 The nonlinear run (:mod:`bioflex_jsb.simulation.full_span`) flies the antisymmetric modes on
-quasi-steady strips with the roll rate, their own η_a, η̇_a, JSBSim's ailerons and the gust
-roll rate p_g; its linear model is :func:`bioflex_jsb.api.lateral_model`'s, the coupled
-lateral model of the same strips with the aileron's generalised force on the modes (one
-builder: :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`), its
+quasi-steady strips with the roll rate, their own η_a, η̇_a, JSBSim's ailerons, the gust
+roll rate p_g, the yaw rate and the sideslip (and their side force and yawing moment); its
+linear model is :func:`bioflex_jsb.api.lateral_model`'s, the coupled lateral model of the
+same strips with the aileron's generalised force on the modes and the yaw rate's and
+sideslip's terms linearised about the trim, a rigid one: η_s = 0 (one builder:
+:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`), its
 rigid block identified from the run's JSBSim airframe at the same trim
 (:func:`~bioflex_jsb.runtime.identification.identify_lateral`). Its inputs, each held over
 a step and exactly discretised (zero-order hold, as the run holds them):
@@ -28,7 +30,9 @@ model's increment; JSBSim's trim is not exactly wings level, the prototype's and
 bank −0.16 mrad, held in calm air), the
 first antisymmetric mode ``asym_eta1`` [rad] and the modes' rolling moment
 ``modal_roll_n_m`` [N·m] = Q Σ R^η_i η_i + (Q/V) Σ R^η̇_i η̇_i at the trim's Q and V (the
-quasi-static model: its η̇ is zero); the rigid model has neither of the last two.
+quasi-static model: its η̇ is zero; the run's also holds the rolling moment of r and β on
+the symmetric deflection, which from a rigid trim is of second order); the rigid model has
+neither of the last two.
 """
 
 from __future__ import annotations
