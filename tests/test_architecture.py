@@ -212,3 +212,18 @@ def test_no_function_is_graded_e_or_f():
                 graded.append(f"{path.relative_to(ROOT)}:{block.lineno} {block.name} "
                               f"{rank} ({block.complexity})")
     assert not graded, graded
+
+
+def test_no_private_name_is_imported_across_modules():
+    """A module's private names (a leading underscore) are its own: another module that
+    needs one gets a public name, so what a module offers shows in what it names."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith(
+                    "bioflex_jsb")):
+                found += [f"{path.relative_to(ROOT)}: {node.module}.{a.name}"
+                          for a in node.names
+                          if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not found, found

@@ -50,7 +50,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
-from bioflex_jsb.runtime.full_span_step import FullSpanSteps, _check_span
+from bioflex_jsb.runtime.full_span_step import FullSpanSteps, check_span
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
@@ -221,7 +221,7 @@ class CoupledStep(FullSpanSteps):
                  controller=None, over_autopilot: bool = False, span: str = "half",
                  aileron=None) -> None:
         build, wing = _step_options(wing, model, aero, trim_mode, trim)
-        _check_span(span, build, model, aero)
+        check_span(span, build, model, aero)
         native = model == "native"
         self.native, self.model, self.aero, self.trim_mode = native, model, aero, trim_mode
         self.speed_m_s = float(speed_m_s)

@@ -31,7 +31,7 @@ AILERON_PROPERTIES = (JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD)
 IXX_PROPERTY = JP.INERTIA_IXX_SLUGS_FT2
 
 
-def _check_span(span: str, build, model: str, aero: str) -> None:
+def check_span(span: str, build, model: str, aero: str) -> None:
     """A full-span step needs the wing's build (its beam: the antisymmetric modes), the
     quasi-steady strips and a wing of ours (not the native one); one line otherwise."""
     if span not in SPANS:
