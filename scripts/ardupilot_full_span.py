@@ -6,20 +6,20 @@
         [--speed 57.8] [--altitude-m A] [--window-s 4]
 
 Each log is a ``bioflex-jsb ardupilot --span full`` session (the physics of
-``scripts/ardupilot_sitl.py fly``): its run (``api.read_log``) and its autopilot topic
-(the servo frames ArduPlane sent). For each flight it reports, in flight only (the launcher
+``scripts/ardupilot_sitl.py fly``): its run (``api.read_log``) and its autopilot topic (the
+servo frames ArduPlane sent). For each flight it reports, in flight only (the launcher
 excluded): the largest |asym_eta1| [rad], |modal_roll_n_m| [N·m] (the antisymmetric
 deformation's rolling moment given to JSBSim) and its sign against the roll rate, the
 largest |p| [rad/s] and |phi| [rad]; and each *turn entry* (wings level, |phi| < LEVEL_DEG
 for LEVEL_S, then a roll past ENTRY_DEG within ENTRY_WITHIN_S: the waypoint turns of the
 mission), from PRE_S before the last level sample with |p| < P_START_RAD_S (the roll's
-start; ``t0_s``) for ``--window-s``: the peak |p − p(t0)| flown, and the linear lateral models' (rigid and
-coupled, docs/lateral.md, built at the flight's trim: ``--speed``, default the aircraft's
-cruise, and ``--altitude-m``, default the mean altitude of the turn entries) driven by the
-aileron and rudder that turn flew over their values at t0: the aileron is JSBSim's
-(``aileron_rad``), the rudder the frames' ``rudder_cmd_norm`` through the aircraft's
-JSBSim rudder map, measured on a fresh instance (``fcs/rudder-pos-rad`` per unit of
-``fcs/rudder-cmd-norm``; JSBSim's rudder has no actuator lag in the c172p).
+start; ``t0_s``) for ``--window-s``: the peak |p − p(t0)| flown, and the linear lateral
+models' (rigid and coupled, docs/lateral.md, built at the flight's trim: ``--speed``,
+default the aircraft's cruise, and ``--altitude-m``, default the mean altitude of the turn
+entries) driven by the aileron and rudder that turn flew over their values at t0: the
+aileron is JSBSim's (``aileron_rad``), the rudder the frames' ``rudder_cmd_norm`` through
+the aircraft's JSBSim rudder map, measured on a fresh instance (``fcs/rudder-pos-rad`` per
+unit of ``fcs/rudder-cmd-norm``; JSBSim's rudder has no actuator lag in the c172p).
 
 ``open_loop_ratio``: the coupled model's peak over the rigid model's, both driven by the
 same surfaces (the elastic flight's): what the elastic wing alone does to the same aileron.

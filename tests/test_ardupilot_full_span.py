@@ -7,9 +7,8 @@ servo step rolls the elastic aircraft left, the rigid one right."""
 
 from __future__ import annotations
 
-import pytest
-
 import numpy as np
+import pytest
 
 from bioflex_jsb import api
 from bioflex_jsb.drivers import ardupilot as ad
@@ -91,12 +90,12 @@ def c172_roll_log(tmp_path_factory):
     """A c172_elastic session with both halves logged as `ardupilot` logs it: launched, level
     at 57.8 m/s, then an aileron and rudder step from servo frames (open loop). Returns (the
     log's path, JSBSim's rudder angle at every step [rad], the physics)."""
-    from bioflex_jsb.sinks import mcap as sink
     from bioflex_jsb.links.ardupilot_json import STEP, FrameRecord
     from bioflex_jsb.runtime.control_power import measure_control_power
     from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
     from bioflex_jsb.simulation import jsbsim_properties as JP
     from bioflex_jsb.simulation.run import RunDescription
+    from bioflex_jsb.sinks import mcap as sink
 
     ac = api.load_aircraft("c172_elastic")
     channels = ad.aircraft_channels(measure_control_power(airframe_for(ac), 57.8, 0.0))
