@@ -7,19 +7,21 @@
 
 Each log is a ``bioflex-jsb ardupilot --span full`` session (the physics of
 ``scripts/ardupilot_sitl.py fly``): its run (``api.read_log``) and its autopilot topic (the
-servo frames ArduPlane sent). For each flight it reports, in flight only (the launcher
-excluded): the largest |asym_eta1| [rad], |modal_roll_n_m| [N·m] (the antisymmetric
-deformation's rolling moment given to JSBSim) and its sign against the roll rate, the
-largest |p| [rad/s] and |phi| [rad]; and each *turn entry* (wings level, |phi| < LEVEL_DEG
-for LEVEL_S, then a roll past ENTRY_DEG within ENTRY_WITHIN_S: the waypoint turns of the
-mission), from PRE_S before the last level sample with |p| < P_START_RAD_S (the roll's
-start; ``t0_s``) for ``--window-s``: the peak |p − p(t0)| flown, and the linear lateral
-models' (rigid and coupled, docs/lateral.md, built at the flight's trim: ``--speed``,
-default the aircraft's cruise, and ``--altitude-m``, default the mean altitude of the turn
-entries) driven by the aileron and rudder that turn flew over their values at t0: the
-aileron is JSBSim's (``aileron_rad``), the rudder the frames' ``rudder_cmd_norm`` through
-the aircraft's JSBSim rudder map, measured on a fresh instance (``fcs/rudder-pos-rad`` per
-unit of ``fcs/rudder-cmd-norm``; JSBSim's rudder has no actuator lag in the c172p).
+servo frames ArduPlane sent); or its ``--table FILE.npz`` written with ``--record-every 1``
+(a row a frame: the state after the frame, its servos). For each flight it reports, in
+flight only (the launcher excluded): the largest |asym_eta1| [rad], |modal_roll_n_m| [N·m]
+(the antisymmetric deformation's rolling moment given to JSBSim) and its sign against the
+roll rate, the largest |p| [rad/s] and |phi| [rad]; and each *turn entry* (wings level,
+|phi| < LEVEL_DEG for LEVEL_S, then a roll past ENTRY_DEG within ENTRY_WITHIN_S: the
+waypoint turns of the mission), from PRE_S before the last level sample with |p| <
+P_START_RAD_S (the roll's start; ``t0_s``) for ``--window-s``: the peak |p − p(t0)| flown,
+and the linear lateral models' (rigid and coupled, docs/lateral.md, built at the flight's
+trim: ``--speed`` and ``--altitude-m``, default the mean true airspeed and altitude of the
+turn entries' starts) driven by the aileron and rudder that turn flew over their values at
+t0: the aileron is JSBSim's (``aileron_rad``), the rudder the frames' ``rudder_cmd_norm``
+through the aircraft's JSBSim rudder map, measured on a fresh instance (``fcs/rudder-pos-
+rad`` per unit of ``fcs/rudder-cmd-norm``; JSBSim's rudder has no actuator lag in the
+c172p).
 
 ``open_loop_ratio``: the coupled model's peak over the rigid model's, both driven by the
 same surfaces (the elastic flight's): what the elastic wing alone does to the same aileron.
@@ -35,8 +37,10 @@ Exit status 0; 2 for bad input (one line).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -59,6 +63,9 @@ ENTRY_WITHIN_S = 4.0
 P_START_RAD_S = 0.01
 PRE_S = 0.5
 WINDOW_S = 4.0  # the turn entry compared [s from t0]: the roll-in and the bank's hold
+# the full-span channels a flight's report reads
+LATERAL_CHANNELS = ("asym_eta1", "modal_roll_n_m", "tip_twist_port_rad",
+                    "tip_twist_starboard_rad")
 
 
 class AnalysisError(Exception):
@@ -92,6 +99,65 @@ def _flight(path: Path) -> tuple[str, dict[str, np.ndarray], dict[str, np.ndarra
         raise AnalysisError(f"{path}: no {topic} (not an ardupilot session's log)")
     return model, ch, {"time_s": np.array(t), "rudder_cmd_norm": np.array(rud),
                        "phase": np.array(phase)}
+
+
+def _flight_table(path: Path, aircraft, need_modes: bool = True
+                  ) -> tuple[str, dict[str, np.ndarray], dict]:
+    """The same as :func:`_flight` from a session's ``--table`` (``--record-every 1``: a row
+    a frame, the state after the frame's steps; the rudder command from servo 4 through the
+    aircraft's channel map, as the session applied it). The model is not in the table:
+    ``table``."""
+    from bioflex_jsb.drivers import ardupilot as ad
+    from bioflex_jsb.runtime.control_power import measure_control_power
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+
+    with np.load(path) as z:
+        names, table = [str(n) for n in z["names"]], z["table"]
+    if need_modes and "asym_eta1" not in names:
+        raise AnalysisError(f"{path}: no antisymmetric modes (not a --span full session)")
+    col = {n: table[:, i] for i, n in enumerate(names)}
+    flying = ((col["phase"] == ad.PHASES.index(ad.FLIGHT))
+              & (col["action"] != ad.ACTIONS.index(ad.RESEND))
+              & np.isfinite(col["p_rad_s"]))  # the launch's last frame has no step yet
+    if not flying.any():
+        raise AnalysisError(f"{path}: no row in flight")
+    speed = flight_speeds_of(aircraft)
+    channels = ad.aircraft_channels(measure_control_power(airframe_for(aircraft), speed, 0.0))
+    rows = {n: v[flying] for n, v in col.items()}
+    rud = np.array([channels[3].value(int(us)) for us in rows["servo4_us"]])
+    if "aileron_rad" not in rows:  # a half wing's table: JSBSim's aileron from servo 1
+        up, down = aileron_gains_rad(aircraft)
+        cmd = np.array([channels[0].value(int(us)) for us in rows["servo1_us"]])
+        rows["aileron_rad"] = np.where(cmd >= 0.0, up * cmd, down * cmd)
+    ch = {n: v for n, v in rows.items() if n not in ad.RECORD_HEAD}
+    ch["time_s"] = rows["time_s"]
+    for name in LATERAL_CHANNELS:  # a half wing's reference flight has none: zero
+        ch.setdefault(name, np.zeros_like(ch["time_s"]))
+    return "table", ch, {"time_s": rows["time_s"], "rudder_cmd_norm": rud}
+
+
+def flight_speeds_of(aircraft) -> float:
+    """The aircraft's cruise speed [m/s]."""
+    from bioflex_jsb.definition.flying import flight_speeds
+
+    return flight_speeds(aircraft)[0]
+
+
+def aileron_gains_rad(aircraft) -> tuple[float, float]:
+    """JSBSim's aileron ½ (left − right) [rad] per unit of ``fcs/aileron-cmd-norm`` above and
+    below zero (the c172p's surfaces deflect 20 deg up, 15 down: the two differ), measured on
+    a fresh instance at commands ±0.5."""
+    from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
+
+    fdm = airframe_for(aircraft)._fdm
+    fdm.run_ic()
+    out = []
+    for cmd in (0.5, -0.5):
+        fdm["fcs/aileron-cmd-norm"] = cmd
+        fdm.run()
+        out.append(0.5 * (fdm["fcs/left-aileron-pos-rad"] - fdm["fcs/right-aileron-pos-rad"])
+                   / cmd)
+    return out[0], out[1]
 
 
 def held(frame_t: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -222,6 +288,7 @@ def flight_report(ch: dict, frames: dict, rudder_gain: float,
         "airspeed_m_s_mean": float(np.mean(ch["airspeed_m_s"])),
         "altitude_m_mean": float(np.mean(ch["altitude_m"])),
         "_windows": windows, "_t": t, "_altitude": ch["altitude_m"],
+        "_airspeed": ch["airspeed_m_s"],
     }
 
 
@@ -238,7 +305,8 @@ def turn_figures(w: dict, t: np.ndarray, models: dict) -> dict:
         out[f"{m}_model_peak_abs_p_rad_s"] = float(np.max(np.abs(y["p"])))
         out[f"{m}_model_nrmse_p"] = _nrmse(y["p"], w["p"])
     out["coupled_model_peak_abs_eta1_rad"] = float(np.max(np.abs(lin["coupled"]["eta1"])))
-    out["coupled_model_nrmse_eta1"] = _nrmse(lin["coupled"]["eta1"], w["eta1"])
+    out["coupled_model_nrmse_eta1"] = (_nrmse(lin["coupled"]["eta1"], w["eta1"])
+                                       if np.ptp(w["eta1"]) > 0.0 else None)  # rigid: none
     out["open_loop_ratio"] = (out["coupled_model_peak_abs_p_rad_s"]
                               / out["rigid_model_peak_abs_p_rad_s"])
     return out
@@ -247,7 +315,6 @@ def turn_figures(w: dict, t: np.ndarray, models: dict) -> dict:
 def analyse(elastic: Path, rigid: Path | None, aircraft_name: str, speed_m_s: float | None,
             altitude_m: float | None, window_s: float = WINDOW_S) -> dict:
     from bioflex_jsb import api
-    from bioflex_jsb.definition.flying import flight_speeds
 
     aircraft = api.load_aircraft(aircraft_name)
     gain = rudder_gain_rad(aircraft)
@@ -255,18 +322,21 @@ def analyse(elastic: Path, rigid: Path | None, aircraft_name: str, speed_m_s: fl
     for label, path in (("elastic", elastic), ("rigid", rigid)):
         if path is None:
             continue
-        model, ch, frames = _flight(path)
+        if path.suffix == ".npz":
+            model, ch, frames = _flight_table(path, aircraft, need_modes=label == "elastic")
+        else:
+            model, ch, frames = _flight(path)
         rep = flight_report(ch, frames, gain, window_s)
         rep["model"], rep["log"] = model, str(path)
         flights[label] = rep
     if not flights["elastic"]["_windows"]:
         raise AnalysisError(f"{elastic}: no turn entry (wings level {LEVEL_S:g} s, then past "
                             f"{ENTRY_DEG:g} deg within {ENTRY_WITHIN_S:g} s)")
-    speed = flight_speeds(aircraft)[0] if speed_m_s is None else speed_m_s
+    starts = [(f["_airspeed"][w["slice"].start], f["_altitude"][w["slice"].start])
+              for f in flights.values() for w in f["_windows"]]
+    speed = float(np.mean([v for v, _ in starts])) if speed_m_s is None else speed_m_s
     if altitude_m is None:
-        starts = [f["_altitude"][w["slice"].start] for f in flights.values()
-                  for w in f["_windows"]]
-        altitude_m = float(np.mean(starts))
+        altitude_m = float(np.mean([h for _, h in starts]))
     models = linear_models(aircraft, speed, altitude_m)
     for rep in flights.values():
         rep["turns"] = [turn_figures(w, rep["_t"], models) for w in rep["_windows"]]
@@ -289,6 +359,20 @@ def analyse(elastic: Path, rigid: Path | None, aircraft_name: str, speed_m_s: fl
     return out
 
 
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """File descriptor 1 (C libraries' stdout too) onto stderr, so stdout is the JSON."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("elastic", type=Path, help="the --span full session's log (coupled)")
@@ -296,7 +380,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="the same mission flown with --model rigid")
     parser.add_argument("--aircraft", default="c172_elastic")
     parser.add_argument("--speed", type=float, default=None,
-                        help="the linear models' trim speed [m/s] (default its cruise)")
+                        help="the linear models' trim speed [m/s] (default the turn "
+                        "entries' mean true airspeed)")
     parser.add_argument("--altitude-m", type=float, default=None,
                         help="their trim altitude [m] (default the turn entries' mean)")
     parser.add_argument("--window-s", type=float, default=WINDOW_S,
@@ -305,8 +390,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not (math.isfinite(args.window_s) and 0.5 <= args.window_s <= 30.0):
             raise AnalysisError(f"--window-s must be 0.5 to 30 s, got {args.window_s:g}")
-        out = analyse(args.elastic, args.rigid, args.aircraft, args.speed, args.altitude_m,
-                      args.window_s)
+        with _stdout_to_stderr():  # JSBSim prints its loading reports on stdout
+            out = analyse(args.elastic, args.rigid, args.aircraft, args.speed,
+                          args.altitude_m, args.window_s)
     except AnalysisError as exc:
         print(f"ardupilot_full_span: {exc}", file=sys.stderr)
         return 2

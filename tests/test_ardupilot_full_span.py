@@ -100,7 +100,8 @@ def c172_roll_log(tmp_path_factory):
     ac = api.load_aircraft("c172_elastic")
     channels = ad.aircraft_channels(measure_control_power(airframe_for(ac), 57.8, 0.0))
     ph = ad.ArduPilotPhysics(airframe_for(ac), ac.wing(), "coupled", speed_m_s=57.8,
-                             channels=channels, span="full", aileron=ac.definition.aileron)
+                             channels=channels, span="full", aileron=ac.definition.aileron,
+                             record_every=1)
     path = tmp_path_factory.mktemp("c172roll") / "session.mcap"
     desc = RunDescription(kind="ardupilot", wing="c172_elastic", speed_m_s=57.8, gust="none",
                           models=("coupled",), dt_s=ph.dt_s, extra={"autopilot": "ardupilot"})
@@ -121,6 +122,9 @@ def c172_roll_log(tmp_path_factory):
         assert ph.summary()["stop_count"] == 0
     finally:
         log.close()
+    # the session's --table, as the command writes it (cli/sitl_ardupilot.py)
+    np.savez_compressed(path.with_suffix(".npz"), names=np.array(ph.record_names),
+                        table=ph.table())
     return path, np.array(rudder), ph
 
 
@@ -154,3 +158,40 @@ def test_the_analysis_finds_the_roll_and_reads_the_surfaces_flown(analysis, c172
     assert 0.94 < turn["open_loop_ratio"] < 0.99
     assert rep["peak_abs_asym_eta1_rad"] > 1e-5 and rep["tip_twists_opposite_at_peak_p"]
     assert rep["modal_roll_opposes_p_fraction"] > 0.9
+
+
+def test_the_analysis_reads_the_sessions_table_as_its_log(analysis, c172_roll_log, tmp_path):
+    """The session's --table (--record-every 1: a row a frame, the state after it, its
+    servos) read as its log: the same rows (times one step later: the reply's), the rudder
+    from servo 4 through the aircraft's channel map; a half wing's table, which has no
+    aileron_rad, gets JSBSim's aileron from servo 1 through its aileron map (the c172p's
+    15 deg down, 20 deg up): measured equal to the logged one to 1e-12 rad (one frame
+    later: the row's aileron is JSBSim's as its step began)."""
+    path, _, ph = c172_roll_log
+    ac = api.load_aircraft("c172_elastic")
+    _, ch, frames = analysis._flight(path)
+    _, tab, tab_frames = analysis._flight_table(path.with_suffix(".npz"), ac)
+    assert tab["time_s"].size == ch["time_s"].size  # one step a frame at 1200 Hz
+    assert np.array_equal(tab["p_rad_s"], ch["p_rad_s"])
+    assert np.allclose(tab["time_s"] - ch["time_s"], ph.dt_s, rtol=0.0, atol=1e-9)
+    assert np.max(np.abs(tab_frames["rudder_cmd_norm"] - analysis.held(
+        frames["time_s"], frames["rudder_cmd_norm"], ch["time_s"]))) < 1e-12
+    gain = analysis.rudder_gain_rad(ac)
+    rep_log = analysis.flight_report(ch, frames, gain)
+    rep_tab = analysis.flight_report(tab, tab_frames, gain)
+    assert rep_tab["_windows"][0]["t0_s"] == pytest.approx(
+        rep_log["_windows"][0]["t0_s"] + ph.dt_s, abs=1e-9)
+    assert rep_tab["peak_abs_p_rad_s"] == rep_log["peak_abs_p_rad_s"]
+    up, down = analysis.aileron_gains_rad(ac)
+    assert (up, down) == pytest.approx((np.radians(15.0), np.radians(20.0)), rel=1e-3)
+    with np.load(path.with_suffix(".npz")) as z:  # as a half wing's table: no such column
+        names = [str(n) for n in z["names"]]
+        keep = [i for i, n in enumerate(names) if n != "aileron_rad"]
+        half = tmp_path / "half.npz"
+        np.savez_compressed(half, names=np.array([names[i] for i in keep]),
+                            table=z["table"][:, keep])
+    _, rebuilt, _ = analysis._flight_table(half, ac, need_modes=False)
+    # a row's aileron_rad is JSBSim's as the step began: one frame behind its servo at one
+    # step a frame (the first flight row: the trim's)
+    assert np.max(np.abs(rebuilt["aileron_rad"][1:-1] - tab["aileron_rad"][2:])) < 1e-12
+    assert np.ptp(tab["aileron_rad"]) > 0.1
