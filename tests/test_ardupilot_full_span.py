@@ -224,3 +224,14 @@ def test_the_analysis_reads_the_sessions_table_as_its_log(analysis, c172_roll_lo
     # step a frame (the first flight row: the trim's)
     assert np.max(np.abs(rebuilt["aileron_rad"][1:-1] - tab["aileron_rad"][2:])) < 1e-12
     assert np.ptp(tab["aileron_rad"]) > 0.1
+
+
+def test_the_analysis_refuses_bad_input_in_one_line(analysis, c172_roll_log, capsys):
+    """A missing log, a window out of range:
+    exit 2 and one line."""
+    path, _, _ = c172_roll_log
+    for argv, words in (([str(path.with_name("missing.mcap"))], "no such log"),
+                        ([str(path), "--window-s", "0.1"], "--window-s")):
+        assert analysis.main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and words in err, err
