@@ -3,7 +3,7 @@
 
     python scripts/ardupilot_sitl.py build /path/to/ardupilot [--jobs 1] [--venv DIR]
     python scripts/ardupilot_sitl.py fly /path/to/ardupilot [--timeout-s 900] [--out DIR]
-        [--speedup 1] [--rate HZ] [--defaults EXTRA.parm]
+        [--speedup 1] [--rate HZ] [--defaults EXTRA.parm] [--square-m 300] [--home-radius-m 100]
 
 ``build`` runs ``./waf configure --board sitl --no-submodule-update`` and ``./waf plane`` at
 ``nice 19`` (the checkout must have its submodules: waf, mavlink + pymavlink, DroneCAN
@@ -16,8 +16,10 @@ packages (empy==3.3.4, pexpect, future, dronecan, pymavlink); its ``bin`` goes f
 root) or ``unshare -rn`` (as a user), brings ``lo`` up, starts the physics
 (``--physics-cmd``, default the bioflex JSON backend on UDP 9002), starts ArduPlane with
 ``bioflex_jsb/data/ardupilot/bioflex_plane.parm`` (then each ``--defaults`` file, whose
-values win), and flies a takeoff + 4-waypoint + RTL
-mission over MAVLink (pymavlink, TCP 5760). ``--speedup N`` is ArduPlane's ``--speedup`` (it
+values win), and flies a takeoff + 4-waypoint + RTL mission over MAVLink (pymavlink, TCP
+5760): a square of ``--square-m`` a side (300 m, the prototype's; 3000 m for the c172's
+341 m turn radius), ended in RTL within ``--home-radius-m`` of home (100 m; it must exceed
+the aircraft's loiter radius ``WP_LOITER_RAD``). ``--speedup N`` is ArduPlane's ``--speedup`` (it
 paces its frames to N times real time; lock-stepped, the backend sets the pace it reaches)
 and ``--rate HZ`` its ``--rate`` (``SIM_RATE_HZ``, ArduPilot's default 1200 when not given);
 the script's own waits in wall time (the arming retry, the launch switch) are divided by N
@@ -76,11 +78,17 @@ DEFAULT_PHYSICS_CMD = (f"{shlex.quote(sys.executable)} -m bioflex_jsb ardupilot 
                        "--wing optimised --model coupled --gust 1cos:2:30 --gust-at 30 "
                        f"--end-when-silent {PHYSICS_END_SILENCE_S:g} "
                        "--summary physics.json --table physics.npz")
-# Mission (metres from home, NED; altitude above home [m]): a 300 m square flown clockwise.
+# Mission (metres from home, NED; altitude above home [m]): a square flown clockwise, 300 m a
+# side unless --square-m.
 TAKEOFF_ALT_M = 40.0  # NAV_TAKEOFF altitude
 TAKEOFF_PITCH_DEG = 12.0  # NAV_TAKEOFF minimum pitch (ArduPlane docs suggest 10..15 deg)
 MISSION_ALT_M = 60.0
-SQUARE_M = ((300.0, 0.0), (300.0, 300.0), (0.0, 300.0), (0.0, 0.0))
+SQUARE_SIDE_M = 300.0  # the prototype's: 13 of its 22.9 m turn radii at 45 deg of bank
+# the corners, in units of the side, flown in this order
+SQUARE_CORNERS = ((1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0))
+# RTL ends the flight when the aircraft is this near home [m] (the prototype's loiter circle,
+# WP_LOITER_RAD, is within it; a larger aircraft's is not: --home-radius-m)
+HOME_RADIUS_M = 100.0
 LAUNCH_SWITCH_PWM_US = 1900  # RC 5 "fire" (the physics fires at 1880..1920 us held 0.5 s)
 RTL_WATCH_S = 30.0  # the flight ends after this long [s] in RTL near home
 LAUNCH_SWITCH_S = 2.0  # how long the switch is held [s of wall time at --speedup 1]
@@ -146,14 +154,15 @@ def _offset(lat_deg: float, lon_deg: float, north_m: float, east_m: float):
     return lat, lon
 
 
-def _mission(mav, home_lat: float, home_lon: float):
+def _mission(mav, home_lat: float, home_lon: float, side_m: float = SQUARE_SIDE_M):
     from pymavlink import mavutil
 
     m = mavutil.mavlink
     rel = m.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
     items = [(m.MAV_CMD_NAV_WAYPOINT, 0.0, 0.0, 0.0)]  # item 0: home (ArduPilot overwrites it)
     items.append((m.MAV_CMD_NAV_TAKEOFF, TAKEOFF_PITCH_DEG, 0.0, TAKEOFF_ALT_M))
-    items += [(m.MAV_CMD_NAV_WAYPOINT, n, e, MISSION_ALT_M) for n, e in SQUARE_M]
+    items += [(m.MAV_CMD_NAV_WAYPOINT, n * side_m, e * side_m, MISSION_ALT_M)
+              for n, e in SQUARE_CORNERS]
     items.append((m.MAV_CMD_NAV_RETURN_TO_LAUNCH, 0.0, 0.0, 0.0))
     messages = []
     for seq, (cmd, a, b, alt) in enumerate(items):
@@ -180,7 +189,8 @@ def _mission(mav, home_lat: float, home_lon: float):
 
 
 def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float = 1.0,
-        rate_hz: int | None = None, defaults: tuple[Path, ...] = ()) -> dict:
+        rate_hz: int | None = None, defaults: tuple[Path, ...] = (),
+        square_m: float = SQUARE_SIDE_M, home_radius_m: float = HOME_RADIUS_M) -> dict:
     if os.environ.get(NETNS_ENV) != "1":
         _in_private_netns()
     from pymavlink import mavutil
@@ -190,7 +200,8 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float 
         raise ScriptError(f"{binary} not built: run the build step first")
     out.mkdir(parents=True, exist_ok=True)
     procs = []
-    summary: dict = {"speedup": speedup, "sim_rate_hz": rate_hz,
+    summary: dict = {"speedup": speedup, "sim_rate_hz": rate_hz, "square_m": square_m,
+                     "home_radius_m": home_radius_m,
                      "loadavg_start": list(os.getloadavg()),
                      "statustext": [], "reached": [], "xtrack_m": []}
     ap_cmd = [str(binary), "--model", "JSON:127.0.0.1", "--speedup", f"{speedup:g}",
@@ -211,7 +222,7 @@ def fly(ap: Path, physics_cmd: str, timeout_s: float, out: Path, speedup: float 
             procs.append(subprocess.Popen(ap_cmd, cwd=out, stdout=alog,
                                           stderr=subprocess.STDOUT))
             mav = _connect(mavutil, procs)
-            _run_mission(mav, procs, timeout_s, summary, speedup)
+            _run_mission(mav, procs, timeout_s, summary, speedup, square_m, home_radius_m)
     finally:
         summary["physics_end"] = end_processes(procs, PHYSICS_END_WAIT_S)
     summary["wall_s"] = time.monotonic() - wall0
@@ -333,7 +344,7 @@ def cross_track_report(samples: list[tuple[float, int, float]]) -> dict:
 
 def incomplete(summary: dict) -> list[str]:
     """Why the mission was not completed ([] when it was)."""
-    why = [f"waypoint item {seq} not reached" for seq in range(2, 2 + len(SQUARE_M))
+    why = [f"waypoint item {seq} not reached" for seq in range(2, 2 + len(SQUARE_CORNERS))
            if seq not in summary.get("reached", [])]
     if summary.get("ended") != "home reached in RTL":
         why.append(f"ended: {summary.get('ended', 'timeout')}")
@@ -375,9 +386,11 @@ class _Mission:
     """The mission flown over MAVLink, one message at a time (:func:`_run_mission`): what
     each message records, then the next step of the flight it allows (home, mission upload
     and arming, the launch switch, RTL and the end). The waits in wall time are divided by
-    ``speedup``: as long in ArduPlane's time."""
+    ``speedup``: as long in ArduPlane's time. ``square_m`` the square's side [m];
+    ``home_radius_m`` how near home [m] RTL ends the flight."""
 
-    def __init__(self, mav, summary: dict, speedup: float) -> None:
+    def __init__(self, mav, summary: dict, speedup: float, square_m: float = SQUARE_SIDE_M,
+                 home_radius_m: float = HOME_RADIUS_M) -> None:
         from pymavlink import mavutil
 
         self.m = mavutil.mavlink
@@ -386,6 +399,7 @@ class _Mission:
         self.arm_retry_s = ARM_RETRY_S / speedup
         self.launch_hold_s = LAUNCH_SWITCH_S / speedup
         self.launch_resend_s = LAUNCH_RESEND_S / speedup
+        self.square_m, self.home_radius_m = square_m, home_radius_m
         self.state = "wait_gps"
         self.home = None
         self.n_items = 0
@@ -426,7 +440,7 @@ class _Mission:
         elif kind == "NAV_CONTROLLER_OUTPUT" and self.state == "auto":
             # the square's legs only (items 3..5 fly from corner to corner; item 2 from the
             # end of the take-off)
-            if 2 <= self.current_seq <= 1 + len(SQUARE_M):
+            if 2 <= self.current_seq <= 1 + len(SQUARE_CORNERS):
                 summary["xtrack_m"].append((self.sim_s - self.leg_start_s, self.current_seq,
                                             msg.xtrack_error))
         elif kind == "GPS_RAW_INT" and self.state == "wait_gps" and msg.fix_type >= 3:
@@ -454,7 +468,7 @@ class _Mission:
             # SITL boots in MANUAL (seen in the documented flight); AUTO only (re)starts the
             # mission on entering it, so go through FBWA first, then start at the take-off
             mav.set_mode("FBWA")
-            self.n_items = _mission(mav, *self.home)
+            self.n_items = _mission(mav, *self.home, self.square_m)
             mav.waypoint_set_current_send(1)
             mav.set_mode("AUTO")
             mav.arducopter_arm()
@@ -495,14 +509,16 @@ class _Mission:
         if self.state == "auto" and "rtl_at_s" in summary \
                 and self.sim_s - summary["rtl_at_s"] > RTL_WATCH_S:
             # the mission's RTL flown: home and loitering there
-            return self.mav.location().alt is not None and _near_home(self.mav, self.home)
+            return self.mav.location().alt is not None and _near_home(
+                self.mav, self.home, self.home_radius_m)
         return False
 
 
-def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1.0) -> None:
+def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1.0,
+                 square_m: float = SQUARE_SIDE_M, home_radius_m: float = HOME_RADIUS_M) -> None:
     """Wait for a GPS fix and home, upload the mission, AUTO + arm, watch until home.
     The waits in wall time are divided by ``speedup``: as long in ArduPlane's time."""
-    flight = _Mission(mav, summary, speedup)
+    flight = _Mission(mav, summary, speedup, square_m, home_radius_m)
     for stream in STREAMS:
         mav.mav.request_data_stream_send(mav.target_system, mav.target_component,
                                          getattr(flight.m, stream), STREAM_RATE_HZ, 1)
@@ -527,7 +543,7 @@ def _run_mission(mav, procs, timeout_s: float, summary: dict, speedup: float = 1
     summary["track"] = flight.track[::10]  # ≈ 1 s apart at the 10 Hz stream
 
 
-def _near_home(mav, home, radius_m: float = 100.0) -> bool:
+def _near_home(mav, home, radius_m: float = HOME_RADIUS_M) -> bool:
     loc = mav.location()
     dn = math.radians(loc.lat - home[0]) * EARTH_RADIUS_M
     de = math.radians(loc.lng - home[1]) * EARTH_RADIUS_M * math.cos(math.radians(home[0]))
@@ -554,6 +570,12 @@ def main(argv: list[str] | None = None) -> int:
     f.add_argument("--defaults", type=Path, action="append", default=[],
                    help="a parameter file loaded after bioflex_plane.parm (its values win; "
                    "ArduPlane's --defaults takes them comma-separated); repeatable")
+    f.add_argument("--square-m", type=float, default=SQUARE_SIDE_M,
+                   help="the mission square's side [m] (default 300, the prototype's; "
+                   "scale it with the turn radius, e.g. 3000 for the c172)")
+    f.add_argument("--home-radius-m", type=float, default=HOME_RADIUS_M,
+                   help="RTL ends the flight this near home [m] (default 100; above the "
+                   "aircraft's WP_LOITER_RAD)")
     args = parser.parse_args(argv)
     try:
         if args.command == "build":
@@ -565,12 +587,17 @@ def main(argv: list[str] | None = None) -> int:
                 raise ScriptError(f"--speedup must be > 0, got {args.speedup:g}")
             if args.rate is not None and args.rate < 1:
                 raise ScriptError(f"--rate must be >= 1 Hz, got {args.rate}")
+            for name, value in (("--square-m", args.square_m),
+                                ("--home-radius-m", args.home_radius_m)):
+                if not (math.isfinite(value) and value > 0):
+                    raise ScriptError(f"{name} must be > 0 m, got {value:g}")
             for extra in args.defaults:
                 if not extra.is_file() or "," in str(extra.resolve()):
                     raise ScriptError(f"--defaults {extra}: not a file (or a comma in its path)")
             summary = fly(args.ardupilot.resolve(), args.physics_cmd, args.timeout_s,
                           args.out.resolve(), args.speedup, args.rate,
-                          tuple(p.resolve() for p in args.defaults))
+                          tuple(p.resolve() for p in args.defaults), args.square_m,
+                          args.home_radius_m)
             print(json.dumps(summary, indent=1))
             if summary["incomplete"]:
                 print(f"ardupilot_sitl: mission not completed: {'; '.join(summary['incomplete'])}",

@@ -121,6 +121,38 @@ def test_the_command_line_flies_the_c172(tmp_path, capsys):
     assert "c172_elastic" in err and "Traceback" not in err
 
 
+@pytest.mark.xfail(strict=True, raises=AttributeError, reason=(
+    "cli/sitl_ardupilot.py _open_log hands RunLog.open the wing's variant without its build: "
+    "the scene rebuilds the wing from WingVariant(**as_dict()), whose beam is then the "
+    "digest string ('str' object has no attribute 'digest'); pass build= as cli/gust.py does"))
+def test_the_command_line_logs_the_c172s_session(tmp_path, capsys):
+    """``ardupilot --aircraft c172_elastic`` writing its MCAP log (as scripts/ardupilot_sitl.py
+    fly's physics does without --no-log): the session runs and the log holds its frames. Found
+    flying ArduPlane (docs/ardupilot.md, "Both wing halves with a real ArduPlane"): the
+    session fails before it listens, for either span."""
+    from bioflex_jsb.cli import build_parser
+    from bioflex_jsb.sinks import mcap as sink
+
+    out = tmp_path / "c172.mcap"
+    args = build_parser().parse_args(["ardupilot", "--port", str(_free_port()), "--aircraft",
+                                      "c172_elastic", "--duration", "0.1", "--out", str(out)])
+    opened = {}
+    real_open = sink.RunLog.open
+
+    def spy(*a, **kw):  # the log is opened before the session listens: no stand-in needed
+        opened["log"] = real_open(*a, **kw)
+        raise SystemExit(0)
+
+    import bioflex_jsb.sinks.mcap.log as log_module
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(log_module.RunLog, "open", spy)
+        with pytest.raises(SystemExit):
+            args.run(args)
+    opened["log"].close()
+    assert out.is_file()
+
+
 def test_the_parameter_file_is_the_c172s(c172, tmp_path, capsys):
     """--write-parm: the prototype's file's names (every one it sets, no other), the
     airspeeds from the c172's flight speeds (cruise 57.8, 31.1..68.9 m/s), its stall speed

@@ -99,18 +99,71 @@ def test_speedup_and_rate_reach_fly(script, monkeypatch, tmp_path):
     seen = []
     monkeypatch.setattr(script, "fly", lambda *a: seen.append(a) or {"incomplete": []})
     assert script.main(["fly", str(tmp_path), "--speedup", "12", "--rate", "240"]) == 0
-    assert seen[-1][4:] == (12.0, 240, ())
+    assert seen[-1][4:] == (12.0, 240, (), 300.0, 100.0)
     assert script.main(["fly", str(tmp_path)]) == 0
-    assert seen[-1][4:] == (1.0, None, ())  # ArduPilot's own SIM_RATE_HZ
+    assert seen[-1][4:] == (1.0, None, (), 300.0, 100.0)  # ArduPilot's own SIM_RATE_HZ
     extra = tmp_path / "fft.parm"
     extra.write_text("FFT_ENABLE 1\n")
     assert script.main(["fly", str(tmp_path), "--defaults", str(extra)]) == 0
     assert seen[-1][6] == (extra.resolve(),)  # loaded after bioflex_plane.parm
 
 
+def test_the_square_and_the_home_radius_reach_fly(script, monkeypatch, tmp_path):
+    """A larger aircraft's mission (the c172: 341 m turn radius at 45 deg, WP_RADIUS 443 m,
+    WP_LOITER_RAD 590 m) needs a larger square and a home radius beyond its loiter circle."""
+    seen = []
+    monkeypatch.setattr(script, "fly", lambda *a: seen.append(a) or {"incomplete": []})
+    assert script.main(["fly", str(tmp_path), "--square-m", "3000",
+                        "--home-radius-m", "800"]) == 0
+    assert seen[-1][7:] == (3000.0, 800.0)
+
+
+class _MissionLink:
+    """What _mission sends, and ArduPlane's requests for every item, then its ACK."""
+
+    def __init__(self, m, n_items: int) -> None:
+        self.m, self.target_system, self.target_component = m, 1, 1
+        self.mav = self
+        self.sent = []
+        self._replies = [m.MAVLink_mission_request_int_message(1, 1, i)
+                         for i in range(n_items)]
+        self._replies.append(m.MAVLink_mission_ack_message(1, 1, m.MAV_MISSION_ACCEPTED))
+
+    def mission_count_send(self, *a) -> None:
+        pass
+
+    def recv_match(self, **kw):
+        return self._replies.pop(0)
+
+    def send(self, msg) -> None:
+        self.sent.append(msg)
+
+
+def test_the_mission_square_scales_with_its_side(script, monkeypatch):
+    """The four corners at north/east (s, 0), (s, s), (0, s), (0, 0) from home [m]. The
+    MAVLink 2 messages: pymavlink switches its module to them at ArduPlane's first MAVLink 2
+    packet, before the mission is sent."""
+    from pymavlink import mavutil
+    from pymavlink.dialects.v20 import ardupilotmega as m
+
+    monkeypatch.setattr(mavutil, "mavlink", m)
+    home = (47.0, 8.0)
+    for side in (300.0, 3000.0):
+        link = _MissionLink(m, 7)
+        assert script._mission(link, *home, side) == 7
+        corners = [(msg.x * 1e-7, msg.y * 1e-7) for msg in link.sent[2:6]]
+        metres = [(math.radians(lat - home[0]) * script.EARTH_RADIUS_M,
+                   math.radians(lon - home[1]) * script.EARTH_RADIUS_M
+                   * math.cos(math.radians(home[0]))) for lat, lon in corners]
+        want = [(side, 0.0), (side, side), (0.0, side), (0.0, 0.0)]
+        for (n, e), (wn, we) in zip(metres, want, strict=True):
+            assert n == pytest.approx(wn, abs=0.02) and e == pytest.approx(we, abs=0.02)
+
+
 @pytest.mark.parametrize("bad", [["--speedup", "0"], ["--speedup", "-2"],
                                  ["--speedup", "nan"], ["--speedup", "inf"],
-                                 ["--rate", "0"]])
+                                 ["--rate", "0"], ["--square-m", "0"],
+                                 ["--home-radius-m", "-5"], ["--square-m", "nan"]])
 def test_bad_speedup_or_rate_is_exit_2(script, monkeypatch, capsys, tmp_path, bad):
     monkeypatch.setattr(script, "fly", lambda *a: pytest.fail("flown with bad input"))
     assert script.main(["fly", str(tmp_path), *bad]) == script.EXIT_ERROR == 2
