@@ -121,15 +121,12 @@ def test_the_command_line_flies_the_c172(tmp_path, capsys):
     assert "c172_elastic" in err and "Traceback" not in err
 
 
-@pytest.mark.xfail(strict=True, raises=AttributeError, reason=(
-    "cli/sitl_ardupilot.py _open_log hands RunLog.open the wing's variant without its build: "
-    "the scene rebuilds the wing from WingVariant(**as_dict()), whose beam is then the "
-    "digest string ('str' object has no attribute 'digest'); pass build= as cli/gust.py does"))
 def test_the_command_line_logs_the_c172s_session(tmp_path, capsys):
     """``ardupilot --aircraft c172_elastic`` writing its MCAP log (as scripts/ardupilot_sitl.py
     fly's physics does without --no-log): the session runs and the log holds its frames. Found
-    flying ArduPlane (docs/ardupilot.md, "Both wing halves with a real ArduPlane"): the
-    session fails before it listens, for either span."""
+    flying ArduPlane (docs/ardupilot.md, "Both wing halves with a real ArduPlane"; the
+    session failed before it listened, for either span: the scene rebuilt the wing from its
+    variant, whose beam is a digest string for an aircraft's wing.)"""
     from bioflex_jsb.cli import build_parser
     from bioflex_jsb.sinks import mcap as sink
 

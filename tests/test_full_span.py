@@ -366,3 +366,19 @@ def test_fly_gust_flies_both_halves_with_an_aileron_step():
         api.fly_gust(ac, gust="none", models=["coupled"], duration_s=0.1, span="both")
     with pytest.raises(InputError, match="aileron_step_deg"):
         api.fly_gust(ac, gust="none", models=["coupled"], duration_s=0.1, aileron_step_deg=45)
+
+
+def test_a_diverged_mode_is_named_by_its_symmetry():
+    """The range check names the coordinate that left the linear range as the logs and
+    ``modes`` name it: the half wing's aeroelastic_i / eta<i>, both halves'
+    antisymmetric_i / asym_eta<i> (after the symmetric ones in the checked vector)."""
+    from bioflex_jsb.simulation.limits import mode_labels, out_of_range
+
+    labels = mode_labels(3, 2)
+    assert labels[0] == ("aeroelastic_1", "eta1") and labels[4] == ("antisymmetric_2",
+                                                                      "asym_eta2")
+    eta = [0.0, 0.1, 0.0, 0.0, -0.6]
+    args = (["a"], [0.0], 1.0, 0.05, eta, 100.0, (-0.3, 0.5))
+    assert out_of_range(*args, labels).startswith(
+        "mode antisymmetric_2 diverged: |asym_eta2| = 0.600 rad")
+    assert out_of_range(*args).startswith("mode aeroelastic_5 diverged: |eta5|")  # half wing

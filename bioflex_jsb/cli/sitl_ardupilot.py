@@ -321,9 +321,15 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "step": physics.step_kind, "gust_repeat": args.gust_repeat,
                "duration": ("until stopped: the flown duration is in the session-end event "
                             "(session_s)") if args.duration is None else "--duration"})
+    from bioflex_jsb.flight_dynamics.wing_model import WingBuild
+
+    # the scene draws the wing flown: its build (an aircraft's wing is not rebuilt from its
+    # variant); a wing model without one (modal data) the scene rebuilds from the variant
+    build = physics.wing_model if isinstance(physics.wing_model, WingBuild) else None
     try:  # the aircraft in 3-D as in every gust, compare and sitl log (docs/logging.md)
         return live_opener(args, RunLog.open)(args.out, description, wing_variant=variant,
-                                              overrides=overrides, scene=SCENE_EXAGGERATION)
+                                              overrides=overrides, scene=SCENE_EXAGGERATION,
+                                              build=build)
     except LogWriteError as exc:
         raise UsageError(str(exc)) from None
 

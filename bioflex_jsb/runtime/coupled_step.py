@@ -56,7 +56,7 @@ from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
 from bioflex_jsb.simulation.controller_kernel import linear_step
 from bioflex_jsb.simulation.jsbsim_settings import INTEGRATORS
-from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
+from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, mode_labels, out_of_range
 from bioflex_jsb.simulation.modal_wing import (
     DEFAULT_DT_S,
     WING_MODELS,
@@ -584,8 +584,10 @@ class CoupledStep(FullSpanSteps):
         self.k += 1
         alpha = flow.alpha_rad
         self._stall_steps += alpha > self.alpha_peak_rad
+        labels = (None if self.lateral is None
+                  else mode_labels(self.n_modes, len(self.lateral.eta)))
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
-                                    self._agl_m() * U.M_PER_FT, self.alpha_range_rad)
+                                    self._agl_m() * U.M_PER_FT, self.alpha_range_rad, labels)
         return values
 
     def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot,

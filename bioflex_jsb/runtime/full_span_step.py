@@ -24,7 +24,7 @@ from bioflex_jsb.generators.airframe import external_property
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
-from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, out_of_range
+from bioflex_jsb.simulation.limits import ETA_LIMIT_RAD, mode_labels, out_of_range
 
 SPANS = ("half", "full")
 AILERON_PROPERTIES = (JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD)
@@ -233,6 +233,7 @@ class FullSpanSteps:
         set_roll, set_side, set_yaw = self._set_roll, self._set_side, self._set_yaw
         reactions, out_flow = self._reactions, self._out_flow
         ft_per_m, alpha_range = U.FT_PER_M, self.alpha_range_rad
+        labels = mode_labels(len(self.wing.eta), len(self.lateral.eta))
         control = self._control_step
         fast_control = self._control_fast
         if fast_control is not None:
@@ -278,7 +279,7 @@ class FullSpanSteps:
                 eta = np.concatenate([self.wing.eta, self.lateral.eta])
                 self.stopped = out_of_range(self.names, table[k].tolist(), step_k * self.dt_s,
                                             out_flow[0], eta, agl_ft * U.M_PER_FT,
-                                            alpha_range)
+                                            alpha_range, labels)
                 return self.stopped
             return None
 

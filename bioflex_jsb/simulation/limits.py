@@ -20,14 +20,25 @@ ETA_LIMIT_RAD = 0.52
 # 12.8° peak) is shown rather than hidden or fatal.
 
 
+def mode_labels(n_symmetric: int, n_antisymmetric: int = 0) -> tuple[tuple[str, str], ...]:
+    """(mode name, coordinate channel) of each modal coordinate of a run: the half wing's
+    symmetric modes ``aeroelastic_i`` / ``eta<i>``, then both halves' antisymmetric modes
+    ``antisymmetric_i`` / ``asym_eta<i>`` (the names ``modes`` and the logs use)."""
+    return (tuple((f"aeroelastic_{i + 1}", f"eta{i + 1}") for i in range(n_symmetric))
+            + tuple((f"antisymmetric_{i + 1}", f"asym_eta{i + 1}")
+                    for i in range(n_antisymmetric)))
+
+
 def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float,
-                 alpha_range_rad: tuple[float, float]) -> str | None:
+                 alpha_range_rad: tuple[float, float],
+                 labels: tuple[tuple[str, str], ...] | None = None) -> str | None:
     """Why the run must stop after the step whose row is ``values`` (``names`` its channel
     names) at ``t_s`` [s], with the angle of attack ``alpha_rad`` [rad], the new modal
     state ``eta`` [rad] and the height above ground ``agl_m`` [m]; None if it may go on.
     ``alpha_range_rad``: the α range of the flown airframe's tables [rad] (the generated
     prototype's from its generator; another aircraft's from its XML:
-    runtime/aircraft_files.py)."""
+    runtime/aircraft_files.py). ``labels``: (mode name, channel) of each coordinate of
+    ``eta`` (:func:`mode_labels`; None: all symmetric, the half wing's)."""
     isfinite = math.isfinite
     if not all(map(isfinite, values)):
         bad = next(n for n, v in zip(names, values, strict=True) if not isfinite(v))
@@ -44,8 +55,10 @@ def out_of_range(names, values, t_s: float, alpha_rad: float, eta, agl_m: float,
         if abs(e) > worst:
             worst, i_worst = abs(e), i
     if worst > ETA_LIMIT_RAD:
+        mode, channel = (labels[i_worst] if labels is not None
+                         else (f"aeroelastic_{i_worst + 1}", f"eta{i_worst + 1}"))
         return (
-            f"mode aeroelastic_{i_worst + 1} diverged: |eta{i_worst + 1}| = {worst:.3f} rad > "
+            f"mode {mode} diverged: |{channel}| = {worst:.3f} rad > "
             f"{ETA_LIMIT_RAD:.3f} rad (beyond the linear range) at t = {t_s:.3f} s"
         )
     if agl_m <= 0.0:
