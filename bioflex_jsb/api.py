@@ -601,12 +601,14 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
         raise InputError(f"the lateral {model} model needs an elastic wing: pass a wing or "
                          "an Aircraft, not None")
     wing_a = antisymmetric_wing(subject.build, point.trim.ixx_kg_m2)
+    # the model compare --span full drives (drivers/compare_lateral.py): the aircraft's
+    # aileron on the strips, its generalised force on the modes; the unsteady model is
+    # that coupled model with the unsteady strips' increments
+    surface = _aileron_surface(subject, subject.build)
     if aero == "unsteady":
         strips = anti.aircraft_strips(subject.build, wing_a, point.trim.ixx_kg_m2)
-        return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips), None)
-    # the model compare --span full drives (drivers/compare_lateral.py): the aircraft's
-    # aileron on the strips, its generalised force on the modes
-    surface = _aileron_surface(subject, subject.build)
+        return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips,
+                                                surface, subject.build.aero.chord_m), None)
     ss, _ = lateral_model_with_aileron(model, point.trim, point.aero, wing_a, surface,
                                        subject.build.aero.chord_m)
     return ss, rigid, wing_a
@@ -633,9 +635,10 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     balance) beside JSBSim's rigid C_l_delta_a: the model ``compare --span full`` drives
     (:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`;
     ``notes["aileron_on_modes"]``). ``aero``
-    ``quasi-steady`` (default) or ``unsteady`` (coupled only: the strips' Jones lag states
-    lag1[k], lag2[k] [m/s] and apparent mass on the modes and the roll rate;
-    :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
+    ``quasi-steady`` (default) or ``unsteady`` (coupled only: that coupled model, the
+    aileron's quasi-steady load and the yaw rate's and sideslip's terms included, with the
+    strips' Jones lag states lag1[k], lag2[k] [m/s] and apparent mass on the modes and the
+    roll rate; :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
     :class:`Aircraft` (its JSBSim airframe and wing), the prototype's wing or None (the
     prototype, rigid only). One line (InputError) when the aircraft cannot be trimmed at
     that speed, or its wing has no beam (a modal-data file: no antisymmetric modes)."""

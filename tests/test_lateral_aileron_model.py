@@ -140,3 +140,26 @@ def test_an_aircraft_without_an_aileron_has_none_on_its_modes():
     col = ss.inputs.index("aileron")
     assert not np.any(ss.b[4:, col])
     assert ss.notes["aileron_on_modes"].startswith("none")
+
+
+@pytest.mark.parametrize("name", [PROTOTYPE, "c172_elastic"])
+def test_the_unsteady_api_model_is_the_coupled_one_with_the_unsteady_strips(name):
+    """api.lateral_model(..., "coupled", aero="unsteady") at the aircraft's cruise: its
+    quasi-steady part is the API's coupled model (the aileron's load on the modes, the yaw
+    rate's and sideslip's terms), so in a steady state every input's response of β … η̇
+    and n_y is the coupled model's (measured 7e-15 of the largest state, 9e-16 of n_y,
+    prototype; 9e-17, 4e-16, c172); the notes say both terms, the lag states follow η̇."""
+    ac = api.load_aircraft(name)
+    qs = api.lateral_model(ac, None, "coupled")
+    u = api.lateral_model(ac, None, "coupled", aero="unsteady")
+    assert u.model == "unsteady-lateral" and u.speed_m_s == qs.speed_m_s
+    n0 = qs.n_states
+    assert u.states[:n0] == qs.states and u.states[n0] == "lag1[0]"
+    assert u.inputs == qs.inputs and u.outputs[-1] == "n_y"
+    for key in ("aileron_on_modes", "yaw_sideslip"):
+        assert u.notes[key] == qs.notes[key]
+    x_u, x_q = np.linalg.solve(u.a, -u.b), np.linalg.solve(qs.a, -qs.b)
+    y_u = u.c[-1] @ x_u + u.d[-1]
+    y_q = qs.c[qs.outputs.index("n_y")] @ x_q + qs.d[qs.outputs.index("n_y")]
+    assert np.max(np.abs(x_u[:n0] - x_q)) < 1e-10 * np.max(np.abs(x_q))
+    assert np.max(np.abs(y_u - y_q)) < 1e-10 * np.max(np.abs(y_q))

@@ -33,11 +33,16 @@ the elastic axis (leading edge up).
 
 Two systems are built from it:
 
-* :func:`unsteady_lateral_model`: the lateral model (β, p, r, φ, η, η̇; JSBSim's rigid
-  derivatives) with these increments and the lag states appended; with ``unsteadiness``
-  0 its rows and columns of β … η̇ are the quasi-steady model's exactly (the lags then only
-  listen: block triangular), which labels its roots by continuation to 1
-  (:func:`unsteady_lateral_mode_set`);
+* :func:`unsteady_lateral_model`: the coupled lateral model of the one builder
+  (β, p, r, φ, η, η̇; JSBSim's rigid derivatives, the aileron's quasi-steady load on the
+  modes, the yaw rate's and sideslip's terms:
+  :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`) with
+  these increments and the lag states appended; with ``unsteadiness`` 0 its rows and
+  columns of β … η̇ are that quasi-steady model's exactly (the lags then only listen: block
+  triangular), which labels its roots by continuation to 1
+  (:func:`unsteady_lateral_mode_set`). The aileron's own unsteady terms (Theodorsen's
+  T-functions: its circulatory lift through the lag, its δ̇, δ̈ apparent mass) are not in
+  it: they need the surface's rate and acceleration, an actuator model's states;
 * :func:`antisymmetric_family`: the antisymmetric aeroelastic system of the flutter search:
   the roll rate p (the aircraft's I_xx, roll damping from the same strips: the wing's, the
   tail's left out) and the modes, the sideslip, yaw and bank left out (they do not load the
@@ -53,6 +58,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
+from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.eigen import IMAG_TOL_RAD_S, Mode, ModeSet
@@ -270,16 +277,44 @@ def lag_names(n_strips: int) -> tuple[str, ...]:
 # the lateral model on unsteady strips
 # --------------------------------------------------------------------------------------
 def unsteady_lateral_model(trim: LateralTrim, aero: LateralAerodynamics,
-                           wing: AntisymmetricWing, strips: AntisymmetricStrips, *,
-                           unsteadiness: float = 1.0) -> StateSpace:
-    """The coupled lateral model (:func:`build_lateral_elastic`, quasi-steady strips) with
-    the unsteady strips' increments (module docstring): states β, p, r, φ, η_i, η̇_i, then
-    lag1[k], lag2[k] [m/s]; inputs v_g, aileron, rudder; outputs the states and n_y.
-    ``unsteadiness`` (0 … 1) scales the increments: 0 is the quasi-steady model with the
-    lags listening (its eigenvalues the quasi-steady ones and −β_j V/b_k)."""
-    base = build_lateral_elastic("coupled", trim, aero, wing)
-    n, k = wing.n_modes, strips.n_strips
+                           wing: AntisymmetricWing, strips: AntisymmetricStrips,
+                           surface: ControlSurface | None, chord_m: np.ndarray, *,
+                           unsteadiness: float = 1.0, static_eta_s=None) -> StateSpace:
+    """The coupled lateral model of the one builder
+    (:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`:
+    quasi-steady strips, ``surface``'s quasi-steady load on the modes, the yaw rate's and
+    sideslip's terms about the trim with ``static_eta_s``) with the unsteady strips'
+    increments (module docstring): states β, p, r, φ, η_i, η̇_i, then lag1[k], lag2[k]
+    [m/s]; inputs v_g, aileron, rudder; outputs the states and n_y. ``chord_m`` [m] the
+    builder's strips' chords (the lattice's, ``build.aero.chord_m``). ``unsteadiness``
+    (0 … 1) scales the increments: 0 is the quasi-steady model with the lags listening (its
+    eigenvalues the quasi-steady ones and −β_j V/b_k)."""
+    base = _quasi_steady_base(trim, aero, wing, surface, chord_m, static_eta_s)
+    return with_unsteady_strips(base, trim, strips, unsteadiness=unsteadiness)
+
+
+def _quasi_steady_base(trim: LateralTrim, aero: LateralAerodynamics, wing: AntisymmetricWing,
+                       surface: ControlSurface | None, chord_m: np.ndarray,
+                       static_eta_s) -> StateSpace:
+    """The one builder's coupled lateral model: the unsteady model's quasi-steady part."""
+    base, _ = lateral_model_with_aileron("coupled", trim, aero, wing, surface, chord_m,
+                                         static_eta_s)
+    return base
+
+
+def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: AntisymmetricStrips, *,
+                         unsteadiness: float = 1.0) -> StateSpace:
+    """``base`` (a coupled lateral model, states β, p, r, φ, η_i, η̇_i) with the unsteady
+    strips' increments of ``strips`` (the same modes) scaled by ``unsteadiness`` and their
+    lag states appended. The increments' rolling moment acts on ṗ, ṙ through J⁻¹, their
+    generalised force on η̈; their side force and the yawing moment of their induced drag
+    are left out (they vanish in a steady state, as the increments do). ``base``'s B, n_y
+    row and notes are carried over (B through the apparent mass's E⁻¹)."""
+    n, k = strips.n_modes, strips.n_strips
     n0 = 4 + 2 * n
+    if base.n_states != n0 or base.model != "coupled-lateral":
+        raise ValueError(f"the unsteady strips go onto a coupled lateral model of {n} modes, "
+                         f"not {base.model!r} with {base.n_states} states")
     n_all = n0 + 2 * k
     layout = Layout(n_all, 1, slice(4, 4 + n), slice(4 + n, n0),
                     (slice(n0, n0 + k), slice(n0 + k, n_all)))
@@ -304,10 +339,12 @@ def unsteady_lateral_model(trim: LateralTrim, aero: LateralAerodynamics,
     lags = lag_names(k)
     states = base.states + lags
     units = base.state_units + ("m/s",) * 2 * k
-    n_y_c = np.r_[base.c[-1], np.zeros(2 * k)]
-    # n_y is the rigid aerodynamic side force: it reads the states, not their rates
+    i_ny = base.outputs.index("n_y")
+    n_y_c = np.r_[base.c[i_ny], np.zeros(2 * k)]
+    # n_y is the aerodynamic side force (the rigid one and the modes'): it reads the states,
+    # not their rates
     c = np.vstack([np.eye(n_all), n_y_c])
-    d = np.vstack([np.zeros((n_all, b.shape[1])), base.d[-1]])
+    d = np.vstack([np.zeros((n_all, b.shape[1])), base.d[i_ny]])
     notes = {**base.notes, "wing": "antisymmetric modes, unsteady strips (Jones lag states, "
              "apparent mass)", "lag_states": 2 * k, "unsteadiness": float(unsteadiness)}
     return StateSpace(model="unsteady-lateral", speed_m_s=trim.speed_m_s, a=a, b=b,
@@ -339,21 +376,24 @@ def _homotopy(matrix, reference_a: np.ndarray, reference_labels: list[str],
 
 
 def unsteady_lateral_mode_set(trim: LateralTrim, aero: LateralAerodynamics,
-                              wing: AntisymmetricWing, strips: AntisymmetricStrips
-                              ) -> tuple[StateSpace, ModeSet]:
+                              wing: AntisymmetricWing, strips: AntisymmetricStrips,
+                              surface: ControlSurface | None, chord_m: np.ndarray,
+                              static_eta_s=None) -> tuple[StateSpace, ModeSet]:
     """(the unsteady lateral model, its labelled modes): the quasi-steady coupled model's
-    labels (:func:`coupled_mode_set`) carried to the unsteady one by continuation in the
-    unsteadiness (0 → 1, :data:`HOMOTOPY_STEPS` steps); the lag roots left out."""
+    labels (:func:`coupled_mode_set` on the one builder's model, the quasi-steady part of
+    :func:`unsteady_lateral_model` with the same arguments) carried to the unsteady one by
+    continuation in the unsteadiness (0 → 1, :data:`HOMOTOPY_STEPS` steps); the lag roots
+    left out."""
     rigid = build_lateral_elastic("rigid", trim, aero, None)
-    qs = build_lateral_elastic("coupled", trim, aero, wing)
+    qs = _quasi_steady_base(trim, aero, wing, surface, chord_m, static_eta_s)
     qs_modes = coupled_mode_set(qs, rigid, wing)
     labels = _root_labels(qs, rigid, wing)
 
     def matrix(eps: float) -> np.ndarray:
-        return unsteady_lateral_model(trim, aero, wing, strips, unsteadiness=eps).a
+        return with_unsteady_strips(qs, trim, strips, unsteadiness=eps).a
 
     lam, names = _homotopy(matrix, qs.a, labels)
-    ss = unsteady_lateral_model(trim, aero, wing, strips)
+    ss = with_unsteady_strips(qs, trim, strips)
     return ss, _mode_set(lam, names, ss, [m.mode for m in qs_modes.modes])
 
 
