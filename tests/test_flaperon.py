@@ -420,12 +420,12 @@ def test_shipped_two_surface_controller(gla_both):
 
 @pytest.mark.slow
 def test_two_surface_tuned_gust_nonlinear_gives_the_prediction(wing, gla_both):
-    """Every tuned gradient flown open and closed with elevator and flaperon (the flaperon's
-    runs on the Python step): measured nonlinear tuned ratio 0.9298 against the LTI's
-    0.9323, per gradient within 0.0148; the elevator-only controller, the same way, 0.9246
-    against 0.9276 (tests/test_gla.py). Tolerances those of tests/test_gla.py; the flaperon's
-    command peaks 0.34-0.89°, within its 8° design limit. Slow: 12.5 s alone, 20 open and
-    closed runs, half of them on the Python step; with the file's other tests over 30 s."""
+    """Every tuned gradient flown open and closed with elevator and flaperon: measured
+    nonlinear tuned ratio 0.9298 against the LTI's 0.9323, per gradient within 0.0148; the
+    elevator-only controller, the same way, 0.9246 against 0.9276 (tests/test_gla.py).
+    Tolerances those of tests/test_gla.py; the flaperon's command peaks 0.34-0.89°, within
+    its 8° design limit. Slow: 20 open and closed runs, 2.3 s on a 2-core machine (7.0 s
+    with the closed runs on the Python step, compiled=False)."""
     ctrl, pred = gla_both
     airframe = Airframe()
     peaks, flap = [], []
@@ -491,7 +491,8 @@ def test_two_surface_turbulence_rms_nonlinear_gives_the_prediction(wing, gla_bot
     """60 s of von Kármán turbulence (seed 1), open and closed with both surfaces: the RMS
     ratio of the root bending moment over 0.25-150 Hz, measured 0.8982 against the LTI's
     0.9000 (elevator only, the same way: 0.9077 against 0.9069); within 0.03 as
-    tests/test_gla.py. About 35 s (the closed run on the Python step: 26 s)."""
+    tests/test_gla.py. About 3.3 s on a 2-core machine, both runs on the compiled step (8.7 s
+    with the closed run on the Python step, compiled=False)."""
     from bioflex_jsb.loads.spectral import compare_spectra
 
     ctrl, pred = gla_both
