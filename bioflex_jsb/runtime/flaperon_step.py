@@ -151,6 +151,7 @@ def compiled_flaperon_control(step, control):
     fl = step.flaperon
     size = sum(n for _, n in K.layout(step.n_modes).values())
     params = step._params[:size]  # the half wing's block (the whole array on a half wing)
+    K.say_if_compiling(K.flaperon_loads, "flaperon's loads")
     entry, accepts = K.flaperon_entry(params)
     set_lift, set_drag, set_pitch = step._set_reactions
     loads = K.flaperon_loads
