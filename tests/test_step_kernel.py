@@ -138,3 +138,54 @@ def test_the_unsteady_kernel_has_a_direct_entry_of_the_same_arguments():
             == entry(reads, p2, x.copy(), cols, np.zeros((1, len(cols))), 0, 0.4, 0.1)
             == K.NEEDS_REFRESH)
     assert np.array_equal(params, p2, equal_nan=True) and views["out_flow"][3] > 0.0  # V
+
+
+def test_the_flaperon_column_in_one_call():
+    """The kernel's flaperon block (runtime/flaperon_step.py: the Python step it matches in
+    tests/test_flaperon.py) on one call: the deflection held δ moves the state by exactly
+    Ψ_r b_δf Q δ (the rest of the step as without a flaperon), is logged in its column, and
+    flaperon_loads (dispatcher and machine code alike) adds Q S C_Lδf δf, its induced drag
+    and Q S c̄ C_mδf δf to the row's loads, returns the reactions of the sum and holds δf."""
+    import math
+
+    K, params, x, cols, reads = _kernel_case(2)
+    lay = K.layout(3)
+    v = {name: params[o:o + size] for name, (o, size) in lay.items()}
+    table = np.zeros((1, len(cols) + 1))  # the flaperon's column last
+    plain_x, plain_params, plain = x.copy(), params.copy(), table.copy()
+    assert K.step_kernel(reads, plain_params, plain_x, cols, plain, 0, 0.4, -0.12) == K.OK
+    v["flap_cols"][:] = np.linspace(-0.03, 0.04, 6)  # η moved by < 0.11 rad
+    flap = v["flap"]
+    flap[K.FLAP_HELD] = 0.02
+    flap[[K.FLAP_AREA, K.FLAP_CL, K.FLAP_K2, K.FLAP_CHORD, K.FLAP_CM]] = (
+        0.5, 0.96, 0.03, 0.2, -0.72)
+    flap[K.FLAP_COL] = len(cols) + 1
+    lift_col, drag_col, moment_col = (int(cols[K.KERNEL_SLOTS.index(s)])
+                                      for s in ("lift_n", "drag_n", "pitch_moment_n_m"))
+    flap[K.FLAP_LOAD_COLS:K.FLAP_LOAD_COLS + 3] = (lift_col, drag_col, moment_col)
+    flap[K.FLAP_LBF], flap[K.FLAP_LBF_FT] = 0.224809, 0.737562
+    assert K.step_kernel(reads, params, x, cols, table, 0, 0.4, -0.12) == K.OK
+    qbar = params[lay["out_flow"][0] + 2]
+    assert np.allclose(x - plain_x, v["flap_cols"] * qbar * 0.02, rtol=1e-12, atol=1e-18)
+    assert table[0, -1] == 0.02
+    # the wing's loads are those of its state: the flaperon's enter after the controller
+    entry, accepts = K.flaperon_entry(params)
+    assert accepts(table)
+    with pytest.raises(TypeError, match="parameters"):
+        K.flaperon_entry(params.astype(np.float32))
+    t2, p2 = table.copy(), params.copy()
+    out = K.flaperon_loads(params, table, 0, -0.05)
+    assert entry(p2, t2, 0, -0.05) == out and np.array_equal(t2, table)
+    alpha = params[lay["out_flow"][0]]
+    d_lift = qbar * 0.5 * 0.96 * -0.05
+    lift = params[lay["flap"][0] + K.FLAP_WING] + d_lift
+    drag = params[lay["flap"][0] + K.FLAP_WING + 1] + 0.03 * d_lift
+    moment = params[lay["flap"][0] + K.FLAP_WING + 2] + qbar * 0.5 * 0.2 * -0.72 * -0.05
+    assert table[0, lift_col] == pytest.approx(lift, rel=1e-15)
+    assert table[0, drag_col] == pytest.approx(drag, rel=1e-15)
+    assert table[0, moment_col] == pytest.approx(moment, rel=1e-15)
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    assert out == pytest.approx(((lift * ca + drag * sa) * 0.224809,
+                                 (drag * ca - lift * sa) * 0.224809, moment * 0.737562),
+                                rel=1e-15)
+    assert flap[K.FLAP_HELD] == -0.05  # held for the next step

@@ -6,7 +6,6 @@ import argparse
 import math
 import os
 import sys
-import warnings
 
 from bioflex_jsb.cli.case import (
     DEFAULT_GUST,
@@ -310,7 +309,6 @@ def fly(args, build, config, log=None, airframe=None):
     from bioflex_jsb.cli.aircraft_option import airframe_from_args
     from bioflex_jsb.drivers.gust import run_gust
     from bioflex_jsb.runtime.fdm import FdmError
-    from bioflex_jsb.runtime.flaperon_step import FlaperonStepWarning
 
     runs, stops = [], []
     # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
@@ -333,15 +331,11 @@ def fly(args, build, config, log=None, airframe=None):
             wing = build if config.needs_build(model) or lateral.get("span") == "full" \
                 or flaperon else build.model  # a flaperon's strips are the build's
             try:
-                with warnings.catch_warnings():  # said once, below, as a note
-                    warnings.simplefilter("ignore", FlaperonStepWarning)
-                    run = run_gust(airframe, wing, model, config, progress=progress,
-                                   recorder=recorder, loads=build, controller=controller,
-                                   **lateral)
+                run = run_gust(airframe, wing, model, config, progress=progress,
+                               recorder=recorder, loads=build, controller=controller,
+                               **lateral)
             finally:
                 close_bar(bar)
-            if run.meta.get("step_note"):
-                print(f"bioflex-jsb: note: {model}: {run.meta['step_note']}", file=sys.stderr)
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)

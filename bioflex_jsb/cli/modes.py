@@ -60,12 +60,12 @@ derivatives are identified from the aircraft's JSBSim model at its trim at each 
 (the prototype's generated JSBSim airframe, whose lateral tables are estimates: the paper
 has no lateral data), --models rigid (the rigid aircraft), coupled (with the wing's
 antisymmetric modes on quasi-steady strips that see the roll rate, the yaw rate, the
-sideslip and the aileron, and their side force and yawing moment; --aero unsteady: the same
-with Theodorsen strips, Jones lag states and apparent mass on the modes and the roll rate,
-the lag roots not listed) and qsd (their static deformation); a wing given as a
-modal-data file has no antisymmetric modes (rigid only). The aircraft must trim there (the prototype 9..32 m/s; an --aircraft
-its flight speeds, default its cruise speed); --structural-damping, --plot, --animate and
---mode-sheet do not apply.
+sideslip and the aileron, and their side force and yawing moment; --aero unsteady: the
+same with Theodorsen strips, Jones lag states and apparent mass on the modes and the roll
+rate, the lag roots not listed) and qsd (their static deformation); a wing given as a
+modal-data file has no antisymmetric modes (rigid only). The aircraft must trim there (the
+prototype 9..32 m/s; an --aircraft its flight speeds, default its cruise speed);
+--structural-damping, --plot, --animate and --mode-sheet do not apply.
 JSON: "derivatives" (body axes, per rad; rates with b/2V) and "source" per result;
 docs/lateral.md."""
 

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
-import warnings
 
 from bioflex_jsb.cli.case import airspeed, speed_help
 from bioflex_jsb.cli.common import (
@@ -169,17 +167,14 @@ def run(args: argparse.Namespace) -> int:
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)
     try:
         airframe, speeds = _airframe(args, home[2] + args.start_height)
-        with _step_notes_said_once():
-            sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
-                          home=home, start_height_m=args.start_height, speedup=args.speedup,
-                          trim_mode=args.trim, aero=args.aero, airframe=airframe,
-                          controller=controller,
-                          **({} if speeds is None else {"airspeed_range_m_s": speeds}),
-                          **span_options(args, build))
+        sim = SitlSim(build, build.modes, model=args.model, speed_m_s=args.speed,
+                      home=home, start_height_m=args.start_height, speedup=args.speedup,
+                      trim_mode=args.trim, aero=args.aero, airframe=airframe,
+                      controller=controller,
+                      **({} if speeds is None else {"airspeed_range_m_s": speeds}),
+                      **span_options(args, build))
     except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing,
         raise UsageError(str(exc)) from None  # a home out of range
-    if sim.core.step_note:  # the step flown is not the one asked for (a flaperon)
-        print(f"bioflex-jsb: note: {args.model}: {sim.core.step_note}", file=sys.stderr)
     try:
         link = MavlinkLink(endpoint, SitlParameters(sim), sim.vehicle, signing_key=key)
     except LinkError as exc:
@@ -203,8 +198,7 @@ def run(args: argparse.Namespace) -> int:
     interrupted = False
     stats = PacingStats()  # filled as the session flies: Ctrl-C, its usual end, keeps it
     try:
-        with _step_notes_said_once():  # a reset builds the step again
-            run_paced(sim, args.duration, link, on_sample, idle=idle, stats=stats)
+        run_paced(sim, args.duration, link, on_sample, idle=idle, stats=stats)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -218,18 +212,6 @@ def run(args: argparse.Namespace) -> int:
                                                 if args.out else ""), file=sys.stderr)
         return 130
     return 0
-
-
-@contextlib.contextmanager
-def _step_notes_said_once():
-    """Warnings filtered so that the coupled step's fall-back to the Python step (a
-    flaperon controller: the compiled kernel has no flaperon column) is said once, as a
-    note at the session's start, not as a Python warning at each (re)build of the step."""
-    from bioflex_jsb.runtime.flaperon_step import FlaperonStepWarning
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", FlaperonStepWarning)
-        yield
 
 
 def _check_session_options(args: argparse.Namespace):

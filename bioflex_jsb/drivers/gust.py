@@ -254,8 +254,6 @@ def run_gust(
     if aileron_input is not None:
         history.meta["aileron_input"] = aileron_input.as_dict()
     history.meta["span"] = span
-    if step.step_note is not None:  # the step flown is not the one asked for (a flaperon)
-        history.meta["step_note"] = step.step_note
     if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
         history.meta["flaperon"] = step.flaperon.deriv.as_dict()
     if sensor_set is not None:

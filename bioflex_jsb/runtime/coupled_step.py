@@ -225,8 +225,7 @@ class CoupledStep(FullSpanSteps):
         native = model == "native"
         self.native, self.model, self.aero, self.trim_mode = native, model, aero, trim_mode
         self.speed_m_s = float(speed_m_s)
-        # the native wing has no step of ours; a controller's flaperon flies the Python step
-        self.compiled = bool(compiled) and not native
+        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's, or for a
         # native wing given alone its aircraft definition's
         data = (_native_airframe_data(airframe) if wing is None else wing.airframe
@@ -258,6 +257,10 @@ class CoupledStep(FullSpanSteps):
                 self._setup_full_span_kernel()
         if controller is not None:
             self._map_commands()
+        if self.compiled and self.flaperon is not None:  # its loads after the controller
+            from bioflex_jsb.runtime.flaperon_step import compiled_flaperon_control
+
+            self._control_step = compiled_flaperon_control(self, self._control_step)
         self._stall_steps = 0  # steps flown beyond the lift peak (Python step)
         self.k = 0
         self.stopped: str | None = None
@@ -266,10 +269,9 @@ class CoupledStep(FullSpanSteps):
 
     def _controller_outputs(self, controller, sensors, build, aileron):
         """The controller checked before the airframe is touched (None without one), and the
-        step's attributes its outputs decide: a flaperon flies the Python step."""
+        step's attributes its outputs decide (a flaperon: runtime/flaperon_step.py)."""
         self._build, self._aileron = build, aileron  # a controller's flaperon's strips
         self.flaperon = None  # a controller's flaperon (runtime/flaperon_step.py)
-        self.step_note: str | None = None  # why the step is not the one asked for
         self._kin_get = None  # the readers of _kinematics, bound at its first call
         self.control = None  # the controller in the loop (_attach_controller)
         self._control_step = None
@@ -415,12 +417,10 @@ class CoupledStep(FullSpanSteps):
             ControlLoop,
         )
 
-        if "flaperon" in controller.outputs:  # on the Python step (runtime/flaperon_step.py)
-            from bioflex_jsb.runtime.flaperon_step import flaperon_for, python_step_fallback
+        if "flaperon" in controller.outputs:  # runtime/flaperon_step.py
+            from bioflex_jsb.runtime.flaperon_step import flaperon_for
 
             self.flaperon = flaperon_for(self, self._build, self._aileron)
-            self.step_note = python_step_fallback(self.compiled)  # said, never silent
-            self.compiled = False
             self.units["flaperon_rad"] = "rad"
         for o in controller.outputs:
             self.units[COMMAND_CHANNELS[o]] = CONTROL_OUTPUTS[o]
@@ -456,13 +456,15 @@ class CoupledStep(FullSpanSteps):
         """The compiled controller's update maps its commands to the surfaces' JSBSim
         values (each command's offset, scale and limits) and returns the first; one command
         with one setter flies the fast path (:meth:`_bind_fast_step`: the update's machine
-        code, then the setter)."""
+        code, then the setter), unless it is a flaperon (its loads follow the controller:
+        runtime/flaperon_step.py)."""
         binding, commands = self.control.binding, self._commands
         if binding is None:
             return
         for i, c in enumerate(commands):
             binding.set_map(i, c.offset, c.angle, c.down, c.up)
-        if len(commands) == 1 and len(commands[0].setters) == 1 and commands[0].adds == (0.0,):
+        if (len(commands) == 1 and len(commands[0].setters) == 1
+                and commands[0].adds == (0.0,) and self.flaperon is None):
             self._control_fast = (binding, commands[0].setters[0])
 
     # -- the wing ---------------------------------------------------------------------------
@@ -665,6 +667,10 @@ class CoupledStep(FullSpanSteps):
             v["static_load"][:] = mw._static_load
             v["model"][0] = K.MODEL_CODES[mw.model]
             mw.prepare_arrays()
+            if self.flaperon is not None:  # its block (runtime/flaperon_step.py)
+                from bioflex_jsb.runtime.flaperon_step import pack_flaperon
+
+                pack_flaperon(self, v)
         self._views = v
         lo, hi = self.alpha_range_rad
         ref = self.airframe_data.reference
@@ -695,6 +701,8 @@ class CoupledStep(FullSpanSteps):
             return
         v["stack"][:] = np.ravel(mw._stack)
         v["input_cols"][:] = np.ravel(mw._input_cols)
+        if mw._flap_cols is not None:  # a flaperon's step column, renewed with the others
+            v["flap_cols"][:] = mw._flap_cols
         v["key"][:] = mw._key
 
     def advance_into(self, w_g_m_s: float, table: np.ndarray, k: int,

@@ -22,18 +22,24 @@ over step k (``flaperon_rad``: δf_{k−1} clipped, as ``elevator_rad`` is JSBSi
 x_k), and in ``lift_n``, ``drag_n``, ``pitch_moment_n_m`` the reactions as written, the
 flaperon's included.
 
-**The step.** The compiled kernel has no flaperon column: a run with a flaperon flies the
-readable Python step (the kernel's reference, ``tests/test_step_kernel.py``), at the Python
-step's cost (``bench``'s ``python``). When the compiled step was asked for (every driver's
-default) the fall-back is said, never silent: a :class:`FlaperonStepWarning` (printed once
-on stderr by the CLI) and ``meta["step_note"]`` of the run's history.
+**The step.** Both steps fly it: the readable Python step (:func:`apply_flaperon`, the
+reference) and the compiled kernel (:func:`~bioflex_jsb.simulation.step_kernel.step_kernel`
+with its flaperon block, :func:`pack_flaperon`: the held deflection's forcing of the modes
+and ``flaperon_rad``; then :func:`~bioflex_jsb.simulation.step_kernel.flaperon_loads` after
+the controller, :func:`compiled_flaperon_control`: the loads of the new command into the
+row and the reactions), the half wing's and, through it, both halves' (the full-span
+kernel steps the half wing with the half wing's kernel). ``tests/test_flaperon.py`` holds
+the two to 1e-9 of each channel's range. The compiled step holds δf in its parameter array
+(:attr:`FlaperonLoads.applied_rad` and the wing's ``flaperon_rad`` are the Python step's).
 """
 
 from __future__ import annotations
 
 import math
-import warnings
 
+import numpy as np
+
+from bioflex_jsb import units as U
 from bioflex_jsb.aeroelasticity.flaperon import (
     FLAPERON_LIMIT_RAD,
     FlaperonDerivatives,
@@ -41,24 +47,7 @@ from bioflex_jsb.aeroelasticity.flaperon import (
 )
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.runtime.control_surfaces import Command
-
-# What a run that asked for the compiled step is told when its flaperon flies the Python one
-PYTHON_STEP_NOTE = ("a flaperon command flies the Python coupled step: the compiled kernel "
-                    "has no flaperon column")
-
-
-class FlaperonStepWarning(UserWarning):
-    """The compiled step was asked for, the flaperon flies the Python one (module
-    docstring, "The step")."""
-
-
-def python_step_fallback(compiled: bool) -> str | None:
-    """The note of a step with a flaperon (None: the Python step was asked for); warns
-    (:class:`FlaperonStepWarning`) when ``compiled`` was asked for."""
-    if not compiled:
-        return None
-    warnings.warn(PYTHON_STEP_NOTE, FlaperonStepWarning, stacklevel=3)
-    return PYTHON_STEP_NOTE
+from bioflex_jsb.simulation import step_kernel as K
 
 
 class FlaperonLoads:
@@ -130,3 +119,52 @@ def apply_flaperon(step, flow, loads, values: tuple[float, ...]) -> tuple[float,
     fl.applied_rad = delta
     step.wing.flaperon_rad = delta
     return tuple(row)
+
+
+def pack_flaperon(step, views) -> None:
+    """Fill the compiled kernel's flaperon blocks (``views``: the half wing's parameter
+    array by :func:`~bioflex_jsb.simulation.step_kernel.layout` block) of ``step``, whose
+    row (``step.names``) is complete: the forcing b_δf of the quasi-static wing, the
+    flaperon's constants and the row's columns (step_kernel.N_FLAP); the step column
+    Ψ_r b_δf follows each reference (CoupledStep._load_reference)."""
+    fl, names = step.flaperon, step.names
+    views["flap_force"][:] = step.wing._flap_force
+    d = fl.deriv
+    block = views["flap"]
+    block[K.FLAP_HELD] = 0.0  # the trim's: no deflection before the first command
+    block[K.FLAP_AREA], block[K.FLAP_CL], block[K.FLAP_K2] = (d.area_m2, d.c_l_per_rad,
+                                                              fl.k_induced2)
+    block[K.FLAP_CHORD], block[K.FLAP_CM] = d.chord_m, d.c_m_per_rad
+    block[K.FLAP_COL] = names.index("flaperon_rad") + 1
+    for i, name in enumerate(("lift_n", "drag_n", "pitch_moment_n_m")):
+        block[K.FLAP_LOAD_COLS + i] = names.index(name)
+    block[K.FLAP_LBF], block[K.FLAP_LBF_FT] = U.LBF_PER_N, U.LBF_FT_PER_N_M
+
+
+def compiled_flaperon_control(step, control):
+    """The compiled step's controller with the flaperon (module docstring, "Timing"):
+    ``control(table, k)`` (the controller, its commands written, the flaperon's
+    :meth:`FlaperonLoads.set_command` among them), then
+    :func:`~bioflex_jsb.simulation.step_kernel.flaperon_loads` with the command and the
+    reactions it returns written, before JSBSim's step (they replace the wing's alone,
+    written before the controller)."""
+    fl = step.flaperon
+    size = sum(n for _, n in K.layout(step.n_modes).values())
+    params = step._params[:size]  # the half wing's block (the whole array on a half wing)
+    K.say_if_compiling(K.flaperon_loads, "flaperon's loads")
+    entry, accepts = K.flaperon_entry(params)
+    set_lift, set_drag, set_pitch = step._set_reactions
+    loads = K.flaperon_loads
+    checked, call = None, loads
+
+    def control_flaperon(table: np.ndarray, k: int) -> None:
+        nonlocal checked, call
+        if table is not checked:  # the machine code for the table type it was built for
+            checked, call = table, (entry if accepts(table) else loads)
+        control(table, k)
+        lift_lbf, drag_lbf, pitch_lbf_ft = call(params, table, k, fl.command_rad)
+        set_lift(lift_lbf)
+        set_drag(drag_lbf)
+        set_pitch(pitch_lbf_ft)
+
+    return control_flaperon

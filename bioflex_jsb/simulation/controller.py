@@ -25,8 +25,9 @@ and signs (its inputs ``elevator`` and ``throttle``, :mod:`bioflex_jsb.flight_dy
   (:mod:`bioflex_jsb.aeroelasticity.flaperon`: sign, section data, what is left out).
   JSBSim's tables have no symmetric aileron: its loads go to JSBSim's external reactions
   beside the modes' (never through ``fcs/aileron-cmd-norm``), its strip loads onto the
-  symmetric modes, and the run's steps are the Python (reference) step's
-  (:mod:`bioflex_jsb.runtime.control_surfaces`, "The flaperon").
+  symmetric modes, on the compiled step as on the Python one
+  (:mod:`bioflex_jsb.runtime.control_surfaces`, "The flaperon";
+  :mod:`bioflex_jsb.runtime.flaperon_step`).
 
 The runtime converts them once at the JSBSim boundary (``fcs/elevator-cmd-norm`` through
 the aircraft's own rad-per-command scaling, ``fcs/throttle-cmd-norm[i]``); the surface's

@@ -9,6 +9,13 @@ checks that need no JSBSim state after the step. Python keeps the gust, the prop
 and writes, JSBSim's step and the (rare) reference refreshes. ``tests/test_step_kernel.py``
 holds both paths to 1e-9 of each channel's range on the golden cases.
 
+A controller's flaperon (:mod:`bioflex_jsb.runtime.flaperon_step`) has a column of its own:
+the kernel adds the deflection held over the step to the modes' forcing (Ψ_r b_δf Q δf, or
+Q b_δf δf in the quasi-static balance) and logs it, and :func:`flaperon_loads`, called after
+the controller, adds the new command's loads to the row and the reactions. Without a
+flaperon the block is zero and the kernel's arithmetic is what it was
+(``tests/test_flaperon.py`` holds the two steps to 1e-9 with one).
+
 Why numba: the per-step work is ~40 scalar operations and three 6×6 products; in Python
 each costs an object allocation (the measured profile: 6.5 µs for the wing step, 3.2 µs for
 the loads, 2.9 µs for the row, 2.7 µs for the range check, against 7.7 µs for JSBSim's own
@@ -47,6 +54,19 @@ ALPHA_OUT = 11
 ETA_OUT = 12
 
 N_CONSTS = 10
+# The flaperon block, the last of :func:`layout` (so that :func:`flaperon_loads` finds it at
+# the end of the array), by entry: the deflection δf held over the step [rad]; the
+# flaperon's S [m²], C_Lδf [1/rad], the induced-drag factor 2 k C_L0 of its lift [-], c̄
+# [m], C_mδf [1/rad] (runtime/flaperon_step.py FlaperonLoads); the table column of
+# ``flaperon_rad`` plus one (0: no flaperon, and the kernel steps as without one); the
+# columns of ``lift_n``, ``drag_n``, ``pitch_moment_n_m``; the wing's own lift, drag [N] and
+# moment [N·m] of the step and α [rad], Q [Pa] of its flow (written by the kernel); N→lbf,
+# N·m→lbf·ft.
+N_FLAP = 17
+FLAP_HELD, FLAP_AREA, FLAP_CL, FLAP_K2, FLAP_CHORD, FLAP_CM, FLAP_COL = 0, 1, 2, 3, 4, 5, 6
+FLAP_LOAD_COLS = 7  # lift_n, drag_n, pitch_moment_n_m: 7, 8, 9
+FLAP_WING = 10  # the wing's lift, drag, moment: 10, 11, 12
+FLAP_ALPHA, FLAP_Q, FLAP_LBF, FLAP_LBF_FT = 13, 14, 15, 16
 
 
 def layout(n_modes: int) -> dict[str, tuple[int, int]]:
@@ -59,7 +79,7 @@ def layout(n_modes: int) -> dict[str, tuple[int, int]]:
              ("k_aero", n * n), ("omega2", n), ("forcing", n * 3), ("load_eta", 3 * n),
              ("load_etadot", 3 * n), ("consts", N_CONSTS), ("refresh_rel", 1), ("model", 1),
              ("reactions", 3), ("out_flow", 4), ("stall_steps", 1), ("scratch", n2),
-             ("static_load", 3))
+             ("static_load", 3), ("flap_cols", n2), ("flap_force", n), ("flap", N_FLAP))
     out, offset = {}, 0
     for name, size in sizes:
         out[name] = (offset, size)
@@ -127,7 +147,8 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     N→lbf, N·m→lbf·ft, η limit [rad], α min, α max, α peak [rad]; refresh_rel; model
     (:data:`MODEL_CODES`); out: reactions (body axes, written to JSBSim [lbf, lbf, lbf·ft])
     and out_flow (α [rad], q [rad/s], Q [Pa], V [m/s]), the count of steps beyond the lift
-    peak, a scratch block; x: [Δη, Δη̇]
+    peak, a scratch block; static_load; flap_cols, flap_force, flap: the flaperon's step
+    column, its forcing and its block (:data:`N_FLAP`; zero: no flaperon); x: [Δη, Δη̇]
     (updated in place to η_{k+1}); cols: the table column of each slot; wind_down_fps: the
     NED down wind written for this step [ft/s]; w_g: the gust [m/s, up]. Returns a status
     code."""
@@ -148,6 +169,10 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     o_out = o_rr + 2
     o_scratch = o_out + 8
     o_sl = o_scratch + n2  # the static deflection's loads per unit Q S (elastic trim; or 0)
+    o_fc2 = o_sl + 3  # the flaperon's step column Ψ_r b_δf (coupled)
+    o_ff = o_fc2 + n2  # its forcing b_δf, η̈ per unit Q δf (qsd)
+    o_fl = o_ff + n  # the flaperon block (N_FLAP)
+    flap_col = int(params[o_fl + FLAP_COL]) - 1  # -1: no flaperon
     consts = params[o_c:o_c + N_CONSTS]
     refresh_rel = params[o_rr]
     model = int(params[o_rr + 1])
@@ -167,6 +192,8 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     base = len(cols) - 2 * n
     for i in range(n2):
         row[cols[base + i]] = x[i]
+    if flap_col >= 0:  # the deflection whose loads act over this step, δf_{k-1}
+        row[flap_col] = params[o_fl + FLAP_HELD]
     f0 = qbar * (alpha - trim[0])
     f1 = qbar / vt * q
     f2 = qbar - trim[2]
@@ -182,8 +209,13 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             c = o_in + 3 * i
             params[o_scratch + i] = (acc + params[c] * f0 + params[c + 1] * f1
                                      + params[c + 2] * f2)
-        for i in range(n2):
-            x[i] = params[o_scratch + i]
+        if flap_col >= 0:  # the flaperon held over the step: + Ψ_r b_δf Q δf
+            qf = qbar * params[o_fl + FLAP_HELD]
+            for i in range(n2):
+                x[i] = params[o_scratch + i] + params[o_fc2 + i] * qf
+        else:
+            for i in range(n2):
+                x[i] = params[o_scratch + i]
     elif model == 2:
         kq = np.empty((n, n))
         rhs = np.empty(n)
@@ -193,6 +225,8 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             kq[i, i] += params[o_w2 + i]
             c = o_fc + 3 * i
             rhs[i] = params[c] * f0 + params[c + 1] * f1 + params[c + 2] * f2
+            if flap_col >= 0:
+                rhs[i] += qbar * params[o_fl + FLAP_HELD] * params[o_ff + i]
         eta_qs = np.linalg.solve(kq, rhs)
         for i in range(n):
             x[i] = eta_qs[i]
@@ -207,6 +241,12 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             l2 += params[o_le + 2 * n + i] * e + params[o_ld + 2 * n + i] * ed
         qs = qbar * s_ref
         lift, drag, moment = qs * l0, qs * l1, qs * l2
+    if flap_col >= 0:  # for flaperon_loads, after the controller
+        params[o_fl + FLAP_WING] = lift
+        params[o_fl + FLAP_WING + 1] = drag
+        params[o_fl + FLAP_WING + 2] = moment
+        params[o_fl + FLAP_ALPHA] = alpha
+        params[o_fl + FLAP_Q] = qbar
     ca, sa = math.cos(alpha), math.sin(alpha)
     params[o_out] = (lift * ca + drag * sa) * consts[4]
     params[o_out + 1] = (drag * ca - lift * sa) * consts[4]
@@ -215,6 +255,36 @@ def step_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
         params[o_out + 7] += 1.0  # steps beyond the lift peak
     return finish_row(row, cols, reads, trim, consts, x, n, va, vt_fps, vt, alpha, w_g,
                       lift, drag, moment)
+
+
+@numba.njit(cache=True, nogil=True)
+def flaperon_loads(params, table, k, delta_rad):
+    """After the controller of step k: the flaperon's command ``delta_rad`` δf_k [rad,
+    clipped] adds its lift ΔL = Q S C_Lδf δf_k, induced drag 2 k C_L0 ΔL and moment
+    Q S c̄ C_mδf δf_k to the wing's loads of the step in row ``k`` (``lift_n``, ``drag_n``,
+    ``pitch_moment_n_m``) and is held for the wing's next step; returns the reactions to
+    write before JSBSim's step (lbf, lbf, lbf·ft; the kernel's ``reactions``, the flaperon's
+    included). ``params``: the kernel's array (the flaperon block at its end, filled by the
+    kernel's step k). The arithmetic of runtime/flaperon_step.py ``apply_flaperon``."""
+    o = params.shape[0] - N_FLAP
+    q = params[o + FLAP_Q]
+    d_lift = q * params[o + FLAP_AREA] * params[o + FLAP_CL] * delta_rad
+    d_drag = params[o + FLAP_K2] * d_lift
+    d_moment = (q * params[o + FLAP_AREA] * params[o + FLAP_CHORD] * params[o + FLAP_CM]
+                * delta_rad)
+    lift = params[o + FLAP_WING] + d_lift
+    drag = params[o + FLAP_WING + 1] + d_drag
+    moment = params[o + FLAP_WING + 2] + d_moment
+    row = table[k]
+    row[int(params[o + FLAP_LOAD_COLS])] = lift
+    row[int(params[o + FLAP_LOAD_COLS + 1])] = drag
+    row[int(params[o + FLAP_LOAD_COLS + 2])] = moment
+    params[o + FLAP_HELD] = delta_rad
+    alpha = params[o + FLAP_ALPHA]
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    lbf = params[o + FLAP_LBF]
+    return ((lift * ca + drag * sa) * lbf, (drag * ca - lift * sa) * lbf,
+            moment * params[o + FLAP_LBF_FT])
 
 
 # ---------------------------------------------------------------------------------------
@@ -317,6 +387,7 @@ def _discard_cache(dispatcher, cache, exc: BaseException) -> None:
 guard_cache(air_flow)  # the helpers are loaded from their own caches with the kernels
 guard_cache(finish_row)
 guard_cache(step_kernel)
+guard_cache(flaperon_loads)
 
 
 # -- the kernel called without numba's dispatcher ------------------------------------------
@@ -345,6 +416,24 @@ def direct_entry(dispatcher, params: np.ndarray, x: np.ndarray, cols: np.ndarray
     reads_type = numba.typeof((0.0,) * n_reads)
     entry = dispatcher.compile((reads_type, *types, table_type, numba.int64, numba.float64,
                                 numba.float64))
+
+    def accepts(table) -> bool:
+        return isinstance(table, np.ndarray) and numba.typeof(table) == table_type
+
+    return entry, accepts
+
+
+def flaperon_entry(params: np.ndarray):
+    """``(entry, accepts)`` for :func:`flaperon_loads` as :func:`direct_entry` gives them
+    for the step kernel: ``entry(params, table, k, delta_rad)`` its machine code for these
+    ``params`` (checked here), a C-ordered float64 table, an int row and a float command;
+    ``accepts(table)``: whether ``table`` is of that type, else call :func:`flaperon_loads`."""
+    params_type = numba.typeof(params)
+    if params_type != numba.typeof(np.zeros(1)):
+        raise TypeError(f"the flaperon's parameters must be {numba.typeof(np.zeros(1))}, "
+                        f"got {params_type}")
+    table_type = numba.typeof(np.zeros((1, 1)))
+    entry = flaperon_loads.compile((params_type, table_type, numba.int64, numba.float64))
 
     def accepts(table) -> bool:
         return isinstance(table, np.ndarray) and numba.typeof(table) == table_type
