@@ -1,5 +1,6 @@
-"""numba's cache of the compiled kernels is per user (bioflex_jsb/__init__.py), and a first
-run that has to compile says so on a terminal (step_kernel.say_if_compiling)."""
+"""numba's cache of the compiled kernels is per user and per version of the kernels' sources
+(bioflex_jsb/__init__.py), and a first run that has to compile says so on a terminal
+(step_kernel.say_if_compiling)."""
 
 import io
 import os
@@ -20,12 +21,15 @@ def _cache_dir(env: dict) -> str:
 def test_the_cache_is_the_users_unless_numba_cache_dir_says_otherwise(tmp_path):
     env = {k: v for k, v in os.environ.items()
            if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME")}
+    import bioflex_jsb
+
+    key = bioflex_jsb.kernel_sources_key()
     home = tmp_path / "home"
     assert _cache_dir({**env, "HOME": str(home)}) == str(home / ".cache" / "bioflex-jsb"
-                                                          / "numba")
+                                                          / "numba" / key)
     xdg = tmp_path / "xdg"
     assert _cache_dir({**env, "HOME": str(home), "XDG_CACHE_HOME": str(xdg)}) == \
-        str(xdg / "bioflex-jsb" / "numba")
+        str(xdg / "bioflex-jsb" / "numba" / key)
     own = tmp_path / "own"
     assert _cache_dir({**env, "NUMBA_CACHE_DIR": str(own)}) == str(own)
 
@@ -67,3 +71,30 @@ def test_a_cold_compile_is_said_once_on_a_terminal_and_never_on_a_pipe(tmp_path,
     monkeypatch.setattr(sys, "stderr", warm)
     K.say_if_compiling(cold, "coupled step")
     assert warm.getvalue() == ""
+
+
+def test_the_cache_key_covers_every_module_that_compiles(tmp_path):
+    """The cache folder is named by the content of every module that imports numba (a
+    kernel calling another file's kernel kept its stale machine code when only that file
+    changed: the full-span kernel, cached against the half wing's kernel before its
+    flaperon block, flew wrong values until the cache was cleared); an edit of any of them
+    is a new folder."""
+    import ast
+    import hashlib
+    from pathlib import Path
+
+    import bioflex_jsb
+
+    package = Path(bioflex_jsb.__file__).parent
+    users = set()
+    for path in package.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            if any(n == "numba" or n.startswith("numba.") for n in names):
+                users.add(path.relative_to(package).as_posix())
+    assert users == set(bioflex_jsb.NUMBA_MODULES)
+    digest = hashlib.sha256()
+    for rel in bioflex_jsb.NUMBA_MODULES:
+        digest.update((package / rel).read_bytes())
+    assert bioflex_jsb.kernel_sources_key() == digest.hexdigest()[:16]
