@@ -243,6 +243,10 @@ class CoupledStep(FullSpanSteps):
         self._make_wing(model, aero, build, wing)
         self.units = channel_units(self.n_modes)
         self.lateral = self._make_lateral(span, aileron, build, model)
+        # the names of the range check's modal coordinates (None: the half wing's, all
+        # symmetric), made once rather than at every Python step
+        self._mode_labels = (None if self.lateral is None
+                             else mode_labels(self.n_modes, len(self.lateral.eta)))
         self._sensors = self._sensor_rows(sensors)
         if self._sensors is not None:
             self.units.update(sensors.units)
@@ -586,10 +590,9 @@ class CoupledStep(FullSpanSteps):
         self.k += 1
         alpha = flow.alpha_rad
         self._stall_steps += alpha > self.alpha_peak_rad
-        labels = (None if self.lateral is None
-                  else mode_labels(self.n_modes, len(self.lateral.eta)))
         self.stopped = out_of_range(self.names, values, t, alpha, new_eta,
-                                    self._agl_m() * U.M_PER_FT, self.alpha_range_rad, labels)
+                                    self._agl_m() * U.M_PER_FT, self.alpha_range_rad,
+                                    self._mode_labels)
         return values
 
     def _controlled_row(self, s: Sensed, w_g: float, loads: WingLoads, eta, eta_dot,
