@@ -379,17 +379,21 @@ class _GustRun:
         k, table, dt = self.k, self.table, self.dt
         # the gust by step number [m/s, up], one block at a time
         ws = self.gust.samples(min(self.block, self.n_steps - k), k).tolist()
-        stop, i = None, 0
-        self._in_block = (j0, 0)
-        for w in ws:
-            stop = advance_into(w, table, j0 + i)
-            i += 1
-            self._in_block = (j0, i)
-            if on_sample is not None:
-                on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
-            if stop or STOP.pending:
-                break
-        self._in_block = (j0, 0)
+        stop, i, ended = None, 0, False
+        # the steps flown are counted once, when the block ends (returned) or fails (kept in
+        # _in_block for _finish), not after every step
+        try:
+            for w in ws:
+                stop = advance_into(w, table, j0 + i)
+                i += 1
+                if on_sample is not None:
+                    on_sample(k + i - 1, (k + i - 1) * dt, table[j0 + i - 1])
+                if stop or STOP.pending:
+                    break
+            ended = True
+        finally:
+            if not ended:  # an error or Ctrl-C inside the block: _finish hands its i rows
+                self._in_block = (j0, i)
         return i, stop
 
     def fly(self, airframe: Airframe, on_sample, progress) -> None:
@@ -454,14 +458,13 @@ class _GustRun:
         names, load_names = self.names, self.load_names
         if self.envelope is None:
             time_s = np.arange(n) * dt
-            channels = {name: self.table[:n, c].copy() for c, name in enumerate(names)}
+            channels = table_columns(self.table[:n], names)
             if self.loads_table is not None:
-                channels.update({name: self.loads_table[:n, c].copy()
-                                 for c, name in enumerate(load_names)})
+                channels.update(table_columns(self.loads_table[:n], load_names))
             history = "all"
         else:
             time_s, rows = self.envelope.history(len(names) + len(load_names))
-            channels = {name: rows[:, c].copy() for c, name in enumerate(names + load_names)}
+            channels = table_columns(rows, names + load_names)
             history = "envelope"
         if self.stream is not None:
             units.update(self.stream.units)
@@ -503,6 +506,24 @@ class _GustRun:
             },
             stopped=stopped,
         )
+
+
+# Rows of the table turned into the history's columns this many at a time: a block of rows
+# (≤ 512 × 8 bytes × the channels) stays in the core's cache while it is written out column
+# after column. A 76 800-step full-span table of 50 channels (30 MB): 5.3-5.4 ms in blocks
+# of 256 or 512 rows, 7.1-10 ms in blocks of 1024-8192, 13.6-14.5 ms copying one column at
+# a time (the Intel guest, least of 3, load 4.7; 25-30 ms column by column inside a run,
+# whose JSBSim steps have left the table out of the caches).
+COLUMN_BLOCK_ROWS = 512
+
+
+def table_columns(table: np.ndarray, names) -> dict[str, np.ndarray]:
+    """``table``'s columns (rows × names) by name, each contiguous (rows of one transposed
+    copy, made :data:`COLUMN_BLOCK_ROWS` rows at a time): the values of ``table[:, c]``."""
+    out = np.empty((table.shape[1], table.shape[0]))
+    for r0 in range(0, table.shape[0], COLUMN_BLOCK_ROWS):
+        out[:, r0:r0 + COLUMN_BLOCK_ROWS] = table[r0:r0 + COLUMN_BLOCK_ROWS].T
+    return {name: out[c] for c, name in enumerate(names)}
 
 
 def _aileron_changes(step: CoupledStep, aileron_input):
