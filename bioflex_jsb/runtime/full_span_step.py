@@ -66,6 +66,7 @@ class FullSpanSteps:
             AntisymmetricModalWing,
             lateral_channel_units,
         )
+        from bioflex_jsb.simulation.modal_wing import one_blas_thread
 
         airframe = self.airframe
         for name in AILERON_PROPERTIES:
@@ -73,11 +74,15 @@ class FullSpanSteps:
                 raise InputError(f"span='full' reads the ailerons' positions; the JSBSim "
                                  f"aircraft {airframe.aircraft!r} has no {name!r}")
         ixx = airframe[IXX_PROPERTY] * U.KG_PER_SLUG * U.M_PER_FT**2
-        wing_a = antisymmetric_wing(build, ixx)
-        strips = antisymmetric_strips(wing_a, aileron, np.asarray(build.aero.chord_m))
-        sym_tip = np.asarray(build.modes.twist_rad, dtype=float)[:self.n_modes, -1]
-        terms = yaw_sideslip_terms(wing_a, build.modes, self.n_modes, build.planform,
-                                   2.0 * float(build.aero.semispan_m))
+        # on one BLAS thread, as the reference steps are: a multi-threaded call leaves
+        # OpenBLAS's other thread spinning for ~0.1 s after it, on this process's CPU clock
+        # and on the second core, while the run steps (the results are the same, bit for bit)
+        with one_blas_thread():
+            wing_a = antisymmetric_wing(build, ixx)
+            strips = antisymmetric_strips(wing_a, aileron, np.asarray(build.aero.chord_m))
+            sym_tip = np.asarray(build.modes.twist_rad, dtype=float)[:self.n_modes, -1]
+            terms = yaw_sideslip_terms(wing_a, build.modes, self.n_modes, build.planform,
+                                       2.0 * float(build.aero.semispan_m))
         lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
                                          refresh_rel=getattr(self.wing, "refresh_rel", 0.05),
                                          terms=terms)
