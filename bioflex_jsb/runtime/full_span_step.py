@@ -31,18 +31,24 @@ AILERON_PROPERTIES = (JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD)
 IXX_PROPERTY = JP.INERTIA_IXX_SLUGS_FT2
 
 
+def compiled_span(span: str, aero: str, compiled: bool) -> bool:
+    """Whether the step runs compiled: both halves on unsteady strips have the Python step
+    only (:mod:`bioflex_jsb.simulation.unsteady_full_span`; a run records it in its
+    ``meta["step"]``), every other span and strips as ``compiled`` asks."""
+    return bool(compiled) and not (span == "full" and aero == "unsteady")
+
+
 def check_span(span: str, build, model: str, aero: str) -> None:
-    """A full-span step needs the wing's build (its beam: the antisymmetric modes), the
-    quasi-steady strips and a wing of ours (not the native one); one line otherwise."""
+    """A full-span step needs the wing's build (its beam: the antisymmetric modes) and a
+    wing of ours (not the native one); one line otherwise. Its strips are the run's
+    ``aero`` (unsteady: the coupled wing's, :mod:`bioflex_jsb.simulation
+    .unsteady_full_span`)."""
     if span not in SPANS:
         raise InputError(f"unknown span {span!r}; accepted: {', '.join(SPANS)}")
     if span == "half":
         return
     if model == "native":
         raise InputError("span='full' flies the Python modal wing, not the native one")
-    if aero != "quasi-steady":
-        raise InputError("span='full' has quasi-steady antisymmetric strips only; accepted "
-                         "with it: aero='quasi-steady'")
     if build is None:
         raise InputError("span='full' needs the wing's build (its beam, for the "
                          "antisymmetric modes), not only its ElasticWingModel")
@@ -78,9 +84,17 @@ class FullSpanSteps:
         sym_tip = np.asarray(build.modes.twist_rad, dtype=float)[:self.n_modes, -1]
         terms = yaw_sideslip_terms(wing_a, build.modes, self.n_modes, build.planform,
                                    2.0 * float(build.aero.semispan_m))
-        lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
-                                         refresh_rel=getattr(self.wing, "refresh_rel", 0.05),
-                                         terms=terms)
+        refresh = getattr(self.wing, "refresh_rel", 0.05)
+        if self.aero == "unsteady":  # the coupled wing's unsteady strips, both halves
+            from bioflex_jsb.aeroelasticity.antisymmetric import aircraft_strips
+            from bioflex_jsb.simulation.unsteady_full_span import UnsteadyAntisymmetricWing
+
+            lateral = UnsteadyAntisymmetricWing(
+                strips, aircraft_strips(build, wing_a, ixx), model, self.dt_s, sym_tip,
+                refresh_rel=refresh, terms=terms)
+        else:
+            lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
+                                             refresh_rel=refresh, terms=terms)
         # the aircraft's weight [N] (L_w = n_z W) and the symmetric trim deflection [rad]
         self._weight_n = (airframe[JP.INERTIA_MASS_SLUGS] * U.KG_PER_SLUG
                           * STANDARD_GRAVITY_M_S2)
