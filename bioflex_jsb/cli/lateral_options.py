@@ -24,8 +24,9 @@ WIDTH_RANGE_S = (0.01, 10.0)  # a doublet's half width [s]
 HELP_SPAN = ("half (the half wing's symmetric modes, the paper's) or full (both halves: the "
              "antisymmetric modes too, driven by the roll rate and the ailerons; their rolling "
              "moment to JSBSim; channels asym_eta<i>, tip_twist_port_rad, "
-             "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad). Default: full with an "
-             "aileron input, else half")
+             "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad; with --aero unsteady "
+             "their own lag states and apparent mass, on the Python step). Default: full "
+             "with an aileron input, else half")
 
 
 def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,9 +68,6 @@ def lateral_run_options(args, build) -> dict:
                                                 args.aileron_start, args.aileron_width)
     if span == "half":
         return options | {"span": "half"} if options else {}
-    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
-        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
-                         "--aero unsteady")
     return options | {"span": "full", "aileron": _aileron(args, build)}
 
 
@@ -77,9 +75,6 @@ def span_options(args, build) -> dict:
     """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
     if args.span != "full":
         return {}
-    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
-        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
-                         "--aero unsteady")
     return {"span": "full", "aileron": _aileron(args, build)}
 
 

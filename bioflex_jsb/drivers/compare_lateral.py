@@ -173,9 +173,13 @@ def respond(lm: FullSpanLateralModel, time_s, inputs: np.ndarray) -> dict[str, n
         if "eta1_dot" in out:  # the coupled model; the quasi-static one has η̇ = 0
             eta_dot = np.column_stack([out[f"eta{i + 1}_dot"] for i in range(s.n_modes)])
             roll = roll + lm.q_pa / lm.speed_m_s * eta_dot @ s.roll_etadot
-        if lm.roll_rows is not None:  # the unsteady increments' (ẋ = A x + B u)
+        if lm.roll_rows is not None:  # the unsteady increments' (ẋ = A x + B u): the
+            # strips see p − p_g, the apparent mass the body's ṗ
             x_dot = x @ a.T + u @ b.T
-            roll = roll + x @ lm.roll_rows[0] + x_dot @ lm.roll_rows[1]
+            roll_x, roll_xd = lm.roll_rows
+            p_g = u[:, INPUTS.index("p_g")]
+            roll = (roll + x @ roll_x - p_g * roll_x[ss.states.index("p")]
+                    + x_dot @ roll_xd)
         channels["asym_eta1"] = eta[:, 0]
         channels["modal_roll_n_m"] = roll
     return channels
