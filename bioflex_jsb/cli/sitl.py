@@ -95,12 +95,13 @@ def register(sub) -> None:
     p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
                    help="the coupled wing's strips: quasi-steady (the paper's, default) or "
                    "unsteady (Jones lag states, apparent mass, Kuessner gust; --model "
-                   "coupled, --trim rigid); both on the compiled step")
+                   "coupled, --trim rigid); both on the compiled step, both halves (--span "
+                   "full) on unsteady strips on the Python one")
     p.add_argument("--span", choices=("half", "full"), default="half",
                    help="half (the half wing's symmetric modes, default) or full (both "
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
-                   "the autopilot flies in its turns, their rolling moment to JSBSim; "
-                   "quasi-steady strips; docs/lateral.md)")
+                   "the autopilot flies in its turns, their rolling moment to JSBSim; on "
+                   "--aero's strips, unsteady on the Python step; docs/lateral.md)")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
