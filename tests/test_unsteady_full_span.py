@@ -252,3 +252,10 @@ def test_sitl_and_ardupilot_fly_both_halves_on_unsteady_strips():
     ph = ad.ArduPilotPhysics(Airframe(), prototype.wing(), "coupled", span="full",
                              aero="unsteady", aileron=prototype.definition.aileron)
     assert ph.step_kind == "python"
+    armed_idle = (1500, 1500, 1050, 1500) + (0,) * 12  # fires the launcher
+    while ph.phase != ad.FLIGHT:
+        ph.step(armed_idle, 1200)
+    for _ in range(100):
+        ph.step(armed_idle, 1200)
+    assert not ph.stops
+    assert ph.summary()["step"] == "python"
