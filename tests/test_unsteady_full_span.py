@@ -259,3 +259,24 @@ def test_sitl_and_ardupilot_fly_both_halves_on_unsteady_strips():
         ph.step(armed_idle, 1200)
     assert not ph.stops
     assert ph.summary()["step"] == "python"
+
+
+def test_the_log_records_both_halves_and_rerun_flies_them_again(capsys, tmp_path):
+    """A gust log's run description holds --aero unsteady, --span full and the aileron
+    step; rerun flies the same run again (the Python step is deterministic: rtol 1e-8)."""
+    from bioflex_jsb.cli.rerun import argv_for
+    from bioflex_jsb.simulation.run import RunDescription
+
+    log = tmp_path / "run.mcap"
+    code, _, _ = run_cli(capsys, "gust", "--span", "full", "--aero", "unsteady", "--models",
+                         "coupled", "--aileron-step", "0.5", "--aileron-start", "0.1",
+                         "--gust", "none", "--duration", "0.3", "--out", str(log), "--json")
+    assert code == 0
+    code, _, err = run_cli(capsys, "rerun", str(log), "--out", str(tmp_path / "again.mcap"))
+    assert code == 0, err
+    d = RunDescription("gust", "optimised", 15.0, models=("coupled",),
+                       extra={"aero": "unsteady", "span": "full", "aileron_step": 0.5,
+                              "aileron_start": 0.1, "aileron_width": 0.5})
+    argv = dict(a.split("=", 1) for a in argv_for(d)[1:])
+    assert argv["--span"] == "full" and float(argv["--aileron-step"]) == 0.5
+    assert float(argv["--aileron-start"]) == 0.1 and argv["--aero"] == "unsteady"

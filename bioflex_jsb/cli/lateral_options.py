@@ -71,6 +71,22 @@ def lateral_run_options(args, build) -> dict:
     return options | {"span": "full", "aileron": _aileron(args, build)}
 
 
+def lateral_description(args) -> dict:
+    """The run description's entries of ``--span full`` and an aileron input (``rerun``
+    flies them again; {} for a half-wing run without one, whose description is as before)."""
+    angle = getattr(args, "aileron_step", None)
+    kind = "aileron_step" if angle is not None else "aileron_doublet"
+    if angle is None:
+        angle = getattr(args, "aileron_doublet", None)
+    out: dict = {}
+    if getattr(args, "span", None) == "full" or angle is not None:
+        out["span"] = getattr(args, "span", None) or "full"
+    if angle is not None:
+        out.update({kind: float(angle), "aileron_start": float(args.aileron_start),
+                    "aileron_width": float(args.aileron_width)})
+    return out
+
+
 def span_options(args, build) -> dict:
     """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
     if args.span != "full":
