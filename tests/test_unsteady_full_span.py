@@ -280,3 +280,38 @@ def test_the_log_records_both_halves_and_rerun_flies_them_again(capsys, tmp_path
     argv = dict(a.split("=", 1) for a in argv_for(d)[1:])
     assert argv["--span"] == "full" and float(argv["--aileron-step"]) == 0.5
     assert float(argv["--aileron-start"]) == 0.1 and argv["--aero"] == "unsteady"
+
+
+def test_a_sitl_sessions_log_says_both_halves_and_the_python_step(tmp_path, monkeypatch,
+                                                                  capsys):
+    """bioflex-jsb sitl --span full --aero unsteady: the session flies (1 s, no ground
+    station needed: udpout) and its log's description records the span, the strips and
+    the Python step."""
+    import socket
+
+    from bioflex_jsb import cli
+    from bioflex_jsb.sinks.mcap import (
+        RUN_METADATA,
+        description_from_metadata,
+        open_reader,
+        read_metadata,
+    )
+
+    if "sitl" not in cli.COMMAND_MODULES:
+        monkeypatch.setattr(cli, "COMMAND_MODULES", cli.COMMAND_MODULES + ("sitl",))
+    listener = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)  # the "ground station"
+    listener.bind(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+    out = tmp_path / "sitl.mcap"
+    try:
+        rc = cli.main(["sitl", "--aircraft", C172, "--span", "full", "--aero", "unsteady",
+                       "--duration", "1", "--speedup", "4", "--out", str(out), "--mavlink",
+                       f"udpout:127.0.0.1:{port}", "--json"])
+    finally:
+        listener.close()
+    assert rc == 0
+    assert json.loads(capsys.readouterr().out)["aero"] == "unsteady"
+    with open_reader(str(out)) as (reader, _summary):
+        d = description_from_metadata(read_metadata(reader)[RUN_METADATA])
+    assert d.extra["span"] == "full" and d.extra["step"] == "python"
+    assert d.extra["aero"] == "unsteady"

@@ -263,6 +263,9 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
                **_controller_extra(args),
+               # both halves: which step flies them (unsteady strips: the Python one)
+               **({"span": "full", "step": "compiled kernel" if sim.core.compiled
+                   else "python"} if args.span == "full" else {}),
                **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
     return SplitLog(args.out, description, build, args.log_max_mb,
                     live_opener(args, open_log), replace=args.force,

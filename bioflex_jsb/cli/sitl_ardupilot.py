@@ -321,6 +321,7 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "launch_height_m": physics.launcher.height_m,
                "record_every": args.record_every, "aero": args.aero,
                "step": physics.step_kind, "gust_repeat": args.gust_repeat,
+               **({"span": "full"} if args.span == "full" else {}),
                "duration": ("until stopped: the flown duration is in the session-end event "
                             "(session_s)") if args.duration is None else "--duration"})
     from bioflex_jsb.flight_dynamics.wing_model import WingBuild
