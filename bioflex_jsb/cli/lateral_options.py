@@ -25,7 +25,7 @@ HELP_SPAN = ("half (the half wing's symmetric modes, the paper's) or full (both 
              "antisymmetric modes too, driven by the roll rate and the ailerons; their rolling "
              "moment to JSBSim; channels asym_eta<i>, tip_twist_port_rad, "
              "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad; with --aero unsteady "
-             "their own lag states and apparent mass, on the Python step). Default: full "
+             "their own lag states and apparent mass). Default: full "
              "with an aileron input, else half")
 
 

@@ -95,13 +95,12 @@ def register(sub) -> None:
     p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
                    help="the coupled wing's strips: quasi-steady (the paper's, default) or "
                    "unsteady (Jones lag states, apparent mass, Kuessner gust; --model "
-                   "coupled, --trim rigid); both on the compiled step, both halves (--span "
-                   "full) on unsteady strips on the Python one")
+                   "coupled, --trim rigid); both on the compiled step")
     p.add_argument("--span", choices=("half", "full"), default="half",
                    help="half (the half wing's symmetric modes, default) or full (both "
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
                    "the autopilot flies in its turns, their rolling moment to JSBSim; on "
-                   "--aero's strips, unsteady on the Python step; docs/lateral.md)")
+                   "--aero's strips; docs/lateral.md)")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
@@ -263,7 +262,7 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
                **_controller_extra(args),
-               # both halves: which step flies them (unsteady strips: the Python one)
+               # both halves: which step flies them
                **({"span": "full", "step": "compiled kernel" if sim.core.compiled
                    else "python"} if args.span == "full" else {}),
                **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})

@@ -39,8 +39,7 @@ __all__ = ("preflight", "register", "run", "session_summary")
 HELP = """Be ArduPilot's physics: answer ArduPlane SITL started with --model JSON:127.0.0.1
 (UDP 9002 + 10 x --instance) lock-step, one co-simulation step per ArduPilot frame, with the
 JSBSim airframe and the elastic wing (--model rigid, coupled, qsd or native; --aero unsteady
-for the coupled wing's unsteady strips; both run on the compiled step, but both halves on
-unsteady strips on the Python one). The session binds to
+for the coupled wing's unsteady strips; both run on the compiled step). The session binds to
 the first ArduPilot that sends (address and port); packets from any other source are counted
 and reported, never answered, until the bound one has been silent for 3 s: then a new
 ArduPilot's frame 0, from any address and port, is bound and resets the physics (a restart;
@@ -107,8 +106,8 @@ def register(sub) -> None:
     p.add_argument("--span", choices=("half", "full"), default="half",
                    help="half (the half wing's symmetric modes, default) or full (both "
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
-                   "ArduPlane flies, their rolling moment to JSBSim; on --aero's strips, "
-                   "unsteady on the Python step; docs/lateral.md)")
+                   "ArduPlane flies, their rolling moment to JSBSim; on --aero's strips; "
+                   "docs/lateral.md)")
     from bioflex_jsb.cli.aircraft_option import cruise_speed_default
 
     p.add_argument("--speed", type=airspeed, default=cruise_speed_default(),
@@ -142,8 +141,7 @@ def register(sub) -> None:
     p.add_argument("--aero", choices=AERO_CHOICES, default="quasi-steady",
                    help="the coupled wing's strips: quasi-steady (the paper's) or unsteady "
                    "(Jones lag states, apparent mass, Kuessner gust); both on the compiled "
-                   "step, both halves (--span full) on unsteady strips on the Python one "
-                   "(the summary's 'step' says which ran); default quasi-steady")
+                   "step (the summary's 'step' says which ran); default quasi-steady")
     add_allow_unstable(p)
     p.add_argument("--instance", type=int, default=0,
                    help="ArduPilot SITL instance (-I): UDP port 9002 + 10 x N (default 0)")

@@ -50,7 +50,7 @@ from bioflex_jsb.flight_dynamics.rigid import level_flight_condition
 from bioflex_jsb.flight_dynamics.wing_model import WingBuild
 from bioflex_jsb.generators import airframe as airframe_xml
 from bioflex_jsb.runtime.fdm import Airframe, TrimResult
-from bioflex_jsb.runtime.full_span_step import FullSpanSteps, check_span, compiled_span
+from bioflex_jsb.runtime.full_span_step import FullSpanSteps, check_span
 from bioflex_jsb.simulation import jsbsim_properties as JP
 from bioflex_jsb.simulation import step_kernel as K
 from bioflex_jsb.simulation.channels import channel_units, eta_names, row_getter
@@ -202,8 +202,7 @@ class CoupledStep(FullSpanSteps):
             the roll rate, JSBSim's ailerons and a gust roll rate, their rolling moment to
             JSBSim's modal-roll (:mod:`bioflex_jsb.simulation.full_span`; needs the wing's
             build; with ``aero="unsteady"`` the antisymmetric modes' own unsteady strips,
-            :mod:`bioflex_jsb.simulation.unsteady_full_span`, on the Python step); the rows
-            gain the channels of
+            :mod:`bioflex_jsb.simulation.unsteady_full_span`); the rows gain the channels of
             :func:`~bioflex_jsb.simulation.full_span.lateral_channel_units`.
         aileron: the wing's aileron (a
             :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`, the
@@ -227,8 +226,7 @@ class CoupledStep(FullSpanSteps):
         native = model == "native"
         self.native, self.model, self.aero, self.trim_mode = native, model, aero, trim_mode
         self.speed_m_s = float(speed_m_s)
-        # the native wing has no step of ours; both halves on unsteady strips the Python one
-        self.compiled = compiled_span(span, aero, compiled) and not native
+        self.compiled = bool(compiled) and not native  # the native wing has no step of ours
         # the aircraft's own data (S, c̄, derivatives at this speed): its wing model's, or for a
         # native wing given alone its aircraft definition's
         data = (_native_airframe_data(airframe) if wing is None else wing.airframe

@@ -31,13 +31,6 @@ AILERON_PROPERTIES = (JP.FCS_LEFT_AILERON_POS_RAD, JP.FCS_RIGHT_AILERON_POS_RAD)
 IXX_PROPERTY = JP.INERTIA_IXX_SLUGS_FT2
 
 
-def compiled_span(span: str, aero: str, compiled: bool) -> bool:
-    """Whether the step runs compiled: both halves on unsteady strips have the Python step
-    only (:mod:`bioflex_jsb.simulation.unsteady_full_span`; a run records it in its
-    ``meta["step"]``), every other span and strips as ``compiled`` asks."""
-    return bool(compiled) and not (span == "full" and aero == "unsteady")
-
-
 def check_span(span: str, build, model: str, aero: str) -> None:
     """A full-span step needs the wing's build (its beam: the antisymmetric modes) and a
     wing of ours (not the native one); one line otherwise. Its strips are the run's
@@ -143,7 +136,11 @@ class FullSpanSteps:
         if lat.model != "coupled":
             return
         lat.reference(float(q_pa), float(v_m_s))
-        if self.compiled:
+        if self.compiled and self.aero == "unsteady":  # runtime/unsteady_full_span_step.py
+            from bioflex_jsb.runtime.unsteady_full_span_step import load_reference
+
+            load_reference(self)
+        elif self.compiled:
             lv = self._lat_views
             lv["stack"][:] = np.ravel(lat._stack)
             lv["input_cols"][:] = np.ravel(lat._input_cols)
@@ -174,7 +171,13 @@ class FullSpanSteps:
         """One parameter array, state and column index for both wings (the layout of
         :mod:`bioflex_jsb.simulation.full_span_kernel`): the half wing's as _setup_kernel
         made them, the antisymmetric block after them; the half wing's views, state and
-        reactions rebound onto them."""
+        reactions rebound onto them. On unsteady strips:
+        :func:`~bioflex_jsb.runtime.unsteady_full_span_step.setup_kernel`."""
+        if self.aero == "unsteady":
+            from bioflex_jsb.runtime.unsteady_full_span_step import setup_kernel
+
+            setup_kernel(self)
+            return
         from bioflex_jsb.simulation import full_span_kernel as FK
         from bioflex_jsb.simulation.full_span import LATERAL_FIXED, lateral_names
 

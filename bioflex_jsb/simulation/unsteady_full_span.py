@@ -43,6 +43,10 @@ inputs and the last step's ṗ); the side force plus the increments' lift on the
 dihedral, −2 Σ Δl Γ_g w; the yawing moment with the induced drag of all the elastic rolling
 moment, −α_i (ΔL + ΔL_u) (:mod:`~bioflex_jsb.simulation.full_span`, "Yaw rate, sideslip,
 side force and yawing moment"). The linear unsteady lateral model carries the same three.
+
+This is the readable reference; the co-simulation runs the same arithmetic compiled
+(:mod:`bioflex_jsb.simulation.unsteady_full_span_kernel`, held to it by
+tests/test_unsteady_full_span.py).
 """
 
 from __future__ import annotations
