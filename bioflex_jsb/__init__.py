@@ -33,6 +33,7 @@ import sys as _sys
 NUMBA_MODULES = (
     "loads/stream.py", "simulation/controller_kernel.py", "simulation/full_span_kernel.py",
     "simulation/sensors.py", "simulation/step_kernel.py", "simulation/unsteady_kernel.py",
+    "simulation/unsteady_full_span_kernel.py",
     "sinks/mcap/scene.py", "sinks/mcap/scene_loads.py", "sinks/mcap_io/records.py",
 )
 

@@ -291,7 +291,9 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
     modes driven by the roll rate and the ailerons, their rolling moment to JSBSim; the
     aircraft definition's ``[aileron]`` on the strips; channels ``asym_eta<i>``,
     ``tip_twist_port_rad``, ``tip_twist_starboard_rad``, ``modal_roll_n_m``,
-    ``aileron_rad``; docs/lateral.md "Both halves in the co-simulation").
+    ``aileron_rad``; docs/lateral.md "Both halves in the co-simulation"; with
+    ``aero="unsteady"`` the antisymmetric modes on unsteady strips too, "Both halves on
+    unsteady strips").
     ``aileron_step_deg``: an aileron step over the trim [deg, JSBSim's (left − right)/2, +
     rolls right, |δa| <= 30] from ``aileron_start_s`` [s] (None: none)."""
     return _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m,
@@ -397,7 +399,8 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     ``span="full"``: both wing halves in the run (as :func:`fly_gust`'s) and the lateral
     model of the same wing model beside Eq. (4), driven by the run's gust roll rate, lateral
     gust and aileron (:mod:`bioflex_jsb.drivers.compare_lateral`): β, p, r, φ, ``asym_eta1``
-    and ``modal_roll_n_m`` compared too (quasi-steady, about the rigid trim)."""
+    and ``modal_roll_n_m`` compared too (about the rigid trim; ``aero="unsteady"``: the
+    run's antisymmetric modes and the lateral model both on the unsteady strips)."""
     _check_choice("model", model, MODELS)
     _check_choice("span", span, ("half", "full"))
     check_comparable(model, aero, trim, controller is not None, span)  # before flying

@@ -141,8 +141,8 @@ def test_compare_an_aileron_step(capsys):
 
 
 @pytest.mark.parametrize(("argv", "needle"), [
-    (("--span", "full", "--aero", "unsteady"), "quasi-steady lateral model"),
-    (("--span", "full", "--trim", "elastic"), "quasi-steady lateral model"),
+    (("--span", "full", "--aero", "unsteady", "--model", "qsd"), "coupled model"),
+    (("--span", "full", "--trim", "elastic"), "about the rigid trim"),
     (("--span", "half", "--aileron-step", "1"), "compared with both wing halves"),
 ])
 def test_compare_refuses_what_the_lateral_model_has_not(capsys, argv, needle):

@@ -58,7 +58,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
-from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
+from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
+    dihedral_rad,
+    lateral_model_with_aileron,
+)
 from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics import flutter_engine as engine
@@ -71,6 +74,7 @@ from bioflex_jsb.flight_dynamics.lateral_elastic import (
     coupled_mode_set,
 )
 from bioflex_jsb.flight_dynamics.modal_coefficients import spanwise_geometry
+from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
 from bioflex_jsb.state_space import StateSpace
 
 AERO_MODELS = engine.AERO_MODELS
@@ -99,7 +103,9 @@ class AntisymmetricStrips:
     the root is clamped, no roll freedom); ``name``; ``quasi_steady_form`` what
     quasi-steady strips are: ``paper`` (the lift l_qs alone, the lateral model's and Eq.
     4's) or ``theodorsen`` (Theodorsen's section with C = 1: three-quarter-chord upwash
-    and apparent mass, the clamped wing's quasi-steady strips)."""
+    and apparent mass, the clamped wing's quasi-steady strips); ``dihedral_rad`` (K,) the
+    strips' geometric dihedral Γ_g [rad, tip up] of the increments' side force (None:
+    flat)."""
 
     stations_m: np.ndarray
     weights_m: np.ndarray
@@ -117,6 +123,7 @@ class AntisymmetricStrips:
     roll_inertia_kg_m2: float | None
     name: str = ""
     quasi_steady_form: str = "paper"
+    dihedral_rad: np.ndarray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -148,7 +155,8 @@ def aircraft_strips(build, wing: AntisymmetricWing, roll_inertia_kg_m2: float | 
         damping_ratios=np.asarray(modes.damping_ratios, dtype=float),
         generalised_masses_kg_m2=np.asarray(modes.generalised_masses_kg_m2, dtype=float),
         mode_labels=tuple(f"{ANTISYMMETRIC_PREFIX}{i + 1}" for i in range(n)),
-        roll_inertia_kg_m2=roll_inertia_kg_m2, name=build.variant.name)
+        roll_inertia_kg_m2=roll_inertia_kg_m2, name=build.variant.name,
+        dihedral_rad=dihedral_rad(build.planform, y))
 
 
 def clamped_strips(model, structural_damping: float = 0.0, name: str = ""
@@ -192,24 +200,28 @@ class StripLoads:
     """Loads of the strips on a state x (rows ``*_x``) and its rate ẋ (``*_xd``, the
     apparent mass): ``roll_*`` (N,) the rolling moment [N·m per unit, right wing down],
     ``force_*`` (n, N) the generalised forces [N·m per unit]; ``lag_a`` (n_lag, N) the lag
-    states' rates [1/s on m/s]."""
+    states' rates [1/s on m/s]; ``side_*`` (N,) the side force of the lift on the strips'
+    geometric dihedral Γ_g, −2 Σ l Γ_g w [N per unit, body +y] (zero for a flat wing)."""
 
     roll_x: np.ndarray
     roll_xd: np.ndarray
     force_x: np.ndarray
     force_xd: np.ndarray
     lag_a: np.ndarray
+    side_x: np.ndarray
+    side_xd: np.ndarray
 
 
 def strip_loads(s: AntisymmetricStrips, layout: Layout, speed_m_s: float,
                 density_kg_m3: float, *, quasi_steady: bool, unsteady: bool,
                 amplitudes: tuple[float, float] = JONES_WAGNER.amplitudes,
-                unsteadiness: float = 1.0) -> StripLoads:
+                unsteadiness: float = 1.0, gamma_rad=None) -> StripLoads:
     """The loads of the strips ``s`` on the states of ``layout`` (module docstring):
     ``quasi_steady`` the paper's strips l_qs; ``unsteady`` Theodorsen's beyond them (the
     circulatory increment through Jones's lags with ``amplitudes``, (0, 0): C = 1 without
     lag states, and the apparent mass), scaled by ``unsteadiness`` (the lags' own rates
-    are not: with 0 they listen without acting)."""
+    are not: with 0 they listen without acting). ``gamma_rad`` (K,) the strips' geometric
+    dihedral Γ_g [rad, tip up] of the side force (None: ``s.dihedral_rad``, or flat)."""
     v, rho = float(speed_m_s), float(density_kg_m3)
     n_all, k = layout.n_all, s.n_strips
     y, b = s.stations_m, 0.5 * s.chord_m
@@ -264,8 +276,14 @@ def strip_loads(s: AntisymmetricStrips, layout: Layout, speed_m_s: float,
     def force(lift, torque):
         return -(s.phi * w) @ lift + (s.theta * w) @ torque
 
+    gamma = s.dihedral_rad if gamma_rad is None else gamma_rad
+    gamma = np.zeros(k) if gamma is None else np.asarray(gamma, dtype=float)
+
+    def side(lift):  # a half's lift leans inboard on its dihedral: port mirrors starboard
+        return -2.0 * (w * gamma) @ lift
+
     return StripLoads(roll(lift_x), roll(lift_xd), force(lift_x, torque_x),
-                      force(lift_xd, torque_xd), lag_a)
+                      force(lift_xd, torque_xd), lag_a, side(lift_x), side(lift_xd))
 
 
 def lag_names(n_strips: int) -> tuple[str, ...]:
@@ -306,10 +324,12 @@ def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: Antisymmet
                          unsteadiness: float = 1.0) -> StateSpace:
     """``base`` (a coupled lateral model, states β, p, r, φ, η_i, η̇_i) with the unsteady
     strips' increments of ``strips`` (the same modes) scaled by ``unsteadiness`` and their
-    lag states appended. The increments' rolling moment acts on ṗ, ṙ through J⁻¹, their
-    generalised force on η̈; their side force and the yawing moment of their induced drag
-    are left out (they vanish in a steady state, as the increments do). ``base``'s B, n_y
-    row and notes are carried over (B through the apparent mass's E⁻¹)."""
+    lag states appended. The increments' rolling moment acts on ṗ, ṙ through J⁻¹, with the
+    yawing moment of their induced drag, −α_i ΔL_u (α_i = L_w/(Q π b²), L_w = m g, b twice
+    the strips' semispan: the full-span step's induced angle); their generalised force on
+    η̈; their side force on the strips' dihedral (``strips.dihedral_rad``), −2 Σ Δl Γ_g w, on
+    β̇ (÷ m V) and n_y (÷ m g). ``base``'s B, n_y row and notes are carried over (B through
+    the apparent mass's E⁻¹)."""
     n, k = strips.n_modes, strips.n_strips
     n0 = 4 + 2 * n
     if base.n_states != n0 or base.model != "coupled-lateral":
@@ -320,31 +340,40 @@ def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: Antisymmet
                     (slice(n0, n0 + k), slice(n0 + k, n_all)))
     loads = strip_loads(strips, layout, trim.speed_m_s, trim.density_kg_m3,
                         quasi_steady=False, unsteady=True, unsteadiness=unsteadiness)
-    j_inv = np.linalg.inv(inertia_matrix(trim))[:, 0]  # (ṗ, ṙ) per unit rolling moment
+    q, mass, v = float(trim.dynamic_pressure_pa), float(trim.mass_kg), float(trim.speed_m_s)
+    span_m = 2.0 * float(np.sum(strips.weights_m))
+    induced = mass * STANDARD_GRAVITY_M_S2 / (q * math.pi * span_m**2)  # α_i [rad]
+    # (ṗ, ṙ) per unit rolling moment with its induced drag's yawing moment
+    j_inv = np.linalg.inv(inertia_matrix(trim)) @ np.array([1.0, -induced])
     m = strips.generalised_masses_kg_m2
+    i_beta = base.states.index("beta")
 
-    def rates(roll, force) -> np.ndarray:
+    def rates(roll, force, side) -> np.ndarray:
         out = np.zeros((n_all, n_all))
         out[1:3] = np.outer(j_inv, roll)
         out[layout.eta_dot] = force / m[:, None]
+        out[i_beta] = side / (mass * v)
         return out
 
     a = np.zeros((n_all, n_all))
     a[:n0, :n0] = base.a
-    a += rates(loads.roll_x, loads.force_x)
+    a += rates(loads.roll_x, loads.force_x, loads.side_x)
     a[n0:] += loads.lag_a
-    e = np.eye(n_all) - rates(loads.roll_xd, loads.force_xd)
+    e = np.eye(n_all) - rates(loads.roll_xd, loads.force_xd, loads.side_xd)
     a = np.linalg.solve(e, a)
     b = np.linalg.solve(e, np.vstack([base.b, np.zeros((2 * k, base.b.shape[1]))]))
     lags = lag_names(k)
     states = base.states + lags
     units = base.state_units + ("m/s",) * 2 * k
     i_ny = base.outputs.index("n_y")
-    n_y_c = np.r_[base.c[i_ny], np.zeros(2 * k)]
-    # n_y is the aerodynamic side force (the rigid one and the modes'): it reads the states,
-    # not their rates
+    # n_y: the aerodynamic side force (the rigid one, the modes', the increments' with
+    # their apparent mass on ẋ = A x + B u)
+    weight = mass * STANDARD_GRAVITY_M_S2
+    n_y_c = (np.r_[base.c[i_ny], np.zeros(2 * k)] + loads.side_x / weight
+             + loads.side_xd @ a / weight)
+    n_y_d = base.d[i_ny] + loads.side_xd @ b / weight
     c = np.vstack([np.eye(n_all), n_y_c])
-    d = np.vstack([np.zeros((n_all, b.shape[1])), base.d[i_ny]])
+    d = np.vstack([np.zeros((n_all, b.shape[1])), n_y_d])
     notes = {**base.notes, "wing": "antisymmetric modes, unsteady strips (Jones lag states, "
              "apparent mass)", "lag_states": 2 * k, "unsteadiness": float(unsteadiness)}
     return StateSpace(model="unsteady-lateral", speed_m_s=trim.speed_m_s, a=a, b=b,

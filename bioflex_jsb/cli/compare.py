@@ -56,7 +56,8 @@ run's step, with the run's one step of delay, and the commands are compared too.
 --span full (both wing halves; implied by --aileron-step or --aileron-doublet) the lateral
 model of the same wing model (beta, p, r, phi and the antisymmetric modes, docs/lateral.md)
 is driven by the run's gust roll rate, lateral gust and aileron, and beta_rad, p_rad_s,
-r_rad_s, phi_rad, asym_eta1 and modal_roll_n_m are compared too."""
+r_rad_s, phi_rad, asym_eta1 and modal_roll_n_m are compared too; with --aero unsteady both
+the run's antisymmetric modes and the lateral model are on the unsteady strips."""
 
 # The table's unit of each channel's largest difference, and its factor from SI.
 DISPLAY_UNITS = {"u": ("m/s", 1.0), "alpha": ("deg", 57.29577951308232),

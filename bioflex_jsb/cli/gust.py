@@ -34,6 +34,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.lateral_options import (
     add_lateral_arguments,
+    lateral_description,
     lateral_run_options,
     lateral_summary,
 )
@@ -270,6 +271,7 @@ def run_description(args, kind: str, models):
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
         extra["aircraft"] = aircraft.source
+    extra.update(lateral_description(args))  # both halves, an aileron input ({}: none)
     if getattr(args, "controller", None) is not None:  # a file by its absolute path
         c = args.controller
         extra["controller"] = os.path.abspath(c) if os.path.isfile(c) else c

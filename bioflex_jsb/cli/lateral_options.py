@@ -24,8 +24,9 @@ WIDTH_RANGE_S = (0.01, 10.0)  # a doublet's half width [s]
 HELP_SPAN = ("half (the half wing's symmetric modes, the paper's) or full (both halves: the "
              "antisymmetric modes too, driven by the roll rate and the ailerons; their rolling "
              "moment to JSBSim; channels asym_eta<i>, tip_twist_port_rad, "
-             "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad). Default: full with an "
-             "aileron input, else half")
+             "tip_twist_starboard_rad, modal_roll_n_m, aileron_rad; with --aero unsteady "
+             "their own lag states and apparent mass). Default: full "
+             "with an aileron input, else half")
 
 
 def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,19 +68,29 @@ def lateral_run_options(args, build) -> dict:
                                                 args.aileron_start, args.aileron_width)
     if span == "half":
         return options | {"span": "half"} if options else {}
-    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
-        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
-                         "--aero unsteady")
     return options | {"span": "full", "aileron": _aileron(args, build)}
+
+
+def lateral_description(args) -> dict:
+    """The run description's entries of ``--span full`` and an aileron input (``rerun``
+    flies them again; {} for a half-wing run without one, whose description is as before)."""
+    angle = getattr(args, "aileron_step", None)
+    kind = "aileron_step" if angle is not None else "aileron_doublet"
+    if angle is None:
+        angle = getattr(args, "aileron_doublet", None)
+    out: dict = {}
+    if getattr(args, "span", None) == "full" or angle is not None:
+        out["span"] = getattr(args, "span", None) or "full"
+    if angle is not None:
+        out.update({kind: float(angle), "aileron_start": float(args.aileron_start),
+                    "aileron_width": float(args.aileron_width)})
+    return out
 
 
 def span_options(args, build) -> dict:
     """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
     if args.span != "full":
         return {}
-    if getattr(args, "aero", "quasi-steady") != "quasi-steady":
-        raise UsageError("--span full has quasi-steady antisymmetric strips only: drop "
-                         "--aero unsteady")
     return {"span": "full", "aileron": _aileron(args, build)}
 
 

@@ -33,7 +33,8 @@ LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold
 RUN_COMMANDS = ("gust", "compare")
 RUN_OPTIONS = ("--wing", "--aircraft", "--mass-basis", "--speed", "--gust", "--duration",
                "--gust-start", "--dt", "--models", "--model", "--aero",
-               "--structural-damping", "--trim", "--controller")
+               "--structural-damping", "--trim", "--controller", "--span", "--aileron-step",
+               "--aileron-doublet", "--aileron-start", "--aileron-width")
 
 
 tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
@@ -79,6 +80,11 @@ def argv_for(description) -> list[str]:
         common += ["--trim", str(d.extra["trim"])]
     if d.extra.get("controller"):
         common += ["--controller", str(d.extra["controller"])]
+    if d.extra.get("span"):  # both halves and an aileron input (cli/lateral_options.py)
+        common += ["--span", str(d.extra["span"])]
+        for key in ("aileron_step", "aileron_doublet", "aileron_start", "aileron_width"):
+            if key in d.extra:
+                common += [f"--{key.replace('_', '-')}", repr(float(d.extra[key]))]
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")

@@ -99,8 +99,8 @@ def register(sub) -> None:
     p.add_argument("--span", choices=("half", "full"), default="half",
                    help="half (the half wing's symmetric modes, default) or full (both "
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
-                   "the autopilot flies in its turns, their rolling moment to JSBSim; "
-                   "quasi-steady strips; docs/lateral.md)")
+                   "the autopilot flies in its turns, their rolling moment to JSBSim; on "
+                   "--aero's strips; docs/lateral.md)")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
@@ -262,6 +262,9 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
                **_controller_extra(args),
+               # both halves: which step flies them
+               **({"span": "full", "step": "compiled kernel" if sim.core.compiled
+                   else "python"} if args.span == "full" else {}),
                **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
     return SplitLog(args.out, description, build, args.log_max_mb,
                     live_opener(args, open_log), replace=args.force,

@@ -106,7 +106,7 @@ def register(sub) -> None:
     p.add_argument("--span", choices=("half", "full"), default="half",
                    help="half (the half wing's symmetric modes, default) or full (both "
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
-                   "ArduPlane flies, their rolling moment to JSBSim; quasi-steady strips; "
+                   "ArduPlane flies, their rolling moment to JSBSim; on --aero's strips; "
                    "docs/lateral.md)")
     from bioflex_jsb.cli.aircraft_option import cruise_speed_default
 
@@ -319,6 +319,7 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "launch_height_m": physics.launcher.height_m,
                "record_every": args.record_every, "aero": args.aero,
                "step": physics.step_kind, "gust_repeat": args.gust_repeat,
+               **({"span": "full"} if args.span == "full" else {}),
                "duration": ("until stopped: the flown duration is in the session-end event "
                             "(session_s)") if args.duration is None else "--duration"})
     from bioflex_jsb.flight_dynamics.wing_model import WingBuild

@@ -134,11 +134,11 @@ def check_comparable(model: str, aero: str, trim: str, controller: bool = False,
                      span: str = "half") -> None:
     """Raise InputError (one line) for a model, aerodynamics and trim with no linear model
     (with a ``controller``: one with the controls, quasi-steady about the rigid trim; with
-    ``span`` ``full``, both wing halves: the quasi-steady lateral model about the rigid
-    trim)."""
-    if span == "full" and (aero != "quasi-steady" or trim != "rigid"):
-        raise InputError("both wing halves are compared on the quasi-steady lateral model "
-                         "about the rigid trim (--aero quasi-steady --trim rigid)")
+    ``span`` ``full``, both wing halves: the lateral model about the rigid trim, on the
+    run's strips)."""
+    if span == "full" and trim != "rigid":
+        raise InputError("both wing halves are compared on the lateral model about the "
+                         "rigid trim (--trim rigid)")
     if controller and (aero != "quasi-steady" or trim != "rigid"):
         raise InputError("a controller is compared on the quasi-steady model about the rigid "
                          "trim (the unsteady and elastic-trim LTI models have no controls)")
@@ -216,7 +216,7 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         from bioflex_jsb.drivers.compare_lateral import add_full_span_lateral
 
         add_full_span_lateral(linear, nonlinear, build, model, speed_m_s,
-                              airframe or Airframe(), aileron)
+                              airframe or Airframe(), aileron, aero)
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
     return linear

@@ -58,42 +58,76 @@ class FullSpanLateralModel:
     """The linear lateral model of a full-span run: ``ss`` with the inputs v_g [m/s],
     aileron [rad], p_g [rad/s] (:data:`INPUTS`; module docstring) and the outputs of the
     lateral model; ``strips`` the antisymmetric strips (None for the rigid model), ``q_pa``
-    and ``speed_m_s`` the trim's dynamic pressure [Pa] and airspeed [m/s]."""
+    and ``speed_m_s`` the trim's dynamic pressure [Pa] and airspeed [m/s]; ``roll_rows``
+    the unsteady strips' rolling moment [N·m] on the states and on their rates (None:
+    quasi-steady strips)."""
 
     ss: StateSpace
     strips: object | None
     q_pa: float
     speed_m_s: float
+    roll_rows: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def full_span_lateral_model(build: WingBuild, airframe: Airframe, model: str,
-                            speed_m_s: float, aileron=None, altitude_m: float = 0.0
-                            ) -> FullSpanLateralModel:
+                            speed_m_s: float, aileron=None, altitude_m: float = 0.0,
+                            aero: str = "quasi-steady") -> FullSpanLateralModel:
     """The lateral model (module docstring) of the wing model ``model`` of ``build`` on the
     JSBSim ``airframe`` trimmed at ``speed_m_s`` [m/s], ``altitude_m`` [m]; ``aileron`` the
     run's :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface` (None: none on
     the strips). The model is :func:`bioflex_jsb.api.lateral_model`'s (one builder:
-    :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`)
-    with the inputs v_g, aileron, p_g."""
+    :func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`;
+    ``aero="unsteady"``, coupled only: that model on the unsteady strips,
+    :func:`~bioflex_jsb.aeroelasticity.antisymmetric.with_unsteady_strips`) with the inputs
+    v_g, aileron, p_g."""
     from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
-    from bioflex_jsb.flight_dynamics.lateral_elastic import antisymmetric_wing
+    from bioflex_jsb.flight_dynamics.lateral_elastic import (
+        antisymmetric_wing,
+        build_lateral_elastic,
+    )
     from bioflex_jsb.runtime.identification import identify_lateral
 
     point = identify_lateral(airframe, speed_m_s, build.airframe.reference, altitude_m)
     wing_a = None if model == "rigid" else antisymmetric_wing(build, point.trim.ixx_kg_m2)
     ss, strips = lateral_model_with_aileron(model, point.trim, point.aero, wing_a, aileron,
                                             build.aero.chord_m)
-    return FullSpanLateralModel(_with_gust_roll(ss), strips, point.trim.dynamic_pressure_pa,
-                                point.trim.speed_m_s)
+    rows = None
+    if aero == "unsteady":
+        ss, rows = _unsteady(ss, point.trim, build, wing_a)
+    rigid = build_lateral_elastic("rigid", point.trim, point.aero, None)
+    return FullSpanLateralModel(_with_gust_roll(ss, rigid), strips,
+                                point.trim.dynamic_pressure_pa, point.trim.speed_m_s, rows)
 
 
-def _with_gust_roll(ss: StateSpace) -> StateSpace:
+def _unsteady(ss: StateSpace, trim, build: WingBuild, wing_a):
+    """(the coupled model ``ss`` on the unsteady strips, the increments' rolling moment on
+    its states and on their rates [N·m])."""
+    from bioflex_jsb.aeroelasticity.antisymmetric import (
+        Layout,
+        aircraft_strips,
+        strip_loads,
+        with_unsteady_strips,
+    )
+
+    sections = aircraft_strips(build, wing_a, trim.ixx_kg_m2)
+    unsteady = with_unsteady_strips(ss, trim, sections)
+    n, k, n0 = sections.n_modes, sections.n_strips, ss.n_states
+    layout = Layout(unsteady.n_states, 1, slice(4, 4 + n), slice(4 + n, n0),
+                    (slice(n0, n0 + k), slice(n0 + k, n0 + 2 * k)))
+    loads = strip_loads(sections, layout, trim.speed_m_s, trim.density_kg_m3,
+                        quasi_steady=False, unsteady=True)
+    return unsteady, (loads.roll_x, loads.roll_xd)
+
+
+def _with_gust_roll(ss: StateSpace, rigid: StateSpace) -> StateSpace:
     """``ss`` with the inputs v_g, aileron, p_g (the rudder dropped; p_g's column: module
-    docstring)."""
+    docstring): in the β and φ rows the p column less the ``rigid`` model's (the kinematic
+    w₀/V, C_Yp and φ̇ = p), so that the elastic side force of p − p_g stays."""
     p = ss.states.index("p")
     b_pg = -np.asarray(ss.a, dtype=float)[:, p].copy()
-    b_pg[ss.states.index("beta")] = 0.0
-    b_pg[ss.states.index("phi")] = 0.0
+    a_rigid, p_rigid = np.asarray(rigid.a, dtype=float), rigid.states.index("p")
+    for name in ("beta", "phi"):
+        b_pg[ss.states.index(name)] += a_rigid[rigid.states.index(name), p_rigid]
     c, d = np.asarray(ss.c, dtype=float), np.asarray(ss.d, dtype=float)
     d_pg = np.zeros(len(ss.outputs))
     for i, name in enumerate(ss.outputs):  # a quasi-static model's η: its static response
@@ -139,17 +173,25 @@ def respond(lm: FullSpanLateralModel, time_s, inputs: np.ndarray) -> dict[str, n
         if "eta1_dot" in out:  # the coupled model; the quasi-static one has η̇ = 0
             eta_dot = np.column_stack([out[f"eta{i + 1}_dot"] for i in range(s.n_modes)])
             roll = roll + lm.q_pa / lm.speed_m_s * eta_dot @ s.roll_etadot
+        if lm.roll_rows is not None:  # the unsteady increments' (ẋ = A x + B u): the
+            # strips see p − p_g, the apparent mass the body's ṗ
+            x_dot = x @ a.T + u @ b.T
+            roll_x, roll_xd = lm.roll_rows
+            p_g = u[:, INPUTS.index("p_g")]
+            roll = (roll + x @ roll_x - p_g * roll_x[ss.states.index("p")]
+                    + x_dot @ roll_xd)
         channels["asym_eta1"] = eta[:, 0]
         channels["modal_roll_n_m"] = roll
     return channels
 
 
 def add_full_span_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
-                          model: str, speed_m_s: float, airframe: Airframe, aileron=None
-                          ) -> None:
+                          model: str, speed_m_s: float, airframe: Airframe, aileron=None,
+                          aero: str = "quasi-steady") -> None:
     """Add to ``linear`` the lateral model's response (module docstring) to what the
-    full-span run ``nonlinear`` flew: its v_g, aileron and p_g (channels absent: zero)."""
-    lm = full_span_lateral_model(build, airframe, model, speed_m_s, aileron)
+    full-span run ``nonlinear`` flew: its v_g, aileron and p_g (channels absent: zero); the
+    run's strips ``aero``."""
+    lm = full_span_lateral_model(build, airframe, model, speed_m_s, aileron, aero=aero)
     t = np.asarray(nonlinear.time_s, dtype=float)
     zeros = np.zeros(t.size)
 

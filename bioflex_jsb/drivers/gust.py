@@ -254,6 +254,9 @@ def run_gust(
     if aileron_input is not None:
         history.meta["aileron_input"] = aileron_input.as_dict()
     history.meta["span"] = span
+    if span == "full":  # the antisymmetric wing's strips and which step flew them
+        history.meta["lateral_strips"] = (f"{aero}, "
+                                          f"{'compiled kernel' if step.compiled else 'python'}")
     if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
         history.meta["flaperon"] = step.flaperon.deriv.as_dict()
     if sensor_set is not None:

@@ -201,7 +201,8 @@ class CoupledStep(FullSpanSteps):
             ``full``: both halves, the antisymmetric modes beside the symmetric ones driven by
             the roll rate, JSBSim's ailerons and a gust roll rate, their rolling moment to
             JSBSim's modal-roll (:mod:`bioflex_jsb.simulation.full_span`; needs the wing's
-            build and the quasi-steady strips); the rows gain the channels of
+            build; with ``aero="unsteady"`` the antisymmetric modes' own unsteady strips,
+            :mod:`bioflex_jsb.simulation.unsteady_full_span`); the rows gain the channels of
             :func:`~bioflex_jsb.simulation.full_span.lateral_channel_units`.
         aileron: the wing's aileron (a
             :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`, the

@@ -32,17 +32,16 @@ IXX_PROPERTY = JP.INERTIA_IXX_SLUGS_FT2
 
 
 def check_span(span: str, build, model: str, aero: str) -> None:
-    """A full-span step needs the wing's build (its beam: the antisymmetric modes), the
-    quasi-steady strips and a wing of ours (not the native one); one line otherwise."""
+    """A full-span step needs the wing's build (its beam: the antisymmetric modes) and a
+    wing of ours (not the native one); one line otherwise. Its strips are the run's
+    ``aero`` (unsteady: the coupled wing's, :mod:`bioflex_jsb.simulation
+    .unsteady_full_span`)."""
     if span not in SPANS:
         raise InputError(f"unknown span {span!r}; accepted: {', '.join(SPANS)}")
     if span == "half":
         return
     if model == "native":
         raise InputError("span='full' flies the Python modal wing, not the native one")
-    if aero != "quasi-steady":
-        raise InputError("span='full' has quasi-steady antisymmetric strips only; accepted "
-                         "with it: aero='quasi-steady'")
     if build is None:
         raise InputError("span='full' needs the wing's build (its beam, for the "
                          "antisymmetric modes), not only its ElasticWingModel")
@@ -77,15 +76,23 @@ class FullSpanSteps:
         # on one BLAS thread, as the reference steps are: a multi-threaded call leaves
         # OpenBLAS's other thread spinning for ~0.1 s after it, on this process's CPU clock
         # and on the second core, while the run steps (the results are the same, bit for bit)
+        refresh = getattr(self.wing, "refresh_rel", 0.05)
         with one_blas_thread():
             wing_a = antisymmetric_wing(build, ixx)
             strips = antisymmetric_strips(wing_a, aileron, np.asarray(build.aero.chord_m))
             sym_tip = np.asarray(build.modes.twist_rad, dtype=float)[:self.n_modes, -1]
             terms = yaw_sideslip_terms(wing_a, build.modes, self.n_modes, build.planform,
                                        2.0 * float(build.aero.semispan_m))
-        lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
-                                         refresh_rel=getattr(self.wing, "refresh_rel", 0.05),
-                                         terms=terms)
+            if self.aero == "unsteady":  # the coupled wing's unsteady strips, both halves
+                from bioflex_jsb.aeroelasticity.antisymmetric import aircraft_strips
+                from bioflex_jsb.simulation.unsteady_full_span import UnsteadyAntisymmetricWing
+
+                lateral = UnsteadyAntisymmetricWing(
+                    strips, aircraft_strips(build, wing_a, ixx), model, self.dt_s, sym_tip,
+                    refresh_rel=refresh, terms=terms)
+            else:
+                lateral = AntisymmetricModalWing(strips, model, self.dt_s, sym_tip,
+                                                 refresh_rel=refresh, terms=terms)
         # the aircraft's weight [N] (L_w = n_z W) and the symmetric trim deflection [rad]
         self._weight_n = (airframe[JP.INERTIA_MASS_SLUGS] * U.KG_PER_SLUG
                           * STANDARD_GRAVITY_M_S2)
@@ -134,7 +141,11 @@ class FullSpanSteps:
         if lat.model != "coupled":
             return
         lat.reference(float(q_pa), float(v_m_s))
-        if self.compiled:
+        if self.compiled and self.aero == "unsteady":  # runtime/unsteady_full_span_step.py
+            from bioflex_jsb.runtime.unsteady_full_span_step import load_reference
+
+            load_reference(self)
+        elif self.compiled:
             lv = self._lat_views
             lv["stack"][:] = np.ravel(lat._stack)
             lv["input_cols"][:] = np.ravel(lat._input_cols)
@@ -165,7 +176,13 @@ class FullSpanSteps:
         """One parameter array, state and column index for both wings (the layout of
         :mod:`bioflex_jsb.simulation.full_span_kernel`): the half wing's as _setup_kernel
         made them, the antisymmetric block after them; the half wing's views, state and
-        reactions rebound onto them."""
+        reactions rebound onto them. On unsteady strips:
+        :func:`~bioflex_jsb.runtime.unsteady_full_span_step.setup_kernel`."""
+        if self.aero == "unsteady":
+            from bioflex_jsb.runtime.unsteady_full_span_step import setup_kernel
+
+            setup_kernel(self)
+            return
         from bioflex_jsb.simulation import full_span_kernel as FK
         from bioflex_jsb.simulation.full_span import LATERAL_FIXED, lateral_names
 

@@ -68,7 +68,8 @@ moment arm (the wing's aerodynamic centre is taken at the CG, where the reaction
 the products of two lateral quantities (β η_a, r η_a: symmetric loads), the plunge rate of
 the symmetric modes under r and β, the drag's own change with V − r y (C_nr of the rigid
 drag is JSBSim's) and the change of the induced angle the deformation's lift makes (a
-lattice term), unsteady strips for the antisymmetric modes.
+lattice term). The antisymmetric modes on unsteady strips:
+:mod:`bioflex_jsb.simulation.unsteady_full_span`.
 """
 
 from __future__ import annotations
