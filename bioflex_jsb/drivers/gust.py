@@ -256,8 +256,8 @@ def run_gust(
     history.meta["span"] = span
     if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
         history.meta["flaperon"] = step.flaperon.deriv.as_dict()
-    if sensor_set is not None:
-        history.meta["sensors"] = sensor_set.describe()
+    if sensor_set is not None:  # as flown (both halves: the antisymmetric columns too)
+        history.meta["sensors"] = step.sensor_set.describe()
     return history
 
 

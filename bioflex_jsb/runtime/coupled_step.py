@@ -369,7 +369,17 @@ class CoupledStep(FullSpanSteps):
         if sensors.n_modes not in (0, self.n_modes):
             raise InputError(f"the sensors carry {sensors.n_modes} modes, the wing flies "
                              f"{self.n_modes}")
-        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state)
+        if self.lateral is not None:  # both halves: the antisymmetric modes' columns too
+            wing_a = self.antisymmetric_wing
+            sensors = sensors.with_antisymmetric(wing_a.modes, wing_a.root_slope)
+        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state,
+                          lateral=self.lateral)
+
+    @property
+    def sensor_set(self) -> SensorSet | None:
+        """The sensors the rows read (both halves: with the antisymmetric modes' columns
+        after the symmetric ones); None without sensors."""
+        return None if self._sensors is None else self._sensors.set
 
     def rigid_kinematics(self, wind_down_fps: float) -> np.ndarray:
         """The rigid body's kinematics now, as the sensor channels take them
@@ -742,7 +752,9 @@ class CoupledStep(FullSpanSteps):
         sensors = self._sensors
         if sensors is None:
             return self._bind_fast_step()
-        x, dt = self.wing._x, self.dt_s  # x: updated in place by the kernel
+        # x: updated in place by the kernel (both halves: the full-span kernel's state)
+        x = self.wing._x if self.lateral is None else self._x_full
+        dt = self.dt_s
         cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.int64)
         ft_per_m = U.FT_PER_M
         hold, write = sensors.compiled(x, cols, U.M_PER_FT)
