@@ -165,3 +165,31 @@ def test_a_rolling_wing_pair_reads_its_antisymmetric_modes(rolling):
     assert np.max(np.abs(mean - p - modal)) < 1e-3 * np.max(np.abs(modal))
     az_s, az_p = np.asarray(run["imu_stbd_az_m_s2"]), np.asarray(run["imu_port_az_m_s2"])
     assert np.max(np.abs(az_s - az_p)) > 0.1  # starboard pushed down, port up
+
+
+def test_the_autopilot_imu_rolls_with_the_fuselage_on_both_halves(c172, wing_a):
+    """The autopilot's IMU (the ArduPilot backend's, the MAVLink vehicle's) following a
+    full-span step reads the antisymmetric modes' state with the symmetric one's: at the CG
+    its gyro x is p + Σ ρ₀ η̇_a; following a half-wing step it reads as before (p)."""
+    from types import SimpleNamespace
+
+    from bioflex_jsb.simulation.sensors import AutopilotImu
+
+    build = c172.wing()
+    n_s = build.model.n_modes
+    lateral = SimpleNamespace(n_modes=3, eta=np.zeros(3), eta_dot=np.zeros(3))
+    full = SimpleNamespace(n_modes=n_s, lateral=lateral, antisymmetric_wing=wing_a)
+    half = SimpleNamespace(n_modes=n_s, lateral=None)
+    kin = np.zeros(len(KINEMATICS))
+    kin[3] = 0.1  # p [rad/s]
+    dt = 1.0 / 960.0
+    for step, expected in ((half, 0.1), (full, None)):
+        imu = AutopilotImu(ImuSpec("ap", (0.0, 0.0, 0.0), autopilot=True), build.modes, n_s, dt)
+        imu.follow(step)
+        lateral.eta_dot = np.array([0.02, -0.01, 0.03])
+        imu.before_step(np.zeros(n_s), np.zeros(n_s))
+        _, gyro = imu.read(kin, np.zeros(n_s), np.zeros(n_s), 0.0, True)
+        if expected is None:
+            expected = 0.1 + np.asarray(wing_a.root_slope) @ lateral.eta_dot
+            assert abs(expected - 0.1) > 1e-3
+        assert gyro[0] == pytest.approx(expected, rel=1e-12)

@@ -312,8 +312,9 @@ def fly(args, build, config, log=None, airframe=None):
 
     runs, stops = [], []
     # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
-    lateral = lateral_run_options(args, build) if hasattr(args, "aileron_step") else {}
     controller = getattr(args, "controller_object", None)
+    lateral = (lateral_run_options(args, build, controller) if hasattr(args, "aileron_step")
+               else {})
     flaperon = "flaperon" in getattr(controller, "outputs", ())
     if flaperon and "aileron" not in lateral:  # the aileron it deflects: --aircraft's
         aircraft = getattr(args, "aircraft_definition", None)  # (None: the prototype's)

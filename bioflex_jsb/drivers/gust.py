@@ -235,6 +235,9 @@ def run_gust(
     build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
         else None
     sensor_set = _sensor_set(sensors, build, wing)
+    if aileron_input is not None and "aileron" in getattr(controller, "outputs", ()):
+        raise InputError("an aileron step or doublet and a controller's aileron command both "
+                         "write JSBSim's aileron command: give one of them")
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
                        trim_mode=trim_mode, sensors=sensor_set, controller=controller,

@@ -445,8 +445,15 @@ class CoupledStep(FullSpanSteps):
         if self._sensors is not None:  # their true reading at the trim, the wing at rest
             trim.update(self._sensors.set.clean(self._kinematics(0.0), zeros, zeros, zeros))
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
+        aileron = None
+        if "aileron" in controller.outputs:  # JSBSim's aileron: both halves only
+            from bioflex_jsb.runtime.aileron_input import controller_aileron
+
+            aileron = controller_aileron(self.airframe, self.lateral is not None,
+                                         over_autopilot)
         commands = commands_for(self.airframe, loop.outputs, over_autopilot,
-                                None if self.flaperon is None else self.flaperon.command())
+                                None if self.flaperon is None else self.flaperon.command(),
+                                aileron)
         self._commands = commands  # their maps go into the compiled update last
         binding = loop.binding
         step = loop.step

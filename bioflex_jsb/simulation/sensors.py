@@ -629,30 +629,52 @@ class AutopilotImu:
     the MAVLink vehicle's HIGHRES_IMU): its own :class:`SensorSet` (its own noise stream,
     read once per sample) and the wing's states before the last step, for
     :func:`latest_modal_kinematics`. Call :meth:`before_step` with the wing's η, η̇ before
-    each step, :meth:`read` after it."""
+    each step, :meth:`read` after it. Both wing halves (:meth:`follow` a full-span step): the
+    antisymmetric wing's η_a, η̇_a are read with the symmetric ones given (module docstring,
+    "Both wing halves": an IMU on the fuselage rolls with their root slope)."""
 
     def __init__(self, spec: ImuSpec, modes=None, n_modes: int | None = None,
                  dt_s: float = 1.0) -> None:
         self.spec = spec
         self.set = SensorSet(Sensors(imus=(spec,)), modes, n_modes)
         self.dt_s = float(dt_s)
+        self._lateral = None
         self.reset(self.set.n_modes)
 
     def reset(self, n_modes: int) -> None:
         """A new flight: the wing at rest before it (η_{k−1} = η_k = 0, η̇_k = 0)."""
-        self._hist = (np.zeros(n_modes), np.zeros(n_modes), np.zeros(n_modes))
+        n = n_modes + (0 if self._lateral is None else self._lateral.n_modes)
+        self._hist = (np.zeros(n), np.zeros(n), np.zeros(n))
+
+    def follow(self, step) -> None:
+        """A new flight of the coupled step ``step`` (its ``n_modes``, ``lateral`` and, with
+        both halves, ``antisymmetric_wing``): the wing at rest; with both halves the IMU's
+        columns gain the antisymmetric modes (once; a fresh noise stream, the same seed)."""
+        lateral = getattr(step, "lateral", None)
+        if lateral is not None and self.set.n_antisymmetric != lateral.n_modes:
+            wing_a = step.antisymmetric_wing
+            self.set = self.set.with_antisymmetric(wing_a.modes, wing_a.root_slope)
+        self._lateral = lateral
+        self.reset(step.n_modes)
+
+    def _both(self, eta, lateral_eta) -> np.ndarray:
+        eta = np.array(eta, dtype=float)
+        return eta if self._lateral is None else np.concatenate([eta, lateral_eta])
 
     def before_step(self, eta, eta_dot) -> None:
         """The wing's η [rad], η̇ [rad/s] before the step about to be flown."""
-        self._hist = (self._hist[1], np.array(eta, dtype=float),
-                      np.array(eta_dot, dtype=float))
+        lat = self._lateral
+        self._hist = (self._hist[1], self._both(eta, None if lat is None else lat.eta),
+                      self._both(eta_dot, None if lat is None else lat.eta_dot))
 
     def read(self, kin, eta, eta_dot, t_s: float, rate_state: bool
              ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """(specific force [m/s²], rates [rad/s]) in the IMU's axes at the newest state: the
         rigid body's :data:`KINEMATICS` ``kin`` and the wing's η, η̇ now, at ``t_s`` [s]."""
         eta_prev, eta_k, eta_dot_k = self._hist
-        eta, eta_dot = np.asarray(eta, dtype=float), np.asarray(eta_dot, dtype=float)
+        lat = self._lateral
+        eta = self._both(eta, None if lat is None else lat.eta)
+        eta_dot = self._both(eta_dot, None if lat is None else lat.eta_dot)
         dot, ddot = latest_modal_kinematics(eta_prev, eta_k, eta, eta_dot_k, eta_dot,
                                             self.dt_s, rate_state)
         v = self.set.read(kin, eta, dot, ddot, t_s).tolist()
