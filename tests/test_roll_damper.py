@@ -201,3 +201,19 @@ def test_a_sensor_fed_damper_flies_the_compiled_step_as_the_python_one(c172):
         assert np.max(np.abs(a - b)) <= 1e-12 * np.ptp(a), name
     # the fuselage's gyro reads p plus the modes' roll at the root: not p itself
     assert np.max(np.abs(np.asarray(fast["imu_fus_gx_rad_s"]) - fast["p_rad_s"])) > 1e-7
+
+
+def test_the_log_carries_the_aileron_command(capsys, tmp_path):
+    """/bioflex/<model>/controller carries aileron_cmd_rad; read_log gives it back as the
+    run's ctrl_aileron_rad (the gust CLI flying the damper on both halves, implied by it)."""
+    out = tmp_path / "damper.mcap"
+    code, _, _ = run_cli(capsys, "gust", "--aircraft", C172, "--controller", DAMPER,
+                         "--gust", GUST, "--duration", "1.5", "--models", "coupled",
+                         "--out", str(out), "--plot", str(tmp_path / "damper.png"))
+    assert code == 0
+    run = api.read_log(out)["coupled"]
+    assert run.meta["controller"]["outputs"] == ["aileron"]
+    k = -load_controller(DAMPER).system.d[0, 0]
+    p = np.asarray(run["p_rad_s"])
+    assert np.max(np.abs(run["ctrl_aileron_rad"])) > 5e-3
+    assert np.allclose(run["ctrl_aileron_rad"], -k * (p - p[0]), rtol=0, atol=1e-15)
