@@ -144,10 +144,11 @@ def add_controller_argument(p: argparse.ArgumentParser, linear: bool = False) ->
     p.add_argument("--controller", metavar="FILE", default=None,
                    help=f"fly with {what} in the loop: a .npz or .toml file (A, B, C, D, "
                    "dt_s [s], the signals it reads: the run's channels such as alpha, q, "
-                   "n_z, eta1; the commands it writes: elevator [rad], throttle [-] over the "
-                   "trim) or a shipped one by name (gla_optimised, fs_inertial-backward); "
-                   "its commands are logged as ctrl_elevator_rad, ctrl_throttle "
-                   "(docs/api.md)")
+                   "n_z, eta1; the commands it writes: elevator [rad], throttle [-], "
+                   "flaperon [rad], aileron [rad, (left - right)/2, + rolls right: both wing "
+                   "halves, implies --span full] over the trim) or a shipped one by name "
+                   "(gla_optimised, fs_inertial-backward, roll_damper_c172_elastic, ...); "
+                   "its commands are logged as ctrl_<command>[_rad] (docs/api.md)")
 
 
 def controller_from_args(args, linear: bool = False):
