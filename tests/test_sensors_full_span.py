@@ -193,3 +193,24 @@ def test_the_autopilot_imu_rolls_with_the_fuselage_on_both_halves(c172, wing_a):
             expected = 0.1 + np.asarray(wing_a.root_slope) @ lateral.eta_dot
             assert abs(expected - 0.1) > 1e-3
         assert gyro[0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_the_unsteady_half_wings_sensors_read_its_modes():
+    """The compiled sensor row finds η, η̇ at the front of the unsteady wing's longer state
+    (its lag states after them): its sensor channels equal the Python step's to 1e-9 of
+    their range (measured 1.9e-12; the sensor row indexes the state, which is why it is
+    tested here)."""
+    from bioflex_jsb.flight_dynamics.wing_model import VARIANTS, build_wing
+    from bioflex_jsb.runtime.fdm import Airframe
+
+    build = build_wing(VARIANTS["optimised"])
+    sensors = Sensors(imus=(ImuSpec("tip", (-0.3, 0.85, 0.0),
+                                    wing=WingPoint(0.85, 1.0, 0.0, 0.14)),))
+    runs = [run_gust(Airframe(), build, "coupled",
+                     RunConfig(15.0, parse_gust("1cos:1:5"), 0.6, models=("coupled",),
+                               aero="unsteady", gust_start_s=0.1),
+                     sensors=sensors, compiled=compiled) for compiled in (True, False)]
+    for name in (c for c in runs[0].channels if c.startswith("imu_tip")):
+        a, b = np.asarray(runs[0][name]), np.asarray(runs[1][name])
+        assert np.ptp(a) > 0.0
+        assert np.max(np.abs(a - b)) <= 1e-9 * np.ptp(a), name

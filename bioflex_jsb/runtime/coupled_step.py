@@ -759,12 +759,15 @@ class CoupledStep(FullSpanSteps):
         sensors = self._sensors
         if sensors is None:
             return self._bind_fast_step()
-        # x: updated in place by the kernel (both halves: the full-span kernel's state)
-        x = self.wing._x if self.lateral is None else self._x_full
+        # x: updated in place by the kernel (both halves: the full-span kernel's state, the
+        # two wings' states views into it)
+        x, parts = self.wing._x, None
+        if self.lateral is not None:
+            x, parts = self._x_full, (self.wing._x, self.lateral._x)
         dt = self.dt_s
         cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.int64)
         ft_per_m = U.FT_PER_M
-        hold, write = sensors.compiled(x, cols, U.M_PER_FT)
+        hold, write = sensors.compiled(x, cols, U.M_PER_FT, parts)
         (g_fx, g_fy, g_fz, g_mass, g_pd, g_qd, g_rd, g_u, g_v, g_w, g_theta, g_phi, g_p, g_q,
          g_r) = self._kinematics_readers()
         if self._control_step is not None:

@@ -558,24 +558,19 @@ class SensorRows:
             self.eta_prev[:] = self.eta_k - self.dt_s * self.eta_dot_k
             self.flags[0] = 1.0
 
-    def compiled(self, x: np.ndarray, cols: np.ndarray, m_per_ft: float):
+    def compiled(self, x: np.ndarray, cols: np.ndarray, m_per_ft: float, parts=None):
         """``(hold, write)``: :meth:`before` and :meth:`row` (with the rigid body's
         kinematics) as compiled calls for the coupled step's compiled path, bound once to
         the wing's state ``x`` (η, η̇, updated in place; both halves: the full-span kernel's
-        [η_s, η̇_s, η_a, η̇_a]), the table columns ``cols`` of
+        state, ``parts`` the symmetric and antisymmetric wings' states, each [η, η̇], as views
+        into it: where each lies in ``x`` is read from them), the table columns ``cols`` of
         :attr:`channels` and ft→m ``m_per_ft``: ``hold()`` before the wing's step,
         ``write(reads, wind_down_fps, table, k, t_s)`` after it (``reads`` the
         :data:`KINEMATICS_READS` of the airframe at t_k, the wind down [ft/s]) writes the
         row's channels into ``table[k]``. The same arithmetic as the readable methods."""
         ss, n, dt = self.set, self.n_modes, self.dt_s
         hist, flags = self.hist, self.flags
-        n_s, n_a = ss.n_modes, ss.n_antisymmetric
-        at = np.concatenate([np.arange(n_s), 2 * n_s + np.arange(n_a),
-                             n_s + np.arange(n_s), 2 * n_s + n_a + np.arange(n_a)]
-                            ).astype(np.int64)  # η then η̇ in x
-        if x.size != 2 * n:
-            raise ValueError(f"the wing's state has {x.size} values, the sensors read {2 * n}")
-        x = np.ascontiguousarray(x)
+        at = _state_positions(x, ss.n_modes, ss.n_antisymmetric, parts)  # η, then η̇ in x
         cols = np.ascontiguousarray(cols, dtype=np.int64)
         kin, dot, ddot = np.zeros(len(KINEMATICS)), np.zeros(n), np.zeros(n)
         noisy, air_noisy = ss._noisy, ss._air_noisy
@@ -622,6 +617,32 @@ class SensorRows:
         values = self.set.read(kin, self.eta_k, dot, ddot, t_s)
         self.eta_prev[:] = self.eta_k
         return values
+
+
+def _state_positions(x: np.ndarray, n_s: int, n_a: int, parts) -> np.ndarray:
+    """Where η_s, η_a, then η̇_s, η̇_a lie in the state ``x`` (int64): the half wing's
+    [η, η̇, …] (``parts`` None; the unsteady wing's lag states after them), or each of
+    ``parts`` (the symmetric and antisymmetric wings' [η, η̇], views into ``x``) at its own
+    offset; ValueError for a part not inside ``x``."""
+    if not x.flags.c_contiguous:
+        raise ValueError("the wing's state must be one contiguous array")
+    if parts is None:
+        if n_a or x.size < 2 * n_s:
+            raise ValueError(f"the wing's state has {x.size} values, the sensors read "
+                             f"{2 * (n_s + n_a)}")
+        return np.arange(2 * n_s, dtype=np.int64)
+    offsets = []
+    for view, n in zip(parts, (n_s, n_a), strict=True):
+        start = (view.__array_interface__["data"][0] - x.__array_interface__["data"][0]) \
+            // x.itemsize
+        if view.size != 2 * n or start < 0 or start + 2 * n > x.size \
+                or not np.shares_memory(view, x):
+            raise ValueError("a wing's state is not a view into the full-span state")
+        offsets.append(start)
+    (o_s, o_a) = offsets
+    return np.concatenate([o_s + np.arange(n_s), o_a + np.arange(n_a),
+                           o_s + n_s + np.arange(n_s), o_a + n_a + np.arange(n_a)]
+                          ).astype(np.int64)
 
 
 class AutopilotImu:
