@@ -54,8 +54,8 @@ def test_unknown_signals_are_one_line(inputs, fragment):
 
 
 def test_unknown_command_is_one_line():
-    with pytest.raises(InputError, match="'aileron' is not a command; accepted: elevator"):
-        LinearController.from_arrays(None, None, None, [[1.0]], DT, ["q"], ["aileron"])
+    with pytest.raises(InputError, match="'rudder' is not a command; accepted: elevator"):
+        LinearController.from_arrays(None, None, None, [[1.0]], DT, ["q"], ["rudder"])
 
 
 @pytest.mark.parametrize("d, dt, fragment", [

@@ -154,7 +154,8 @@ def test_cli_refuses_a_bad_controller_in_one_line(capsys, tmp_path):
         assert_one_line_error(code, err, "'qq' is not a signal of the run")
     code, _, err = run_cli(capsys, "gust", "--controller", "no_such", "--no-log")
     assert_one_line_error(code, err, "shipped controller (fs_inertial-backward, "
-                                     "gla_flaperon_optimised, gla_optimised)")
+                                     "gla_flaperon_optimised, gla_optimised, "
+                                     "roll_damper_c172_elastic)")
 
 
 def test_rerun_flies_the_controller_again():

@@ -62,6 +62,9 @@ def test_a_file_enters_the_id_by_its_content(tmp_path):
     ('["no_such"]', "axes.controllers[0]: no controller 'no_such'"),
     ('["none", "none"]', "axes.controllers: None appears twice"),
     ("[3]", "axes.controllers[0]: must be a controller file"),
+    # an aileron command needs both wing halves, which a campaign's runs do not fly
+    ('["roll_damper_c172_elastic"]', "axes.controllers[0]: 'roll_damper_c172_elastic' "
+     "commands the aileron"),
 ])
 def test_a_bad_controller_is_one_line_naming_the_key(value, needle):
     with pytest.raises(CampaignError) as err:

@@ -142,6 +142,11 @@ def _checked(args: argparse.Namespace):
 
         if not isinstance(controller, LinearController):  # a file is always linear
             raise UsageError("--controller: the LTI model needs a linear controller")
+        if "aileron" in controller.outputs:  # both halves' lateral loop (drivers/compare)
+            if args.span == "half":
+                raise UsageError("--controller commands the aileron, which needs both wing "
+                                 "halves: drop --span half (accepted: --span full)")
+            full_span = True
     if not aileron_input:  # an aileron input excites the aircraft
         try:
             check_gust_excites(args.gust)

@@ -145,10 +145,11 @@ def add_controller_argument(p: argparse.ArgumentParser, linear: bool = False) ->
     p.add_argument("--controller", metavar="FILE", default=None,
                    help=f"fly with {what} in the loop: a .npz or .toml file (A, B, C, D, "
                    "dt_s [s], the signals it reads: the run's channels such as alpha, q, "
-                   "n_z, eta1; the commands it writes: elevator [rad], throttle [-] over the "
-                   "trim) or a shipped one by name (gla_optimised, fs_inertial-backward); "
-                   "its commands are logged as ctrl_elevator_rad, ctrl_throttle "
-                   "(docs/api.md)")
+                   "n_z, eta1; the commands it writes: elevator [rad], throttle [-], "
+                   "flaperon [rad], aileron [rad, (left - right)/2, + rolls right: both wing "
+                   "halves, implies --span full] over the trim) or a shipped one by name "
+                   "(gla_optimised, fs_inertial-backward, roll_damper_c172_elastic, ...); "
+                   "its commands are logged as ctrl_<command>[_rad] (docs/api.md)")
 
 
 def controller_from_args(args, linear: bool = False):
@@ -314,8 +315,9 @@ def fly(args, build, config, log=None, airframe=None):
 
     runs, stops = [], []
     # both wing halves and an aileron input (cli/lateral_options.py; {} for a half wing)
-    lateral = lateral_run_options(args, build) if hasattr(args, "aileron_step") else {}
     controller = getattr(args, "controller_object", None)
+    lateral = (lateral_run_options(args, build, controller) if hasattr(args, "aileron_step")
+               else {})
     flaperon = "flaperon" in getattr(controller, "outputs", ())
     if flaperon and "aileron" not in lateral:  # the aileron it deflects: --aircraft's
         aircraft = getattr(args, "aircraft_definition", None)  # (None: the prototype's)

@@ -51,13 +51,21 @@ def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
         f"to {WIDTH_RANGE_S[1]:g} (default 0.5)")
 
 
-def lateral_run_options(args, build) -> dict:
+def lateral_run_options(args, build, controller=None) -> dict:
     """run_gust's ``span``, ``aileron``, ``aileron_input`` of the arguments (only those
-    that differ from a half-wing run's: {} for one)."""
+    that differ from a half-wing run's: {} for one); a ``controller`` that commands the
+    aileron flies both halves (``--span half`` and an aileron input beside it refused)."""
     from bioflex_jsb.simulation.full_span import AileronInput
 
     angle_deg = args.aileron_step if args.aileron_step is not None else args.aileron_doublet
-    span = args.span or ("full" if angle_deg is not None else "half")
+    aileron_ctrl = "aileron" in getattr(controller, "outputs", ())
+    if aileron_ctrl and angle_deg is not None:
+        raise UsageError("--controller commands the aileron: drop --aileron-step / "
+                         "--aileron-doublet (both write JSBSim's aileron command)")
+    if aileron_ctrl and args.span == "half":
+        raise UsageError("--controller commands the aileron, which needs both wing halves: "
+                         "drop --span half (accepted: --span full)")
+    span = args.span or ("full" if angle_deg is not None or aileron_ctrl else "half")
     options: dict = {}
     if angle_deg is not None:
         if args.aileron_start >= args.duration:

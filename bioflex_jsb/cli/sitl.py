@@ -162,6 +162,10 @@ def run(args: argparse.Namespace) -> int:
     from bioflex_jsb.cli.gust import controller_from_args
 
     controller = controller_from_args(args)  # a bad file: one line before the trim
+    if "aileron" in getattr(controller, "outputs", ()):
+        raise UsageError("--controller commands the aileron, which the SITL aircraft's "
+                         "autopilot writes itself (fcs/aileron-cmd-norm); accepted over it: "
+                         "elevator, throttle")
     from bioflex_jsb.cli.lateral_options import span_options
 
     check = checked(args, build, UsageError)  # the pre-flight check (cli/preflight.py)

@@ -421,7 +421,7 @@ class ArduPilotPhysics:
                                                               "aileron": self.aileron}))
         self.core = core
         self._autopilot.dt_s = core.dt_s
-        self._autopilot.reset(core.n_modes)  # the wing at rest before the flight
+        self._autopilot.follow(core)  # the wing at rest before the flight (both halves too)
         a = self.airframe
         node = a.property_node
         self._h_launch_m = core.get["h"]() * U.M_PER_FT

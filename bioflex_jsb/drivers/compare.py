@@ -48,7 +48,8 @@ from bioflex_jsb.simulation.lti_response import simulate
 from bioflex_jsb.simulation.results import TimeHistory, nrmse
 
 CHANNELS = ("u", "alpha", "q", "theta", "eta1")
-COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle", "ctrl_flaperon_rad")  # a controller's
+# a controller's commands
+COMMANDS = ("ctrl_elevator_rad", "ctrl_throttle", "ctrl_flaperon_rad", "ctrl_aileron_rad")
 # a gust with a rolling or lateral part: the rigid lateral model's (_add_lateral)
 LATERAL_CHANNELS = ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad")
 # both wing halves: the first antisymmetric mode and the modes' rolling moment
@@ -165,7 +166,9 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     ``controller``: the linear controller the run flew with
     (:class:`~bioflex_jsb.simulation.controller.LinearController`): the model with its
     controls closes the loop at the run's step with its one step of delay
-    (:mod:`bioflex_jsb.simulation.closed_loop`); the prediction has its commands too.
+    (:mod:`bioflex_jsb.simulation.closed_loop`); the prediction has its commands too. A
+    controller commanding the ``aileron`` (alone: one axis's loop) closes the full-span
+    run's lateral model instead, the longitudinal model then flying open loop.
 
     A run with both wing halves (``nonlinear.meta["span"] == "full"``): the lateral model of
     the same wing model is added, driven by the run's v_g, aileron and gust roll rate
@@ -173,6 +176,14 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
     :class:`~bioflex_jsb.aeroelasticity.control_surface.ControlSurface`, None: none)."""
     check_comparable(model, aero, trim, controller is not None,
                      nonlinear.meta.get("span", "half"))
+    lateral_controller = None  # a controller of the aileron: the lateral loop's
+    if controller is not None and "aileron" in controller.outputs:
+        if tuple(controller.outputs) != ("aileron",) or \
+                nonlinear.meta.get("span") != "full":
+            raise InputError("a controller commanding the aileron is compared on both wing "
+                             "halves' lateral model, as its only command (outputs "
+                             f"{list(controller.outputs)})")
+        lateral_controller, controller = controller, None
     # the JSBSim airframe the run flew (the prototype's by default): A_RR at its trim (an
     # aircraft without an engine: its steady glide, runtime/trim.py)
     lin = (airframe or Airframe()).linearize(speed_m_s)
@@ -216,7 +227,7 @@ def linear_prediction(build: WingBuild, nonlinear: TimeHistory, model: str, spee
         from bioflex_jsb.drivers.compare_lateral import add_full_span_lateral
 
         add_full_span_lateral(linear, nonlinear, build, model, speed_m_s,
-                              airframe or Airframe(), aileron, aero)
+                              airframe or Airframe(), aileron, aero, lateral_controller)
     if lm is not None:
         _add_linear_loads(linear, lm, layout)
     return linear

@@ -185,12 +185,47 @@ def respond(lm: FullSpanLateralModel, time_s, inputs: np.ndarray) -> dict[str, n
     return channels
 
 
+def closed_loop_respond(lm: FullSpanLateralModel, controller, dt_s: float, v_g, p_g
+                        ) -> dict[str, np.ndarray]:
+    """The outputs of ``lm`` with ``controller`` (a LinearController commanding the
+    ``aileron``) in the loop at the run's step ``dt_s`` [s] with its one step of delay
+    (:func:`~bioflex_jsb.simulation.closed_loop.close_loop`), from rest under the run's
+    ``v_g`` [m/s] and ``p_g`` [rad/s] samples (the loop is linear: the two responses
+    added): the compared channels and the command ``ctrl_aileron_rad``."""
+    from bioflex_jsb.simulation.closed_loop import close_loop, lateral_signal_outputs
+    from bioflex_jsb.simulation.closed_loop import respond as respond_closed
+
+    plant = lateral_signal_outputs(lm.ss)
+    out: dict[str, np.ndarray] = {}
+    for name, samples in (("v_g", v_g), ("p_g", p_g)):
+        if not np.any(samples):
+            continue
+        run = respond_closed(close_loop(plant, controller, dt_s, disturbance=name), samples)
+        for key, values in run.channels.items():
+            out[key] = out.get(key, 0.0) + np.asarray(values, dtype=float)
+    size = np.asarray(p_g).size
+    channels = {c: out.get(c, np.zeros(size)) for c in (*RIGID_CHANNELS, "ctrl_aileron_rad")}
+    if lm.strips is not None:
+        s = lm.strips
+        eta = np.column_stack([out.get(f"asym_eta{i + 1}", np.zeros(size))
+                               for i in range(s.n_modes)])
+        roll = lm.q_pa * eta @ s.roll_eta
+        if "asym_eta1_dot" in plant.outputs:  # the coupled model
+            eta_dot = np.column_stack([out.get(f"asym_eta{i + 1}_dot", np.zeros(size))
+                                       for i in range(s.n_modes)])
+            roll = roll + lm.q_pa / lm.speed_m_s * eta_dot @ s.roll_etadot
+        channels["asym_eta1"] = eta[:, 0]
+        channels["modal_roll_n_m"] = roll
+    return channels
+
+
 def add_full_span_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: WingBuild,
                           model: str, speed_m_s: float, airframe: Airframe, aileron=None,
-                          aero: str = "quasi-steady") -> None:
+                          aero: str = "quasi-steady", controller=None) -> None:
     """Add to ``linear`` the lateral model's response (module docstring) to what the
     full-span run ``nonlinear`` flew: its v_g, aileron and p_g (channels absent: zero); the
-    run's strips ``aero``."""
+    run's strips ``aero``; with ``controller`` (commanding the aileron) the closed loop's to
+    v_g and p_g (:func:`closed_loop_respond`), its command ``ctrl_aileron_rad`` too."""
     lm = full_span_lateral_model(build, airframe, model, speed_m_s, aileron, aero=aero)
     t = np.asarray(nonlinear.time_s, dtype=float)
     zeros = np.zeros(t.size)
@@ -202,7 +237,14 @@ def add_full_span_lateral(linear: TimeHistory, nonlinear: TimeHistory, build: Wi
     delta = flown("aileron_rad")
     inputs = np.column_stack([flown("v_g"), delta - (delta[0] if delta.size else 0.0),
                               flown("p_g")])
-    for name, values in respond(lm, t, inputs).items():
+    if controller is None:
+        response = respond(lm, t, inputs)
+    else:
+        dt = float(nonlinear.meta.get("dt_s") or t[1] - t[0])
+        response = closed_loop_respond(lm, controller, dt, inputs[:, 0], inputs[:, 2])
+        linear.channels["ctrl_aileron_rad"] = response.pop("ctrl_aileron_rad")
+        linear.units["ctrl_aileron_rad"] = "rad"
+    for name, values in response.items():
         # β, p, r, φ are the run's absolute values, the model's their increments over the
         # trim: the trim's own (its first sample) added
         start = float(nonlinear[name][0]) if name in RIGID_CHANNELS and t.size else 0.0

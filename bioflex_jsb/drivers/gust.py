@@ -235,6 +235,9 @@ def run_gust(
     build = wing if isinstance(wing, WingBuild) else loads if isinstance(loads, WingBuild) \
         else None
     sensor_set = _sensor_set(sensors, build, wing)
+    if aileron_input is not None and "aileron" in getattr(controller, "outputs", ()):
+        raise InputError("an aileron step or doublet and a controller's aileron command both "
+                         "write JSBSim's aileron command: give one of them")
     step = CoupledStep(airframe, wing, model, setup.speed_m_s, setup.altitude_m,
                        setup.dt_s, trim=trim, compiled=compiled, aero=aero,
                        trim_mode=trim_mode, sensors=sensor_set, controller=controller,
@@ -259,8 +262,8 @@ def run_gust(
                                           f"{'compiled kernel' if step.compiled else 'python'}")
     if step.flaperon is not None:  # its surface and derivatives (compare's LTI flies them)
         history.meta["flaperon"] = step.flaperon.deriv.as_dict()
-    if sensor_set is not None:
-        history.meta["sensors"] = sensor_set.describe()
+    if sensor_set is not None:  # as flown (both halves: the antisymmetric columns too)
+        history.meta["sensors"] = step.sensor_set.describe()
     return history
 
 

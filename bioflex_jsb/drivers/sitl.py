@@ -515,7 +515,7 @@ class SitlSim:
                                 sensors=self._sensor_set, controller=self._controller,
                                 over_autopilot=True, span=self.span, aileron=self.aileron)
         self._autopilot_imu.dt_s = self.core.dt_s
-        self._autopilot_imu.reset(self.core.n_modes)
+        self._autopilot_imu.follow(self.core)  # both halves: the antisymmetric modes too
         self.trim = self.core.trim
         self._relocate()
         self._get = self.core.get

@@ -68,7 +68,10 @@ class AntisymmetricWing:
     What the yaw rate's and sideslip's terms take from the wing's build (None, 0: a wing
     without them): ``symmetric`` the half wing's symmetric modes (:class:`ModalData`, bending
     down, twist leading edge up), ``n_symmetric`` how many of them the wing model flies,
-    ``planform`` (its dihedral) and ``span_m`` [m] the wing's span."""
+    ``planform`` (its dihedral) and ``span_m`` [m] the wing's span; ``root_slope`` (n,) each
+    mode's bending slope at the root [rad per unit η, starboard wing down outboard positive]:
+    the fuselage's roll relative to the mean axes, from the beam's root node (None: not
+    known)."""
 
     modes: ModalData
     stations_m: np.ndarray
@@ -82,6 +85,7 @@ class AntisymmetricWing:
     n_symmetric: int = 0
     planform: object = None
     span_m: float = 0.0
+    root_slope: np.ndarray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -132,6 +136,8 @@ def antisymmetric_wing(build, aircraft_ixx_kg_m2: float, n_modes: int = 3) -> An
         source=sections.description,
         notes=f"antisymmetric, fuselage roll inertia {j_f:.6g} kg m^2")
     modes = raw.normalised()
+    # the root node's slope w'(0) (the fuselage's roll), scaled as the shapes are
+    root_slope = np.asarray(sol.roll_slope, dtype=float) / raw.normalisation_factors()
     strips = spanwise_geometry(build.aero, build.planform, modes.x_elastic_frac,
                                modes.stations_m)
     # the symmetric model's pin of C_η1^Q1 (a shift of e, the paper's wings) holds here too
@@ -142,7 +148,8 @@ def antisymmetric_wing(build, aircraft_ixx_kg_m2: float, n_modes: int = 3) -> An
     return AntisymmetricWing(modes, y, strips.weights_m, strips.cl_alpha_c_m, strips.e_m, phi,
                              theta, j_f, symmetric=build.modes,
                              n_symmetric=int(build.model.n_modes), planform=build.planform,
-                             span_m=2.0 * float(build.aero.semispan_m))
+                             span_m=2.0 * float(build.aero.semispan_m),
+                             root_slope=root_slope)
 
 
 @dataclass(frozen=True)

@@ -62,8 +62,9 @@ class SensorNoise:
 @dataclass(frozen=True)
 class WingPoint:
     """Where on the elastic wing a sensor sits: ``y_m`` [m] along the span from the plane of
-    symmetry (starboard positive, port negative: the modes are symmetric, so a port station
-    moves as its starboard mirror, its roll slope mirrored), ``chord_position`` [fraction
+    symmetry (starboard positive, port negative: the symmetric modes move a port station as
+    its starboard mirror, its roll slope mirrored; a full-span run's antisymmetric modes move
+    it the opposite way, simulation/sensors.py), ``chord_position`` [fraction
     of the local chord aft of the leading edge], ``height_m`` [m] above the chord plane, and
     the wing's elastic axis there (``elastic_axis_offset_m``: the sensor's distance aft of
     the elastic axis [m]), all of the undeformed wing."""

@@ -179,12 +179,18 @@ COMMANDS = {"elevator": elevator_command, "throttle": throttle_command}
 
 
 def commands_for(airframe: Airframe, outputs: tuple[str, ...], over_autopilot: bool = False,
-                 flaperon: Command | None = None) -> tuple[Command, ...]:
+                 flaperon: Command | None = None, aileron: Command | None = None
+                 ) -> tuple[Command, ...]:
     """One :class:`Command` per command of ``outputs`` (in that order), for the trimmed
     ``airframe`` (``over_autopilot``: added to its autopilot's, module docstring);
-    ``flaperon`` the flaperon's writer (module docstring, "The flaperon")."""
+    ``flaperon`` the flaperon's writer (module docstring, "The flaperon"), ``aileron`` the
+    aileron's (a full-span step's: runtime/aileron_input.py controller_aileron)."""
+    given = {"flaperon": flaperon, "aileron": aileron}
     if "flaperon" in outputs and flaperon is None:
         raise InputError("a flaperon command needs the coupled step's flaperon (the half "
                          "wing's strips): runtime/flaperon_step.py")
-    return tuple(flaperon if o == "flaperon" else COMMANDS[o](airframe, over_autopilot)
+    if "aileron" in outputs and aileron is None:
+        raise InputError("an aileron command needs the full-span step's aileron writer: "
+                         "runtime/aileron_input.py")
+    return tuple(given[o] if o in given else COMMANDS[o](airframe, over_autopilot)
                  for o in outputs)

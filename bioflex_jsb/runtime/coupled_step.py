@@ -370,7 +370,17 @@ class CoupledStep(FullSpanSteps):
         if sensors.n_modes not in (0, self.n_modes):
             raise InputError(f"the sensors carry {sensors.n_modes} modes, the wing flies "
                              f"{self.n_modes}")
-        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state)
+        if self.lateral is not None:  # both halves: the antisymmetric modes' columns too
+            wing_a = self.antisymmetric_wing
+            sensors = sensors.with_antisymmetric(wing_a.modes, wing_a.root_slope)
+        return SensorRows(sensors, self.dt_s, rate_state=self.model_rate_state,
+                          lateral=self.lateral)
+
+    @property
+    def sensor_set(self) -> SensorSet | None:
+        """The sensors the rows read (both halves: with the antisymmetric modes' columns
+        after the symmetric ones); None without sensors."""
+        return None if self._sensors is None else self._sensors.set
 
     def rigid_kinematics(self, wind_down_fps: float) -> np.ndarray:
         """The rigid body's kinematics now, as the sensor channels take them
@@ -436,8 +446,15 @@ class CoupledStep(FullSpanSteps):
         if self._sensors is not None:  # their true reading at the trim, the wing at rest
             trim.update(self._sensors.set.clean(self._kinematics(0.0), zeros, zeros, zeros))
         loop = ControlLoop(controller, self.names, self.dt_s, trim, compiled=self.compiled)
+        aileron = None
+        if "aileron" in controller.outputs:  # JSBSim's aileron: both halves only
+            from bioflex_jsb.runtime.aileron_input import controller_aileron
+
+            aileron = controller_aileron(self.airframe, self.lateral is not None,
+                                         over_autopilot)
         commands = commands_for(self.airframe, loop.outputs, over_autopilot,
-                                None if self.flaperon is None else self.flaperon.command())
+                                None if self.flaperon is None else self.flaperon.command(),
+                                aileron)
         self._commands = commands  # their maps go into the compiled update last
         binding = loop.binding
         step = loop.step
@@ -743,10 +760,15 @@ class CoupledStep(FullSpanSteps):
         sensors = self._sensors
         if sensors is None:
             return self._bind_fast_step()
-        x, dt = self.wing._x, self.dt_s  # x: updated in place by the kernel
+        # x: updated in place by the kernel (both halves: the full-span kernel's state, the
+        # two wings' states views into it)
+        x, parts = self.wing._x, None
+        if self.lateral is not None:
+            x, parts = self._x_full, (self.wing._x, self.lateral._x)
+        dt = self.dt_s
         cols = np.array([self.names.index(c) for c in sensors.channels], dtype=np.int64)
         ft_per_m = U.FT_PER_M
-        hold, write = sensors.compiled(x, cols, U.M_PER_FT)
+        hold, write = sensors.compiled(x, cols, U.M_PER_FT, parts)
         (g_fx, g_fy, g_fz, g_mass, g_pd, g_qd, g_rd, g_u, g_v, g_w, g_theta, g_phi, g_p, g_q,
          g_r) = self._kinematics_readers()
         if self._control_step is not None:

@@ -91,9 +91,26 @@ COMMAND_CHANNELS: dict[str, Channel] = {
     "ctrl_flaperon_rad": Channel("rad", _P, "flaperon (both ailerons together, trailing edges "
                                  "down positive) commanded by the controller in the loop "
                                  "(the deflection, within its travel: flaperon_rad)"),
+    "ctrl_aileron_rad": Channel("rad", _P, "aileron δa = (left - right)/2 commanded by the "
+                                "controller in the loop, added to the trim's, + rolls right "
+                                "(the surfaces' angle, within their travel: aileron_rad)"),
     "flaperon_rad": Channel("rad", _P, "flaperon deflection whose loads act over this step "
                             "(the previous step's command within the ±10° travel), trailing "
                             "edges down positive"),
+}
+# A full-span run's channels (both wing halves, bioflex_jsb.simulation.full_span)
+LATERAL_CHANNELS: dict[str, Channel] = {
+    "aileron_rad": Channel("rad", _A, "JSBSim's aileron δa = (left - right)/2 the "
+                           "antisymmetric modes saw this step, + rolls right"),
+    "modal_roll_n_m": Channel("N*m", _P, "the antisymmetric modes' rolling moment applied "
+                              "over this step, right wing down positive"),
+    "tip_twist_starboard_rad": Channel("rad", _P, "starboard tip twist of the modes, leading "
+                                       "edge up"),
+    "tip_twist_port_rad": Channel("rad", _P, "port tip twist of the modes, leading edge up"),
+    "modal_side_n": Channel("N", _P, "the antisymmetric modes' side force applied over this "
+                            "step, body +y"),
+    "modal_yaw_n_m": Channel("N*m", _P, "the modes' yawing moment applied over this step, "
+                             "nose right"),
 }
 BASE_UNITS: dict[str, str] = {name: c.unit for name, c in CHANNELS.items()}
 # the self-describing name → the channel's own (``TimeHistory`` answers to both)
@@ -102,6 +119,8 @@ ALIASES: dict[str, str] = {c.alias: name for name, c in CHANNELS.items() if c.al
 # Channels by pattern: the modal state, the section loads, the LTI model's inertial α
 _ETA = re.compile(r"eta(\d+)")
 _ETA_DOT = re.compile(r"eta(\d+)_dot")
+_ASYM = re.compile(r"asym_eta(\d+)")
+_ASYM_DOT = re.compile(r"asym_eta(\d+)_dot")
 _LOADS = re.compile(r"loads_(fs|md)_(shear_n|bending_n_m|torque_n_m)_s(\d+)")
 # the sensor stations' channels (bioflex_jsb.simulation.sensors: imu_channels, airspeed_channel)
 _IMU = re.compile(r"imu_([a-z][a-z0-9_]{0,31})_(a|g)([xyz])_(m_s2|rad_s)")
@@ -122,6 +141,15 @@ def describe(name: str, unit: str | None = None) -> Channel:
         return CHANNELS[name]
     if name in COMMAND_CHANNELS:
         return COMMAND_CHANNELS[name]
+    if name in LATERAL_CHANNELS:
+        return LATERAL_CHANNELS[name]
+    if m := _ASYM.fullmatch(name):
+        return Channel("rad", _P, f"modal coordinate of antisymmetric wing mode {m.group(1)} "
+                       "(a full-span run; starboard tip twist positive, the port half the "
+                       "opposite)")
+    if m := _ASYM_DOT.fullmatch(name):
+        return Channel("rad/s", _P, "rate of the modal coordinate of antisymmetric wing mode "
+                       f"{m.group(1)}")
     if m := _ETA.fullmatch(name):
         return Channel("rad", _P, f"modal coordinate of wing mode {m.group(1)} (twist-"
                        "normalised: its largest section twist per unit η is 1 rad, tip twist "

@@ -20,6 +20,16 @@ the plant ``delay_steps`` later (the co-simulation's one step:
 The result is a discrete :class:`~bioflex_jsb.state_space.StateSpace` from ``w_g`` to every
 output of the plant and the commands (``ctrl_<command>``); :func:`respond` is its time
 response as a run's history (``n_z`` 1 + its perturbation, as the runs log it).
+
+**The lateral axis** (a full-span run's controller commanding the ``aileron``):
+:func:`lateral_signal_outputs` gives the lateral model (β, p, r, φ and the antisymmetric
+modes, ``docs/lateral.md``; inputs v_g, aileron, p_g as ``drivers/compare_lateral.py``
+builds it from the run's JSBSim airframe) the run's channel names as outputs (``beta_rad``,
+``p_rad_s``, ``r_rad_s``, ``phi_rad``, ``asym_eta<i>``, ``asym_eta<i>_dot``), and
+:func:`close_loop` closes it with the controller the same way, its disturbance the gust
+roll rate ``p_g`` [rad/s] (or the lateral gust ``v_g`` [m/s]): the aileron written to
+JSBSim before its step k reaches the rigid forces of x_{k+1} and the antisymmetric modes,
+which read JSBSim's aileron positions at step k+1, both one step late as the elevator's.
 """
 
 from __future__ import annotations
@@ -36,6 +46,10 @@ from bioflex_jsb.simulation.results import TimeHistory
 from bioflex_jsb.state_space import StateSpace
 
 GUST = "w_g"
+# The lateral model's states and the run's channels they are (the antisymmetric modes:
+# eta<i> -> asym_eta<i>, simulation/full_span.py lateral_names)
+LATERAL_SIGNALS = {"beta": "beta_rad", "p": "p_rad_s", "r": "r_rad_s", "phi": "phi_rad"}
+LATERAL_DISTURBANCES = ("p_g", "v_g")
 
 
 def signal_outputs(ss: StateSpace) -> StateSpace:
@@ -85,15 +99,44 @@ def signal_outputs(ss: StateSpace) -> StateSpace:
                              "(simulation/closed_loop.py)"})
 
 
+def lateral_signal_outputs(ss: StateSpace) -> StateSpace:
+    """The lateral model ``ss`` (continuous; states β, p, r, φ and, coupled, η_i, η̇_i of the
+    antisymmetric modes; a quasi-static model's η_i outputs) with its outputs named as the
+    run's channels (module docstring, "The lateral axis"); the others (``n_y``) kept."""
+    if not ss.continuous or not all(s in ss.states for s in LATERAL_SIGNALS):
+        raise ValueError("lateral_signal_outputs takes a continuous lateral model (states "
+                         "beta, p, r, phi)")
+
+    def channel(name: str) -> str:
+        if name in LATERAL_SIGNALS:
+            return LATERAL_SIGNALS[name]
+        if name.startswith("eta") and name[3:].split("_")[0].isdigit():
+            return "asym_" + name
+        return name
+
+    return StateSpace(model=ss.model, speed_m_s=ss.speed_m_s, a=ss.a, b=ss.b, c=ss.c, d=ss.d,
+                      states=ss.states, state_units=ss.state_units, inputs=ss.inputs,
+                      input_units=ss.input_units,
+                      outputs=tuple(channel(o) for o in ss.outputs),
+                      output_units=ss.output_units,
+                      notes={**ss.notes, "signals": "the run's channels, perturbations "
+                             "(simulation/closed_loop.py)"})
+
+
 def close_loop(plant: StateSpace, controller: LinearController, dt_s: float,
-               delay_steps: int = 1) -> StateSpace:
+               delay_steps: int = 1, disturbance: str = GUST) -> StateSpace:
     """The discrete closed loop at the step ``dt_s`` [s] (module docstring): ``plant`` a
-    continuous model with the run's signals as outputs (:func:`signal_outputs`) and the
-    controller's commands among its inputs; ``delay_steps`` 1 (the co-simulation) or 0.
-    InputError (one line) for a signal the model does not have, a command it has no input
-    for, or a controller that samples slower than the step."""
+    continuous model with the run's signals as outputs (:func:`signal_outputs`,
+    :func:`lateral_signal_outputs`) and the controller's commands among its inputs;
+    ``delay_steps`` 1 (the co-simulation) or 0; ``disturbance`` the plant's input the closed
+    loop is driven by (``w_g``; the lateral model's ``p_g`` or ``v_g``). InputError (one
+    line) for a signal the model does not have, a command it has no input for, or a
+    controller that samples slower than the step."""
     if delay_steps not in (0, 1):
         raise ValueError("delay_steps is 0 or 1")
+    if disturbance not in plant.inputs:
+        raise InputError(f"the linear model has no input {disturbance!r} to be driven by "
+                         f"(its inputs: {', '.join(plant.inputs)})")
     missing = [s for s in controller.inputs if s not in plant.outputs]
     if missing:
         raise InputError(f"the linear model has no signal {missing[0]!r} for the controller "
@@ -107,7 +150,7 @@ def close_loop(plant: StateSpace, controller: LinearController, dt_s: float,
         raise InputError(f"controller {controller.name!r} samples every {every} steps: the "
                          "closed-loop LTI model is for a controller at the run's step")
     pd = plant.to_discrete(dt_s)
-    ig = plant.inputs.index(GUST)
+    ig = plant.inputs.index(disturbance)
     iu = [plant.inputs.index(o) for o in controller.outputs]
     isig = [plant.outputs.index(s) for s in controller.inputs]
     n, nc, nu = plant.n_states, ctrl.n_states, len(iu)
@@ -154,7 +197,7 @@ def close_loop(plant: StateSpace, controller: LinearController, dt_s: float,
     commands = tuple(COMMAND_CHANNELS[o] for o in controller.outputs)
     return StateSpace(
         model=f"{plant.model}+{controller.name}", speed_m_s=plant.speed_m_s, a=a, b=b,
-        c=c_out, d=d_out, states=states, state_units=units, inputs=(GUST,),
+        c=c_out, d=d_out, states=states, state_units=units, inputs=(disturbance,),
         input_units=(plant.input_units[ig],), outputs=plant.outputs + commands,
         output_units=plant.output_units + tuple(CONTROL_OUTPUTS[o]
                                                 for o in controller.outputs),
@@ -163,9 +206,10 @@ def close_loop(plant: StateSpace, controller: LinearController, dt_s: float,
 
 
 def respond(cl: StateSpace, w_g_m_s: np.ndarray) -> TimeHistory:
-    """The time response of the discrete closed loop ``cl`` to the gust samples
-    ``w_g_m_s`` [m/s] at its steps (from the trim): a history with every output as a
-    channel, ``n_z`` 1 + its perturbation (the runs' load factor)."""
+    """The time response of the discrete closed loop ``cl`` to the samples ``w_g_m_s`` of
+    its disturbance at its steps (the gust [m/s]; a lateral loop's p_g [rad/s] or v_g
+    [m/s]), from the trim: a history with every output as a channel, ``n_z`` 1 + its
+    perturbation (the runs' load factor)."""
     if cl.continuous:
         raise ValueError("respond takes a discrete model (close_loop)")
     w = np.asarray(w_g_m_s, dtype=float)

@@ -27,7 +27,17 @@ and signs (its inputs ``elevator`` and ``throttle``, :mod:`bioflex_jsb.flight_dy
   beside the modes' (never through ``fcs/aileron-cmd-norm``), its strip loads onto the
   symmetric modes, on the compiled step as on the Python one
   (:mod:`bioflex_jsb.runtime.control_surfaces`, "The flaperon";
-  :mod:`bioflex_jsb.runtime.flaperon_step`).
+  :mod:`bioflex_jsb.runtime.flaperon_step`);
+* ``aileron`` [rad]: JSBSim's differential aileron δa = ½ (δ_left − δ_right) added to the
+  trim's, **+ rolls right** (the starboard trailing edge up), on a full-span run only
+  (``span="full"``: both wing halves, whose antisymmetric modes read JSBSim's two aileron
+  positions every step, :mod:`bioflex_jsb.simulation.full_span`); written to
+  ``fcs/aileron-cmd-norm`` through the aileron's measured map
+  (:mod:`bioflex_jsb.runtime.aileron_input`), so JSBSim's rigid tables carry its rolling
+  moment (C_lδa) and the strips its load on the modes. Refused (one line) on the half wing
+  (no antisymmetric modes to load), over an autopilot (the SITL aircraft's roll loop writes
+  that command itself), beside an aileron step or doublet (the same command) and in a
+  campaign (its runs fly the half wing).
 
 The runtime converts them once at the JSBSim boundary (``fcs/elevator-cmd-norm`` through
 the aircraft's own rad-per-command scaling, ``fcs/throttle-cmd-norm[i]``); the surface's
@@ -103,10 +113,12 @@ from bioflex_jsb.tomlfile import loads_toml
 
 # The commands a controller may write: name → unit (increments over the trim, module
 # docstring).
-CONTROL_OUTPUTS: dict[str, str] = {"elevator": "rad", "throttle": "-", "flaperon": "rad"}
+CONTROL_OUTPUTS: dict[str, str] = {"elevator": "rad", "throttle": "-", "flaperon": "rad",
+                                   "aileron": "rad"}
 # The channel each command is logged as.
 COMMAND_CHANNELS: dict[str, str] = {"elevator": "ctrl_elevator_rad", "throttle": "ctrl_throttle",
-                                    "flaperon": "ctrl_flaperon_rad"}
+                                    "flaperon": "ctrl_flaperon_rad",
+                                    "aileron": "ctrl_aileron_rad"}
 # A controller file is read whole: at most this many bytes (a 10-state controller of a few
 # signals is ~2 kB as .npz; 1000 states of double matrices would be 8 MB).
 MAX_CONTROLLER_BYTES = 16 * 1024 * 1024

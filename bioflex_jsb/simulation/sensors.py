@@ -39,6 +39,21 @@ quasi-static wing, whose η̇ is not a state: (η_{k+1} − η_{k−1}) / (2Δt)
 autopilot sent the state a step reached (ArduPilot's JSON backend): η̈ the mean over the last
 step, (η̇_{k+1} − η̇_k)/Δt, half a step old (0.52 ms at 960 Hz).
 
+**Both wing halves** (a full-span run: :mod:`bioflex_jsb.simulation.full_span`). The
+modal columns are the symmetric modes η_s, then the antisymmetric ones η_a
+(:meth:`SensorSet.with_antisymmetric`). A wing point at y moves by Σ U^s η_s + sign(y) Σ U^a
+η_a, U^a the antisymmetric shape of the starboard half at |y| (normalised with the starboard
+tip twist positive): a positive η_a twists the starboard section leading edge up and the
+port one leading edge down, and bends them opposite ways; the columns of a port station are
+the starboard mirror's times −1 (its roll slope included, so both halves of a mode that
+dips the starboard tip and lifts the port one read the same roll). A point of the rigid
+airframe (no wing point: a fuselage IMU, the autopilot's) rolls with the fuselage, whose roll
+relative to the mean axes (JSBSim's body axes) is the antisymmetric modes' root slope
+ρ₀ = Σ w'_i(0) η_a,i (the beam with the fuselage's roll freedom,
+:mod:`bioflex_jsb.structures.antisymmetric`): Ψ^a = (ρ₀, 0, 0), U^a = Ψ^a × r. The symmetric
+modes are clamped at the root: they leave such a point alone, as on the half wing, whose
+sensors read exactly as before.
+
 **Noise** (:class:`NoiseSource`): ArduPilot's SITL meanings (:mod:`bioflex_jsb.parameters.
 sensors`): bias, uniform ±RND, or a sine at SIM_VIB_FREQ with amplitude RND (1 ± 5 %),
 in the sensor's axes, seeded.
@@ -126,6 +141,27 @@ def station_shapes(modes, point: WingPoint | None, n_modes: int | None = None
     return u, psi
 
 
+def antisymmetric_shapes(modes, root_slope, point: WingPoint | None, position_m
+                         ) -> tuple[np.ndarray, np.ndarray]:
+    """(U (3, n), Ψ (3, n)) of the antisymmetric modes ``modes`` (``ModalData`` of the
+    starboard half) at a sensor (module docstring, "Both wing halves"): at the wing point
+    ``point``, sign(y) times :func:`station_shapes` of the starboard shape at |y| (a point on
+    the centreline, y = 0: zeros); on the rigid airframe (``point`` None) at ``position_m``
+    (body axes from the CG [m]), the fuselage's roll Ψ = (ρ₀, 0, 0) and U = Ψ × r with
+    ``root_slope`` ρ₀ (n,) [rad per unit η] (None: zeros)."""
+    n = modes.n_modes
+    if point is not None:
+        u, psi = station_shapes(modes, point)
+        side = math.copysign(1.0, point.y_m) if point.y_m != 0.0 else 0.0
+        return side * u, side * psi
+    if root_slope is None:
+        return np.zeros((3, n)), np.zeros((3, n))
+    rho = np.asarray(root_slope, dtype=float)
+    _, y, z = (float(v) for v in position_m)
+    return (np.vstack([np.zeros(n), -rho * z, rho * y]),
+            np.vstack([rho, np.zeros(n), np.zeros(n)]))
+
+
 @numba.njit(cache=True, nogil=True)
 def _imu_readings(kin, eta, eta_dot, eta_ddot, r, u, psi, mount, noise, out):
     """The readings of m IMUs (module docstring) into ``out`` (m, 6): ``kin`` the
@@ -191,13 +227,13 @@ def _airspeed_readings(kin, eta_dot, r, u, noise, out):
 
 
 @numba.njit(cache=True, nogil=True)
-def _hold_kernel(x, n, dt, hist, flags):
-    """:meth:`SensorRows.before` compiled: the wing's η_k, η̇_k from its state ``x`` (2n,)
-    into ``hist`` rows 1 and 2; row 0 (η_{k−1}) made η_k − Δt η̇_k at the first call
-    (``flags[0]`` 0)."""
+def _hold_kernel(x, at, n, dt, hist, flags):
+    """:meth:`SensorRows.before` compiled: the wing's η_k, η̇_k from its state ``x`` (η_i at
+    ``x[at[i]]``, η̇_i at ``x[at[n + i]]``) into ``hist`` rows 1 and 2; row 0 (η_{k−1}) made
+    η_k − Δt η̇_k at the first call (``flags[0]`` 0)."""
     for i in range(n):
-        hist[1, i] = x[i]
-        hist[2, i] = x[n + i]
+        hist[1, i] = x[at[i]]
+        hist[2, i] = x[at[n + i]]
     if flags[0] == 0.0:
         for i in range(n):
             hist[0, i] = hist[1, i] - dt * hist[2, i]
@@ -205,12 +241,12 @@ def _hold_kernel(x, n, dt, hist, flags):
 
 
 @numba.njit(cache=True, nogil=True)
-def _row_kernel(reads, wind_down_fps, m_per_ft, x, n, dt, rate_state, hist, kin, dot, ddot,
-                r, u, psi, mount, noise, imu_out, r_air, u_air, air_noise, air_out, table, k,
-                cols):
+def _row_kernel(reads, wind_down_fps, m_per_ft, x, at, n, dt, rate_state, hist, kin, dot,
+                ddot, r, u, psi, mount, noise, imu_out, r_air, u_air, air_noise, air_out, table,
+                k, cols):
     """:meth:`SensorRows.row` and the rigid body's kinematics compiled (module docstring):
-    ``reads`` the :data:`KINEMATICS_READS`, the wind down [ft/s]; the wing's η_{k+1} the
-    first n of ``x``; the channels written into ``table[k, cols]`` (IMUs, then probes);
+    ``reads`` the :data:`KINEMATICS_READS`, the wind down [ft/s]; the wing's η_{k+1} at
+    ``x[at[:n]]``; the channels written into ``table[k, cols]`` (IMUs, then probes);
     η_{k−1} ← η_k after."""
     fx, fy, fz, mass, pd, qd, rd = reads[0], reads[1], reads[2], reads[3], reads[4], reads[5], \
         reads[6]
@@ -224,8 +260,9 @@ def _row_kernel(reads, wind_down_fps, m_per_ft, x, n, dt, rate_state, hist, kin,
     kin[10] = (vv - wind_down_fps * math.sin(phi) * ct) * m_per_ft
     kin[11] = (ww - wind_down_fps * math.cos(phi) * ct) * m_per_ft
     for i in range(n):
-        ddot[i] = (x[i] - 2.0 * hist[1, i] + hist[0, i]) / (dt * dt)
-        dot[i] = hist[2, i] if rate_state else (x[i] - hist[0, i]) / (2.0 * dt)
+        xi = x[at[i]]
+        ddot[i] = (xi - 2.0 * hist[1, i] + hist[0, i]) / (dt * dt)
+        dot[i] = hist[2, i] if rate_state else (xi - hist[0, i]) / (2.0 * dt)
     m = imu_out.shape[0]
     if m:
         _imu_readings(kin, hist[1], dot, ddot, r, u, psi, mount, noise, imu_out)
@@ -314,10 +351,14 @@ class SensorSet:
 
     ``sensors``: the :class:`~bioflex_jsb.parameters.sensors.Sensors` (positions in body
     axes from the CG); ``modes``: the wing's ``ModalData`` (None: a rigid wing, no modal
-    part); ``n_modes``: the modes the run flies (the first ones of ``modes``).
+    part); ``n_modes``: the modes the run flies (the first ones of ``modes``);
+    ``antisymmetric``: a full-span run's antisymmetric modes (``ModalData``, starboard half)
+    and ``root_slope`` their root slopes [rad per unit η] (module docstring, "Both wing
+    halves"): their columns after the symmetric ones (:attr:`n_columns` in all).
     """
 
-    def __init__(self, sensors: Sensors, modes=None, n_modes: int | None = None) -> None:
+    def __init__(self, sensors: Sensors, modes=None, n_modes: int | None = None,
+                 antisymmetric=None, root_slope=None) -> None:
         self.sensors = sensors
         self.imus: tuple[ImuSpec, ...] = tuple(sensors.imus)
         self.airspeeds: tuple[AirspeedSpec, ...] = tuple(sensors.airspeeds)
@@ -334,22 +375,34 @@ class SensorSet:
             raise ValueError(f"{n} modes flown, the modes hold {modes.n_modes}")
         if modes is not None and n < modes.n_modes:
             modes = modes.truncated(n)
-        self.n_modes = n
-        m = len(self.imus)
+        self.modes, self.n_modes = modes, n
+        self.antisymmetric, self.root_slope = antisymmetric, root_slope
+        self.n_antisymmetric = 0 if antisymmetric is None else antisymmetric.n_modes
+        self.n_columns = n + self.n_antisymmetric  # the symmetric modes, then the others
+
+        def shapes(spec) -> tuple[np.ndarray, np.ndarray]:
+            u, psi = station_shapes(modes, spec.wing, n)
+            if antisymmetric is None:
+                return u, psi
+            u_a, psi_a = antisymmetric_shapes(antisymmetric, root_slope, spec.wing,
+                                              spec.position_m)
+            return np.hstack([u, u_a]), np.hstack([psi, psi_a])
+
+        m, nc = len(self.imus), self.n_columns
         self.r = np.zeros((m, 3))
-        self.u = np.zeros((m, 3, n))
-        self.psi = np.zeros((m, 3, n))
+        self.u = np.zeros((m, 3, nc))
+        self.psi = np.zeros((m, 3, nc))
         self.mount = np.zeros((m, 3, 3))
         for s, imu in enumerate(self.imus):
             self.r[s] = imu.position_m
-            self.u[s], self.psi[s] = station_shapes(modes, imu.wing, n)
+            self.u[s], self.psi[s] = shapes(imu)
             self.mount[s] = np.array(euler_matrix(*imu.orientation_rad))
         a = len(self.airspeeds)
         self.r_air = np.zeros((a, 3))
-        self.u_air = np.zeros((a, 3, n))
+        self.u_air = np.zeros((a, 3, nc))
         for s, probe in enumerate(self.airspeeds):
             self.r_air[s] = probe.position_m
-            self.u_air[s], _ = station_shapes(modes, probe.wing, n)
+            self.u_air[s], _ = shapes(probe)
         self._noise = [imu_noise(imu.noise) for imu in self.imus]
         self._noisy = any(src.random or np.any(src.biases) for src in self._noise)
         self._imu_noise = np.zeros((m, 6))
@@ -372,13 +425,30 @@ class SensorSet:
     def __len__(self) -> int:
         return len(self.channels)
 
+    def with_antisymmetric(self, modes, root_slope=None) -> SensorSet:
+        """These sensors on both wing halves: a new set (fresh noise streams, the same
+        seeds) whose columns add the antisymmetric ``modes`` (``ModalData``, starboard half)
+        with their root slopes ``root_slope`` [rad per unit η] (module docstring)."""
+        return SensorSet(self.sensors, self.modes, self.n_modes, modes, root_slope)
+
+    def _columns(self, a) -> np.ndarray:
+        """``a`` as the :attr:`n_columns` modal columns: cut to them, zeros after a shorter
+        one (a wing at rest given by its symmetric modes alone)."""
+        a = np.asarray(a, dtype=float)[:self.n_columns]
+        if a.size == self.n_columns:
+            return a
+        out = np.zeros(self.n_columns)
+        out[:a.size] = a
+        return out
+
     def read(self, kin, eta, eta_dot, eta_ddot, t_s: float) -> np.ndarray:
         """Every channel (:attr:`channels` order) for the rigid body's :data:`KINEMATICS`
         ``kin`` (12,) and the modal state η [rad], η̇ [rad/s], η̈ [rad/s²] at time ``t_s``
-        [s] (the noise's clock: call once per sample, in order). The returned array is
-        reused by the next call."""
+        [s] (the noise's clock: call once per sample, in order; both halves: the symmetric
+        modes, then the antisymmetric ones). The returned array is reused by the next
+        call."""
         kin = np.asarray(kin, dtype=float)
-        eta, eta_dot, eta_ddot = (np.asarray(a, dtype=float)[:self.n_modes]
+        eta, eta_dot, eta_ddot = (np.asarray(a, dtype=float)[:self.n_columns]
                                   for a in (eta, eta_dot, eta_ddot))
         if self._noisy:
             for s, src in enumerate(self._noise):
@@ -402,8 +472,7 @@ class SensorSet:
         (the sensor's true reading; its noise streams untouched): a controller's trim
         values (:class:`~bioflex_jsb.simulation.controller.ControlLoop`)."""
         kin = np.asarray(kin, dtype=float)
-        eta, eta_dot, eta_ddot = (np.asarray(a, dtype=float)[:self.n_modes]
-                                  for a in (eta, eta_dot, eta_ddot))
+        eta, eta_dot, eta_ddot = (self._columns(a) for a in (eta, eta_dot, eta_ddot))
         imu = np.zeros((len(self.imus), 6))
         air = np.zeros(len(self.airspeeds))
         if len(self.imus):
@@ -421,8 +490,11 @@ class SensorSet:
         raise KeyError(name)
 
     def describe(self) -> dict[str, object]:
-        """The sensors as plain data (logs, --json): each IMU's spec and its modal shapes."""
-        return {"imus": [dict(imu.as_dict(), channels=list(imu_channels(imu.name)),
+        """The sensors as plain data (logs, --json): each IMU's spec and its modal shapes
+        (columns: the symmetric modes, then any antisymmetric ones)."""
+        extra = ({} if self.antisymmetric is None
+                 else {"antisymmetric_modes": self.n_antisymmetric})
+        return {**extra, "imus": [dict(imu.as_dict(), channels=list(imu_channels(imu.name)),
                               translation_m_per_rad=self.u[s].tolist(),
                               rotation_rad_per_rad=self.psi[s].tolist())
                          for s, imu in enumerate(self.imus)],
@@ -445,13 +517,20 @@ class SensorRows:
     before its step, :meth:`row` with the rigid body's :data:`KINEMATICS` at t_k and the
     wing's η_{k+1} after it (module docstring: central differences, η_{−1} = η_0 − Δt η̇_0,
     a wing at rest before the run). ``rate_state``: the wing's η̇ is a state (the coupled,
-    unsteady and native wings; not the quasi-static one)."""
+    unsteady and native wings; not the quasi-static one). ``lateral``: a full-span run's
+    antisymmetric wing (its ``eta``, ``eta_dot`` [rad, rad/s], read when the symmetric
+    wing's are given: the set's columns after them, :meth:`SensorSet.with_antisymmetric`)."""
 
-    def __init__(self, sensor_set: SensorSet, dt_s: float, rate_state: bool) -> None:
+    def __init__(self, sensor_set: SensorSet, dt_s: float, rate_state: bool,
+                 lateral=None) -> None:
         self.set = sensor_set
         self.dt_s = float(dt_s)
         self.rate_state = bool(rate_state)
-        n = sensor_set.n_modes
+        self.lateral = lateral
+        if (lateral is None) != (sensor_set.n_antisymmetric == 0) or (
+                lateral is not None and lateral.n_modes != sensor_set.n_antisymmetric):
+            raise ValueError("the sensors' antisymmetric modes and the lateral wing differ")
+        n = sensor_set.n_columns
         self.n_modes = n
         # η_{k−1}, η_k, η̇_k: one array, shared by this readable step and :meth:`compiled`
         self.hist = np.zeros((3, n))
@@ -462,44 +541,54 @@ class SensorRows:
     def channels(self) -> tuple[str, ...]:
         return self.set.channels
 
+    def _both(self, eta, lateral_eta) -> np.ndarray:
+        """The symmetric wing's ``eta`` with the antisymmetric one's after it (both halves)."""
+        if self.lateral is None:
+            return np.asarray(eta, dtype=float)[:self.n_modes]
+        n_s = self.set.n_modes
+        return np.concatenate([np.asarray(eta, dtype=float)[:n_s], lateral_eta])
+
     def before(self, eta, eta_dot) -> None:
-        """The wing's η_k [rad], η̇_k [rad/s] (before its step k)."""
-        n = self.n_modes
-        self.eta_k[:] = np.asarray(eta, dtype=float)[:n]
-        self.eta_dot_k[:] = np.asarray(eta_dot, dtype=float)[:n]
+        """The wing's η_k [rad], η̇_k [rad/s] (before its step k; both halves: the
+        antisymmetric wing's read here)."""
+        lat = self.lateral
+        self.eta_k[:] = self._both(eta, None if lat is None else lat.eta)
+        self.eta_dot_k[:] = self._both(eta_dot, None if lat is None else lat.eta_dot)
         if not self.flags[0]:
             self.eta_prev[:] = self.eta_k - self.dt_s * self.eta_dot_k
             self.flags[0] = 1.0
 
-    def compiled(self, x: np.ndarray, cols: np.ndarray, m_per_ft: float):
+    def compiled(self, x: np.ndarray, cols: np.ndarray, m_per_ft: float, parts=None):
         """``(hold, write)``: :meth:`before` and :meth:`row` (with the rigid body's
         kinematics) as compiled calls for the coupled step's compiled path, bound once to
-        the wing's state ``x`` (2n,: η, η̇, updated in place), the table columns ``cols`` of
+        the wing's state ``x`` (η, η̇, updated in place; both halves: the full-span kernel's
+        state, ``parts`` the symmetric and antisymmetric wings' states, each [η, η̇], as views
+        into it: where each lies in ``x`` is read from them), the table columns ``cols`` of
         :attr:`channels` and ft→m ``m_per_ft``: ``hold()`` before the wing's step,
         ``write(reads, wind_down_fps, table, k, t_s)`` after it (``reads`` the
         :data:`KINEMATICS_READS` of the airframe at t_k, the wind down [ft/s]) writes the
         row's channels into ``table[k]``. The same arithmetic as the readable methods."""
         ss, n, dt = self.set, self.n_modes, self.dt_s
         hist, flags = self.hist, self.flags
-        x = np.ascontiguousarray(x)
+        at = _state_positions(x, ss.n_modes, ss.n_antisymmetric, parts)  # η, then η̇ in x
         cols = np.ascontiguousarray(cols, dtype=np.int64)
         kin, dot, ddot = np.zeros(len(KINEMATICS)), np.zeros(n), np.zeros(n)
         noisy, air_noisy = ss._noisy, ss._air_noisy
         sources, air_sources = ss._noise, ss._air_noise
         imu_noise, air_noise = ss._imu_noise, ss._air_noise_now
-        arrays = (x, n, dt, self.rate_state, hist, kin, dot, ddot, ss.r, ss.u, ss.psi,
+        arrays = (x, at, n, dt, self.rate_state, hist, kin, dot, ddot, ss.r, ss.u, ss.psi,
                   ss.mount, imu_noise, ss.imu_out, ss.r_air, ss.u_air, air_noise, ss.air_out)
         types = tuple(numba.typeof(a) for a in arrays)
         table_type = numba.typeof(np.zeros((1, 1)))
         reads_type = numba.typeof((0.0,) * len(KINEMATICS_READS))
         entry = _row_kernel.compile((reads_type, numba.float64, numba.float64, *types,
                                      table_type, numba.int64, numba.typeof(cols)))
-        hold_entry = _hold_kernel.compile(tuple(numba.typeof(a) for a in (x, n, dt, hist,
+        hold_entry = _hold_kernel.compile(tuple(numba.typeof(a) for a in (x, at, n, dt, hist,
                                                                            flags)))
         checked, call = None, _row_kernel
 
         def hold() -> None:
-            hold_entry(x, n, dt, hist, flags)
+            hold_entry(x, at, n, dt, hist, flags)
 
         def write(reads, wind_down_fps: float, table: np.ndarray, k: int, t_s: float) -> None:
             nonlocal checked, call
@@ -518,13 +607,42 @@ class SensorRows:
 
     def row(self, kin, eta_next, t_s: float) -> np.ndarray:
         """The channels at t_k (``t_s`` [s]) from the rigid body's ``kin`` then and the
-        wing's η_{k+1} [rad] (reused array)."""
+        wing's η_{k+1} [rad] (reused array; both halves: the antisymmetric wing's η_{k+1}
+        read here, its step done)."""
+        lat = self.lateral
         dot, ddot = central_modal_kinematics(self.eta_prev, self.eta_k,
-                                             np.asarray(eta_next, dtype=float)[:self.n_modes],
+                                             self._both(eta_next, None if lat is None
+                                                        else lat.eta),
                                              self.eta_dot_k, self.dt_s, self.rate_state)
         values = self.set.read(kin, self.eta_k, dot, ddot, t_s)
         self.eta_prev[:] = self.eta_k
         return values
+
+
+def _state_positions(x: np.ndarray, n_s: int, n_a: int, parts) -> np.ndarray:
+    """Where η_s, η_a, then η̇_s, η̇_a lie in the state ``x`` (int64): the half wing's
+    [η, η̇, …] (``parts`` None; the unsteady wing's lag states after them), or each of
+    ``parts`` (the symmetric and antisymmetric wings' [η, η̇], views into ``x``) at its own
+    offset; ValueError for a part not inside ``x``."""
+    if not x.flags.c_contiguous:
+        raise ValueError("the wing's state must be one contiguous array")
+    if parts is None:
+        if n_a or x.size < 2 * n_s:
+            raise ValueError(f"the wing's state has {x.size} values, the sensors read "
+                             f"{2 * (n_s + n_a)}")
+        return np.arange(2 * n_s, dtype=np.int64)
+    offsets = []
+    for view, n in zip(parts, (n_s, n_a), strict=True):
+        start = (view.__array_interface__["data"][0] - x.__array_interface__["data"][0]) \
+            // x.itemsize
+        if view.size != 2 * n or start < 0 or start + 2 * n > x.size \
+                or not np.shares_memory(view, x):
+            raise ValueError("a wing's state is not a view into the full-span state")
+        offsets.append(start)
+    (o_s, o_a) = offsets
+    return np.concatenate([o_s + np.arange(n_s), o_a + np.arange(n_a),
+                           o_s + n_s + np.arange(n_s), o_a + n_a + np.arange(n_a)]
+                          ).astype(np.int64)
 
 
 class AutopilotImu:
@@ -532,30 +650,52 @@ class AutopilotImu:
     the MAVLink vehicle's HIGHRES_IMU): its own :class:`SensorSet` (its own noise stream,
     read once per sample) and the wing's states before the last step, for
     :func:`latest_modal_kinematics`. Call :meth:`before_step` with the wing's η, η̇ before
-    each step, :meth:`read` after it."""
+    each step, :meth:`read` after it. Both wing halves (:meth:`follow` a full-span step): the
+    antisymmetric wing's η_a, η̇_a are read with the symmetric ones given (module docstring,
+    "Both wing halves": an IMU on the fuselage rolls with their root slope)."""
 
     def __init__(self, spec: ImuSpec, modes=None, n_modes: int | None = None,
                  dt_s: float = 1.0) -> None:
         self.spec = spec
         self.set = SensorSet(Sensors(imus=(spec,)), modes, n_modes)
         self.dt_s = float(dt_s)
+        self._lateral = None
         self.reset(self.set.n_modes)
 
     def reset(self, n_modes: int) -> None:
         """A new flight: the wing at rest before it (η_{k−1} = η_k = 0, η̇_k = 0)."""
-        self._hist = (np.zeros(n_modes), np.zeros(n_modes), np.zeros(n_modes))
+        n = n_modes + (0 if self._lateral is None else self._lateral.n_modes)
+        self._hist = (np.zeros(n), np.zeros(n), np.zeros(n))
+
+    def follow(self, step) -> None:
+        """A new flight of the coupled step ``step`` (its ``n_modes``, ``lateral`` and, with
+        both halves, ``antisymmetric_wing``): the wing at rest; with both halves the IMU's
+        columns gain the antisymmetric modes (once; a fresh noise stream, the same seed)."""
+        lateral = getattr(step, "lateral", None)
+        if lateral is not None and self.set.n_antisymmetric != lateral.n_modes:
+            wing_a = step.antisymmetric_wing
+            self.set = self.set.with_antisymmetric(wing_a.modes, wing_a.root_slope)
+        self._lateral = lateral
+        self.reset(step.n_modes)
+
+    def _both(self, eta, lateral_eta) -> np.ndarray:
+        eta = np.array(eta, dtype=float)
+        return eta if self._lateral is None else np.concatenate([eta, lateral_eta])
 
     def before_step(self, eta, eta_dot) -> None:
         """The wing's η [rad], η̇ [rad/s] before the step about to be flown."""
-        self._hist = (self._hist[1], np.array(eta, dtype=float),
-                      np.array(eta_dot, dtype=float))
+        lat = self._lateral
+        self._hist = (self._hist[1], self._both(eta, None if lat is None else lat.eta),
+                      self._both(eta_dot, None if lat is None else lat.eta_dot))
 
     def read(self, kin, eta, eta_dot, t_s: float, rate_state: bool
              ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """(specific force [m/s²], rates [rad/s]) in the IMU's axes at the newest state: the
         rigid body's :data:`KINEMATICS` ``kin`` and the wing's η, η̇ now, at ``t_s`` [s]."""
         eta_prev, eta_k, eta_dot_k = self._hist
-        eta, eta_dot = np.asarray(eta, dtype=float), np.asarray(eta_dot, dtype=float)
+        lat = self._lateral
+        eta = self._both(eta, None if lat is None else lat.eta)
+        eta_dot = self._both(eta_dot, None if lat is None else lat.eta_dot)
         dot, ddot = latest_modal_kinematics(eta_prev, eta_k, eta, eta_dot_k, eta_dot,
                                             self.dt_s, rate_state)
         v = self.set.read(kin, eta, dot, ddot, t_s).tolist()

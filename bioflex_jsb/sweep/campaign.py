@@ -565,9 +565,13 @@ def _controllers(axes: dict, metrics: tuple[str, ...], base_dir: Path | None) ->
                 path = base_dir / path
             c = str(path.resolve())
         try:
-            load_controller(c)
+            outputs = load_controller(c).outputs
         except InputError as exc:
             raise CampaignError(f"{key}: {exc}") from None
+        if "aileron" in outputs:  # a campaign's gust runs fly the half wing
+            raise CampaignError(f"{key}: {c!r} commands the aileron, which needs both wing "
+                                "halves; a campaign's runs fly the half wing (accepted: "
+                                "elevator, throttle, flaperon)")
         out.append(c)
     return _unique(out, "axes.controllers")
 

@@ -1,7 +1,8 @@
 """A gust run's controller on ``/bioflex/<model>/controller``.
 
 ``bioflex.Controller`` (:data:`~.schemas.SCHEMAS` ``["controller"]``): per step the commands
-the controller wrote (``elevator_cmd_rad``, ``throttle_cmd``, ``flaperon_cmd_rad``:
+the controller wrote (``elevator_cmd_rad``, ``throttle_cmd``, ``flaperon_cmd_rad``,
+``aileron_cmd_rad``:
 increments over the trim, NaN for a command it does not write) and the signals it read
 (``signals``, a packed array in the order the channel's metadata lists them). The run hands
 the step rows over a block at a time (``drivers.gust.StepRecorder``'s optional
@@ -27,7 +28,7 @@ if TYPE_CHECKING:
 
 GROUP = "controller"
 COMMAND_FIELDS = {"ctrl_elevator_rad": "elevator_cmd_rad", "ctrl_throttle": "throttle_cmd",
-                  "ctrl_flaperon_rad": "flaperon_cmd_rad"}
+                  "ctrl_flaperon_rad": "flaperon_cmd_rad", "ctrl_aileron_rad": "aileron_cmd_rad"}
 
 
 def channel_metadata(model: str, meta: dict) -> dict[str, str]:
@@ -41,8 +42,8 @@ def channel_metadata(model: str, meta: dict) -> dict[str, str]:
             "signals": json.dumps(list(meta["inputs"])),
             "commands": ",".join(meta["outputs"]),
             "n_states": json.dumps(meta.get("n_states")), "dt_s": json.dumps(meta.get("dt_s")),
-            "units": "elevator_cmd_rad rad, throttle_cmd -, flaperon_cmd_rad rad, signals: "
-                     "the channels' "
+            "units": "elevator_cmd_rad rad, throttle_cmd -, flaperon_cmd_rad rad, "
+                     "aileron_cmd_rad rad, signals: the channels' "
                      "(docs/api.md)"}
 
 

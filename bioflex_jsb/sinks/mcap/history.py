@@ -94,7 +94,7 @@ def _values(group: str, msg: dict, topic: str, ns: int) -> dict[str, float]:
     if group == "controller":  # its commands (a command it does not write is NaN: left out)
         values = {c: _number(msg, f, topic, ns) for c, f in (
             ("ctrl_elevator_rad", "elevator_cmd_rad"), ("ctrl_throttle", "throttle_cmd"),
-            ("ctrl_flaperon_rad", "flaperon_cmd_rad"))}
+            ("ctrl_flaperon_rad", "flaperon_cmd_rad"), ("ctrl_aileron_rad", "aileron_cmd_rad"))}
         return {c: v for c, v in values.items() if not math.isnan(v)}
     if group == "lateral":  # a full-span run's antisymmetric wing (lateral_topic.py)
         out = {f: _number(msg, f, topic, ns) for f in (

@@ -322,6 +322,9 @@ SCHEMAS["controller"] = {
         "flaperon_cmd_rad": _num("flaperon (both ailerons together) commanded over the "
                                  "trim, trailing edges down positive; NaN when it does not "
                                  "command the flaperon [rad]"),
+        "aileron_cmd_rad": _num("aileron (left - right)/2 commanded over the trim on both "
+                                "wing halves, + rolls right; NaN when it does not command "
+                                "the aileron [rad]"),
     },
 }
 # The antisymmetric wing of a full-span run (bioflex_jsb.sinks.mcap.lateral_topic;
