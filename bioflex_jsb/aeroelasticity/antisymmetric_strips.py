@@ -66,7 +66,9 @@ from bioflex_jsb.flight_dynamics.lateral import (
 from bioflex_jsb.flight_dynamics.lateral_elastic import (
     LATERAL_MODELS,
     AntisymmetricWing,
+    StripTerms,
     build_lateral_elastic,
+    lattice_unit_terms,
     residualised,
 )
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
@@ -141,21 +143,29 @@ def antisymmetric_strips(wing: AntisymmetricWing, surface: ControlSurface | None
         force_delta = np.zeros(wing.n_modes)
     else:
         chi = strip_coverage(w, surface)
-        # flap lift per Pa per rad [m]: c χ c_lδ a₀/2π = χ C_lα c c_lδ/2π (flight_roll_strips)
-        lift_delta = chi * wing.cl_alpha_c_m * flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+        # flap lift per Pa per rad [m]: c χ c_lδ a₀/2π = χ C_lα c c_lδ/2π (flight_roll_strips);
+        # the lattice's: its loading of the angle τ χ, τ = c_lδ/2π (roll_derivatives')
+        tau = flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+        lift_delta = (chi * wing.cl_alpha_c_m * flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+                      if wing.lift_matrix_m is None else wing.lift_m(chi * tau))
         moment_delta = chord**2 * chi * flap_moment_slope_per_rad(surface.hinge)  # [m²]
         force_delta = (w * (lift_delta * work + moment_delta * wing.theta)).sum(axis=1)
     modes = wing.modes
+    if wing.lift_matrix_m is not None:  # the lattice's loading (lateral_elastic's terms)
+        unit = lattice_unit_terms(wing)
+    else:
+        unit = StripTerms(
+            force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, clac_w),
+            force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, clac_w),
+            force_p=work @ (clac_w * y),
+            roll_eta=-2.0 * (wing.theta * clac_w) @ y,
+            roll_etadot=-2.0 * (wing.phi * clac_w) @ y)
     return AntisymmetricStrips(
         omega_rad_s=np.asarray(modes.frequencies_rad_s, dtype=float),
         zeta=np.asarray(modes.damping_ratios, dtype=float),
         mass_kg_m2=np.asarray(modes.generalised_masses_kg_m2, dtype=float),
-        force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, clac_w),
-        force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, clac_w),
-        force_p=work @ (clac_w * y),
-        force_delta=force_delta,
-        roll_eta=-2.0 * (wing.theta * clac_w) @ y,
-        roll_etadot=-2.0 * (wing.phi * clac_w) @ y,
+        force_eta=unit.force_eta, force_etadot=unit.force_etadot, force_p=unit.force_p,
+        force_delta=force_delta, roll_eta=unit.roll_eta, roll_etadot=unit.roll_etadot,
         tip_twist_rad=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
         surface=surface)
 
