@@ -1050,7 +1050,9 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
         strips, rho, name, settings = _clamped_roll_strips(wing, aileron, density_kg_m3,
                                                            lift_slope)
     return A.aileron_effectiveness(strips, density_kg_m3=rho, range_m_s=range_m_s, name=name,
-                                   settings=dict(settings, aero="steady strips",
+                                   settings=dict(settings, aero=(
+                                       "steady strips" if strips.lift_matrix_m is None else
+                                       "steady strips, the lattice's antisymmetric loading"),
                                                  range_derived=range_m_s is None),
                                    reference_speed_m_s=cruise)
 

@@ -15,7 +15,10 @@ import pytest
 from bioflex_jsb import api
 from bioflex_jsb.aerodynamics.vortex_lattice import solve_spanwise_aerodynamics
 from bioflex_jsb.aeroelasticity import aileron as A
-from bioflex_jsb.aeroelasticity.antisymmetric_strips import antisymmetric_strips
+from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
+    antisymmetric_strips,
+    yaw_sideslip_terms,
+)
 from bioflex_jsb.aeroelasticity.roll_derivatives import lattice_roll_derivatives
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics import lateral_elastic as le
@@ -70,6 +73,15 @@ def test_diagonal_matrix_is_the_strips(name):
     for f in ("force_eta", "force_etadot", "force_p", "force_delta", "roll_eta",
               "roll_etadot"):
         assert _relative(getattr(s_diag, f), getattr(s_strip, f)) < TOL_ROUND_OFF, f
+    t_diag, t_strip = (yaw_sideslip_terms(w, build.modes, build.model.n_modes,
+                                          build.planform, 2.0 * build.aero.semispan_m)
+                       for w in (diag, wing))
+    for f in dataclasses.fields(t_strip):
+        b = getattr(t_strip, f.name)
+        if np.any(b):  # the flat prototype's dihedral terms are zero either way
+            assert _relative(getattr(t_diag, f.name), b) < TOL_ROUND_OFF, f.name
+        else:
+            assert not np.any(getattr(t_diag, f.name)), f.name
     strips = A.flight_roll_strips(build, surface)
     diag_strips = dataclasses.replace(
         strips, lift_matrix_m=np.diag(strips.chord_m * strips.lift_slope_per_rad))

@@ -47,7 +47,7 @@ the gust's imposer's to add, not this module's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -409,7 +409,7 @@ def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, pla
     slope_s = _slope_at(st, symmetric.bending_m[:ns], y)  # (n_s, K) down per outboard
     slope_a = _slope_at(wing.modes.stations_m, wing.modes.bending_m, y)
     gamma = dihedral_rad(planform, y)
-    return YawSideslipTerms(
+    terms = YawSideslipTerms(
         force_r=-2.0 * work @ (y * share),
         force_beta=work @ (clac_w * gamma),
         force_beta_s=-np.einsum("ik,jk,k->ij", work, slope_s, clac_w),
@@ -421,3 +421,13 @@ def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, pla
         yaw_etadot=-2.0 * wing.phi @ (share * y),
         yaw_p_s=-2.0 * theta_s @ (clac_w * y * y),
         induced_per_lift=1.0 / (np.pi * float(span_m) ** 2))
+    if wing.lift_matrix_m is None:
+        return terms
+    # the lattice: the sideslip's antisymmetric angles ±β Γ, ∓β dφ_s/dy η_s and the
+    # antisymmetric deformation's θ_a, φ_a load the strips through its matrix; the yaw
+    # rate's terms and the lift's lean (l_r, l_e: symmetric loadings) stay the strips'
+    l_gamma, l_slope = w * wing.lift_m(gamma), w * wing.lift_m(slope_s)
+    return replace(terms, force_beta=work @ l_gamma, force_beta_s=-work @ l_slope.T,
+                   roll_beta_s=2.0 * l_slope @ y,
+                   side_dihedral_eta=-2.0 * (w * wing.lift_m(wing.theta)) @ gamma,
+                   side_dihedral_etadot=-2.0 * (w * wing.lift_m(wing.phi)) @ gamma)

@@ -34,6 +34,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.lateral_options import (
     add_lateral_arguments,
+    lateral_aero_extra,
     lateral_run_options,
     lateral_summary,
 )
@@ -267,6 +268,7 @@ def run_description(args, kind: str, models):
         extra["structural_damping"] = args.structural_damping
     if getattr(args, "trim", "rigid") != "rigid":
         extra["trim"] = args.trim
+    extra.update(lateral_aero_extra(args))
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
         extra["aircraft"] = aircraft.source

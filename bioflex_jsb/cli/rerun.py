@@ -33,7 +33,7 @@ LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold
 RUN_COMMANDS = ("gust", "compare")
 RUN_OPTIONS = ("--wing", "--aircraft", "--mass-basis", "--speed", "--gust", "--duration",
                "--gust-start", "--dt", "--models", "--model", "--aero",
-               "--structural-damping", "--trim", "--controller")
+               "--structural-damping", "--trim", "--controller", "--lateral-aero", "--span")
 
 
 tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
@@ -79,6 +79,9 @@ def argv_for(description) -> list[str]:
         common += ["--trim", str(d.extra["trim"])]
     if d.extra.get("controller"):
         common += ["--controller", str(d.extra["controller"])]
+    if d.extra.get("lateral_aero"):  # both halves on the recorded loading
+        common += ["--lateral-aero", str(d.extra["lateral_aero"]), "--span",
+                   str(d.extra.get("span", "full"))]
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")

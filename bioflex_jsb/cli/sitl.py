@@ -101,6 +101,9 @@ def register(sub) -> None:
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
                    "the autopilot flies in its turns, their rolling moment to JSBSim; "
                    "quasi-steady strips; docs/lateral.md)")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --span full")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
@@ -249,6 +252,7 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
     if not args.out:
         return None
     from bioflex_jsb.cli.gust import open_log
+    from bioflex_jsb.cli.lateral_options import lateral_aero_extra
     from bioflex_jsb.simulation.run import RunDescription
 
     description = RunDescription(
@@ -261,7 +265,7 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "mavlink": endpoint.text(), "signed": key is not None,
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
-               **_controller_extra(args),
+               **_controller_extra(args), **lateral_aero_extra(args),
                **({"aircraft": _aircraft_source(args)} if airframe is not None else {})})
     return SplitLog(args.out, description, build, args.log_max_mb,
                     live_opener(args, open_log), replace=args.force,
