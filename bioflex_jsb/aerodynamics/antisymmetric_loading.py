@@ -55,13 +55,3 @@ def lift_per_alpha(strip_lift_m: np.ndarray, matrix_m: np.ndarray | None,
         return alpha * strip_lift_m
     return alpha @ np.asarray(matrix_m, dtype=float).T
 
-
-def loading_factors(strip_lift_m: np.ndarray, matrix_m: np.ndarray,
-                    alpha_rad: np.ndarray) -> np.ndarray:
-    """The lattice's lift over the strips' for each distribution of ``alpha_rad`` (…, k)
-    [-], per strip (NaN where the strips carry none: a part-span distribution's lift
-    outside it is the lattice's alone); for the report of what the lattice changes."""
-    strip = lift_per_alpha(strip_lift_m, None, alpha_rad)
-    lattice = lift_per_alpha(strip_lift_m, matrix_m, alpha_rad)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(strip != 0.0, lattice / strip, np.nan)

@@ -11,7 +11,10 @@ same arithmetic, tested to 1e-12): the starboard strip at y sees
 
     Δα = Σ θ_i η_i + Σ φ_i η̇_i / V + (p − p_g) y / V,
 
-carries the lift l = Q C_lα c Δα (up) and, where the aileron covers the part χ of it, the flap
+carries the lift l = Q C_lα c Δα (up; with the wing's ``lift_matrix_m``, the lattice's
+loading, l = Q A Δα of the whole distribution: :mod:`~bioflex_jsb.aerodynamics
+.antisymmetric_loading`, the flap's lift then A τ χ δ_s) and, where the aileron covers the
+part χ of it, the flap
 lift Q c χ c_lδ (a₀/2π) δ_s and the quarter-chord moment Q c² χ c_mδ δ_s (thin aerofoil:
 :mod:`~bioflex_jsb.aeroelasticity.control_surface`, the section of
 :func:`~bioflex_jsb.aeroelasticity.aileron.flight_roll_strips`); the port strip carries the
