@@ -92,3 +92,37 @@ def test_rerun_flies_the_lattice_with_both_halves():
     assert argv["--lateral-aero"] == "lattice" and argv["--span"] == "full"
     plain = argv_for(RunDescription("gust", "optimised", 15.0, models=("coupled",)))
     assert not any(a.startswith(("--lateral-aero", "--span")) for a in plain)
+
+
+def test_ardupilot_backend_flies_the_lattice():
+    """``ardupilot --span full --lateral-aero lattice`` without ArduPlane (servo frames, as
+    tests/test_ardupilot_full_span.py): a right-aileron step's roll rate 0.3 s on, elastic
+    over rigid, measured −2.83 on the strips and −1.31 on the lattice. The aileron's lift
+    on the modes and the modes' rolling moment are each about 0.8 of the strips' (docs/
+    lateral.md), so the reversing increment, 1 − ratio = 3.83 on the strips, is about 0.64
+    of it: 1 − 0.64 × 3.83 = −1.45 expected; the lattice's is within 0.5 of that and less
+    reversed than the strips'."""
+    from bioflex_jsb.drivers import ardupilot as ad
+    from bioflex_jsb.runtime.fdm import Airframe
+
+    idle, right = (1500, 1500, 1050, 1500) + (0,) * 12, (1510, 1500, 1050, 1500) + (0,) * 12
+    ac = api.load_aircraft("bioflex_optimised")
+
+    def roll(aircraft, model):
+        ph = ad.ArduPilotPhysics(Airframe(), aircraft.wing(), model, span="full",
+                                 aileron=aircraft.definition.aileron)
+        for _ in range(ph.launch_hold_steps + ph.stroke_steps + int(round(0.25 / ph.dt_s))):
+            ph.step(idle, 1200)
+        p0 = ph.core.get["p"]()
+        for _ in range(int(round(0.3 / ph.dt_s))):
+            ph.step(right, 1200)
+        return ph.core.get["p"]() - p0, ph
+
+    p_rigid, _ = roll(ac, "rigid")
+    p_strips, ph_strips = roll(ac, "coupled")
+    p_lattice, ph_lattice = roll(ac.with_lateral_aero("lattice"), "coupled")
+    assert ph_strips.core.antisymmetric_wing.lift_matrix_m is None
+    assert ph_lattice.core.antisymmetric_wing.lift_matrix_m is not None
+    assert p_strips / p_rigid < p_lattice / p_rigid < 0.0
+    assert p_lattice / p_rigid == pytest.approx(1.0 - 0.64 * (1.0 - p_strips / p_rigid),
+                                                abs=0.5)

@@ -109,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
             "input_units": list(ss.input_units), "outputs": list(ss.outputs),
             "output_units": list(ss.output_units),
             "aerodynamics": ss.notes.get("aerodynamics"),
-            "overrides": dict(build.model.coefficients.overrides)}
+            "overrides": dict(build.model.coefficients.overrides),
+            **({} if args.lateral_aero is None else {"lateral_aero": args.lateral_aero})}
     if args.json:
         print_json(info)
     else:
