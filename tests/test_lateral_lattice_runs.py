@@ -126,3 +126,21 @@ def test_ardupilot_backend_flies_the_lattice():
     assert p_strips / p_rigid < p_lattice / p_rigid < 0.0
     assert p_lattice / p_rigid == pytest.approx(1.0 - 0.64 * (1.0 - p_strips / p_rigid),
                                                 abs=0.5)
+
+
+def test_a_logged_lattice_run_is_flown_again_by_rerun(capsys, tmp_path):
+    """gust --span full --lateral-aero lattice --out: the log's description records the
+    loading and rerun flies it (both halves, the lattice) to the same messages."""
+    first, again = tmp_path / "g.mcap", tmp_path / "r.mcap"
+    code, out, err = run_cli(capsys, "gust", "--span", "full", "--lateral-aero", "lattice",
+                             "--gust", "sharp:0.3", "--duration", "0.6", "--models",
+                             "coupled", "--out", str(first), "--json")
+    assert code == 0, err
+    assert json.loads(out)["lateral_aero"] == "lattice"
+    from bioflex_jsb.cli.rerun import argv_from_log
+
+    argv = dict(a.split("=", 1) for a in argv_from_log(str(first))[1:])
+    assert argv["--lateral-aero"] == "lattice" and argv["--span"] == "full"
+    code, out, err = run_cli(capsys, "rerun", str(first), "--out", str(again))
+    assert code == 0, err
+    assert "same result" in out

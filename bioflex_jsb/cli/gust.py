@@ -413,6 +413,7 @@ def run(args: argparse.Namespace) -> int:
             "controller": runs[0].meta.get("controller") if runs else None,
             "lateral": {r.model: lateral_summary(r) for r in runs
                         if r.meta.get("span") == "full"},
+            **lateral_aero_extra(args),
             "stopped": stops,
             "plot": plot,
             "out": args.out,
