@@ -427,10 +427,19 @@ def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, pla
     if wing.lift_matrix_m is None:
         return terms
     # the lattice: the sideslip's antisymmetric angles ±β Γ, ∓β dφ_s/dy η_s and the
-    # antisymmetric deformation's θ_a, φ_a load the strips through its matrix; the yaw
-    # rate's terms and the lift's lean (l_r, l_e: symmetric loadings) stay the strips'
+    # antisymmetric deformation's θ_a, φ_a load the strips through its matrix. The yaw rate:
+    # a strip's onset flow V − r y changes its normal wash (α (1 − r y/V), whose
+    # antisymmetric part −α r y/V the matrix loads) and its Kutta–Joukowski speed (the
+    # symmetric load l times −r y/V): Δl = −(r/V) (y l + Q A (α y)), the strips' −2 (r y/V) l
+    # when A is their diagonal; α the trim's uniform α_w (l_r = Q C_lα c α_w, so Q α_w =
+    # L_w / (2 Σ C_lα c w)) and the symmetric twist θ_s η_s (l_e). The lift's lean stays the
+    # strips' (it tilts l, it adds none)
     l_gamma, l_slope = w * wing.lift_m(gamma), w * wing.lift_m(slope_s)
+    l_y = w * wing.lift_m(y) / (2.0 * clac_w.sum())  # per unit L_w of α_w y [-]
+    l_theta_s_y = w * wing.lift_m(theta_s * y)  # (n_s, K) per unit Q η_s of θ_s y [m²]
     return replace(terms, force_beta=work @ l_gamma, force_beta_s=-work @ l_slope.T,
+                   force_r=-work @ (y * share) - work @ l_y,
+                   roll_r_s=2.0 * theta_s @ (clac_w * y * y) + 2.0 * l_theta_s_y @ y,
                    roll_beta_s=2.0 * l_slope @ y,
                    side_dihedral_eta=-2.0 * (w * wing.lift_m(wing.theta)) @ gamma,
                    side_dihedral_etadot=-2.0 * (w * wing.lift_m(wing.phi)) @ gamma)
