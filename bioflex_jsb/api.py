@@ -68,6 +68,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     WingBuild,
     build_wing,
     resolve_variant,
+    with_lateral_aero,
 )
 from bioflex_jsb.inputs import Choice, Interval, Real, argument
 from bioflex_jsb.runtime.fdm import Airframe
@@ -249,13 +250,33 @@ def _linear_speed(speed_m_s, name: str = "speed_m_s") -> float:
     return argument(LINEAR_SPEED, speed_m_s, name)
 
 
+def _lateral_aero(wing, lateral_aero: str | None):
+    """``wing`` (a WingBuild, an Aircraft, None) with its lateral elastic models' loading
+    ``lateral_aero`` (``strips`` or ``lattice``: aerodynamics/antisymmetric_loading.py;
+    None: the wing's own, ``strips`` unless set); one line for anything else."""
+    from bioflex_jsb.aerodynamics.antisymmetric_loading import LATERAL_AERO
+
+    if lateral_aero is None:
+        return wing
+    _check_choice("lateral aerodynamics", lateral_aero, LATERAL_AERO)
+    if isinstance(wing, WingBuild):
+        return with_lateral_aero(wing, lateral_aero)
+    if isinstance(wing, Aircraft):
+        return wing.with_lateral_aero(lateral_aero)
+    if lateral_aero == "strips":
+        return wing
+    raise InputError("lateral_aero='lattice' loads an elastic wing's antisymmetric modes: "
+                     f"give a WingBuild or an Aircraft, not {wing!r}")
+
+
 def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:3",
              models: Iterable[str] | None = None, duration_s: float = 5.0,
              gust_start_s: float = 0.5, altitude_m: float = 0.0, dt_s: float = DEFAULT_DT_S,
              recorders: dict[str, StepRecorder] | None = None,
              aero: str = "quasi-steady", trim: str = "rigid",
              controller=None, span: str = "half", aileron_step_deg: float | None = None,
-             aileron_start_s: float = 0.5) -> dict[str, TimeHistory]:
+             aileron_start_s: float = 0.5, lateral_aero: str | None = None
+             ) -> dict[str, TimeHistory]:
     """Nonlinear 6-DoF gust runs of the JSBSim airframe with ``wing`` (a WingBuild or an
     Aircraft), one per model of ``models`` (``rigid``, ``coupled``, ``qsd``; None: all
     three, or ``coupled`` alone with ``aero="unsteady"``): trim at ``speed_m_s`` [m/s] and
@@ -295,9 +316,13 @@ def fly_gust(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp
     ``aero="unsteady"`` the antisymmetric modes on unsteady strips too, "Both halves on
     unsteady strips").
     ``aileron_step_deg``: an aileron step over the trim [deg, JSBSim's (left − right)/2, +
-    rolls right, |δa| <= 30] from ``aileron_start_s`` [s] (None: none)."""
-    return _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_m,
-                     dt_s, recorders, aero, trim, controller,
+    rolls right, |δa| <= 30] from ``aileron_start_s`` [s] (None: none). ``lateral_aero``
+    the antisymmetric strips' loading of ``span="full"``: ``strips`` or ``lattice`` (the
+    vortex lattice's antisymmetric loading; docs/lateral.md, "The lattice in the lateral
+    elastic model"); None: the wing's own (``strips`` unless set); ``lattice`` with the
+    half wing is refused (one line)."""
+    return _fly_gust(_lateral_aero(wing, lateral_aero), speed_m_s, gust, models, duration_s,
+                     gust_start_s, altitude_m, dt_s, recorders, aero, trim, controller,
                      lateral=(span, aileron_step_deg, aileron_start_s))[0]
 
 
@@ -338,6 +363,8 @@ def _fly_gust(wing, speed_m_s, gust, models, duration_s, gust_start_s, altitude_
                               controller=controller, **options)
         # which wing flew, as the command's runs say (plot_runs' title, a user's table)
         out[model].meta.update(wing=build.variant.name, mass_basis=build.mass_basis)
+        if build.lateral_aero != "strips":  # the default's meta unchanged
+            out[model].meta.update(lateral_aero=build.lateral_aero)
     return out, airframe, build, config.speed_m_s
 
 
@@ -347,6 +374,9 @@ def _lateral_options(subject, build, span: str, aileron_step_deg, aileron_start_
     from bioflex_jsb.simulation.full_span import AileronInput
 
     _check_choice("span", span, ("half", "full"))
+    if span == "half" and build.lateral_aero != "strips":
+        raise InputError(f"lateral_aero={build.lateral_aero!r} loads the antisymmetric modes "
+                         "of both halves: not with span='half' (accepted: span='full')")
     options: dict = {}
     if aileron_step_deg is not None:
         deg = argument(AILERON_STEP, aileron_step_deg, "aileron_step_deg")
@@ -377,8 +407,8 @@ def fly_fig21(model: str = "coupled", duration_s: float = 3.0) -> TimeHistory:
 def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:0.3",
             model: str = "coupled", duration_s: float = 5.0, gust_start_s: float = 0.5,
             aero: str = "quasi-steady", trim: str = "rigid",
-            recorder: StepRecorder | None = None, controller=None, span: str = "half"
-            ) -> Comparison:
+            recorder: StepRecorder | None = None, controller=None, span: str = "half",
+            lateral_aero: str | None = None) -> Comparison:
     """The nonlinear gust run of ``model`` with ``wing`` (as :func:`fly_gust`: ``speed_m_s``
     [m/s], ``gust``, ``duration_s`` [s] from ``gust_start_s`` [s]) and the LTI model of Eq. (4)
     driven by the same gust samples at the same trim (its rigid block JSBSim's own
@@ -400,7 +430,9 @@ def compare(wing: WingBuild, speed_m_s: float | None = None, gust: str = "sharp:
     model of the same wing model beside Eq. (4), driven by the run's gust roll rate, lateral
     gust and aileron (:mod:`bioflex_jsb.drivers.compare_lateral`): β, p, r, φ, ``asym_eta1``
     and ``modal_roll_n_m`` compared too (about the rigid trim; ``aero="unsteady"``: the
-    run's antisymmetric modes and the lateral model both on the unsteady strips)."""
+    run's antisymmetric modes and the lateral model both on the unsteady strips);
+    ``lateral_aero`` as :func:`fly_gust`'s (the lateral model then on the same loading)."""
+    wing = _lateral_aero(wing, lateral_aero)
     _check_choice("model", model, MODELS)
     _check_choice("span", span, ("half", "full"))
     check_comparable(model, aero, trim, controller is not None, span)  # before flying
@@ -580,7 +612,8 @@ def _lateral_point(wing, speed_m_s: float | None):
     return subject, identify_lateral(airframe, speed, reference, altitude, source)
 
 
-def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
+def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady",
+             lateral_aero: str | None = None):
     """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`;
     ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None)."""
     from bioflex_jsb.aeroelasticity import antisymmetric as anti
@@ -593,6 +626,7 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
 
     _check_choice("model", model, LATERAL_MODELS)
     _check_choice("aerodynamics", aero, anti.LATERAL_AERO)
+    wing = _lateral_aero(wing, lateral_aero)
     if aero == "unsteady" and model != "coupled":
         raise InputError(f"aero='unsteady' is the coupled lateral model's (the wing's strips "
                          f"on its antisymmetric modes), not the {model} one")
@@ -618,7 +652,7 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady"):
 
 
 def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid",
-                  aero: str = "quasi-steady") -> StateSpace:
+                  aero: str = "quasi-steady", lateral_aero: str | None = None) -> StateSpace:
     """The linear lateral-directional model at ``speed_m_s`` [m/s] (None: the aircraft's
     cruise speed, the prototype's 15 m/s), about its JSBSim trim there (docs/lateral.md):
     states beta [rad] (sideslip, air from the right), p, r [rad/s] (roll right, yaw right,
@@ -643,21 +677,25 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     strips' Jones lag states lag1[k], lag2[k] [m/s] and apparent mass on the modes and the
     roll rate; :mod:`bioflex_jsb.aeroelasticity.antisymmetric`). ``wing`` an
     :class:`Aircraft` (its JSBSim airframe and wing), the prototype's wing or None (the
-    prototype, rigid only). One line (InputError) when the aircraft cannot be trimmed at
-    that speed, or its wing has no beam (a modal-data file: no antisymmetric modes)."""
-    return _lateral(wing, speed_m_s, model, aero)[0]
+    prototype, rigid only). ``lateral_aero``: the strips' antisymmetric loading, ``strips``
+    (C_lα c of each strip alone) or ``lattice`` (the vortex lattice's antisymmetric loading
+    of the whole distribution: docs/lateral.md, "The lattice in the lateral elastic
+    model"; quasi-steady only); None: the wing's own (``strips`` unless set). One line
+    (InputError) when the aircraft cannot be trimmed at that speed, or its wing has no beam
+    (a modal-data file: no antisymmetric modes)."""
+    return _lateral(wing, speed_m_s, model, aero, lateral_aero)[0]
 
 
 def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
-                  model: str = "rigid", aero: str = "quasi-steady"
-                  ) -> ModeSet | list[ModeSet]:
+                  model: str = "rigid", aero: str = "quasi-steady",
+                  lateral_aero: str | None = None) -> ModeSet | list[ModeSet]:
     """The labelled lateral-directional modes of :func:`lateral_model` of ``wing`` (an
     :class:`Aircraft`, the prototype's wing or None: the prototype) at ``speed_m_s``
     [m/s] (or a list, one per speed of a sequence), ``model`` rigid, coupled or qsd:
     ``roll`` (roll subsidence), ``spiral`` (unstable when its ``re`` > 0), ``dutch_roll``
     and the coupled model's ``antisymmetric_k`` [rad/s]; ``aero`` as
     :func:`lateral_model`'s (unsteady: the quasi-steady model's labels carried over by
-    continuation, the lag roots left out)."""
+    continuation, the lag roots left out), ``lateral_aero`` as :func:`lateral_model`'s."""
     from bioflex_jsb.flight_dynamics.lateral import lateral_mode_set
     from bioflex_jsb.flight_dynamics.lateral_elastic import coupled_mode_set
 
@@ -665,8 +703,8 @@ def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,
         speeds = list(speed_m_s)
         if not speeds:
             raise InputError("speed_m_s: give a speed [m/s] or a non-empty sequence of them")
-        return [lateral_modes(wing, v, model, aero) for v in speeds]
-    ss, rigid, wing_a = _lateral(wing, speed_m_s, model, aero)
+        return [lateral_modes(wing, v, model, aero, lateral_aero) for v in speeds]
+    ss, rigid, wing_a = _lateral(wing, speed_m_s, model, aero, lateral_aero)
     if aero == "unsteady":
         return rigid  # the unsteady model's labelled modes (_lateral)
     if model == "coupled":
@@ -715,7 +753,7 @@ def _clamped(definition, lift_slope: str | None):
 # inputs.argument as one line, "<argument>: <what is wrong; what is accepted>".
 def _check_choice(what: str, value, accepted) -> None:
     """``value`` one of ``accepted``: "<argument>: unknown <what> 'x'; accepted: …"."""
-    name = {"aerodynamics": "aero"}.get(what, what)
+    name = {"aerodynamics": "aero", "lateral aerodynamics": "lateral_aero"}.get(what, what)
     argument(Choice(tuple(accepted), noun=what), value, name)
 
 
@@ -971,7 +1009,7 @@ def _clamped_flutter(definition, range_m_s, aero, method, zeta, rho, lift_slope,
 
 def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] | None = None,
                           *, aileron=None, density_kg_m3: float | None = None,
-                          lift_slope: str | None = None):
+                          lift_slope: str | None = None, lateral_aero: str | None = None):
     """Aileron effectiveness and reversal of an elastic wing
     (:class:`bioflex_jsb.aeroelasticity.aileron.AileronResult`: ``.as_dict()``,
     ``.plot(path)``; docs/aeroelasticity.md, "Aileron effectiveness and reversal"): against
@@ -991,7 +1029,9 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
     (low, high) [m/s], 0 <= low < high <= 400 (default 0 to 1.5 × the reversal speed);
     ``density_kg_m3`` [kg/m^3] defaults to the definition's (a WingBuild's: sea level);
     ``lift_slope`` (``strip``, ``vlm``: a clamped wing's; an aircraft's is the lattice's)
-    to the definition's."""
+    to the definition's. ``lateral_aero`` an aircraft's antisymmetric loading: ``strips``
+    (each strip's C_lα c) or ``lattice`` (the vortex lattice's antisymmetric loading;
+    docs/lateral.md, "The lattice in the lateral elastic model"); None: the wing's own."""
     from bioflex_jsb.aeroelasticity import aileron as A
 
     if range_m_s is not None:
@@ -1001,15 +1041,21 @@ def aileron_effectiveness(wing="goland_aileron", range_m_s: tuple[float, float] 
         _check_choice("lift_slope", lift_slope, LIFT_SLOPES)
     cruise = None
     if isinstance(wing, Aircraft | WingBuild):
+        wing = _lateral_aero(wing, lateral_aero)
         strips, rho, name, settings = _aircraft_roll_strips(wing, aileron, density_kg_m3,
                                                             lift_slope)
         if isinstance(wing, Aircraft) or wing.airframe is _prototype_airframe():
             cruise = _Subject.of(wing).flight_speed(None)  # its cruise speed [m/s]
     else:
+        if lateral_aero not in (None, "strips"):
+            raise InputError("lateral_aero is an aircraft's (its flight model's lattice); a "
+                             "clamped wing takes lift_slope ('strip' or 'vlm')")
         strips, rho, name, settings = _clamped_roll_strips(wing, aileron, density_kg_m3,
                                                            lift_slope)
     return A.aileron_effectiveness(strips, density_kg_m3=rho, range_m_s=range_m_s, name=name,
-                                   settings=dict(settings, aero="steady strips",
+                                   settings=dict(settings, aero=(
+                                       "steady strips" if strips.lift_matrix_m is None else
+                                       "steady strips, the lattice's antisymmetric loading"),
                                                  range_derived=range_m_s is None),
                                    reference_speed_m_s=cruise)
 
@@ -1051,6 +1097,7 @@ def _aircraft_roll_strips(wing, aileron, density_kg_m3, lift_slope):
         else build.variant.name, "clamped": False, "semispan_m": semispan,
         "lift_slope": "vlm", "n_flown_modes": build.model.n_modes,
         "e_shift_frac": float(build.e_shift_frac),
+        **({} if build.lateral_aero == "strips" else {"lateral_aero": build.lateral_aero}),
         "aircraft": {"name": build.airframe.name,
                      "cl_delta_a_per_rad": float(rigid.cl_delta_a_per_rad),
                      "cl_p_per_rad": float(rigid.cl_p_per_rad)}}

@@ -82,7 +82,10 @@ class RollStrips:
     ``coverage`` χ, ``flap_lift_per_rad`` c_lδ (a₀/2π of the thin aerofoil's),
     ``flap_moment_per_rad`` c_mδ about the quarter chord; per mode (n, K) ``heave_m``
     (down) and ``twist_rad`` (leading edge up) per unit modal coordinate; ``stiffness``
-    (n, n) the modal stiffness in the same units; ``semispan_m`` l; ``surface``."""
+    (n, n) the modal stiffness in the same units; ``semispan_m`` l; ``surface``;
+    ``lift_matrix_m`` (K, K) [m/rad] the lattice's antisymmetric loading l'/q = A α of the
+    strips (:mod:`~bioflex_jsb.aerodynamics.antisymmetric_loading`: it replaces c a₀ in
+    every lift, the flap's as A (τ χ), τ = c_lδ/a₀), None: the strips' c a₀."""
 
     stations_m: np.ndarray
     weights_m: np.ndarray
@@ -97,6 +100,7 @@ class RollStrips:
     stiffness: np.ndarray = field(repr=False)
     semispan_m: float = 0.0
     surface: ControlSurface | None = None
+    lift_matrix_m: np.ndarray | None = field(default=None, repr=False)
 
 
 def clamped_roll_strips(model: ClampedWingModel, surface: ControlSurface) -> RollStrips:
@@ -127,7 +131,10 @@ def flight_roll_strips(build, surface: ControlSurface) -> RollStrips:
     the lattice's C_lα c and the arm of Table B1 (x_E − x_ac, after a C_η1^Q1 pin's shift:
     the flight model's), the surface's coverage of each strip a fraction where an end falls
     inside one. The antisymmetric problem on the modes of the clamped half wing: what the
-    body frame sees of a wing rolling steadily (module docstring)."""
+    body frame sees of a wing rolling steadily (module docstring). The build's
+    ``lateral_aero`` ``lattice`` loads the strips by the lattice's antisymmetric influence
+    matrix (``lift_matrix_m``)."""
+    from bioflex_jsb.aerodynamics.antisymmetric_loading import antisymmetric_lift_matrix
     from bioflex_jsb.aeroelasticity.free_aircraft import strip_geometry
 
     semispan = float(build.aero.semispan_m)
@@ -149,7 +156,8 @@ def flight_roll_strips(build, surface: ControlSurface) -> RollStrips:
         flap_lift_per_rad=flap_lift_slope_per_rad(surface.hinge) * a0 / TWO_PI,
         flap_moment_per_rad=np.full(w.size, flap_moment_slope_per_rad(surface.hinge)),
         heave_m=np.asarray(g.phi[:n], float), twist_rad=np.asarray(g.theta[:n], float),
-        stiffness=stiffness, semispan_m=semispan, surface=surface)
+        stiffness=stiffness, semispan_m=semispan, surface=surface,
+        lift_matrix_m=antisymmetric_lift_matrix(build.aero, build.lateral_aero))
 
 
 @dataclass(frozen=True, eq=False)
@@ -256,6 +264,8 @@ def static_roll_matrices(strips: RollStrips) -> StaticRollMatrices:
     lift_delta = c * s.coverage * s.flap_lift_per_rad  # [m/rad]
     moment_delta = s.arm_m * lift_delta + c * c * s.coverage * s.flap_moment_per_rad
     roll_alpha = -y / s.semispan_m  # local angle of attack per unit p̂ [rad]
+    if s.lift_matrix_m is not None:
+        return _lattice_roll_matrices(s, work, roll_alpha)
     return StaticRollMatrices(
         stiffness=np.asarray(s.stiffness, float),
         aero=(work * (w * lift_alpha)) @ s.twist_rad.T,
@@ -264,6 +274,27 @@ def static_roll_matrices(strips: RollStrips) -> StaticRollMatrices:
         moment_eta=s.twist_rad @ (w * y * lift_alpha),
         moment_delta=float(np.sum(w * y * lift_delta)),
         moment_roll=float(np.sum(w * y * lift_alpha * roll_alpha)),
+        area_m2=float(2.0 * np.sum(w * c)), span_m=2.0 * s.semispan_m)
+
+
+def _lattice_roll_matrices(s: RollStrips, work: np.ndarray, roll_alpha: np.ndarray
+                           ) -> StaticRollMatrices:
+    """:func:`static_roll_matrices` with the lattice's loading: each lift l'/q = A α of its
+    distribution α (the twists, the roll rate's, the flap's τ χ) in place of c a₀ α."""
+    w, y, c, a = s.weights_m, s.stations_m, s.chord_m, np.asarray(s.lift_matrix_m, float)
+    lift_twist = s.twist_rad @ a.T  # (n, K) [m per unit η]
+    lift_roll = a @ roll_alpha  # [m per unit p̂]
+    tau = s.flap_lift_per_rad / s.lift_slope_per_rad  # c_lδ/a₀ = the thin aerofoil's τ
+    lift_delta = a @ (s.coverage * tau)  # [m/rad]
+    moment_delta = s.arm_m * lift_delta + c * c * s.coverage * s.flap_moment_per_rad
+    return StaticRollMatrices(
+        stiffness=np.asarray(s.stiffness, float),
+        aero=(work * w) @ lift_twist.T,
+        force_delta=(w * (-lift_delta * s.heave_m + moment_delta * s.twist_rad)).sum(axis=1),
+        force_roll=(w * lift_roll * work).sum(axis=1),
+        moment_eta=lift_twist @ (w * y),
+        moment_delta=float(np.sum(w * y * lift_delta)),
+        moment_roll=float(np.sum(w * y * lift_roll)),
         area_m2=float(2.0 * np.sum(w * c)), span_m=2.0 * s.semispan_m)
 
 

@@ -138,7 +138,13 @@ def aircraft_strips(build, wing: AntisymmetricWing, roll_inertia_kg_m2: float | 
                     ) -> AntisymmetricStrips:
     """:class:`AntisymmetricStrips` of an aircraft's wing: ``wing`` (the antisymmetric modes
     of ``build``, a WingBuild, at the lattice's strips, e shifted by the pin) with the
-    physical chord, elastic axis and three-quarter-chord point of ``build``'s planform."""
+    physical chord, elastic axis and three-quarter-chord point of ``build``'s planform.
+    Strips only: the lattice's loading (``lateral_aero = "lattice"``) has no unsteady
+    counterpart here (one line)."""
+    if wing.lift_matrix_m is not None:
+        raise InputError("lateral_aero='lattice' is quasi-steady: the unsteady lateral model "
+                         "has Theodorsen's strips only; accepted with aero='unsteady': "
+                         "lateral_aero='strips'")
     modes = wing.modes
     strips = spanwise_geometry(build.aero, build.planform, modes.x_elastic_frac,
                                modes.stations_m)

@@ -11,7 +11,10 @@ same arithmetic, tested to 1e-12): the starboard strip at y sees
 
     Δα = Σ θ_i η_i + Σ φ_i η̇_i / V + (p − p_g) y / V,
 
-carries the lift l = Q C_lα c Δα (up) and, where the aileron covers the part χ of it, the flap
+carries the lift l = Q C_lα c Δα (up; with the wing's ``lift_matrix_m``, the lattice's
+loading, l = Q A Δα of the whole distribution: :mod:`~bioflex_jsb.aerodynamics
+.antisymmetric_loading`, the flap's lift then A τ χ δ_s) and, where the aileron covers the
+part χ of it, the flap
 lift Q c χ c_lδ (a₀/2π) δ_s and the quarter-chord moment Q c² χ c_mδ δ_s (thin aerofoil:
 :mod:`~bioflex_jsb.aeroelasticity.control_surface`, the section of
 :func:`~bioflex_jsb.aeroelasticity.aileron.flight_roll_strips`); the port strip carries the
@@ -47,7 +50,7 @@ the gust's imposer's to add, not this module's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -66,7 +69,9 @@ from bioflex_jsb.flight_dynamics.lateral import (
 from bioflex_jsb.flight_dynamics.lateral_elastic import (
     LATERAL_MODELS,
     AntisymmetricWing,
+    StripTerms,
     build_lateral_elastic,
+    lattice_unit_terms,
     residualised,
 )
 from bioflex_jsb.parameters.constants import STANDARD_GRAVITY_M_S2
@@ -141,21 +146,29 @@ def antisymmetric_strips(wing: AntisymmetricWing, surface: ControlSurface | None
         force_delta = np.zeros(wing.n_modes)
     else:
         chi = strip_coverage(w, surface)
-        # flap lift per Pa per rad [m]: c χ c_lδ a₀/2π = χ C_lα c c_lδ/2π (flight_roll_strips)
-        lift_delta = chi * wing.cl_alpha_c_m * flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+        # flap lift per Pa per rad [m]: c χ c_lδ a₀/2π = χ C_lα c c_lδ/2π (flight_roll_strips);
+        # the lattice's: its loading of the angle τ χ, τ = c_lδ/2π (roll_derivatives')
+        tau = flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+        lift_delta = (chi * wing.cl_alpha_c_m * flap_lift_slope_per_rad(surface.hinge) / TWO_PI
+                      if wing.lift_matrix_m is None else wing.lift_m(chi * tau))
         moment_delta = chord**2 * chi * flap_moment_slope_per_rad(surface.hinge)  # [m²]
         force_delta = (w * (lift_delta * work + moment_delta * wing.theta)).sum(axis=1)
     modes = wing.modes
+    if wing.lift_matrix_m is not None:  # the lattice's loading (lateral_elastic's terms)
+        unit = lattice_unit_terms(wing)
+    else:
+        unit = StripTerms(
+            force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, clac_w),
+            force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, clac_w),
+            force_p=work @ (clac_w * y),
+            roll_eta=-2.0 * (wing.theta * clac_w) @ y,
+            roll_etadot=-2.0 * (wing.phi * clac_w) @ y)
     return AntisymmetricStrips(
         omega_rad_s=np.asarray(modes.frequencies_rad_s, dtype=float),
         zeta=np.asarray(modes.damping_ratios, dtype=float),
         mass_kg_m2=np.asarray(modes.generalised_masses_kg_m2, dtype=float),
-        force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, clac_w),
-        force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, clac_w),
-        force_p=work @ (clac_w * y),
-        force_delta=force_delta,
-        roll_eta=-2.0 * (wing.theta * clac_w) @ y,
-        roll_etadot=-2.0 * (wing.phi * clac_w) @ y,
+        force_eta=unit.force_eta, force_etadot=unit.force_etadot, force_p=unit.force_p,
+        force_delta=force_delta, roll_eta=unit.roll_eta, roll_etadot=unit.roll_etadot,
         tip_twist_rad=np.asarray(modes.twist_rad, dtype=float)[:, -1].copy(),
         surface=surface)
 
@@ -399,7 +412,7 @@ def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, pla
     slope_s = _slope_at(st, symmetric.bending_m[:ns], y)  # (n_s, K) down per outboard
     slope_a = _slope_at(wing.modes.stations_m, wing.modes.bending_m, y)
     gamma = dihedral_rad(planform, y)
-    return YawSideslipTerms(
+    terms = YawSideslipTerms(
         force_r=-2.0 * work @ (y * share),
         force_beta=work @ (clac_w * gamma),
         force_beta_s=-np.einsum("ik,jk,k->ij", work, slope_s, clac_w),
@@ -411,3 +424,22 @@ def yaw_sideslip_terms(wing: AntisymmetricWing, symmetric, n_symmetric: int, pla
         yaw_etadot=-2.0 * wing.phi @ (share * y),
         yaw_p_s=-2.0 * theta_s @ (clac_w * y * y),
         induced_per_lift=1.0 / (np.pi * float(span_m) ** 2))
+    if wing.lift_matrix_m is None:
+        return terms
+    # the lattice: the sideslip's antisymmetric angles ±β Γ, ∓β dφ_s/dy η_s and the
+    # antisymmetric deformation's θ_a, φ_a load the strips through its matrix. The yaw rate:
+    # a strip's onset flow V − r y changes its normal wash (α (1 − r y/V), whose
+    # antisymmetric part −α r y/V the matrix loads) and its Kutta–Joukowski speed (the
+    # symmetric load l times −r y/V): Δl = −(r/V) (y l + Q A (α y)), the strips' −2 (r y/V) l
+    # when A is their diagonal; α the trim's uniform α_w (l_r = Q C_lα c α_w, so Q α_w =
+    # L_w / (2 Σ C_lα c w)) and the symmetric twist θ_s η_s (l_e). The lift's lean stays the
+    # strips' (it tilts l, it adds none)
+    l_gamma, l_slope = w * wing.lift_m(gamma), w * wing.lift_m(slope_s)
+    l_y = w * wing.lift_m(y) / (2.0 * clac_w.sum())  # per unit L_w of α_w y [-]
+    l_theta_s_y = w * wing.lift_m(theta_s * y)  # (n_s, K) per unit Q η_s of θ_s y [m²]
+    return replace(terms, force_beta=work @ l_gamma, force_beta_s=-work @ l_slope.T,
+                   force_r=-work @ (y * share) - work @ l_y,
+                   roll_r_s=2.0 * theta_s @ (clac_w * y * y) + 2.0 * l_theta_s_y @ y,
+                   roll_beta_s=2.0 * l_slope @ y,
+                   side_dihedral_eta=-2.0 * (w * wing.lift_m(wing.theta)) @ gamma,
+                   side_dihedral_etadot=-2.0 * (w * wing.lift_m(wing.phi)) @ gamma)

@@ -87,6 +87,9 @@ def register(sub) -> None:
                    help="strip lift slope: strip (the definition's 2-D slope on every strip) "
                    "or vlm (the vortex lattice's spanwise C_la(y), a rectangular wing); "
                    "default the definition's")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --aircraft (a clamped wing takes --lift-slope)")
     p.add_argument("--range", type=speed_range, default=None, metavar="LOW:HIGH",
                    help=f"airspeeds [m/s], 0 <= LOW < HIGH <= {SPEED_LIMIT_M_S:g}; default 0 "
                    "to 1.5 x the reversal speed (to 1.1 x the divergence speed when that is "
@@ -114,9 +117,13 @@ def run(args: argparse.Namespace) -> int:
                              "vortex lattice's span loading (its flight model's)")
         wing = api.load_aircraft(args.aircraft)
     else:
+        if args.lateral_aero is not None:
+            raise UsageError("--lateral-aero is for --aircraft (its flight model's lattice); "
+                             "a clamped wing takes --lift-slope")
         wing = args.clamped or DEFAULT_WING
     res = api.aileron_effectiveness(wing, args.range, aileron=args.aileron,
-                                    density_kg_m3=args.density, lift_slope=args.lift_slope)
+                                    density_kg_m3=args.density, lift_slope=args.lift_slope,
+                                    lateral_aero=args.lateral_aero)
     payload = res.as_dict()
     payload["plot"] = None
     if args.plot:
@@ -151,7 +158,9 @@ def text_report(res, p: dict) -> str:
         f"wing {p['wing']} ({what}): {s['name']} {s['start_m']:.4g}-{s['end_m']:.4g} m "
         f"({s['start_m'] / semispan:.3g}-{s['end_m'] / semispan:.3g} of the semispan), hinge "
         f"{s['hinge_chord_fraction']:g} c ({100 * s['flap_chord_ratio']:.3g} % chord); steady "
-        f"strips, lift slope {p['lift_slope']}, rho {p['density_kg_m3']:g} kg/m^3",
+        f"strips, lift slope {p['lift_slope']}"
+        + (", the lattice's antisymmetric loading" if p.get("lateral_aero") == "lattice"
+           else "") + f", rho {p['density_kg_m3']:g} kg/m^3",
         f"  section: c_l_delta {s['flap_lift_per_rad']:.4g} /rad, c_m_delta (quarter chord) "
         f"{s['flap_moment_quarter_chord_per_rad']:.4g} /rad",
         f"  rigid wing: C_l_delta {p['rigid']['cl_delta_per_rad']:.4g} /rad, C_lp "

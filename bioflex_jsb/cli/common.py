@@ -388,8 +388,16 @@ def add_wing_arguments(parser: argparse.ArgumentParser, default: str = "original
 
 
 def wing_from_args(args: argparse.Namespace):
-    """Build the wing named by --wing (or --aircraft); any problem becomes a one-line
-    UsageError."""
+    """Build the wing named by --wing (or --aircraft), with ``--lateral-aero`` where the
+    command has it; any problem becomes a one-line UsageError."""
+    from bioflex_jsb.flight_dynamics.wing_model import with_lateral_aero
+
+    lateral_aero = getattr(args, "lateral_aero", None)
+    build = _wing_from_args(args)
+    return build if lateral_aero is None else with_lateral_aero(build, lateral_aero)
+
+
+def _wing_from_args(args: argparse.Namespace):
     if getattr(args, "aircraft_definition", None) is not None:
         from bioflex_jsb.cli.aircraft_option import wing_from_aircraft
 

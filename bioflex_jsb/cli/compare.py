@@ -37,7 +37,11 @@ from bioflex_jsb.cli.gust import (
     run_description,
     wing_for_run,
 )
-from bioflex_jsb.cli.lateral_options import add_lateral_arguments, span_aileron
+from bioflex_jsb.cli.lateral_options import (
+    add_lateral_arguments,
+    lateral_aero_extra,
+    span_aileron,
+)
 
 HELP = f"""Fly --gust through the nonlinear JSBSim co-simulation and through the linear model
 of Eq. (4) with its gust input G (same wing model, same time grid, same gust samples) and
@@ -213,7 +217,7 @@ def _payload(args, build, result, nonlinear, stops) -> dict:
         "diverged": result.diverged, "divergence_time_s": nonlinear.stop_time_s,
         "controller": nonlinear.meta.get("controller"),
         "duration_s": float(nonlinear.time_s[-1]) if len(nonlinear.time_s) else 0.0,
-        "plot": args.plot, "out": args.out,
+        "plot": args.plot, "out": args.out, **lateral_aero_extra(args),
     }
 
 

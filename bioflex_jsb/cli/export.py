@@ -52,6 +52,9 @@ def register(sub) -> None:
                    help="longitudinal (default: Eq. 4) or lateral (the lateral-directional "
                    "model of the aircraft's JSBSim airframe and the wing's antisymmetric "
                    "modes)")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --axis lateral")
     p.add_argument("--out", required=True, metavar="FILE.npz|FILE.mat",
                    help="the model file (required)")
     add_force_argument(p)
@@ -77,13 +80,16 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"unknown model file type of {args.out!r}; accepted: "
                          f"{', '.join(FORMATS)}")
     check_output(args.out, args.force, "model file", ours=_is_our_model)
+    from bioflex_jsb.cli.lateral_options import check_lateral_aero
+
+    check_lateral_aero(args, args.axis == "lateral", "give --axis lateral")
     build = wing_from_args(args)
     if args.speed is None:
         args.speed = aircraft_speeds(args)[0]
     if args.axis == "lateral":  # its JSBSim airframe's trim (api.lateral_model)
         aircraft = getattr(args, "aircraft_definition", None)
         ss = api.lateral_model(aircraft if aircraft is not None else build, args.speed,
-                               args.model)
+                               args.model, lateral_aero=args.lateral_aero)
     else:  # the API's model (one builder): the wing's own aircraft (its S, mass, derivatives)
         ss = api.linear_model(build, args.speed, args.model)
     metadata = {"software": f"bioflex-jsb {__version__}", "wing": build.variant.name,
@@ -91,6 +97,8 @@ def run(args: argparse.Namespace) -> int:
                 "mass_basis": build.mass_basis, "model": args.model, "axis": args.axis,
                 "altitude_m": float(ss.notes.get("altitude_m", 0.0)),
                 "overrides": dict(build.model.coefficients.overrides)}
+    if args.lateral_aero is not None:  # the default's metadata unchanged
+        metadata["lateral_aero"] = args.lateral_aero
     try:
         write_state_space(ss, args.out, metadata)
     except OSError as exc:
@@ -101,7 +109,8 @@ def run(args: argparse.Namespace) -> int:
             "input_units": list(ss.input_units), "outputs": list(ss.outputs),
             "output_units": list(ss.output_units),
             "aerodynamics": ss.notes.get("aerodynamics"),
-            "overrides": dict(build.model.coefficients.overrides)}
+            "overrides": dict(build.model.coefficients.overrides),
+            **({} if args.lateral_aero is None else {"lateral_aero": args.lateral_aero})}
     if args.json:
         print_json(info)
     else:

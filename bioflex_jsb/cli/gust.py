@@ -34,6 +34,7 @@ from bioflex_jsb.cli.common import (
 )
 from bioflex_jsb.cli.lateral_options import (
     add_lateral_arguments,
+    lateral_aero_extra,
     lateral_description,
     lateral_run_options,
     lateral_summary,
@@ -269,6 +270,7 @@ def run_description(args, kind: str, models):
         extra["structural_damping"] = args.structural_damping
     if getattr(args, "trim", "rigid") != "rigid":
         extra["trim"] = args.trim
+    extra.update(lateral_aero_extra(args))
     aircraft = getattr(args, "aircraft_definition", None)
     if aircraft is not None and aircraft.flight_problem():  # another airframe: its file
         extra["aircraft"] = aircraft.source
@@ -415,6 +417,7 @@ def run(args: argparse.Namespace) -> int:
             "controller": runs[0].meta.get("controller") if runs else None,
             "lateral": {r.model: lateral_summary(r) for r in runs
                         if r.meta.get("span") == "full"},
+            **lateral_aero_extra(args),
             "stopped": stops,
             "plot": plot,
             "out": args.out,

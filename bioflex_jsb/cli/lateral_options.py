@@ -29,9 +29,41 @@ HELP_SPAN = ("half (the half wing's symmetric modes, the paper's) or full (both 
              "with an aileron input, else half")
 
 
+LATERAL_AERO_CHOICES = ("strips", "lattice")  # aerodynamics/antisymmetric_loading.py
+HELP_LATERAL_AERO = ("the antisymmetric loading of the wing's lateral elastic model (both "
+                     "halves): strips (default: each strip's C_la c alone) or lattice (the "
+                     "vortex lattice's antisymmetric loading of the whole distribution: the "
+                     "roll rate's, the modes' and the aileron's lift; quasi-steady only; "
+                     "docs/lateral.md, \"The lattice in the lateral elastic model\")")
+
+
+def add_lateral_aero_argument(p: argparse.ArgumentParser, where: str = "") -> None:
+    """--lateral-aero {strips,lattice}; ``where`` ends its help (when it applies)."""
+    p.add_argument("--lateral-aero", choices=LATERAL_AERO_CHOICES, default=None,
+                   help=HELP_LATERAL_AERO + where)
+
+
+def check_lateral_aero(args, full_span: bool, what: str) -> None:
+    """One line (UsageError) for ``--lateral-aero lattice`` where no lateral elastic model
+    is built (``full_span`` False; ``what`` says where it would be)."""
+    if getattr(args, "lateral_aero", None) == "lattice" and not full_span:
+        raise UsageError(f"--lateral-aero lattice loads both wing halves' antisymmetric "
+                         f"modes: {what}")
+
+
+def lateral_aero_extra(args) -> dict:
+    """What a run description records of ``--lateral-aero`` (a rerun flies it again):
+    ``lateral_aero`` and the ``span`` it loads, or nothing for the default."""
+    if getattr(args, "lateral_aero", None) is None:
+        return {}
+    return {"lateral_aero": args.lateral_aero, "span": "full"}
+
+
 def add_lateral_arguments(p: argparse.ArgumentParser) -> None:
-    """--span, --aileron-step, --aileron-doublet, --aileron-start, --aileron-width."""
+    """--span, --aileron-step, --aileron-doublet, --aileron-start, --aileron-width,
+    --lateral-aero."""
     p.add_argument("--span", choices=("half", "full"), default=None, help=HELP_SPAN)
+    add_lateral_aero_argument(p, "; with --span full (or an aileron input)")
     angle = number_type("aileron angle", "deg", low=-AILERON_MAX_DEG, high=AILERON_MAX_DEG)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--aileron-step", type=angle, default=None, metavar="DEG",
@@ -74,6 +106,7 @@ def lateral_run_options(args, build, controller=None) -> dict:
         kind = "step" if args.aileron_step is not None else "doublet"
         options["aileron_input"] = AileronInput(kind, math.radians(angle_deg),
                                                 args.aileron_start, args.aileron_width)
+    check_lateral_aero(args, span == "full", "give --span full (or an aileron input)")
     if span == "half":
         return options | {"span": "half"} if options else {}
     return options | {"span": "full", "aileron": _aileron(args, build)}
@@ -97,6 +130,7 @@ def lateral_description(args) -> dict:
 
 def span_options(args, build) -> dict:
     """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
+    check_lateral_aero(args, args.span == "full", "give --span full")
     if args.span != "full":
         return {}
     return {"span": "full", "aileron": _aileron(args, build)}

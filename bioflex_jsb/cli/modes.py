@@ -94,6 +94,9 @@ def register(sub) -> None:
                    help="longitudinal (default: the paper's models) or lateral (roll, "
                    "spiral, Dutch roll from the JSBSim model's derivatives and the wing's "
                    "antisymmetric modes; eigenvalues in rad/s)")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --axis lateral")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument(
         "--plot", metavar="FILE.png",
@@ -136,6 +139,9 @@ def _check_shape_outputs(args, speeds) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from bioflex_jsb.cli.lateral_options import check_lateral_aero
+
+    check_lateral_aero(args, args.axis == "lateral", "give --axis lateral")
     if args.axis == "lateral":
         return _run_lateral(args)
     default_speed, flight_top = aircraft_speeds(args)
@@ -232,10 +238,12 @@ def _run_lateral(args: argparse.Namespace) -> int:
             # --aero unsteady is the coupled model's (rigid has no strips; the qsd's static
             # deformation is the same: the unsteady increments vanish in a steady state)
             aero = args.aero if model == "coupled" else "quasi-steady"
-            ss = api.lateral_model(subject, v, model, aero)
-            results.append((ss, api.lateral_modes(subject, ss.speed_m_s, model, aero)))
+            ss = api.lateral_model(subject, v, model, aero, args.lateral_aero)
+            results.append((ss, api.lateral_modes(subject, ss.speed_m_s, model, aero,
+                                                  args.lateral_aero)))
     payload = {
         "axis": "lateral", "aircraft": name,
+        **({} if args.lateral_aero is None else {"lateral_aero": args.lateral_aero}),
         "results": [{**ms.as_dict(), "derivatives": ss.notes["derivatives"],
                      "alpha_trim_rad": ss.notes["alpha_trim_rad"],
                      "source": ss.notes["source"]} for ss, ms in results],

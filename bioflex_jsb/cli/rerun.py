@@ -33,8 +33,8 @@ LEGACY_REPEATABLE = ("gust", "sweep", "compare")  # commands whose old logs hold
 RUN_COMMANDS = ("gust", "compare")
 RUN_OPTIONS = ("--wing", "--aircraft", "--mass-basis", "--speed", "--gust", "--duration",
                "--gust-start", "--dt", "--models", "--model", "--aero",
-               "--structural-damping", "--trim", "--controller", "--span", "--aileron-step",
-               "--aileron-doublet", "--aileron-start", "--aileron-width")
+               "--structural-damping", "--trim", "--controller", "--lateral-aero", "--span",
+               "--aileron-step", "--aileron-doublet", "--aileron-start", "--aileron-width")
 
 
 tolerance = number_type("rtol", low=0.0, high=1.0, high_open=True)
@@ -85,6 +85,10 @@ def argv_for(description) -> list[str]:
         for key in ("aileron_step", "aileron_doublet", "aileron_start", "aileron_width"):
             if key in d.extra:
                 common += [f"--{key.replace('_', '-')}", repr(float(d.extra[key]))]
+    if d.extra.get("lateral_aero"):  # both halves on the recorded loading
+        common += ["--lateral-aero", str(d.extra["lateral_aero"])]
+        if not d.extra.get("span"):
+            common += ["--span", "full"]
     if d.kind == "compare":
         if len(d.models) != 1:
             raise UsageError(f"a comparison flies one model; the log names {list(d.models)}")

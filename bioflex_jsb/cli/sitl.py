@@ -101,6 +101,9 @@ def register(sub) -> None:
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
                    "the autopilot flies in its turns, their rolling moment to JSBSim; on "
                    "--aero's strips; docs/lateral.md)")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --span full")
     add_allow_unstable(p)
     from bioflex_jsb.cli.gust import add_controller_argument
 
@@ -253,6 +256,7 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
     if not args.out:
         return None
     from bioflex_jsb.cli.gust import open_log
+    from bioflex_jsb.cli.lateral_options import lateral_aero_extra
     from bioflex_jsb.simulation.run import RunDescription
 
     description = RunDescription(
@@ -265,7 +269,7 @@ def _session_log(args, build, sim, home, endpoint, key, check, airframe):
                "mavlink": endpoint.text(), "signed": key is not None,
                "trim": args.trim, "aero": args.aero,
                "preflight_stable": check["stable"], "glider": sim.glider,
-               **_controller_extra(args),
+               **_controller_extra(args), **lateral_aero_extra(args),
                # both halves: which step flies them
                **({"span": "full", "step": "compiled kernel" if sim.core.compiled
                    else "python"} if args.span == "full" else {}),

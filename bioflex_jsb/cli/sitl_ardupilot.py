@@ -94,6 +94,9 @@ def _span(args: argparse.Namespace, build) -> dict:
     if args.span == "full" and args.model == NATIVE:
         raise UsageError("--span full flies our wing's antisymmetric modes: not with --model "
                          "native")
+    if args.lateral_aero == "lattice" and args.model == NATIVE:
+        raise UsageError("--lateral-aero lattice loads our wing's antisymmetric modes: not "
+                         "with --model native")
     return span_options(args, build)
 
 
@@ -108,6 +111,9 @@ def register(sub) -> None:
                    "halves: the antisymmetric modes driven by the roll rate and the ailerons "
                    "ArduPlane flies, their rolling moment to JSBSim; on --aero's strips; "
                    "docs/lateral.md)")
+    from bioflex_jsb.cli.lateral_options import add_lateral_aero_argument
+
+    add_lateral_aero_argument(p, "; with --span full")
     from bioflex_jsb.cli.aircraft_option import cruise_speed_default
 
     p.add_argument("--speed", type=airspeed, default=cruise_speed_default(),
@@ -301,6 +307,7 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
     """The session's MCAP log (None with --no-log); a one-line UsageError if it cannot be
     written."""
     from bioflex_jsb.cli.gust import SCENE_EXAGGERATION
+    from bioflex_jsb.cli.lateral_options import lateral_aero_extra
     from bioflex_jsb.simulation.run import RunDescription
     from bioflex_jsb.sinks.mcap import LogWriteError, RunLog
 
@@ -320,6 +327,7 @@ def _open_log(args: argparse.Namespace, physics, variant: dict, overrides: dict,
                "record_every": args.record_every, "aero": args.aero,
                "step": physics.step_kind, "gust_repeat": args.gust_repeat,
                **({"span": "full"} if args.span == "full" else {}),
+               **lateral_aero_extra(args),
                "duration": ("until stopped: the flown duration is in the session-end event "
                             "(session_s)") if args.duration is None else "--duration"})
     from bioflex_jsb.flight_dynamics.wing_model import WingBuild

@@ -32,6 +32,7 @@ model holds the prototype's numbers), never flown with them in its place.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import functools
 import math
@@ -39,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bioflex_jsb.aerodynamics.antisymmetric_loading import LATERAL_AERO
 from bioflex_jsb.definition.airframe import GENERATED
 from bioflex_jsb.definition.clamped import beam_wing
 from bioflex_jsb.definition.flying import FLYING_N_MODES, axes, check_span
@@ -57,6 +59,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     WingBuild,
     WingVariant,
     build_wing,
+    with_lateral_aero,
 )
 from bioflex_jsb.parameters.airframe import (
     AIRFRAME_GEOMETRY,
@@ -112,7 +115,11 @@ def _constant_chord_form(y, chord, x, z) -> tuple[float, float] | None:
 
 
 class Aircraft:
-    """An aircraft definition and what the analyses build from it."""
+    """An aircraft definition and what the analyses build from it; ``lateral_aero`` the
+    antisymmetric loading its wing's lateral elastic models take (:meth:`wing`'s
+    ``WingBuild.lateral_aero``: ``strips``, or ``lattice`` by :meth:`with_lateral_aero`)."""
+
+    lateral_aero = "strips"
 
     def __init__(self, definition: Definition) -> None:
         if definition.airframe is None:
@@ -380,12 +387,25 @@ class Aircraft:
             return f"{head}structure.n_modes must be {FLYING_N_MODES}"
         return None
 
+    def with_lateral_aero(self, lateral_aero: str) -> Aircraft:
+        """This aircraft with its wing's lateral elastic models loaded by ``lateral_aero``
+        (``strips`` or ``lattice``; anything else one line)."""
+        if lateral_aero not in LATERAL_AERO:
+            raise DefinitionError(f"lateral_aero: unknown lateral aerodynamics "
+                                  f"{lateral_aero!r}; accepted: {', '.join(LATERAL_AERO)}")
+        other = copy.copy(self)
+        other.lateral_aero = lateral_aero
+        return other
+
     def wing(self, mass_basis: str = DEFAULT_MASS_BASIS) -> WingBuild:
         """The elastic wing on this airframe (modes, strips, the Table B1/B2 model, the
         :class:`AirframeData` its model carries); a :class:`DefinitionError` with
         :meth:`linear_problem`'s line if the linear analyses cannot take it. Flying it
         is a separate check (:meth:`flight_problem`: the CLI's flight commands and
-        ``api.fly_gust``/``compare`` make it)."""
+        ``api.fly_gust``/``compare`` make it). Its ``lateral_aero`` is the aircraft's."""
+        return with_lateral_aero(self._wing(mass_basis), self.lateral_aero)
+
+    def _wing(self, mass_basis: str) -> WingBuild:
         if self.flight_problem() is None:
             # the prototype's own planform and airframe objects: flight_problem has checked
             # these equal them, and the nonlinear runs read those objects

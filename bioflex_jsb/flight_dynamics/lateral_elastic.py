@@ -9,7 +9,9 @@ quasi-steady strips, as Eq. (4) couples the symmetric modes to the longitudinal 
   max |twist| = 1 on the starboard half, tip twist positive; the port half is the mirror
   image with the opposite sign);
 * the starboard strip at y (the lattice's strips, C_lα c of a uniform α: the symmetric
-  loading's, a strip-theory approximation for the antisymmetric one; e shifted as the
+  loading's, a strip-theory approximation for the antisymmetric one, or with the build's
+  ``lateral_aero = "lattice"`` the lattice's antisymmetric loading of the whole
+  distribution, :mod:`~bioflex_jsb.aerodynamics.antisymmetric_loading`; e shifted as the
   symmetric model's pin of C_η1^Q1 shifts it, the paper's wings) sees
   Δα = Σ θ_i η_i + Σ φ_i η̇_i / V + p y / V (φ_i bending down, a wing going down sees the
   air come up) and carries the lift l = Q C_lα c Δα (up); the port strip the opposite;
@@ -35,6 +37,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from bioflex_jsb.aerodynamics.antisymmetric_loading import (
+    antisymmetric_lift_matrix,
+    lift_per_alpha,
+)
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics.eigen import IMAG_TOL_RAD_S, Mode, ModeSet
 from bioflex_jsb.flight_dynamics.lateral import (
@@ -71,7 +77,9 @@ class AntisymmetricWing:
     ``planform`` (its dihedral) and ``span_m`` [m] the wing's span; ``root_slope`` (n,) each
     mode's bending slope at the root [rad per unit η, starboard wing down outboard positive]:
     the fuselage's roll relative to the mean axes, from the beam's root node (None: not
-    known)."""
+    known). ``lift_matrix_m`` (K, K) [m/rad] the lattice's antisymmetric loading of the
+    strips, l'/q = A α (:mod:`~bioflex_jsb.aerodynamics.antisymmetric_loading`); None: the
+    strips' own C_lα c α."""
 
     modes: ModalData
     stations_m: np.ndarray
@@ -86,6 +94,12 @@ class AntisymmetricWing:
     planform: object = None
     span_m: float = 0.0
     root_slope: np.ndarray | None = None
+    lift_matrix_m: np.ndarray | None = None
+
+    def lift_m(self, alpha_rad: np.ndarray) -> np.ndarray:
+        """l'/q [m] at the strips of the antisymmetric distributions ``alpha_rad`` (…, K)
+        [rad], by the strips or the lattice (``lift_matrix_m``)."""
+        return lift_per_alpha(self.cl_alpha_c_m, self.lift_matrix_m, alpha_rad)
 
     @property
     def n_modes(self) -> int:
@@ -149,7 +163,9 @@ def antisymmetric_wing(build, aircraft_ixx_kg_m2: float, n_modes: int = 3) -> An
                              theta, j_f, symmetric=build.modes,
                              n_symmetric=int(build.model.n_modes), planform=build.planform,
                              span_m=2.0 * float(build.aero.semispan_m),
-                             root_slope=root_slope)
+                             root_slope=root_slope,
+                             lift_matrix_m=antisymmetric_lift_matrix(
+                                 build.aero, build.lateral_aero))
 
 
 @dataclass(frozen=True)
@@ -171,8 +187,13 @@ def strip_terms(wing: AntisymmetricWing, dynamic_pressure_pa: float, speed_m_s: 
     """:class:`StripTerms` of ``wing`` (module docstring)."""
     q, v = float(dynamic_pressure_pa), float(speed_m_s)
     w, y = wing.weights_m, wing.stations_m
-    lift = q * wing.cl_alpha_c_m * w  # lift of a strip per rad of Δα [N]
     work = wing.e_m * wing.theta - wing.phi  # (n, K) upward AC displacement per unit η
+    if wing.lift_matrix_m is not None:  # the lattice's loading, per unit Q and Q/V
+        u = lattice_unit_terms(wing)
+        return StripTerms(roll_eta=q * u.roll_eta, roll_etadot=q / v * u.roll_etadot,
+                          force_p=q / v * u.force_p, force_eta=q * u.force_eta,
+                          force_etadot=q / v * u.force_etadot)
+    lift = q * wing.cl_alpha_c_m * w  # lift of a strip per rad of Δα [N]
     return StripTerms(
         roll_eta=-2.0 * (wing.theta * lift) @ y,
         roll_etadot=-2.0 * (wing.phi * lift / v) @ y,
@@ -180,6 +201,19 @@ def strip_terms(wing: AntisymmetricWing, dynamic_pressure_pa: float, speed_m_s: 
         force_eta=np.einsum("ik,jk,k->ij", work, wing.theta, lift),
         force_etadot=np.einsum("ik,jk,k->ij", work, wing.phi, lift / v),
     )
+
+
+def lattice_unit_terms(wing: AntisymmetricWing) -> StripTerms:
+    """:class:`StripTerms` of ``wing``'s lattice loading (``lift_matrix_m``) per unit
+    dynamic pressure (η terms) and per unit Q/V (η̇ and p terms) [N·m/Pa, N·m/(Pa·s/m)]:
+    each distribution's lift l'/q = A α (θ_i, φ_i, y), its rolling moment −2 Σ w y l'/q
+    and its virtual work Σ w (e θ_i − φ_i) l'/q."""
+    w, y = wing.weights_m, wing.stations_m
+    work = wing.e_m * wing.theta - wing.phi  # (n, K) upward AC displacement per unit η
+    l_theta, l_phi = w * wing.lift_m(wing.theta), w * wing.lift_m(wing.phi)
+    return StripTerms(roll_eta=-2.0 * l_theta @ y, roll_etadot=-2.0 * l_phi @ y,
+                      force_p=work @ (w * wing.lift_m(y)), force_eta=work @ l_theta.T,
+                      force_etadot=work @ l_phi.T)
 
 
 def build_lateral_elastic(model: str, trim: LateralTrim, aero: LateralAerodynamics,

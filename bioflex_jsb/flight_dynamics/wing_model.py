@@ -388,6 +388,9 @@ class WingBuild:
     # the aircraft's sensor stations in body axes from the CG (an aircraft definition's
     # [sensors], Aircraft.wing; none: the autopilot's IMU at the CG)
     sensors: Sensors = NO_SENSORS
+    # the antisymmetric loading of the lateral elastic models (aerodynamics/
+    # antisymmetric_loading.py: LATERAL_AERO): "strips" (default) or "lattice"
+    lateral_aero: str = "strips"
 
     @property
     def airframe(self) -> AirframeData:
@@ -408,6 +411,19 @@ class WingBuild:
             "overrides": dict(c.overrides),
             "coefficients": c.as_dict(),
         }
+
+
+def with_lateral_aero(build: WingBuild, lateral_aero: str) -> WingBuild:
+    """``build`` with its lateral elastic models' antisymmetric loading ``lateral_aero``
+    (``strips`` or ``lattice``; aerodynamics/antisymmetric_loading.py); anything else is
+    refused in one line."""
+    from bioflex_jsb.aerodynamics.antisymmetric_loading import LATERAL_AERO
+
+    if lateral_aero not in LATERAL_AERO:
+        raise InputError(f"lateral_aero: unknown lateral aerodynamics {lateral_aero!r}; "
+                         f"accepted: {', '.join(LATERAL_AERO)}")
+    return build if build.lateral_aero == lateral_aero else replace(
+        build, lateral_aero=lateral_aero)
 
 
 @lru_cache(maxsize=4)

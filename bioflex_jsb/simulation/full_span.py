@@ -27,6 +27,13 @@ the step; the rolling moment of η_{k+1} in that flow, ΔL = Q R^η η_a + (Q/V)
 the symmetric loads go to modal-lift, -drag, -pitch. ``qsd``: η_a the quasi-static balance of
 the flow of t_k, η̇_a = 0; ``rigid``: no antisymmetric wing (η_a = 0, no moment).
 
+**The loading** (the build's ``lateral_aero``, :mod:`bioflex_jsb.aerodynamics
+.antisymmetric_loading`): the strips' C_lα c, or the vortex lattice's antisymmetric loading
+of each distribution (p y/V, θ_a, φ_a, the aileron's, the sideslip's), folded into the
+per-unit-flow matrices above (:class:`~bioflex_jsb.aeroelasticity.antisymmetric_strips
+.AntisymmetricStrips`, :class:`~bioflex_jsb.aeroelasticity.antisymmetric_strips
+.YawSideslipTerms`): the step and its kernel are the same either way.
+
 No double count: the rigid wing's roll damping and the aileron's own rolling moment are
 JSBSim's (C_lp, C_lδa in its rigid tables); ΔL is the lift of the deformation alone, which is
 also how the aileron's loss of effectiveness (its twist of the wing) reaches the airframe.
