@@ -156,3 +156,24 @@ def flap_strip_loads(strips, surface: ControlSurface, n_all: int, lags: tuple[sl
         rate = JONES_WAGNER.exponents[j] * v / b
         lag_a[j * k:(j + 1) * k] = spread(JONES_WAGNER.amplitudes[j] * rate[:, None] * w34)
     return roll(lx), roll(lxd), force(lx, tx), force(lxd, txd), lag_a
+
+
+def step_response(ss: StateSpace, input_name: str, amplitude: float,
+                  times_s: np.ndarray) -> np.ndarray:
+    """The outputs of ``ss`` (continuous, from rest) after a step of ``amplitude`` [the
+    input's unit] in ``input_name`` at t = 0, at ``times_s`` [s] (rows: times, columns: the
+    outputs), exactly: x(t) = ∫₀ᵗ e^{Aτ} dτ B u, the integral the upper-right block of the
+    exponential of [[A, B u], [0, 0]] t (Van Loan 1978)."""
+    from scipy.linalg import expm
+
+    col = ss.inputs.index(input_name)
+    n = ss.n_states
+    u = float(amplitude)
+    big = np.zeros((n + 1, n + 1))
+    big[:n, :n] = ss.a
+    big[:n, n] = ss.b[:, col] * u
+    out = []
+    for t in np.asarray(times_s, dtype=float):
+        x = expm(big * t)[:n, n]
+        out.append(ss.c @ x + ss.d[:, col] * u)
+    return np.array(out)
