@@ -291,3 +291,19 @@ def test_cli_lists_the_actuator_and_unchanged_modes(tmp_path, capsys):
     assert "40 rad/s" in r["aileron_actuator"] and "Theodorsen" in r["aileron_unsteady"]
     assert "aileron_actuator" not in without["results"][0]
     assert r["modes"] == without["results"][0]["modes"]
+
+
+def test_modes_help_states_the_checked_ranges(capsys):
+    """modes --help's [aileron.actuator] ranges are the definition's checks."""
+    from bioflex_jsb.definition.ranges import (
+        ACTUATOR_DAMPING_RANGE,
+        ACTUATOR_FREQUENCY_RANGE_RAD_S,
+    )
+
+    code, out, _ = run_cli(capsys, "modes", "--help")
+    assert code == 0
+    flat = " ".join(out.split())
+    lo, hi = ACTUATOR_FREQUENCY_RANGE_RAD_S
+    assert f"natural_frequency_rad_s ({lo:g}..{hi:g} rad/s)" in flat
+    lo, hi = ACTUATOR_DAMPING_RANGE
+    assert f"damping_ratio ({lo:g}..{hi:g})" in flat

@@ -41,8 +41,10 @@ Two systems are built from it:
   columns of β … η̇ are that quasi-steady model's exactly (the lags then only listen: block
   triangular), which labels its roots by continuation to 1
   (:func:`unsteady_lateral_mode_set`). The aileron's own unsteady terms (Theodorsen's
-  T-functions: its circulatory lift through the lag, its δ̇, δ̈ apparent mass) are not in
-  it: they need the surface's rate and acceleration, an actuator model's states;
+  T-functions: its circulatory lift through the lag, its δ̇, δ̈ apparent mass) need the
+  surface's rate and acceleration: with an actuator
+  (:mod:`bioflex_jsb.aeroelasticity.actuated_aileron`) they are in it, its states δa, δ̇a
+  after the lags;
 * :func:`antisymmetric_family`: the antisymmetric aeroelastic system of the flutter search:
   the roll rate p (the aircraft's I_xx, roll damping from the same strips: the wing's, the
   tail's left out) and the modes, the sideslip, yaw and bank left out (they do not load the
