@@ -214,3 +214,17 @@ def test_jones_lag_against_exact_c(c):
                                           **SECTION))
         worst = np.maximum(worst, np.abs(lag - exact) / np.abs(exact))
     assert np.all(worst < JONES_TOLERANCE[c]), worst
+
+
+@pytest.mark.parametrize("a", AXES_A)
+def test_trailing_edge_limit(a):
+    """c → 1 (a flap of no chord): every T but T₁₄ (1/16 + a c/2) vanishes, as the flap's
+    loads must: at c = 1 − 1e-12 (r = √(1 − c²) = 1.4e-6) T₁₀ = r + arccos c ≈ 2r (the
+    steady flap lift goes as the square root of the flap's chord), every other one below
+    r² (measured ≤ 1.6e-18)."""
+    t = flap_t_functions(1.0 - 1e-12, a)
+    r = math.sqrt(1.0 - (1.0 - 1e-12) ** 2)
+    assert t.t10 == pytest.approx(2.0 * r, rel=1e-6)
+    for name in ("t1", "t2", "t3", "t4", "t5", "t6", "t7", "t8", "t9", "t11", "t12", "t13"):
+        assert abs(getattr(t, name)) < r * r, (name, getattr(t, name))
+    assert t.t14 == pytest.approx(1.0 / 16.0 + 0.5 * a, abs=1e-12)
