@@ -70,7 +70,7 @@ from bioflex_jsb.flight_dynamics.wing_model import (
     resolve_variant,
     with_lateral_aero,
 )
-from bioflex_jsb.inputs import Choice, Interval, Real, argument
+from bioflex_jsb.inputs import Choice, Flag, Interval, Real, argument
 from bioflex_jsb.runtime.fdm import Airframe
 from bioflex_jsb.runtime.jsbsim_aircraft import airframe_for
 from bioflex_jsb.runtime.jsbsim_aircraft import complete as complete_aircraft
@@ -613,10 +613,14 @@ def _lateral_point(wing, speed_m_s: float | None):
 
 
 def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady",
-             lateral_aero: str | None = None):
+             lateral_aero: str | None = None, actuated: bool = False, flap_terms: bool = True):
     """(the model, its rigid model, the antisymmetric wing or None) of :func:`lateral_model`;
-    ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None)."""
+    ``aero`` ``unsteady``: (the unsteady model, its labelled modes, None). ``actuated``: the
+    model behind the aircraft's ``[aileron.actuator]`` when it has one (the modes are the
+    model's without it: the actuator's roots are its own); ``flap_terms`` the aileron's
+    unsteady loads on the unsteady strips (with an actuator)."""
     from bioflex_jsb.aeroelasticity import antisymmetric as anti
+    from bioflex_jsb.aeroelasticity.actuated_aileron import with_actuator
     from bioflex_jsb.aeroelasticity.antisymmetric_strips import lateral_model_with_aileron
     from bioflex_jsb.flight_dynamics.lateral_elastic import (
         LATERAL_MODELS,
@@ -631,9 +635,15 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady",
         raise InputError(f"aero='unsteady' is the coupled lateral model's (the wing's strips "
                          f"on its antisymmetric modes), not the {model} one")
     subject, point = _lateral_point(wing, speed_m_s)
+    actuator = (subject.aircraft.definition.aileron_actuator
+                if actuated and subject.aircraft is not None else None)
+
+    def behind(ss):
+        return ss if actuator is None else with_actuator(ss, actuator)
+
     rigid = build_lateral_elastic("rigid", point.trim, point.aero, None)
     if model == "rigid":
-        return rigid, rigid, None
+        return behind(rigid), rigid, None
     if subject.build is None:
         raise InputError(f"the lateral {model} model needs an elastic wing: pass a wing or "
                          "an Aircraft, not None")
@@ -645,14 +655,17 @@ def _lateral(wing, speed_m_s, model: str, aero: str = "quasi-steady",
     if aero == "unsteady":
         strips = anti.aircraft_strips(subject.build, wing_a, point.trim.ixx_kg_m2)
         return (*anti.unsteady_lateral_mode_set(point.trim, point.aero, wing_a, strips,
-                                                surface, subject.build.aero.chord_m), None)
+                                                surface, subject.build.aero.chord_m,
+                                                actuator=actuator, flap_terms=flap_terms),
+                None)
     ss, _ = lateral_model_with_aileron(model, point.trim, point.aero, wing_a, surface,
                                        subject.build.aero.chord_m)
-    return ss, rigid, wing_a
+    return behind(ss), rigid, wing_a
 
 
 def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid",
-                  aero: str = "quasi-steady", lateral_aero: str | None = None) -> StateSpace:
+                  aero: str = "quasi-steady", lateral_aero: str | None = None,
+                  flap_terms: bool = True) -> StateSpace:
     """The linear lateral-directional model at ``speed_m_s`` [m/s] (None: the aircraft's
     cruise speed, the prototype's 15 m/s), about its JSBSim trim there (docs/lateral.md):
     states beta [rad] (sideslip, air from the right), p, r [rad/s] (roll right, yaw right,
@@ -682,8 +695,18 @@ def lateral_model(wing=None, speed_m_s: float | None = None, model: str = "rigid
     of the whole distribution: docs/lateral.md, "The lattice in the lateral elastic
     model"; quasi-steady only); None: the wing's own (``strips`` unless set). One line
     (InputError) when the aircraft cannot be trimmed at that speed, or its wing has no beam
-    (a modal-data file: no antisymmetric modes)."""
-    return _lateral(wing, speed_m_s, model, aero, lateral_aero)[0]
+    (a modal-data file: no antisymmetric modes).
+
+    An aircraft whose definition has an ``[aileron.actuator]`` (docs/lateral.md, "The
+    aileron's actuator and unsteady flap") gets, in every model, the states aileron [rad]
+    and aileron_dot [rad/s] (appended; outputs too) and the input aileron_cmd [rad] in
+    the aileron's place; with ``aero="unsteady"`` the aileron's own unsteady loads
+    (Theodorsen's T-functions: circulatory lift through the lags, apparent mass in its rate
+    and acceleration) are on the strips, unless ``flap_terms`` is False (the aileron's
+    quasi-steady load only, for comparison; no effect without an actuator)."""
+    flap_terms = argument(Flag(), flap_terms, "flap_terms")
+    return _lateral(wing, speed_m_s, model, aero, lateral_aero, actuated=True,
+                    flap_terms=flap_terms)[0]
 
 
 def lateral_modes(wing=None, speed_m_s: float | Iterable[float] | None = None,

@@ -41,8 +41,10 @@ Two systems are built from it:
   columns of β … η̇ are that quasi-steady model's exactly (the lags then only listen: block
   triangular), which labels its roots by continuation to 1
   (:func:`unsteady_lateral_mode_set`). The aileron's own unsteady terms (Theodorsen's
-  T-functions: its circulatory lift through the lag, its δ̇, δ̈ apparent mass) are not in
-  it: they need the surface's rate and acceleration, an actuator model's states;
+  T-functions: its circulatory lift through the lag, its δ̇, δ̈ apparent mass) need the
+  surface's rate and acceleration: with an actuator
+  (:mod:`bioflex_jsb.aeroelasticity.actuated_aileron`) they are in it, its states δa, δ̇a
+  after the lags;
 * :func:`antisymmetric_family`: the antisymmetric aeroelastic system of the flutter search:
   the roll rate p (the aircraft's I_xx, roll damping from the same strips: the wing's, the
   tail's left out) and the modes, the sideslip, yaw and bank left out (they do not load the
@@ -58,11 +60,19 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bioflex_jsb.aerodynamics.indicial import JONES_WAGNER
+from bioflex_jsb.aeroelasticity.actuated_aileron import (
+    ACTUATOR_STATES,
+    ACTUATOR_UNITS,
+    SURFACE_INPUT,
+    actuated_inputs,
+    actuator_note,
+    flap_strip_loads,
+)
 from bioflex_jsb.aeroelasticity.antisymmetric_strips import (
     dihedral_rad,
     lateral_model_with_aileron,
 )
-from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface, SurfaceActuator
 from bioflex_jsb.errors import InputError
 from bioflex_jsb.flight_dynamics import flutter_engine as engine
 from bioflex_jsb.flight_dynamics.eigen import IMAG_TOL_RAD_S, Mode, ModeSet
@@ -303,7 +313,9 @@ def lag_names(n_strips: int) -> tuple[str, ...]:
 def unsteady_lateral_model(trim: LateralTrim, aero: LateralAerodynamics,
                            wing: AntisymmetricWing, strips: AntisymmetricStrips,
                            surface: ControlSurface | None, chord_m: np.ndarray, *,
-                           unsteadiness: float = 1.0, static_eta_s=None) -> StateSpace:
+                           unsteadiness: float = 1.0, static_eta_s=None,
+                           actuator: SurfaceActuator | None = None,
+                           flap_terms: bool = True) -> StateSpace:
     """The coupled lateral model of the one builder
     (:func:`~bioflex_jsb.aeroelasticity.antisymmetric_strips.lateral_model_with_aileron`:
     quasi-steady strips, ``surface``'s quasi-steady load on the modes, the yaw rate's and
@@ -312,9 +324,17 @@ def unsteady_lateral_model(trim: LateralTrim, aero: LateralAerodynamics,
     [m/s]; inputs v_g, aileron, rudder; outputs the states and n_y. ``chord_m`` [m] the
     builder's strips' chords (the lattice's, ``build.aero.chord_m``). ``unsteadiness``
     (0 … 1) scales the increments: 0 is the quasi-steady model with the lags listening (its
-    eigenvalues the quasi-steady ones and −β_j V/b_k)."""
+    eigenvalues the quasi-steady ones and −β_j V/b_k).
+
+    ``actuator``: the aileron's actuator (None: none, the model above); with it the states
+    ``aileron`` [rad], ``aileron_dot`` [rad/s] follow the lags, the input ``aileron_cmd``
+    [rad] replaces ``aileron``, and, with ``flap_terms`` and a ``surface``, the aileron's
+    own unsteady loads (Theodorsen's T-functions: its circulatory lift through the lags,
+    its δ̇, δ̈ apparent mass; :mod:`bioflex_jsb.aeroelasticity.actuated_aileron`) are on
+    the strips."""
     base = _quasi_steady_base(trim, aero, wing, surface, chord_m, static_eta_s)
-    return with_unsteady_strips(base, trim, strips, unsteadiness=unsteadiness)
+    return with_unsteady_strips(base, trim, strips, unsteadiness=unsteadiness,
+                                actuator=actuator, surface=surface if flap_terms else None)
 
 
 def _quasi_steady_base(trim: LateralTrim, aero: LateralAerodynamics, wing: AntisymmetricWing,
@@ -327,7 +347,8 @@ def _quasi_steady_base(trim: LateralTrim, aero: LateralAerodynamics, wing: Antis
 
 
 def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: AntisymmetricStrips, *,
-                         unsteadiness: float = 1.0) -> StateSpace:
+                         unsteadiness: float = 1.0, actuator: SurfaceActuator | None = None,
+                         surface: ControlSurface | None = None) -> StateSpace:
     """``base`` (a coupled lateral model, states β, p, r, φ, η_i, η̇_i) with the unsteady
     strips' increments of ``strips`` (the same modes) scaled by ``unsteadiness`` and their
     lag states appended. The increments' rolling moment acts on ṗ, ṙ through J⁻¹, with the
@@ -335,17 +356,26 @@ def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: Antisymmet
     the strips' semispan: the full-span step's induced angle); their generalised force on
     η̈; their side force on the strips' dihedral (``strips.dihedral_rad``), −2 Σ Δl Γ_g w, on
     β̇ (÷ m V) and n_y (÷ m g). ``base``'s B, n_y row and notes are carried over (B through
-    the apparent mass's E⁻¹)."""
+    the apparent mass's E⁻¹). ``actuator`` (None: none) appends the aileron's states after
+    the lags, and ``surface`` (with an actuator; None: none) puts the aileron's unsteady
+    loads on the strips (:func:`unsteady_lateral_model`), their side force too."""
     n, k = strips.n_modes, strips.n_strips
     n0 = 4 + 2 * n
     if base.n_states != n0 or base.model != "coupled-lateral":
         raise ValueError(f"the unsteady strips go onto a coupled lateral model of {n} modes, "
                          f"not {base.model!r} with {base.n_states} states")
-    n_all = n0 + 2 * k
+    n_lagged = n0 + 2 * k
+    n_all = n_lagged + (0 if actuator is None else 2)
     layout = Layout(n_all, 1, slice(4, 4 + n), slice(4 + n, n0),
-                    (slice(n0, n0 + k), slice(n0 + k, n_all)))
+                    (slice(n0, n0 + k), slice(n0 + k, n_lagged)))
     loads = strip_loads(strips, layout, trim.speed_m_s, trim.density_kg_m3,
                         quasi_steady=False, unsteady=True, unsteadiness=unsteadiness)
+    if actuator is not None and surface is not None:
+        extra = flap_strip_loads(strips, surface, n_all, layout.lags, n_lagged, n_lagged + 1,
+                                 trim.speed_m_s, trim.density_kg_m3, unsteadiness)
+        loads = StripLoads(*(x + y for x, y in zip(
+            (loads.roll_x, loads.roll_xd, loads.force_x, loads.force_xd, loads.lag_a,
+             loads.side_x, loads.side_xd), extra, strict=True)))
     q, mass, v = float(trim.dynamic_pressure_pa), float(trim.mass_kg), float(trim.speed_m_s)
     span_m = 2.0 * float(np.sum(strips.weights_m))
     induced = mass * STANDARD_GRAVITY_M_S2 / (q * math.pi * span_m**2)  # α_i [rad]
@@ -364,26 +394,46 @@ def with_unsteady_strips(base: StateSpace, trim: LateralTrim, strips: Antisymmet
     a = np.zeros((n_all, n_all))
     a[:n0, :n0] = base.a
     a += rates(loads.roll_x, loads.force_x, loads.side_x)
-    a[n0:] += loads.lag_a
+    a[n0:n_lagged] += loads.lag_a
     e = np.eye(n_all) - rates(loads.roll_xd, loads.force_xd, loads.side_xd)
-    a = np.linalg.solve(e, a)
-    b = np.linalg.solve(e, np.vstack([base.b, np.zeros((2 * k, base.b.shape[1]))]))
-    lags = lag_names(k)
+    b_plant = np.vstack([base.b, np.zeros((n_all - n0, base.b.shape[1]))])
+    i_ny = base.outputs.index("n_y")
+    n_y_c = np.r_[base.c[i_ny], np.zeros(n_all - n0)]
+    d_ny = np.asarray(base.d[i_ny], dtype=float)
+    inputs, lags = base.inputs, lag_names(k)
     states = base.states + lags
     units = base.state_units + ("m/s",) * 2 * k
-    i_ny = base.outputs.index("n_y")
+    notes = {**base.notes, "wing": "antisymmetric modes, unsteady strips (Jones lag states, "
+             "apparent mass)", "lag_states": 2 * k, "unsteadiness": float(unsteadiness)}
+    if actuator is not None:
+        col = base.inputs.index(SURFACE_INPUT)
+        a[:n0, n_lagged] += base.b[:, col]  # the surface's loads now read its state
+        a_act, b_act = actuator.matrices()
+        a[n_lagged:, n_lagged:] = a_act
+        b_plant[:, col] = 0.0
+        b_plant[n_lagged:, col] = b_act[:, 0]
+        n_y_c[n_lagged] = d_ny[col]
+        d_ny = d_ny.copy()
+        d_ny[col] = 0.0
+        inputs = actuated_inputs(base.inputs)
+        states += ACTUATOR_STATES
+        units += ACTUATOR_UNITS
+        notes["aileron_actuator"] = actuator_note(actuator)
+        notes["aileron_unsteady"] = (
+            "none: the aileron's quasi-steady load only" if surface is None else
+            "Theodorsen's flap terms: circulatory lift through the lags, apparent mass in "
+            "aileron_dot and its rate (aeroelasticity/actuated_aileron.py)")
+    a = np.linalg.solve(e, a)
+    b = np.linalg.solve(e, b_plant)
     # n_y: the aerodynamic side force (the rigid one, the modes', the increments' with
     # their apparent mass on ẋ = A x + B u)
     weight = mass * STANDARD_GRAVITY_M_S2
-    n_y_c = (np.r_[base.c[i_ny], np.zeros(2 * k)] + loads.side_x / weight
-             + loads.side_xd @ a / weight)
-    n_y_d = base.d[i_ny] + loads.side_xd @ b / weight
+    n_y_c = n_y_c + loads.side_x / weight + loads.side_xd @ a / weight
+    d_ny = d_ny + loads.side_xd @ b / weight
     c = np.vstack([np.eye(n_all), n_y_c])
-    d = np.vstack([np.zeros((n_all, b.shape[1])), n_y_d])
-    notes = {**base.notes, "wing": "antisymmetric modes, unsteady strips (Jones lag states, "
-             "apparent mass)", "lag_states": 2 * k, "unsteadiness": float(unsteadiness)}
+    d = np.vstack([np.zeros((n_all, b.shape[1])), d_ny])
     return StateSpace(model="unsteady-lateral", speed_m_s=trim.speed_m_s, a=a, b=b,
-                      c=c, d=d, states=states, state_units=units, inputs=base.inputs,
+                      c=c, d=d, states=states, state_units=units, inputs=inputs,
                       input_units=base.input_units, outputs=states + ("n_y",),
                       output_units=units + ("-",), notes=notes)
 
@@ -413,12 +463,14 @@ def _homotopy(matrix, reference_a: np.ndarray, reference_labels: list[str],
 def unsteady_lateral_mode_set(trim: LateralTrim, aero: LateralAerodynamics,
                               wing: AntisymmetricWing, strips: AntisymmetricStrips,
                               surface: ControlSurface | None, chord_m: np.ndarray,
-                              static_eta_s=None) -> tuple[StateSpace, ModeSet]:
+                              static_eta_s=None, actuator: SurfaceActuator | None = None,
+                              flap_terms: bool = True) -> tuple[StateSpace, ModeSet]:
     """(the unsteady lateral model, its labelled modes): the quasi-steady coupled model's
     labels (:func:`coupled_mode_set` on the one builder's model, the quasi-steady part of
     :func:`unsteady_lateral_model` with the same arguments) carried to the unsteady one by
     continuation in the unsteadiness (0 → 1, :data:`HOMOTOPY_STEPS` steps); the lag roots
-    left out."""
+    left out. ``actuator``, ``flap_terms`` as :func:`unsteady_lateral_model`'s (the model
+    with them; its modes are those without the actuator, whose roots are its own)."""
     rigid = build_lateral_elastic("rigid", trim, aero, None)
     qs = _quasi_steady_base(trim, aero, wing, surface, chord_m, static_eta_s)
     qs_modes = coupled_mode_set(qs, rigid, wing)
@@ -428,7 +480,10 @@ def unsteady_lateral_mode_set(trim: LateralTrim, aero: LateralAerodynamics,
         return with_unsteady_strips(qs, trim, strips, unsteadiness=eps).a
 
     lam, names = _homotopy(matrix, qs.a, labels)
-    ss = with_unsteady_strips(qs, trim, strips)
+    # the actuator's states leave the aircraft's roots as they are (block triangular): the
+    # modes are the model's without it
+    ss = with_unsteady_strips(qs, trim, strips, actuator=actuator,
+                              surface=surface if flap_terms else None)
     return ss, _mode_set(lam, names, ss, [m.mode for m in qs_modes.modes])
 
 

@@ -75,6 +75,36 @@ class ControlSurface:
                 "flap_chord_ratio": round(self.flap_chord_ratio, 12)}
 
 
+@dataclass(frozen=True)
+class SurfaceActuator:
+    """A control surface's actuator as a second-order lag from the command δ_c to the
+    surface angle δ [rad]: δ̈ = ω_n² (δ_c − δ) − 2 ζ ω_n δ̇, ``natural_frequency_rad_s`` ω_n
+    [rad/s], ``damping_ratio`` ζ [-]; unit steady gain, no rate or travel limit (a linear
+    model's). Its states δ, δ̇ carry the surface's rate and acceleration, which the flap's
+    unsteady (apparent-mass) loads need."""
+
+    natural_frequency_rad_s: float
+    damping_ratio: float
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.natural_frequency_rad_s)
+                and self.natural_frequency_rad_s > 0.0):
+            raise ValueError(f"actuator natural frequency must be a positive number [rad/s], "
+                             f"got {self.natural_frequency_rad_s!r}")
+        if not (math.isfinite(self.damping_ratio) and self.damping_ratio > 0.0):
+            raise ValueError(f"actuator damping ratio must be positive, got "
+                             f"{self.damping_ratio!r}")
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """(A (2, 2), B (2, 1)) of the states (δ [rad], δ̇ [rad/s]) and the command [rad]."""
+        w, z = float(self.natural_frequency_rad_s), float(self.damping_ratio)
+        return (np.array([[0.0, 1.0], [-w * w, -2.0 * z * w]]), np.array([[0.0], [w * w]]))
+
+    def as_dict(self) -> dict:
+        return {"natural_frequency_rad_s": self.natural_frequency_rad_s,
+                "damping_ratio": self.damping_ratio}
+
+
 def hinge_angle_rad(hinge: float) -> float:
     """Glauert's θ_h [rad] of a hinge at ``hinge`` chord fractions: cos θ_h = 1 − 2·hinge."""
     return math.acos(1.0 - 2.0 * float(hinge))

@@ -65,7 +65,12 @@ same with Theodorsen strips, Jones lag states and apparent mass on the modes and
 rate, the lag roots not listed) and qsd (their static deformation); a wing given as a
 modal-data file has no antisymmetric modes (rigid only). The aircraft must trim there (the
 prototype 9..32 m/s; an --aircraft its flight speeds, default its cruise speed);
---structural-damping, --plot, --animate and --mode-sheet do not apply.
+--structural-damping, --plot, --animate and --mode-sheet do not apply. An --aircraft whose
+[aileron.actuator] gives natural_frequency_rad_s (1..1000 rad/s) and damping_ratio
+(0.1..3) drives its aileron through that actuator: with --aero unsteady the aileron's
+Theodorsen terms (circulatory lift through the lags, apparent mass in its rate and
+acceleration) load the modes and the roll; the modes listed are unchanged (the actuator's
+roots are its own), JSON "aileron_actuator", "aileron_unsteady".
 JSON: "derivatives" (body axes, per rad; rates with b/2V) and "source" per result;
 docs/lateral.md."""
 
@@ -246,7 +251,8 @@ def _run_lateral(args: argparse.Namespace) -> int:
         **({} if args.lateral_aero is None else {"lateral_aero": args.lateral_aero}),
         "results": [{**ms.as_dict(), "derivatives": ss.notes["derivatives"],
                      "alpha_trim_rad": ss.notes["alpha_trim_rad"],
-                     "source": ss.notes["source"]} for ss, ms in results],
+                     "source": ss.notes["source"], **_actuator_notes(ss)}
+                    for ss, ms in results],
         "unstable": [{"speed_m_s": ms.speed_m_s, "model": ms.model, "mode": m.mode,
                       "re": m.re, "im": m.im}
                      for _, ms in results for m in ms.modes if m.unstable],
@@ -265,7 +271,17 @@ def _run_lateral(args: argparse.Namespace) -> int:
                 note += f" (doubles in {math.log(2.0) / m.re:.0f} s)"
             print(f"{ms.speed_m_s:8.2f} {ms.model:<16} {m.mode:<16} {m.re:11.4f} {m.im:11.4f} "
                   f"{m.damping:8.3f} {m.frequency_rad_s:12.4f}  {note}")
+    for key, text in _actuator_notes(results[0][0] if results else None).items():
+        print(f"{key.replace('_', ' ')}: {text}")
     return 0
+
+
+def _actuator_notes(ss) -> dict:
+    """The model's notes on the aircraft's ``[aileron.actuator]`` and the aileron's unsteady
+    terms ({} without an actuator: its roots are its own, the modes unchanged)."""
+    notes = {} if ss is None else ss.notes
+    return {key: notes[key] for key in ("aileron_actuator", "aileron_unsteady")
+            if key in notes}
 
 
 def _shapes(args, build, speed_m_s: float) -> dict:

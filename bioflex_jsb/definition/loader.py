@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface, SurfaceActuator
 from bioflex_jsb.definition.airframe import parse_airframe
 from bioflex_jsb.definition.flying import (
     FLYING_AERO_FIELDS,
@@ -33,6 +33,8 @@ from bioflex_jsb.definition.model import (
     WingStation,
 )
 from bioflex_jsb.definition.ranges import (  # noqa: F401  (re-exported: api, cli)
+    ACTUATOR_DAMPING_RANGE,
+    ACTUATOR_FREQUENCY_RANGE_RAD_S,
     AERO_MODELS,
     CHORD_RANGE_M,
     DAMPING_RANGE,
@@ -247,7 +249,7 @@ def _aileron(r: Reader, semispan_m: float) -> ControlSurface | None:
     """``[aileron]`` (optional): ``span = [start, end]`` as fractions of the semispan or
     ``y_m = [start, end]`` in metres (one of them), ``hinge`` the hinge line's chord
     fraction aft of the leading edge (docs/aircraft.md)."""
-    t = r.table("aileron", ("span", "y_m", "hinge"), required=False)
+    t = r.table("aileron", ("span", "y_m", "hinge", "actuator"), required=False)
     if not t:
         return None
     given = [k for k in ("span", "y_m") if k in t]
@@ -271,6 +273,26 @@ def _aileron(r: Reader, semispan_m: float) -> ControlSurface | None:
                      hint=" (the hinge line aft of the leading edge: a 25 %-chord aileron "
                      "is 0.75)")
     return ControlSurface(lo_v * scale, hi_v * scale, hinge, "aileron")
+
+
+def _aileron_actuator(r: Reader) -> SurfaceActuator | None:
+    """``[aileron.actuator]`` (optional): ``natural_frequency_rad_s`` and ``damping_ratio``
+    of the aileron's second-order actuator (docs/lateral.md, "The aileron's actuator and
+    unsteady flap")."""
+    t = r.data.get("aileron")
+    if not isinstance(t, dict) or "actuator" not in t:
+        return None
+    a = t["actuator"]
+    if not isinstance(a, dict):
+        raise r.fail("aileron.actuator", "must be a table [aileron.actuator] with "
+                     "natural_frequency_rad_s and damping_ratio")
+    r.keys(a, "aileron.actuator", ("natural_frequency_rad_s", "damping_ratio"))
+    return SurfaceActuator(
+        r.number(a, "aileron.actuator", "natural_frequency_rad_s",
+                 *ACTUATOR_FREQUENCY_RANGE_RAD_S, "rad/s",
+                 hint=" (rad/s, not Hz: a 10 Hz servo is 62.8)"),
+        r.number(a, "aileron.actuator", "damping_ratio", *ACTUATOR_DAMPING_RANGE, "(ratio)",
+                 hint=" (a ratio: 70 % of critical is 0.7)"))
 
 
 def parse_aileron(table: dict, semispan_m: float, where: str) -> ControlSurface:
@@ -326,7 +348,8 @@ def parse_definition(data: dict, where: str, path: str = "") -> Definition:
                       monitoring_stations=_monitoring_stations(r),
                       sensor_stations=parse_sensors(r, data, stations[-1].y_m,
                                                     airframe is not None),
-                      aileron=_aileron(r, stations[-1].y_m))
+                      aileron=_aileron(r, stations[-1].y_m),
+                      aileron_actuator=_aileron_actuator(r))
 
 
 def shipped_path(name: str) -> Path:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bioflex_jsb.aeroelasticity.control_surface import ControlSurface
+from bioflex_jsb.aeroelasticity.control_surface import ControlSurface, SurfaceActuator
 from bioflex_jsb.parameters.airframe import DerivativeSchedule
 from bioflex_jsb.structures.beam import PointMass, VerticalSpring
 
@@ -253,6 +253,8 @@ class Definition:
     sensor_stations: tuple = ()
     # [aileron]: the wing's aileron (span range in metres, hinge line), or None: no surface
     aileron: ControlSurface | None = None
+    # [aileron.actuator]: its second-order actuator, or None: the aileron is at its command
+    aileron_actuator: SurfaceActuator | None = None
 
     @property
     def clamped(self) -> bool:

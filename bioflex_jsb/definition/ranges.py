@@ -62,3 +62,10 @@ MAX_MONITORING_STATIONS = 50  # a table of section loads, not a spanwise distrib
 # [aileron]: its span [fraction of the semispan] is at least this wide: narrower is a tab,
 # not an aileron, and no strip analysis resolves it (200 strips are 0.5 % of the semispan).
 MIN_CONTROL_SPAN_FRACTION = 0.01
+# [aileron.actuator]: the second-order actuator's natural frequency [rad/s] and damping
+# ratio. 1 rad/s is slower than any flown surface (a glider's ailerons through cables and a
+# pilot move in 0.2 s or less); 1000 rad/s (160 Hz) is above any servo's bandwidth, where
+# the actuator is no longer a lag worth a state. ζ from 0.1 (a lightly damped servo
+# resonance) to 3 (an overdamped, nearly first-order lag).
+ACTUATOR_FREQUENCY_RANGE_RAD_S = (1.0, 1000.0)
+ACTUATOR_DAMPING_RANGE = (0.1, 3.0)
