@@ -622,8 +622,9 @@ class SensorRows:
 def _state_positions(x: np.ndarray, n_s: int, n_a: int, parts) -> np.ndarray:
     """Where η_s, η_a, then η̇_s, η̇_a lie in the state ``x`` (int64): the half wing's
     [η, η̇, …] (``parts`` None; the unsteady wing's lag states after them), or each of
-    ``parts`` (the symmetric and antisymmetric wings' [η, η̇], views into ``x``) at its own
-    offset; ValueError for a part not inside ``x``."""
+    ``parts`` (the symmetric and antisymmetric wings' [η, η̇, …], views into ``x``; on
+    unsteady strips each wing's lag states after its η̇) at its own offset; ValueError for a
+    part not inside ``x``."""
     if not x.flags.c_contiguous:
         raise ValueError("the wing's state must be one contiguous array")
     if parts is None:
@@ -635,7 +636,7 @@ def _state_positions(x: np.ndarray, n_s: int, n_a: int, parts) -> np.ndarray:
     for view, n in zip(parts, (n_s, n_a), strict=True):
         start = (view.__array_interface__["data"][0] - x.__array_interface__["data"][0]) \
             // x.itemsize
-        if view.size != 2 * n or start < 0 or start + 2 * n > x.size \
+        if view.size < 2 * n or start < 0 or start + view.size > x.size \
                 or not np.shares_memory(view, x):
             raise ValueError("a wing's state is not a view into the full-span state")
         offsets.append(start)
