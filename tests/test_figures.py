@@ -305,3 +305,59 @@ def test_the_tuned_envelope_has_a_colour_bar_and_keeps_its_labels_inside(tmp_pat
         for text in ax.texts:
             inside = text.get_window_extent().expanded(0.98, 0.9)
             assert box.x0 <= inside.x0 and inside.x1 <= box.x1, (text.get_text(), box, inside)
+
+
+def _rolling(model: str, label: str | None = None, controller: bool = False,
+             p_g: bool = True) -> TimeHistory:
+    """A synthetic full-span run: the longitudinal channels and the lateral ones."""
+    run = _run(model, label)
+    t = run.time_s
+    lateral = {name: np.cos(t + i) * 0.02 for i, name in enumerate(
+        ("beta_rad", "p_rad_s", "r_rad_s", "phi_rad", "asym_eta1", "aileron_rad"))}
+    lateral["modal_roll_n_m"] = 3.0 * np.sin(2.0 * t)
+    lateral["p_g"] = np.where(t >= 0.5, 0.1, 0.0) if p_g else np.zeros_like(t)
+    lateral["v_g"] = np.where(t >= 0.5, 1.0, 0.0)
+    if controller:
+        lateral["ctrl_aileron_rad"] = -0.01 * np.sin(t)
+    for name, values in lateral.items():
+        run.channels[name] = values
+        run.units[name] = "-"
+    return run
+
+
+def test_a_run_that_rolls_gets_the_lateral_panels_beside_the_longitudinal_ones(captured):
+    """Eight lateral-directional panels after the eight longitudinal ones (which keep their
+    places in fig.axes), each drawing its channel in the drawn unit; the aileron panel the
+    controller's command when one flew, the gust panel p_g when it blows."""
+    run, lti = _rolling("coupled", controller=True), _rolling("coupled", "LTI coupled")
+    lti.meta["source"] = "lti"  # its lines carry the NRMSE
+    plotting.time_histories([run, lti], "x.png", "t", nrmse={"p_rad_s": 0.01})
+    fig = captured[0]
+    assert len(fig.axes) == 16
+    assert [ax.get_ylabel() for ax in fig.axes[:6]] == [
+        "Δu [m/s]", "Δα [deg]", "q [deg/s]", "Δθ [deg]", "n_z [-]", "gust w_g [m/s] (up)"]
+    labels = [ax.get_ylabel() for ax in fig.axes[8:]]
+    assert labels == ["β [deg]", "p [deg/s]", "r [deg/s]", "φ [deg]",
+                      "δa command over trim [deg]", "gust roll rate p_g [deg/s]",
+                      "η_a1 [deg]", "modes' rolling moment [N·m]"]
+    for ax, channel, scale in ((fig.axes[9], "p_rad_s", np.degrees(1.0)),
+                               (fig.axes[12], "ctrl_aileron_rad", np.degrees(1.0)),
+                               (fig.axes[13], "p_g", np.degrees(1.0)),
+                               (fig.axes[15], "modal_roll_n_m", 1.0)):
+        np.testing.assert_allclose(ax.get_lines()[0].get_ydata(), scale * run[channel])
+    gust_lines = [ln for ln in fig.axes[13].get_lines() if ln.get_label().startswith("p_g")]
+    assert len(gust_lines) == 1  # the gust input once
+    assert any("NRMSE 0.010" in t.get_text() for t in fig.axes[9].get_legend().get_texts())
+    notes = " ".join(t.get_text() for t in fig.texts)
+    assert "Lateral signs" in notes and "lateral-directional" in notes
+
+
+def test_the_lateral_panels_choose_the_surface_and_the_lateral_gust_when_so_flown(captured):
+    plotting.time_histories([_rolling("coupled", p_g=False)], "x.png", "t")
+    labels = [ax.get_ylabel() for ax in captured[0].axes[8:]]
+    assert labels[4] == "aileron δa [deg]" and labels[5] == "lateral gust v_g [m/s]"
+
+
+def test_a_run_that_does_not_roll_keeps_the_eight_panels(captured):
+    plotting.time_histories([_run("coupled")], "x.png", "t")
+    assert len(captured[0].axes) == 8

@@ -288,6 +288,38 @@ TIME_PANELS = (
     ("eta1", "{label}, 0.1 s envelope", None),  # scale: ModeDisplay's
     ("eta1_zoom", "{label}, gust onset", None),
 )
+DEG = 180.0 / np.pi
+# The lateral-directional panels of a run that rolls (a full-span run, a gust that varies
+# over the aircraft: its channels p_rad_s …), in the sign conventions of
+# simulation/channels.py. Two panels are chosen by what the runs carry: the aileron (the
+# command over the trim when a controller flew, else the surfaces' δa) and the gust input
+# (its roll rate p_g when it has one, else its lateral v_g).
+LATERAL_PANELS = (
+    ("beta_rad", "β [deg]", DEG),
+    ("p_rad_s", "p [deg/s]", DEG),
+    ("r_rad_s", "r [deg/s]", DEG),
+    ("phi_rad", "φ [deg]", DEG),
+    ("aileron", "", DEG),
+    ("lateral_gust", "", None),
+    ("asym_eta1", "η_a1 [deg]", DEG),
+    ("modal_roll_n_m", "modes' rolling moment [N·m]", 1.0),
+)
+AILERON_PANELS = {
+    "ctrl_aileron_rad": "δa command over trim [deg]",
+    "aileron_rad": "aileron δa [deg]",
+}
+LATERAL_GUST_PANELS = {
+    "p_g": ("gust roll rate p_g [deg/s]", DEG),
+    "v_g": ("lateral gust v_g [m/s]", 1.0),
+}
+LATERAL_NOTE = ("Lateral signs: β wind from starboard +; p, φ, p_g, rolling moment right wing "
+                "down +; r nose right +; δa rolls right +; v_g to starboard +; η_a1 the "
+                "coordinate of antisymmetric mode 1 (docs/lateral.md)")
+INPUT_CHANNELS = ("w_g", "p_g", "v_g")  # the gust's samples: drawn once, in black
+# what a lateral panel says when no run carries its channel (a half-wing run that rolls)
+_HALF_WING = "the half wing: no antisymmetric modes (--span full flies both halves)"
+ABSENT = {"asym_eta1": _HALF_WING, "modal_roll_n_m": _HALF_WING,
+          "aileron_rad": "no aileron input in these runs"}
 ENVELOPE_NOTE = "Left: its running mean, the running min/max over 0.1 s shaded"
 # Runs that share a model's style (e.g. two wings flown with the same model) get these
 # colours instead, in order, so that every line in a figure can be told apart.
@@ -401,8 +433,16 @@ class _Panels:
                    _distinct_styles(runs), t_gust, t_zoom, t_end, nrmse)
 
     def draw(self, ax, name: str, ylabel: str, scale: float | None) -> None:
-        """One panel: every run's ``name`` channel, the diverged runs' ×, limits and labels."""
+        """One panel: every run's ``name`` channel, the diverged runs' ×, limits and labels;
+        a channel no run carries (the half wing's antisymmetric mode): a note instead."""
         channel = "eta1" if name == "eta1_zoom" else name
+        if not self._runs_on(name, channel):
+            ax.text(0.5, 0.5, ABSENT.get(channel, "not in these runs"), transform=ax.transAxes,
+                    ha="center", va="center", color="0.45", fontsize=9)
+            ax.set_ylabel(ylabel)
+            ax.set_xlim(0.0, self.t_end)
+            ax.set_yticks([])
+            return
         zoom = ((self.t_zoom - ZOOM_BEFORE_S, self.t_zoom + ZOOM_AFTER_S)
                 if name == "eta1_zoom" else None)
         limits: list[float] = []
@@ -422,7 +462,7 @@ class _Panels:
             ax.axvline(self.t_gust, color="0.6", lw=0.7, ls=":")
         ax.set_ylabel(ylabel.format(label=self.shown.label))
         ax.grid(True, alpha=0.3)
-        if self.nrmse is not None or name == "w_g":
+        if self.nrmse is not None or name in INPUT_CHANNELS:
             ax.legend(fontsize=7, loc="best")  # NRMSE differs by panel: a legend in each
 
     def _runs_on(self, name: str, channel: str) -> list[TimeHistory]:
@@ -431,12 +471,12 @@ class _Panels:
         same samples)."""
         out = [r for r in self.runs if channel in r.channels and len(r.time_s)
                and not (channel == "eta1" and r.model == "rigid")]
-        return out[:1] if name == "w_g" else out
+        return out[:1] if name in INPUT_CHANNELS else out
 
     def _label(self, run: TimeHistory, name: str, channel: str) -> str:
-        if name == "w_g":
+        if name in INPUT_CHANNELS:
             gust_text = str(run.meta.get("gust", "") or "")
-            return f"w_g, gust {gust_text}" if gust_text else "w_g"
+            return f"{name}, gust {gust_text}" if gust_text else name
         label = str(run.meta.get("label", run.model))
         if (self.nrmse is not None and run.meta.get("source") == "lti"
                 and channel in self.nrmse):
@@ -450,7 +490,7 @@ class _Panels:
               stops: list[tuple[float, float]]) -> None:
         """One run's line on a panel (η₁ as its running envelope and mean); the finished
         runs' extremes go to ``limits``, a diverged run's last point to ``stops``."""
-        style = (dict(color="black", ls="-", lw=1.2, zorder=2) if name == "w_g"
+        style = (dict(color="black", ls="-", lw=1.2, zorder=2) if name in INPUT_CHANNELS
                  else dict(self.styles[id(run)]))
         t, y = run.time_s, run[channel] * (self.shown.scale(run) if scale is None else scale)
         label = self._label(run, name, channel)
@@ -470,7 +510,7 @@ class _Panels:
             extremes = [float(y.min()), float(y.max())]
         if run.stopped is None:
             limits += extremes
-        elif name != "w_g" and (zoom is None or run.time_s[-1] <= zoom[1]):
+        elif name not in INPUT_CHANNELS and (zoom is None or run.time_s[-1] <= zoom[1]):
             stops.append((float(t[-1]), float(y[-1])))
 
 
@@ -479,7 +519,7 @@ def _figure_legend(fig, axes) -> None:
     handles: dict[str, object] = {}
     for ax in axes.flat:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            if not label.startswith("w_g"):
+            if not label.startswith(INPUT_CHANNELS):
                 handles.setdefault(label, handle)
     if handles:
         fig.legend(list(handles.values()), list(handles), loc="upper center",
@@ -499,21 +539,78 @@ def time_histories(runs: Sequence[TimeHistory], path: str | Path, title: str,
     early (diverged) ends in a red × on every panel and says when in the legend; the axes
     are scaled to the runs that finished, so they stay readable. ``nrmse`` (channel →
     NRMSE [-]) labels the LTI prediction's line in every panel (``compare``).
+
+    Runs that roll (a full-span run, a gust that varies over the aircraft: any run with the
+    channel ``p_rad_s``) get eight lateral-directional panels beside those
+    (:data:`LATERAL_PANELS`: β, p, r, φ [deg, deg/s], the aileron [deg], the gust's roll rate
+    p_g [deg/s] or lateral v_g [m/s], the first antisymmetric mode η_a1 [deg] and the
+    modes' rolling moment [N·m]); the figure's first eight axes stay the longitudinal ones.
     """
-    fig, axes = plt.subplots(4, 2, figsize=(12, 12.6), sharex=False)
+    lateral = _lateral_panels(runs)
+    cols = 4 if lateral else 2
+    fig = plt.figure(figsize=(12 * cols / 2, 12.6))
+    grid = fig.add_gridspec(4, cols)
+    # made column block by column block: the longitudinal axes are fig.axes[:8] (callers and
+    # tests index them), the lateral ones after them
+    axes = np.empty((4, cols), dtype=object)
+    for c0 in range(0, cols, 2):
+        for r in range(4):
+            for c in (c0, c0 + 1):
+                axes[r, c] = fig.add_subplot(grid[r, c])
+    longitudinal = axes[:, :2]
     panels = _Panels.of(runs, nrmse)
-    for ax, (name, ylabel, scale) in zip(axes.flat, TIME_PANELS, strict=True):
+    for ax, (name, ylabel, scale) in zip(longitudinal.flat, TIME_PANELS, strict=True):
         panels.draw(ax, name, ylabel, scale)
+    if lateral:
+        for ax, (name, ylabel, scale) in zip(axes[:, 2:].flat, lateral, strict=True):
+            panels.draw(ax, name, ylabel, scale)
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     fig.suptitle(title, y=0.995)
     if nrmse is None:
         _figure_legend(fig, axes)
+    notes = []
     if any("eta1" in r.channels and r.model != "rigid" for r in runs):
-        fig.text(0.5, 0.004, f"{panels.shown.note}. {ENVELOPE_NOTE}", ha="center",
-                 va="bottom", fontsize=8, color="0.25", wrap=True)
-    fig.tight_layout(rect=(0.0, 0.02, 1.0, 0.955 if nrmse is None else 0.98))
+        notes.append(f"{panels.shown.note}. {ENVELOPE_NOTE}")
+    if lateral:
+        notes.append(LATERAL_NOTE)
+    if notes:
+        fig.text(0.5, 0.004, "\n".join(notes), ha="center", va="bottom", fontsize=8,
+                 color="0.25", wrap=True)
+    top = 0.955 if nrmse is None else 0.98
+    fig.tight_layout(rect=(0.0, 0.02 * max(len(notes), 1), 1.0,
+                           top - (0.02 if lateral else 0.0)))
+    if lateral:  # each block's heading over its two columns
+        for block, text in ((axes[0, :2], "longitudinal"), (axes[0, 2:], "lateral-directional")):
+            left, right = block[0].get_position(), block[1].get_position()
+            fig.text(0.5 * (left.x0 + right.x1), right.y1 + 0.012, text, ha="center",
+                     va="bottom", fontsize=11, fontweight="bold")
     return save_figure(fig, path)
+
+
+def _lateral_panels(runs: Sequence[TimeHistory]) -> tuple | None:
+    """:data:`LATERAL_PANELS` with the aileron and gust panels chosen for ``runs`` (None:
+    no run rolls)."""
+    if not any("p_rad_s" in r.channels for r in runs):
+        return None
+
+    def carried(name: str) -> bool:
+        return any(name in r.channels for r in runs)
+
+    def blows(name: str) -> bool:
+        return any(name in r.channels and np.any(np.asarray(r[name]) != 0.0) for r in runs)
+
+    aileron = next((c for c in AILERON_PANELS if carried(c)), "aileron_rad")
+    gust = next((c for c in LATERAL_GUST_PANELS if blows(c)),
+                next((c for c in LATERAL_GUST_PANELS if carried(c)), "p_g"))
+    out = []
+    for name, ylabel, scale in LATERAL_PANELS:
+        if name == "aileron":
+            name, ylabel = aileron, AILERON_PANELS[aileron]
+        elif name == "lateral_gust":
+            name, (ylabel, scale) = gust, LATERAL_GUST_PANELS[gust]
+        out.append((name, ylabel, scale))
+    return tuple(out)
 
 
 def _distinct_styles(runs: Sequence[TimeHistory]) -> dict[int, dict]:
