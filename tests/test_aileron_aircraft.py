@@ -93,3 +93,33 @@ def test_cli_aircraft(capsys):
     code, _, err = run_cli(capsys, "aileron", "--aircraft", "bioflex_optimised",
                            "--lift-slope", "strip")
     assert_one_line_error(code, err, "--lift-slope is for --clamped")
+
+
+def test_a_full_span_run_near_or_above_reversal_says_so():
+    """cli/lateral_options.reversal_note: the reversal speed of the run's wing and aileron
+    is `aileron`'s exactly (the same static problem), and a run at 90 % of it or more gets
+    one line saying which side it is on (the prototype: 12.82 m/s at sea level)."""
+    from bioflex_jsb.aeroelasticity.aileron import flight_roll_strips, reversal_speed_m_s
+    from bioflex_jsb.cli.lateral_options import reversal_note
+    from bioflex_jsb.simulation.full_span import prototype_aileron
+
+    build, aileron = api.load_wing("optimised"), prototype_aileron("optimised")
+    v_r = reversal_speed_m_s(flight_roll_strips(build, aileron), 1.225)
+    assert v_r == api.aileron_effectiveness(build, aileron=aileron).reversal_speed_m_s
+    assert v_r == pytest.approx(12.82, abs=0.01)
+    assert "is above" in reversal_note(build, aileron, 15.0, 0.0)
+    assert "roll the elastic aircraft the other way" in reversal_note(build, aileron, 15.0, 0.0)
+    assert "within 10 %" in reversal_note(build, aileron, 0.95 * v_r, 0.0)
+    assert reversal_note(build, aileron, 0.89 * v_r, 0.0) is None
+    # thinner air, the same speed: the reversal's dynamic pressure is reached at a higher
+    # true airspeed (√(ρ₀/ρ)), so 12.9 m/s at 3000 m (ρ 0.909) is below 0.9 of it
+    assert reversal_note(build, aileron, 12.9, 0.0) is not None
+    assert reversal_note(build, aileron, 12.9, 3000.0) is None
+
+
+def test_gust_above_reversal_prints_the_note_and_flies(capsys):
+    code, _out, err = run_cli(capsys, "gust", "--aileron-step", "2", "--models", "coupled",
+                              "--duration", "0.6", "--gust-start", "0.2", "--no-log")
+    assert code == 0, err
+    notes = [ln for ln in err.splitlines() if "aileron reversal speed" in ln]
+    assert len(notes) == 1 and "15 m/s is above the optimised wing's" in notes[0], err

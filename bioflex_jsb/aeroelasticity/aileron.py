@@ -460,6 +460,15 @@ def derived_range_m_s(reversal_m_s: float | None, divergence_m_s: float | None
     return 0.0, min(SPEED_LIMIT_M_S, top)
 
 
+def reversal_speed_m_s(strips: RollStrips, density_kg_m3: float) -> float | None:
+    """The aileron reversal speed [m/s] of ``strips`` at ``density_kg_m3`` [kg/m³] (None:
+    none): the lowest speed at which the rolling moment per aileron angle, root held, is
+    zero; the steady roll rate per aileron angle of the wing free to roll, −R_δ/R_p of the
+    same elastic balance, changes sign there too (module docstring)."""
+    return _speed(static_roll_matrices(strips).reversal_dynamic_pressure_pa(),
+                  float(density_kg_m3))
+
+
 def aileron_effectiveness(strips: RollStrips, *, density_kg_m3: float,
                           range_m_s: tuple[float, float] | None = None,
                           n_speeds: int = N_SPEEDS, name: str = "",

@@ -38,6 +38,7 @@ from bioflex_jsb.cli.lateral_options import (
     lateral_description,
     lateral_run_options,
     lateral_summary,
+    print_pending_notes,
 )
 from bioflex_jsb.cli.live_option import add_live_arguments, live_opener, start_live, stop_live
 from bioflex_jsb.simulation.modal_wing import DEFAULT_DT_S, MAX_DT_S, MIN_DT_S
@@ -345,6 +346,7 @@ def fly(args, build, config, log=None, airframe=None):
             run.meta.update(wing=build.variant.name, mass_basis=build.mass_basis,
                             overrides=dict(build.model.coefficients.overrides))
             runs.append(run)
+            print_pending_notes(args)  # the reversal note, once a run was set up
             if run.meta.get("interrupted"):
                 raise Interrupted(runs)
             if run.stopped:

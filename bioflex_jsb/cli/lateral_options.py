@@ -49,6 +49,11 @@ def check_lateral_aero(args, full_span: bool, what: str) -> None:
     if getattr(args, "lateral_aero", None) == "lattice" and not full_span:
         raise UsageError(f"--lateral-aero lattice loads both wing halves' antisymmetric "
                          f"modes: {what}")
+    if getattr(args, "lateral_aero", None) == "lattice" and \
+            getattr(args, "aero", None) == "unsteady":
+        raise UsageError("--lateral-aero lattice is quasi-steady (the unsteady strips are "
+                         "Theodorsen's, strip by strip); accepted with --aero unsteady: "
+                         "--lateral-aero strips")
 
 
 def lateral_aero_extra(args) -> dict:
@@ -128,12 +133,16 @@ def lateral_description(args) -> dict:
     return out
 
 
-def span_options(args, build) -> dict:
-    """``span`` and ``aileron`` of ``--span`` for a session (sitl): {} for the half wing."""
+def span_options(args, build, altitude_m: float | None = None) -> dict:
+    """``span`` and ``aileron`` of ``--span`` for a session (sitl, ardupilot) starting at
+    ``altitude_m`` [m above sea level; None: ``--altitude``, else sea level]: {} for the
+    half wing."""
     check_lateral_aero(args, args.span == "full", "give --span full")
     if args.span != "full":
         return {}
-    return {"span": "full", "aileron": _aileron(args, build)}
+    if altitude_m is None:
+        altitude_m = float(getattr(args, "altitude", None) or 0.0)
+    return {"span": "full", "aileron": _aileron(args, build, altitude_m)}
 
 
 def span_aileron(args, build):
@@ -145,13 +154,53 @@ def span_aileron(args, build):
             else prototype_aileron(build.variant.name))
 
 
-def _aileron(args, build):
-    """:func:`span_aileron`, with a note on stderr when there is none."""
+def _aileron(args, build, altitude_m: float = 0.0):
+    """:func:`span_aileron`, with a note on stderr when there is none, or when the run's
+    speed at ``altitude_m`` [m above sea level] is near or above the wing's aileron reversal
+    speed (:func:`reversal_note`)."""
     aileron = span_aileron(args, build)
     if aileron is None:
         print(f"bioflex-jsb: note: wing {build.variant.name!r} has no [aileron]: its "
               "antisymmetric modes are driven by the roll rate alone", file=sys.stderr)
+        return None
+    speed = getattr(args, "speed", None)
+    if speed is not None:
+        note = reversal_note(build, aileron, float(speed), altitude_m)
+        if note:  # said once the run is set up: a refusal of the setup stays one line
+            args.pending_notes = [*getattr(args, "pending_notes", []), note]
     return aileron
+
+
+def print_pending_notes(args) -> None:
+    """Print on stderr the notes :func:`_aileron` kept for after the run's setup (the
+    reversal note), once."""
+    for note in getattr(args, "pending_notes", []):
+        print(f"bioflex-jsb: note: {note}", file=sys.stderr)
+    args.pending_notes = []
+
+
+REVERSAL_MARGIN = 0.9  # a run at 90 % of the reversal speed or more gets the note
+
+
+def reversal_note(build, aileron, speed_m_s: float, altitude_m: float) -> str | None:
+    """One line when ``speed_m_s`` [m/s] is at least :data:`REVERSAL_MARGIN` of the aileron
+    reversal speed of ``build``'s wing with ``aileron`` in the ISA at ``altitude_m`` [m]
+    (as `bioflex-jsb aileron` reports it: the flight model's modes, root held), else None:
+    above it the ailerons roll the elastic aircraft the other way, and an autopilot's roll
+    loop then drives the bank away from its target."""
+    from bioflex_jsb.aeroelasticity.aileron import flight_roll_strips, reversal_speed_m_s
+    from bioflex_jsb.runtime.jsbsim_aircraft import isa_density_kg_m3
+
+    v_r = reversal_speed_m_s(flight_roll_strips(build, aileron), isa_density_kg_m3(altitude_m))
+    if v_r is None or speed_m_s < REVERSAL_MARGIN * v_r:
+        return None
+    if speed_m_s >= v_r:
+        what = "above", "its ailerons roll the elastic aircraft the other way"
+    else:
+        what = "within 10 % of", "its ailerons have lost most of their rolling power"
+    return (f"{speed_m_s:g} m/s is {what[0]} the {build.variant.name} wing's aileron "
+            f"reversal speed, {v_r:.1f} m/s (ISA at {altitude_m:g} m; `bioflex-jsb aileron "
+            f"--aircraft`): {what[1]}")
 
 
 def lateral_summary(run) -> dict[str, float]:

@@ -179,9 +179,12 @@ def run(args: argparse.Namespace) -> int:
                       trim_mode=args.trim, aero=args.aero, airframe=airframe,
                       controller=controller,
                       **({} if speeds is None else {"airspeed_range_m_s": speeds}),
-                      **span_options(args, build))
+                      **span_options(args, build, home[2] + args.start_height))
     except (FdmError, InputError) as exc:  # it cannot be trimmed, a control moves nothing,
         raise UsageError(str(exc)) from None  # a home out of range
+    from bioflex_jsb.cli.lateral_options import print_pending_notes
+
+    print_pending_notes(args)  # the reversal note, the session set up
     try:
         link = MavlinkLink(endpoint, SitlParameters(sim), sim.vehicle, signing_key=key)
     except LinkError as exc:

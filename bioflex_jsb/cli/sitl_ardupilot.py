@@ -300,6 +300,9 @@ def _build(args: argparse.Namespace):
                                    compiled=compiled, **extra, **_span(args, build))
     except FdmError as exc:  # the airframe cannot load or trim (InputErrors reach the CLI)
         raise UsageError(str(exc)) from None
+    from bioflex_jsb.cli.lateral_options import print_pending_notes
+
+    print_pending_notes(args)  # the reversal note, the physics set up
     return physics, variant, overrides, check
 
 

@@ -143,7 +143,7 @@ def envelope(airframe: Airframe, reference: ReferenceGeometry, mass_kg: float,
              altitude_m: float) -> tuple[float, float, float, float]:
     """(stall speed, lowest, cruise, highest speed) [m/s] of the aircraft (module
     docstring). Raises :class:`TrimError` when it trims nowhere."""
-    rho = _density(altitude_m)
+    rho = isa_density_kg_m3(altitude_m)
     weight = mass_kg * STANDARD_GRAVITY_M_S2
 
     def level_speed(cl: float) -> float:
@@ -207,7 +207,8 @@ def envelope(airframe: Airframe, reference: ReferenceGeometry, mass_kg: float,
     return stall, low, cruise, high
 
 
-def _density(altitude_m: float) -> float:
+def isa_density_kg_m3(altitude_m: float) -> float:
+    """The ISA troposphere's density [kg/m³] at ``altitude_m`` [m above sea level]."""
     return ISA_RHO0_KG_M3 * (1.0 - ISA_LAPSE_K_M * altitude_m / ISA_T0_K) ** ISA_EXPONENT
 
 
