@@ -32,6 +32,7 @@ an estimate the timings do not support is reported as not trusted, with the reas
 of a figure (never negative). Timed on the process's CPU clock (a run preempted by other
 work is not charged for the wait; wall-clock figures beside them in --json). Ratios, the
 figure and its groups': ratio = co-simulation / bare, logged_ratio = logged co-simulation /
+bare (the whole gust log), logged_rows_ratio = the co-simulation logging its rows alone /
 bare, log_ratio = logged / unlogged, unsteady_ratio = unsteady co-simulation / bare,
 native_ratio = native / bare, python_ratio = Python step / bare, full_span_ratio = the
 co-simulation of both wing halves (span full: the antisymmetric modes, the ailerons) / bare;
@@ -233,6 +234,7 @@ def _print(p: dict) -> None:
           f"after {load}")
     rows = (("bare JSBSim", "bare", None), ("co-simulation", "cosim", "ratio"),
             ("  logged (gust log)", "logged", "logged_ratio"),
+            ("  logged (rows only)", "logged_rows", "logged_rows_ratio"),
             ("  unsteady strips", "unsteady", "unsteady_ratio"),
             ("  Python step", "python", "python_ratio"),
             ("  both halves", "full_span", "full_span_ratio"),
@@ -241,23 +243,23 @@ def _print(p: dict) -> None:
         print(f"{label:20s} {_spread(us[key], ' µs/step')}")
         if ratio_key is not None:
             r = p[ratio_key]
-            print(f"{'':20s} {ratio_key:14s} {_spread(r)}{_against_bar(r)}")
-    print(f"{'':20s} {'log_ratio':14s} {_spread(p['log_ratio'])}")
+            print(f"{'':20s} {ratio_key:17s} {_spread(r)}{_against_bar(r)}")
+    print(f"{'':20s} {'log_ratio':17s} {_spread(p['log_ratio'])}")
     for key, label in (("rows", "the rows"), ("section_loads", "section loads"),
                        ("scene", "3-D scene"), ("all", "the whole log")):
         print(f"  logging cost, {label:15s} {_spread(p['log_costs_us_per_step'][key], ' µs/step')}")
     for gust, d in p["cosim_us_per_step_by_gust"].items():
         print(f"co-simulation, {gust:18s} {_spread(d, ' µs/step')}")
     print(f"{'  with a controller':20s} {_spread(us['controlled'], ' µs/step')}")
-    print(f"{'':20s} {'/ cosim':14s} {_spread(p['controlled_ratio'])}")
+    print(f"{'':20s} {'/ cosim':17s} {_spread(p['controlled_ratio'])}")
     print(f"  controller in the loop (with - without) "
           f"{_spread(p['controller_in_loop_us_per_step'], ' µs/step')}")
     print(f"{'  with 2 IMUs':20s} {_spread(us['sensors'], ' µs/step')}")
-    print(f"{'':20s} {'/ cosim':14s} {_spread(p['sensors_ratio'])}")
+    print(f"{'':20s} {'/ cosim':17s} {_spread(p['sensors_ratio'])}")
     print(f"  sensor stations (with - without) "
           f"{_spread(p['sensor_stations_us_per_step'], ' µs/step')}")
     print(f"{'  and a controller':20s} {_spread(us['sensed_controlled'], ' µs/step')}")
-    print(f"{'':20s} {'/ cosim':14s} {_spread(p['sensed_controlled_ratio'])}")
+    print(f"{'':20s} {'/ cosim':17s} {_spread(p['sensed_controlled_ratio'])}")
     print(f"  its controller on the tip a_z (with - without) "
           f"{_spread(p['sensor_controller_in_loop_us_per_step'], ' µs/step')}")
     c = p["controller_us"]

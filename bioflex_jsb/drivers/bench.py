@@ -94,13 +94,16 @@ LENGTH_SCALE = {"unsteady": 4, "full_span": 64}
 # slope agrees with the least per-repeat cost within 25 %.
 MAX_RESIDUAL = 0.10
 MAX_DISAGREEMENT = 0.25
-# The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step.
-BARS = {"ratio": 1.5, "logged_ratio": 1.8, "unsteady_ratio": 2.0, "native_ratio": 1.2,
-        "full_span_ratio": 1.6}
+# The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step. The
+# log's (decided with the maintainers, issues 26 and 28): a gust log as it is written (the
+# rows and section loads every step, the 3-D scene at 60 Hz) ≤ 2.0, the rows alone ≤ 1.8.
+BARS = {"ratio": 1.5, "logged_ratio": 2.0, "logged_rows_ratio": 1.8, "unsteady_ratio": 2.0,
+        "native_ratio": 1.2, "full_span_ratio": 1.6}
 CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
 LOGS = (None, "rows", "loads", "gust")  # StepBench.cosim's logs
 # figure → (numerator, denominator) configurations
 RATIOS = {"ratio": ("cosim", "bare"), "logged_ratio": ("logged", "bare"),
+          "logged_rows_ratio": ("logged_rows", "bare"),
           "log_ratio": ("logged", "cosim"), "unsteady_ratio": ("unsteady", "bare"),
           "native_ratio": ("native", "bare"), "python_ratio": ("python", "bare"),
           # sensor stations and controllers, against the co-simulation without them
