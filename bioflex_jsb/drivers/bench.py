@@ -95,8 +95,8 @@ LENGTH_SCALE = {"unsteady": 4, "full_span": 64}
 MAX_RESIDUAL = 0.10
 MAX_DISAGREEMENT = 0.25
 # The project's bars on a quiet 2-core machine: co-simulation step / bare JSBSim step. The
-# log's (decided with the maintainers, issues 26 and 28): a gust log as it is written (the
-# rows and section loads every step, the 3-D scene at 60 Hz) ≤ 2.0, the rows alone ≤ 1.8.
+# log's, as the maintainers set them: a gust log as it is written (the rows and section
+# loads every step, the 3-D scene at 60 Hz) ≤ 2.0, the rows alone ≤ 1.8.
 BARS = {"ratio": 1.5, "logged_ratio": 2.0, "logged_rows_ratio": 1.8, "unsteady_ratio": 2.0,
         "native_ratio": 1.2, "full_span_ratio": 1.6}
 CLOCKS = ("cpu", "wall")  # time.process_time, time.perf_counter
