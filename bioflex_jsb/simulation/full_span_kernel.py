@@ -59,6 +59,93 @@ def lateral_block_size(n_modes: int, n_symmetric: int) -> int:
     return sum(s for _, s in lateral_layout(n_modes, n_symmetric).values())
 
 
+# --------------------------------------------------------------------------------------
+# The pieces both full-span kernels share (this one and unsteady_full_span_kernel): the
+# terms of the quasi-steady strips that do not depend on how the antisymmetric modes are
+# stepped. Each takes its offsets into params, so either kernel's layout serves; each is
+# inlined into its caller (numba's IR inlining: a call per step would cost the hot path).
+# --------------------------------------------------------------------------------------
+@numba.njit(cache=True, nogil=True, inline="always")
+def start_lateral(params, xs, xa, row, cols, base, ns, na, o_ts, o_ta, o_ss, o_fbs, o_g):
+    """Before the half wing's step: η_a, η̇_a of t_k into the row's full-span columns; the
+    sideslip's forcing's symmetric part with η_s of t_k, Σ_j F^βs_ij (η_static + Δη)_j, into
+    params[o_g + i] (per unit Q β); returns the symmetric and antisymmetric starboard tip
+    twists [rad] of t_k."""
+    for i in range(2 * na):
+        row[cols[base + N_FIXED + i]] = xa[i]
+    tip = 0.0
+    for i in range(ns):  # η_s of t_k, before the half wing's step
+        tip += params[o_ts + i] * xs[i]
+    anti = 0.0
+    for i in range(na):
+        anti += params[o_ta + i] * xa[i]
+    for i in range(na):
+        acc = 0.0
+        for j in range(ns):
+            acc += params[o_fbs + ns * i + j] * (params[o_ss + j] + xs[j])
+        params[o_g + i] = acc
+    return tip, anti
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def modal_loads(params, xs, xa, ns, na, qbar, qv, vt, lift, p_rate, r_rate, beta, moment,
+                side, induced, o_re, o_rd, o_ss, o_rrs, o_rbs, o_yps, o_se, o_sge, o_sgd,
+                o_yd):
+    """The quasi-steady strips' loads of η_{k+1} added to ``moment`` [N·m, right wing down]
+    and ``side`` [N, body +y] (what the kernel's own strips gave: 0, or the unsteady
+    increments'), and the yawing moment [N·m, nose right]: the modes' rolling moment, the
+    yaw rate's and sideslip's rolling moment and the yawing moment of the symmetric
+    deflection after the half wing's step (η_s of t_k+1), the side force on the dihedral,
+    the yawing moment of η̇_a's lift and the induced drag's, −``induced`` L_w/Q · moment.
+    Returns (moment, side, yaw)."""
+    for i in range(na):
+        moment += qbar * params[o_re + i] * xa[i] + qv * params[o_rd + i] * xa[na + i]
+    roll_s, yaw_s = 0.0, 0.0
+    for j in range(ns):
+        eta_s = params[o_ss + j] + xs[j]
+        roll_s += (qv * r_rate * params[o_rrs + j] + qbar * beta * params[o_rbs + j]) * eta_s
+        yaw_s += qv * p_rate * params[o_yps + j] * eta_s
+    moment += roll_s
+    yaw = 0.0
+    for i in range(na):
+        side += ((lift * params[o_se + i] + qbar * params[o_sge + i]) * xa[i]
+                 + qv * params[o_sgd + i] * xa[na + i])
+        yaw += lift / vt * params[o_yd + i] * xa[na + i]
+    yaw += yaw_s - induced * lift / qbar * moment
+    return moment, side, yaw
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def finish_lateral(params, row, cols, base, na, xa, status, o_rx, o_half, to_lbf_ft, to_lbf,
+                   eta_limit, aileron, moment, tip, anti, side, yaw):
+    """The reactions JSBSim applies (the half wing's three from params[o_half:], then the
+    roll [lbf·ft], side [lbf] and yaw [lbf·ft] from N·m and N by ``to_lbf_ft``,
+    ``to_lbf``), the row's fixed full-span channels, then the step's status: the half
+    wing's when not OK, NON_FINITE for a full-span channel, ETA_OUT for |η_a| above
+    ``eta_limit`` [rad]."""
+    params[o_rx] = params[o_half]
+    params[o_rx + 1] = params[o_half + 1]
+    params[o_rx + 2] = params[o_half + 2]
+    params[o_rx + 3] = moment * to_lbf_ft
+    params[o_rx + 4] = side * to_lbf
+    params[o_rx + 5] = yaw * to_lbf_ft
+    row[cols[base]] = aileron
+    row[cols[base + 1]] = moment
+    row[cols[base + 2]] = tip + anti
+    row[cols[base + 3]] = tip - anti
+    row[cols[base + 4]] = side
+    row[cols[base + 5]] = yaw
+    if status != K.OK:
+        return status
+    for c in range(base, base + N_FIXED + 2 * na):
+        if not math.isfinite(row[cols[c]]):
+            return K.NON_FINITE
+    for i in range(na):
+        if abs(xa[i]) > eta_limit:
+            return K.ETA_OUT
+    return K.OK
+
+
 @numba.njit(cache=True, nogil=True)
 def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     """One full-span step (module docstring), writing row ``k`` of ``table``; returns the
@@ -115,21 +202,9 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
     xa = x[n2s:n2s + n2a]
     base = c_sym  # the full-span channels' columns: LATERAL_FIXED, η_a, η̇_a
     row = table[k]
-    for i in range(n2a):
-        row[cols[base + N_FIXED + i]] = xa[i]
-    tip = 0.0
-    for i in range(ns):  # η_s of t_k, before the half wing's step
-        tip += params[o_ts + i] * xs[i]
-    anti = 0.0
-    for i in range(na):
-        anti += params[o_ta + i] * xa[i]
-    # the sideslip's forcing's symmetric part with η_s of t_k: Σ_j F^βs_ij (η_static + Δη)_j
     o_g = o_scr + n2a  # the generalised force on the antisymmetric modes [N·m]
-    for i in range(na):
-        acc = 0.0
-        for j in range(ns):
-            acc += params[o_fbs + ns * i + j] * (params[o_ss + j] + xs[j])
-        params[o_g + i] = acc
+    tip, anti = start_lateral(params, xs, xa, row, cols, base, ns, na, o_ts, o_ta, o_ss,
+                              o_fbs, o_g)
     status = K.step_kernel(reads, params[:p_sym], xs, cols[:c_sym], table, k, wind_down_fps,
                            w_g)
     if status == K.NEEDS_REFRESH:
@@ -175,42 +250,17 @@ def full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w_g):
             xa[na + i] = 0.0
     moment, side, yaw = 0.0, 0.0, 0.0
     if model != 0:
-        for i in range(na):
-            moment += qbar * params[o_re + i] * xa[i] + qv * params[o_rd + i] * xa[na + i]
-        # the yaw rate's and sideslip's rolling moment and the yawing moment of the
-        # symmetric deflection after the half wing's step (η_s of t_k+1)
-        roll_s, yaw_s = 0.0, 0.0
-        for j in range(ns):
-            eta_s = params[o_ss + j] + xs[j]
-            roll_s += (qv * r_rate * params[o_rrs + j] + qbar * beta * params[o_rbs + j]) * eta_s
-            yaw_s += qv * p_rate * params[o_yps + j] * eta_s
-        moment += roll_s
-        for i in range(na):
-            side += ((lift * params[o_se + i] + qbar * params[o_sge + i]) * xa[i]
-                     + qv * params[o_sgd + i] * xa[na + i])
-            yaw += lift / vt * params[o_yd + i] * xa[na + i]
-        yaw += yaw_s - params[o_c + 7] * lift / qbar * moment
-    params[o_rx] = params[o_flow - 3]  # the half wing's reactions (lbf, lbf, lbf·ft), the
-    params[o_rx + 1] = params[o_flow - 2]  # block before its out_flow (step_kernel.layout) …
-    params[o_rx + 2] = params[o_flow - 1]
-    params[o_rx + 3] = moment * params[o_c + 3]  # … and the roll [lbf·ft], side [lbf],
-    params[o_rx + 4] = side * params[o_c + 5]
-    params[o_rx + 5] = yaw * params[o_c + 3]  # yaw [lbf·ft]
-    row[cols[base]] = aileron
-    row[cols[base + 1]] = moment
-    row[cols[base + 2]] = tip + anti
-    row[cols[base + 3]] = tip - anti
-    row[cols[base + 4]] = side
-    row[cols[base + 5]] = yaw
-    if status != K.OK:
-        return status
-    for c in range(base, base + N_FIXED + n2a):
-        if not math.isfinite(row[cols[c]]):
-            return K.NON_FINITE
-    for i in range(na):
-        if abs(xa[i]) > params[o_c + 4]:
-            return K.ETA_OUT
-    return K.OK
+        moment, side, yaw = modal_loads(params, xs, xa, ns, na, qbar, qv, vt, lift, p_rate,
+                                        r_rate, beta, moment, side, params[o_c + 7], o_re,
+                                        o_rd, o_ss, o_rrs, o_rbs, o_yps, o_se, o_sge, o_sgd,
+                                        o_yd)
+    # the half wing's reactions: the block before its out_flow (step_kernel.layout)
+    return finish_lateral(params, row, cols, base, na, xa, status, o_rx, o_flow - 3,
+                          params[o_c + 3], params[o_c + 5], params[o_c + 4], aileron, moment,
+                          tip, anti, side, yaw)
 
 
+K.guard_cache(start_lateral)
+K.guard_cache(modal_loads)
+K.guard_cache(finish_lateral)
 K.guard_cache(full_span_kernel)

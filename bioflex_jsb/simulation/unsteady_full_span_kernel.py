@@ -21,18 +21,19 @@ lbf·ft) and the row's full-span channels.
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
 from bioflex_jsb.simulation import unsteady_kernel as UK
-from bioflex_jsb.simulation.full_span_kernel import BETA_SLOT, EXTRA_READS, N_FIXED
+from bioflex_jsb.simulation.full_span_kernel import (
+    BETA_SLOT,
+    EXTRA_READS,
+    finish_lateral,
+    modal_loads,
+    start_lateral,
+)
 from bioflex_jsb.simulation.step_kernel import (
-    ETA_OUT,
     NEEDS_REFRESH,
-    NON_FINITE,
-    OK,
     READ_KEYS,
     air_flow,
     guard_cache,
@@ -141,21 +142,10 @@ def unsteady_full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w
     xa = x[nxs:nxs + nz]
     base = c_sym  # the full-span channels' columns: LATERAL_FIXED, η_a, η̇_a
     row = table[k]
-    for i in range(2 * na):
-        row[cols[base + N_FIXED + i]] = xa[i]
     o_ts, o_ta, o_ss, o_fbs = int(h[L_TS]), int(h[L_TA]), int(h[L_SS]), int(h[L_FBS])
-    tip = 0.0
-    for i in range(ns):  # η_s of t_k, before the half wing's step
-        tip += params[o_ts + i] * xs[i]
-    anti = 0.0
-    for i in range(na):
-        anti += params[o_ta + i] * xa[i]
-    u = params[o_u:o_u + nu]
-    for i in range(na):  # the sideslip's forcing's symmetric part with η_s of t_k
-        acc = 0.0
-        for j in range(ns):
-            acc += params[o_fbs + ns * i + j] * (params[o_ss + j] + xs[j])
-        u[2 + i] = acc
+    u = params[o_u:o_u + nu]  # [p − p_g, ṗ, the generalised forces]
+    tip, anti = start_lateral(params, xs, xa, row, cols, base, ns, na, o_ts, o_ta, o_ss,
+                              o_fbs, o_u + 2)
     status = UK.unsteady_kernel(reads, params[:p_sym], xs, cols[:c_sym], table, k,
                                 wind_down_fps, w_g)
     if status == NEEDS_REFRESH:
@@ -186,46 +176,14 @@ def unsteady_full_span_kernel(reads, params, x, cols, table, k, wind_down_fps, w
     moment = _increments(rows, xa, u, dq, ds, 0)
     side = _increments(rows, xa, u, dq, ds, 1)
     o_re, o_rd = int(h[L_RE]), int(h[L_RD])
-    for i in range(na):
-        moment += qbar * params[o_re + i] * xa[i] + qv * params[o_rd + i] * xa[na + i]
-    # the yaw rate's and sideslip's rolling moment and the yawing moment of the symmetric
-    # deflection after the half wing's step (η_s of t_k+1)
     o_rrs, o_rbs, o_yps = int(h[L_RRS]), int(h[L_RBS]), int(h[L_YPS])
-    roll_s, yaw_s = 0.0, 0.0
-    for j in range(ns):
-        eta_s = params[o_ss + j] + xs[j]
-        roll_s += (qv * r_rate * params[o_rrs + j] + qbar * beta * params[o_rbs + j]) * eta_s
-        yaw_s += qv * p_rate * params[o_yps + j] * eta_s
-    moment += roll_s
     o_se, o_sge, o_sgd, o_yd = int(h[L_SE]), int(h[L_SGE]), int(h[L_SGD]), int(h[L_YD])
-    yaw = 0.0
-    for i in range(na):
-        side += ((lift * params[o_se + i] + qbar * params[o_sge + i]) * xa[i]
-                 + qv * params[o_sgd + i] * xa[na + i])
-        yaw += lift / vt * params[o_yd + i] * xa[na + i]
-    yaw += yaw_s - params[o_c + 4] * lift / qbar * moment
-    o_rx, o_rs = int(h[L_REACT]), int(params[UK.H_REACT])
-    params[o_rx] = params[o_rs]  # the half wing's reactions (lbf, lbf, lbf·ft) …
-    params[o_rx + 1] = params[o_rs + 1]
-    params[o_rx + 2] = params[o_rs + 2]
-    params[o_rx + 3] = moment * params[o_c]  # … and the roll [lbf·ft], side [lbf],
-    params[o_rx + 4] = side * params[o_c + 2]
-    params[o_rx + 5] = yaw * params[o_c]  # yaw [lbf·ft]
-    row[cols[base]] = aileron
-    row[cols[base + 1]] = moment
-    row[cols[base + 2]] = tip + anti
-    row[cols[base + 3]] = tip - anti
-    row[cols[base + 4]] = side
-    row[cols[base + 5]] = yaw
-    if status != OK:
-        return status
-    for c in range(base, base + N_FIXED + 2 * na):
-        if not math.isfinite(row[cols[c]]):
-            return NON_FINITE
-    for i in range(na):
-        if abs(xa[i]) > params[o_c + 1]:
-            return ETA_OUT
-    return OK
+    moment, side, yaw = modal_loads(params, xs, xa, ns, na, qbar, qv, vt, lift, p_rate, r_rate,
+                                    beta, moment, side, params[o_c + 4], o_re, o_rd, o_ss,
+                                    o_rrs, o_rbs, o_yps, o_se, o_sge, o_sgd, o_yd)
+    return finish_lateral(params, row, cols, base, na, xa, status, int(h[L_REACT]),
+                          int(params[UK.H_REACT]), params[o_c], params[o_c + 2],
+                          params[o_c + 1], aileron, moment, tip, anti, side, yaw)
 
 
 guard_cache(_advance)
