@@ -184,7 +184,7 @@ class FullSpanSteps:
             setup_kernel(self)
             return
         from bioflex_jsb.simulation import full_span_kernel as FK
-        from bioflex_jsb.simulation.full_span import LATERAL_FIXED, lateral_names
+        from bioflex_jsb.simulation.full_span import full_span_columns, joined_state
 
         lat, n_s = self.lateral, self.n_modes
         n_a = lat.n_modes
@@ -221,14 +221,9 @@ class FullSpanSteps:
         params[-FK.N_DIMS:] = (sym_size, self._cols.size, n_s, n_a, lay_s["out_flow"][0])
         self._reactions = lv["reactions"]  # lift, drag, pitch, roll, side, yaw (lbf, lbf·ft)
         self._out_flow = self._views["out_flow"]
-        x = np.zeros(2 * n_s + 2 * n_a)
-        x[:2 * n_s] = self.wing._x
-        x[2 * n_s:] = lat._x
-        self.wing._x, lat._x = x[:2 * n_s], x[2 * n_s:]  # views: the kernel updates x
-        self._x_full = x
-        eta, eta_dot = lateral_names(n_a)
-        extra = [self.names.index(c) for c in (*LATERAL_FIXED, *eta, *eta_dot)]
-        self._cols = np.concatenate([self._cols, np.array(extra, dtype=np.int64)])
+        # views: the kernel updates x
+        self._x_full, self.wing._x, lat._x = joined_state(self.wing._x, lat._x)
+        self._cols = np.concatenate([self._cols, full_span_columns(self.names, n_a)])
         self._kernel = FK.full_span_kernel
         K.say_if_compiling(self._kernel, "full-span coupled step")
         if lat._key is not None:

@@ -26,7 +26,7 @@ def setup_kernel(step) -> None:
     half wing's views, state and reactions rebound onto them."""
     from bioflex_jsb.simulation import unsteady_full_span_kernel as UFK
     from bioflex_jsb.simulation import unsteady_kernel as UK
-    from bioflex_jsb.simulation.full_span import LATERAL_FIXED, lateral_names
+    from bioflex_jsb.simulation.full_span import full_span_columns, joined_state
 
     lat, n_s, wing = step.lateral, step.n_modes, step.wing
     n_a, n_k = lat.n_modes, lat.n_strips
@@ -56,14 +56,8 @@ def setup_kernel(step) -> None:
     params[-UFK.N_DIMS:] = (sym_size, step._cols.size, nxs, n_s, n_a, n_k)
     step._reactions = lv["reactions"]  # lift, drag, pitch, roll, side, yaw (lbf, lbf·ft)
     step._out_flow = step._views["out_flow"]
-    x = np.zeros(nxs + lat.n_states)
-    x[:nxs] = wing._x
-    x[nxs:] = lat._x
-    wing._x, lat._x = x[:nxs], x[nxs:]  # views: the kernel updates x
-    step._x_full = x
-    eta, eta_dot = lateral_names(n_a)
-    extra = [step.names.index(c) for c in (*LATERAL_FIXED, *eta, *eta_dot)]
-    step._cols = np.concatenate([step._cols, np.array(extra, dtype=np.int64)])
+    step._x_full, wing._x, lat._x = joined_state(wing._x, lat._x)  # views: the kernel updates x
+    step._cols = np.concatenate([step._cols, full_span_columns(step.names, n_a)])
     step._kernel = UFK.unsteady_full_span_kernel
     K.say_if_compiling(step._kernel, "full-span unsteady step")
     if lat._key is not None:

@@ -106,6 +106,25 @@ def lateral_names(n_modes: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
             tuple(f"asym_eta{i + 1}_dot" for i in range(n_modes)))
 
 
+def full_span_columns(names, n_modes: int) -> np.ndarray:
+    """The row's columns (int64) of the compiled full-span step's channels, in the order
+    its kernels write them: :data:`LATERAL_FIXED`, then η_a and η̇_a of ``n_modes``
+    antisymmetric modes, as indices into the run's channel ``names``."""
+    eta, eta_dot = lateral_names(n_modes)
+    return np.array([list(names).index(c) for c in (*LATERAL_FIXED, *eta, *eta_dot)],
+                    dtype=np.int64)
+
+
+def joined_state(symmetric: np.ndarray, antisymmetric: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Both wings' states end to end in one new array, as the compiled full-span step
+    updates them in place: (the array, a view of its symmetric part, a view of its
+    antisymmetric part), the views to stand for the wings' own states."""
+    n = symmetric.size
+    x = np.concatenate([symmetric, antisymmetric]).astype(float, copy=False)
+    return x, x[:n], x[n:]
+
+
 def lateral_channel_units(n_modes: int) -> dict[str, str]:
     """The full-span run's extra channels and their units, in the row's order."""
     eta, eta_dot = lateral_names(n_modes)
